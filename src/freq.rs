@@ -1,0 +1,199 @@
+//! Frequency grids: log-spaced grids from `FLO:N:FHI`, frequency files, and the default grid
+//! that adds points around every resonance so that no peak is missed.
+//!
+//! All frequencies are in Hz. Depends on `modes` (for resonance placement) and `error` only.
+
+use crate::error::FreqError;
+use crate::model::Model;
+use crate::modes::NormalModes;
+use std::path::Path;
+
+/// Lower end of the default grid (Hz): 0.1 mHz, below the torsion modes.
+pub const DEFAULT_F_LO_HZ: f64 = 1e-4;
+/// Upper end of the default grid (Hz): above the bouncing modes.
+pub const DEFAULT_F_HI_HZ: f64 = 30.0;
+/// Log-spaced points of the default grid before resonance refinement.
+pub const DEFAULT_POINTS: usize = 2000;
+/// Relative offsets `f_k (1 +/- x)` added around an undamped resonance: they bracket the pole
+/// down to 1e-6, where an undamped peak is 5e5 times its off-resonance scale, and never hit it.
+const UNDAMPED_OFFSETS: [f64; 11] = [
+    3e-2, 1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 3e-7,
+];
+/// Points across a damped resonance, in units of its half-width at half power `phi_k / 2`.
+const DAMPED_WIDTHS: [f64; 9] = [0.0, 0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 5.0, 10.0];
+
+fn check(value: f64, origin: impl FnOnce() -> String) -> Result<f64, FreqError> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(FreqError::Invalid {
+            value,
+            origin: origin(),
+        })
+    }
+}
+
+/// `n` log-spaced frequencies from `lo` to `hi` inclusive (`n = 1` gives `[lo]`).
+pub fn log_grid(lo: f64, hi: f64, n: usize) -> Result<Vec<f64>, FreqError> {
+    let spec = || format!("log grid {lo}:{n}:{hi}");
+    if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi >= lo && n >= 1) {
+        return Err(FreqError::Spec {
+            origin: spec(),
+            message: "need 0 < FLO <= FHI, both finite, and N >= 1".into(),
+        });
+    }
+    if n == 1 {
+        return Ok(vec![lo]);
+    }
+    let (a, b) = (lo.ln(), hi.ln());
+    Ok((0..n)
+        .map(|k| {
+            if k + 1 == n {
+                hi
+            } else {
+                (a + (b - a) * k as f64 / (n - 1) as f64).exp()
+            }
+        })
+        .collect())
+}
+
+/// Parses `FLO:N:FHI` (Hz, count, Hz), e.g. `1e-4:2000:30`.
+pub fn parse_spec(spec: &str) -> Result<Vec<f64>, FreqError> {
+    let err = |message: &str| FreqError::Spec {
+        origin: format!("--freq {spec}"),
+        message: message.into(),
+    };
+    let parts: Vec<&str> = spec.split(':').map(str::trim).collect();
+    let [lo, n, hi] = parts[..] else {
+        return Err(err("expected FLO:N:FHI, e.g. 1e-4:2000:30 (Hz:count:Hz)"));
+    };
+    let lo: f64 = lo.parse().map_err(|_| err("FLO is not a number"))?;
+    let hi: f64 = hi.parse().map_err(|_| err("FHI is not a number"))?;
+    let n: usize = n
+        .parse()
+        .map_err(|_| err("N is not a positive whole number"))?;
+    log_grid(lo, hi, n).map_err(|e| match e {
+        FreqError::Spec { message, .. } => err(&message),
+        other => other,
+    })
+}
+
+/// Parses a frequency file: one frequency in Hz per line; blank lines and lines starting with
+/// `#` are ignored. Every value must be finite and >= 0; at least one is required.
+pub fn parse_freq_text(text: &str, origin: &str) -> Result<Vec<f64>, FreqError> {
+    let mut freqs = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let value: f64 = line.parse().map_err(|_| FreqError::Spec {
+            origin: format!("{origin}, line {}", n + 1),
+            message: format!("`{line}` is not a number (one frequency in Hz per line)"),
+        })?;
+        freqs.push(check(value, || format!("{origin}, line {}", n + 1))?);
+    }
+    if freqs.is_empty() {
+        return Err(FreqError::Spec {
+            origin: origin.into(),
+            message: "no frequencies (one frequency in Hz per line expected)".into(),
+        });
+    }
+    Ok(freqs)
+}
+
+/// Reads a frequency file (see [`parse_freq_text`]).
+pub fn read_freq_file(path: &Path) -> Result<Vec<f64>, FreqError> {
+    let origin = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| FreqError::Spec {
+        origin: origin.clone(),
+        message: format!("cannot read: {e}"),
+    })?;
+    parse_freq_text(&text, &origin)
+}
+
+/// Adds points around every mode of `model` inside `[lo, hi]` of `grid`, then sorts and
+/// removes duplicates. Undamped modes are bracketed by relative offsets down to 3e-7 (never on the
+/// pole); a mode with modal loss angle `phi_k` gets points across its width `f_k phi_k / 2`.
+pub fn refine_around_modes(grid: &[f64], model: &Model) -> Vec<f64> {
+    let (lo, hi) = grid
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), &f| (a.min(f), b.max(f)));
+    let modes = NormalModes::new(model);
+    let k_imag = model.stiffness_complex().map(|z| z.im);
+    let mut out = grid.to_vec();
+    for mode in &modes.modes {
+        let f = mode.frequency_hz;
+        let loss = (mode.shape.transpose() * k_imag * mode.shape)[(0, 0)] / mode.omega_sq;
+        let mut add = |x: f64| {
+            let g = f * (1.0 + x);
+            if g >= lo && g <= hi {
+                out.push(g);
+            }
+        };
+        for x in UNDAMPED_OFFSETS {
+            if x > loss {
+                add(x);
+                add(-x);
+            }
+        }
+        if loss > 0.0 {
+            for w in DAMPED_WIDTHS {
+                add(w * loss / 2.0);
+                add(-w * loss / 2.0);
+            }
+        }
+    }
+    out.sort_by(f64::total_cmp);
+    out.dedup();
+    out
+}
+
+/// The default grid: [`DEFAULT_POINTS`] log-spaced points from 0.1 mHz to 30 Hz, refined
+/// around every resonance.
+pub fn default_grid(model: &Model) -> Vec<f64> {
+    let base = log_grid(DEFAULT_F_LO_HZ, DEFAULT_F_HI_HZ, DEFAULT_POINTS)
+        .expect("default grid bounds are valid");
+    refine_around_modes(&base, model)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn log_grid_endpoints_and_ratio() {
+        let g = log_grid(1e-3, 10.0, 5).unwrap();
+        assert_eq!(g.len(), 5);
+        assert_eq!((g[0], g[4]), (1e-3, 10.0));
+        // Constant ratio 10 between neighbours, to the rounding of exp/ln (a few ulps).
+        for w in g.windows(2) {
+            assert!((w[1] / w[0] - 10.0).abs() < 1e-13 * 10.0, "{w:?}");
+        }
+    }
+
+    #[test]
+    fn spec_errors_name_the_problem() {
+        assert!(parse_spec("1e-3:10").unwrap_err().to_string().contains("FLO:N:FHI"));
+        assert!(parse_spec("a:10:1").unwrap_err().to_string().contains("FLO"));
+        assert!(parse_spec("1:0:10").unwrap_err().to_string().contains("N >= 1"));
+        assert!(parse_spec("-1:10:10").unwrap_err().to_string().contains("0 < FLO"));
+        assert!(parse_spec("10:10:1").unwrap_err().to_string().contains("FLO <= FHI"));
+    }
+
+    #[test]
+    fn freq_text_rules() {
+        assert_eq!(
+            parse_freq_text("# f\n0.1\n\n 2 \n", "f.txt").unwrap(),
+            vec![0.1, 2.0]
+        );
+        let e = parse_freq_text("0.1\nabc\n", "f.txt").unwrap_err().to_string();
+        assert!(e.contains("f.txt, line 2") && e.contains("abc"), "{e}");
+        let e = parse_freq_text("0.1\n-3\n", "f.txt").unwrap_err().to_string();
+        assert!(e.contains("-3") && e.contains("line 2"), "{e}");
+        let e = parse_freq_text("NaN\n", "f.txt").unwrap_err().to_string();
+        assert!(e.contains("NaN"), "{e}");
+        let e = parse_freq_text("# only a comment\n", "f.txt").unwrap_err().to_string();
+        assert!(e.contains("no frequencies"), "{e}");
+    }
+}

@@ -1,0 +1,154 @@
+//! Normal modes: the generalized symmetric eigenproblem `K v = w^2 M v` of the undamped model,
+//! and which observables see each mode.
+//!
+//! The problem is solved per decoupled block ([`Block`]), so a mode's shape is exactly zero on
+//! the other block's coordinates and "observable X does not see mode 5" is an exact statement,
+//! not a rounding threshold. Within a block: Cholesky `M = L L^T`, symmetric eigenproblem of
+//! `L^-1 K L^-T`, shapes `v = L^-T y`, normalized so that `V^T M V = I` (mass-normalized).
+//! Pure numerics: depends on `model` only.
+
+use crate::model::{Block, Coord, Mat8, Model, Observable, Vec8};
+use nalgebra::{Matrix4, Vector4};
+
+/// An observable "sees" a mode when its amplitude in the mass-normalized shape is at least this
+/// fraction of the largest amplitude of that observable over all modes. Modes outside the
+/// observable's block have amplitude exactly 0; this threshold only matters within a block.
+pub const VISIBILITY_THRESHOLD: f64 = 1e-3;
+
+/// One normal mode.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mode {
+    /// 1-based, in order of increasing frequency (the paper's nu_1 ... nu_8).
+    pub index: usize,
+    /// Eigenvalue w^2 (rad^2/s^2).
+    pub omega_sq: f64,
+    /// Frequency w / 2 pi (Hz).
+    pub frequency_hz: f64,
+    /// The decoupled block the mode lives in.
+    pub block: Block,
+    /// Mass-normalized shape (v^T M v = 1), coordinate order [`Coord::ALL`].
+    pub shape: Vec8,
+    /// Share of the modal kinetic energy in each coordinate, `v_i (M v)_i`; sums to 1.
+    pub energy_share: [f64; 8],
+    /// Observable amplitudes `C v` of the mass-normalized shape (units: observable / sqrt(kg m^2)).
+    pub observable_amplitude: [f64; 7],
+}
+
+impl Mode {
+    /// Coordinates holding at least `min_share` of the modal kinetic energy, largest first.
+    pub fn dominant_coords(&self, min_share: f64) -> Vec<(Coord, f64)> {
+        let mut v: Vec<(Coord, f64)> = Coord::ALL
+            .into_iter()
+            .map(|c| (c, self.energy_share[c.index()]))
+            .filter(|&(_, s)| s >= min_share)
+            .collect();
+        v.sort_by(|a, b| b.1.total_cmp(&a.1));
+        v
+    }
+}
+
+/// All normal modes of a model, sorted by frequency, with the observability table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NormalModes {
+    /// The modes, nu_1 first.
+    pub modes: Vec<Mode>,
+    /// `visible[k][o]`: observable `o` sees mode `k` (see [`VISIBILITY_THRESHOLD`]).
+    pub visible: Vec<[bool; 7]>,
+}
+
+fn block_matrix(m: &Mat8, block: Block) -> Matrix4<f64> {
+    Model::block_of(m, block)
+}
+
+impl NormalModes {
+    /// Solves the undamped eigenproblem of `model` (loss angles are ignored here).
+    pub fn new(model: &Model) -> NormalModes {
+        let mass = model.mass();
+        let stiffness = model.stiffness();
+        let mut modes = Vec::with_capacity(8);
+        for block in Block::ALL {
+            let mb = block_matrix(mass, block);
+            let kb = block_matrix(&stiffness, block);
+            let l = mb
+                .cholesky()
+                .expect("Model::new checked that M is positive definite")
+                .l();
+            let l_inv = l
+                .try_inverse()
+                .expect("a Cholesky factor with positive diagonal is invertible");
+            let a = &l_inv * kb * l_inv.transpose();
+            let a = (a + a.transpose()) * 0.5;
+            let eig = a.symmetric_eigen();
+            for k in 0..4 {
+                let y: Vector4<f64> = eig.eigenvectors.column(k).into();
+                let v4 = l_inv.transpose() * y;
+                let v4 = v4 / (v4.transpose() * mb * v4)[(0, 0)].sqrt();
+                let mut shape = Vec8::zeros();
+                for (i, c) in block.coords().into_iter().enumerate() {
+                    shape[c.index()] = v4[i];
+                }
+                let omega_sq = eig.eigenvalues[k];
+                modes.push(Mode {
+                    index: 0,
+                    omega_sq,
+                    frequency_hz: omega_sq.max(0.0).sqrt() / std::f64::consts::TAU,
+                    block,
+                    shape,
+                    energy_share: std::array::from_fn(|i| shape[i] * (mass * shape)[i]),
+                    observable_amplitude: std::array::from_fn(|o| {
+                        (model.observation().row(o) * shape)[(0, 0)]
+                    }),
+                });
+            }
+        }
+        modes.sort_by(|a, b| a.omega_sq.total_cmp(&b.omega_sq));
+        for (k, m) in modes.iter_mut().enumerate() {
+            m.index = k + 1;
+        }
+        let largest: [f64; 7] = std::array::from_fn(|o| {
+            modes
+                .iter()
+                .map(|m| m.observable_amplitude[o].abs())
+                .fold(0.0, f64::max)
+        });
+        let visible = modes
+            .iter()
+            .map(|m| {
+                std::array::from_fn(|o| {
+                    largest[o] > 0.0
+                        && m.observable_amplitude[o].abs() >= VISIBILITY_THRESHOLD * largest[o]
+                })
+            })
+            .collect();
+        NormalModes { modes, visible }
+    }
+
+    /// Observables that see mode `k` (0-based position in `modes`).
+    pub fn observables_seeing(&self, k: usize) -> Vec<Observable> {
+        Observable::ALL
+            .into_iter()
+            .filter(|o| self.visible[k][o.index()])
+            .collect()
+    }
+
+    /// Mode frequencies (Hz), nu_1 first.
+    pub fn frequencies_hz(&self) -> Vec<f64> {
+        self.modes.iter().map(|m| m.frequency_hz).collect()
+    }
+}
+
+/// Section III's decoupled physical-pendulum estimates of the swinging frequencies (Hz):
+/// `(crossbar nu_{3,4}, test mass nu_{5,6})`.
+pub fn decoupled_swing_estimates_hz(model: &Model) -> (f64, f64) {
+    let p = model.params();
+    let (m_a, m_b, g) = (p.mass.m_a_kg, p.mass.m_b_kg, p.environment.g_m_per_s2);
+    let l = &p.length;
+    let la = l.z_m + l.z_a_m;
+    let crossbar = (m_a * g * la / (p.inertia.a11_kg_m2 + m_a * la * la)).sqrt();
+    let test_mass =
+        (m_b * g * l.z_b_m / (p.inertia.b11_kg_m2 + m_b * l.z_b_m * l.z_b_m)).sqrt();
+    (
+        crossbar / std::f64::consts::TAU,
+        test_mass / std::f64::consts::TAU,
+    )
+}

@@ -1,0 +1,404 @@
+//! Parameters of the double torsion pendulum: the TOML file format, the embedded Table I default,
+//! `--set KEY=VALUE` overrides and validation.
+//!
+//! Every quantity is SI and carries its unit in its key (`m_a_kg`, `z_b_m`, ...). The embedded
+//! default is `src/params/table1.toml`: the values of Table I of De Marchi et al. (2013) plus the
+//! assumptions the paper does not state (`length.h_m`, `environment.g_m_per_s2`) and loss angles of 0.
+//! This module depends on nothing else in the crate but the error types.
+
+use crate::error::ParamError;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The embedded default parameter file (Table I of the paper), with a unit comment on every line.
+pub const TABLE_I_TOML: &str = include_str!("table1.toml");
+
+/// Masses of the two suspended bodies.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Masses {
+    /// Crossbar system (crossbar + counterweights), m_a (kg).
+    pub m_a_kg: f64,
+    /// Test mass with its shaft, m_b (kg).
+    pub m_b_kg: f64,
+}
+
+/// Inertia tensors about each body's centre of mass in the body frame (kg m^2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Inertia {
+    /// I^a_11.
+    pub a11_kg_m2: f64,
+    /// I^a_22.
+    pub a22_kg_m2: f64,
+    /// I^a_33.
+    pub a33_kg_m2: f64,
+    /// I^a_23, the only off-diagonal term of the crossbar (any sign).
+    pub a23_kg_m2: f64,
+    /// I^b_11.
+    pub b11_kg_m2: f64,
+    /// I^b_22.
+    pub b22_kg_m2: f64,
+    /// I^b_33.
+    pub b33_kg_m2: f64,
+}
+
+/// Torsional spring constants of the fibres (N m / rad).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Torsion {
+    /// Upper fibre, k_a.
+    pub k_a_n_m_per_rad: f64,
+    /// Lower fibre, k_b.
+    pub k_b_n_m_per_rad: f64,
+}
+
+/// Longitudinal (bouncing) spring constants of the fibres (N/m).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Bouncing {
+    /// Upper fibre, kappa_{e,a}.
+    pub kappa_a_n_per_m: f64,
+    /// Lower fibre, kappa_{e,b}.
+    pub kappa_b_n_per_m: f64,
+}
+
+/// Lengths (m). See section II.A of the paper for the geometry.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Lengths {
+    /// Crossbar arm, d: horizontal distance of the lower fibre from the upper fibre.
+    pub d_m: f64,
+    /// Cube geometric centre below the test-mass centre of mass, h_c.
+    pub h_c_m: f64,
+    /// Distance between the two fibre suspension points along the upper fibre, Z.
+    pub z_m: f64,
+    /// Lower suspension point to the crossbar centre of mass, Z_a.
+    pub z_a_m: f64,
+    /// Lower suspension point to the test-mass centre of mass, Z_b.
+    pub z_b_m: f64,
+    /// Height of the upper suspension point above the floor pivot of the tilt, h.
+    /// Not given in the paper: an assumption (default 2.0 m).
+    pub h_m: f64,
+}
+
+/// Environment.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Environment {
+    /// Local gravitational acceleration (m s^-2). Not given in the paper: standard gravity assumed.
+    pub g_m_per_s2: f64,
+}
+
+/// Structural loss angles of the fibres' elastic stiffness (rad): k -> k (1 + i phi).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LossAngles {
+    /// Torsion of the upper fibre.
+    pub torsion_a_rad: f64,
+    /// Torsion of the lower fibre.
+    pub torsion_b_rad: f64,
+    /// Bouncing of the upper fibre.
+    pub bouncing_a_rad: f64,
+    /// Bouncing of the lower fibre.
+    pub bouncing_b_rad: f64,
+}
+
+/// A complete parameter set. Build it with [`Params::table_i`], [`Params::from_toml_str`] or
+/// [`Params::from_file`]; all of them validate, so a `Params` in hand is physical.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Params {
+    /// Masses.
+    pub mass: Masses,
+    /// Inertia tensors.
+    pub inertia: Inertia,
+    /// Torsional constants.
+    pub torsion: Torsion,
+    /// Bouncing constants.
+    pub bouncing: Bouncing,
+    /// Lengths.
+    pub length: Lengths,
+    /// Gravity.
+    pub environment: Environment,
+    /// Loss angles.
+    pub loss: LossAngles,
+}
+
+/// What values a parameter may take.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Allowed {
+    /// Finite and strictly positive.
+    Positive,
+    /// Finite and >= 0.
+    NonNegative,
+    /// Any finite value.
+    Finite,
+    /// A loss angle: finite, >= 0 and < 1 rad.
+    LossAngle,
+}
+
+impl Allowed {
+    fn admits(self, v: f64) -> bool {
+        v.is_finite()
+            && match self {
+                Allowed::Positive => v > 0.0,
+                Allowed::NonNegative => v >= 0.0,
+                Allowed::Finite => true,
+                Allowed::LossAngle => (0.0..1.0).contains(&v),
+            }
+    }
+
+    /// Human-readable rule, used in error messages and the README table.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Allowed::Positive => "finite and > 0",
+            Allowed::NonNegative => "finite and >= 0",
+            Allowed::Finite => "finite",
+            Allowed::LossAngle => "finite, >= 0 and < 1",
+        }
+    }
+}
+
+/// One parameter as seen by validation, documentation and `--set`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Field {
+    /// Dotted key, `section.name`.
+    pub key: &'static str,
+    /// Current value.
+    pub value: f64,
+    /// SI unit.
+    pub unit: &'static str,
+    /// Paper symbol or short description.
+    pub symbol: &'static str,
+    /// Allowed range.
+    pub allowed: Allowed,
+}
+
+impl Params {
+    /// The embedded Table I parameter set.
+    pub fn table_i() -> Params {
+        Params::from_toml_str(TABLE_I_TOML, "embedded Table I")
+            .expect("the embedded Table I parameter file is valid")
+    }
+
+    /// Parses and validates a TOML parameter set. `origin` names the source in error messages.
+    pub fn from_toml_str(text: &str, origin: &str) -> Result<Params, ParamError> {
+        let params: Params = toml::from_str(text).map_err(|e| ParamError::Syntax {
+            origin: origin.to_string(),
+            message: e.to_string().trim_end().replace('\n', " "),
+        })?;
+        params.validate()?;
+        Ok(params)
+    }
+
+    /// Reads, parses and validates a TOML parameter file.
+    pub fn from_file(path: &Path) -> Result<Params, ParamError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ParamError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Params::from_toml_str(&text, &path.display().to_string())
+    }
+
+    /// The effective parameter set as TOML, with units in the keys; it reads back unchanged.
+    pub fn to_toml(&self) -> String {
+        let mut text = String::from(
+            "# tiltnoise parameter set (SI units; unit in every key).\n\
+             # Defaults: Table I of De Marchi et al., Phys. Rev. D 87, 122006 (2013);\n\
+             # length.h_m and environment.g_m_per_s2 are assumptions, not from the paper.\n\n",
+        );
+        text.push_str(&toml::to_string(self).expect("parameters serialize to TOML"));
+        text
+    }
+
+    /// Applies one `KEY=VALUE` override (e.g. `length.h_m=1.5`) and re-validates.
+    pub fn with_override(&self, assignment: &str) -> Result<Params, ParamError> {
+        let err = |message: String| ParamError::Override {
+            assignment: assignment.to_string(),
+            message,
+        };
+        let (key, value) = assignment
+            .split_once('=')
+            .ok_or_else(|| err("expected KEY=VALUE, e.g. length.h_m=1.5".into()))?;
+        let (key, value) = (key.trim(), value.trim());
+        let keys: Vec<&str> = self.fields().iter().map(|f| f.key).collect();
+        if !keys.contains(&key) {
+            return Err(err(format!(
+                "unknown key `{key}`; allowed keys: {}",
+                keys.join(", ")
+            )));
+        }
+        let number: f64 = value
+            .parse()
+            .map_err(|_| err(format!("value `{value}` of `{key}` is not a number")))?;
+        let mut table = toml::Table::try_from(self).expect("parameters convert to a TOML table");
+        let (section, name) = key.split_once('.').expect("keys are section.name");
+        table
+            .get_mut(section)
+            .and_then(|s| s.as_table_mut())
+            .expect("every key's section exists")
+            .insert(name.to_string(), toml::Value::Float(number));
+        let params: Params = table.try_into().map_err(|e: toml::de::Error| {
+            err(e.to_string().trim_end().replace('\n', " "))
+        })?;
+        params.validate()?;
+        Ok(params)
+    }
+
+    /// Every parameter with its key, unit, symbol and allowed range, in file order.
+    pub fn fields(&self) -> Vec<Field> {
+        use Allowed::*;
+        let f = |key, value, unit, symbol, allowed| Field {
+            key,
+            value,
+            unit,
+            symbol,
+            allowed,
+        };
+        let (m, i, t, b, l) = (
+            &self.mass,
+            &self.inertia,
+            &self.torsion,
+            &self.bouncing,
+            &self.length,
+        );
+        vec![
+            f("mass.m_a_kg", m.m_a_kg, "kg", "m_a", Positive),
+            f("mass.m_b_kg", m.m_b_kg, "kg", "m_b", Positive),
+            f("inertia.a11_kg_m2", i.a11_kg_m2, "kg m^2", "I^a_11", Positive),
+            f("inertia.a22_kg_m2", i.a22_kg_m2, "kg m^2", "I^a_22", Positive),
+            f("inertia.a33_kg_m2", i.a33_kg_m2, "kg m^2", "I^a_33", Positive),
+            f("inertia.a23_kg_m2", i.a23_kg_m2, "kg m^2", "I^a_23", Finite),
+            f("inertia.b11_kg_m2", i.b11_kg_m2, "kg m^2", "I^b_11", Positive),
+            f("inertia.b22_kg_m2", i.b22_kg_m2, "kg m^2", "I^b_22", Positive),
+            f("inertia.b33_kg_m2", i.b33_kg_m2, "kg m^2", "I^b_33", Positive),
+            f("torsion.k_a_n_m_per_rad", t.k_a_n_m_per_rad, "N m/rad", "k_a", Positive),
+            f("torsion.k_b_n_m_per_rad", t.k_b_n_m_per_rad, "N m/rad", "k_b", Positive),
+            f("bouncing.kappa_a_n_per_m", b.kappa_a_n_per_m, "N/m", "kappa_e,a", Positive),
+            f("bouncing.kappa_b_n_per_m", b.kappa_b_n_per_m, "N/m", "kappa_e,b", Positive),
+            f("length.d_m", l.d_m, "m", "d", Positive),
+            f("length.h_c_m", l.h_c_m, "m", "h_c", NonNegative),
+            f("length.z_m", l.z_m, "m", "Z", Positive),
+            f("length.z_a_m", l.z_a_m, "m", "Z_a", Positive),
+            f("length.z_b_m", l.z_b_m, "m", "Z_b", Positive),
+            f("length.h_m", l.h_m, "m", "h (assumption)", Positive),
+            f("environment.g_m_per_s2", self.environment.g_m_per_s2, "m/s^2", "g (assumption)", Positive),
+            f("loss.torsion_a_rad", self.loss.torsion_a_rad, "rad", "phi_torsion,a", LossAngle),
+            f("loss.torsion_b_rad", self.loss.torsion_b_rad, "rad", "phi_torsion,b", LossAngle),
+            f("loss.bouncing_a_rad", self.loss.bouncing_a_rad, "rad", "phi_bouncing,a", LossAngle),
+            f("loss.bouncing_b_rad", self.loss.bouncing_b_rad, "rad", "phi_bouncing,b", LossAngle),
+        ]
+    }
+
+    /// Checks every value against its allowed range and both inertia tensors for positive
+    /// definiteness. (The assembled mass matrix is checked when the model is built.)
+    pub fn validate(&self) -> Result<(), ParamError> {
+        for field in self.fields() {
+            if !field.allowed.admits(field.value) {
+                return Err(ParamError::OutOfRange {
+                    key: field.key.to_string(),
+                    value: field.value,
+                    unit: field.unit,
+                    allowed: field.allowed.describe(),
+                });
+            }
+        }
+        // The crossbar tensor is diag(I11) (+) [[I22, I23], [I23, I33]]: positive definite iff
+        // the 2x2 block's determinant is positive (its diagonal is already checked).
+        let i = &self.inertia;
+        let det = i.a22_kg_m2 * i.a33_kg_m2 - i.a23_kg_m2 * i.a23_kg_m2;
+        if det <= 0.0 {
+            return Err(ParamError::NotPositiveDefinite {
+                what: "inertia tensor of body a",
+                keys: "inertia.a22_kg_m2, inertia.a33_kg_m2, inertia.a23_kg_m2".into(),
+                detail: format!(
+                    "I22 I33 - I23^2 = {det:e} kg^2 m^4; need |I23| < sqrt(I22 I33) = {:e} kg m^2",
+                    (i.a22_kg_m2 * i.a33_kg_m2).sqrt()
+                ),
+            });
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn table_i_round_trips_through_toml() {
+        let p = Params::table_i();
+        let back = Params::from_toml_str(&p.to_toml(), "round trip").unwrap();
+        assert_eq!(p, back);
+    }
+
+    #[test]
+    fn override_changes_one_value_only() {
+        let p = Params::table_i();
+        let q = p.with_override("length.h_m = 1.25").unwrap();
+        assert_eq!(q.length.h_m, 1.25);
+        assert_eq!(
+            Params {
+                length: Lengths {
+                    h_m: p.length.h_m,
+                    ..q.length.clone()
+                },
+                ..q.clone()
+            },
+            p
+        );
+    }
+
+    #[test]
+    fn override_rejects_unknown_key_and_non_number() {
+        let p = Params::table_i();
+        let e = p.with_override("length.hh=1").unwrap_err().to_string();
+        assert!(e.contains("unknown key `length.hh`") && e.contains("length.h_m"), "{e}");
+        let e = p.with_override("length.h_m=abc").unwrap_err().to_string();
+        assert!(e.contains("not a number"), "{e}");
+        let e = p.with_override("length.h_m").unwrap_err().to_string();
+        assert!(e.contains("KEY=VALUE"), "{e}");
+    }
+
+    #[test]
+    fn negative_inertia_names_key_value_unit_and_rule() {
+        let e = Params::table_i()
+            .with_override("inertia.b33_kg_m2=-1e-5")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("inertia.b33_kg_m2"), "{e}");
+        assert!(e.contains("-0.00001") || e.contains("-1e-5"), "{e}");
+        assert!(e.contains("kg m^2") && e.contains("> 0"), "{e}");
+    }
+
+    #[test]
+    fn non_finite_and_unknown_and_missing_keys_are_rejected() {
+        let nan = TABLE_I_TOML.replace("m_b_kg = 0.11", "m_b_kg = nan");
+        let e = Params::from_toml_str(&nan, "t.toml").unwrap_err().to_string();
+        assert!(e.contains("mass.m_b_kg") && e.contains("NaN"), "{e}");
+        let unknown = TABLE_I_TOML.replace("m_b_kg = 0.11", "m_b_kg = 0.11\nm_c_kg = 1.0");
+        let e = Params::from_toml_str(&unknown, "t.toml").unwrap_err().to_string();
+        assert!(e.contains("t.toml") && e.contains("m_c_kg"), "{e}");
+        let missing = TABLE_I_TOML.replace("m_b_kg = 0.11", "");
+        let e = Params::from_toml_str(&missing, "t.toml").unwrap_err().to_string();
+        assert!(e.contains("m_b_kg"), "{e}");
+    }
+
+    #[test]
+    fn crossbar_tensor_must_be_positive_definite() {
+        let e = Params::table_i()
+            .with_override("inertia.a23_kg_m2=0.1")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("not positive definite") && e.contains("a23"), "{e}");
+    }
+
+    #[test]
+    fn loss_angle_range() {
+        let p = Params::table_i();
+        assert!(p.with_override("loss.torsion_b_rad=1e-3").is_ok());
+        assert!(p.with_override("loss.torsion_b_rad=-1e-3").is_err());
+        assert!(p.with_override("loss.torsion_b_rad=1.5").is_err());
+    }
+}
