@@ -48,7 +48,10 @@ pub fn log_grid(lo: f64, hi: f64, n: usize) -> Result<Vec<f64>, FreqError> {
     let (a, b) = (lo.ln(), hi.ln());
     Ok((0..n)
         .map(|k| {
-            if k + 1 == n {
+            // Endpoints exactly as given (exp(ln x) is not always x).
+            if k == 0 {
+                lo
+            } else if k + 1 == n {
                 hi
             } else {
                 (a + (b - a) * k as f64 / (n - 1) as f64).exp()
@@ -174,11 +177,26 @@ mod tests {
 
     #[test]
     fn spec_errors_name_the_problem() {
-        assert!(parse_spec("1e-3:10").unwrap_err().to_string().contains("FLO:N:FHI"));
-        assert!(parse_spec("a:10:1").unwrap_err().to_string().contains("FLO"));
-        assert!(parse_spec("1:0:10").unwrap_err().to_string().contains("N >= 1"));
-        assert!(parse_spec("-1:10:10").unwrap_err().to_string().contains("0 < FLO"));
-        assert!(parse_spec("10:10:1").unwrap_err().to_string().contains("FLO <= FHI"));
+        assert!(parse_spec("1e-3:10")
+            .unwrap_err()
+            .to_string()
+            .contains("FLO:N:FHI"));
+        assert!(parse_spec("a:10:1")
+            .unwrap_err()
+            .to_string()
+            .contains("FLO"));
+        assert!(parse_spec("1:0:10")
+            .unwrap_err()
+            .to_string()
+            .contains("N >= 1"));
+        assert!(parse_spec("-1:10:10")
+            .unwrap_err()
+            .to_string()
+            .contains("0 < FLO"));
+        assert!(parse_spec("10:10:1")
+            .unwrap_err()
+            .to_string()
+            .contains("FLO <= FHI"));
     }
 
     #[test]
@@ -187,13 +205,19 @@ mod tests {
             parse_freq_text("# f\n0.1\n\n 2 \n", "f.txt").unwrap(),
             vec![0.1, 2.0]
         );
-        let e = parse_freq_text("0.1\nabc\n", "f.txt").unwrap_err().to_string();
+        let e = parse_freq_text("0.1\nabc\n", "f.txt")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("f.txt, line 2") && e.contains("abc"), "{e}");
-        let e = parse_freq_text("0.1\n-3\n", "f.txt").unwrap_err().to_string();
+        let e = parse_freq_text("0.1\n-3\n", "f.txt")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("-3") && e.contains("line 2"), "{e}");
         let e = parse_freq_text("NaN\n", "f.txt").unwrap_err().to_string();
         assert!(e.contains("NaN"), "{e}");
-        let e = parse_freq_text("# only a comment\n", "f.txt").unwrap_err().to_string();
+        let e = parse_freq_text("# only a comment\n", "f.txt")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("no frequencies"), "{e}");
     }
 }

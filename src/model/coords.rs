@@ -45,7 +45,9 @@ impl Coord {
 
     /// ASCII name as used in files.
     pub fn name(self) -> &'static str {
-        ["theta_a", "eta_a", "phi_a", "delta_a", "theta_b", "eta_b", "phi_b", "delta_b"][self.index()]
+        [
+            "theta_a", "eta_a", "phi_a", "delta_a", "theta_b", "eta_b", "phi_b", "delta_b",
+        ][self.index()]
     }
 
     /// SI unit.

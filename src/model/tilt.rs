@@ -87,8 +87,9 @@ impl TiltForcing {
                 let rot = cross(w_dot, r_g);
                 [0, 1, 2].map(|k| -m * (r_s[k] + rot[k]))
             };
-            let apparent_torque =
-                |inertia: [[f64; 3]; 3]| [0, 1, 2].map(|k| -(0..3).map(|j| inertia[k][j] * w_dot[j]).sum::<f64>());
+            let apparent_torque = |inertia: [[f64; 3]; 3]| {
+                [0, 1, 2].map(|k| -(0..3).map(|j| inertia[k][j] * w_dot[j]).sum::<f64>())
+            };
             let f_a = apparent_force(p.mass.m_a_kg, dv.r_ga0_m);
             let f_b = apparent_force(p.mass.m_b_kg, dv.r_gb0_m);
             let m_a = apparent_torque(inertia_a);

@@ -239,9 +239,9 @@ impl Params {
             .and_then(|s| s.as_table_mut())
             .expect("every key's section exists")
             .insert(name.to_string(), toml::Value::Float(number));
-        let params: Params = table.try_into().map_err(|e: toml::de::Error| {
-            err(e.to_string().trim_end().replace('\n', " "))
-        })?;
+        let params: Params = table
+            .try_into()
+            .map_err(|e: toml::de::Error| err(e.to_string().trim_end().replace('\n', " ")))?;
         params.validate()?;
         Ok(params)
     }
@@ -266,28 +266,118 @@ impl Params {
         vec![
             f("mass.m_a_kg", m.m_a_kg, "kg", "m_a", Positive),
             f("mass.m_b_kg", m.m_b_kg, "kg", "m_b", Positive),
-            f("inertia.a11_kg_m2", i.a11_kg_m2, "kg m^2", "I^a_11", Positive),
-            f("inertia.a22_kg_m2", i.a22_kg_m2, "kg m^2", "I^a_22", Positive),
-            f("inertia.a33_kg_m2", i.a33_kg_m2, "kg m^2", "I^a_33", Positive),
+            f(
+                "inertia.a11_kg_m2",
+                i.a11_kg_m2,
+                "kg m^2",
+                "I^a_11",
+                Positive,
+            ),
+            f(
+                "inertia.a22_kg_m2",
+                i.a22_kg_m2,
+                "kg m^2",
+                "I^a_22",
+                Positive,
+            ),
+            f(
+                "inertia.a33_kg_m2",
+                i.a33_kg_m2,
+                "kg m^2",
+                "I^a_33",
+                Positive,
+            ),
             f("inertia.a23_kg_m2", i.a23_kg_m2, "kg m^2", "I^a_23", Finite),
-            f("inertia.b11_kg_m2", i.b11_kg_m2, "kg m^2", "I^b_11", Positive),
-            f("inertia.b22_kg_m2", i.b22_kg_m2, "kg m^2", "I^b_22", Positive),
-            f("inertia.b33_kg_m2", i.b33_kg_m2, "kg m^2", "I^b_33", Positive),
-            f("torsion.k_a_n_m_per_rad", t.k_a_n_m_per_rad, "N m/rad", "k_a", Positive),
-            f("torsion.k_b_n_m_per_rad", t.k_b_n_m_per_rad, "N m/rad", "k_b", Positive),
-            f("bouncing.kappa_a_n_per_m", b.kappa_a_n_per_m, "N/m", "kappa_e,a", Positive),
-            f("bouncing.kappa_b_n_per_m", b.kappa_b_n_per_m, "N/m", "kappa_e,b", Positive),
+            f(
+                "inertia.b11_kg_m2",
+                i.b11_kg_m2,
+                "kg m^2",
+                "I^b_11",
+                Positive,
+            ),
+            f(
+                "inertia.b22_kg_m2",
+                i.b22_kg_m2,
+                "kg m^2",
+                "I^b_22",
+                Positive,
+            ),
+            f(
+                "inertia.b33_kg_m2",
+                i.b33_kg_m2,
+                "kg m^2",
+                "I^b_33",
+                Positive,
+            ),
+            f(
+                "torsion.k_a_n_m_per_rad",
+                t.k_a_n_m_per_rad,
+                "N m/rad",
+                "k_a",
+                Positive,
+            ),
+            f(
+                "torsion.k_b_n_m_per_rad",
+                t.k_b_n_m_per_rad,
+                "N m/rad",
+                "k_b",
+                Positive,
+            ),
+            f(
+                "bouncing.kappa_a_n_per_m",
+                b.kappa_a_n_per_m,
+                "N/m",
+                "kappa_e,a",
+                Positive,
+            ),
+            f(
+                "bouncing.kappa_b_n_per_m",
+                b.kappa_b_n_per_m,
+                "N/m",
+                "kappa_e,b",
+                Positive,
+            ),
             f("length.d_m", l.d_m, "m", "d", Positive),
             f("length.h_c_m", l.h_c_m, "m", "h_c", NonNegative),
             f("length.z_m", l.z_m, "m", "Z", Positive),
             f("length.z_a_m", l.z_a_m, "m", "Z_a", Positive),
             f("length.z_b_m", l.z_b_m, "m", "Z_b", Positive),
             f("length.h_m", l.h_m, "m", "h (assumption)", Positive),
-            f("environment.g_m_per_s2", self.environment.g_m_per_s2, "m/s^2", "g (assumption)", Positive),
-            f("loss.torsion_a_rad", self.loss.torsion_a_rad, "rad", "phi_torsion,a", LossAngle),
-            f("loss.torsion_b_rad", self.loss.torsion_b_rad, "rad", "phi_torsion,b", LossAngle),
-            f("loss.bouncing_a_rad", self.loss.bouncing_a_rad, "rad", "phi_bouncing,a", LossAngle),
-            f("loss.bouncing_b_rad", self.loss.bouncing_b_rad, "rad", "phi_bouncing,b", LossAngle),
+            f(
+                "environment.g_m_per_s2",
+                self.environment.g_m_per_s2,
+                "m/s^2",
+                "g (assumption)",
+                Positive,
+            ),
+            f(
+                "loss.torsion_a_rad",
+                self.loss.torsion_a_rad,
+                "rad",
+                "phi_torsion,a",
+                LossAngle,
+            ),
+            f(
+                "loss.torsion_b_rad",
+                self.loss.torsion_b_rad,
+                "rad",
+                "phi_torsion,b",
+                LossAngle,
+            ),
+            f(
+                "loss.bouncing_a_rad",
+                self.loss.bouncing_a_rad,
+                "rad",
+                "phi_bouncing,a",
+                LossAngle,
+            ),
+            f(
+                "loss.bouncing_b_rad",
+                self.loss.bouncing_b_rad,
+                "rad",
+                "phi_bouncing,b",
+                LossAngle,
+            ),
         ]
     }
 
@@ -354,7 +444,10 @@ mod tests {
     fn override_rejects_unknown_key_and_non_number() {
         let p = Params::table_i();
         let e = p.with_override("length.hh=1").unwrap_err().to_string();
-        assert!(e.contains("unknown key `length.hh`") && e.contains("length.h_m"), "{e}");
+        assert!(
+            e.contains("unknown key `length.hh`") && e.contains("length.h_m"),
+            "{e}"
+        );
         let e = p.with_override("length.h_m=abc").unwrap_err().to_string();
         assert!(e.contains("not a number"), "{e}");
         let e = p.with_override("length.h_m").unwrap_err().to_string();
@@ -375,13 +468,19 @@ mod tests {
     #[test]
     fn non_finite_and_unknown_and_missing_keys_are_rejected() {
         let nan = TABLE_I_TOML.replace("m_b_kg = 0.11", "m_b_kg = nan");
-        let e = Params::from_toml_str(&nan, "t.toml").unwrap_err().to_string();
+        let e = Params::from_toml_str(&nan, "t.toml")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("mass.m_b_kg") && e.contains("NaN"), "{e}");
         let unknown = TABLE_I_TOML.replace("m_b_kg = 0.11", "m_b_kg = 0.11\nm_c_kg = 1.0");
-        let e = Params::from_toml_str(&unknown, "t.toml").unwrap_err().to_string();
+        let e = Params::from_toml_str(&unknown, "t.toml")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("t.toml") && e.contains("m_c_kg"), "{e}");
         let missing = TABLE_I_TOML.replace("m_b_kg = 0.11", "");
-        let e = Params::from_toml_str(&missing, "t.toml").unwrap_err().to_string();
+        let e = Params::from_toml_str(&missing, "t.toml")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("m_b_kg"), "{e}");
     }
 
@@ -391,7 +490,10 @@ mod tests {
             .with_override("inertia.a23_kg_m2=0.1")
             .unwrap_err()
             .to_string();
-        assert!(e.contains("not positive definite") && e.contains("a23"), "{e}");
+        assert!(
+            e.contains("not positive definite") && e.contains("a23"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -105,7 +105,8 @@ impl TransferFunction for Direct {
         let lu = d_s.lu();
         let inverse = lu.try_inverse().ok_or_else(|| singular(0.0))?;
         let rcond = 1.0 / (one_norm(&d_s) * one_norm(&inverse));
-        if !(rcond >= SINGULAR_RCOND) {
+        // A NaN rcond (non-finite entries) is singular too.
+        if rcond.is_nan() || rcond < SINGULAR_RCOND {
             return Err(singular(rcond));
         }
         let forcing = DMatrix::from_fn(8, n_in, |r, c| {
@@ -124,9 +125,7 @@ impl TransferFunction for Direct {
         let n_out = self.request.outputs.len();
         for o in 0..n_out {
             for i in 0..n_in {
-                out[o * n_in + i] = (0..8)
-                    .map(|k| y[(k, i)] * self.observe[(o, k)])
-                    .sum();
+                out[o * n_in + i] = (0..8).map(|k| y[(k, i)] * self.observe[(o, k)]).sum();
             }
         }
         Ok(())

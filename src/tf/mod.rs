@@ -147,7 +147,12 @@ impl TransferMatrix {
 
     /// Unit of entry (o, i): output unit per input unit.
     pub fn unit(&self, o: usize, i: usize) -> String {
-        format!("{}/{}", self.outputs[o].unit(), self.inputs[i].unit())
+        let input = self.inputs[i].unit();
+        if input.contains(' ') {
+            format!("{}/({input})", self.outputs[o].unit())
+        } else {
+            format!("{}/{input}", self.outputs[o].unit())
+        }
     }
 
     /// Position of an observable among the rows.

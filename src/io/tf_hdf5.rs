@@ -1,0 +1,137 @@
+//! Transfer matrix as HDF5 (schema `tiltnoise.tf`, documented in `docs/schemas.md`).
+
+use super::RunMeta;
+use crate::atomic::write_atomic;
+use crate::error::OutputError;
+use crate::tf::TransferMatrix;
+use hdf5::types::VarLenUnicode;
+use hdf5::{H5Type, Location};
+use ndarray::{arr0, ArrayView, ArrayView1, ArrayView3, Dimension};
+use std::path::Path;
+
+/// Value of the root attribute `schema`.
+pub const SCHEMA_TF: &str = "tiltnoise.tf";
+
+/// Value of the root attribute `schema_version`. Bumped on any change that can break a reader.
+pub const SCHEMA_VERSION_TF: i64 = 1;
+
+/// Value of the root attribute `sign_convention` (see [`crate::model::tilt`]).
+pub const SIGN_CONVENTION: &str = "tilt t = small right-handed rotation taking the floor frame \
+     to the inertial frame; X -> -eta_t (Z+Z_b+h_c), Y -> +theta_t (Z+Z_b+h_c) as f -> 0";
+
+/// Value of the root attribute `time_dependence`: values are complex amplitudes of
+/// `exp(+i w t)`.
+pub const TIME_DEPENDENCE: &str = "exp(+i w t)";
+
+/// Writes `tf` and the run's provenance `meta` as an HDF5 file of schema [`SCHEMA_TF`],
+/// atomically (see [`super::write_atomic`]).
+///
+/// Layout: root attributes `schema`, `schema_version`, `tool_version`, `created_by`, `method`,
+/// `parameters_toml`, `sign_convention`, `time_dependence`; datasets `/frequency_hz`,
+/// `/transfer` (complex, `[n_freq, n_outputs, n_inputs]`), `/outputs`, `/inputs`,
+/// `/output_units`, `/input_units`, and `/modes/{index,frequency_hz}` when `meta.modes` is not
+/// empty. Every item is described in `docs/schemas.md`.
+///
+/// # Errors
+///
+/// [`OutputError::Write`] naming `path` on any I/O or HDF5 failure; nothing is left at `path`.
+pub fn write_tf_hdf5(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> Result<(), OutputError> {
+    write_atomic(path, |temp| {
+        write_file(temp, tf, meta).map_err(|e| format!("HDF5: {e}"))
+    })
+}
+
+fn write_file(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> hdf5::Result<()> {
+    let (nf, no, ni) = (tf.freqs_hz.len(), tf.outputs.len(), tf.inputs.len());
+    if tf.values.len() != nf * no * ni {
+        return Err(format!(
+            "transfer matrix has {} values, expected {nf} x {no} x {ni}",
+            tf.values.len()
+        )
+        .into());
+    }
+    let file = hdf5::File::create(path)?;
+
+    str_attr(&file, "schema", SCHEMA_TF)?;
+    file.new_attr_builder()
+        .with_data(&arr0(SCHEMA_VERSION_TF))
+        .create("schema_version")?;
+    str_attr(&file, "tool_version", &meta.tool_version)?;
+    str_attr(&file, "created_by", &meta.command_line)?;
+    str_attr(&file, "method", tf.method.name())?;
+    str_attr(&file, "parameters_toml", &meta.params_toml)?;
+    str_attr(&file, "sign_convention", SIGN_CONVENTION)?;
+    str_attr(&file, "time_dependence", TIME_DEPENDENCE)?;
+
+    let outputs = strings(tf.outputs.iter().map(|o| o.name()))?;
+    let inputs = strings(tf.inputs.iter().map(|i| i.name()))?;
+    let output_units = strings(tf.outputs.iter().map(|o| o.unit()))?;
+    let input_units = strings(tf.inputs.iter().map(|i| i.unit()))?;
+    let units: Vec<String> = (0..no)
+        .flat_map(|o| (0..ni).map(move |i| (o, i)))
+        .map(|(o, i)| tf.unit(o, i))
+        .collect();
+    let units = strings(units.iter().map(String::as_str))?;
+
+    let freq = dataset(&file, "frequency_hz", ArrayView1::from(&tf.freqs_hz))?;
+    str_attr(&freq, "units", "Hz")?;
+
+    let values = ArrayView3::from_shape((nf, no, ni), &tf.values).map_err(|e| e.to_string())?;
+    let transfer = dataset(&file, "transfer", values)?;
+    strs_attr(&transfer, "outputs", &outputs)?;
+    strs_attr(&transfer, "inputs", &inputs)?;
+    strs_attr(&transfer, "units", &units)?;
+
+    dataset(&file, "outputs", ArrayView1::from(&outputs))?;
+    dataset(&file, "inputs", ArrayView1::from(&inputs))?;
+    dataset(&file, "output_units", ArrayView1::from(&output_units))?;
+    dataset(&file, "input_units", ArrayView1::from(&input_units))?;
+
+    if !meta.modes.is_empty() {
+        let modes = file.create_group("modes")?;
+        let index: Vec<i64> = meta
+            .modes
+            .iter()
+            .map(|&(n, _)| i64::try_from(n).map_err(|e| e.to_string()))
+            .collect::<Result<_, _>>()?;
+        let freqs: Vec<f64> = meta.modes.iter().map(|&(_, f)| f).collect();
+        dataset(&modes, "index", ArrayView1::from(&index))?;
+        let mf = dataset(&modes, "frequency_hz", ArrayView1::from(&freqs))?;
+        str_attr(&mf, "units", "Hz")?;
+    }
+
+    file.close()
+}
+
+fn dataset<T: H5Type, D: Dimension>(
+    group: &hdf5::Group,
+    name: &str,
+    data: ArrayView<'_, T, D>,
+) -> hdf5::Result<hdf5::Dataset> {
+    group.new_dataset_builder().with_data(data).create(name)
+}
+
+fn strings<'a>(items: impl Iterator<Item = &'a str>) -> hdf5::Result<Vec<VarLenUnicode>> {
+    items
+        .map(|s| s.parse::<VarLenUnicode>().map_err(|e| e.to_string().into()))
+        .collect()
+}
+
+/// A scalar variable-length UTF-8 string attribute (h5py reads it as `str`).
+fn str_attr(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
+    let value: VarLenUnicode = value
+        .parse()
+        .map_err(|e: hdf5::types::StringError| e.to_string())?;
+    loc.new_attr_builder()
+        .with_data(&arr0(value))
+        .create(name)?;
+    Ok(())
+}
+
+/// A 1-D attribute of variable-length UTF-8 strings.
+fn strs_attr(loc: &Location, name: &str, values: &[VarLenUnicode]) -> hdf5::Result<()> {
+    loc.new_attr_builder()
+        .with_data(ArrayView1::from(values))
+        .create(name)?;
+    Ok(())
+}

@@ -1,0 +1,84 @@
+//! Statistics of per-segment budgets (for example hourly): the median and a percentile band at
+//! every frequency, because floor tilt changes through the day.
+
+/// Median and percentile band of one quantity (a PSD) across segments, per frequency.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SegmentBand {
+    /// Lower percentile (e.g. 10).
+    pub lower_pct: f64,
+    /// Upper percentile (e.g. 90).
+    pub upper_pct: f64,
+    /// Median across segments, per frequency (same unit as the inputs).
+    pub median: Vec<f64>,
+    /// Lower percentile per frequency.
+    pub lower: Vec<f64>,
+    /// Upper percentile per frequency.
+    pub upper: Vec<f64>,
+    /// Number of segments.
+    pub n_segments: usize,
+}
+
+/// Percentile `p` (0..=100) of `values` with linear interpolation between order statistics
+/// (NumPy's default `method='linear'`). `values` is sorted in place. Panics if empty.
+pub fn percentile(values: &mut [f64], p: f64) -> f64 {
+    assert!(!values.is_empty(), "percentile of no values");
+    values.sort_by(f64::total_cmp);
+    let pos = (p / 100.0).clamp(0.0, 1.0) * (values.len() - 1) as f64;
+    let (lo, frac) = (pos.floor() as usize, pos - pos.floor());
+    if lo + 1 < values.len() {
+        values[lo] + (values[lo + 1] - values[lo]) * frac
+    } else {
+        values[lo]
+    }
+}
+
+impl SegmentBand {
+    /// Band of `per_segment[s][k]` (segment `s`, frequency `k`) at the given percentiles.
+    pub fn new(per_segment: &[Vec<f64>], lower_pct: f64, upper_pct: f64) -> SegmentBand {
+        let n_f = per_segment.first().map_or(0, Vec::len);
+        let mut column = vec![0.0; per_segment.len()];
+        let mut stat = |k: usize, p: f64| {
+            for (c, seg) in column.iter_mut().zip(per_segment) {
+                *c = seg[k];
+            }
+            percentile(&mut column, p)
+        };
+        let median = (0..n_f).map(|k| stat(k, 50.0)).collect();
+        let lower = (0..n_f).map(|k| stat(k, lower_pct)).collect();
+        let upper = (0..n_f).map(|k| stat(k, upper_pct)).collect();
+        SegmentBand {
+            lower_pct,
+            upper_pct,
+            median,
+            lower,
+            upper,
+            n_segments: per_segment.len(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn percentile_matches_numpy_linear_definition() {
+        // numpy.percentile([1, 2, 3, 4], [0, 10, 50, 90, 100]) = [1, 1.3, 2.5, 3.7, 4]
+        let v = [4.0, 1.0, 3.0, 2.0];
+        let p = |q| percentile(&mut v.clone(), q);
+        assert_eq!(p(0.0), 1.0);
+        assert!((p(10.0) - 1.3).abs() < 4.0 * f64::EPSILON);
+        assert_eq!(p(50.0), 2.5);
+        assert!((p(90.0) - 3.7).abs() < 4.0 * f64::EPSILON);
+        assert_eq!(p(100.0), 4.0);
+    }
+
+    #[test]
+    fn band_orders_lower_median_upper() {
+        let segs = vec![vec![1.0, 10.0], vec![3.0, 30.0], vec![2.0, 20.0]];
+        let b = SegmentBand::new(&segs, 10.0, 90.0);
+        assert_eq!(b.median, vec![2.0, 20.0]);
+        assert!(b.lower[0] < b.median[0] && b.median[0] < b.upper[0]);
+        assert_eq!(b.n_segments, 3);
+    }
+}
