@@ -46,6 +46,60 @@ enum Command {
     },
     /// Transfer functions from floor tilt (theta_t, eta_t, phi_t) to the 7 observables.
     Tf(TfArgs),
+    /// Noise budget of X, phi, phi_a from measured floor tilt (time series or spectra).
+    Budget(BudgetArgs),
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct BudgetArgs {
+    /// Tilt input: HDF5 or CSV time series (angle or rate) or spectra; see docs/input_formats.md.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) tilt: PathBuf,
+    /// Axis map, e.g. `theta_t=-E,eta_t=-N` (default: from the file, else theta_t=-E, eta_t=-N).
+    #[arg(long, value_name = "MAP")]
+    pub(crate) axes: Option<String>,
+    /// Quantity of the channels: angle (rad) or rate (rad/s); default from the file, else angle.
+    #[arg(long, value_name = "angle|rate")]
+    pub(crate) quantity: Option<String>,
+    /// Non-finite samples: reject (default) or interpolate linearly across interior gaps.
+    #[arg(long, value_name = "reject|interpolate", default_value = "reject")]
+    pub(crate) gaps: String,
+    /// Welch segment length in samples (default 2^14, or the largest power of two <= N/4).
+    #[arg(long, value_name = "N")]
+    pub(crate) nperseg: Option<usize>,
+    /// Welch overlap as a fraction of the segment.
+    #[arg(long, value_name = "FRACTION", default_value_t = 0.5)]
+    pub(crate) overlap: f64,
+    /// Welch averaging: mean, or median (with scipy's bias correction).
+    #[arg(long, value_enum, default_value_t = AverageArg::Mean)]
+    pub(crate) average: AverageArg,
+    /// Split the record into segments of this many seconds (e.g. 3600) for a percentile band.
+    #[arg(long, value_name = "SECONDS")]
+    pub(crate) segment_duration: Option<f64>,
+    /// Percentiles of the band across segments, LOWER,UPPER.
+    #[arg(long, value_name = "LO,HI", default_value = "10,90")]
+    pub(crate) percentiles: String,
+    /// White readout noise OBS=ASD in the observable's unit/sqrt(Hz) (repeatable; default
+    /// X=9e-9 m/sqrt(Hz) from the paper; OBS=0 removes it).
+    #[arg(long, value_name = "OBS=ASD")]
+    pub(crate) readout: Vec<String>,
+    /// Model grid for spectra input, FLO:N:FHI (default 1e-4:2000:30 plus resonance points);
+    /// restricted to the band the data cover.
+    #[arg(long, value_name = "FLO:N:FHI")]
+    pub(crate) freq: Option<String>,
+    /// Measured spectrum of the observables for comparison: CSV `freq_hz,X[,phi,phi_a]`, one-sided
+    /// ASD (m/sqrt(Hz), rad/sqrt(Hz)); adds the terms `measured` and `residual`.
+    #[arg(long, value_name = "FILE")]
+    pub(crate) measured: Option<PathBuf>,
+    /// Output file (.h5, .csv, .png, .svg), repeatable.
+    #[arg(long, value_name = "PATH")]
+    pub(crate) save: Vec<PathBuf>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum AverageArg {
+    Mean,
+    Median,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -117,6 +171,7 @@ pub fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Tf(args) => run_tf(&params, args),
+        Command::Budget(args) => crate::cli_budget::run_budget(&params, args),
     }
 }
 

@@ -26,9 +26,12 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 pub mod atomic;
+pub mod budget;
 pub mod cli;
+mod cli_budget;
 pub mod error;
 pub mod freq;
+pub mod input;
 pub mod io;
 pub mod model;
 pub mod modes;

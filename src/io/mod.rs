@@ -1,18 +1,27 @@
-//! Output files: transfer functions as HDF5 or CSV (schemas in `docs/schemas.md`), figures via
-//! [`crate::plot`].
+//! Output files: transfer functions and noise budgets as HDF5 or CSV (schemas in
+//! `docs/schemas.md`), figures via [`crate::plot`].
 //!
 //! Pure I/O: the numerical modules never import this one. Every writer is atomic (see
 //! [`write_atomic`]): a failed write leaves nothing at the target path and never clobbers an
 //! existing file.
 
+mod budget_csv;
+mod budget_hdf5;
+mod h5util;
 mod tf_csv;
 mod tf_hdf5;
 
 pub use crate::atomic::write_atomic;
+pub(crate) use budget_csv::check_report as check_budget_report;
+pub use budget_csv::{budget_csv_string, write_budget_csv};
+pub use budget_hdf5::{
+    write_budget_hdf5, SCHEMA_BUDGET, SCHEMA_VERSION_BUDGET, SPECTRAL_CONVENTION,
+};
 pub use tf_csv::{format_f64, tf_csv_string, write_tf_csv};
 pub use tf_hdf5::{write_tf_hdf5, SCHEMA_TF, SCHEMA_VERSION_TF, SIGN_CONVENTION, TIME_DEPENDENCE};
 
 use crate::error::OutputError;
+use crate::noise::BudgetReport;
 use crate::tf::TransferMatrix;
 use std::path::Path;
 
@@ -29,6 +38,27 @@ pub struct RunMeta {
     /// convention it is the mode's `index` from the `modes` module (1-based, in order of
     /// increasing frequency: the paper's nu_1 ... nu_8). Empty: no `/modes` group is written.
     pub modes: Vec<(usize, f64)>,
+}
+
+/// Provenance of the tilt input of a budget run, stored in the budget's HDF5 file and shown in
+/// its figure. Plain strings, so that this module does not depend on [`crate::input`]; the
+/// caller fills it from the reader's `crate::input::Provenance`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct InputMeta {
+    /// The input file, as given.
+    pub path: String,
+    /// File format: `hdf5` or `csv`.
+    pub format: String,
+    /// `series` (time series) or `spectra`.
+    pub kind: String,
+    /// Quantity of the file's channels before conversion to angle: `angle` or `rate`.
+    pub quantity: String,
+    /// The effective axis map, e.g. `theta_t=-LJE,eta_t=-LJN`.
+    pub axis_map: String,
+    /// Start time of the record (ISO 8601), if the file gives one.
+    pub start_time: Option<String>,
+    /// The reader's notes: where the map and quantity came from, assumptions, gaps.
+    pub notes: Vec<String>,
 }
 
 /// This crate's version, `env!("CARGO_PKG_VERSION")`, for [`RunMeta::tool_version`].
@@ -88,5 +118,33 @@ pub fn save_tf(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> Result<(), O
         OutputKind::Hdf5 => write_tf_hdf5(path, tf, meta),
         OutputKind::Csv => write_tf_csv(path, tf),
         OutputKind::Png | OutputKind::Svg => crate::plot::tf_figure(tf, path),
+    }
+}
+
+/// Saves a noise budget in the format named by the extension of `path`: HDF5
+/// ([`write_budget_hdf5`], with `meta` and `input`), CSV ([`write_budget_csv`]; ASDs only,
+/// `meta` and `input` are not stored), or a PNG/SVG figure
+/// ([`crate::plot::budget_figure_with`], with the input named in the caption).
+///
+/// # Errors
+///
+/// [`OutputError::UnknownFormat`] for an unsupported extension (nothing is written), or the
+/// writer's [`OutputError::Write`].
+pub fn save_budget(
+    path: &Path,
+    report: &BudgetReport,
+    meta: &RunMeta,
+    input: &InputMeta,
+) -> Result<(), OutputError> {
+    match OutputKind::from_path(path)? {
+        OutputKind::Hdf5 => write_budget_hdf5(path, report, meta, input),
+        OutputKind::Csv => write_budget_csv(path, report),
+        OutputKind::Png | OutputKind::Svg => {
+            let options = crate::plot::BudgetFigureOptions {
+                input: Some(input.clone()),
+                ..crate::plot::BudgetFigureOptions::default()
+            };
+            crate::plot::budget_figure_with(report, path, &options)
+        }
     }
 }

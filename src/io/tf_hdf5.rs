@@ -1,12 +1,11 @@
 //! Transfer matrix as HDF5 (schema `tiltnoise.tf`, documented in `docs/schemas.md`).
 
+use super::h5util::{dataset, scalar_attr, str_attr, strings, strs_attr};
 use super::RunMeta;
 use crate::atomic::write_atomic;
 use crate::error::OutputError;
 use crate::tf::TransferMatrix;
-use hdf5::types::VarLenUnicode;
-use hdf5::{H5Type, Location};
-use ndarray::{arr0, ArrayView, ArrayView1, ArrayView3, Dimension};
+use ndarray::ArrayView3;
 use std::path::Path;
 
 /// Value of the root attribute `schema`.
@@ -53,9 +52,7 @@ fn write_file(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> hdf5::Result<
     let file = hdf5::File::create(path)?;
 
     str_attr(&file, "schema", SCHEMA_TF)?;
-    file.new_attr_builder()
-        .with_data(&arr0(SCHEMA_VERSION_TF))
-        .create("schema_version")?;
+    scalar_attr(&file, "schema_version", SCHEMA_VERSION_TF)?;
     str_attr(&file, "tool_version", &meta.tool_version)?;
     str_attr(&file, "created_by", &meta.command_line)?;
     str_attr(&file, "method", tf.method.name())?;
@@ -63,29 +60,37 @@ fn write_file(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> hdf5::Result<
     str_attr(&file, "sign_convention", SIGN_CONVENTION)?;
     str_attr(&file, "time_dependence", TIME_DEPENDENCE)?;
 
-    let outputs = strings(tf.outputs.iter().map(|o| o.name()))?;
-    let inputs = strings(tf.inputs.iter().map(|i| i.name()))?;
-    let output_units = strings(tf.outputs.iter().map(|o| o.unit()))?;
-    let input_units = strings(tf.inputs.iter().map(|i| i.unit()))?;
+    let output_names: Vec<&str> = tf.outputs.iter().map(|o| o.name()).collect();
+    let input_names: Vec<&str> = tf.inputs.iter().map(|i| i.name()).collect();
     let units: Vec<String> = (0..no)
         .flat_map(|o| (0..ni).map(move |i| (o, i)))
         .map(|(o, i)| tf.unit(o, i))
         .collect();
-    let units = strings(units.iter().map(String::as_str))?;
 
-    let freq = dataset(&file, "frequency_hz", ArrayView1::from(&tf.freqs_hz))?;
+    let freq = dataset(&file, "frequency_hz", &tf.freqs_hz)?;
     str_attr(&freq, "units", "Hz")?;
 
     let values = ArrayView3::from_shape((nf, no, ni), &tf.values).map_err(|e| e.to_string())?;
-    let transfer = dataset(&file, "transfer", values)?;
-    strs_attr(&transfer, "outputs", &outputs)?;
-    strs_attr(&transfer, "inputs", &inputs)?;
-    strs_attr(&transfer, "units", &units)?;
+    let transfer = file
+        .new_dataset_builder()
+        .with_data(values)
+        .create("transfer")?;
+    strs_attr(&transfer, "outputs", output_names.iter().copied())?;
+    strs_attr(&transfer, "inputs", input_names.iter().copied())?;
+    strs_attr(&transfer, "units", units.iter().map(String::as_str))?;
 
-    dataset(&file, "outputs", ArrayView1::from(&outputs))?;
-    dataset(&file, "inputs", ArrayView1::from(&inputs))?;
-    dataset(&file, "output_units", ArrayView1::from(&output_units))?;
-    dataset(&file, "input_units", ArrayView1::from(&input_units))?;
+    dataset(&file, "outputs", &strings(output_names.iter().copied())?)?;
+    dataset(&file, "inputs", &strings(input_names.iter().copied())?)?;
+    dataset(
+        &file,
+        "output_units",
+        &strings(tf.outputs.iter().map(|o| o.unit()))?,
+    )?;
+    dataset(
+        &file,
+        "input_units",
+        &strings(tf.inputs.iter().map(|i| i.unit()))?,
+    )?;
 
     if !meta.modes.is_empty() {
         let modes = file.create_group("modes")?;
@@ -95,43 +100,10 @@ fn write_file(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> hdf5::Result<
             .map(|&(n, _)| i64::try_from(n).map_err(|e| e.to_string()))
             .collect::<Result<_, _>>()?;
         let freqs: Vec<f64> = meta.modes.iter().map(|&(_, f)| f).collect();
-        dataset(&modes, "index", ArrayView1::from(&index))?;
-        let mf = dataset(&modes, "frequency_hz", ArrayView1::from(&freqs))?;
+        dataset(&modes, "index", &index)?;
+        let mf = dataset(&modes, "frequency_hz", &freqs)?;
         str_attr(&mf, "units", "Hz")?;
     }
 
     file.close()
-}
-
-fn dataset<T: H5Type, D: Dimension>(
-    group: &hdf5::Group,
-    name: &str,
-    data: ArrayView<'_, T, D>,
-) -> hdf5::Result<hdf5::Dataset> {
-    group.new_dataset_builder().with_data(data).create(name)
-}
-
-fn strings<'a>(items: impl Iterator<Item = &'a str>) -> hdf5::Result<Vec<VarLenUnicode>> {
-    items
-        .map(|s| s.parse::<VarLenUnicode>().map_err(|e| e.to_string().into()))
-        .collect()
-}
-
-/// A scalar variable-length UTF-8 string attribute (h5py reads it as `str`).
-fn str_attr(loc: &Location, name: &str, value: &str) -> hdf5::Result<()> {
-    let value: VarLenUnicode = value
-        .parse()
-        .map_err(|e: hdf5::types::StringError| e.to_string())?;
-    loc.new_attr_builder()
-        .with_data(&arr0(value))
-        .create(name)?;
-    Ok(())
-}
-
-/// A 1-D attribute of variable-length UTF-8 strings.
-fn strs_attr(loc: &Location, name: &str, values: &[VarLenUnicode]) -> hdf5::Result<()> {
-    loc.new_attr_builder()
-        .with_data(ArrayView1::from(values))
-        .create(name)?;
-    Ok(())
 }

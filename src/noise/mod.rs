@@ -204,7 +204,8 @@ pub fn tilt_budget(tf: &TransferMatrix, tilt: &TiltCsd, readout: &Readout) -> Bu
 }
 
 /// Adds a measured spectrum of an observable for comparison, with the unexplained residual
-/// `measured - total` in power (clipped at 0 where the model explains everything).
+/// `measured - total` in power (clipped at 0 where the model explains everything; NaN where
+/// the measured PSD is NaN, i.e. not measured at that frequency).
 pub fn add_measured(budget: &mut Budget, o: Observable, measured_psd: Vec<f64>) {
     let Some(b) = budget.observables.iter_mut().find(|b| b.observable == o) else {
         return;
@@ -212,7 +213,14 @@ pub fn add_measured(budget: &mut Budget, o: Observable, measured_psd: Vec<f64>) 
     let residual = measured_psd
         .iter()
         .zip(&b.total().psd)
-        .map(|(m, t)| (m - t).max(0.0))
+        // f64::max would turn a NaN (not measured there) into 0: keep it NaN.
+        .map(|(m, t)| {
+            if m.is_nan() {
+                f64::NAN
+            } else {
+                (m - t).max(0.0)
+            }
+        })
         .collect();
     let at = b.terms.len() - 1;
     b.terms.insert(
@@ -297,4 +305,49 @@ mod tests {
         assert_eq!(x.term("residual").unwrap().psd[0], 3.0);
         assert_eq!(x.terms.last().unwrap().name, "total");
     }
+}
+
+/// How the tilt spectra of a budget were estimated, for provenance in the output files.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SpectralSource {
+    /// Welch estimate from a time series.
+    Welch {
+        /// Sample rate of the series (Hz).
+        sample_rate_hz: f64,
+        /// Samples per Welch segment.
+        segment_len: usize,
+        /// Overlapping samples between consecutive Welch segments.
+        overlap: usize,
+        /// `mean` or `median`.
+        averaging: String,
+        /// Welch segments averaged over the whole record.
+        n_welch_segments: usize,
+        /// Samples in the record.
+        n_samples: usize,
+    },
+    /// Spectra given as input, interpolated log-log onto the model grid.
+    Spectra {
+        /// Frequency band covered by the input (Hz).
+        data_band_hz: (f64, f64),
+    },
+}
+
+/// A complete budget run: the whole-record budget, the per-segment statistics and what went in.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BudgetReport {
+    /// The budget of the whole record (or of the given spectra).
+    pub budget: Budget,
+    /// Per-segment statistics of the `tilt` term (PSD), one band per observable, when the record
+    /// was split into segments (for example hourly).
+    pub segment_bands: Vec<(Observable, SegmentBand)>,
+    /// Segment length (s) of `segment_bands`, if any.
+    pub segment_duration_s: Option<f64>,
+    /// How the tilt spectra were obtained.
+    pub source: SpectralSource,
+    /// The tilt axes that entered the budget.
+    pub axes: Vec<TiltAxis>,
+    /// Readout noise used (observable, ASD in unit/sqrt(Hz)).
+    pub readout: Readout,
+    /// Human-readable notes for the user and the files (band restrictions, assumptions).
+    pub notes: Vec<String>,
 }

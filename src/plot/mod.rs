@@ -11,7 +11,8 @@
 //! The module consumes plain data: [`chart`] has the reusable log-log chart
 //! ([`chart::LogLogFigure`] of [`chart::Panel`]s of [`chart::Trace`]s and an optional
 //! [`chart::Band`]), [`tf_figure()`] builds the paper's Figure 5 from a
-//! [`TransferMatrix`](crate::tf::TransferMatrix).
+//! [`TransferMatrix`](crate::tf::TransferMatrix), [`budget_figure()`] a noise budget from a
+//! [`BudgetReport`](crate::noise::BudgetReport).
 //!
 //! Text is rendered with DejaVu Sans (`assets/DejaVuSans.ttf`, licence in
 //! `assets/DejaVuSans-LICENSE.txt`), embedded in the binary and registered with plotters once
@@ -19,10 +20,12 @@
 //! plotters' glyph spacing. In SVG output text stays text (`<text font-family="sans-serif">`),
 //! so the viewer's sans-serif font is used there.
 
+pub mod budget_figure;
 pub mod chart;
 mod text;
 pub mod tf_figure;
 
+pub use budget_figure::{budget_figure, budget_figure_with, BudgetFigureOptions};
 pub use chart::{Band, Dash, LegendPlacement, LogLogFigure, Panel, TextSizes, Trace, TraceStyle};
 pub use text::GlyphPlacement;
 pub use tf_figure::{tf_figure, tf_figure_with, TfFigureOptions};

@@ -1,0 +1,398 @@
+//! Readers for floor-tilt inputs: tilt **time series** and tilt **spectra**, from HDF5 or CSV,
+//! with strict validation. Pure input code: no plotting, no command line. The exact file
+//! layouts are documented in `docs/input_formats.md`.
+//!
+//! # Conventions
+//!
+//! **Tilt sign.** The crate's tilt `t = (theta_t, eta_t, phi_t)` (rad) is the small
+//! right-handed rotation taking the **floor** frame to the **inertial** frame: the floor itself
+//! rotates by `-t` (see [`crate::model::tilt`]). Lab axes: `x`, `y` horizontal (`x` along the
+//! crossbar arm, `y` along the other), `z` up. Every value returned by this module is `t` in
+//! this convention, in rad (angle), one-sided PSD/CSD in rad²/Hz for spectra.
+//!
+//! **Instrument axes and the default mapping.** Seismological rotation channels give the
+//! right-handed rotation (or rotation rate) *of the ground* about North, East (and Up). Unless
+//! an axis map is given, `tiltnoise` **assumes** lab `x` = East, `y` = North, `z` = Up, so
+//!
+//! ```text
+//! theta_t = -E,   eta_t = -N,   phi_t = -Z
+//! ```
+//!
+//! (the minus because `t` is minus the floor rotation). Channels named `E`, `N`, `Z`, or with
+//! a SEED rotation-sensor code `?JE`, `?JN`, `?JZ` (band letter, instrument `J`, orientation;
+//! e.g. `LJE`), are mapped this way; channels already named `theta_t`, `eta_t`, `phi_t` map to
+//! themselves with `+1`. Other channels are ignored (listed in the provenance notes). Two
+//! channels qualifying for one axis are an error ([`InputError::AmbiguousAxis`]).
+//!
+//! **Axis map.** An explicit [`AxisMap`] (from [`ReadOptions::axis_map`], or from the file:
+//! HDF5 root attribute `axis_map`, CSV line `# axes: ...`; the options win) replaces the
+//! default: `theta_t=-E,eta_t=-N` means `theta_t = -(channel E)`, `eta_t = -(channel N)`. Each
+//! target is `[+|-]SOURCE`; only the mapped axes are read.
+//!
+//! **Quantity.** A channel is a tilt angle (rad) or a tilt rate (rad/s) ([`Quantity`]). The
+//! quantity comes from [`ReadOptions::quantity`] if given (it overrides the file, with a note),
+//! else from the file's metadata (HDF5 attribute `units` on each channel dataset: `rad` or
+//! `rad/s`; CSV: a `# units:` line), else it **defaults to angle** and the provenance says so.
+//! A rate is converted to angle by removing its mean and integrating with the trapezoidal rule,
+//! `theta[0] = 0`, `theta[k] = theta[k-1] + (r[k-1] + r[k]) * (dt/2)` with `r = rate - mean`
+//! (the mean is a compensated sum over the whole channel divided by its length). Spectra of a
+//! rate are divided by `(2 pi f)²`.
+//!
+//! **Gaps.** NaN or infinite samples are refused ([`InputError::NonFinite`], naming channel
+//! and sample index) unless [`GapPolicy::Interpolate`] is selected: then each interior run of
+//! non-finite samples is replaced by the straight line between its finite neighbours, in the
+//! signed channel, before any integration; a run touching either end is an error
+//! ([`InputError::EdgeGap`]). In CSV an empty field is a non-finite sample.
+//!
+//! # Entry points
+//!
+//! * [`read_tilt`]: decides by extension (`.h5`/`.hdf5` vs `.csv`) and content whether the
+//!   file holds a series or spectra, and returns a [`TiltInput`].
+//! * [`read_tilt_series`] / [`read_tilt_spectra`]: the same, insisting on one kind.
+//! * [`TiltSeriesSource`]: streaming access to an HDF5 series in chunks (bounded memory), with
+//!   results bit-identical to [`read_tilt_series`].
+//!
+//! Every result carries a [`Provenance`] for the output files.
+
+mod axis_map;
+mod csv;
+mod error;
+mod h5;
+mod measured;
+mod meta;
+mod series;
+mod series_csv;
+mod source;
+mod spectra;
+mod spectra_csv;
+mod spectra_hdf5;
+
+pub use axis_map::{AxisMap, AxisMapEntry, Sign};
+pub use error::InputError;
+pub use measured::{read_measured, MeasuredSpectra};
+pub use series::TiltSeries;
+pub use source::TiltSeriesSource;
+pub use spectra::{TiltSpectra, CSD_RTOL};
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+/// Schema name of HDF5 tilt time series (root attribute `schema`, optional).
+pub const SCHEMA_TILT_SERIES: &str = "tiltnoise.tilt_series";
+/// Schema name of HDF5 tilt spectra (root attribute `schema`, optional).
+pub const SCHEMA_TILT_SPECTRA: &str = "tiltnoise.tilt_spectra";
+/// The schema version these readers understand (root attribute `schema_version`, optional).
+pub const INPUT_SCHEMA_VERSION: i64 = 1;
+
+/// What the accepted layouts are, for error messages.
+pub(crate) const ACCEPTED_LAYOUTS: &str = "HDF5 time series (root attribute sample_rate_hz, \
+     one 1-D dataset per channel), HDF5 spectra (datasets /frequency_hz and /asd or /csd, root \
+     attribute axes), CSV time series (header starting with time_s), CSV spectra (header \
+     starting with freq_hz); see docs/input_formats.md";
+
+/// Physical quantity of the input channels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Quantity {
+    /// Tilt angle, rad (spectra: rad/sqrt(Hz) or rad²/Hz).
+    Angle,
+    /// Tilt rate, rad/s (spectra: rad/s/sqrt(Hz) or rad²/s²/Hz); converted to angle.
+    Rate,
+}
+
+impl Quantity {
+    /// `angle` or `rate`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Quantity::Angle => "angle",
+            Quantity::Rate => "rate",
+        }
+    }
+
+    /// Unit of a time-series sample: `rad` or `rad/s`.
+    pub fn unit(self) -> &'static str {
+        match self {
+            Quantity::Angle => "rad",
+            Quantity::Rate => "rad/s",
+        }
+    }
+}
+
+impl fmt::Display for Quantity {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Quantity {
+    type Err = String;
+    /// `angle` or `rate` (case-insensitive).
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "angle" => Ok(Quantity::Angle),
+            "rate" => Ok(Quantity::Rate),
+            _ => Err(format!(
+                "quantity `{s}` is not allowed: must be angle (rad) or rate (rad/s)"
+            )),
+        }
+    }
+}
+
+/// What to do with NaN or infinite samples in a time series.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum GapPolicy {
+    /// Refuse the file, naming the channel and the sample index (default).
+    #[default]
+    Reject,
+    /// Bridge interior gaps linearly between the finite neighbours; gaps at either end are
+    /// still an error.
+    Interpolate,
+}
+
+impl GapPolicy {
+    /// `reject` or `interpolate`.
+    pub fn name(self) -> &'static str {
+        match self {
+            GapPolicy::Reject => "reject",
+            GapPolicy::Interpolate => "interpolate",
+        }
+    }
+}
+
+impl FromStr for GapPolicy {
+    type Err = String;
+    /// `reject` or `interpolate` (case-insensitive).
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "reject" => Ok(GapPolicy::Reject),
+            "interpolate" => Ok(GapPolicy::Interpolate),
+            _ => Err(format!(
+                "gap policy `{s}` is not allowed: must be reject or interpolate"
+            )),
+        }
+    }
+}
+
+/// How to read a tilt input. `Default` = default axis mapping, quantity from the file (else
+/// angle), gaps rejected.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ReadOptions {
+    /// Explicit axis map; overrides the file's `axis_map` / `# axes:` and the default mapping.
+    pub axis_map: Option<AxisMap>,
+    /// Explicit quantity; overrides the file's units.
+    pub quantity: Option<Quantity>,
+    /// Treatment of NaN / infinite samples (time series only).
+    pub gaps: GapPolicy,
+}
+
+/// File format of an input.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum InputFormat {
+    /// HDF5 (`.h5`, `.hdf5`).
+    Hdf5,
+    /// Comma-separated text (`.csv`).
+    Csv,
+}
+
+impl InputFormat {
+    /// `hdf5` or `csv`.
+    pub fn name(self) -> &'static str {
+        match self {
+            InputFormat::Hdf5 => "hdf5",
+            InputFormat::Csv => "csv",
+        }
+    }
+
+    /// The format named by the extension of `path` (case-insensitive).
+    ///
+    /// # Errors
+    ///
+    /// [`InputError::Extension`] for anything but `.h5`, `.hdf5`, `.csv`.
+    pub fn from_path(path: &Path) -> Result<InputFormat, InputError> {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        match ext.as_str() {
+            "h5" | "hdf5" => Ok(InputFormat::Hdf5),
+            "csv" => Ok(InputFormat::Csv),
+            _ => Err(InputError::Extension {
+                path: path.to_path_buf(),
+                extension: ext,
+            }),
+        }
+    }
+}
+
+impl fmt::Display for InputFormat {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Kind of input: a time series or spectra.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum InputKind {
+    /// Time series of tilt angle or rate.
+    Series,
+    /// One-sided amplitude or cross spectral densities.
+    Spectra,
+}
+
+impl InputKind {
+    /// `series` or `spectra`.
+    pub fn name(self) -> &'static str {
+        match self {
+            InputKind::Series => "series",
+            InputKind::Spectra => "spectra",
+        }
+    }
+}
+
+impl fmt::Display for InputKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Where an input came from and how it was interpreted, for the output files.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Provenance {
+    /// The file read.
+    pub path: PathBuf,
+    /// Its format.
+    pub format: InputFormat,
+    /// Series or spectra.
+    pub kind: InputKind,
+    /// The quantity of the file's channels (before conversion to angle).
+    pub quantity: Quantity,
+    /// The effective axis map in [`AxisMap`] syntax, e.g. `theta_t=-LJE,eta_t=-LJN`.
+    pub axis_map: String,
+    /// Start time (ISO 8601) if the file gives one.
+    pub start_time: Option<String>,
+    /// Human-readable notes: where the map and quantity came from, assumptions, ignored
+    /// channels, interpolated gaps, band restriction.
+    pub notes: Vec<String>,
+}
+
+/// The content of a tilt input file.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TiltInput {
+    /// A time series (angle, rad).
+    Series(TiltSeries),
+    /// Spectra (one-sided CSD, rad²/Hz).
+    Spectra(TiltSpectra),
+}
+
+impl TiltInput {
+    /// The provenance of either kind.
+    pub fn provenance(&self) -> &Provenance {
+        match self {
+            TiltInput::Series(s) => &s.provenance,
+            TiltInput::Spectra(s) => &s.provenance,
+        }
+    }
+}
+
+/// Reads a tilt input of either kind: the format from the extension (`.h5`/`.hdf5`, `.csv`),
+/// the kind from the content (HDF5: `schema` attribute if present, else root attribute
+/// `sample_rate_hz` -> series, dataset `/frequency_hz` -> spectra; CSV: first header column
+/// `time_s` -> series, `freq_hz` -> spectra).
+///
+/// # Errors
+///
+/// [`InputError::Extension`], [`InputError::UnknownLayout`] (naming the accepted layouts), or
+/// any validation error of the specific reader.
+pub fn read_tilt(path: &Path, opts: &ReadOptions) -> Result<TiltInput, InputError> {
+    match InputFormat::from_path(path)? {
+        InputFormat::Csv => {
+            let mut file = csv::CsvFile::open(path)?;
+            let prelude = file.prelude()?;
+            match csv_kind(path, &prelude)? {
+                InputKind::Series => series_csv::read(file, prelude, opts).map(TiltInput::Series),
+                InputKind::Spectra => {
+                    spectra_csv::read(file, prelude, opts).map(TiltInput::Spectra)
+                }
+            }
+        }
+        InputFormat::Hdf5 => {
+            let file = h5::open(path)?;
+            match h5::detect_kind(path, &file, None)? {
+                InputKind::Series => {
+                    let mut src = TiltSeriesSource::from_file(path, file, opts)?;
+                    src.read_all().map(TiltInput::Series)
+                }
+                InputKind::Spectra => spectra_hdf5::read(path, &file, opts).map(TiltInput::Spectra),
+            }
+        }
+    }
+}
+
+/// Reads a tilt time series (angle, rad), all in memory. For long HDF5 series use
+/// [`TiltSeriesSource`]; the values are bit-identical.
+///
+/// # Errors
+///
+/// [`InputError::WrongKind`] if the file holds spectra; otherwise as [`read_tilt`].
+pub fn read_tilt_series(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputError> {
+    match InputFormat::from_path(path)? {
+        InputFormat::Hdf5 => {
+            let mut src = TiltSeriesSource::open(path, opts)?;
+            src.read_all()
+        }
+        InputFormat::Csv => match read_tilt(path, opts)? {
+            TiltInput::Series(s) => Ok(s),
+            TiltInput::Spectra(_) => Err(wrong_kind(path, InputKind::Series, InputKind::Spectra)),
+        },
+    }
+}
+
+/// Reads tilt spectra (one-sided CSD, rad²/Hz).
+///
+/// # Errors
+///
+/// [`InputError::WrongKind`] if the file holds a time series; otherwise as [`read_tilt`].
+pub fn read_tilt_spectra(path: &Path, opts: &ReadOptions) -> Result<TiltSpectra, InputError> {
+    match InputFormat::from_path(path)? {
+        InputFormat::Hdf5 => {
+            let file = h5::open(path)?;
+            match h5::detect_kind(path, &file, Some(InputKind::Spectra))? {
+                InputKind::Spectra => spectra_hdf5::read(path, &file, opts),
+                InputKind::Series => Err(wrong_kind(path, InputKind::Spectra, InputKind::Series)),
+            }
+        }
+        InputFormat::Csv => {
+            let mut file = csv::CsvFile::open(path)?;
+            let prelude = file.prelude()?;
+            match csv_kind(path, &prelude)? {
+                InputKind::Spectra => spectra_csv::read(file, prelude, opts),
+                InputKind::Series => Err(wrong_kind(path, InputKind::Spectra, InputKind::Series)),
+            }
+        }
+    }
+}
+
+fn wrong_kind(path: &Path, expected: InputKind, found: InputKind) -> InputError {
+    InputError::WrongKind {
+        path: path.to_path_buf(),
+        expected: expected.name(),
+        found: found.name(),
+    }
+}
+
+fn csv_kind(path: &Path, prelude: &csv::Prelude) -> Result<InputKind, InputError> {
+    match prelude.header.first().map(String::as_str) {
+        Some("time_s") => Ok(InputKind::Series),
+        Some("freq_hz") => Ok(InputKind::Spectra),
+        other => Err(InputError::UnknownLayout {
+            path: path.to_path_buf(),
+            format: "csv",
+            found: format!(
+                "the header (line {}) starts with column `{}`, not time_s or freq_hz",
+                prelude.header_line,
+                other.unwrap_or("")
+            ),
+            accepted: ACCEPTED_LAYOUTS,
+        }),
+    }
+}

@@ -1,0 +1,102 @@
+//! Real data through the whole time-series path: the two-axis ROMY tilt-rate record (LJN, LJE)
+//! -> tilt angle -> Welch ASD and CSD -> transfer functions -> budget of X, phi, phi_a, checked
+//! against the independent reference of `scripts/reference/tilt_budget_reference.py` (SciPy for
+//! the spectra, mpmath at 40 digits for the model, built from the paper, not from this crate).
+
+mod common;
+
+use common::{assert_close, floats, json, shared_tilt_data};
+use tiltnoise::budget::{budget_from_series, BudgetOptions, SeriesInput};
+use tiltnoise::input::{read_tilt_series, AxisMap, Quantity, ReadOptions};
+use tiltnoise::model::{Model, Observable};
+use tiltnoise::params::Params;
+
+/// Agreement required between the two pipelines, relative per bin: the issue's criterion for
+/// equal results (1e-8). The spectral parts agree with SciPy to ~1e-14 (tests/welch_scipy.rs);
+/// the loss comes from the f64 direct solve, whose cancellation in phi/eta_t at the lowest bins
+/// (true response ~ f^4) costs digits (measured in issue 4's methods table).
+const PIPELINE_REL: f64 = 1e-8;
+/// Floor for bins far below a spectrum's peak, as a fraction of the peak: the integrated angle
+/// carries the rounding of 8192 trapezoid steps, n eps ~ 2e-12 of its amplitude, so a PSD bin
+/// can be off by about that fraction of the peak PSD.
+const PEAK_FLOOR: f64 = 1e-11;
+
+fn romy_budget() -> tiltnoise::noise::BudgetReport {
+    let path = shared_tilt_data("romy_6c_teleseism_20180123/ROMY_gulf_of_alaska_teleseism.csv");
+    let opts = ReadOptions {
+        axis_map: Some(AxisMap::parse("theta_t=-LJE,eta_t=-LJN").unwrap()),
+        quantity: Some(Quantity::Rate),
+        ..ReadOptions::default()
+    };
+    let series = read_tilt_series(&path, &opts).unwrap();
+    assert_eq!((series.len(), series.sample_rate_hz), (8192, 1.0));
+    let model = Model::new(&Params::table_i()).unwrap();
+    let budget_opts = BudgetOptions {
+        welch_segment_len: Some(2048),
+        ..BudgetOptions::default()
+    };
+    budget_from_series(
+        &model,
+        SeriesInput::Memory(series),
+        &budget_opts,
+        &mut |_, _| {},
+    )
+    .unwrap()
+}
+
+#[test]
+fn romy_budget_matches_independent_reference() {
+    let reference = json("scripts/reference/romy_budget_reference.json");
+    let report = romy_budget();
+    let b = &report.budget;
+    let freqs = floats(&reference["freqs_hz"]);
+    assert_eq!(b.freqs_hz.len(), freqs.len());
+    for (k, (&got, &want)) in b.freqs_hz.iter().zip(&freqs).enumerate() {
+        assert_eq!(got, want, "frequency bin {k}");
+    }
+    for o in [Observable::X, Observable::Phi, Observable::PhiA] {
+        let ob = b.observable(o).unwrap();
+        let r = &reference["outputs"][o.name()];
+        for (term, key) in [
+            ("tilt", &r["tilt_psd"]),
+            ("tilt.theta_t", &r["per_axis_psd"]["theta_t"]),
+            ("tilt.eta_t", &r["per_axis_psd"]["eta_t"]),
+            ("total", &r["total_psd"]),
+        ] {
+            let want = floats(key);
+            let got = &ob.term(term).unwrap().psd;
+            let peak = want.iter().cloned().fold(0.0, f64::max);
+            for k in 0..want.len() {
+                assert_close(
+                    &format!("{}.{term} PSD", o.name()),
+                    &format!("{} Hz", freqs[k]),
+                    got[k],
+                    want[k],
+                    PIPELINE_REL,
+                    PEAK_FLOOR * peak,
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn romy_x_tilt_noise_is_the_lever_times_eta_t_below_the_torsion_modes() {
+    // The quasi-static picture on real data: X = -eta_t (Z + Z_b + h_c), so their ASDs are in
+    // the ratio 1.664 m/rad at 1 mHz, up to the f^2 approach (4e-5 relative at 0.5 mHz).
+    let report = romy_budget();
+    let x = report.budget.observable(Observable::X).unwrap();
+    let (tilt, eta) = (
+        &x.term("tilt").unwrap().psd,
+        &x.term("tilt.eta_t").unwrap().psd,
+    );
+    let k = 1; // 0.488 mHz
+    assert_eq!(
+        tilt[k], eta[k],
+        "X sees eta_t only (theta_t drives the other block)"
+    );
+    let reference = json("scripts/reference/romy_budget_reference.json");
+    let s_eta = floats(&reference["csd"]["re"])[(k * 2 + 1) * 2 + 1];
+    let ratio = (tilt[k] / s_eta).sqrt();
+    assert!((ratio - 1.664).abs() < 1e-3, "|X|/|eta_t| = {ratio}");
+}
