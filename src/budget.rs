@@ -137,7 +137,7 @@ fn tilt_tf(
         outputs: outputs.to_vec(),
         inputs: axes.iter().map(|&a| Input::Tilt(a)).collect(),
     };
-    let plan = tf::plan(model, &request, Method::Direct);
+    let plan = tf::plan(model, &request, Method::Direct).expect("direct plans every request");
     tf::evaluate(plan.as_ref(), grid)
 }
 
@@ -297,13 +297,7 @@ fn band_per_observable(
         .iter()
         .zip(per_segment)
         .filter(|(_, segs)| !segs.is_empty())
-        .map(|(&o, segs)| {
-            let as_f64: Vec<Vec<f64>> = segs
-                .iter()
-                .map(|s| s.iter().map(|&p| f64::from(p)).collect())
-                .collect();
-            (o, SegmentBand::new(&as_f64, lo, hi))
-        })
+        .map(|(&o, segs)| (o, SegmentBand::new(segs, lo, hi)))
         .collect()
 }
 

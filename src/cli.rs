@@ -187,7 +187,7 @@ fn run_tf(params: &Params, args: TfArgs) -> Result<()> {
         crate::io::OutputKind::from_path(path)?;
     }
     let method = Method::from(args.method);
-    let plan = tf::plan(&model, &Request::all_tilt(), method);
+    let plan = tf::plan(&model, &Request::all_tilt(), method)?;
     let tf = tf::evaluate(plan.as_ref(), &freqs).context("evaluating the transfer functions")?;
     let modes = NormalModes::new(&model);
     if args.save.is_empty() {

@@ -18,7 +18,7 @@
 //! let modes = NormalModes::new(&model);
 //! assert!((modes.modes[0].frequency_hz - 1.31e-3).abs() < 1e-5);
 //! // Tilt transfer functions: H[o * 3 + t], observable o per radian of tilt t.
-//! let tf = plan(&model, &Request::all_tilt(), Method::Direct);
+//! let tf = plan(&model, &Request::all_tilt(), Method::Direct)?;
 //! let h = tf.eval(1e-5)?; // Hz
 //! let x_per_eta = h[Observable::X.index() * 3 + TiltAxis::EtaT.index()];
 //! // Quasi-static limit X -> -eta_t (Z + Z_b + h_c) = -1.664 m/rad.
@@ -38,6 +38,7 @@ pub mod modes;
 pub mod noise;
 pub mod params;
 pub mod plot;
+pub mod reference;
 pub mod report;
 pub mod spectral;
 pub mod tf;

@@ -80,7 +80,8 @@ pub fn modes_json(modes: &NormalModes) -> String {
 
 /// The quasi-static (f = 0) tilt response next to the paper's stated limits.
 pub fn static_limits(model: &Model) -> String {
-    let plan = tf::plan(model, &Request::all_tilt(), Method::Direct);
+    let plan =
+        tf::plan(model, &Request::all_tilt(), Method::Direct).expect("direct plans every request");
     let h = plan
         .eval(0.0)
         .expect("K is positive definite: f = 0 is never singular");

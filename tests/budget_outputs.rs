@@ -2,9 +2,11 @@
 //! are written, failures leave nothing behind. A realistic Table I budget is rendered too; set
 //! `TILTNOISE_PLOT_PREVIEW=<dir>` to keep its files (budget.png, .svg, .h5, .csv) in `<dir>`.
 
-use hdf5::types::VarLenUnicode;
+mod common;
+
+use common::{listing, str_attr, strs_attr};
 use num_complex::Complex64;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use tiltnoise::error::{OutputError, TfError};
 use tiltnoise::io::{
     budget_csv_string, save_budget, write_budget_hdf5, InputMeta, RunMeta, SCHEMA_BUDGET,
@@ -104,34 +106,6 @@ fn input_meta() -> InputMeta {
         start_time: Some("2024-05-01T00:00:00Z".to_string()),
         notes: vec!["quantity: angle (from the file's units `rad`)".to_string()],
     }
-}
-
-fn listing(dir: &Path) -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    v.sort();
-    v
-}
-
-fn str_attr(loc: &hdf5::Location, name: &str) -> String {
-    loc.attr(name)
-        .unwrap_or_else(|e| panic!("attribute {name}: {e}"))
-        .read_scalar::<VarLenUnicode>()
-        .unwrap()
-        .as_str()
-        .to_string()
-}
-
-fn strs_attr(loc: &hdf5::Location, name: &str) -> Vec<String> {
-    loc.attr(name)
-        .unwrap_or_else(|e| panic!("attribute {name}: {e}"))
-        .read_1d::<VarLenUnicode>()
-        .unwrap()
-        .iter()
-        .map(|s| s.as_str().to_string())
-        .collect()
 }
 
 fn f64_attr(loc: &hdf5::Location, name: &str) -> f64 {
@@ -440,7 +414,7 @@ fn realistic_report() -> BudgetReport {
         outputs: vec![Observable::X, Observable::Phi, Observable::PhiA],
         inputs: axes.iter().map(|&a| Input::Tilt(a)).collect(),
     };
-    let tf = plan(&model, &request, Method::Direct);
+    let tf = plan(&model, &request, Method::Direct).unwrap();
     let n = 1500;
     let freqs: Vec<f64> = (0..n)
         .map(|k| {

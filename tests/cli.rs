@@ -1,34 +1,10 @@
 //! The command line as a user meets it: exit codes, one-line errors naming the problem, no
 //! partial output files, and machine-readable output.
 
+mod common;
+
+use common::{assert_fails, stderr, tiltnoise};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn tiltnoise(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tiltnoise"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-/// Runs a failing command: exit code 2, a single error line that contains every `needle`.
-fn assert_fails(args: &[&str], needles: &[&str]) {
-    let out = tiltnoise(args);
-    let err = stderr(&out);
-    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-    assert_eq!(
-        err.trim_end().lines().count(),
-        1,
-        "{args:?}: not one line: {err}"
-    );
-    for n in needles {
-        assert!(err.contains(n), "{args:?}: `{n}` missing from: {err}");
-    }
-}
 
 fn dir_is_empty(dir: &Path) -> bool {
     std::fs::read_dir(dir).unwrap().next().is_none()

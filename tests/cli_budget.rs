@@ -3,38 +3,8 @@
 
 mod common;
 
+use common::{assert_fails_without_output, tiltnoise};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn tiltnoise(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tiltnoise"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn assert_fails_without_output(args: &[&str], out_dir: &Path, needles: &[&str]) {
-    let before: Vec<_> = std::fs::read_dir(out_dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    let out = tiltnoise(args);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-    assert_eq!(
-        err.trim_end().lines().count(),
-        1,
-        "{args:?}: not one line: {err}"
-    );
-    for n in needles {
-        assert!(err.contains(n), "{args:?}: `{n}` missing from: {err}");
-    }
-    let after: Vec<_> = std::fs::read_dir(out_dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    assert_eq!(before, after, "{args:?} left files behind");
-}
 
 /// Writes an HDF5 tilt series: `channels` as (name, samples), optional sample rate.
 fn write_series(path: &Path, channels: &[(&str, Vec<f64>)], fs: Option<f64>) {

@@ -608,71 +608,84 @@ fn hdf5_series_attribute_and_shape_errors() {
         assert!(matches!(e, InputError::BadAttribute { .. }));
         err_msg(e, &p, &["sample_rate_hz", shown, "finite number > 0"]);
     }
-    let p = dir.path().join("str_rate.h5");
-    write_series_h5(
-        &p,
-        None,
-        &[Ch("theta_t", &a, None)],
-        &[("sample_rate_hz", "10 Hz")],
-    );
-    let e = series_err(&p, &ReadOptions::default());
-    err_msg(e, &p, &["sample_rate_hz", "`10 Hz`"]);
-
-    let p = dir.path().join("lengths.h5");
-    write_series_h5(
-        &p,
-        Some(1.0),
-        &[Ch("theta_t", &a, None), Ch("eta_t", &[1.0, 2.0], None)],
-        &[],
-    );
-    let e = series_err(&p, &ReadOptions::default());
-    assert!(matches!(e, InputError::LengthMismatch { .. }));
-    err_msg(e, &p, &["`theta_t` has 3 samples", "`eta_t` has 2"]);
-
-    let p = dir.path().join("one.h5");
-    write_series_h5(&p, Some(1.0), &[Ch("theta_t", &[1.0], None)], &[]);
-    let e = series_err(&p, &ReadOptions::default());
-    assert!(matches!(e, InputError::TooShort { .. }));
-    err_msg(e, &p, &["/theta_t", "1 samples", "at least 2"]);
-
-    let p = dir.path().join("units.h5");
-    write_series_h5(&p, Some(1.0), &[Ch("theta_t", &a, Some("deg"))], &[]);
-    let e = series_err(&p, &ReadOptions::default());
-    assert!(matches!(e, InputError::Units { .. }));
-    err_msg(e, &p, &["units", "/theta_t", "`deg`", "rad/s"]);
-
-    let p = dir.path().join("mixed.h5");
-    write_series_h5(
-        &p,
-        Some(1.0),
-        &[
-            Ch("theta_t", &a, Some("rad")),
-            Ch("eta_t", &a, Some("rad/s")),
-        ],
-        &[],
-    );
-    let e = series_err(&p, &ReadOptions::default());
-    err_msg(e, &p, &["eta_t", "rad/s", "theta_t"]);
-
-    let p = dir.path().join("start.h5");
-    write_series_h5(
-        &p,
-        Some(1.0),
-        &[Ch("theta_t", &a, None)],
-        &[("start_time", "noon")],
-    );
-    let e = series_err(&p, &ReadOptions::default());
-    err_msg(e, &p, &["start_time", "`noon`", "ISO 8601"]);
-
-    let p = dir.path().join("schema.h5");
-    write_series_h5(
-        &p,
-        Some(1.0),
-        &[Ch("theta_t", &a, None)],
-        &[("schema", "tiltnoise.tf")],
-    );
-    let e = series_err(&p, &ReadOptions::default());
-    err_msg(e, &p, &["schema", "tiltnoise.tf", "tiltnoise.tilt_series"]);
+    /// A series file that `read_tilt_series` refuses: the error `is` the right variant and its
+    /// message names the file and every needle.
+    struct Case<'a> {
+        file: &'a str,
+        fs: Option<f64>,
+        channels: Vec<Ch<'a>>,
+        attrs: &'a [(&'a str, &'a str)],
+        is: fn(&InputError) -> bool,
+        needles: &'a [&'a str],
+    }
+    let cases = [
+        Case {
+            file: "str_rate.h5",
+            fs: None,
+            channels: vec![Ch("theta_t", &a, None)],
+            attrs: &[("sample_rate_hz", "10 Hz")],
+            is: |_| true,
+            needles: &["sample_rate_hz", "`10 Hz`"],
+        },
+        Case {
+            file: "lengths.h5",
+            fs: Some(1.0),
+            channels: vec![Ch("theta_t", &a, None), Ch("eta_t", &[1.0, 2.0], None)],
+            attrs: &[],
+            is: |e| matches!(e, InputError::LengthMismatch { .. }),
+            needles: &["`theta_t` has 3 samples", "`eta_t` has 2"],
+        },
+        Case {
+            file: "one.h5",
+            fs: Some(1.0),
+            channels: vec![Ch("theta_t", &[1.0], None)],
+            attrs: &[],
+            is: |e| matches!(e, InputError::TooShort { .. }),
+            needles: &["/theta_t", "1 samples", "at least 2"],
+        },
+        Case {
+            file: "units.h5",
+            fs: Some(1.0),
+            channels: vec![Ch("theta_t", &a, Some("deg"))],
+            attrs: &[],
+            is: |e| matches!(e, InputError::Units { .. }),
+            needles: &["units", "/theta_t", "`deg`", "rad/s"],
+        },
+        Case {
+            file: "mixed.h5",
+            fs: Some(1.0),
+            channels: vec![
+                Ch("theta_t", &a, Some("rad")),
+                Ch("eta_t", &a, Some("rad/s")),
+            ],
+            attrs: &[],
+            is: |_| true,
+            needles: &["eta_t", "rad/s", "theta_t"],
+        },
+        Case {
+            file: "start.h5",
+            fs: Some(1.0),
+            channels: vec![Ch("theta_t", &a, None)],
+            attrs: &[("start_time", "noon")],
+            is: |_| true,
+            needles: &["start_time", "`noon`", "ISO 8601"],
+        },
+        Case {
+            file: "schema.h5",
+            fs: Some(1.0),
+            channels: vec![Ch("theta_t", &a, None)],
+            attrs: &[("schema", "tiltnoise.tf")],
+            is: |_| true,
+            needles: &["schema", "tiltnoise.tf", "tiltnoise.tilt_series"],
+        },
+    ];
+    for case in cases {
+        let p = dir.path().join(case.file);
+        write_series_h5(&p, case.fs, &case.channels, case.attrs);
+        let e = series_err(&p, &ReadOptions::default());
+        assert!((case.is)(&e), "{}: unexpected error {e:?}", case.file);
+        err_msg(e, &p, case.needles);
+    }
 
     let p = dir.path().join("version.h5");
     write_series_h5(

@@ -1,9 +1,11 @@
 //! Output writers: bit-exact round trips through HDF5 and CSV, the documented layout, and the
 //! atomicity guarantees (nothing left behind on failure, existing files never clobbered).
 
-use hdf5::types::VarLenUnicode;
+mod common;
+
+use common::{listing, str_attr, strs_attr, strs_dataset};
 use num_complex::Complex64;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use tiltnoise::error::OutputError;
 use tiltnoise::io::{
     save_tf, write_atomic, write_tf_csv, write_tf_hdf5, OutputKind, RunMeta, TOOL_VERSION,
@@ -22,7 +24,11 @@ fn freqs() -> Vec<f64> {
 
 fn table_i_tf(freqs: &[f64]) -> TransferMatrix {
     let model = Model::new(&Params::table_i()).unwrap();
-    evaluate(&*plan(&model, &Request::all_tilt(), Method::Direct), freqs).unwrap()
+    evaluate(
+        &*plan(&model, &Request::all_tilt(), Method::Direct).unwrap(),
+        freqs,
+    )
+    .unwrap()
 }
 
 fn meta() -> RunMeta {
@@ -32,45 +38,6 @@ fn meta() -> RunMeta {
         command_line: "tiltnoise tf --out tf.h5 --freq 1e-4:40:10 (ünïcode ok)".to_string(),
         modes: vec![(1, 0.0123), (2, 0.5), (8, 17.25)],
     }
-}
-
-/// Every entry of the directory, sorted.
-fn listing(dir: &Path) -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    v.sort();
-    v
-}
-
-fn str_attr(loc: &hdf5::Location, name: &str) -> String {
-    loc.attr(name)
-        .unwrap()
-        .read_scalar::<VarLenUnicode>()
-        .unwrap()
-        .as_str()
-        .to_string()
-}
-
-fn strs_attr(loc: &hdf5::Location, name: &str) -> Vec<String> {
-    loc.attr(name)
-        .unwrap()
-        .read_1d::<VarLenUnicode>()
-        .unwrap()
-        .iter()
-        .map(|s| s.as_str().to_string())
-        .collect()
-}
-
-fn strs_dataset(file: &hdf5::File, name: &str) -> Vec<String> {
-    file.dataset(name)
-        .unwrap()
-        .read_1d::<VarLenUnicode>()
-        .unwrap()
-        .iter()
-        .map(|s| s.as_str().to_string())
-        .collect()
 }
 
 #[test]

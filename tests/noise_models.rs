@@ -72,7 +72,8 @@ fn check_model(rows: &[(f64, f64)], expected_key: &str) {
             inputs: vec![Input::Tilt(TiltAxis::EtaT)],
         },
         Method::Direct,
-    );
+    )
+    .unwrap();
     for (k, (&f, &level)) in freqs.iter().zip(&expected).enumerate() {
         let h = tf.eval(f).unwrap()[0].norm();
         assert_close(

@@ -18,7 +18,7 @@ fn entry(h: &[Complex64], o: Observable, t: TiltAxis) -> Complex64 {
 }
 
 fn direct(model: &Model) -> Box<dyn TransferFunction> {
-    plan(model, &Request::all_tilt(), Method::Direct)
+    plan(model, &Request::all_tilt(), Method::Direct).unwrap()
 }
 
 /// 1-norm condition number of the symmetrically equilibrated stiffness: the direct method's

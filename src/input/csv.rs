@@ -3,7 +3,9 @@
 //! line, then records with exactly as many comma-separated fields as the header. Blank lines
 //! are skipped; fields are trimmed and may be enclosed in double quotes (no embedded commas).
 
+use super::axis_map::{resolve, MapOrigin, Resolved};
 use super::error::InputError;
+use super::meta::decide_quantity;
 use std::fs::File;
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -227,7 +229,7 @@ pub(crate) fn decimal_resolution(text: &str) -> f64 {
 /// The units declared by the `# units:` line for the mapped columns `mapped` (names), either
 /// one unit for every column (`# units: rad/s`) or per column (`# units: LJN=rad/s, LJE=rad/s`).
 /// Returns the declared units and the mapped columns without one.
-pub(crate) fn declared_units(
+fn declared_units(
     path: &Path,
     prelude: &Prelude,
     mapped: &[String],
@@ -306,7 +308,7 @@ pub(crate) fn declared_units(
 }
 
 /// The `# axes:` map, if any.
-pub(crate) fn axis_map(
+fn axis_map(
     path: &Path,
     prelude: &Prelude,
 ) -> Result<Option<(super::AxisMap, String)>, InputError> {
@@ -321,8 +323,60 @@ pub(crate) fn axis_map(
     )))
 }
 
+/// What a CSV prelude decides for either reader: the channel mapping, the quantity, the start
+/// time and the provenance notes so far.
+pub(crate) struct Interpreted {
+    /// The axis map resolved against the data columns (`prelude.header[1..]`).
+    pub resolved: Resolved,
+    /// From the explicit quantity, else the `# units:` line, else angle.
+    pub quantity: super::Quantity,
+    /// The validated `# start_time:` value.
+    pub start_time: Option<String>,
+    /// Axis-map, quantity and description notes, in that order.
+    pub notes: Vec<String>,
+}
+
+/// Interprets the prelude of a CSV input: resolves the axis map (explicit, else `# axes:`,
+/// else the default) against the data columns, decides the quantity from the `# units:` line,
+/// whose units `classify` recognises (`allowed` lists them for the error), and reads
+/// `# start_time:` and `# description:`.
+pub(crate) fn interpret(
+    path: &Path,
+    prelude: &Prelude,
+    opts: &super::ReadOptions,
+    classify: fn(&str) -> Option<super::Quantity>,
+    allowed: &'static str,
+) -> Result<Interpreted, InputError> {
+    let file_map = axis_map(path, prelude)?;
+    let origin = match (&opts.axis_map, &file_map) {
+        (Some(m), _) => MapOrigin::Options(m),
+        (None, Some((m, from))) => MapOrigin::File(m, from),
+        (None, None) => MapOrigin::Default,
+    };
+    let resolved = resolve(path, &prelude.header[1..], origin, "column")?;
+    let mut notes = resolved.notes.clone();
+    if let (Some(_), Some((m, from))) = (&opts.axis_map, &file_map) {
+        notes.push(format!(
+            "the explicit axis map overrides the file's map {m} ({from})"
+        ));
+    }
+    let mapped: Vec<String> = resolved.channels.iter().map(|m| m.source.clone()).collect();
+    let (declared, undeclared) = declared_units(path, prelude, &mapped, classify, allowed)?;
+    let quantity = decide_quantity(path, opts.quantity, &declared, &undeclared, &mut notes)?;
+    let start_time = start_time(path, prelude)?;
+    if let Some(d) = prelude.meta("description") {
+        notes.push(format!("description: {}", d.value));
+    }
+    Ok(Interpreted {
+        resolved,
+        quantity,
+        start_time,
+        notes,
+    })
+}
+
 /// The `# start_time:` value, validated.
-pub(crate) fn start_time(path: &Path, prelude: &Prelude) -> Result<Option<String>, InputError> {
+fn start_time(path: &Path, prelude: &Prelude) -> Result<Option<String>, InputError> {
     let Some(m) = prelude.meta("start_time") else {
         return Ok(None);
     };

@@ -4,7 +4,7 @@
 //! index, the unit where there is one, and what is allowed. Sample indices are 0-based (the
 //! sample index in the series); CSV line numbers are 1-based (as shown by an editor).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Formats an optional CSV line number as ` (line N)`.
 fn at_line(line: &Option<usize>) -> String {
@@ -450,6 +450,26 @@ pub enum InputError {
         /// Length of the series.
         available: usize,
     },
+}
+
+/// Checks that `what` of `path` has at least the 2 `unit` (`samples` or `frequencies`) every
+/// series or spectrum needs; else [`InputError::TooShort`].
+pub(crate) fn require_two(
+    path: &Path,
+    what: &str,
+    len: usize,
+    unit: &'static str,
+) -> Result<(), InputError> {
+    if len < 2 {
+        return Err(InputError::TooShort {
+            path: path.to_path_buf(),
+            what: what.to_string(),
+            len,
+            unit,
+            min: 2,
+        });
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -1,9 +1,11 @@
 //! HDF5 helpers: opening, layout detection, typed attribute reading with precise errors.
 
+use super::axis_map::{resolve, MapOrigin, Resolved};
 use super::error::InputError;
 use super::meta::{is_iso8601, ISO8601_ALLOWED};
 use super::{
-    InputKind, ACCEPTED_LAYOUTS, INPUT_SCHEMA_VERSION, SCHEMA_TILT_SERIES, SCHEMA_TILT_SPECTRA,
+    AxisMap, InputKind, ReadOptions, ACCEPTED_LAYOUTS, INPUT_SCHEMA_VERSION, SCHEMA_TILT_SERIES,
+    SCHEMA_TILT_SPECTRA,
 };
 use hdf5::types::{FixedAscii, FixedUnicode, TypeDescriptor, VarLenAscii, VarLenUnicode};
 use hdf5::{Attribute, Location, LocationType};
@@ -276,6 +278,32 @@ pub(crate) fn axis_map(
     };
     let origin = format!("{}, root attribute axis_map", path.display());
     super::AxisMap::parse_from(&spec, &origin).map(Some)
+}
+
+/// Resolves the explicit axis map of `opts`, else the root attribute `axis_map` (`file_map`,
+/// see [`axis_map`]), else the default, against the channels `available` of `path` (`kind`:
+/// `dataset` or `axis name`), and appends the provenance notes to `notes`.
+pub(crate) fn resolve_axes(
+    path: &Path,
+    available: &[String],
+    kind: &'static str,
+    opts: &ReadOptions,
+    file_map: Option<&AxisMap>,
+    notes: &mut Vec<String>,
+) -> Result<Resolved, InputError> {
+    let origin = match (&opts.axis_map, file_map) {
+        (Some(m), _) => MapOrigin::Options(m),
+        (None, Some(m)) => MapOrigin::File(m, "root attribute axis_map of the file"),
+        (None, None) => MapOrigin::Default,
+    };
+    let resolved = resolve(path, available, origin, kind)?;
+    notes.extend(resolved.notes.iter().cloned());
+    if let (Some(_), Some(m)) = (&opts.axis_map, file_map) {
+        notes.push(format!(
+            "the explicit axis map overrides the file's axis_map attribute {m}"
+        ));
+    }
+    Ok(resolved)
 }
 
 /// Whether a dataset holds a floating-point type.

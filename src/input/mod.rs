@@ -116,6 +116,22 @@ impl Quantity {
             Quantity::Rate => "rad/s",
         }
     }
+
+    /// Unit of an amplitude spectral density value: `rad/sqrt(Hz)` or `rad/s/sqrt(Hz)`.
+    pub(crate) fn asd_unit(self) -> &'static str {
+        match self {
+            Quantity::Angle => "rad/sqrt(Hz)",
+            Quantity::Rate => "rad/s/sqrt(Hz)",
+        }
+    }
+
+    /// Unit of a cross-spectral density value: `rad^2/Hz` or `rad^2/s^2/Hz`.
+    pub(crate) fn csd_unit(self) -> &'static str {
+        match self {
+            Quantity::Angle => "rad^2/Hz",
+            Quantity::Rate => "rad^2/s^2/Hz",
+        }
+    }
 }
 
 impl fmt::Display for Quantity {

@@ -1,9 +1,8 @@
 //! Tilt time series from CSV: header `time_s,CH1,CH2,...`, optional `#` metadata lines.
 
-use super::axis_map::{resolve, MapOrigin};
 use super::csv::{self, decimal_resolution, parse_field, CsvFile, Prelude};
-use super::error::InputError;
-use super::meta::{decide_quantity, series_quantity, SERIES_UNITS};
+use super::error::{require_two, InputError};
+use super::meta::{series_quantity, SERIES_UNITS};
 use super::series::{gap_note, process_channel, ChannelCtx, TiltSeries};
 use super::{GapPolicy, InputFormat, InputKind, Provenance, ReadOptions};
 
@@ -15,28 +14,12 @@ pub(crate) fn read(
     opts: &ReadOptions,
 ) -> Result<TiltSeries, InputError> {
     let path = file.path.clone();
-    let columns: Vec<String> = prelude.header[1..].to_vec();
-    let file_map = csv::axis_map(&path, &prelude)?;
-    let origin = match (&opts.axis_map, &file_map) {
-        (Some(m), _) => MapOrigin::Options(m),
-        (None, Some((m, from))) => MapOrigin::File(m, from),
-        (None, None) => MapOrigin::Default,
-    };
-    let resolved = resolve(&path, &columns, origin, "column")?;
-    let mut notes = resolved.notes.clone();
-    if let (Some(_), Some((m, from))) = (&opts.axis_map, &file_map) {
-        notes.push(format!(
-            "the explicit axis map overrides the file's map {m} ({from})"
-        ));
-    }
-    let mapped: Vec<String> = resolved.channels.iter().map(|m| m.source.clone()).collect();
-    let (declared, undeclared) =
-        csv::declared_units(&path, &prelude, &mapped, series_quantity, SERIES_UNITS)?;
-    let quantity = decide_quantity(&path, opts.quantity, &declared, &undeclared, &mut notes)?;
-    let start_time = csv::start_time(&path, &prelude)?;
-    if let Some(d) = prelude.meta("description") {
-        notes.push(format!("description: {}", d.value));
-    }
+    let csv::Interpreted {
+        resolved,
+        quantity,
+        start_time,
+        mut notes,
+    } = csv::interpret(&path, &prelude, opts, series_quantity, SERIES_UNITS)?;
 
     let unit = quantity.unit();
     let mut times: Vec<f64> = Vec::new();
@@ -103,16 +86,7 @@ pub(crate) fn read(
         Ok(())
     })?;
 
-    let n = times.len();
-    if n < 2 {
-        return Err(InputError::TooShort {
-            path: path.clone(),
-            what: "column time_s".to_string(),
-            len: n,
-            unit: "samples",
-            min: 2,
-        });
-    }
+    require_two(&path, "column time_s", times.len(), "samples")?;
     let dt = check_uniform(&path, &times, &resolution, &lines)?;
     let sample_rate_hz = 1.0 / dt;
     notes.push(format!(

@@ -1,8 +1,8 @@
 //! [`TiltSeriesSource`]: streaming access to an HDF5 tilt time series (schema
 //! `tiltnoise.tilt_series`), chunk by chunk, in bounded memory.
 
-use super::axis_map::{resolve, MapOrigin, Mapped};
-use super::error::InputError;
+use super::axis_map::Mapped;
+use super::error::{require_two, InputError};
 use super::h5::{self, h5err, AttrValue};
 use super::meta::{decide_quantity, series_quantity, Declared, SERIES_UNITS};
 use super::series::{gap_note, ChannelCtx, Gap, GapScanner, Integrator, TiltSeries};
@@ -107,19 +107,15 @@ impl TiltSeriesSource {
         let mut notes = Vec::new();
         let start_time = h5::start_and_description(path, &file, &mut notes)?;
         let file_map = h5::axis_map(path, &file)?;
-        let origin = match (&opts.axis_map, &file_map) {
-            (Some(m), _) => MapOrigin::Options(m),
-            (None, Some(m)) => MapOrigin::File(m, "root attribute axis_map of the file"),
-            (None, None) => MapOrigin::Default,
-        };
         let available = h5::root_datasets(path, &file)?;
-        let resolved = resolve(path, &available, origin, "dataset")?;
-        notes.extend(resolved.notes.iter().cloned());
-        if let (Some(_), Some(m)) = (&opts.axis_map, &file_map) {
-            notes.push(format!(
-                "the explicit axis map overrides the file's axis_map attribute {m}"
-            ));
-        }
+        let resolved = h5::resolve_axes(
+            path,
+            &available,
+            "dataset",
+            opts,
+            file_map.as_ref(),
+            &mut notes,
+        )?;
 
         let mut datasets = Vec::new();
         let mut declared = Vec::new();
@@ -185,15 +181,7 @@ impl TiltSeriesSource {
         }
         let quantity = decide_quantity(path, opts.quantity, &declared, &undeclared, &mut notes)?;
         let (first_name, len) = first_len.unwrap_or_default();
-        if len < 2 {
-            return Err(InputError::TooShort {
-                path: path.to_path_buf(),
-                what: format!("dataset /{first_name}"),
-                len,
-                unit: "samples",
-                min: 2,
-            });
-        }
+        require_two(path, &format!("dataset /{first_name}"), len, "samples")?;
         notes.push(format!(
             "sample rate {sample_rate_hz} Hz from root attribute sample_rate_hz"
         ));

@@ -1,12 +1,11 @@
 //! Tilt spectra from CSV: header `freq_hz,theta_t,eta_t[,phi_t]`, one-sided ASD per axis in
 //! rad/sqrt(Hz), axes uncorrelated.
 
-use super::axis_map::{resolve, MapOrigin};
 use super::csv::{self, parse_field, CsvFile, Prelude};
-use super::error::InputError;
-use super::meta::{asd_quantity, decide_quantity, ASD_UNITS};
+use super::error::{require_two, InputError};
+use super::meta::{asd_quantity, ASD_UNITS};
 use super::spectra::{assemble, TiltSpectra};
-use super::{InputFormat, InputKind, Provenance, Quantity, ReadOptions};
+use super::{InputFormat, InputKind, Provenance, ReadOptions};
 use num_complex::Complex64;
 
 /// Reads the records of a CSV spectrum whose prelude has been read (`prelude.header[0]` is
@@ -17,37 +16,18 @@ pub(crate) fn read(
     opts: &ReadOptions,
 ) -> Result<TiltSpectra, InputError> {
     let path = file.path.clone();
-    let columns: Vec<String> = prelude.header[1..].to_vec();
-    let file_map = csv::axis_map(&path, &prelude)?;
-    let origin = match (&opts.axis_map, &file_map) {
-        (Some(m), _) => MapOrigin::Options(m),
-        (None, Some((m, from))) => MapOrigin::File(m, from),
-        (None, None) => MapOrigin::Default,
-    };
-    let resolved = resolve(&path, &columns, origin, "column")?;
-    let mut notes = resolved.notes.clone();
-    if let (Some(_), Some((m, from))) = (&opts.axis_map, &file_map) {
-        notes.push(format!(
-            "the explicit axis map overrides the file's map {m} ({from})"
-        ));
-    }
-    let mapped: Vec<String> = resolved.channels.iter().map(|m| m.source.clone()).collect();
-    let (declared, undeclared) =
-        csv::declared_units(&path, &prelude, &mapped, asd_quantity, ASD_UNITS)?;
-    let quantity = decide_quantity(&path, opts.quantity, &declared, &undeclared, &mut notes)?;
-    let start_time = csv::start_time(&path, &prelude)?;
-    if let Some(d) = prelude.meta("description") {
-        notes.push(format!("description: {}", d.value));
-    }
+    let csv::Interpreted {
+        resolved,
+        quantity,
+        start_time,
+        mut notes,
+    } = csv::interpret(&path, &prelude, opts, asd_quantity, ASD_UNITS)?;
     notes.push("CSV spectra: axes taken as uncorrelated (off-diagonal CSD = 0)".to_string());
-    let unit = match quantity {
-        Quantity::Angle => "rad/sqrt(Hz)",
-        Quantity::Rate => "rad/s/sqrt(Hz)",
-    };
+    let unit = quantity.asd_unit();
 
     let mut freqs: Vec<f64> = Vec::new();
     // asd[source column index][k]
-    let mut asd: Vec<Vec<f64>> = vec![Vec::new(); columns.len()];
+    let mut asd: Vec<Vec<f64>> = vec![Vec::new(); prelude.header.len() - 1];
     file.for_each_record(prelude.header.len(), |line, fields| {
         let row = freqs.len();
         let location = || format!("line {line} (row {row}), column freq_hz");
@@ -111,15 +91,7 @@ pub(crate) fn read(
         }
         Ok(())
     })?;
-    if freqs.len() < 2 {
-        return Err(InputError::TooShort {
-            path: path.clone(),
-            what: "column freq_hz".to_string(),
-            len: freqs.len(),
-            unit: "frequencies",
-            min: 2,
-        });
-    }
+    require_two(&path, "column freq_hz", freqs.len(), "frequencies")?;
     let csd = assemble(&freqs, &resolved.channels, quantity, |k, a, b| {
         if a == b {
             Complex64::new(asd[a][k] * asd[a][k], 0.0)

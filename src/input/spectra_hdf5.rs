@@ -1,8 +1,7 @@
 //! Tilt spectra from HDF5 (schema `tiltnoise.tilt_spectra`): `/frequency_hz` and either `/asd`
 //! `[n, n_axes]` or `/csd` `[n, n_axes, n_axes]` (complex), root attribute `axes`.
 
-use super::axis_map::{resolve, MapOrigin};
-use super::error::InputError;
+use super::error::{require_two, InputError};
 use super::h5::{self, h5err, AttrValue};
 use super::meta::{asd_quantity, csd_quantity, decide_quantity, Declared, ASD_UNITS, CSD_UNITS};
 use super::spectra::{assemble, TiltSpectra, CSD_RTOL};
@@ -64,16 +63,7 @@ pub(crate) fn read(
             )));
         }
     }
-    let nf = freqs.len();
-    if nf < 2 {
-        return Err(InputError::TooShort {
-            path: path.to_path_buf(),
-            what: "dataset /frequency_hz".to_string(),
-            len: nf,
-            unit: "frequencies",
-            min: 2,
-        });
-    }
+    require_two(path, "dataset /frequency_hz", freqs.len(), "frequencies")?;
 
     match (has("asd"), has("csd")) {
         (true, true) => {
@@ -141,18 +131,14 @@ pub(crate) fn read(
     };
 
     let file_map = h5::axis_map(path, file)?;
-    let origin = match (&opts.axis_map, &file_map) {
-        (Some(map), _) => MapOrigin::Options(map),
-        (None, Some(map)) => MapOrigin::File(map, "root attribute axis_map of the file"),
-        (None, None) => MapOrigin::Default,
-    };
-    let resolved = resolve(path, &names, origin, "axis name")?;
-    notes.extend(resolved.notes.iter().cloned());
-    if let (Some(_), Some(map)) = (&opts.axis_map, &file_map) {
-        notes.push(format!(
-            "the explicit axis map overrides the file's axis_map attribute {map}"
-        ));
-    }
+    let resolved = h5::resolve_axes(
+        path,
+        &names,
+        "axis name",
+        opts,
+        file_map.as_ref(),
+        &mut notes,
+    )?;
     let mapped: Vec<String> = resolved.channels.iter().map(|c| c.source.clone()).collect();
     let (declared, undeclared) = match declared {
         Some(d) => (
@@ -218,6 +204,61 @@ fn units(
     }
 }
 
+/// What the spectral dataset `/asd` or `/csd` holds.
+struct ValuesKind {
+    /// Dataset name without the leading `/`.
+    name: &'static str,
+    /// Checks the element type; returns whether it fits and the type's description.
+    is_type: fn(&hdf5::Dataset) -> hdf5::Result<(bool, String)>,
+    /// Recognises the units of its `units` attribute.
+    classify: fn(&str) -> Option<Quantity>,
+    /// The accepted units, for messages.
+    units_allowed: &'static str,
+}
+
+const ASD: ValuesKind = ValuesKind {
+    name: "asd",
+    is_type: h5::is_float,
+    classify: asd_quantity,
+    units_allowed: ASD_UNITS,
+};
+
+const CSD: ValuesKind = ValuesKind {
+    name: "csd",
+    is_type: h5::is_complex,
+    classify: csd_quantity,
+    units_allowed: CSD_UNITS,
+};
+
+/// Opens the dataset of `kind`, checks its element type and its shape against `shape`
+/// (`allowed` describes both for the error), and reads its `units` attribute.
+fn open_values(
+    path: &Path,
+    file: &hdf5::File,
+    kind: &ValuesKind,
+    shape: &[usize],
+    allowed: String,
+) -> Result<(hdf5::Dataset, Option<Declared>), InputError> {
+    let object = format!("dataset /{}", kind.name);
+    let ds = file.dataset(kind.name).map_err(h5err(path, &object))?;
+    let (right_type, dtype) = (kind.is_type)(&ds).map_err(h5err(path, &object))?;
+    if ds.shape() != shape || !right_type {
+        return Err(InputError::BadDataset {
+            path: path.to_path_buf(),
+            dataset: format!("/{}", kind.name),
+            found: format!("type {dtype} and shape {:?}", ds.shape()),
+            allowed,
+        });
+    }
+    let declared = units(path, &ds, kind.name, kind.classify, kind.units_allowed)?;
+    Ok((ds, declared))
+}
+
+/// The quantity the `units` attribute declares; angle without one.
+fn declared_quantity(declared: &Option<Declared>) -> Quantity {
+    declared.as_ref().map_or(Quantity::Angle, |d| d.quantity)
+}
+
 fn read_asd(
     path: &Path,
     file: &hdf5::File,
@@ -225,23 +266,14 @@ fn read_asd(
     names: &[String],
 ) -> Result<Values, InputError> {
     let (nf, m) = (freqs.len(), names.len());
-    let ds = file.dataset("asd").map_err(h5err(path, "dataset /asd"))?;
-    let (float, dtype) = h5::is_float(&ds).map_err(h5err(path, "dataset /asd"))?;
-    if ds.shape() != [nf, m] || !float {
-        return Err(InputError::BadDataset {
-            path: path.to_path_buf(),
-            dataset: "/asd".to_string(),
-            found: format!("type {dtype} and shape {:?}", ds.shape()),
-            allowed: format!(
-                "float64 of shape [{nf}, {m}] ([len(/frequency_hz), len(axes)]), rad/sqrt(Hz)"
-            ),
-        });
-    }
-    let declared = units(path, &ds, "asd", asd_quantity, ASD_UNITS)?;
-    let unit = match declared.as_ref().map(|d| d.quantity) {
-        Some(Quantity::Rate) => "rad/s/sqrt(Hz)",
-        _ => "rad/sqrt(Hz)",
-    };
+    let (ds, declared) = open_values(
+        path,
+        file,
+        &ASD,
+        &[nf, m],
+        format!("float64 of shape [{nf}, {m}] ([len(/frequency_hz), len(axes)]), rad/sqrt(Hz)"),
+    )?;
+    let unit = declared_quantity(&declared).asd_unit();
     let asd = ds.read_raw::<f64>().map_err(h5err(path, "dataset /asd"))?;
     let mut src = vec![Complex64::new(0.0, 0.0); nf * m * m];
     for k in 0..nf {
@@ -269,24 +301,17 @@ fn read_csd(
     names: &[String],
 ) -> Result<Values, InputError> {
     let (nf, m) = (freqs.len(), names.len());
-    let ds = file.dataset("csd").map_err(h5err(path, "dataset /csd"))?;
-    let (complex, dtype) = h5::is_complex(&ds).map_err(h5err(path, "dataset /csd"))?;
-    if ds.shape() != [nf, m, m] || !complex {
-        return Err(InputError::BadDataset {
-            path: path.to_path_buf(),
-            dataset: "/csd".to_string(),
-            found: format!("type {dtype} and shape {:?}", ds.shape()),
-            allowed: format!(
-                "complex128 (compound {{r: float64, i: float64}}, as h5py writes) of shape \
-                 [{nf}, {m}, {m}] ([len(/frequency_hz), len(axes), len(axes)]), rad^2/Hz"
-            ),
-        });
-    }
-    let declared = units(path, &ds, "csd", csd_quantity, CSD_UNITS)?;
-    let unit = match declared.as_ref().map(|d| d.quantity) {
-        Some(Quantity::Rate) => "rad^2/s^2/Hz",
-        _ => "rad^2/Hz",
-    };
+    let (ds, declared) = open_values(
+        path,
+        file,
+        &CSD,
+        &[nf, m, m],
+        format!(
+            "complex128 (compound {{r: float64, i: float64}}, as h5py writes) of shape \
+             [{nf}, {m}, {m}] ([len(/frequency_hz), len(axes), len(axes)]), rad^2/Hz"
+        ),
+    )?;
+    let unit = declared_quantity(&declared).csd_unit();
     let mut src = ds
         .read_raw::<Complex64>()
         .map_err(h5err(path, "dataset /csd"))?;

@@ -118,17 +118,22 @@ fn propagate(
     cols: &[usize],
     k: usize,
     o: usize,
-) -> (f64, Vec<f64>) {
+) -> (f64, [f64; 3]) {
     let n = tilt.axes.len();
     let s = &tilt.csd[k * n * n..(k + 1) * n * n];
-    let h: Vec<Complex64> = cols.iter().map(|&c| tf.get(k, o, c)).collect();
+    // At most the three tilt axes: fixed arrays, no allocation per bin.
+    let mut h = [Complex64::new(0.0, 0.0); 3];
+    for (hi, &c) in h.iter_mut().zip(cols) {
+        *hi = tf.get(k, o, c);
+    }
     let mut total = 0.0;
+    let mut per_axis = [0.0; 3];
     for i in 0..n {
         for j in 0..n {
             total += (h[i].conj() * s[i * n + j] * h[j]).re;
         }
+        per_axis[i] = h[i].norm_sqr() * s[i * n + i].re;
     }
-    let per_axis = (0..n).map(|i| h[i].norm_sqr() * s[i * n + i].re).collect();
     // A positive semi-definite S gives total >= 0; rounding can leave -eps * scale.
     (total.max(0.0), per_axis)
 }
@@ -160,8 +165,8 @@ pub fn tilt_budget(tf: &TransferMatrix, tilt: &TiltCsd, readout: &Readout) -> Bu
             for k in 0..n_f {
                 let (t, per) = propagate(tf, tilt, &cols, k, o);
                 tilt_psd[k] = t;
-                for (i, p) in per.into_iter().enumerate() {
-                    axis_psd[i][k] = p;
+                for (axis, p) in axis_psd.iter_mut().zip(per) {
+                    axis[k] = p;
                 }
             }
             let mut terms = vec![NoiseTerm {

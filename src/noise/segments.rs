@@ -23,6 +23,11 @@ pub struct SegmentBand {
 pub fn percentile(values: &mut [f64], p: f64) -> f64 {
     assert!(!values.is_empty(), "percentile of no values");
     values.sort_by(f64::total_cmp);
+    percentile_of_sorted(values, p)
+}
+
+/// [`percentile`] of values already sorted by `f64::total_cmp`.
+fn percentile_of_sorted(values: &[f64], p: f64) -> f64 {
     let pos = (p / 100.0).clamp(0.0, 1.0) * (values.len() - 1) as f64;
     let (lo, frac) = (pos.floor() as usize, pos - pos.floor());
     if lo + 1 < values.len() {
@@ -33,19 +38,28 @@ pub fn percentile(values: &mut [f64], p: f64) -> f64 {
 }
 
 impl SegmentBand {
-    /// Band of `per_segment[s][k]` (segment `s`, frequency `k`) at the given percentiles.
-    pub fn new(per_segment: &[Vec<f64>], lower_pct: f64, upper_pct: f64) -> SegmentBand {
+    /// Band of `per_segment[s][k]` (segment `s`, frequency `k`) at the given percentiles. The
+    /// values may be stored as `f32` (converted exactly to `f64`); each frequency's column is
+    /// copied and sorted once for all three statistics.
+    pub fn new<T: Copy + Into<f64>>(
+        per_segment: &[Vec<T>],
+        lower_pct: f64,
+        upper_pct: f64,
+    ) -> SegmentBand {
         let n_f = per_segment.first().map_or(0, Vec::len);
         let mut column = vec![0.0; per_segment.len()];
-        let mut stat = |k: usize, p: f64| {
+        let mut median = Vec::with_capacity(n_f);
+        let mut lower = Vec::with_capacity(n_f);
+        let mut upper = Vec::with_capacity(n_f);
+        for k in 0..n_f {
             for (c, seg) in column.iter_mut().zip(per_segment) {
-                *c = seg[k];
+                *c = seg[k].into();
             }
-            percentile(&mut column, p)
-        };
-        let median = (0..n_f).map(|k| stat(k, 50.0)).collect();
-        let lower = (0..n_f).map(|k| stat(k, lower_pct)).collect();
-        let upper = (0..n_f).map(|k| stat(k, upper_pct)).collect();
+            column.sort_by(f64::total_cmp);
+            median.push(percentile_of_sorted(&column, 50.0));
+            lower.push(percentile_of_sorted(&column, lower_pct));
+            upper.push(percentile_of_sorted(&column, upper_pct));
+        }
         SegmentBand {
             lower_pct,
             upper_pct,

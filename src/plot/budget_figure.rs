@@ -3,8 +3,8 @@
 //! thick and black, the spread of the tilt noise across segments as a shaded band.
 
 use super::chart::{Band, Dash, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
+use super::labels::{observable_symbol, observable_title, tilt_symbol};
 use super::save_figure;
-use super::tf_figure::observable_symbol;
 use crate::error::OutputError;
 use crate::io::InputMeta;
 use crate::model::{Observable, TiltAxis};
@@ -93,13 +93,13 @@ fn term_style(name: &str, readout: Option<(f64, Observable)>) -> Option<(String,
         _ => {
             let axis = name.strip_prefix("tilt.")?;
             let axis = TiltAxis::ALL.into_iter().find(|a| a.name() == axis)?;
-            let (symbol, color) = match axis {
-                TiltAxis::ThetaT => ("θₜ", PALETTE[5]),
-                TiltAxis::EtaT => ("ηₜ", PALETTE[1]),
-                TiltAxis::PhiT => ("φₜ", PALETTE[2]),
+            let color = match axis {
+                TiltAxis::ThetaT => PALETTE[5],
+                TiltAxis::EtaT => PALETTE[1],
+                TiltAxis::PhiT => PALETTE[2],
             };
             (
-                format!("tilt, {symbol} alone"),
+                format!("tilt, {} alone", tilt_symbol(axis)),
                 style(color, Dash::Dashed, 2),
             )
         }
@@ -306,27 +306,6 @@ pub fn si_asd(value: f64, unit: &str) -> String {
             format!("{} {prefix}{unit}/√Hz", compact(scaled))
         }
         None => format!("{} {unit}/√Hz", compact(value)),
-    }
-}
-
-fn observable_title(o: Observable) -> String {
-    let what = match o {
-        Observable::X => "test-mass displacement along x",
-        Observable::Y => "test-mass displacement along y",
-        Observable::Z => "test-mass displacement along z",
-        Observable::Theta => "test-mass rotation about x",
-        Observable::Eta => "test-mass rotation about y",
-        Observable::Phi => "test-mass torsion",
-        Observable::PhiA => "crossbar torsion",
-    };
-    format!("{}: {what}", observable_symbol(o))
-}
-
-fn tilt_symbol(a: TiltAxis) -> &'static str {
-    match a {
-        TiltAxis::ThetaT => "θₜ",
-        TiltAxis::EtaT => "ηₜ",
-        TiltAxis::PhiT => "φₜ",
     }
 }
 

@@ -22,6 +22,7 @@
 
 pub mod budget_figure;
 pub mod chart;
+mod labels;
 mod text;
 pub mod tf_figure;
 

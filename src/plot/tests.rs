@@ -12,7 +12,7 @@ use crate::tf::{evaluate, plan, Method, Request, TransferMatrix};
 /// undamped resonance exactly is nudged by 1e-9 relative.
 fn table_i_matrix(n: usize, lo: f64, hi: f64) -> TransferMatrix {
     let model = Model::new(&Params::table_i()).unwrap();
-    let tf = plan(&model, &Request::all_tilt(), Method::Direct);
+    let tf = plan(&model, &Request::all_tilt(), Method::Direct).unwrap();
     let mut freqs = Vec::with_capacity(n);
     for k in 0..n {
         let mut f = lo * (hi / lo).powf(k as f64 / (n - 1) as f64);

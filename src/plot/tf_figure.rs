@@ -2,6 +2,9 @@
 //! (θₜ solid, ηₜ dashed, φₜ dotted) to the soft-DoF observables X, φ and φₐ.
 
 use super::chart::{Dash, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
+// Re-exported: `plot::tf_figure::observable_symbol` is a public path.
+pub use super::labels::observable_symbol;
+use super::labels::{observable_title, tilt_symbol};
 use super::save_figure;
 use crate::error::OutputError;
 use crate::model::{Observable, TiltAxis};
@@ -51,39 +54,14 @@ pub fn tf_figure_with(
     save_figure(path, &figure)
 }
 
-/// Display name of an observable (Greek letters, Unicode subscripts).
-pub fn observable_symbol(o: Observable) -> &'static str {
-    match o {
-        Observable::X => "X",
-        Observable::Y => "Y",
-        Observable::Z => "Z",
-        Observable::Theta => "θ",
-        Observable::Eta => "η",
-        Observable::Phi => "φ",
-        Observable::PhiA => "φₐ",
-    }
-}
-
-fn observable_title(o: Observable) -> String {
-    let what = match o {
-        Observable::X => "test-mass displacement along x",
-        Observable::Y => "test-mass displacement along y",
-        Observable::Z => "test-mass displacement along z",
-        Observable::Theta => "test-mass rotation about x",
-        Observable::Eta => "test-mass rotation about y",
-        Observable::Phi => "test-mass torsion",
-        Observable::PhiA => "crossbar torsion",
-    };
-    format!("{}: {what}", observable_symbol(o))
-}
-
 /// Display name and line style of a tilt axis: θₜ solid, ηₜ dashed, φₜ dotted (as in the paper).
 pub fn tilt_symbol_style(t: TiltAxis) -> (&'static str, TraceStyle) {
-    match t {
-        TiltAxis::ThetaT => ("θₜ", TraceStyle::new(PALETTE[0], Dash::Solid, 2)),
-        TiltAxis::EtaT => ("ηₜ", TraceStyle::new(PALETTE[1], Dash::Dashed, 2)),
-        TiltAxis::PhiT => ("φₜ", TraceStyle::new(PALETTE[2], Dash::Dotted, 3)),
-    }
+    let style = match t {
+        TiltAxis::ThetaT => TraceStyle::new(PALETTE[0], Dash::Solid, 2),
+        TiltAxis::EtaT => TraceStyle::new(PALETTE[1], Dash::Dashed, 2),
+        TiltAxis::PhiT => TraceStyle::new(PALETTE[2], Dash::Dotted, 3),
+    };
+    (tilt_symbol(t), style)
 }
 
 /// The figure as data, ready for [`save_figure`]; errors are plain messages.
@@ -203,7 +181,7 @@ mod tests {
 
     fn matrix() -> TransferMatrix {
         let model = Model::new(&Params::table_i()).unwrap();
-        let tf = plan(&model, &Request::all_tilt(), Method::Direct);
+        let tf = plan(&model, &Request::all_tilt(), Method::Direct).unwrap();
         let freqs: Vec<f64> = (0..4).map(|k| 10f64.powi(k - 3)).collect();
         evaluate(&*tf, &freqs).unwrap()
     }

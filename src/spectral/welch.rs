@@ -211,21 +211,12 @@ impl WelchAccumulator {
         let n = chunk[0].len();
         check_equal_lengths(chunk)?;
         let len = self.cfg.segment_len;
-        let mut pos = 0;
-        while pos < n {
-            let take = (len - self.filled).min(n - pos);
+        self.feed(n, |segment, at, pos, take| {
             for (c, ch) in chunk.iter().enumerate() {
-                let dst = c * len + self.filled;
-                self.segment[dst..dst + take].copy_from_slice(&ch[pos..pos + take]);
+                let dst = c * len + at;
+                segment[dst..dst + take].copy_from_slice(&ch[pos..pos + take]);
             }
-            self.filled += take;
-            pos += take;
-            if self.filled == len {
-                self.process_segment()?;
-            }
-        }
-        self.n_samples += n;
-        Ok(())
+        })
     }
 
     /// Appends frame-major samples: `frames[t * n_channels + c]` is sample `t` of channel `c`
@@ -241,15 +232,29 @@ impl WelchAccumulator {
         }
         let n = frames.len() / nc;
         let len = self.cfg.segment_len;
-        let mut pos = 0;
-        while pos < n {
-            let take = (len - self.filled).min(n - pos);
+        self.feed(n, |segment, at, pos, take| {
             for t in 0..take {
                 let frame = &frames[(pos + t) * nc..(pos + t + 1) * nc];
                 for (c, &v) in frame.iter().enumerate() {
-                    self.segment[c * len + self.filled + t] = v;
+                    segment[c * len + at + t] = v;
                 }
             }
+        })
+    }
+
+    /// Takes the next `n` samples of every channel into the segment buffer, processing each
+    /// segment as it fills. `copy(segment, at, pos, take)` copies samples `pos .. pos + take`
+    /// of every channel `c` to `segment[c * segment_len + at ..][..take]`.
+    fn feed(
+        &mut self,
+        n: usize,
+        mut copy: impl FnMut(&mut [f64], usize, usize, usize),
+    ) -> Result<(), SpectralError> {
+        let len = self.cfg.segment_len;
+        let mut pos = 0;
+        while pos < n {
+            let take = (len - self.filled).min(n - pos);
+            copy(&mut self.segment, self.filled, pos, take);
             self.filled += take;
             pos += take;
             if self.filled == len {

@@ -6,6 +6,8 @@
 //! resonance rather than the choice of units. After the solve the reciprocal 1-norm condition
 //! number of `D_s` is computed from its explicit inverse (cheap for 8x8); below
 //! [`SINGULAR_RCOND`] fewer than three digits are guaranteed and the result is reported as singular.
+//! [`EquilibratedLu`] is that factorization for any small dimension; the block-reduced, split and
+//! 2-DoF methods use it on their 4x4 and 2x2 systems.
 //!
 //! Exact zeros are preserved: the model is block diagonal (see [`crate::model::Block`]), and
 //! Gaussian elimination never fills in across blocks (multipliers are exactly 0), so entries such
@@ -15,14 +17,91 @@ use super::{Input, Method, Request, TransferFunction};
 use crate::error::{FreqError, TfError};
 use crate::model::{CMat8, Mat8, Model};
 use crate::units::angular;
-use nalgebra::{DMatrix, SMatrix};
+use nalgebra::{Const, DMatrix, DimMin, SMatrix, SVector};
 use num_complex::Complex64;
 
 /// Below this reciprocal condition number of the equilibrated dynamic stiffness the LU's
 /// forward error bound `n eps cond` (n = 8 unknowns) exceeds 1e-3, so fewer than three digits
 /// of the result would be guaranteed: the frequency is on an undamped resonance to working
 /// precision (relative detuning of order 1e-12 or less) and the result is reported as singular.
+/// The same threshold is used for the smaller systems of the other methods, where it is
+/// slightly conservative (their bound `n eps cond` has n = 4 or 2).
 pub const SINGULAR_RCOND: f64 = 1e3 * 8.0 * f64::EPSILON;
+
+/// Checks that `freq_hz` can be evaluated and returns `w^2` (rad^2/s^2).
+pub(super) fn omega_sq(freq_hz: f64) -> Result<f64, TfError> {
+    if !(freq_hz.is_finite() && freq_hz >= 0.0) {
+        return Err(FreqError::Invalid {
+            value: freq_hz,
+            origin: "transfer-function evaluation".into(),
+        }
+        .into());
+    }
+    Ok(angular(freq_hz).powi(2))
+}
+
+/// LU factorization of the symmetrically equilibrated dynamic stiffness `K_c - w^2 M` (N x N),
+/// with the singularity check of the module docs. Solves take and return unscaled vectors.
+pub(super) struct EquilibratedLu<const N: usize>
+where
+    Const<N>: DimMin<Const<N>, Output = Const<N>>,
+{
+    lu: nalgebra::LU<Complex64, Const<N>, Const<N>>,
+    scale: [f64; N],
+    freq_hz: f64,
+}
+
+impl<const N: usize> EquilibratedLu<N>
+where
+    Const<N>: DimMin<Const<N>, Output = Const<N>>,
+{
+    /// Factors `stiffness - w2 mass`; fails with [`TfError::Singular`] when the equilibrated
+    /// matrix has a reciprocal condition number below [`SINGULAR_RCOND`] (or NaN).
+    pub(super) fn factor(
+        stiffness: &SMatrix<Complex64, N, N>,
+        mass: &SMatrix<f64, N, N>,
+        w2: f64,
+        freq_hz: f64,
+    ) -> Result<Self, TfError> {
+        let scale: [f64; N] =
+            std::array::from_fn(|i| 1.0 / (stiffness[(i, i)].norm() + w2 * mass[(i, i)]).sqrt());
+        let d_s = SMatrix::<Complex64, N, N>::from_fn(|r, c| {
+            (stiffness[(r, c)] - Complex64::from(w2 * mass[(r, c)])) * (scale[r] * scale[c])
+        });
+        let singular = |rcond: f64| TfError::Singular { freq_hz, rcond };
+        let lu = d_s.lu();
+        let inverse = lu.try_inverse().ok_or_else(|| singular(0.0))?;
+        let rcond = 1.0 / (one_norm(&d_s) * one_norm(&inverse));
+        // A NaN rcond (non-finite entries) is singular too.
+        if rcond.is_nan() || rcond < SINGULAR_RCOND {
+            return Err(singular(rcond));
+        }
+        Ok(EquilibratedLu { lu, scale, freq_hz })
+    }
+
+    /// Overwrites `x` (a generalized force) with `(K_c - w^2 M)^-1 x`.
+    pub(super) fn solve_mut(&self, x: &mut SVector<Complex64, N>) -> Result<(), TfError> {
+        for (v, s) in x.iter_mut().zip(self.scale) {
+            *v *= s;
+        }
+        if !self.lu.solve_mut(x) {
+            return Err(TfError::Singular {
+                freq_hz: self.freq_hz,
+                rcond: 0.0,
+            });
+        }
+        for (v, s) in x.iter_mut().zip(self.scale) {
+            *v *= s;
+        }
+        Ok(())
+    }
+}
+
+fn one_norm<const N: usize>(m: &SMatrix<Complex64, N, N>) -> f64 {
+    (0..N)
+        .map(|c| m.column(c).iter().map(|z| z.norm()).sum::<f64>())
+        .fold(0.0, f64::max)
+}
 
 /// Plan of the direct method.
 pub struct Direct {
@@ -37,24 +116,30 @@ pub struct Direct {
     observe: DMatrix<f64>,
 }
 
+/// The `8 x inputs` forcing matrices `(G0, G2)` of a request: tilt columns from
+/// [`Model::tilt_forcing`], force columns (frequency independent) from [`Model::force_matrix`].
+pub(super) fn forcing_columns(model: &Model, inputs: &[Input]) -> (DMatrix<f64>, DMatrix<f64>) {
+    let mut forcing0 = DMatrix::zeros(8, inputs.len());
+    let mut forcing2 = DMatrix::zeros(8, inputs.len());
+    let tilt = model.tilt_forcing();
+    for (col, input) in inputs.iter().enumerate() {
+        match input {
+            Input::Tilt(axis) => {
+                forcing0.set_column(col, &tilt.g0.column(axis.index()));
+                forcing2.set_column(col, &tilt.g2.column(axis.index()));
+            }
+            Input::Force(f) => {
+                forcing0.set_column(col, &model.force_matrix().column(f.index()));
+            }
+        }
+    }
+    (forcing0, forcing2)
+}
+
 impl Direct {
     /// Prepares the matrices of `request` for `model`.
     pub fn new(model: &Model, request: Request) -> Direct {
-        let n_in = request.inputs.len();
-        let mut forcing0 = DMatrix::zeros(8, n_in);
-        let mut forcing2 = DMatrix::zeros(8, n_in);
-        let tilt = model.tilt_forcing();
-        for (col, input) in request.inputs.iter().enumerate() {
-            match input {
-                Input::Tilt(axis) => {
-                    forcing0.set_column(col, &tilt.g0.column(axis.index()));
-                    forcing2.set_column(col, &tilt.g2.column(axis.index()));
-                }
-                Input::Force(f) => {
-                    forcing0.set_column(col, &model.force_matrix().column(f.index()));
-                }
-            }
-        }
+        let (forcing0, forcing2) = forcing_columns(model, &request.inputs);
         let observe = DMatrix::from_fn(request.outputs.len(), 8, |r, c| {
             model.observation()[(request.outputs[r].index(), c)]
         });
@@ -69,12 +154,6 @@ impl Direct {
     }
 }
 
-fn one_norm(m: &CMat8) -> f64 {
-    (0..8)
-        .map(|c| m.column(c).iter().map(|z| z.norm()).sum::<f64>())
-        .fold(0.0, f64::max)
-}
-
 impl TransferFunction for Direct {
     fn method(&self) -> Method {
         Method::Direct
@@ -85,47 +164,16 @@ impl TransferFunction for Direct {
     }
 
     fn eval_into(&self, freq_hz: f64, out: &mut [Complex64]) -> Result<(), TfError> {
-        if !(freq_hz.is_finite() && freq_hz >= 0.0) {
-            return Err(FreqError::Invalid {
-                value: freq_hz,
-                origin: "transfer-function evaluation".into(),
-            }
-            .into());
-        }
-        let w2 = angular(freq_hz).powi(2);
-        let scale: [f64; 8] = std::array::from_fn(|i| {
-            1.0 / (self.stiffness[(i, i)].norm() + w2 * self.mass[(i, i)]).sqrt()
-        });
-        let d_s = CMat8::from_fn(|r, c| {
-            (self.stiffness[(r, c)] - Complex64::from(w2 * self.mass[(r, c)]))
-                * (scale[r] * scale[c])
-        });
+        let w2 = omega_sq(freq_hz)?;
+        let lu = EquilibratedLu::factor(&self.stiffness, &self.mass, w2, freq_hz)?;
         let n_in = self.request.inputs.len();
-        let singular = |rcond: f64| TfError::Singular { freq_hz, rcond };
-        let lu = d_s.lu();
-        let inverse = lu.try_inverse().ok_or_else(|| singular(0.0))?;
-        let rcond = 1.0 / (one_norm(&d_s) * one_norm(&inverse));
-        // A NaN rcond (non-finite entries) is singular too.
-        if rcond.is_nan() || rcond < SINGULAR_RCOND {
-            return Err(singular(rcond));
-        }
-        let forcing = DMatrix::from_fn(8, n_in, |r, c| {
-            Complex64::from((self.forcing0[(r, c)] + w2 * self.forcing2[(r, c)]) * scale[r])
-        });
-        let mut y = forcing;
-        for c in 0..n_in {
-            let mut col = SMatrix::<Complex64, 8, 1>::from_fn(|r, _| y[(r, c)]);
-            if !lu.solve_mut(&mut col) {
-                return Err(singular(0.0));
-            }
-            for r in 0..8 {
-                y[(r, c)] = col[r] * scale[r];
-            }
-        }
-        let n_out = self.request.outputs.len();
-        for o in 0..n_out {
-            for i in 0..n_in {
-                out[o * n_in + i] = (0..8).map(|k| y[(k, i)] * self.observe[(o, k)]).sum();
+        for i in 0..n_in {
+            let mut y = SVector::<Complex64, 8>::from_fn(|r, _| {
+                Complex64::from(self.forcing0[(r, i)] + w2 * self.forcing2[(r, i)])
+            });
+            lu.solve_mut(&mut y)?;
+            for o in 0..self.request.outputs.len() {
+                out[o * n_in + i] = (0..8).map(|k| y[k] * self.observe[(o, k)]).sum();
             }
         }
         Ok(())

@@ -8,15 +8,36 @@
 //!
 //! Methods are plain data ([`Method`]); [`plan`] builds a [`TransferFunction`] that does the
 //! per-model work once and then evaluates cheaply at many frequencies
-//! (RustFFT's recipe/plan pattern). The direct LU method is the oracle for the others.
+//! (RustFFT's recipe/plan pattern). The direct LU method is the `f64` oracle (slow, obviously
+//! correct); the double-double [`crate::reference`] evaluator is the oracle of the accuracy
+//! tests of every method, the direct one included.
+//!
+//! | method | what it computes | relative error, 7x3 tilt, 1e-5..100 Hz (Table I, measured) |
+//! |---|---|---|
+//! | [`Method::Direct`] | 8x8 LU per frequency | 1e-6: phi/eta_t, phi_a/eta_t grow as f^-2 below the torsion modes, eta/phi_t as f^2 above the swing modes |
+//! | [`Method::Block`] | 4x4 LU per needed block | as direct (the same operations) |
+//! | [`Method::Split`] | static part + translation forcing, absolute test-mass angles | 4e-13 outside 1 % of each entry's poles and zeros |
+//! | [`Method::Modal`] | modal superposition | 1e-9 where modal terms do not cancel (the eigenvalues' error, 1 % from nu_1); none on phi/eta_t, phi_a/eta_t at low frequency (1e2 at 1e-5 Hz); damping approximate |
+//! | [`Method::Torsion2`] | the 2-DoF torsional model of section IV.C | a reduced model: 1e-5..1e-3 from the 8-DoF one at 0.5..5 mHz |
+//!
+//! `tests/methods.rs` checks every method against the reference with a tolerance derived from
+//! its rounding model and prints these numbers.
 
+mod block;
 mod direct;
+mod modal;
+mod split;
+mod torsion2;
 
 use crate::error::TfError;
 use crate::model::{ForceInput, Model, Observable, TiltAxis};
 use num_complex::Complex64;
 
+pub use block::BlockReduced;
 pub use direct::{Direct, SINGULAR_RCOND};
+pub use modal::Modal;
+pub use split::Split;
+pub use torsion2::Torsion2;
 
 /// An input of a transfer function.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -65,15 +86,70 @@ pub enum Method {
     /// Per-frequency LU of the full 8x8 dynamic stiffness, with equilibration and a condition
     /// check. Slow and obviously correct: the oracle for the other methods.
     Direct,
+    /// Per-frequency 4x4 LU of each decoupled block the request needs ([`crate::model::Block`]),
+    /// with the direct method's equilibration and condition check. Same results as direct.
+    Block,
+    /// Modal superposition over the undamped normal modes. Damping enters as modal loss angles,
+    /// an approximation (see [`Method::exact_for_damping`]); loses all relative accuracy where
+    /// the modal terms cancel (phi/eta_t and phi_a/eta_t at low frequency). A comparison method.
+    Modal,
+    /// Block LU in absolute test-mass angles, with the tilt response split into its exact static
+    /// part and a translation forcing: full relative accuracy on every tilt entry, including the
+    /// f^4 fall of phi/eta_t at low frequency, and on the force entries up to 100 Hz.
+    Split,
+    /// The 2-DoF torsional model of section IV.C (phi_a, phi_b only): a reduced model, valid
+    /// near and below the torsion modes; refuses inputs and outputs it cannot represent.
+    Torsion2,
 }
 
 impl Method {
+    /// Every method, the oracle first.
+    pub const ALL: [Method; 5] = [
+        Method::Direct,
+        Method::Block,
+        Method::Split,
+        Method::Modal,
+        Method::Torsion2,
+    ];
+
     /// Name used on the command line and in files.
     pub fn name(self) -> &'static str {
         match self {
             Method::Direct => "direct",
+            Method::Block => "block",
+            Method::Modal => "modal",
+            Method::Split => "split",
+            Method::Torsion2 => "torsion2",
         }
     }
+
+    /// False when the method treats loss angles approximately (modal loss angles neglect the
+    /// coupling of modes by damping); every other method solves `K_c - w^2 M` with the complex
+    /// stiffness itself.
+    pub fn exact_for_damping(self) -> bool {
+        !matches!(self, Method::Modal)
+    }
+
+    /// False for the reduced 2-DoF model, whose transfer functions differ from the 8-DoF
+    /// model's by the neglected coupling to the swing modes.
+    pub fn full_model(self) -> bool {
+        !matches!(self, Method::Torsion2)
+    }
+}
+
+/// A request that a method cannot evaluate, found at plan time.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum PlanError {
+    /// The method's model has no way to represent an input or an output of the request.
+    #[error("method `{}` cannot evaluate {item}: {reason}", method.name())]
+    Unsupported {
+        /// The method asked for.
+        method: Method,
+        /// The input or output it cannot represent, e.g. `input eta_t`.
+        item: String,
+        /// Why, and what the method supports instead.
+        reason: String,
+    },
 }
 
 /// What to compute: which observables respond to which inputs.
@@ -116,11 +192,21 @@ pub trait TransferFunction: Send + Sync {
     }
 }
 
-/// Builds the plan for `method` (factorizations and forcing matrices prepared once).
-pub fn plan(model: &Model, request: &Request, method: Method) -> Box<dyn TransferFunction> {
-    match method {
+/// Builds the plan for `method` (factorizations and forcing matrices prepared once). Fails
+/// only for a method that cannot represent part of the request ([`Method::Torsion2`]); the
+/// methods of the full model plan every request.
+pub fn plan(
+    model: &Model,
+    request: &Request,
+    method: Method,
+) -> Result<Box<dyn TransferFunction>, PlanError> {
+    Ok(match method {
         Method::Direct => Box::new(Direct::new(model, request.clone())),
-    }
+        Method::Block => Box::new(BlockReduced::new(model, request.clone())),
+        Method::Modal => Box::new(Modal::new(model, request.clone())),
+        Method::Split => Box::new(Split::new(model, request.clone())),
+        Method::Torsion2 => Box::new(Torsion2::new(model, request.clone())?),
+    })
 }
 
 /// Transfer functions on a frequency grid.
