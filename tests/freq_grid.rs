@@ -11,14 +11,32 @@ use tiltnoise::tf::{plan, Method, Request};
 fn undamped_poles_are_bracketed_within_1e_6_and_never_hit() {
     let model = Model::new(&Params::table_i()).unwrap();
     let grid = default_grid(&model);
-    assert!(grid.windows(2).all(|w| w[0] < w[1]), "sorted, no duplicates");
-    assert_eq!((grid[0], *grid.last().unwrap()), (DEFAULT_F_LO_HZ, DEFAULT_F_HI_HZ));
+    assert!(
+        grid.windows(2).all(|w| w[0] < w[1]),
+        "sorted, no duplicates"
+    );
+    assert_eq!(
+        (grid[0], *grid.last().unwrap()),
+        (DEFAULT_F_LO_HZ, DEFAULT_F_HI_HZ)
+    );
     let tf = plan(&model, &Request::all_tilt(), Method::Direct).unwrap();
     for mode in NormalModes::new(&model).modes {
         let f = mode.frequency_hz;
-        let below = grid.iter().filter(|&&g| g < f).map(|g| (f - g) / f).fold(1.0, f64::min);
-        let above = grid.iter().filter(|&&g| g > f).map(|g| (g - f) / f).fold(1.0, f64::min);
-        assert!(below <= 1e-6 && above <= 1e-6, "nu_{}: {below:e} {above:e}", mode.index);
+        let below = grid
+            .iter()
+            .filter(|&&g| g < f)
+            .map(|g| (f - g) / f)
+            .fold(1.0, f64::min);
+        let above = grid
+            .iter()
+            .filter(|&&g| g > f)
+            .map(|g| (g - f) / f)
+            .fold(1.0, f64::min);
+        assert!(
+            below <= 1e-6 && above <= 1e-6,
+            "nu_{}: {below:e} {above:e}",
+            mode.index
+        );
         assert!(!grid.contains(&f));
     }
     // And the whole grid evaluates: no point is singular.
@@ -43,9 +61,20 @@ fn damped_peaks_are_sampled_across_their_width() {
         let phi = (mode.shape.transpose() * k_imag * mode.shape)[(0, 0)] / mode.omega_sq;
         assert!(phi > 5e-4, "torsion modes are damped: phi_k = {phi}");
         let half_width = f * phi / 2.0;
-        let inside = grid.iter().filter(|&&g| (g - f).abs() <= half_width).count();
-        assert!(inside >= 5, "nu_{}: {inside} points within the half-width", mode.index);
+        let inside = grid
+            .iter()
+            .filter(|&&g| (g - f).abs() <= half_width)
+            .count();
+        assert!(
+            inside >= 5,
+            "nu_{}: {inside} points within the half-width",
+            mode.index
+        );
         // The peak value itself is on the grid (damped: not singular).
-        assert!(grid.iter().any(|&g| ((g - f) / f).abs() < 1e-15), "nu_{} centre", mode.index);
+        assert!(
+            grid.iter().any(|&g| ((g - f) / f).abs() < 1e-15),
+            "nu_{} centre",
+            mode.index
+        );
     }
 }
