@@ -48,6 +48,19 @@ enum Command {
     Tf(TfArgs),
     /// Noise budget of X, phi, phi_a from measured floor tilt (time series or spectra).
     Budget(BudgetArgs),
+    /// Every evaluation method's worst error against the double-double reference and its time
+    /// per point, for the 7x3 tilt matrix on the given grid (table, JSON, chart).
+    Methods {
+        /// Log grid FLO:N:FHI (Hz:count:Hz).
+        #[arg(long, value_name = "FLO:N:FHI", default_value = "1e-5:400:100")]
+        freq: String,
+        /// Output format on the terminal.
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+        /// Chart of time per point against error (.png or .svg), repeatable.
+        #[arg(long, value_name = "PATH")]
+        save: Vec<PathBuf>,
+    },
 }
 
 #[derive(Debug, Args)]
@@ -109,15 +122,32 @@ enum Format {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum MethodArg {
-    /// Per-frequency LU of the full model (the reference method).
+pub(crate) enum MethodArg {
+    /// Smallest model and cheapest method meeting 1e-9 relative on the grid's band, verified
+    /// against the double-double reference (see --explain).
+    Auto,
+    /// Per-frequency LU of the full 8x8 model (the oracle of the fast methods).
     Direct,
+    /// Per-frequency LU of the decoupled 4x4 blocks the request needs.
+    Block,
+    /// Block LU in absolute angles with the static / mass-line split: full relative accuracy.
+    Split,
+    /// Modal superposition (fast; loses accuracy where modal terms cancel).
+    Modal,
+    /// The 2-DoF torsional model of section IV.C (no tilt inputs).
+    Torsion2,
 }
 
-impl From<MethodArg> for Method {
-    fn from(m: MethodArg) -> Method {
-        match m {
-            MethodArg::Direct => Method::Direct,
+impl MethodArg {
+    /// The fixed method, or `None` for `auto`.
+    pub(crate) fn fixed(self) -> Option<Method> {
+        match self {
+            MethodArg::Auto => None,
+            MethodArg::Direct => Some(Method::Direct),
+            MethodArg::Block => Some(Method::Block),
+            MethodArg::Split => Some(Method::Split),
+            MethodArg::Modal => Some(Method::Modal),
+            MethodArg::Torsion2 => Some(Method::Torsion2),
         }
     }
 }
@@ -136,8 +166,11 @@ struct TfArgs {
     #[arg(long, value_name = "PATH")]
     save: Vec<PathBuf>,
     /// Evaluation method.
-    #[arg(long, value_enum, default_value_t = MethodArg::Direct)]
+    #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
     method: MethodArg,
+    /// Say which method `auto` picked and why (every candidate's measured error).
+    #[arg(long)]
+    explain: bool,
 }
 
 impl ParamArgs {
@@ -172,6 +205,7 @@ pub fn run(cli: Cli) -> Result<()> {
         }
         Command::Tf(args) => run_tf(&params, args),
         Command::Budget(args) => crate::cli_budget::run_budget(&params, args),
+        Command::Methods { freq, format, save } => run_methods(&params, &freq, format, &save),
     }
 }
 
@@ -186,8 +220,31 @@ fn run_tf(params: &Params, args: TfArgs) -> Result<()> {
     for path in &args.save {
         crate::io::OutputKind::from_path(path)?;
     }
-    let method = Method::from(args.method);
-    let plan = tf::plan(&model, &Request::all_tilt(), method)?;
+    let request = Request::all_tilt();
+    let method = match args.method.fixed() {
+        Some(m) => m,
+        None => {
+            let positive: Vec<f64> = freqs.iter().copied().filter(|&f| f > 0.0).collect();
+            let band = match positive.is_empty() {
+                true => (crate::freq::DEFAULT_F_LO_HZ, crate::freq::DEFAULT_F_LO_HZ),
+                false => (
+                    positive.iter().copied().fold(f64::INFINITY, f64::min),
+                    positive.iter().copied().fold(0.0, f64::max),
+                ),
+            };
+            let scene = crate::scene::Scene {
+                request: request.clone(),
+                band_hz: band,
+                rel_tol: crate::scene::DEFAULT_REL_TOL,
+            };
+            let choice = crate::scene::choose(&model, &scene).map_err(anyhow::Error::msg)?;
+            if args.explain {
+                eprintln!("{}", choice.explain());
+            }
+            choice.method
+        }
+    };
+    let plan = tf::plan(&model, &request, method)?;
     let tf = tf::evaluate(plan.as_ref(), &freqs).context("evaluating the transfer functions")?;
     let modes = NormalModes::new(&model);
     if args.save.is_empty() {
@@ -209,6 +266,109 @@ fn run_tf(params: &Params, args: TfArgs) -> Result<()> {
     print!("{}", crate::report::static_limits(&model));
     for path in &args.save {
         save_tf(path, &tf, &meta)?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+fn run_methods(params: &Params, spec: &str, format: Format, save: &[PathBuf]) -> Result<()> {
+    use crate::methods::methods_table;
+    use crate::scene::{choose, Scene, DEFAULT_REL_TOL};
+    for path in save {
+        crate::plot::ImageFormat::from_path(path)?;
+    }
+    let model = Model::new(params)?;
+    let grid = freq::parse_spec(spec)?;
+    let request = Request::all_tilt();
+    let band = (grid[0], grid[grid.len() - 1]);
+    let auto = choose(
+        &model,
+        &Scene {
+            request: request.clone(),
+            band_hz: band,
+            rel_tol: DEFAULT_REL_TOL,
+        },
+    )
+    .map(|c| c.method.name().to_string())
+    .unwrap_or_else(|why| format!("none ({why})"));
+    let rows = methods_table(&model, &request, &grid);
+    match format {
+        Format::Json => {
+            let methods: Vec<_> = rows
+                .iter()
+                .map(|r| {
+                    serde_json::json!({
+                        "name": r.method.name(),
+                        "max_rel_err": r.worst.as_ref().map(|w| w.0),
+                        "worst_entry": r.worst.as_ref().map(|w| w.1.clone()),
+                        "worst_freq_hz": r.worst.as_ref().map(|w| w.2),
+                        "ns_per_point": r.ns_per_point,
+                        "exact_zeros": r.exact_zeros,
+                        "unusable": r.unusable,
+                    })
+                })
+                .collect();
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&serde_json::json!({
+                    "auto": auto,
+                    "target_rel_err": DEFAULT_REL_TOL,
+                    "grid": spec,
+                    "methods": methods,
+                }))?
+            );
+        }
+        Format::Table => {
+            println!(
+                "7x3 tilt matrix on {spec} Hz ({} points; accuracy checked > 1 % from every mode)",
+                grid.len()
+            );
+            println!(
+                "{:<9} {:>13} {:>14} {:>12} {:>12}  exact zeros",
+                "method", "max rel err", "worst entry", "at (Hz)", "ns/point"
+            );
+            for r in &rows {
+                match (&r.worst, r.ns_per_point) {
+                    (Some((e, entry, f)), Some(ns)) => println!(
+                        "{:<9} {:>13.2e} {:>14} {:>12.4e} {:>12.0}  {}",
+                        r.method.name(),
+                        e,
+                        entry,
+                        f,
+                        ns,
+                        if r.exact_zeros == Some(true) {
+                            "yes"
+                        } else {
+                            "no"
+                        }
+                    ),
+                    _ => println!(
+                        "{:<9} not usable: {}",
+                        r.method.name(),
+                        r.unusable.as_deref().unwrap_or("")
+                    ),
+                }
+            }
+            println!("auto picks: {auto} (target: relative error <= {DEFAULT_REL_TOL:e})");
+        }
+    }
+    let points: Vec<crate::plot::methods_figure::MethodPoint> = rows
+        .iter()
+        .filter_map(|r| {
+            Some((
+                r.method.name().to_string(),
+                r.ns_per_point?,
+                r.worst.as_ref()?.0,
+            ))
+        })
+        .collect();
+    for path in save {
+        crate::plot::methods_figure::methods_figure(
+            &points,
+            DEFAULT_REL_TOL,
+            &format!("Speed against accuracy, 7x3 tilt matrix, {spec} Hz"),
+            path,
+        )?;
         println!("wrote {}", path.display());
     }
     Ok(())

@@ -23,6 +23,7 @@
 pub mod budget_figure;
 pub mod chart;
 mod labels;
+pub mod methods_figure;
 mod text;
 pub mod tf_figure;
 
