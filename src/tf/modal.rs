@@ -23,7 +23,8 @@
 //!   or a term's projection `v_k^T (G0 + w^2 G2)` is itself a cancellation (eta_t on the
 //!   torsion modes), the error is that of the parts. phi/eta_t and phi_a/eta_t fall as f^4 at
 //!   low frequency because the gravity and inertia terms cancel exactly; the modal sum levels
-//!   off at a floor of rounding noise instead (1e-11 at f = 0, where the exact value is 0), so
+//!   off at a floor of eigensolver error instead (about 2e-12 at f = 0, where the exact value is
+//!   0: the torsion modes' tiny swing components times the large gravity forcing), so
 //!   their relative error grows as f^-4 (about 1e2 at 1e-5 Hz for Table I). With loss angles
 //!   the neglected damping coupling is worse still: phi_a/eta_t comes out as 5e-4 at f = 0 with
 //!   loss angles of 1e-3. Measured in `tests/methods.rs`.
