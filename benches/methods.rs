@@ -1,0 +1,108 @@
+//! Speed of each transfer-function method (issue 4, item 4): the full 7x3 tilt matrix
+//! ([`Request::all_tilt`]: X, Y, Z, theta, eta, phi, phi_a from theta_t, eta_t, phi_t) of Table I
+//! on a log-spaced grid from 1e-5 to 100 Hz.
+//!
+//! Group `methods_7x3_tilt`, one benchmark per method and thread count:
+//! * `direct/1t`, `block/1t`, `split/1t`, `modal/1t`: one thread, `eval_into` at every grid
+//!   point into a preallocated `[freq][output][input]` buffer (what `tf::evaluate` does, minus
+//!   the allocation of the result);
+//! * `block/2t`, `split/2t`: the grid cut into two halves, the second half evaluated on a thread
+//!   spawned with `std::thread::scope` per iteration, the first on the calling thread (the spawn,
+//!   tens of microseconds, is included and is negligible against the milliseconds of a grid).
+//!
+//! The plan (`tf::plan`: normal modes, block matrices, forcing forms) is built once, outside the
+//! timing; it is amortized over the grid. Throughput is in grid points, so ns per point is the
+//! time per iteration divided by the grid size.
+//!
+//! The grid has 1e4 points by default; `TILTNOISE_BENCH_METHODS_POINTS` changes that
+//! (`scripts/bench/compare_methods.py` sets 1e5, the issue's grid). Sampling is flat with 10
+//! samples, 0.3 s warm-up and 1 s measurement: a run takes about 10 s at 1e4 points and 10 to
+//! 20 s at 1e5 (criterion then stretches the measurement of the slow methods and says so).
+//!
+//! Run with `cargo bench --bench methods`; CI only builds it (`cargo bench --no-run`). The
+//! machine is shared and has 2 cores: read ratios measured in one run, not absolute times.
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
+use num_complex::Complex64;
+use tiltnoise::freq::log_grid;
+use tiltnoise::model::Model;
+use tiltnoise::params::Params;
+use tiltnoise::tf::{self, Method, Request, TransferFunction};
+
+/// Environment variable that overrides the grid size.
+const POINTS_VAR: &str = "TILTNOISE_BENCH_METHODS_POINTS";
+const DEFAULT_POINTS: usize = 10_000;
+const F_LO_HZ: f64 = 1e-5;
+const F_HI_HZ: f64 = 100.0;
+
+fn n_points() -> usize {
+    match std::env::var(POINTS_VAR) {
+        Ok(s) => s
+            .trim()
+            .parse()
+            .ok()
+            .filter(|&n: &usize| n >= 2)
+            .unwrap_or_else(|| panic!("{POINTS_VAR}={s:?}: need an integer >= 2")),
+        Err(_) => DEFAULT_POINTS,
+    }
+}
+
+/// `tf` at every frequency of `grid`, into `out` (`grid.len()` blocks of `block` values).
+fn eval_grid(tf: &dyn TransferFunction, grid: &[f64], block: usize, out: &mut [Complex64]) {
+    for (&f, h) in grid.iter().zip(out.chunks_exact_mut(block)) {
+        tf.eval_into(f, h)
+            .expect("no singular frequency on the grid");
+    }
+}
+
+/// The same, with the second half of the grid on a second thread.
+fn eval_grid_2t(tf: &dyn TransferFunction, grid: &[f64], block: usize, out: &mut [Complex64]) {
+    let mid = grid.len() / 2;
+    let (g0, g1) = grid.split_at(mid);
+    let (o0, o1) = out.split_at_mut(mid * block);
+    std::thread::scope(|s| {
+        s.spawn(|| eval_grid(tf, g1, block, o1));
+        eval_grid(tf, g0, block, o0);
+    });
+}
+
+fn methods(c: &mut Criterion) {
+    let model = Model::new(&Params::table_i()).expect("Table I is valid");
+    let request = Request::all_tilt();
+    let block = request.outputs.len() * request.inputs.len();
+    let n = n_points();
+    let grid = log_grid(F_LO_HZ, F_HI_HZ, n).expect("valid grid");
+    eprintln!(
+        "methods bench: 7x3 tilt matrix, {n} log-spaced points {F_LO_HZ:e}..{F_HI_HZ} Hz \
+         ({POINTS_VAR}={n})"
+    );
+    let mut out = vec![Complex64::new(0.0, 0.0); block * n];
+
+    let mut g = c.benchmark_group("methods_7x3_tilt");
+    g.sample_size(10)
+        .sampling_mode(SamplingMode::Flat)
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(1))
+        .throughput(Throughput::Elements(n as u64));
+    for method in [Method::Direct, Method::Block, Method::Split, Method::Modal] {
+        let plan = tf::plan(&model, &request, method).expect("full-model methods plan 7x3 tilt");
+        let plan = plan.as_ref();
+        // One untimed pass: fails loudly if a grid point is singular for this method.
+        eval_grid(plan, &grid, block, &mut out);
+        g.bench_function(format!("{}/1t", method.name()), |b| {
+            b.iter(|| eval_grid(plan, black_box(&grid), block, black_box(&mut out)))
+        });
+        if matches!(method, Method::Block | Method::Split) {
+            g.bench_function(format!("{}/2t", method.name()), |b| {
+                b.iter(|| eval_grid_2t(plan, black_box(&grid), block, black_box(&mut out)))
+            });
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(benches, methods);
+criterion_main!(benches);
