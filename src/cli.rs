@@ -48,6 +48,22 @@ enum Command {
     Tf(TfArgs),
     /// Noise budget of X, phi, phi_a from measured floor tilt (time series or spectra).
     Budget(BudgetArgs),
+    /// Monte Carlo of the normal modes over the parameter uncertainties (default: Gaussian,
+    /// 2.5 % on masses, lengths, inertias; 10 % on torsion and bouncing constants; g, h exact).
+    Mc {
+        /// Number of draws.
+        #[arg(long, default_value_t = 10_000)]
+        samples: usize,
+        /// Seed of the random streams (results do not depend on the thread count).
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Worker threads (0: all cores).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// Output format on the terminal.
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+    },
     /// Every evaluation method's worst error against the double-double reference and its time
     /// per point, for the 7x3 tilt matrix on the given grid (table, JSON, chart).
     Methods {
@@ -206,6 +222,12 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Tf(args) => run_tf(&params, args),
         Command::Budget(args) => crate::cli_budget::run_budget(&params, args),
         Command::Methods { freq, format, save } => run_methods(&params, &freq, format, &save),
+        Command::Mc {
+            samples,
+            seed,
+            threads,
+            format,
+        } => run_mc(&params, samples, seed, threads, format),
     }
 }
 
@@ -370,6 +392,76 @@ fn run_methods(params: &Params, spec: &str, format: Format, save: &[PathBuf]) ->
             path,
         )?;
         println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+fn run_mc(
+    params: &Params,
+    samples: usize,
+    seed: u64,
+    threads: usize,
+    format: Format,
+) -> Result<()> {
+    use std::io::IsTerminal;
+    let cfg = crate::mc::McConfig {
+        samples,
+        seed,
+        threads,
+        ..crate::mc::McConfig::default_for(params)
+    };
+    let bar = (std::io::stderr().is_terminal() && samples >= 10_000)
+        .then(|| indicatif::ProgressBar::new(samples as u64));
+    let result = crate::mc::run(params, &cfg, &|done| {
+        if let Some(b) = &bar {
+            b.set_position(done as u64);
+        }
+    })?;
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let nominal = NormalModes::new(&Model::new(params)?).frequencies_hz();
+    match format {
+        Format::Json => {
+            let modes: Vec<_> = (0..8)
+                .map(|k| {
+                    serde_json::json!({
+                        "index": k + 1,
+                        "nominal_hz": nominal[k],
+                        "mean_hz": result.mean_hz[k],
+                        "std_hz": result.std_hz[k],
+                    })
+                })
+                .collect();
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&serde_json::json!({
+                    "samples": result.samples,
+                    "rejected": result.rejected,
+                    "seed": seed,
+                    "modes": modes,
+                }))?
+            );
+        }
+        Format::Table => {
+            println!(
+                "Monte Carlo of the normal modes: {} draws ({} rejected as non-physical), seed {seed}",
+                result.samples, result.rejected
+            );
+            println!(
+                "{:<5} {:>14} {:>14} {:>12}",
+                "mode", "nominal (Hz)", "mean (Hz)", "std (Hz)"
+            );
+            for (k, f0) in nominal.iter().enumerate() {
+                println!(
+                    "nu_{:<2} {:>14.6e} {:>14.6e} {:>12.3e}",
+                    k + 1,
+                    f0,
+                    result.mean_hz[k],
+                    result.std_hz[k]
+                );
+            }
+        }
     }
     Ok(())
 }

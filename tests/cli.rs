@@ -169,3 +169,28 @@ fn tf_writes_every_requested_format() {
     assert_eq!(csv.lines().count(), 51);
     assert!(csv.starts_with("freq_hz,X.theta_t.re,X.theta_t.im,X.eta_t.re"));
 }
+
+#[test]
+fn mc_json_reports_every_mode_and_refuses_zero_samples() {
+    let out = tiltnoise(&["mc", "--samples", "2000", "--seed", "7", "--format", "json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let modes = v["modes"].as_array().unwrap();
+    assert_eq!(modes.len(), 8);
+    assert_eq!(v["samples"].as_u64(), Some(2000));
+    // The statistics are tested in tests/mc.rs; here the command must reproduce the library's
+    // result for the same seed exactly (JSON floats round-trip).
+    let params = tiltnoise::params::Params::table_i();
+    let cfg = tiltnoise::mc::McConfig {
+        samples: 2000,
+        seed: 7,
+        ..tiltnoise::mc::McConfig::default_for(&params)
+    };
+    let lib = tiltnoise::mc::run(&params, &cfg, &|_| {}).unwrap();
+    for (k, m) in modes.iter().enumerate() {
+        assert_eq!(m["index"].as_u64(), Some(k as u64 + 1));
+        assert_eq!(m["mean_hz"].as_f64().unwrap(), lib.mean_hz[k], "{m}");
+        assert_eq!(m["std_hz"].as_f64().unwrap(), lib.std_hz[k], "{m}");
+    }
+    assert_fails(&["mc", "--samples", "0"], &["samples = 0"]);
+}
