@@ -148,6 +148,8 @@ pub(crate) enum MethodArg {
     Block,
     /// Block LU in absolute angles with the static / mass-line split: full relative accuracy.
     Split,
+    /// Pole-zero product form per entry, built once in double-double: accurate and fastest.
+    Polezero,
     /// Modal superposition (fast; loses accuracy where modal terms cancel).
     Modal,
     /// The 2-DoF torsional model of section IV.C (no tilt inputs).
@@ -162,6 +164,7 @@ impl MethodArg {
             MethodArg::Direct => Some(Method::Direct),
             MethodArg::Block => Some(Method::Block),
             MethodArg::Split => Some(Method::Split),
+            MethodArg::Polezero => Some(Method::PoleZero),
             MethodArg::Modal => Some(Method::Modal),
             MethodArg::Torsion2 => Some(Method::Torsion2),
         }

@@ -394,7 +394,7 @@ enum Tolerance {
 fn tolerance(method: Method) -> Tolerance {
     match method {
         Method::Direct | Method::Block => Tolerance::Lu,
-        Method::Split => Tolerance::Target,
+        Method::Split | Method::PoleZero => Tolerance::Target,
         Method::Modal => Tolerance::Modal,
         Method::Torsion2 => unreachable!("a reduced model; compared separately"),
     }
@@ -752,7 +752,7 @@ fn static_zeros() {
                     }
                     let (o, i) = (j / request.inputs.len(), j % request.inputs.len());
                     let bound = match method {
-                        Method::Split => 0.0,
+                        Method::Split | Method::PoleZero => 0.0,
                         Method::Direct | Method::Block if entry_point == "tilt" => 0.0,
                         Method::Modal => {
                             modal_tolerance(case, request.outputs[o], request.inputs[i], 0.0)
@@ -973,7 +973,10 @@ fn every_method_reports_exact_resonances() {
 #[test]
 fn methods_have_distinct_names_and_flags() {
     let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
-    assert_eq!(names, ["direct", "block", "split", "modal", "torsion2"]);
+    assert_eq!(
+        names,
+        ["direct", "block", "split", "polezero", "modal", "torsion2"]
+    );
     assert!(!Method::Modal.exact_for_damping());
     assert!(!Method::Torsion2.full_model());
     assert!(Method::ALL

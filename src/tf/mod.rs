@@ -26,6 +26,7 @@
 mod block;
 mod direct;
 mod modal;
+mod polezero;
 mod split;
 mod torsion2;
 
@@ -36,6 +37,7 @@ use num_complex::Complex64;
 pub use block::BlockReduced;
 pub use direct::{Direct, SINGULAR_RCOND};
 pub use modal::Modal;
+pub use polezero::{EntryFactors, PoleZero};
 pub use split::Split;
 pub use torsion2::Torsion2;
 
@@ -100,14 +102,19 @@ pub enum Method {
     /// The 2-DoF torsional model of section IV.C (phi_a, phi_b only): a reduced model, valid
     /// near and below the torsion modes; refuses inputs and outputs it cannot represent.
     Torsion2,
+    /// Each entry as `g s^p prod(z_j - s) / prod(lambda_k - s)` (`s = w^2`), with its poles,
+    /// zeros and gain found once per plan in double-double from the reference's matrices:
+    /// no solve per frequency. See [`PoleZero`].
+    PoleZero,
 }
 
 impl Method {
     /// Every method, the oracle first.
-    pub const ALL: [Method; 5] = [
+    pub const ALL: [Method; 6] = [
         Method::Direct,
         Method::Block,
         Method::Split,
+        Method::PoleZero,
         Method::Modal,
         Method::Torsion2,
     ];
@@ -120,6 +127,7 @@ impl Method {
             Method::Modal => "modal",
             Method::Split => "split",
             Method::Torsion2 => "torsion2",
+            Method::PoleZero => "polezero",
         }
     }
 
@@ -206,6 +214,7 @@ pub fn plan(
         Method::Modal => Box::new(Modal::new(model, request.clone())),
         Method::Split => Box::new(Split::new(model, request.clone())),
         Method::Torsion2 => Box::new(Torsion2::new(model, request.clone())?),
+        Method::PoleZero => Box::new(PoleZero::new(model, request.clone())),
     })
 }
 

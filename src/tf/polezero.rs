@@ -1,0 +1,739 @@
+//! The pole-zero method: every entry as a product of its own poles and zeros, built once per plan
+//! in double-double.
+//!
+//! Within a block ([`Block`], 4x4 in absolute test-mass angles, as the split method and the
+//! reference solve it) `D(s) = K_c - s M` with `s = w^2`, and an entry is
+//!
+//! ```text
+//! H(s) = c^T D(s)^-1 g(s) = N(s) / P(s),   P = det D,   N = -det [[D, g], [c^T, 0]],
+//! ```
+//!
+//! with `g = G0 + s G2` (tilt) or a column of the force matrix. Both determinants are expanded
+//! at plan time as polynomials in `s` (Laplace expansion of matrices of polynomials of degree
+//! <= 1) in double-double, from [`ReferenceModel`]'s matrices. Alongside each coefficient the sum
+//! of the magnitudes of its terms is kept; a coefficient below `ZERO_REL` times that sum is a
+//! structural cancellation (the f^4 of phi/eta_t and phi_a/eta_t at low frequency, the f^-2 of
+//! eta/phi_t and phi/eta_t at high frequency) and is set to exactly zero. The roots of `P`
+//! (the block's eigenvalues) and of `N / s^p` (the entry's zeros) are found in `f64` (Aberth)
+//! and polished in double-double (Aberth-Newton on the double-double coefficients). Then per
+//! frequency
+//!
+//! ```text
+//! H = g s^p prod_j (z_j - s) / prod_k (lambda_k - s)
+//!   = (g prod_j z_j) s^p prod_j (1 - s / z_j) / prod_k (lambda_k - s),
+//! ```
+//!
+//! the second form with `1 / z_j` rounded once to `f64`, in real arithmetic for undamped blocks
+//! whose zeros are all real, in complex arithmetic otherwise (damped blocks, or complex zeros).
+//! `power + #zeros <= 4`, so every entry is four factors `a + b s` (`s`, `1 - s / z`, or 1 for
+//! padding), evaluated four entries at a time in straight-line code. Every factor is relatively
+//! accurate: the relative error of an entry is a few `eps (1 + sum |z| / |z - s| + sum |lambda|
+//! / |lambda - s|)`, about `1e2 eps` at 1 % from a pole or zero and `~eps` elsewhere, with no
+//! cancellation at low or high frequency (`tests/polezero.rs` measures 3e-14 at most outside the
+//! 1 % zones). Entries whose observation row or forcing column misses a block get nothing from
+//! it; entries no block reaches are exactly 0.0.
+//!
+//! Evaluation does not depend on the CPU's features for its results: an AVX build of the same
+//! code (no fused multiply-add) is used when the CPU has AVX.
+//!
+//! Singularity: an undamped block with `|lambda_k - s| < SINGULAR_RCOND lambda_k` (the rounding
+//! of `s` and of `lambda_k` then leaves fewer than three digits of the factor) is reported as
+//! [`TfError::Singular`] with `rcond = |lambda_k - s| / lambda_k`.
+
+use super::direct::{omega_sq, SINGULAR_RCOND};
+use super::{Input, Method, Request, TransferFunction};
+use crate::error::TfError;
+use crate::model::{Block, Coord, Model};
+use crate::params::Params;
+use crate::reference::{CDd, Dd, ReferenceModel, DD_EPS};
+use num_complex::Complex64;
+
+/// A coefficient smaller than this times the sum of its terms' magnitudes is a structural
+/// cancellation: exactly zero in exact arithmetic (rounding of the double-double data and the
+/// expansion leaves a few `DD_EPS`).
+const ZERO_REL: f64 = 1e3 * DD_EPS;
+
+/// Plan of the pole-zero method.
+pub struct PoleZero {
+    request: Request,
+    blocks: Vec<BlockForm>,
+    /// The CPU has AVX (checked at plan time): the same operations, four lanes per instruction.
+    avx: bool,
+}
+
+/// The product forms of one block's entries.
+enum BlockForm {
+    /// Undamped, every zero real: real arithmetic.
+    Real(RealBlock),
+    /// Damped (or complex zeros): complex arithmetic.
+    Complex(ComplexBlock),
+}
+
+/// Entries per chunk: each chunk is evaluated lane by lane in straight-line code that the
+/// compiler vectorizes.
+const LANES: usize = 4;
+
+/// Up to [`LANES`] entries of one block, each `gain prod_k (a_k + b_k s) / prod(lambda - s)`
+/// with exactly four factors: `s` for a zero at the origin (`a = 0, b = 1`), `1 - s / z` for a
+/// zero `z` (`a = 1, b = -1 / z`, and `z` moved into the gain), 1 for padding (`a = 1, b = 0`).
+/// The numerator has degree <= 4, so four factors always suffice. A padding lane has gain 0
+/// and adds its exact 0.0 to the chunk's first entry, so that no lane needs a branch.
+#[derive(Clone, Copy)]
+struct RealChunk {
+    at: [usize; LANES],
+    gain: [f64; LANES],
+    a: [[f64; LANES]; 4],
+    b: [[f64; LANES]; 4],
+}
+
+struct RealBlock {
+    poles: [f64; 4],
+    /// `SINGULAR_RCOND lambda_k`.
+    thresholds: [f64; 4],
+    chunks: Vec<RealChunk>,
+}
+
+/// [`RealChunk`] with complex gains and factors (real and imaginary parts apart).
+#[derive(Clone, Copy)]
+struct ComplexChunk {
+    at: [usize; LANES],
+    gain_re: [f64; LANES],
+    gain_im: [f64; LANES],
+    a_re: [[f64; LANES]; 4],
+    a_im: [[f64; LANES]; 4],
+    b_re: [[f64; LANES]; 4],
+    b_im: [[f64; LANES]; 4],
+}
+
+struct ComplexBlock {
+    poles: [Complex64; 4],
+    /// `(SINGULAR_RCOND |lambda_k|)^2`.
+    thresholds: [f64; 4],
+    chunks: Vec<ComplexChunk>,
+}
+
+/// An entry ready for a chunk: position in the output, gain, factors `(a, b)`.
+type Prepared = (usize, CDd, [(CDd, CDd); 4]);
+
+/// The four factors `(a, b)` and the gain of one entry, in double-double.
+fn entry_factors(f: &EntryFactors) -> (CDd, [(CDd, CDd); 4]) {
+    let one = CDd::real(Dd::ONE);
+    let mut gain = f.gain;
+    let mut factors = [(one, CDd::ZERO); 4];
+    let mut k = 0;
+    for _ in 0..f.power {
+        factors[k] = (CDd::ZERO, one);
+        k += 1;
+    }
+    for z in &f.zeros {
+        factors[k] = (one, -(one / *z));
+        gain = gain * *z;
+        k += 1;
+    }
+    (gain, factors)
+}
+
+/// One entry's factored form in double-double (exposed for the tests).
+#[derive(Debug, Clone)]
+pub struct EntryFactors {
+    /// Request row.
+    pub output: usize,
+    /// Request column.
+    pub input: usize,
+    /// The entry's block.
+    pub block: Block,
+    /// `H = gain s^power prod(z_j - s) / prod(lambda_k - s)`.
+    pub gain: CDd,
+    /// Multiplicity of the zero at `s = 0`.
+    pub power: u32,
+    /// The other zeros (`s = w^2`, rad^2/s^2).
+    pub zeros: Vec<CDd>,
+    /// The block's poles (`s`).
+    pub poles: Vec<CDd>,
+    /// Coefficients of `N` zeroed as structural cancellations: `(power of s, |c| / scale)`.
+    pub cancelled: Vec<(usize, f64)>,
+}
+
+/// A polynomial in `s` (ascending coefficients) with the magnitude sums of its coefficients.
+#[derive(Clone, Debug)]
+struct Poly {
+    c: Vec<CDd>,
+    mag: Vec<f64>,
+}
+
+impl Poly {
+    fn zero() -> Poly {
+        Poly {
+            c: Vec::new(),
+            mag: Vec::new(),
+        }
+    }
+
+    fn is_zero(&self) -> bool {
+        self.c.iter().all(|c| c.is_zero())
+    }
+
+    fn mul(&self, o: &Poly) -> Poly {
+        if self.c.is_empty() || o.c.is_empty() {
+            return Poly::zero();
+        }
+        let n = self.c.len() + o.c.len() - 1;
+        let mut c = vec![CDd::ZERO; n];
+        let mut mag = vec![0.0; n];
+        for (i, (a, ma)) in self.c.iter().zip(&self.mag).enumerate() {
+            if a.is_zero() {
+                continue;
+            }
+            for (j, (b, mb)) in o.c.iter().zip(&o.mag).enumerate() {
+                if b.is_zero() {
+                    continue;
+                }
+                c[i + j] += *a * *b;
+                mag[i + j] += ma * mb;
+            }
+        }
+        Poly { c, mag }
+    }
+
+    fn add_signed(&mut self, o: &Poly, negate: bool) {
+        if self.c.len() < o.c.len() {
+            self.c.resize(o.c.len(), CDd::ZERO);
+            self.mag.resize(o.c.len(), 0.0);
+        }
+        for (k, (b, mb)) in o.c.iter().zip(&o.mag).enumerate() {
+            if negate {
+                self.c[k] -= *b;
+            } else {
+                self.c[k] += *b;
+            }
+            self.mag[k] += mb;
+        }
+    }
+}
+
+/// Determinant of the square matrix of polynomials `a` restricted to `rows` x `cols` (Laplace
+/// expansion along the first row).
+fn det(a: &[Vec<Poly>], rows: &[usize], cols: &[usize]) -> Poly {
+    if rows.len() == 1 {
+        return a[rows[0]][cols[0]].clone();
+    }
+    let mut acc = Poly::zero();
+    let r0 = rows[0];
+    for (k, &c) in cols.iter().enumerate() {
+        let e = &a[r0][c];
+        if e.is_zero() {
+            continue;
+        }
+        let sub_cols: Vec<usize> = cols.iter().copied().filter(|&x| x != c).collect();
+        let minor = det(a, &rows[1..], &sub_cols);
+        acc.add_signed(&e.mul(&minor), k % 2 == 1);
+    }
+    acc
+}
+
+fn lin(c0: CDd, c1: CDd) -> Poly {
+    Poly {
+        c: vec![c0, c1],
+        mag: vec![c0.abs_f64(), c1.abs_f64()],
+    }
+}
+
+/// Evaluates the polynomial and its derivative (ascending coefficients) at `z` in double-double.
+fn horner_dd(c: &[CDd], z: CDd) -> (CDd, CDd) {
+    let mut p = CDd::ZERO;
+    let mut dp = CDd::ZERO;
+    for &a in c.iter().rev() {
+        dp = dp * z + p;
+        p = p * z + a;
+    }
+    (p, dp)
+}
+
+fn horner(c: &[Complex64], z: Complex64) -> (Complex64, Complex64) {
+    let mut p = Complex64::new(0.0, 0.0);
+    let mut dp = p;
+    for &a in c.iter().rev() {
+        dp = dp * z + p;
+        p = p * z + a;
+    }
+    (p, dp)
+}
+
+/// Roots of the polynomial with ascending double-double coefficients `c` (nonzero constant and
+/// leading terms): Aberth in `f64` from the Newton-polygon magnitudes, then Aberth steps in
+/// double-double until the corrections are below double-double precision.
+fn roots(c: &[CDd]) -> Vec<CDd> {
+    let n = c.len() - 1;
+    if n == 0 {
+        return Vec::new();
+    }
+    let cf: Vec<Complex64> = c.iter().map(|x| x.to_c64()).collect();
+    // Starting magnitudes: ratios of consecutive coefficient magnitudes (exact for widely
+    // separated roots), on rotated angles so that complex pairs can be found.
+    let mut z: Vec<Complex64> = (0..n)
+        .map(|k| {
+            let r = (cf[k].norm() / cf[k + 1].norm()).max(1e-300);
+            Complex64::from_polar(r, 0.4 + 2.0 * std::f64::consts::PI * k as f64 / n as f64)
+        })
+        .collect();
+    for _ in 0..500 {
+        let mut done = true;
+        for k in 0..n {
+            let (p, dp) = horner(&cf, z[k]);
+            if p.norm() == 0.0 {
+                continue;
+            }
+            let w = p / dp;
+            let s: Complex64 = (0..n)
+                .filter(|&j| j != k)
+                .map(|j| 1.0 / (z[k] - z[j]))
+                .sum();
+            let step = w / (1.0 - w * s);
+            if step.is_finite() {
+                z[k] -= step;
+                if step.norm() > 1e-15 * z[k].norm() {
+                    done = false;
+                }
+            }
+        }
+        if done {
+            break;
+        }
+    }
+    let mut zd: Vec<CDd> = z.iter().map(|&x| CDd::from_c64(x)).collect();
+    for _ in 0..8 {
+        for k in 0..n {
+            let (p, dp) = horner_dd(c, zd[k]);
+            if p.is_zero() {
+                continue;
+            }
+            let w = p / dp;
+            let mut s = CDd::ZERO;
+            for j in 0..n {
+                if j != k {
+                    s += CDd::real(Dd::ONE) / (zd[k] - zd[j]);
+                }
+            }
+            let step = w / (CDd::real(Dd::ONE) - w * s);
+            if step.is_finite() {
+                zd[k] -= step;
+            }
+        }
+    }
+    zd
+}
+
+/// For real coefficients: make nearly real roots exactly real and complex roots exact
+/// conjugate pairs.
+fn symmetrize(z: &mut [CDd]) {
+    let n = z.len();
+    for x in z.iter_mut() {
+        if x.im.hi.abs() <= 1e-20 * x.abs_f64() {
+            x.im = Dd::ZERO;
+        }
+    }
+    for k in 0..n {
+        if z[k].im.hi > 0.0 {
+            // The partner: the root nearest to the conjugate.
+            let conj = z[k].conj();
+            if let Some(j) = (0..n)
+                .filter(|&j| z[j].im.hi < 0.0)
+                .min_by(|&a, &b| (z[a] - conj).abs_f64().total_cmp(&(z[b] - conj).abs_f64()))
+            {
+                let re = (z[k].re + z[j].re).ldexp(-1);
+                let im = (z[k].im - z[j].im).ldexp(-1);
+                z[k] = CDd::new(re, im);
+                z[j] = CDd::new(re, -im);
+            }
+        }
+    }
+}
+
+/// The block's matrices in absolute test-mass angles (double-double), block-local indices.
+struct BlockData {
+    mass: [[Dd; 4]; 4],
+    stiffness: [[CDd; 4]; 4],
+    idx: [usize; 4],
+}
+
+/// Pairs (crossbar angle, relative test-mass angle), full indices.
+const PAIRS: [(usize, usize); 3] = [(0, 4), (1, 5), (2, 6)];
+
+fn abs_matrix<T: Copy + std::ops::Sub<Output = T>>(m: &[[T; 8]; 8]) -> [[T; 8]; 8] {
+    let mut a = *m;
+    for row in a.iter_mut() {
+        let orig = *row;
+        for (ca, cb) in PAIRS {
+            row[ca] = orig[ca] - orig[cb];
+        }
+    }
+    let b = a;
+    for (ra, rb) in PAIRS {
+        for c in 0..8 {
+            a[ra][c] = b[ra][c] - b[rb][c];
+        }
+    }
+    a
+}
+
+impl PoleZero {
+    /// Builds the product forms of every entry of `request` (about a millisecond per block).
+    pub fn new(model: &Model, request: Request) -> PoleZero {
+        let factors = Self::factors(model.params(), &request);
+        let n_in = request.inputs.len();
+        let blocks = Block::ALL
+            .into_iter()
+            .filter_map(|block| {
+                let fs: Vec<&EntryFactors> = factors.iter().filter(|f| f.block == block).collect();
+                let first = fs.first()?;
+                let real = first.poles.iter().all(|p| p.im.is_zero())
+                    && fs
+                        .iter()
+                        .all(|f| f.gain.im.is_zero() && f.zeros.iter().all(|z| z.im.is_zero()));
+                let prepared: Vec<Prepared> = fs
+                    .iter()
+                    .map(|f| {
+                        let (g, fac) = entry_factors(f);
+                        (f.output * n_in + f.input, g, fac)
+                    })
+                    .collect();
+                Some(if real {
+                    let poles: [f64; 4] = std::array::from_fn(|k| first.poles[k].re.to_f64());
+                    let chunks = prepared
+                        .chunks(LANES)
+                        .map(|group| {
+                            let mut c = RealChunk {
+                                at: [group[0].0; LANES],
+                                gain: [0.0; LANES],
+                                a: [[1.0; LANES]; 4],
+                                b: [[0.0; LANES]; 4],
+                            };
+                            for (l, (at, g, fac)) in group.iter().enumerate() {
+                                c.at[l] = *at;
+                                c.gain[l] = g.re.to_f64();
+                                for (k, (a, b)) in fac.iter().enumerate() {
+                                    c.a[k][l] = a.re.to_f64();
+                                    c.b[k][l] = b.re.to_f64();
+                                }
+                            }
+                            c
+                        })
+                        .collect();
+                    BlockForm::Real(RealBlock {
+                        poles,
+                        thresholds: poles.map(|l| SINGULAR_RCOND * l),
+                        chunks,
+                    })
+                } else {
+                    let poles: [Complex64; 4] = std::array::from_fn(|k| first.poles[k].to_c64());
+                    let chunks = prepared
+                        .chunks(LANES)
+                        .map(|group| {
+                            let mut c = ComplexChunk {
+                                at: [group[0].0; LANES],
+                                gain_re: [0.0; LANES],
+                                gain_im: [0.0; LANES],
+                                a_re: [[1.0; LANES]; 4],
+                                a_im: [[0.0; LANES]; 4],
+                                b_re: [[0.0; LANES]; 4],
+                                b_im: [[0.0; LANES]; 4],
+                            };
+                            for (l, (at, g, fac)) in group.iter().enumerate() {
+                                c.at[l] = *at;
+                                c.gain_re[l] = g.re.to_f64();
+                                c.gain_im[l] = g.im.to_f64();
+                                for (k, (a, b)) in fac.iter().enumerate() {
+                                    c.a_re[k][l] = a.re.to_f64();
+                                    c.a_im[k][l] = a.im.to_f64();
+                                    c.b_re[k][l] = b.re.to_f64();
+                                    c.b_im[k][l] = b.im.to_f64();
+                                }
+                            }
+                            c
+                        })
+                        .collect();
+                    BlockForm::Complex(ComplexBlock {
+                        poles,
+                        thresholds: poles.map(|l| (SINGULAR_RCOND * l.norm()).powi(2)),
+                        chunks,
+                    })
+                })
+            })
+            .collect();
+        PoleZero {
+            request,
+            blocks,
+            avx: avx_available(),
+        }
+    }
+
+    /// The factored form in double-double of every entry (and block) of `request` that is not
+    /// structurally zero.
+    pub fn factors(params: &Params, request: &Request) -> Vec<EntryFactors> {
+        let reference = ReferenceModel::new(params);
+        let mass = abs_matrix(reference.mass());
+        let stiffness = abs_matrix(reference.stiffness());
+        // T^T on forcing rows, C T on observation columns.
+        let to_abs_rows = |col: [Dd; 8]| -> [Dd; 8] {
+            let mut out = col;
+            for (a, b) in PAIRS {
+                out[a] = col[a] - col[b];
+            }
+            out
+        };
+        let obs: Vec<[Dd; 8]> = request
+            .outputs
+            .iter()
+            .map(|o| {
+                let row = reference.observation()[o.index()];
+                let mut out = row;
+                for (a, b) in PAIRS {
+                    out[a] = row[a] - row[b];
+                }
+                out
+            })
+            .collect();
+        let forcing: Vec<([Dd; 8], [Dd; 8])> = request
+            .inputs
+            .iter()
+            .map(|input| match input {
+                Input::Tilt(t) => (
+                    to_abs_rows(std::array::from_fn(|r| reference.tilt_g0()[r][t.index()])),
+                    to_abs_rows(std::array::from_fn(|r| reference.tilt_g2()[r][t.index()])),
+                ),
+                Input::Force(f) => (
+                    to_abs_rows(std::array::from_fn(|r| {
+                        reference.force_matrix()[r][f.index()]
+                    })),
+                    [Dd::ZERO; 8],
+                ),
+            })
+            .collect();
+        let mut out = Vec::new();
+        for block in Block::ALL {
+            let idx = block.coords().map(Coord::index);
+            let data = BlockData {
+                mass: std::array::from_fn(|r| std::array::from_fn(|c| mass[idx[r]][idx[c]])),
+                stiffness: std::array::from_fn(|r| {
+                    std::array::from_fn(|c| stiffness[idx[r]][idx[c]])
+                }),
+                idx,
+            };
+            let mut a: Vec<Vec<Poly>> = (0..5)
+                .map(|r| {
+                    (0..5)
+                        .map(|c| {
+                            if r < 4 && c < 4 {
+                                lin(data.stiffness[r][c], CDd::real(-data.mass[r][c]))
+                            } else {
+                                Poly::zero()
+                            }
+                        })
+                        .collect()
+                })
+                .collect();
+            let all: Vec<usize> = (0..4).collect();
+            let p = det(&a, &all, &all);
+            let poles = roots(&p.c);
+            let mut poles_sorted = poles;
+            poles_sorted.sort_by(|x, y| x.re.hi.total_cmp(&y.re.hi));
+            let undamped_block = p.c.iter().all(|c| c.im.is_zero());
+            if undamped_block {
+                symmetrize(&mut poles_sorted);
+            }
+            let det_m = p.c[4];
+            for (o, c_row) in obs.iter().enumerate() {
+                let c_b: [Dd; 4] = std::array::from_fn(|k| c_row[data.idx[k]]);
+                if c_b.iter().all(|x| x.is_zero()) {
+                    continue;
+                }
+                for (i, (g0, g2)) in forcing.iter().enumerate() {
+                    let g0b: [Dd; 4] = std::array::from_fn(|k| g0[data.idx[k]]);
+                    let g2b: [Dd; 4] = std::array::from_fn(|k| g2[data.idx[k]]);
+                    if g0b.iter().chain(&g2b).all(|x| x.is_zero()) {
+                        continue;
+                    }
+                    for k in 0..4 {
+                        a[k][4] = lin(CDd::real(g0b[k]), CDd::real(g2b[k]));
+                        a[4][k] = lin(CDd::real(c_b[k]), CDd::ZERO);
+                    }
+                    let rows: Vec<usize> = (0..5).collect();
+                    let mut n = det(&a, &rows, &rows);
+                    for c in n.c.iter_mut() {
+                        *c = -*c;
+                    }
+                    let mut cancelled = Vec::new();
+                    for (k, (c, m)) in n.c.iter_mut().zip(&n.mag).enumerate() {
+                        let rel = c.abs_f64() / m;
+                        if !c.is_zero() && rel <= ZERO_REL {
+                            cancelled.push((k, rel));
+                            *c = CDd::ZERO;
+                        }
+                    }
+                    let Some(top) = n.c.iter().rposition(|c| !c.is_zero()) else {
+                        continue;
+                    };
+                    let power = n.c.iter().position(|c| !c.is_zero()).unwrap_or(0);
+                    let reduced = &n.c[power..=top];
+                    let mut zeros = roots(reduced);
+                    if reduced.iter().all(|c| c.im.is_zero()) {
+                        symmetrize(&mut zeros);
+                    }
+                    let nz = zeros.len();
+                    let sign = if nz % 2 == 1 { -1.0 } else { 1.0 };
+                    let gain = (n.c[top] / det_m).scale(Dd::from_f64(sign));
+                    out.push(EntryFactors {
+                        output: o,
+                        input: i,
+                        block,
+                        gain,
+                        power: power as u32,
+                        zeros,
+                        poles: poles_sorted.clone(),
+                        cancelled,
+                    });
+                }
+            }
+        }
+        out
+    }
+}
+
+impl RealBlock {
+    // Lane loops index several arrays in step: written for the vectorizer.
+    #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
+    fn eval(&self, s: f64, freq_hz: f64, out: &mut [Complex64]) -> Result<(), TfError> {
+        let d: [f64; 4] = std::array::from_fn(|k| self.poles[k] - s);
+        if (0..4).any(|k| d[k].abs() < self.thresholds[k]) {
+            return Err(self.singular(s, freq_hz));
+        }
+        let inv = 1.0 / ((d[0] * d[1]) * (d[2] * d[3]));
+        for c in &self.chunks {
+            // 1 - s / z: relative error ~ 1.5 eps |z| / |z - s| (the rounding of 1 / z and of
+            // the product), as z - s with z rounded to f64.
+            // The numerator first, the denominator's reciprocal last: its division overlaps.
+            let mut h: [f64; LANES] = c.gain;
+            for k in 0..4 {
+                for l in 0..LANES {
+                    h[l] *= c.a[k][l] + c.b[k][l] * s;
+                }
+            }
+            for l in 0..LANES {
+                h[l] *= inv;
+            }
+            for l in 0..LANES {
+                out[c.at[l]].re += h[l];
+            }
+        }
+        Ok(())
+    }
+
+    #[cold]
+    fn singular(&self, s: f64, freq_hz: f64) -> TfError {
+        let rcond = self
+            .poles
+            .iter()
+            .map(|&l| (l - s).abs() / l)
+            .fold(f64::INFINITY, f64::min);
+        TfError::Singular { freq_hz, rcond }
+    }
+}
+
+impl ComplexBlock {
+    #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
+    fn eval(&self, s: f64, freq_hz: f64, out: &mut [Complex64]) -> Result<(), TfError> {
+        let d: [Complex64; 4] = std::array::from_fn(|k| self.poles[k] - s);
+        if (0..4).any(|k| d[k].norm_sqr() < self.thresholds[k]) {
+            return Err(self.singular(s, freq_hz));
+        }
+        let den = (d[0] * d[1]) * (d[2] * d[3]);
+        let inv = den.conj() / den.norm_sqr();
+        for c in &self.chunks {
+            let mut re: [f64; LANES] = c.gain_re;
+            let mut im: [f64; LANES] = c.gain_im;
+            for k in 0..4 {
+                for l in 0..LANES {
+                    let fr = c.a_re[k][l] + c.b_re[k][l] * s;
+                    let fi = c.a_im[k][l] + c.b_im[k][l] * s;
+                    let r = re[l] * fr - im[l] * fi;
+                    im[l] = re[l] * fi + im[l] * fr;
+                    re[l] = r;
+                }
+            }
+            for l in 0..LANES {
+                let r = re[l] * inv.re - im[l] * inv.im;
+                im[l] = re[l] * inv.im + im[l] * inv.re;
+                re[l] = r;
+            }
+            for l in 0..LANES {
+                out[c.at[l]] += Complex64::new(re[l], im[l]);
+            }
+        }
+        Ok(())
+    }
+
+    #[cold]
+    fn singular(&self, s: f64, freq_hz: f64) -> TfError {
+        let rcond = self
+            .poles
+            .iter()
+            .map(|&l| (l - s).norm() / l.norm())
+            .fold(f64::INFINITY, f64::min);
+        TfError::Singular { freq_hz, rcond }
+    }
+}
+
+fn avx_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+impl PoleZero {
+    #[inline(always)]
+    fn eval_blocks(&self, s: f64, freq_hz: f64, out: &mut [Complex64]) -> Result<(), TfError> {
+        out.fill(Complex64::new(0.0, 0.0));
+        for b in &self.blocks {
+            match b {
+                BlockForm::Real(r) => r.eval(s, freq_hz, out)?,
+                BlockForm::Complex(c) => c.eval(s, freq_hz, out)?,
+            }
+        }
+        Ok(())
+    }
+
+    /// [`PoleZero::eval_blocks`] compiled for AVX: the same operations in the same order (no
+    /// fused multiply-add), so the results are bit-identical to the baseline build's.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn eval_blocks_avx(&self, s: f64, freq_hz: f64, out: &mut [Complex64]) -> Result<(), TfError> {
+        self.eval_blocks(s, freq_hz, out)
+    }
+}
+
+impl TransferFunction for PoleZero {
+    fn method(&self) -> Method {
+        Method::PoleZero
+    }
+
+    fn request(&self) -> &Request {
+        &self.request
+    }
+
+    fn eval_into(&self, freq_hz: f64, out: &mut [Complex64]) -> Result<(), TfError> {
+        let s = omega_sq(freq_hz)?;
+        #[cfg(target_arch = "x86_64")]
+        if self.avx {
+            // SAFETY: `avx` is true only when the running CPU supports AVX (checked in `new`).
+            return unsafe { self.eval_blocks_avx(s, freq_hz, out) };
+        }
+        self.eval_blocks(s, freq_hz, out)
+    }
+}
