@@ -87,7 +87,13 @@ fn methods(c: &mut Criterion) {
         .warm_up_time(Duration::from_millis(300))
         .measurement_time(Duration::from_secs(1))
         .throughput(Throughput::Elements(n as u64));
-    for method in [Method::Direct, Method::Block, Method::Split, Method::Modal] {
+    for method in [
+        Method::Direct,
+        Method::Block,
+        Method::Split,
+        Method::PoleZero,
+        Method::Modal,
+    ] {
         let plan = tf::plan(&model, &request, method).expect("full-model methods plan 7x3 tilt");
         let plan = plan.as_ref();
         // One untimed pass: fails loudly if a grid point is singular for this method.
@@ -95,7 +101,7 @@ fn methods(c: &mut Criterion) {
         g.bench_function(format!("{}/1t", method.name()), |b| {
             b.iter(|| eval_grid(plan, black_box(&grid), block, black_box(&mut out)))
         });
-        if matches!(method, Method::Block | Method::Split) {
+        if matches!(method, Method::Block | Method::Split | Method::PoleZero) {
             g.bench_function(format!("{}/2t", method.name()), |b| {
                 b.iter(|| eval_grid_2t(plan, black_box(&grid), block, black_box(&mut out)))
             });

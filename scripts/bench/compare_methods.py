@@ -48,9 +48,9 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
-METHODS = ("direct", "block", "split", "modal")
-TWO_THREAD = ("block", "split")
-ACCURATE = "split"
+METHODS = ("direct", "block", "split", "polezero", "modal")
+TWO_THREAD = ("block", "split", "polezero")
+ACCURATE = "polezero"
 GROUP = "methods_7x3_tilt"
 LINE = re.compile(r"test\s+" + GROUP + r"/(\w+)/(\dt)\s+\.\.\.\s+bench:\s+([\d,]+)\s+ns/iter")
 
