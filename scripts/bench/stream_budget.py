@@ -24,7 +24,6 @@ the script prints that estimate next to the measurement.
 """
 
 import argparse
-import hashlib
 import os
 import shutil
 import statistics
@@ -38,6 +37,7 @@ REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
 sys.dont_write_bytecode = True  # no __pycache__ inside the repository
 sys.path.insert(0, HERE)
 import make_inputs  # noqa: E402
+from compare_budget import snapshot  # noqa: E402
 
 
 def run(gnu_time, cmd):
@@ -52,19 +52,6 @@ def run(gnu_time, cmd):
             sys.exit(2)
         rss_kb, user, sys_s = out.read().split()[-3:]
     return wall, int(rss_kb), float(user), float(sys_s)
-
-
-def snapshot(binary, outdir):
-    """Copies the binary into outdir and returns the copy: a concurrent `cargo build` cannot
-    swap it in the middle of the measurement, and profiles stay symbolizable."""
-    os.makedirs(outdir, exist_ok=True)
-    copy = os.path.join(outdir, "tiltnoise.snapshot")
-    shutil.copy2(binary, copy)
-    with open(copy, "rb") as fh:
-        digest = hashlib.sha256(fh.read()).hexdigest()[:12]
-    built = time.strftime("%Y-%m-%d %H:%M", time.localtime(os.path.getmtime(binary)))
-    print(f"binary {binary} (built {built}, sha256 {digest}), measured as {copy}")
-    return copy
 
 
 def main():
@@ -104,7 +91,8 @@ def main():
 
     n_bins = args.nperseg // 2
     n_seg = int(n // round(args.segment_duration * 10.0))
-    est = n_seg * n_bins * (3 * 4 + 8) / 1e6
+    # f32 tilt PSD per segment, bin and observable; the band reads them in place (no f64 copy).
+    est = n_seg * n_bins * 3 * 4 / 1e6
     print(f"{args.runs} alternating runs each after one warm-up; {os.cpu_count()} CPUs; "
           f"{time.strftime('%Y-%m-%d')}")
     print()
@@ -119,7 +107,7 @@ def main():
               f"{n / wall / 1e6:11.2f} {3 * n / wall / 1e6:10.2f} {size / wall / 1e6:7.1f}")
     print("  (samples = per channel; values = samples x 3 axes; MB = 1e6 bytes of the input file)")
     print(f"  hourly run: {n_seg} segments x {n_bins} bins; per-segment tilt PSDs kept as f32 for 3 "
-          f"observables + one f64 copy during the band: estimate {est:.0f} MB of heap on top of the base")
+          f"observables: estimate {est:.0f} MB of heap on top of the base")
     peak_mb = max(r[1] for r in res["hourly"]) * 1024 / 1e6
     ok = peak_mb <= args.limit_mb
     print(f"peak RSS of the hourly run {peak_mb:.1f} MB, limit {args.limit_mb:g} MB: {'met' if ok else 'MISSED'}")
