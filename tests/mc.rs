@@ -1,7 +1,6 @@
 //! Monte Carlo of the normal modes: reproducibility across thread counts, the zero-sigma limit,
 //! first-order error propagation, Table II's calculated column, refusals and speed.
 
-use std::time::Instant;
 use tiltnoise::mc::{
     default_uncertainties, run, Distribution, McConfig, McError, McResult, Uncertainty,
 };
@@ -265,20 +264,4 @@ fn non_physical_draws_are_rejected_and_counted() {
     );
     assert!((frac - 0.289).abs() < 0.05, "{frac}");
     assert_eq!(r.freqs_hz.len(), 2000 - r.rejected);
-}
-
-#[test]
-fn time_for_1e5_samples_on_two_threads() {
-    let p = Params::table_i();
-    // Target (issue 5): at most 5 s in a release build on two cores.
-    let n = 100_000;
-    let c = cfg(n, 12345, 2, default_uncertainties(&p));
-    let t0 = Instant::now();
-    let r = run_ok(&p, &c);
-    let dt = t0.elapsed().as_secs_f64();
-    println!(
-        "{n} samples on 2 threads: {dt:.3} s ({:.2} us/sample/thread), {} rejected",
-        dt * 2.0 / n as f64 * 1e6,
-        r.rejected
-    );
 }

@@ -11,7 +11,6 @@
 //! Run with `cargo test --release --test polezero -- --nocapture` to see the numbers.
 
 use num_complex::Complex64;
-use std::time::Instant;
 use tiltnoise::error::TfError;
 use tiltnoise::model::{ForceInput, Model, Observable, TiltAxis};
 use tiltnoise::params::Params;
@@ -296,58 +295,4 @@ fn undamped_pole_is_singular() {
     let split = plan(&model, &Request::all_tilt(), Method::Split).unwrap();
     assert!(matches!(split.eval(f), Err(TfError::Singular { .. })));
     assert!(split.eval(f * 1.001).is_ok());
-}
-
-#[test]
-fn speed_7x3_tilt() {
-    let n = 100_000;
-    let freqs: Vec<f64> = (0..n)
-        .map(|k| 1e-5 * (1e7f64).powf(k as f64 / (n - 1) as f64))
-        .collect();
-    for (name, params) in [
-        ("undamped", Params::table_i()),
-        ("damped", damped(Params::table_i())),
-    ] {
-        let model = Model::new(&params).unwrap();
-        let t0 = Instant::now();
-        let tf = plan(&model, &Request::all_tilt(), Method::PoleZero).unwrap();
-        let t_plan = t0.elapsed();
-        let mut out = vec![Complex64::new(0.0, 0.0); 21 * n];
-        let mut best = f64::INFINITY;
-        for _ in 0..5 {
-            let t = Instant::now();
-            for (f, o) in freqs.iter().zip(out.chunks_exact_mut(21)) {
-                // Grid points on an undamped resonance would be singular; none here.
-                let _ = tf.eval_into(*f, o);
-            }
-            best = best.min(t.elapsed().as_secs_f64() * 1e9 / n as f64);
-        }
-        std::hint::black_box(&out);
-        // The same evaluations into one 21-value buffer (stays in cache): the arithmetic alone.
-        let mut one = [Complex64::new(0.0, 0.0); 21];
-        let mut best_cached = f64::INFINITY;
-        for _ in 0..5 {
-            let t = Instant::now();
-            for f in &freqs {
-                let _ = tf.eval_into(*f, &mut one);
-                std::hint::black_box(&one);
-            }
-            best_cached = best_cached.min(t.elapsed().as_secs_f64() * 1e9 / n as f64);
-        }
-        // The loop alone (a trivial write per point), for scale.
-        let mut best_loop = f64::INFINITY;
-        for _ in 0..5 {
-            let t = Instant::now();
-            for f in &freqs {
-                one[0] = Complex64::new(*f * *f, 0.0);
-                std::hint::black_box(&one);
-            }
-            best_loop = best_loop.min(t.elapsed().as_secs_f64() * 1e9 / n as f64);
-        }
-        println!(
-            "polezero 7x3 tilt, {name}: {best:.1} ns/point into a 1e5-point buffer, \
-             {best_cached:.1} ns/point into one reused buffer, loop alone {best_loop:.1} ns \
-             (plan {t_plan:?})"
-        );
-    }
 }

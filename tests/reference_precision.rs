@@ -23,7 +23,6 @@ mod common;
 
 use common::{floats, json};
 use num_complex::Complex64;
-use std::time::Instant;
 use tiltnoise::error::{FreqError, TfError};
 use tiltnoise::model::{ForceInput, Model, Observable, TiltAxis};
 use tiltnoise::params::Params;
@@ -834,30 +833,4 @@ fn rejects_invalid_frequencies_like_direct() {
         assert!(reference.entry_condition(&request, f).is_err());
         assert!(reference.condition_number(f).is_err());
     }
-}
-
-/// Test 6: speed of the reference (not asserted).
-#[test]
-fn reference_timing() {
-    let reference = ReferenceModel::new(&Params::table_i());
-    let request = Request::all_tilt();
-    let grid = log_grid(1e-4, 30.0, 2000);
-    let start = Instant::now();
-    let mut sink = 0.0;
-    for &f in &grid {
-        sink += reference.eval(&request, f).unwrap()[1].norm();
-    }
-    let per_point = start.elapsed().as_nanos() as f64 / grid.len() as f64;
-    let model = Model::new(&Params::table_i()).unwrap();
-    let direct = plan(&model, &request, Method::Direct).unwrap();
-    let start = Instant::now();
-    for &f in &grid {
-        sink += direct.eval(f).unwrap()[1].norm();
-    }
-    let direct_per_point = start.elapsed().as_nanos() as f64 / grid.len() as f64;
-    println!(
-        "reference: {per_point:.0} ns per evaluation of the 7 x 3 tilt matrix ({:.0}x the direct \
-         method's {direct_per_point:.0} ns) [checksum {sink:e}]",
-        per_point / direct_per_point
-    );
 }
