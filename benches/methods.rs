@@ -3,12 +3,20 @@
 //! on a log-spaced grid from 1e-5 to 100 Hz.
 //!
 //! Group `methods_7x3_tilt`, one benchmark per method and thread count:
-//! * `direct/1t`, `block/1t`, `split/1t`, `modal/1t`: one thread, `eval_into` at every grid
-//!   point into a preallocated `[freq][output][input]` buffer (what `tf::evaluate` does, minus
-//!   the allocation of the result);
-//! * `block/2t`, `split/2t`: the grid cut into two halves, the second half evaluated on a thread
-//!   spawned with `std::thread::scope` per iteration, the first on the calling thread (the spawn,
-//!   tens of microseconds, is included and is negligible against the milliseconds of a grid).
+//! * `direct/1t`, `block/1t`, `split/1t`, `polezero/1t`, `modal/1t`: one thread, `eval_into`
+//!   at every grid point into a preallocated `[freq][output][input]` buffer (point by point);
+//! * `block/2t`, `split/2t`, `polezero/2t`: the same with the grid cut into two halves, the
+//!   second half evaluated on a thread spawned with `std::thread::scope` per iteration, the
+//!   first on the calling thread (the spawn, tens of microseconds, is included and is
+//!   negligible against the milliseconds of a grid);
+//! * `polezero_batch/1t`: `TransferFunction::eval_grid_into` on the whole grid into the
+//!   preallocated buffer: what `tf::evaluate` does for `auto` (which picks `polezero` for the
+//!   7x3 tilt matrix), minus the allocation of the result. The output is the full complex 7x3
+//!   matrix at every point, structural zeros included, as NumPy's;
+//! * `polezero_evaluate/1t`: `tf::evaluate` itself, which also allocates the `TransferMatrix`
+//!   (34 MB of fresh pages at 1e5 points) and copies the grid;
+//! * `polezero_batch/2t`: `tf::eval_grid_threads(.., 2)`, the library's two-thread split of the
+//!   same call (a scoped thread per call, included).
 //!
 //! The plan (`tf::plan`: normal modes, block matrices, forcing forms) is built once, outside the
 //! timing; it is amortized over the grid. Throughput is in grid points, so ns per point is the
@@ -104,6 +112,26 @@ fn methods(c: &mut Criterion) {
         if matches!(method, Method::Block | Method::Split | Method::PoleZero) {
             g.bench_function(format!("{}/2t", method.name()), |b| {
                 b.iter(|| eval_grid_2t(plan, black_box(&grid), block, black_box(&mut out)))
+            });
+        }
+        if method == Method::PoleZero {
+            // What `tf::evaluate` (and so `auto`) does: the batch evaluation of the whole grid.
+            g.bench_function(format!("{}_batch/1t", method.name()), |b| {
+                b.iter(|| {
+                    plan.eval_grid_into(black_box(&grid), black_box(&mut out))
+                        .expect("no singular frequency on the grid")
+                })
+            });
+            // The same through `tf::evaluate`, which also allocates the result (fresh pages of
+            // 34 MB at 1e5 points) and copies the grid: what a caller of `evaluate` pays.
+            g.bench_function(format!("{}_evaluate/1t", method.name()), |b| {
+                b.iter(|| tf::evaluate(plan, black_box(&grid)).expect("no singular frequency"))
+            });
+            g.bench_function(format!("{}_batch/2t", method.name()), |b| {
+                b.iter(|| {
+                    tf::eval_grid_threads(plan, black_box(&grid), black_box(&mut out), 2)
+                        .expect("no singular frequency on the grid")
+                })
             });
         }
     }

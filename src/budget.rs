@@ -12,7 +12,8 @@ use crate::error::TfError;
 use crate::input::{InputError, TiltSeries, TiltSeriesSource, TiltSpectra};
 use crate::model::{Model, Observable, TiltAxis};
 use crate::noise::{
-    tilt_budget, Budget, BudgetReport, Readout, SegmentBand, SpectralSource, TiltCsd,
+    add_equivalent_response, add_thermal, tilt_budget, Budget, BudgetReport, Readout, SegmentBand,
+    SpectralSource, TiltCsd,
 };
 use crate::spectral::{Averaging, SpectralError, WelchAccumulator, WelchConfig};
 use crate::tf::{self, Input, Method, Request, TransferMatrix};
@@ -143,6 +144,19 @@ fn tilt_tf(
     tf::evaluate(plan.as_ref(), grid)
 }
 
+/// The terms of a damped model: `thermal`, `thermal.<element>` ([`crate::thermal`], added to
+/// `total`) and the `response.<input>` of the equivalent input noise
+/// ([`crate::noise::equivalent`]). Nothing for an undamped model.
+pub fn add_damping_terms(model: &Model, budget: &mut Budget) -> Result<(), TfError> {
+    if model.is_undamped() {
+        return Ok(());
+    }
+    let outputs: Vec<Observable> = budget.observables.iter().map(|b| b.observable).collect();
+    let thermal = crate::thermal::thermal_noise(model, &outputs, &budget.freqs_hz)?;
+    add_thermal(budget, &thermal);
+    add_equivalent_response(budget, model)
+}
+
 /// Drops the DC bin (index 0) of a Welch CSD: the budget is shown on log axes, and detrending
 /// removed the mean anyway.
 fn without_dc(csd: &[num_complex::Complex64], n: usize) -> &[num_complex::Complex64] {
@@ -250,7 +264,7 @@ pub fn budget_from_series(
         Some(tf) => tf,
         None => tilt_tf(model, &opts.outputs, &axes, grid)?,
     };
-    let budget = tilt_budget(
+    let mut budget = tilt_budget(
         &tf,
         &TiltCsd {
             axes: &axes,
@@ -267,6 +281,7 @@ pub fn budget_from_series(
         ));
     }
     let segment_bands = band_per_observable(&opts.outputs, &segment_tilt, opts.percentiles);
+    add_damping_terms(model, &mut budget)?;
     Ok(BudgetReport {
         budget,
         segment_duration_s: segment_samples
@@ -330,7 +345,7 @@ pub fn budget_from_spectra(
         }
     }
     let tf = tilt_tf(model, &opts.outputs, &on_grid.axes, &grid)?;
-    let budget: Budget = tilt_budget(
+    let mut budget: Budget = tilt_budget(
         &tf,
         &TiltCsd {
             axes: &on_grid.axes,
@@ -338,6 +353,7 @@ pub fn budget_from_spectra(
         },
         &opts.readout,
     );
+    add_damping_terms(model, &mut budget)?;
     Ok(BudgetReport {
         budget,
         segment_bands: Vec::new(),

@@ -3,12 +3,11 @@
 //! Everything printed goes to stdout; errors are returned to `main`.
 
 use crate::freq;
-use crate::io::{save_tf, RunMeta, TOOL_VERSION};
 use crate::model::Model;
 use crate::modes::NormalModes;
 use crate::params::Params;
-use crate::tf::{self, Method, Request};
-use anyhow::{Context, Result};
+use crate::tf::{Method, Request};
+use anyhow::Result;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 
@@ -44,10 +43,18 @@ enum Command {
         #[arg(long, value_enum, default_value_t = Format::Table)]
         format: Format,
     },
-    /// Transfer functions from floor tilt (theta_t, eta_t, phi_t) to the 7 observables.
-    Tf(TfArgs),
+    /// Transfer functions from floor tilt (theta_t, eta_t, phi_t) and/or forces and torques
+    /// (F_a.x .. M_b.z) to the observables.
+    Tf(crate::cli_tf::TfArgs),
     /// Noise budget of X, phi, phi_a from measured floor tilt (time series or spectra).
     Budget(BudgetArgs),
+    /// Free motion of the undamped model (exact modal propagation, 12 h at 0.1 s by default)
+    /// with readout noise: ASDs as in Figure 3, the resonance check against the mode
+    /// observability table, the X kick of Figures 4 and 5, HDF5 series the budget reads.
+    Simulate(crate::cli_simulate::SimulateArgs),
+    /// Constrained least-squares fit of chosen parameters, within their error bars, to measured
+    /// mode frequencies (default: Table II's measured column).
+    Fit(crate::cli_fit::FitArgs),
     /// Monte Carlo of the normal modes over the parameter uncertainties (default: Gaussian,
     /// 2.5 % on masses, lengths, inertias; 10 % on torsion and bouncing constants; g, h exact).
     Mc {
@@ -63,6 +70,9 @@ enum Command {
         /// Output format on the terminal.
         #[arg(long, value_enum, default_value_t = Format::Table)]
         format: Format,
+        /// Histograms (.png, .svg) or all draws (.h5), repeatable; see docs/schemas.md.
+        #[arg(long, value_name = "PATH")]
+        save: Vec<PathBuf>,
     },
     /// Every evaluation method's worst error against the double-double reference and its time
     /// per point, for the 7x3 tilt matrix on the given grid (table, JSON, chart).
@@ -116,8 +126,10 @@ pub(crate) struct BudgetArgs {
     /// restricted to the band the data cover.
     #[arg(long, value_name = "FLO:N:FHI")]
     pub(crate) freq: Option<String>,
-    /// Measured spectrum of the observables for comparison: CSV `freq_hz,X[,phi,phi_a]`, one-sided
-    /// ASD (m/sqrt(Hz), rad/sqrt(Hz)); adds the terms `measured` and `residual`.
+    /// Measured record of the observables for comparison: CSV `freq_hz,X[,phi,phi_a]` of
+    /// one-sided ASDs (m/sqrt(Hz), rad/sqrt(Hz)), or a time series (HDF5 as written by
+    /// `tiltnoise simulate`, or CSV `time_s,X,...` in m, rad) turned into ASDs with the
+    /// budget's Welch settings; adds the terms `measured` and `residual`.
     #[arg(long, value_name = "FILE")]
     pub(crate) measured: Option<PathBuf>,
     /// Output file (.h5, .csv, .png, .svg), repeatable.
@@ -171,27 +183,6 @@ impl MethodArg {
     }
 }
 
-#[derive(Debug, Args)]
-struct TfArgs {
-    /// Log-spaced grid FLO:N:FHI (Hz:count:Hz), e.g. 1e-4:2000:30. Default: 0.1 mHz to 30 Hz,
-    /// 2000 points, plus points around every resonance.
-    #[arg(long, value_name = "FLO:N:FHI", conflicts_with = "freq_file")]
-    freq: Option<String>,
-    /// File with one frequency in Hz per line (# comments allowed).
-    #[arg(long, value_name = "FILE")]
-    freq_file: Option<PathBuf>,
-    /// Output file, format from the extension: .h5 (all numbers), .csv, .png/.svg (Figure 5).
-    /// Repeatable. Without --save the CSV goes to stdout.
-    #[arg(long, value_name = "PATH")]
-    save: Vec<PathBuf>,
-    /// Evaluation method.
-    #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
-    method: MethodArg,
-    /// Say which method `auto` picked and why (every candidate's measured error).
-    #[arg(long)]
-    explain: bool,
-}
-
 impl ParamArgs {
     fn resolve(&self) -> Result<Params> {
         let mut params = match &self.params {
@@ -222,78 +213,28 @@ pub fn run(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
-        Command::Tf(args) => run_tf(&params, args),
+        Command::Tf(args) => crate::cli_tf::run_tf(&params, args),
         Command::Budget(args) => crate::cli_budget::run_budget(&params, args),
+        Command::Simulate(args) => crate::cli_simulate::run_simulate(&params, args),
+        Command::Fit(args) => crate::cli_fit::run_fit(&params, args),
         Command::Methods { freq, format, save } => run_methods(&params, &freq, format, &save),
         Command::Mc {
             samples,
             seed,
             threads,
             format,
-        } => run_mc(&params, samples, seed, threads, format),
+            save,
+        } => crate::cli_mc::run_mc(
+            &params,
+            crate::cli_mc::McOptions {
+                samples,
+                seed,
+                threads,
+                json: format == Format::Json,
+                save,
+            },
+        ),
     }
-}
-
-fn run_tf(params: &Params, args: TfArgs) -> Result<()> {
-    let model = Model::new(params)?;
-    let freqs = match (&args.freq, &args.freq_file) {
-        (Some(spec), _) => freq::parse_spec(spec)?,
-        (None, Some(path)) => freq::read_freq_file(path)?,
-        (None, None) => freq::default_grid(&model),
-    };
-    // Check every output's format before computing, so a typo costs nothing.
-    for path in &args.save {
-        crate::io::OutputKind::from_path(path)?;
-    }
-    let request = Request::all_tilt();
-    let method = match args.method.fixed() {
-        Some(m) => m,
-        None => {
-            let positive: Vec<f64> = freqs.iter().copied().filter(|&f| f > 0.0).collect();
-            let band = match positive.is_empty() {
-                true => (crate::freq::DEFAULT_F_LO_HZ, crate::freq::DEFAULT_F_LO_HZ),
-                false => (
-                    positive.iter().copied().fold(f64::INFINITY, f64::min),
-                    positive.iter().copied().fold(0.0, f64::max),
-                ),
-            };
-            let scene = crate::scene::Scene {
-                request: request.clone(),
-                band_hz: band,
-                rel_tol: crate::scene::DEFAULT_REL_TOL,
-            };
-            let choice = crate::scene::choose(&model, &scene).map_err(anyhow::Error::msg)?;
-            if args.explain {
-                eprintln!("{}", choice.explain());
-            }
-            choice.method
-        }
-    };
-    let plan = tf::plan(&model, &request, method)?;
-    let tf = tf::evaluate(plan.as_ref(), &freqs).context("evaluating the transfer functions")?;
-    let modes = NormalModes::new(&model);
-    if args.save.is_empty() {
-        print!("{}", crate::io::tf_csv_string(&tf));
-        return Ok(());
-    }
-    let meta = RunMeta {
-        tool_version: TOOL_VERSION.to_string(),
-        params_toml: params.to_toml(),
-        command_line: std::env::args().collect::<Vec<_>>().join(" "),
-        modes: modes
-            .modes
-            .iter()
-            .map(|m| (m.index, m.frequency_hz))
-            .collect(),
-    };
-    print!("{}", crate::report::modes_table(&modes));
-    println!();
-    print!("{}", crate::report::static_limits(&model));
-    for path in &args.save {
-        save_tf(path, &tf, &meta)?;
-        println!("wrote {}", path.display());
-    }
-    Ok(())
 }
 
 fn run_methods(params: &Params, spec: &str, format: Format, save: &[PathBuf]) -> Result<()> {
@@ -395,76 +336,6 @@ fn run_methods(params: &Params, spec: &str, format: Format, save: &[PathBuf]) ->
             path,
         )?;
         println!("wrote {}", path.display());
-    }
-    Ok(())
-}
-
-fn run_mc(
-    params: &Params,
-    samples: usize,
-    seed: u64,
-    threads: usize,
-    format: Format,
-) -> Result<()> {
-    use std::io::IsTerminal;
-    let cfg = crate::mc::McConfig {
-        samples,
-        seed,
-        threads,
-        ..crate::mc::McConfig::default_for(params)
-    };
-    let bar = (std::io::stderr().is_terminal() && samples >= 10_000)
-        .then(|| indicatif::ProgressBar::new(samples as u64));
-    let result = crate::mc::run(params, &cfg, &|done| {
-        if let Some(b) = &bar {
-            b.set_position(done as u64);
-        }
-    })?;
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
-    let nominal = NormalModes::new(&Model::new(params)?).frequencies_hz();
-    match format {
-        Format::Json => {
-            let modes: Vec<_> = (0..8)
-                .map(|k| {
-                    serde_json::json!({
-                        "index": k + 1,
-                        "nominal_hz": nominal[k],
-                        "mean_hz": result.mean_hz[k],
-                        "std_hz": result.std_hz[k],
-                    })
-                })
-                .collect();
-            println!(
-                "{}",
-                serde_json::to_string_pretty(&serde_json::json!({
-                    "samples": result.samples,
-                    "rejected": result.rejected,
-                    "seed": seed,
-                    "modes": modes,
-                }))?
-            );
-        }
-        Format::Table => {
-            println!(
-                "Monte Carlo of the normal modes: {} draws ({} rejected as non-physical), seed {seed}",
-                result.samples, result.rejected
-            );
-            println!(
-                "{:<5} {:>14} {:>14} {:>12}",
-                "mode", "nominal (Hz)", "mean (Hz)", "std (Hz)"
-            );
-            for (k, f0) in nominal.iter().enumerate() {
-                println!(
-                    "nu_{:<2} {:>14.6e} {:>14.6e} {:>12.3e}",
-                    k + 1,
-                    f0,
-                    result.mean_hz[k],
-                    result.std_hz[k]
-                );
-            }
-        }
     }
     Ok(())
 }

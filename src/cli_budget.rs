@@ -87,24 +87,35 @@ fn read_options(args: &BudgetArgs) -> Result<ReadOptions> {
 }
 
 fn summary(report: &BudgetReport) -> String {
-    let mut s = String::from("tilt-noise budget (one-sided ASD):\n");
+    let mut s = String::from("noise budget (one-sided ASD):\n");
     let b = &report.budget;
+    let damped = b.observables.iter().any(|ob| ob.term("thermal").is_some());
     for ob in &b.observables {
         let unit = format!("{}/sqrt(Hz)", ob.observable.unit());
         for f in SUMMARY_FREQS_HZ {
-            let tilt = loglog_at(&b.freqs_hz, &ob.term("tilt").expect("tilt term").psd, f);
-            let total = loglog_at(&b.freqs_hz, &ob.total().psd, f);
-            if let (Some(t), Some(tot)) = (tilt, total) {
+            let at = |name: &str| {
+                ob.term(name)
+                    .and_then(|t| loglog_at(&b.freqs_hz, &t.psd, f))
+                    .map(f64::sqrt)
+            };
+            if let (Some(t), Some(tot)) = (at("tilt"), at("total")) {
+                let thermal = at("thermal")
+                    .map(|th| format!("thermal {th:.3e}  "))
+                    .unwrap_or_default();
                 let _ = writeln!(
                     s,
-                    "  {:<6} at {:>4} mHz: tilt {:.3e}  total {:.3e} {unit}",
+                    "  {:<6} at {:>4} mHz: tilt {t:.3e}  {thermal}total {tot:.3e} {unit}",
                     ob.observable.name(),
                     f * 1e3,
-                    t.sqrt(),
-                    tot.sqrt()
                 );
             }
         }
+    }
+    if !damped {
+        s.push_str(
+            "thermal: none (undamped model: every loss angle and viscous coefficient is 0; \
+             see docs/damping.md)\n",
+        );
     }
     for note in &report.notes {
         let _ = writeln!(s, "note: {note}");
@@ -201,32 +212,126 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs) -> Result<()> {
     Ok(())
 }
 
-/// Interpolates a measured ASD file log-log onto the budget grid (NaN where it does not reach)
-/// and adds the `measured` and `residual` terms.
+/// Adds the `measured` and `residual` terms from `--measured FILE`: a CSV of ASDs is
+/// interpolated log-log onto the budget grid (NaN where it does not reach); a time series of
+/// the observables (HDF5 from `tiltnoise simulate`, or CSV `time_s,...`) is first turned into
+/// one-sided PSDs by [`measured_series_psd`].
 fn add_measured_file(report: &mut BudgetReport, path: &std::path::Path) -> Result<()> {
-    let measured = crate::input::read_measured(path)?;
-    for (o, asd) in &measured.asd {
+    use crate::input::MeasuredInput;
+    let (freqs_hz, psds, what) = match crate::input::read_measured_input(path)? {
+        MeasuredInput::Spectra(m) => {
+            let psds = m
+                .asd
+                .iter()
+                .map(|(o, asd)| (*o, asd.iter().map(|a| a * a).collect()))
+                .collect();
+            (m.freqs_hz, psds, "measured spectrum".to_string())
+        }
+        MeasuredInput::Series(series) => measured_series_psd(&series, &report.source)
+            .with_context(|| format!("--measured {}", path.display()))?,
+    };
+    let grid = report.budget.freqs_hz.clone();
+    // Same grid when the budget's bins are bins 1.. of the measured Welch grid (the budget
+    // drops DC): compared to 4 eps relative, the rounding of k fs / N computed two ways.
+    let same_grid = freqs_hz.len() > grid.len()
+        && grid
+            .iter()
+            .zip(&freqs_hz[1..])
+            .all(|(a, b)| (a - b).abs() <= 4.0 * f64::EPSILON * a.abs());
+    let mut used = Vec::new();
+    for (o, psd) in &psds {
         if report.budget.observable(*o).is_none() {
             continue;
         }
-        let psd: Vec<f64> = asd.iter().map(|a| a * a).collect();
-        let on_grid = report
-            .budget
-            .freqs_hz
-            .iter()
-            .map(|&f| loglog_at(&measured.freqs_hz, &psd, f).unwrap_or(f64::NAN))
-            .collect();
+        let on_grid = if same_grid {
+            psd[1..=grid.len()].to_vec()
+        } else {
+            grid.iter()
+                .map(|&f| loglog_at(&freqs_hz, psd, f).unwrap_or(f64::NAN))
+                .collect()
+        };
         crate::noise::add_measured(&mut report.budget, *o, on_grid);
+        used.push(o.name());
     }
-    let (lo, hi) = (
-        measured.freqs_hz[0],
-        measured.freqs_hz[measured.freqs_hz.len() - 1],
-    );
+    let (lo, hi) = (freqs_hz[0], freqs_hz[freqs_hz.len() - 1]);
     report.notes.push(format!(
-        "measured spectrum {} covers {lo:e} .. {hi:e} Hz (NaN outside)",
-        path.display()
+        "{what} {} ({}) covers {lo:e} .. {hi:e} Hz (NaN outside); {}",
+        path.display(),
+        if used.is_empty() {
+            "no budgeted observable".to_string()
+        } else {
+            used.join(", ")
+        },
+        if same_grid {
+            "on the budget's own grid"
+        } else {
+            "interpolated log-log onto the budget grid"
+        }
     ));
     Ok(())
+}
+
+/// A measured record on its own grid: frequencies (Hz), one-sided PSD per observable
+/// (unit^2/Hz), and a description for the budget's notes.
+type MeasuredPsds = (Vec<f64>, Vec<(Observable, Vec<f64>)>, String);
+
+/// One-sided PSDs (unit^2/Hz) of a measured time series with the budget's own Welch settings:
+/// the same segment duration (`segment_len * fs_measured / fs_budget` samples, rounded), the
+/// same overlap fraction and averaging, periodic Hann, constant detrend. For a budget from
+/// spectra (no Welch settings): the budget's default segment for the series' length, 50 %
+/// overlap, mean. Returns the Welch grid (with DC), the PSDs and a description for the notes.
+fn measured_series_psd(
+    series: &crate::input::MeasuredSeries,
+    source: &crate::noise::SpectralSource,
+) -> Result<MeasuredPsds> {
+    use crate::spectral::{welch, WelchConfig};
+    let fs = series.sample_rate_hz;
+    let n = series.channels[0].1.len();
+    let cfg = match source {
+        crate::noise::SpectralSource::Welch {
+            sample_rate_hz,
+            segment_len,
+            overlap,
+            averaging,
+            ..
+        } => {
+            let seg = (*segment_len as f64 * fs / sample_rate_hz).round() as usize;
+            let ov = (*overlap as f64 / *segment_len as f64 * seg as f64).round() as usize;
+            if seg < 2 || seg > n {
+                bail!(
+                    "the measured series has {n} samples ({:.6e} s at {fs} Hz): the budget's \
+                     Welch segment of {:.6e} s needs {seg} samples at this rate; use a longer \
+                     record or a shorter --nperseg",
+                    n as f64 / fs,
+                    *segment_len as f64 / sample_rate_hz
+                );
+            }
+            WelchConfig::new(seg)
+                .with_overlap(ov.min(seg - 1))
+                .with_averaging(if averaging == "median" {
+                    Averaging::Median
+                } else {
+                    Averaging::Mean
+                })
+        }
+        crate::noise::SpectralSource::Spectra { .. } => {
+            WelchConfig::new(crate::budget::default_segment_len(n))
+        }
+    };
+    let mut freqs = Vec::new();
+    let mut psds = Vec::new();
+    let mut n_segments = 0;
+    for (o, x) in &series.channels {
+        let p = welch(x, fs, &cfg)?;
+        freqs = p.freqs_hz;
+        n_segments = p.n_segments;
+        psds.push((*o, p.psd));
+    }
+    let what = format!(
+        "measured series at {fs} Hz (Welch: {} samples per segment, overlap {}, {} segments)",
+        cfg.segment_len, cfg.overlap, n_segments
+    );
+    Ok((freqs, psds, what))
 }
 
 /// A progress bar on stderr when it is a terminal and the input is long enough to wait for.

@@ -7,9 +7,14 @@
 //! * Every draw is validated with [`Params::validate`] and [`Model::new`] (mass matrix positive
 //!   definite) and must give eight non-negative eigenvalues; a draw that fails is *rejected* and
 //!   counted, not redrawn.
-//! * A configuration whose error bar can make a parameter non-physical with non-negligible
-//!   probability is refused up front: `rel_sigma` must be below [`MAX_REL_SIGMA`] = 0.25 (4 sigma
-//!   must not reach zero; for a uniform draw the range `+/- sqrt(3) sigma` then stays below 44 %).
+//! * The error model is the parameter file's (see [`crate::params::uncertainty`]):
+//!   [`uncertainties`] merges its `[uncertainty]` table with [`default_uncertainties`].
+//! * A configuration whose error bar can make a parameter non-physical is refused up front:
+//!   `rel_sigma` must be below [`MAX_REL_SIGMA`] = 0.25 for a Gaussian (4 sigma must not reach
+//!   zero) and below 1/sqrt(3) for a uniform draw (its range `+/- sqrt(3) sigma` must not).
+//! * Only parameters that enter the undamped modes are drawn (masses, inertias, torsion and
+//!   bouncing constants, lengths, g); an error on any other (loss angles, damping, temperature)
+//!   is accepted and has no effect.
 //! * Reproducible: sample `i` has its own random stream derived from `(seed, i)`, so the result
 //!   is bit-identical for a given seed whatever the number of threads.
 //! * Per draw only the eigenvalues are computed, per decoupled 4x4 block (Cholesky reduction and
@@ -20,61 +25,21 @@
 
 use crate::error::ParamError;
 use crate::model::{Block, Model};
+use crate::params::uncertainty::{check, UncertaintyError};
 use crate::params::Params;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// Largest relative standard deviation accepted (exclusive): 4 sigma must stay below 100 %.
-pub const MAX_REL_SIGMA: f64 = 0.25;
+pub use crate::params::uncertainty::{
+    default_uncertainties, Distribution, Uncertainty, DEFAULT_REL_SIGMA_GEOMETRY,
+    DEFAULT_REL_SIGMA_SPRINGS, MAX_REL_SIGMA, MAX_REL_SIGMA_UNIFORM,
+};
 
-/// Default relative standard deviation on masses, lengths and inertias (the paper: 2-3 %).
-pub const DEFAULT_REL_SIGMA_GEOMETRY: f64 = 0.025;
-
-/// Default relative standard deviation on the torsion and bouncing constants (the paper: 10 %).
-pub const DEFAULT_REL_SIGMA_SPRINGS: f64 = 0.10;
-
-/// Shape of the distribution of a parameter's relative error.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Distribution {
-    /// Gaussian with standard deviation `rel_sigma`.
-    Gaussian,
-    /// Uniform on `+/- sqrt(3) rel_sigma` (the same standard deviation).
-    Uniform,
-}
-
-/// The error of one parameter.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Uncertainty {
-    /// Dotted parameter key, as in the parameter file (e.g. `mass.m_a_kg`).
-    pub key: String,
-    /// Relative standard deviation (0.025 = 2.5 %), relative to the parameter's own value.
-    pub rel_sigma: f64,
-    /// Distribution shape.
-    pub distribution: Distribution,
-}
-
-/// The default error model: Gaussian, 2.5 % on every `mass.*`, `inertia.*` (I^a_23 too, relative
-/// to its own value) and `length.*` except `length.h_m`; 10 % on `torsion.*` and `bouncing.*`.
-/// `length.h_m`, `environment.g_m_per_s2` and `loss.*` are exact (they do not enter the modes
-/// anyway, except g).
-pub fn default_uncertainties(params: &Params) -> Vec<Uncertainty> {
-    params
-        .fields()
-        .iter()
-        .filter_map(|f| {
-            let section = f.key.split('.').next().unwrap_or("");
-            let rel_sigma = match section {
-                "mass" | "inertia" => DEFAULT_REL_SIGMA_GEOMETRY,
-                "length" if f.key != "length.h_m" => DEFAULT_REL_SIGMA_GEOMETRY,
-                "torsion" | "bouncing" => DEFAULT_REL_SIGMA_SPRINGS,
-                _ => return None,
-            };
-            Some(Uncertainty {
-                key: f.key.to_string(),
-                rel_sigma,
-                distribution: Distribution::Gaussian,
-            })
-        })
-        .collect()
+/// The effective error model of `params`: [`default_uncertainties`] with the entries of the
+/// parameter file's `[uncertainty]` table overriding them (one entry per parameter key, in
+/// [`Params::fields`] order; exact parameters have `rel_sigma = 0`). See
+/// [`Params::effective_uncertainties`].
+pub fn uncertainties(params: &Params) -> Vec<Uncertainty> {
+    params.effective_uncertainties()
 }
 
 /// Monte Carlo settings.
@@ -91,13 +56,13 @@ pub struct McConfig {
 }
 
 impl McConfig {
-    /// 10 000 samples, seed 1, all cores, [`default_uncertainties`].
+    /// 10 000 samples, seed 1, all cores, the error model of `params` ([`uncertainties`]).
     pub fn default_for(params: &Params) -> McConfig {
         McConfig {
             samples: 10_000,
             seed: 1,
             threads: 0,
-            uncertainties: default_uncertainties(params),
+            uncertainties: uncertainties(params),
         }
     }
 }
@@ -111,6 +76,9 @@ pub struct McResult {
     pub rejected: usize,
     /// Mode frequencies (Hz) of every accepted draw, sorted ascending, in sample order.
     pub freqs_hz: Vec<[f64; 8]>,
+    /// Sample number (0-based, `< samples`) of each row of `freqs_hz`; the missing numbers
+    /// are the rejected draws.
+    pub sample_index: Vec<usize>,
     /// Mean frequency per mode (Hz).
     pub mean_hz: [f64; 8],
     /// Sample standard deviation (n - 1) per mode (Hz); 0 with a single accepted draw.
@@ -123,45 +91,9 @@ pub enum McError {
     /// `samples` is 0.
     #[error("Monte Carlo: samples = 0; need at least 1 sample")]
     NoSamples,
-    /// A key that is not a parameter.
-    #[error("Monte Carlo: unknown parameter key `{key}`; allowed keys: {allowed}")]
-    UnknownKey {
-        /// The key given.
-        key: String,
-        /// Every valid key.
-        allowed: String,
-    },
-    /// The same key listed twice.
-    #[error("Monte Carlo: parameter `{key}` has more than one uncertainty; give each key once")]
-    DuplicateKey {
-        /// The repeated key.
-        key: String,
-    },
-    /// A relative sigma that is negative or not finite.
-    #[error(
-        "Monte Carlo: relative sigma of `{key}` = {rel_sigma} is not allowed: must be finite and >= 0"
-    )]
-    InvalidSigma {
-        /// The parameter.
-        key: String,
-        /// The value given.
-        rel_sigma: f64,
-    },
-    /// A relative sigma so large that draws would be non-physical with non-negligible
-    /// probability.
-    #[error(
-        "Monte Carlo: relative sigma of `{key}` = {rel_sigma} ({percent} %) can make the parameter \
-         non-physical (4 sigma reaches zero): must be < {max} ({max_percent} %)",
-        percent = rel_sigma * 100.0,
-        max = MAX_REL_SIGMA,
-        max_percent = MAX_REL_SIGMA * 100.0
-    )]
-    SigmaTooLarge {
-        /// The parameter.
-        key: String,
-        /// The value given.
-        rel_sigma: f64,
-    },
+    /// An error model that cannot be used (unknown or repeated key, invalid or too large sigma).
+    #[error("Monte Carlo: {0}")]
+    Uncertainty(#[from] UncertaintyError),
     /// The nominal parameter set does not build a model.
     #[error("Monte Carlo: nominal parameters: {0}")]
     Nominal(#[from] ParamError),
@@ -239,7 +171,11 @@ pub fn run(
             });
         }
     });
-    let freqs_hz: Vec<[f64; 8]> = draws.into_iter().flatten().collect();
+    let (sample_index, freqs_hz): (Vec<usize>, Vec<[f64; 8]>) = draws
+        .into_iter()
+        .enumerate()
+        .filter_map(|(i, d)| Some((i, d?)))
+        .unzip();
     if freqs_hz.is_empty() {
         return Err(McError::AllRejected { samples: n });
     }
@@ -248,6 +184,7 @@ pub fn run(
         samples: n,
         rejected: n - freqs_hz.len(),
         freqs_hz,
+        sample_index,
         mean_hz,
         std_hz,
     })
@@ -277,10 +214,10 @@ fn mean_and_std(x: &[[f64; 8]]) -> ([f64; 8], [f64; 8]) {
     (mean, std)
 }
 
-/// Which parameter, with what error: indices into a flat array of the parameter values.
+/// Which parameter, with what error: accessors of the drawn parameters.
 struct Plan {
     nominal: Params,
-    draws: Vec<(usize, f64, Distribution)>,
+    draws: Vec<(FieldMut, f64, Distribution)>,
     seed: u64,
 }
 
@@ -290,38 +227,21 @@ impl Plan {
             return Err(McError::NoSamples);
         }
         Model::new(params)?;
-        let fields = params.fields();
-        let keys: Vec<&str> = fields.iter().map(|f| f.key).collect();
-        let mut draws = Vec::with_capacity(cfg.uncertainties.len());
-        for u in &cfg.uncertainties {
-            let i = keys
-                .iter()
-                .position(|&k| k == u.key)
-                .ok_or_else(|| McError::UnknownKey {
-                    key: u.key.clone(),
-                    allowed: keys.join(", "),
-                })?;
-            if draws.iter().any(|&(j, _, _)| j == i) {
-                return Err(McError::DuplicateKey { key: u.key.clone() });
-            }
-            if !(u.rel_sigma.is_finite() && u.rel_sigma >= 0.0) {
-                return Err(McError::InvalidSigma {
-                    key: u.key.clone(),
-                    rel_sigma: u.rel_sigma,
-                });
-            }
-            if u.rel_sigma >= MAX_REL_SIGMA {
-                return Err(McError::SigmaTooLarge {
-                    key: u.key.clone(),
-                    rel_sigma: u.rel_sigma,
-                });
-            }
-            if u.rel_sigma > 0.0 {
-                draws.push((i, u.rel_sigma, u.distribution));
-            }
-        }
+        let keys: Vec<&str> = params.fields().iter().map(|f| f.key).collect();
+        check(&cfg.uncertainties, &keys)?;
+        let draws = cfg
+            .uncertainties
+            .iter()
+            .filter(|u| u.rel_sigma > 0.0)
+            .filter_map(|u| Some((modal_field(&u.key)?, u.rel_sigma, u.distribution)))
+            .collect();
+        // The error model is not needed per draw: clone and validate the values only.
+        let nominal = Params {
+            uncertainty: Default::default(),
+            ..params.clone()
+        };
         Ok(Plan {
-            nominal: params.clone(),
+            nominal,
             draws,
             seed: cfg.seed,
         })
@@ -331,13 +251,12 @@ impl Plan {
     fn draw(&self, index: usize) -> Option<[f64; 8]> {
         let mut rng = Rng::for_sample(self.seed, index as u64);
         let mut p = self.nominal.clone();
-        for &(i, rel_sigma, dist) in &self.draws {
+        for &(field, rel_sigma, dist) in &self.draws {
             let z = match dist {
                 Distribution::Gaussian => rng.gaussian(),
                 Distribution::Uniform => 3f64.sqrt() * (2.0 * rng.uniform() - 1.0),
             };
-            let v = field_mut(&mut p, i);
-            *v *= 1.0 + rel_sigma * z;
+            *field(&mut p) *= 1.0 + rel_sigma * z;
         }
         p.validate().ok()?;
         let model = Model::new(&p).ok()?;
@@ -345,42 +264,36 @@ impl Plan {
     }
 }
 
-/// The parameter at position `i` of [`Params::fields`].
-fn field_mut(p: &mut Params, i: usize) -> &mut f64 {
-    let (m, n, t, b, l) = (
-        &mut p.mass,
-        &mut p.inertia,
-        &mut p.torsion,
-        &mut p.bouncing,
-        &mut p.length,
-    );
-    match i {
-        0 => &mut m.m_a_kg,
-        1 => &mut m.m_b_kg,
-        2 => &mut n.a11_kg_m2,
-        3 => &mut n.a22_kg_m2,
-        4 => &mut n.a33_kg_m2,
-        5 => &mut n.a23_kg_m2,
-        6 => &mut n.b11_kg_m2,
-        7 => &mut n.b22_kg_m2,
-        8 => &mut n.b33_kg_m2,
-        9 => &mut t.k_a_n_m_per_rad,
-        10 => &mut t.k_b_n_m_per_rad,
-        11 => &mut b.kappa_a_n_per_m,
-        12 => &mut b.kappa_b_n_per_m,
-        13 => &mut l.d_m,
-        14 => &mut l.h_c_m,
-        15 => &mut l.z_m,
-        16 => &mut l.z_a_m,
-        17 => &mut l.z_b_m,
-        18 => &mut l.h_m,
-        19 => &mut p.environment.g_m_per_s2,
-        20 => &mut p.loss.torsion_a_rad,
-        21 => &mut p.loss.torsion_b_rad,
-        22 => &mut p.loss.bouncing_a_rad,
-        23 => &mut p.loss.bouncing_b_rad,
-        _ => unreachable!("Params has 24 fields"),
-    }
+/// Access to one parameter value.
+type FieldMut = fn(&mut Params) -> &mut f64;
+
+/// The parameter `key` if it enters the undamped mode frequencies (mass and stiffness
+/// matrices), else `None`.
+fn modal_field(key: &str) -> Option<FieldMut> {
+    let f: FieldMut = match key {
+        "mass.m_a_kg" => |p| &mut p.mass.m_a_kg,
+        "mass.m_b_kg" => |p| &mut p.mass.m_b_kg,
+        "inertia.a11_kg_m2" => |p| &mut p.inertia.a11_kg_m2,
+        "inertia.a22_kg_m2" => |p| &mut p.inertia.a22_kg_m2,
+        "inertia.a33_kg_m2" => |p| &mut p.inertia.a33_kg_m2,
+        "inertia.a23_kg_m2" => |p| &mut p.inertia.a23_kg_m2,
+        "inertia.b11_kg_m2" => |p| &mut p.inertia.b11_kg_m2,
+        "inertia.b22_kg_m2" => |p| &mut p.inertia.b22_kg_m2,
+        "inertia.b33_kg_m2" => |p| &mut p.inertia.b33_kg_m2,
+        "torsion.k_a_n_m_per_rad" => |p| &mut p.torsion.k_a_n_m_per_rad,
+        "torsion.k_b_n_m_per_rad" => |p| &mut p.torsion.k_b_n_m_per_rad,
+        "bouncing.kappa_a_n_per_m" => |p| &mut p.bouncing.kappa_a_n_per_m,
+        "bouncing.kappa_b_n_per_m" => |p| &mut p.bouncing.kappa_b_n_per_m,
+        "length.d_m" => |p| &mut p.length.d_m,
+        "length.h_c_m" => |p| &mut p.length.h_c_m,
+        "length.z_m" => |p| &mut p.length.z_m,
+        "length.z_a_m" => |p| &mut p.length.z_a_m,
+        "length.z_b_m" => |p| &mut p.length.z_b_m,
+        "length.h_m" => |p| &mut p.length.h_m,
+        "environment.g_m_per_s2" => |p| &mut p.environment.g_m_per_s2,
+        _ => return None,
+    };
+    Some(f)
 }
 
 /// SplitMix64 finalizer: a bijective 64-bit mix.
@@ -445,20 +358,46 @@ mod tests {
     use super::*;
 
     #[test]
-    fn field_mut_matches_fields_order() {
+    fn modal_field_sets_its_own_key_only() {
         let p = Params::table_i();
-        for (i, f) in p.fields().iter().enumerate() {
+        let mut drawn = 0;
+        for f in p.fields() {
+            let Some(field) = modal_field(f.key) else {
+                continue;
+            };
+            drawn += 1;
             let mut q = p.clone();
-            *field_mut(&mut q, i) = 1234.5;
-            assert_eq!(q.fields()[i].value, 1234.5, "{}", f.key);
-            assert_eq!(
-                q.fields().iter().filter(|g| g.value == 1234.5).count(),
-                1,
-                "{}",
-                f.key
-            );
+            *field(&mut q) = 1234.5;
+            let changed: Vec<&str> = q
+                .fields()
+                .iter()
+                .zip(p.fields())
+                .filter(|(a, b)| a.value != b.value)
+                .map(|(a, _)| a.key)
+                .collect();
+            assert_eq!(changed, [f.key]);
         }
-        assert_eq!(p.fields().len(), 24);
+        // Every parameter with a non-zero default error enters the modes.
+        for u in default_uncertainties(&p)
+            .iter()
+            .filter(|u| u.rel_sigma > 0.0)
+        {
+            assert!(modal_field(&u.key).is_some(), "{}", u.key);
+        }
+        assert_eq!(drawn, 20);
+    }
+
+    #[test]
+    fn parameters_outside_the_modes_do_not_enter_them() {
+        // The claim behind `modal_field`: the undamped modes depend only on the drawn keys.
+        let p = Params::table_i();
+        let base = mode_frequencies_hz(&Model::new(&p).unwrap()).unwrap();
+        for f in p.fields().iter().filter(|f| modal_field(f.key).is_none()) {
+            let v = if f.value == 0.0 { 1e-3 } else { f.value * 1.5 };
+            let q = p.with_override(&format!("{}={v:?}", f.key)).unwrap();
+            let other = mode_frequencies_hz(&Model::new(&q).unwrap()).unwrap();
+            assert_eq!(other, base, "{}", f.key);
+        }
     }
 
     #[test]

@@ -32,6 +32,12 @@ pub struct Mode {
     pub energy_share: [f64; 8],
     /// Observable amplitudes `C v` of the mass-normalized shape (units: observable / sqrt(kg m^2)).
     pub observable_amplitude: [f64; 7],
+    /// Modal loss angle `1/Q` (rad): `v^T Im(K_c) v / w^2` (structural) plus
+    /// `v^T C v / w` (viscous, at the mode's own frequency), from the undamped shape. 0 when
+    /// the model is undamped. See [`modal_loss_angle`].
+    pub loss_angle: f64,
+    /// Quality factor `Q = 1 / loss_angle`; `f64::INFINITY` when undamped.
+    pub quality_factor: f64,
 }
 
 impl Mode {
@@ -88,6 +94,7 @@ impl NormalModes {
                     shape[c.index()] = v4[i];
                 }
                 let omega_sq = eig.eigenvalues[k];
+                let loss_angle = modal_loss_angle(model, &shape, omega_sq);
                 modes.push(Mode {
                     index: 0,
                     omega_sq,
@@ -98,6 +105,8 @@ impl NormalModes {
                     observable_amplitude: std::array::from_fn(|o| {
                         (model.observation().row(o) * shape)[(0, 0)]
                     }),
+                    loss_angle,
+                    quality_factor: 1.0 / loss_angle,
                 });
             }
         }
@@ -135,6 +144,20 @@ impl NormalModes {
     pub fn frequencies_hz(&self) -> Vec<f64> {
         self.modes.iter().map(|m| m.frequency_hz).collect()
     }
+}
+
+/// Modal loss angle of a mass-normalized undamped shape `v` with eigenvalue `w^2`:
+/// `phi = v^T Im(K_c) v / w^2 + v^T C v / w` (rad), the first-order (weak-damping) value of
+/// `Im(lambda) / Re(lambda)` for the damped eigenvalue `lambda` of `K_c + i w C - lambda M`
+/// (the neglected terms are of second order in the loss: the coupling of modes by damping).
+/// 0 for an undamped model or a non-positive eigenvalue.
+pub fn modal_loss_angle(model: &Model, shape: &Vec8, omega_sq: f64) -> f64 {
+    if model.is_undamped() || omega_sq <= 0.0 {
+        return 0.0;
+    }
+    let structural = (shape.transpose() * model.stiffness_imag() * shape)[(0, 0)] / omega_sq;
+    let viscous = (shape.transpose() * model.damping() * shape)[(0, 0)] / omega_sq.sqrt();
+    structural + viscous
 }
 
 /// Rayleigh-quotient iteration on the undamped pencil `(K, M)` started from `mode`: returns

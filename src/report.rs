@@ -24,8 +24,8 @@ pub fn modes_table(modes: &NormalModes) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:<5} {:>12}  {:<16} {:<34} seen by",
-        "mode", "frequency", "block", "dominant coordinates (energy share)"
+        "{:<5} {:>12} {:>10}  {:<16} {:<34} seen by",
+        "mode", "frequency", "Q", "block", "dominant coordinates (energy share)"
     );
     for (k, m) in modes.modes.iter().enumerate() {
         let dominant = m
@@ -42,15 +42,29 @@ pub fn modes_table(modes: &NormalModes) -> String {
             .join(" ");
         let _ = writeln!(
             s,
-            "nu_{:<3} {:>12}  {:<16} {:<34} {}",
+            "nu_{:<3} {:>12} {:>10}  {:<16} {:<34} {}",
             m.index,
             format_hz(m.frequency_hz),
+            format_q(m.quality_factor),
             m.block.name(),
             dominant,
             seen
         );
     }
     s
+}
+
+/// A quality factor for the table: `inf` when undamped, else 4 significant digits.
+pub fn format_q(q: f64) -> String {
+    if q.is_infinite() {
+        "inf".into()
+    } else if (1e-2..1e6).contains(&q) {
+        // 4 significant digits.
+        let decimals = (3 - q.log10().floor() as i32).max(0) as usize;
+        format!("{q:.decimals$}")
+    } else {
+        format!("{q:.3e}")
+    }
 }
 
 /// `{"modes": [{"index": 1, "frequency_hz": ..., ...}, ...]}`.
@@ -65,6 +79,13 @@ pub fn modes_json(modes: &NormalModes) -> String {
                 "frequency_hz": m.frequency_hz,
                 "omega_sq_rad2_per_s2": m.omega_sq,
                 "block": m.block.name(),
+                // JSON has no infinity: "inf" (a string) when undamped, as in the table.
+                "quality_factor": if m.quality_factor.is_finite() {
+                    json!(m.quality_factor)
+                } else {
+                    json!("inf")
+                },
+                "loss_angle_rad": m.loss_angle,
                 "dominant_coordinates": m.dominant_coords(DOMINANT_SHARE).iter()
                     .map(|(c, share)| json!({"coordinate": c.name(), "energy_share": share}))
                     .collect::<Vec<_>>(),

@@ -4,9 +4,10 @@
 //!   log grid 1e-5 .. 100 Hz (2000 points plus points just outside every exclusion zone),
 //!   excluding 1 % in frequency around the entry's own poles and zeros (taken from the undamped
 //!   model's factors); undamped, damped (loss 1e-3 on torsions and bouncings), and m_a = 1.3 kg.
+//!   The grid is evaluated in one batch (`tf::evaluate`, the path `auto` takes);
+//!   `tests/polezero_batch.rs` checks that it equals the point-by-point path bit for bit.
 //! * Structure: the zeros at s = 0 and the degree drops found by the plan match the physics.
 //! * Structural zeros are exactly 0.0; f = 0 agrees with the reference.
-//! * Speed: ns/point for the 7x3 tilt matrix at 1e5 points (printed, not asserted).
 //!
 //! Run with `cargo test --release --test polezero -- --nocapture` to see the numbers.
 
@@ -15,7 +16,7 @@ use tiltnoise::error::TfError;
 use tiltnoise::model::{ForceInput, Model, Observable, TiltAxis};
 use tiltnoise::params::Params;
 use tiltnoise::reference::{relative_errors, ReferenceModel};
-use tiltnoise::tf::{plan, EntryFactors, Input, Method, PoleZero, Request};
+use tiltnoise::tf::{evaluate, plan, EntryFactors, Input, Method, PoleZero, Request};
 
 const TARGET_REL: f64 = 1e-9;
 const EXCLUSION: f64 = 0.01;
@@ -134,11 +135,15 @@ fn accuracy(params: &Params, zone_params: &Params, request: &Request) -> (f64, S
     let special = zones(zone_params, request);
     let mut worst = (0.0, String::new(), 0.0);
     let mut checked = 0;
-    for f in grid(&special) {
-        let (Ok(h), Ok(r)) = (tf.eval(f), reference.eval_dd(request, f)) else {
+    // The whole grid at once: the batch evaluation that `tf::evaluate` (and `auto`) uses.
+    let freqs = grid(&special);
+    let all = evaluate(tf.as_ref(), &freqs).expect("no grid point is on an undamped pole");
+    let nv = request.outputs.len() * request.inputs.len();
+    for (&f, h) in freqs.iter().zip(all.values.chunks_exact(nv)) {
+        let Ok(r) = reference.eval_dd(request, f) else {
             continue;
         };
-        let err = relative_errors(&h, &r);
+        let err = relative_errors(h, &r);
         for (k, e) in err.iter().enumerate() {
             if r[k].is_zero() {
                 assert_eq!(

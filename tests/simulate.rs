@@ -6,9 +6,11 @@ use nalgebra::SMatrix;
 use tiltnoise::model::{Model, Observable, Vec8};
 use tiltnoise::modes::NormalModes;
 use tiltnoise::params::Params;
+use tiltnoise::simulate::resonance::{check_resonances, Presence, PEAK_FACTOR};
 use tiltnoise::simulate::{
     aliased_frequency_hz, kick_x, simulate, InitialState, ModalPropagator, SimConfig, SimError,
 };
+use tiltnoise::simulate::{equal_energy_init, DEFAULT_MODE_ENERGY_J};
 use tiltnoise::spectral::{welch, WelchConfig};
 
 const EPS: f64 = f64::EPSILON;
@@ -296,11 +298,6 @@ fn peak(asd: &[f64], k0: usize) -> (f64, f64) {
         (best, best / median)
     }
 }
-
-/// Peak over neighbourhood required for "a resonance is present". A noiseless sinusoid under a
-/// Hann window stands above its own leakage 8+ bins away by > 1e3 (sidelobes fall as 1/d^3);
-/// without a resonance the ratio is ~1. 10 separates the two with wide margins on both sides.
-const PEAK_FACTOR: f64 = 10.0;
 
 #[test]
 fn spectra_show_exactly_the_modes_of_the_observability_table() {
@@ -590,20 +587,99 @@ fn invalid_settings_are_refused_with_the_value() {
     );
 }
 
-#[test]
-fn timing_12_hours_all_dof() {
+/// The default run of `tiltnoise simulate` (equal energy per mode, 12 h at 0.1 s, X readout
+/// 9 nm/sqrt(Hz), Welch 2^17): modal amplitudes and the PSDs of the seven channels.
+fn default_run() -> (
+    NormalModes,
+    [f64; 8],
+    Vec<(Observable, tiltnoise::spectral::Psd)>,
+) {
     let model = model();
-    let init = generic_init();
+    let init = equal_energy_init(&model, DEFAULT_MODE_ENERGY_J);
     let cfg = SimConfig::default();
-    let mut best = f64::MAX;
-    for _ in 0..3 {
-        let t0 = std::time::Instant::now();
-        let sim = simulate(&model, &init, &cfg).unwrap();
-        best = best.min(t0.elapsed().as_secs_f64());
-        assert_eq!(sim.len(), 432_000);
+    let sim = simulate(&model, &init, &cfg).unwrap();
+    let p = ModalPropagator::new(&model, &init, cfg.dt_s).unwrap();
+    // Equal energy in every mode. The modal decomposition of q = sum_k v_k a_k mixes the modes
+    // of a block only through rounding: a relative error of a few eps times the ratio of the
+    // largest modal amplitude in the block to this one (at most 1e5 here, torsion vs bouncing
+    // are in different blocks; swing vs bounce within one), squared for the energy.
+    let e = p.modal_energy();
+    let (u0, v0) = p.initial_modal_state();
+    let amp: [f64; 8] = std::array::from_fn(|k| u0[k].hypot(v0[k]));
+    let a_max = amp.iter().copied().fold(0.0, f64::max);
+    for k in 0..8 {
+        let tol = 2.0 * 16.0 * EPS * a_max / amp[k];
+        assert!(
+            (e[k] / DEFAULT_MODE_ENERGY_J - 1.0).abs() <= tol,
+            "nu_{}: energy {:e} (tol {tol:e})",
+            k + 1,
+            e[k]
+        );
     }
-    println!(
-        "12 h of all 8 DoF at 0.1 s (432000 samples, 7 observables, X readout noise): best of 3 {:.4} s (target 0.2 s; meaningful in release only)",
-        best
-    );
+    let wcfg = WelchConfig::new(1 << 17);
+    let psds = sim
+        .observables
+        .iter()
+        .map(|(o, x)| (*o, welch(x, sim.fs_hz(), &wcfg).unwrap()))
+        .collect();
+    (NormalModes::new(&model), amp, psds)
+}
+
+#[test]
+fn resonance_check_agrees_with_the_table_on_the_default_run() {
+    let (modes, amp, psds) = default_run();
+    let readout = SimConfig::default().readout_asd;
+    let check = check_resonances(&modes, &amp, &psds, 10.0, 1 << 17, &readout);
+    print!("{}", check.table());
+    for c in &check.channels {
+        for m in &c.modes {
+            println!(
+                "{:>5} nu_{}: table {:>8} ratio {:8.2e} | spectrum {:>8} ratio {:8.2e}, peak/floor {:8.2e}",
+                c.observable.name(),
+                m.mode_index,
+                if m.table_seen { "seen" } else { "not seen" },
+                m.table_ratio,
+                m.spectrum.name(),
+                m.spectrum_ratio,
+                m.peak_ratio
+            );
+        }
+    }
+    // Every (channel, mode) pair is testable in the default run, and all agree.
+    assert_eq!(check.n_tested(), 56);
+    assert!(check.all_agree(), "{:?}", check.disagreements());
+    // The threshold matters: within a block some modes the table does not see show genuine
+    // peaks (well above the local floor) that are below 1e-3 of the channel's largest, as the
+    // table's own ratio says.
+    let tiny_peaks: Vec<_> = check
+        .channels
+        .iter()
+        .flat_map(|c| c.modes.iter().map(move |m| (c.observable, m)))
+        .filter(|(_, m)| !m.table_seen && m.table_ratio > 0.0 && m.peak_ratio > PEAK_FACTOR)
+        .collect();
+    assert!(!tiny_peaks.is_empty());
+    for (o, m) in &tiny_peaks {
+        assert_eq!(
+            m.spectrum,
+            Presence::NotSeen,
+            "{} nu_{}",
+            o.name(),
+            m.mode_index
+        );
+        assert!(m.spectrum_ratio < tiltnoise::modes::VISIBILITY_THRESHOLD);
+    }
+}
+
+#[test]
+fn resonance_check_reports_a_wrong_table() {
+    let (mut modes, amp, psds) = default_run();
+    let readout = SimConfig::default().readout_asd;
+    // Claim that X does not see nu_6 and that Y sees nu_1: both must be reported.
+    modes.visible[5][Observable::X.index()] = false;
+    modes.visible[0][Observable::Y.index()] = true;
+    let check = check_resonances(&modes, &amp, &psds, 10.0, 1 << 17, &readout);
+    let mut d = check.disagreements();
+    d.sort_by_key(|(o, k)| (o.index(), *k));
+    assert_eq!(d, vec![(Observable::X, 6), (Observable::Y, 1)]);
+    assert!(check.table().contains("DISAGREES: X nu_6"));
 }

@@ -8,7 +8,10 @@ What is compared: the 7x3 tilt matrix of Table I at --points log-spaced frequenc
 100 Hz, in ns per frequency point.
 
 * Rust: the criterion benchmark `benches/methods.rs` (group `methods_7x3_tilt`: direct, block,
-  split, modal on one thread; block and split also on two threads, the grid cut in halves). The
+  split, polezero, modal point by point on one thread; block, split and polezero also on two
+  threads, the grid cut in halves; polezero_batch, the grid evaluation that `tf::evaluate` and
+  so `auto` use, into a preallocated buffer, on one and two threads; polezero_evaluate,
+  `tf::evaluate` itself with the allocation of its result, one thread). The
   script builds it once with `cargo bench --bench methods --no-run --message-format=json`,
   copies the executable to DIR/methods.snapshot (so a concurrent build cannot swap it mid-run;
   its sha256 is printed) and runs the copy as
@@ -28,10 +31,11 @@ machine hit every side alike. Reported: the median over rounds of each figure, t
 medians (NumPy ns/point over Rust ns/point at the same thread count), and the per-round ratio's
 median and range.
 
-Target (issue 4): the default accurate method (split, the only one meeting the 1e-9 relative
-accuracy target of tests/methods.rs) at least --target-ratio (100) times faster per point than
-NumPy, single thread. Exit code 0 if met, 1 if missed, 2 if a run failed. Raw figures go to
-DIR/compare_methods.json.
+Target (issue 4): what `auto` does for the user (polezero_batch: the pole-zero method, which
+meets the 1e-9 relative accuracy target of tests/polezero.rs and tests/methods.rs, evaluating
+the whole grid; the same full complex 7x3 matrix per point as NumPy's H) at least
+--target-ratio (100) times faster per point than NumPy, single thread. Exit code 0 if met, 1 if
+missed, 2 if a run failed. Raw figures go to DIR/compare_methods.json.
 """
 
 import argparse
@@ -48,9 +52,9 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
-METHODS = ("direct", "block", "split", "polezero", "modal")
-TWO_THREAD = ("block", "split", "polezero")
-ACCURATE = "polezero"
+METHODS = ("direct", "block", "split", "polezero", "polezero_batch", "polezero_evaluate", "modal")
+TWO_THREAD = ("block", "split", "polezero", "polezero_batch")
+ACCURATE = "polezero_batch"
 GROUP = "methods_7x3_tilt"
 LINE = re.compile(r"test\s+" + GROUP + r"/(\w+)/(\dt)\s+\.\.\.\s+bench:\s+([\d,]+)\s+ns/iter")
 
@@ -168,8 +172,9 @@ def main():
         rounds.append(rec)
         s = rec["rust"][(ACCURATE, "1t")]
         n1 = rec["numpy1"]["solve_ns_per_point"]
-        print(f"  round {r + 1}: numpy(1t) {n1:.0f} ns/pt, {ACCURATE}(1t) {s:.0f} ns/pt, ratio {n1 / s:.2f}",
-              flush=True)
+        n2, s2 = rec["numpy2"]["solve_ns_per_point"], rec["rust"][(ACCURATE, "2t")]
+        print(f"  round {r + 1}: numpy(1t) {n1:.0f} ns/pt, {ACCURATE}(1t) {s:.1f} ns/pt, ratio {n1 / s:.1f}; "
+              f"2 threads: numpy {n2:.0f}, {ACCURATE} {s2:.1f}, ratio {n2 / s2:.1f}", flush=True)
     info["load_after"] = os.getloadavg()
     info["numpy"] = rounds[0]["numpy1"]["numpy"]
 
@@ -197,9 +202,9 @@ def main():
     print("|---|---|---|---|---|---|")
     for row in rows:
         rr = row["round_ratio1"]
-        print(f"| {row['method']} | {cell(row.get('ns1'), '{:.0f}')} | {cell(row.get('ns2'), '{:.0f}')} "
-              f"| {cell(row.get('ratio1'), '{:.2f}')} | {cell(row.get('ratio2'), '{:.2f}')} "
-              f"| {rr[0]:.2f} ({rr[1]:.2f} .. {rr[2]:.2f}) |")
+        print(f"| {row['method']} | {cell(row.get('ns1'), '{:.1f}')} | {cell(row.get('ns2'), '{:.1f}')} "
+              f"| {cell(row.get('ratio1'), '{:.1f}')} | {cell(row.get('ratio2'), '{:.1f}')} "
+              f"| {rr[0]:.1f} ({rr[1]:.1f} .. {rr[2]:.1f}) |")
     extra = {t: {k: med([rec[f"numpy{t}"][k] for rec in rounds])
                  for k in ("solve_ns_per_point", "stack_ns_per_point", "solve_real_ns_per_point")
                  if k in rounds[0][f"numpy{t}"]} for t in (1, 2)}
@@ -215,7 +220,8 @@ def main():
     met = acc["ratio1"] >= args.target_ratio
     need = np_ns[1] / args.target_ratio
     print(f"target: {ACCURATE} >= {args.target_ratio:g}x NumPy per point (1 thread), i.e. <= {need:.1f} ns/point: "
-          f"{'met' if met else 'MISSED'} ({acc['ratio1']:.2f}x, {acc['ns1']:.0f} ns/point)")
+          f"{'met' if met else 'MISSED'} ({acc['ratio1']:.1f}x, {acc['ns1']:.1f} ns/point; "
+          f"2 threads {acc['ratio2']:.1f}x, {acc['ns2']:.1f} ns/point)")
     with open(os.path.join(args.dir, "compare_methods.json"), "w") as fh:
         json.dump({"info": info, "rows": rows, "numpy": extra,
                    "rounds": [{k: (v if k != "rust" else {f"{a}/{b}": x for (a, b), x in v.items()})

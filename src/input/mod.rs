@@ -69,7 +69,10 @@ mod spectra_hdf5;
 
 pub use axis_map::{AxisMap, AxisMapEntry, Sign};
 pub use error::InputError;
-pub use measured::{read_measured, MeasuredSpectra};
+pub use measured::{
+    read_measured, read_measured_input, MeasuredInput, MeasuredSeries, MeasuredSpectra,
+    SCHEMA_OBSERVABLE_SERIES,
+};
 pub use series::TiltSeries;
 pub use source::TiltSeriesSource;
 pub use spectra::{TiltSpectra, CSD_RTOL};

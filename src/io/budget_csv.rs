@@ -64,7 +64,12 @@ fn asd_columns(report: &BudgetReport) -> (Vec<String>, Vec<Vec<f64>>) {
     let mut names = Vec::new();
     let mut columns = Vec::new();
     for ob in &report.budget.observables {
-        for term in &ob.terms {
+        // `response.<input>` is not a noise (see `noise::equivalent`); HDF5 carries it.
+        for term in ob
+            .terms
+            .iter()
+            .filter(|t| !crate::noise::is_response(&t.name))
+        {
             names.push(format!("{}.{}", ob.observable.name(), term.name));
             columns.push(term.asd());
         }

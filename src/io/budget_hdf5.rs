@@ -5,7 +5,7 @@ use super::h5util::{dataset, scalar_attr, str_attr, strs_attr};
 use super::{InputMeta, RunMeta, SIGN_CONVENTION};
 use crate::atomic::write_atomic;
 use crate::error::OutputError;
-use crate::noise::{BudgetReport, SpectralSource};
+use crate::noise::{is_response, BudgetReport, SpectralSource, RESPONSE_PREFIX};
 use std::path::Path;
 
 /// Value of the root attribute `schema`.
@@ -26,7 +26,9 @@ pub const SPECTRAL_CONVENTION: &str =
 /// obtained); `/frequency_hz`; one group per observable (`/X`, `/phi`, `/phi_a`) holding one
 /// group per term (`/X/tilt`, `/X/tilt.eta_t`, `/X/readout`, `/X/total`, ...) with datasets
 /// `psd` and `asd`; `/segments` with the percentile band of the `tilt` term when the report
-/// has one. Every item is described in `docs/schemas.md`.
+/// has one. A damped budget adds `thermal`, `thermal.<element>` term groups and, per observable,
+/// an `equivalent` group with every term referred to the test mass's acceleration (X) or
+/// torque (phi, phi_a). Every item is described in `docs/schemas.md`.
 ///
 /// # Errors
 ///
@@ -119,15 +121,24 @@ fn write_file(
         let unit = o.unit();
         let group = file.create_group(o.name())?;
         str_attr(&group, "unit", unit)?;
-        let terms: Vec<&str> = ob.terms.iter().map(|t| t.name.as_str()).collect();
+        let terms: Vec<&str> = ob
+            .terms
+            .iter()
+            .filter(|t| !is_response(&t.name))
+            .map(|t| t.name.as_str())
+            .collect();
         strs_attr(&group, "terms", &terms)?;
         if let Some(asd) = report.readout.of(o) {
             scalar_attr(&group, "readout_asd", asd)?;
             str_attr(&group, "readout_asd_units", &asd_unit(unit))?;
         }
-        for term in &ob.terms {
+        let response = ob.terms.iter().find(|t| is_response(&t.name));
+        for term in ob.terms.iter().filter(|t| !is_response(&t.name)) {
             let g = group.create_group(&term.name)?;
             write_psd_asd(&g, "psd", "asd", &term.psd, unit)?;
+        }
+        if let Some(response) = response {
+            write_equivalent(&group, ob, response, unit)?;
         }
     }
 
@@ -164,6 +175,49 @@ fn write_file(
     }
 
     file.close()
+}
+
+/// `/<obs>/equivalent`: every noise term referred to the equivalent input (see
+/// [`crate::noise::equivalent`]), `psd = S_o / |R_o|^2`, plus `response_abs = |R_o|`.
+fn write_equivalent(
+    group: &hdf5::Group,
+    ob: &crate::noise::ObservableBudget,
+    response: &crate::noise::NoiseTerm,
+    unit: &str,
+) -> hdf5::Result<()> {
+    let input = response.name.trim_start_matches(RESPONSE_PREFIX);
+    let (eq_unit, what) = match ob.observable {
+        crate::model::Observable::X => (
+            "m s^-2",
+            "acceleration of the test mass along x (F_b.x / m_b)",
+        ),
+        _ => ("N m", "torque on the test mass about z (M_b.z)"),
+    };
+    let g = group.create_group("equivalent")?;
+    str_attr(&g, "input", input)?;
+    str_attr(&g, "quantity", what)?;
+    str_attr(&g, "unit", eq_unit)?;
+    let terms: Vec<&str> = ob
+        .terms
+        .iter()
+        .filter(|t| !is_response(&t.name) && t.name != "measured" && t.name != "residual")
+        .map(|t| t.name.as_str())
+        .collect();
+    strs_attr(&g, "terms", &terms)?;
+    let abs: Vec<f64> = response.psd.iter().map(|p| p.sqrt()).collect();
+    let d = dataset(&g, "response_abs", &abs)?;
+    str_attr(&d, "units", &format!("{unit}/({eq_unit})"))?;
+    for term in ob.terms.iter().filter(|t| terms.contains(&t.name.as_str())) {
+        let psd: Vec<f64> = term
+            .psd
+            .iter()
+            .zip(&response.psd)
+            .map(|(p, r)| p / r)
+            .collect();
+        let t = g.create_group(&term.name)?;
+        write_psd_asd(&t, "psd", "asd", &psd, eq_unit)?;
+    }
+    Ok(())
 }
 
 /// `m` -> `m/sqrt(Hz)`.

@@ -8,6 +8,8 @@
 mod budget_csv;
 mod budget_hdf5;
 mod h5util;
+mod mc_hdf5;
+mod series_hdf5;
 mod tf_csv;
 mod tf_hdf5;
 
@@ -16,6 +18,11 @@ pub(crate) use budget_csv::check_report as check_budget_report;
 pub use budget_csv::{budget_csv_string, write_budget_csv};
 pub use budget_hdf5::{
     write_budget_hdf5, SCHEMA_BUDGET, SCHEMA_VERSION_BUDGET, SPECTRAL_CONVENTION,
+};
+pub use mc_hdf5::{write_mc_hdf5, REJECTED_DRAWS, SCHEMA_MC, SCHEMA_VERSION_MC};
+pub use series_hdf5::{
+    write_observable_series_hdf5, SeriesAsd, SimulationMeta, SCHEMA_OBSERVABLE_SERIES,
+    SCHEMA_VERSION_OBSERVABLE_SERIES,
 };
 pub use tf_csv::{format_f64, tf_csv_string, write_tf_csv};
 pub use tf_hdf5::{write_tf_hdf5, SCHEMA_TF, SCHEMA_VERSION_TF, SIGN_CONVENTION, TIME_DEPENDENCE};

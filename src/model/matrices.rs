@@ -69,9 +69,9 @@ pub(super) fn mass(p: &Params, dv: &Derived) -> Mat8 {
     m
 }
 
-/// Stiffness split into the gravity part, the elastic part (diagonal: torsion and bouncing of
-/// each fibre) and the loss angle of each elastic entry.
-pub(super) fn stiffness(p: &Params) -> (Mat8, Mat8, Mat8) {
+/// Stiffness split into the gravity part and the elastic part (diagonal: torsion and bouncing
+/// of each fibre). Loss angles live in [`super::damping`].
+pub(super) fn stiffness(p: &Params) -> (Mat8, Mat8) {
     let (m_a, m_b, g) = (p.mass.m_a_kg, p.mass.m_b_kg, p.environment.g_m_per_s2);
     let l = &p.length;
     let c1 = m_b * (l.z_m + l.z_b_m) + m_a * (l.z_m + l.z_a_m);
@@ -83,17 +83,15 @@ pub(super) fn stiffness(p: &Params) -> (Mat8, Mat8, Mat8) {
         kg[(at(b), at(b))] = m_b * g * l.z_b_m;
     }
     let mut ke = Mat8::zeros();
-    let mut loss = Mat8::zeros();
-    for (c, k, phi) in [
-        (PhiA, p.torsion.k_a_n_m_per_rad, p.loss.torsion_a_rad),
-        (PhiB, p.torsion.k_b_n_m_per_rad, p.loss.torsion_b_rad),
-        (DeltaA, p.bouncing.kappa_a_n_per_m, p.loss.bouncing_a_rad),
-        (DeltaB, p.bouncing.kappa_b_n_per_m, p.loss.bouncing_b_rad),
+    for (c, k) in [
+        (PhiA, p.torsion.k_a_n_m_per_rad),
+        (PhiB, p.torsion.k_b_n_m_per_rad),
+        (DeltaA, p.bouncing.kappa_a_n_per_m),
+        (DeltaB, p.bouncing.kappa_b_n_per_m),
     ] {
         ke[(at(c), at(c))] = k;
-        loss[(at(c), at(c))] = phi;
     }
-    (kg, ke, loss)
+    (kg, ke)
 }
 
 /// Zeroth-order generalized forces (Appendix A, last display), columns F_a.xyz, F_b.xyz,

@@ -3,10 +3,12 @@
 //! observation matrix. Pure numerics: depends on `params` and `nalgebra`, never on I/O.
 
 mod coords;
+pub mod damping;
 mod matrices;
 pub mod tilt;
 
 pub use coords::{Block, Coord, ForceInput, Observable, TiltAxis};
+pub use damping::{DampingKind, DissipativeElement};
 
 use crate::error::ParamError;
 use crate::params::Params;
@@ -48,7 +50,11 @@ pub struct Model {
     mass: Mat8,
     stiffness_gravity: Mat8,
     stiffness_elastic: Mat8,
-    elastic_loss: Mat8,
+    /// `Im(K_c)`: the sum of the structural elements' matrices.
+    stiffness_imag: Mat8,
+    /// Viscous damping matrix `C`: the sum of the viscous elements' matrices.
+    damping: Mat8,
+    dissipation: Vec<DissipativeElement>,
     force: ForceMatrix,
     tilt: tilt::TiltForcing,
     observation: ObservationMatrix,
@@ -60,7 +66,10 @@ impl Model {
     pub fn new(params: &Params) -> Result<Model, ParamError> {
         let derived = matrices::derived(params);
         let mass = matrices::mass(params, &derived);
-        let (stiffness_gravity, stiffness_elastic, elastic_loss) = matrices::stiffness(params);
+        let (stiffness_gravity, stiffness_elastic) = matrices::stiffness(params);
+        let dissipation = damping::elements(params);
+        let stiffness_imag = damping::total(&dissipation, DampingKind::Structural);
+        let damping = damping::total(&dissipation, DampingKind::Viscous);
         if mass.cholesky().is_none() {
             let eig = mass.symmetric_eigenvalues().min();
             return Err(ParamError::NotPositiveDefinite {
@@ -78,7 +87,9 @@ impl Model {
             mass,
             stiffness_gravity,
             stiffness_elastic,
-            elastic_loss,
+            stiffness_imag,
+            damping,
+            dissipation,
             force,
             tilt,
             observation,
@@ -116,19 +127,55 @@ impl Model {
         &self.stiffness_elastic
     }
 
-    /// Complex stiffness with structural damping: K_gravity + K_elastic (1 + i phi) per element.
+    /// Complex stiffness with structural damping, `K_c = K + i Im(K_c)`: every structural
+    /// element `k (1 + i phi)` (torsion, bouncing, and the diluted swing of each fibre; see
+    /// [`damping`]). Viscous damping is not in here: see [`Model::damping`].
     pub fn stiffness_complex(&self) -> CMat8 {
         CMat8::from_fn(|r, c| {
             Complex64::new(
                 self.stiffness_gravity[(r, c)] + self.stiffness_elastic[(r, c)],
-                self.stiffness_elastic[(r, c)] * self.elastic_loss[(r, c)],
+                self.stiffness_imag[(r, c)],
             )
         })
     }
 
-    /// True when every loss angle is zero.
+    /// `Im(K_c)`, symmetric positive semi-definite (N m/rad, N/m, N m/m by entry).
+    pub fn stiffness_imag(&self) -> &Mat8 {
+        &self.stiffness_imag
+    }
+
+    /// Viscous damping matrix `C` (N m s/rad, N s/m, ...), symmetric positive semi-definite; the
+    /// dynamic stiffness is `K_c + i w C - w^2 M`.
+    pub fn damping(&self) -> &Mat8 {
+        &self.damping
+    }
+
+    /// True when some viscous coefficient is nonzero.
+    pub fn has_viscous(&self) -> bool {
+        self.damping.iter().any(|&c| c != 0.0)
+    }
+
+    /// `K_c + i w C` at angular frequency `w` (rad/s): the dynamic stiffness without the
+    /// inertia term.
+    pub fn stiffness_dynamic(&self, omega_rad_s: f64) -> CMat8 {
+        let mut k = self.stiffness_complex();
+        if self.has_viscous() {
+            for (z, &c) in k.iter_mut().zip(self.damping.iter()) {
+                z.im += omega_rad_s * c;
+            }
+        }
+        k
+    }
+
+    /// Every dissipative element with a nonzero coefficient (structural first). Empty when
+    /// the model is undamped.
+    pub fn dissipative_elements(&self) -> &[DissipativeElement] {
+        &self.dissipation
+    }
+
+    /// True when there is no dissipation at all (every loss angle and viscous coefficient 0).
     pub fn is_undamped(&self) -> bool {
-        self.elastic_loss.iter().all(|&phi| phi == 0.0)
+        self.dissipation.is_empty()
     }
 
     /// Zeroth-order generalized forces per unit force/torque component (Appendix A), columns in

@@ -9,12 +9,18 @@
 //!
 //! Terms of each observable: `tilt` (full cross-spectral propagation), `tilt.<axis>` (each axis
 //! alone, `|H_oi|^2 S_ii`: a diagnostic breakdown, which does not add up to `tilt` when the axes are
-//! correlated), `readout` (white, configurable per observable), and `total` = the sum in power of
-//! `tilt`, `readout` and any other independent term. Pure numerics: depends on `model` and `tf`
-//! types only.
+//! correlated), `readout` (white, configurable per observable), `thermal` (the sum over the
+//! dissipative elements, [`crate::thermal`]; only for a damped model) with `thermal.<element>`
+//! per element (independent sources: they add up to `thermal`), and `total` = the sum in power
+//! of `tilt`, `readout`, `thermal` and any other independent term (always last). A damped
+//! budget also carries `response.<input>`, the squared response to the equivalent input
+//! ([`equivalent`]), which is not a noise. Pure numerics: depends on `model`, `tf` and
+//! `thermal` only.
 
+pub mod equivalent;
 mod segments;
 
+pub use equivalent::{add_equivalent_response, equivalent_input, is_response, RESPONSE_PREFIX};
 pub use segments::{percentile, SegmentBand};
 
 use crate::model::{Observable, TiltAxis};
@@ -205,6 +211,49 @@ pub fn tilt_budget(tf: &TransferMatrix, tilt: &TiltCsd, readout: &Readout) -> Bu
     Budget {
         freqs_hz: tf.freqs_hz.clone(),
         observables,
+    }
+}
+
+/// Adds the thermal-noise terms of `thermal` (same grid as `budget`) to every observable it
+/// has: `thermal` (sum over the elements) and `thermal.<element>`, inserted before `total`,
+/// and adds `thermal` to `total`. Does nothing when `thermal` has no element (undamped model).
+/// Call it before [`add_measured`], whose residual is taken against `total`.
+///
+/// # Panics
+/// If the grids differ in length.
+pub fn add_thermal(budget: &mut Budget, thermal: &crate::thermal::ThermalNoise) {
+    if thermal.elements.is_empty() {
+        return;
+    }
+    assert_eq!(
+        budget.freqs_hz.len(),
+        thermal.freqs_hz.len(),
+        "thermal and budget grids differ"
+    );
+    for b in budget.observables.iter_mut() {
+        let Some(o) = thermal.outputs.iter().position(|&x| x == b.observable) else {
+            continue;
+        };
+        let total_thermal = thermal.total_psd(o);
+        let at = b
+            .terms
+            .iter()
+            .position(|t| t.name == "total")
+            .expect("every budget has a total");
+        for (k, p) in b.terms[at].psd.iter_mut().enumerate() {
+            *p += total_thermal[k];
+        }
+        let mut new_terms = vec![NoiseTerm {
+            name: "thermal".into(),
+            psd: total_thermal,
+        }];
+        for e in &thermal.elements {
+            new_terms.push(NoiseTerm {
+                name: format!("thermal.{}", e.name),
+                psd: e.psd[o].clone(),
+            });
+        }
+        b.terms.splice(at..at, new_terms);
     }
 }
 

@@ -10,6 +10,9 @@ use crate::error::ParamError;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+pub mod uncertainty;
+pub use uncertainty::UncertaintyTable;
+
 /// The embedded default parameter file (Table I of the paper), with a unit comment on every line.
 pub const TABLE_I_TOML: &str = include_str!("table1.toml");
 
@@ -88,9 +91,26 @@ pub struct Lengths {
 pub struct Environment {
     /// Local gravitational acceleration (m s^-2). Not given in the paper: standard gravity assumed.
     pub g_m_per_s2: f64,
+    /// Temperature of the dissipative elements (K), the T of the fluctuation-dissipation
+    /// theorem in the thermal-noise terms. Optional in files; default 293.15 K (20 degC room
+    /// temperature, an assumption).
+    #[serde(default = "default_temperature_k")]
+    pub temperature_k: f64,
 }
 
-/// Structural loss angles of the fibres' elastic stiffness (rad): k -> k (1 + i phi).
+/// Default of `environment.temperature_k`: 20 degC.
+pub const DEFAULT_TEMPERATURE_K: f64 = 293.15;
+
+fn default_temperature_k() -> f64 {
+    DEFAULT_TEMPERATURE_K
+}
+
+fn default_dilution() -> f64 {
+    1.0
+}
+
+/// Structural loss angles (rad): k -> k (1 + i phi) on each fibre's torsion, bouncing and
+/// swing stiffness. See `docs/damping.md`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LossAngles {
@@ -102,6 +122,59 @@ pub struct LossAngles {
     pub bouncing_a_rad: f64,
     /// Bouncing of the lower fibre.
     pub bouncing_b_rad: f64,
+    /// Material (bending) loss angle of the upper fibre. Its swing (pendulum) loss angle is
+    /// `bending_a_rad / dilution_a` (optional in files, default 0).
+    #[serde(default)]
+    pub bending_a_rad: f64,
+    /// Material (bending) loss angle of the lower fibre (optional, default 0).
+    #[serde(default)]
+    pub bending_b_rad: f64,
+    /// Dilution factor D >= 1 of the upper fibre's swing: gravity stiffness over bending
+    /// stiffness, `phi_pendulum = phi_fibre / D` (optional, default 1: no dilution).
+    #[serde(default = "default_dilution")]
+    pub dilution_a: f64,
+    /// Dilution factor D >= 1 of the lower fibre's swing (optional, default 1).
+    #[serde(default = "default_dilution")]
+    pub dilution_b: f64,
+}
+
+impl LossAngles {
+    /// Swing (pendulum) loss angle of the upper fibre, `bending_a_rad / dilution_a` (rad).
+    pub fn swing_a_rad(&self) -> f64 {
+        self.bending_a_rad / self.dilution_a
+    }
+
+    /// Swing (pendulum) loss angle of the lower fibre, `bending_b_rad / dilution_b` (rad).
+    pub fn swing_b_rad(&self) -> f64 {
+        self.bending_b_rad / self.dilution_b
+    }
+}
+
+/// Viscous damping coefficients per fibre and motion: a generalized damping force `-c q'` on
+/// the element's coordinate (see `docs/damping.md`). The whole section is optional; every
+/// coefficient defaults to 0.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Viscous {
+    /// Torsion of the upper fibre, on phi_a (N m s/rad).
+    #[serde(default)]
+    pub torsion_a_n_m_s_per_rad: f64,
+    /// Torsion of the lower fibre, on phi_b (N m s/rad).
+    #[serde(default)]
+    pub torsion_b_n_m_s_per_rad: f64,
+    /// Bouncing of the upper fibre, on delta_a (N s/m).
+    #[serde(default)]
+    pub bouncing_a_n_s_per_m: f64,
+    /// Bouncing of the lower fibre, on delta_b (N s/m).
+    #[serde(default)]
+    pub bouncing_b_n_s_per_m: f64,
+    /// Swing of the upper fibre, on theta_a and eta_a each (N m s/rad).
+    #[serde(default)]
+    pub swing_a_n_m_s_per_rad: f64,
+    /// Swing of the lower fibre, on the test mass's absolute angles theta_a + theta_b and
+    /// eta_a + eta_b each (N m s/rad).
+    #[serde(default)]
+    pub swing_b_n_m_s_per_rad: f64,
 }
 
 /// A complete parameter set. Build it with [`Params::table_i`], [`Params::from_toml_str`] or
@@ -123,6 +196,12 @@ pub struct Params {
     pub environment: Environment,
     /// Loss angles.
     pub loss: LossAngles,
+    /// Viscous damping coefficients (optional section, default 0).
+    #[serde(default)]
+    pub viscous: Viscous,
+    /// Error bars overriding the defaults (optional section; see [`uncertainty`]).
+    #[serde(default, skip_serializing_if = "UncertaintyTable::is_empty")]
+    pub uncertainty: UncertaintyTable,
 }
 
 /// What values a parameter may take.
@@ -136,6 +215,8 @@ pub enum Allowed {
     Finite,
     /// A loss angle: finite, >= 0 and < 1 rad.
     LossAngle,
+    /// A dilution factor: finite and >= 1.
+    AtLeastOne,
 }
 
 impl Allowed {
@@ -146,6 +227,7 @@ impl Allowed {
                 Allowed::NonNegative => v >= 0.0,
                 Allowed::Finite => true,
                 Allowed::LossAngle => (0.0..1.0).contains(&v),
+                Allowed::AtLeastOne => v >= 1.0,
             }
     }
 
@@ -156,6 +238,7 @@ impl Allowed {
             Allowed::NonNegative => "finite and >= 0",
             Allowed::Finite => "finite",
             Allowed::LossAngle => "finite, >= 0 and < 1",
+            Allowed::AtLeastOne => "finite and >= 1",
         }
     }
 }
@@ -209,6 +292,7 @@ impl Params {
              # length.h_m and environment.g_m_per_s2 are assumptions, not from the paper.\n\n",
         );
         text.push_str(&toml::to_string(self).expect("parameters serialize to TOML"));
+        text.push_str(&self.uncertainty_comment());
         text
     }
 
@@ -351,6 +435,13 @@ impl Params {
                 Positive,
             ),
             f(
+                "environment.temperature_k",
+                self.environment.temperature_k,
+                "K",
+                "T (assumption)",
+                Positive,
+            ),
+            f(
                 "loss.torsion_a_rad",
                 self.loss.torsion_a_rad,
                 "rad",
@@ -377,6 +468,76 @@ impl Params {
                 "rad",
                 "phi_bouncing,b",
                 LossAngle,
+            ),
+            f(
+                "loss.bending_a_rad",
+                self.loss.bending_a_rad,
+                "rad",
+                "phi_fibre,a (swing: / D_a)",
+                LossAngle,
+            ),
+            f(
+                "loss.bending_b_rad",
+                self.loss.bending_b_rad,
+                "rad",
+                "phi_fibre,b (swing: / D_b)",
+                LossAngle,
+            ),
+            f(
+                "loss.dilution_a",
+                self.loss.dilution_a,
+                "1",
+                "D_a",
+                AtLeastOne,
+            ),
+            f(
+                "loss.dilution_b",
+                self.loss.dilution_b,
+                "1",
+                "D_b",
+                AtLeastOne,
+            ),
+            f(
+                "viscous.torsion_a_n_m_s_per_rad",
+                self.viscous.torsion_a_n_m_s_per_rad,
+                "N m s/rad",
+                "c_torsion,a",
+                NonNegative,
+            ),
+            f(
+                "viscous.torsion_b_n_m_s_per_rad",
+                self.viscous.torsion_b_n_m_s_per_rad,
+                "N m s/rad",
+                "c_torsion,b",
+                NonNegative,
+            ),
+            f(
+                "viscous.bouncing_a_n_s_per_m",
+                self.viscous.bouncing_a_n_s_per_m,
+                "N s/m",
+                "c_bouncing,a",
+                NonNegative,
+            ),
+            f(
+                "viscous.bouncing_b_n_s_per_m",
+                self.viscous.bouncing_b_n_s_per_m,
+                "N s/m",
+                "c_bouncing,b",
+                NonNegative,
+            ),
+            f(
+                "viscous.swing_a_n_m_s_per_rad",
+                self.viscous.swing_a_n_m_s_per_rad,
+                "N m s/rad",
+                "c_swing,a",
+                NonNegative,
+            ),
+            f(
+                "viscous.swing_b_n_m_s_per_rad",
+                self.viscous.swing_b_n_m_s_per_rad,
+                "N m s/rad",
+                "c_swing,b",
+                NonNegative,
             ),
         ]
     }
@@ -408,7 +569,18 @@ impl Params {
                 ),
             });
         }
-        Ok(())
+        // Already checked when read from TOML; this catches a table built in code. (Skipped
+        // when empty: the Monte Carlo validates every draw.)
+        if self.uncertainty.is_empty() {
+            return Ok(());
+        }
+        let keys: Vec<&str> = self.fields().iter().map(|f| f.key).collect();
+        self.uncertainty
+            .validate(&keys)
+            .map_err(|e| ParamError::Syntax {
+                origin: "(uncertainty table built in code)".to_string(),
+                message: e.to_string(),
+            })
     }
 }
 
@@ -502,5 +674,34 @@ mod tests {
         assert!(p.with_override("loss.torsion_b_rad=1e-3").is_ok());
         assert!(p.with_override("loss.torsion_b_rad=-1e-3").is_err());
         assert!(p.with_override("loss.torsion_b_rad=1.5").is_err());
+    }
+
+    #[test]
+    fn damping_keys_are_validated_and_optional() {
+        let p = Params::table_i();
+        assert_eq!(p.environment.temperature_k, DEFAULT_TEMPERATURE_K);
+        assert_eq!(p.viscous, Viscous::default());
+        for (set, rule) in [
+            ("loss.bending_b_rad=-1e-4", ">= 0 and < 1"),
+            ("loss.dilution_a=0.5", ">= 1"),
+            ("viscous.swing_b_n_m_s_per_rad=-1", ">= 0"),
+            ("environment.temperature_k=-4", "> 0"),
+            ("viscous.torsion_b_n_m_s_per_rad=inf", ">= 0"),
+        ] {
+            let key = set.split('=').next().unwrap();
+            let e = p.with_override(set).unwrap_err().to_string();
+            assert!(e.contains(key) && e.contains(rule), "{set}: {e}");
+        }
+        let q = p
+            .with_override("loss.bending_b_rad=1e-3")
+            .and_then(|q| q.with_override("loss.dilution_b=50"))
+            .unwrap();
+        assert_eq!(q.loss.swing_b_rad(), 1e-3 / 50.0);
+        // A file without the optional keys (an older parameter file) still reads.
+        assert!(Params::from_toml_str(
+            &TABLE_I_TOML.replace("temperature_k = 293.15", ""),
+            "old.toml"
+        )
+        .is_ok());
     }
 }

@@ -8,7 +8,7 @@ use super::save_figure;
 use crate::error::OutputError;
 use crate::io::InputMeta;
 use crate::model::{Observable, TiltAxis};
-use crate::noise::{BudgetReport, NoiseTerm, Readout, SegmentBand, SpectralSource};
+use crate::noise::{is_response, BudgetReport, NoiseTerm, Readout, SegmentBand, SpectralSource};
 use plotters::style::RGBColor;
 use std::path::Path;
 
@@ -74,6 +74,17 @@ const TILT_COLOR: RGBColor = PALETTE[0];
 const READOUT_COLOR: RGBColor = RGBColor(128, 128, 128);
 /// Black of `total` and `measured`.
 const BLACK: RGBColor = PALETTE[6];
+/// Red of the `thermal` term.
+const THERMAL_COLOR: RGBColor = RGBColor(200, 30, 30);
+/// Element names, for a stable colour per element of `thermal.<element>`.
+const THERMAL_ELEMENTS: [&str; 6] = [
+    "torsion_a",
+    "torsion_b",
+    "bouncing_a",
+    "bouncing_b",
+    "swing_a",
+    "swing_b",
+];
 
 /// Legend label and style of a term; `None` for the colour cycle of unknown terms.
 fn term_style(name: &str, readout: Option<(f64, Observable)>) -> Option<(String, TraceStyle)> {
@@ -90,6 +101,26 @@ fn term_style(name: &str, readout: Option<(f64, Observable)>) -> Option<(String,
         }
         "measured" => ("measured".to_string(), style(BLACK, Dash::Solid, 1)),
         "residual" => ("residual".to_string(), style(PALETTE[3], Dash::Dotted, 2)),
+        "thermal" => (
+            "thermal (FDT)".to_string(),
+            style(THERMAL_COLOR, Dash::Solid, 2),
+        ),
+        _ if name.starts_with("thermal.") => {
+            let element = name.trim_start_matches("thermal.");
+            let k = THERMAL_ELEMENTS
+                .iter()
+                .position(|e| element.starts_with(e))
+                .unwrap_or(0);
+            let dash = if element.ends_with("_viscous") {
+                Dash::Dashed
+            } else {
+                Dash::Dotted
+            };
+            (
+                format!("thermal, {}", element.replace('_', " ")),
+                style(OTHER_COLORS[k % OTHER_COLORS.len()], dash, 2),
+            )
+        }
         _ => {
             let axis = name.strip_prefix("tilt.")?;
             let axis = TiltAxis::ALL.into_iter().find(|a| a.name() == axis)?;
@@ -116,12 +147,16 @@ fn draw_rank(name: &str) -> u8 {
         "tilt" => 3,
         n if n.starts_with("tilt.") => 4,
         "readout" => 5,
-        _ => 6,
+        "thermal" => 6,
+        n if n.starts_with("thermal.") => 7,
+        _ => 8,
     }
 }
 
-/// Extra colours for terms this figure does not know.
-const OTHER_COLORS: [RGBColor; 3] = [PALETTE[4], PALETTE[2], PALETTE[3]];
+/// Extra colours for terms this figure does not know, and for the thermal elements.
+const OTHER_COLORS: [RGBColor; 6] = [
+    PALETTE[4], PALETTE[2], PALETTE[3], PALETTE[5], PALETTE[1], PALETTE[0],
+];
 
 /// The figure as data, ready for [`save_figure`]; errors are plain messages.
 pub fn build_budget_figure(
@@ -146,7 +181,8 @@ pub fn build_budget_figure(
             ),
         );
         panel.max_decades = Some(options.max_decades);
-        let mut terms: Vec<&NoiseTerm> = ob.terms.iter().collect();
+        let mut terms: Vec<&NoiseTerm> =
+            ob.terms.iter().filter(|t| !is_response(&t.name)).collect();
         terms.sort_by_key(|t| draw_rank(&t.name));
         let mut other = 0;
         for term in terms {
@@ -157,6 +193,10 @@ pub fn build_budget_figure(
                 (term.name.clone(), TraceStyle::new(c, Dash::Solid, 2))
             });
             if term.psd.iter().all(|&p| p == 0.0) {
+                // An element of the other block: exactly 0 by the model's structure, not news.
+                if term.name.starts_with("thermal.") {
+                    continue;
+                }
                 let short = label.strip_prefix("tilt, ").unwrap_or(&label);
                 panel.notes.push(format!("{short}: identically 0"));
                 continue;
@@ -171,7 +211,20 @@ pub fn build_budget_figure(
         }
         panels.push(panel);
     }
-    let mut title = "Tilt noise budget: one-sided amplitude spectral densities".to_string();
+    if let Some(panel) = equivalent_panel(report, options) {
+        panels.push(panel);
+    }
+    let damped = report
+        .budget
+        .observables
+        .iter()
+        .any(|b| b.term("thermal").is_some());
+    let mut title = if damped {
+        "Noise budget (tilt, thermal, readout): one-sided amplitude spectral densities"
+    } else {
+        "Tilt noise budget: one-sided amplitude spectral densities"
+    }
+    .to_string();
     if let Some(note) = &options.note {
         title.push_str(&format!(" ({note})"));
     }
@@ -182,6 +235,60 @@ pub fn build_budget_figure(
         columns: 2,
         caption: caption(report, options.input.as_ref()),
     })
+}
+
+/// With a damped model (a `response.F_b.x` term on X), the X budget referred to the test
+/// mass's acceleration, `S_X / |m_b H_X,F_b.x|^2` (m s^-2/sqrt(Hz)): the free-fall figure of
+/// merit, in the fourth slot of the 2x2 grid. Terms as in the X panel, without the measured
+/// ones and the per-axis or per-element breakdown.
+fn equivalent_panel(report: &BudgetReport, options: &BudgetFigureOptions) -> Option<Panel> {
+    let ob = report
+        .budget
+        .observables
+        .iter()
+        .find(|b| b.observable == Observable::X)?;
+    let response = ob.terms.iter().find(|t| is_response(&t.name))?;
+    let mut panel = Panel::new(
+        "Test-mass acceleration noise equivalent to X",
+        ("frequency", "Hz"),
+        ("ASD of aₓ", "m s⁻²/√Hz"),
+    );
+    panel.max_decades = Some(options.max_decades);
+    let mut terms: Vec<&NoiseTerm> = ob
+        .terms
+        .iter()
+        .filter(|t| ["total", "tilt", "thermal", "readout"].contains(&t.name.as_str()))
+        .collect();
+    terms.sort_by_key(|t| draw_rank(&t.name));
+    // The response has zeros (antiresonances), where every equivalent term peaks: scale the y
+    // axis on the floor of the total instead, from a decade below its minimum up 6 decades.
+    let total = ob.term("total")?;
+    let floor = total
+        .psd
+        .iter()
+        .zip(&response.psd)
+        .map(|(p, r)| (p / r).sqrt())
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    if floor.is_finite() {
+        let lo = 10f64.powf(floor.log10().floor() - 1.0);
+        panel.y_range = Some((lo, lo * 1e6));
+    }
+    for term in terms {
+        let (label, style) = term_style(&term.name, None)?;
+        if term.psd.iter().all(|&p| p == 0.0) {
+            continue;
+        }
+        let points = report
+            .budget
+            .freqs_hz
+            .iter()
+            .zip(term.psd.iter().zip(&response.psd))
+            .map(|(&f, (p, r))| (f, (p / r).sqrt()))
+            .collect();
+        panel.traces.push(Trace::new(label, points, style));
+    }
+    Some(panel)
 }
 
 /// The shaded band between the lower and upper percentile of the tilt ASD and the median line.
@@ -368,9 +475,22 @@ fn caption(report: &BudgetReport, input: Option<&InputMeta>) -> Vec<String> {
     }
     out.push(readout_sentence(&report.readout, report));
     out.push(
-        "All curves are one-sided ASDs (√PSD). tilt: all axes with their cross-spectra; \
-         “alone”: one axis, for diagnosis; total: quadrature sum of tilt and readout."
-            .to_string(),
+        if report
+            .budget
+            .observables
+            .iter()
+            .any(|b| b.term("thermal").is_some())
+        {
+            "All curves are one-sided ASDs (√PSD). tilt: all axes with their cross-spectra; \
+             “alone”: one axis, for diagnosis; thermal: fluctuation-dissipation theorem, sum over \
+             the dissipative elements (dotted: each element alone); total: quadrature sum of \
+             tilt, thermal and readout."
+                .to_string()
+        } else {
+            "All curves are one-sided ASDs (√PSD). tilt: all axes with their cross-spectra; \
+             “alone”: one axis, for diagnosis; total: quadrature sum of tilt and readout."
+                .to_string()
+        },
     );
     out.extend(report.notes.iter().map(|n| {
         let n = n.trim();

@@ -468,7 +468,10 @@ pub fn draw_panel<DB: DrawingBackend>(
         }
     }
     for (line, style) in &lines {
-        draw_polyline(&mut chart, decimate(line, &rect, xr, yr, 1.5), *style)?;
+        let line = decimate(line, &rect, xr, yr, 1.5);
+        for run in split_at_reversals(&line, &rect, xr, yr) {
+            draw_polyline(&mut chart, run, *style)?;
+        }
     }
 
     // Close the frame: plotters draws only the left and bottom axes.
@@ -881,6 +884,35 @@ fn decimate(
     out
 }
 
+/// Cuts a polyline where it turns back on itself by more than 90 degrees in pixel space (the two
+/// sides of a resonance peak drawn in one pixel column): a thick plotters path joins such a
+/// U-turn with a degenerate miter and drops the segments around it, so an undamped peak would
+/// look capped far below its height. Consecutive runs share the turning vertex.
+fn split_at_reversals(
+    line: &[(f64, f64)],
+    rect: &PlotRect,
+    xr: (f64, f64),
+    yr: (f64, f64),
+) -> Vec<Vec<(f64, f64)>> {
+    let px: Vec<(f64, f64)> = line.iter().map(|&p| rect.map(p, xr, yr)).collect();
+    let mut runs = Vec::new();
+    let mut current: Vec<(f64, f64)> = line.iter().take(1).copied().collect();
+    for k in 1..line.len() {
+        if k >= 2 {
+            let a = (px[k - 1].0 - px[k - 2].0, px[k - 1].1 - px[k - 2].1);
+            let b = (px[k].0 - px[k - 1].0, px[k].1 - px[k - 1].1);
+            if a.0 * b.0 + a.1 * b.1 < 0.0 {
+                runs.push(std::mem::replace(&mut current, vec![line[k - 1]]));
+            }
+        }
+        current.push(line[k]);
+    }
+    if current.len() >= 2 {
+        runs.push(current);
+    }
+    runs
+}
+
 /// Legend rows: a sample (line, band swatch or nothing) and text.
 enum Sample {
     Line(TraceStyle),
@@ -1115,6 +1147,31 @@ mod tests {
         let first_of_third = lines[2][0];
         assert!((first_of_third.1 - 1e-3).abs() < 1e-12);
         assert!((lines[2][1].0 - 8.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn reversals_split_peaks_and_keep_monotone_lines_whole() {
+        let rect = PlotRect {
+            width: 500.0,
+            height: 300.0,
+        };
+        let (xr, yr) = ((1e-3, 2e-3), (1e2, 1e11));
+        // An undamped peak: up and back down within one pixel column.
+        let peak = [
+            (1.3e-3, 1e5),
+            (1.31e-3, 1e10),
+            (1.3100001e-3, 1e9),
+            (1.4e-3, 1e5),
+        ];
+        let runs = split_at_reversals(&peak, &rect, xr, yr);
+        assert_eq!(runs.len(), 2);
+        assert_eq!(runs[0], peak[..2].to_vec());
+        assert_eq!(runs[1], peak[1..].to_vec());
+        let rising = [(1e-3, 1e3), (1.2e-3, 1e4), (1.5e-3, 1e6), (2e-3, 1e7)];
+        assert_eq!(
+            split_at_reversals(&rising, &rect, xr, yr),
+            vec![rising.to_vec()]
+        );
     }
 
     #[test]

@@ -23,7 +23,9 @@
 pub mod budget_figure;
 pub mod chart;
 mod labels;
+pub mod mc_figure;
 pub mod methods_figure;
+pub mod simulate_figure;
 mod text;
 pub mod tf_figure;
 

@@ -1,5 +1,7 @@
 //! The paper's Figure 5: moduli of the transfer functions from the floor tilt angles
-//! (θₜ solid, ηₜ dashed, φₜ dotted) to the soft-DoF observables X, φ and φₐ.
+//! (θₜ solid, ηₜ dashed, φₜ dotted) to the soft-DoF observables X, φ and φₐ; and the same
+//! layout for force and torque inputs (one panel per observable and kind of input, so each panel
+//! has one unit: m/N, rad/(N m), ...).
 
 use super::chart::{Dash, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
 // Re-exported: `plot::tf_figure::observable_symbol` is a public path.
@@ -7,7 +9,7 @@ pub use super::labels::observable_symbol;
 use super::labels::{observable_title, tilt_symbol};
 use super::save_figure;
 use crate::error::OutputError;
-use crate::model::{Observable, TiltAxis};
+use crate::model::{ForceInput, Observable, TiltAxis};
 use crate::tf::{Input, TransferMatrix};
 use std::path::Path;
 
@@ -36,7 +38,8 @@ impl Default for TfFigureOptions {
 /// Writes Figure 5 of the paper to `path` (`.png` or `.svg`): |H| of X (m/rad), φ (rad/rad)
 /// and φₐ (rad/rad) per floor tilt angle versus frequency, log-log. Entries that are exactly
 /// zero at every frequency are not drawn but listed in the legend as identically 0. Panels for
-/// observables absent from `tf` are skipped; non-tilt inputs are ignored.
+/// observables absent from `tf` are skipped. Force and torque inputs get panels of their own
+/// (m/N, rad/N, m/(N m), rad/(N m)) beside the tilt panels.
 pub fn tf_figure(tf: &TransferMatrix, path: &Path) -> Result<(), OutputError> {
     tf_figure_with(tf, path, &TfFigureOptions::default())
 }
@@ -64,48 +67,115 @@ pub fn tilt_symbol_style(t: TiltAxis) -> (&'static str, TraceStyle) {
     (tilt_symbol(t), style)
 }
 
+/// The kinds of input a panel groups: one panel per observable and kind, since the units differ.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum InputKind {
+    /// Floor tilt angles (rad).
+    Tilt,
+    /// Force components (N).
+    Force,
+    /// Torque components (N m).
+    Torque,
+}
+
+impl InputKind {
+    fn of(input: Input) -> InputKind {
+        match input {
+            Input::Tilt(_) => InputKind::Tilt,
+            Input::Force(f) if f.unit() == "N" => InputKind::Force,
+            Input::Force(_) => InputKind::Torque,
+        }
+    }
+
+    /// `(y-axis symbol of the input, unit of the response per unit input, title suffix)`.
+    fn labels(self, o: Observable) -> (&'static str, String, &'static str) {
+        match self {
+            InputKind::Tilt => ("tilt", format!("{}/rad", o.unit()), ""),
+            InputKind::Force => ("F", format!("{}/N", o.unit()), ", per force"),
+            InputKind::Torque => ("M", format!("{}/(N m)", o.unit()), ", per torque"),
+        }
+    }
+}
+
+/// Display name (the command-line name, e.g. `F_b.x`) and line style of a force or torque
+/// component: colour by axis (x, y, z), solid on the test mass (`b`), dashed on the crossbar (`a`).
+pub fn force_symbol_style(f: ForceInput) -> (String, TraceStyle) {
+    let name = f.name();
+    let axis = match name.as_bytes()[name.len() - 1] {
+        b'x' => 0,
+        b'y' => 1,
+        _ => 2,
+    };
+    let on_test_mass = name.as_bytes()[2] == b'b';
+    let dash = if on_test_mass {
+        Dash::Solid
+    } else {
+        Dash::Dashed
+    };
+    (name.to_string(), TraceStyle::new(PALETTE[axis], dash, 2))
+}
+
 /// The figure as data, ready for [`save_figure`]; errors are plain messages.
+///
+/// One panel per requested observable and kind of input present (tilt in rad, forces in N,
+/// torques in N m), so every panel has a single unit; a tilt-only matrix gives the paper's
+/// Figure 5 layout.
 pub fn build_tf_figure(
     tf: &TransferMatrix,
     options: &TfFigureOptions,
 ) -> Result<LogLogFigure, String> {
-    let tilts: Vec<(usize, TiltAxis)> = TiltAxis::ALL
+    let kinds: Vec<InputKind> = [InputKind::Tilt, InputKind::Force, InputKind::Torque]
         .into_iter()
-        .filter_map(|t| tf.input_index(Input::Tilt(t)).map(|i| (i, t)))
+        .filter(|&k| tf.inputs.iter().any(|&i| InputKind::of(i) == k))
         .collect();
-    if tilts.is_empty() {
-        return Err("the transfer matrix has no tilt input (theta_t, eta_t, phi_t)".to_string());
+    if kinds.is_empty() {
+        return Err("the transfer matrix has no input".to_string());
     }
     let mut panels = Vec::new();
     for &o in &options.observables {
         let Some(oi) = tf.output_index(o) else {
             continue;
         };
-        let unit = format!("{}/rad", o.unit());
-        let mut panel = Panel::new(
-            observable_title(o),
-            ("frequency", "Hz"),
-            (&format!("|{} / tilt|", observable_symbol(o)), &unit),
-        );
-        // Undamped peaks reach 1e6 while phi/eta_t falls as f^4 to 1e-10 at 0.1 mHz: show
-        // 18 decades so the low-frequency cancellation stays visible.
-        panel.max_decades = Some(18.0);
-        for &(ii, t) in &tilts {
-            let (name, style) = tilt_symbol_style(t);
-            let identically_zero = (0..tf.freqs_hz.len()).all(|k| tf.get(k, oi, ii).norm() == 0.0);
-            if identically_zero {
-                panel.notes.push(format!("{name}: identically 0"));
-                continue;
+        for &kind in &kinds {
+            let (input_symbol, unit, suffix) = kind.labels(o);
+            let mut panel = Panel::new(
+                format!("{}{suffix}", observable_title(o)),
+                ("frequency", "Hz"),
+                (
+                    &format!("|{} / {input_symbol}|", observable_symbol(o)),
+                    &unit,
+                ),
+            );
+            // Undamped peaks reach 1e6 while phi/eta_t falls as f^4 to 1e-10 at 0.1 mHz: show
+            // 18 decades so the low-frequency cancellation stays visible.
+            panel.max_decades = Some(18.0);
+            for (ii, &input) in tf.inputs.iter().enumerate() {
+                if InputKind::of(input) != kind {
+                    continue;
+                }
+                let (name, style) = match input {
+                    Input::Tilt(t) => {
+                        let (name, style) = tilt_symbol_style(t);
+                        (name.to_string(), style)
+                    }
+                    Input::Force(f) => force_symbol_style(f),
+                };
+                let identically_zero =
+                    (0..tf.freqs_hz.len()).all(|k| tf.get(k, oi, ii).norm() == 0.0);
+                if identically_zero {
+                    panel.notes.push(format!("{name}: identically 0"));
+                    continue;
+                }
+                let points = tf
+                    .freqs_hz
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &f)| (f, tf.get(k, oi, ii).norm()))
+                    .collect();
+                panel.traces.push(Trace::new(name, points, style));
             }
-            let points = tf
-                .freqs_hz
-                .iter()
-                .enumerate()
-                .map(|(k, &f)| (f, tf.get(k, oi, ii).norm()))
-                .collect();
-            panel.traces.push(Trace::new(name, points, style));
+            panels.push(panel);
         }
-        panels.push(panel);
     }
     if panels.is_empty() {
         let names: Vec<&str> = options.observables.iter().map(|o| o.name()).collect();
@@ -114,24 +184,39 @@ pub fn build_tf_figure(
             names.join(", ")
         ));
     }
-    let mut title = format!(
-        "Floor tilt → observables: |H(f)|, method {}",
-        tf.method.name()
-    );
+    let has_tilt = kinds.contains(&InputKind::Tilt);
+    let has_forces = kinds.len() > usize::from(has_tilt);
+    let what = match (has_tilt, has_forces) {
+        (true, false) => "Floor tilt",
+        (false, _) => "Forces and torques",
+        (true, true) => "Floor tilt, forces and torques",
+    };
+    let mut title = format!("{what} → observables: |H(f)|, method {}", tf.method.name());
     if let Some(note) = &options.note {
         title.push_str(&format!(" ({note})"));
     }
-    let mut caption = vec![
-        "Lines: θₜ solid, ηₜ dashed, φₜ dotted. |H| is the modulus of the complex response \
-         per radian of floor tilt."
-            .to_string(),
-        "Sign convention: tilt t = small rotation taking the floor frame to the inertial \
-         frame (the floor turns by −t); observables are read in the enclosure frame."
-            .to_string(),
-        "Quasi-static limit f → 0: X → −ηₜ (Z + Z_b + h_c), Y → θₜ (Z + Z_b + h_c); the other \
-         entries shown tend to 0 (φ/ηₜ and φₐ/ηₜ as f⁴)."
-            .to_string(),
-    ];
+    let mut caption = Vec::new();
+    if has_tilt {
+        caption.extend([
+            "Tilt lines: θₜ solid, ηₜ dashed, φₜ dotted. |H| is the modulus of the complex \
+             response per radian of floor tilt."
+                .to_string(),
+            "Sign convention: tilt t = small rotation taking the floor frame to the inertial \
+             frame (the floor turns by −t); observables are read in the enclosure frame."
+                .to_string(),
+            "Quasi-static limit f → 0: X → −ηₜ (Z + Z_b + h_c), Y → θₜ (Z + Z_b + h_c); the \
+             other entries shown tend to 0 (φ/ηₜ and φₐ/ηₜ as f⁴)."
+                .to_string(),
+        ]);
+    }
+    if has_forces {
+        caption.push(
+            "Forces F (N) act at the centres of mass, torques M (N m) about them, inertial axes \
+             (Appendix A, zeroth order). Colour: x, y, z component; solid: on the test mass (b), \
+             dashed: on the crossbar (a)."
+                .to_string(),
+        );
+    }
     if let (Some(first), Some(last)) = (tf.freqs_hz.first(), tf.freqs_hz.last()) {
         caption.push(format!(
             "Evaluated at {} frequencies from {} to {} Hz. Without loss angles the resonance \
@@ -197,6 +282,41 @@ mod tests {
         assert_eq!(total, 3);
         // X does not respond to theta_t (the 4-DoF blocks decouple).
         assert!(x.notes.iter().any(|n| n.starts_with("θₜ")), "{:?}", x.notes);
+    }
+
+    #[test]
+    fn force_inputs_get_their_own_panels_and_units() {
+        let model = Model::new(&Params::table_i()).unwrap();
+        let mut request = Request::all_tilt();
+        request.inputs.truncate(2);
+        for name in ["F_b.x", "M_b.z", "M_a.z"] {
+            request
+                .inputs
+                .push(Input::Force(ForceInput::from_name(name).unwrap()));
+        }
+        request.outputs = vec![Observable::X, Observable::Phi];
+        let tf = plan(&model, &request, Method::Direct).unwrap();
+        let tf = evaluate(&*tf, &[1e-3, 1e-2, 1.0]).unwrap();
+        let fig = build_tf_figure(&tf, &TfFigureOptions::default()).unwrap();
+        // 2 observables x (tilt, force, torque).
+        assert_eq!(fig.panels.len(), 6);
+        let units: Vec<&str> = fig.panels.iter().map(|p| p.y_unit.as_str()).collect();
+        assert_eq!(
+            units,
+            ["m/rad", "m/N", "m/(N m)", "rad/rad", "rad/N", "rad/(N m)"]
+        );
+        // The torque panel of phi has both torques drawn, the force panel F_b.x only.
+        assert_eq!(fig.panels[5].traces.len(), 2);
+        assert_eq!(fig.panels[4].traces.len(), 1);
+        assert!(fig
+            .title
+            .as_deref()
+            .unwrap()
+            .starts_with("Floor tilt, forces and torques"));
+        // Styles: test-mass torque solid, crossbar torque dashed, same z colour.
+        let (_, b) = force_symbol_style(ForceInput::from_name("M_b.z").unwrap());
+        let (_, a) = force_symbol_style(ForceInput::from_name("M_a.z").unwrap());
+        assert_ne!(a, b);
     }
 
     #[test]

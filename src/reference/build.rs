@@ -46,8 +46,10 @@ pub(super) const OBS_PHI_A: usize = 6;
 pub(super) struct Matrices {
     pub mass: [[Dd; 8]; 8],
     pub stiffness_gravity: [[Dd; 8]; 8],
-    /// K_gravity + K_elastic (1 + i phi).
+    /// K_gravity + K_elastic (1 + i phi) + i phi_swing (each fibre's share of K_gravity).
     pub stiffness: [[CDd; 8]; 8],
+    /// Viscous damping matrix C (the dynamic stiffness is K_c + i w C - w^2 M).
+    pub damping: [[Dd; 8]; 8],
     pub force: [[Dd; 12]; 8],
     pub g0: [[Dd; 3]; 8],
     pub g2: [[Dd; 3]; 8],
@@ -148,6 +150,40 @@ pub(super) fn build(p: &Params) -> Matrices {
         (DB, p.bouncing.kappa_b_n_per_m, lp.bouncing_b_rad),
     ] {
         stiffness[c][c] += CDd::new(dd(k), Dd::mul_f64_exact(k, phi));
+    }
+    // Swing: the gravity potential is a sum over the fibres' pendulums,
+    // 1/2 g [m_a (Z + Z_a) + m_b Z] theta_a^2 (upper fibre: both bodies, the test mass's weight
+    // at the lower suspension point) + 1/2 m_b g Z_b (theta_a + theta_b)^2 (lower fibre: the
+    // test mass about the lower suspension point), and likewise for eta; each fibre's share
+    // gets its diluted loss angle, phi_swing = phi_bending / D.
+    let k_ga = g * (m_a * zza + m_b * z);
+    let k_gb = m_b * g * z_b;
+    let phi_a = dd(lp.bending_a_rad) / dd(lp.dilution_a);
+    let phi_b = dd(lp.bending_b_rad) / dd(lp.dilution_b);
+    let (im_a, im_b) = (phi_a * k_ga, phi_b * k_gb);
+    for (a, b) in [(TA, TB), (EA, EB)] {
+        stiffness[a][a] += CDd::new(Dd::ZERO, im_a + im_b);
+        stiffness[a][b] += CDd::new(Dd::ZERO, im_b);
+        stiffness[b][a] += CDd::new(Dd::ZERO, im_b);
+        stiffness[b][b] += CDd::new(Dd::ZERO, im_b);
+    }
+    // Viscous damping on the same coordinates (swing of fibre b on the absolute angles).
+    let v = &p.viscous;
+    let mut damping = [[Dd::ZERO; 8]; 8];
+    for (c, coef) in [
+        (PA, v.torsion_a_n_m_s_per_rad),
+        (PB, v.torsion_b_n_m_s_per_rad),
+        (DA, v.bouncing_a_n_s_per_m),
+        (DB, v.bouncing_b_n_s_per_m),
+    ] {
+        damping[c][c] = dd(coef);
+    }
+    let (c_a, c_b) = (dd(v.swing_a_n_m_s_per_rad), dd(v.swing_b_n_m_s_per_rad));
+    for (a, b) in [(TA, TB), (EA, EB)] {
+        damping[a][a] = c_a + c_b;
+        damping[a][b] = c_b;
+        damping[b][a] = c_b;
+        damping[b][b] = c_b;
     }
 
     // Zeroth-order generalized forces (Appendix A, last display).
@@ -250,6 +286,7 @@ pub(super) fn build(p: &Params) -> Matrices {
         mass,
         stiffness_gravity: kg,
         stiffness,
+        damping,
         force,
         g0,
         g2,

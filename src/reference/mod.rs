@@ -14,7 +14,10 @@
 //! It does **not** share code with the `f64` model builder ([`crate::model`]): the mass matrix
 //! (Appendix A, eqs. (def_I) and (EM), with the crate's one generalization, I^b_22 wherever the
 //! test mass turns about its own y axis), the stiffness (gravity part, fibres' elastic part with
-//! loss factors `1 + i phi`), the zeroth-order force matrix, the tilt forcing `G0 + w^2 G2` (the
+//! loss factors `1 + i phi`, each fibre's diluted swing loss on its share of the gravity
+//! stiffness), the viscous damping matrix `C` (the dynamic stiffness is then
+//! `K_c + i w C - w^2 M`, with `w` the double-double square root of `w^2`), the zeroth-order
+//! force matrix, the tilt forcing `G0 + w^2 G2` (the
 //! crate's sign convention, see [`crate::model::tilt`]; `G2` from the apparent forces and torques
 //! `F_i = -m_i (r_s'' + w' x r_gi0)`, `M_i = -I_i w'` themselves) and the observation matrix are
 //! all rebuilt here from the [`Params`] values in double-double arithmetic. Shared with the rest
@@ -110,6 +113,8 @@ pub struct ReferenceModel {
 struct System {
     mass: [[Dd; N]; N],
     stiffness: [[CDd; N]; N],
+    /// Viscous damping matrix (zero unless the parameters have viscous coefficients).
+    damping: [[Dd; N]; N],
 }
 
 /// Dynamic stiffness, forcing and observation in one set of generalized coordinates.
@@ -155,6 +160,7 @@ impl Formulation {
             system: System {
                 mass: m.mass,
                 stiffness: m.stiffness,
+                damping: m.damping,
             },
             g0: m.g0,
             g2: m.g2,
@@ -172,6 +178,7 @@ impl Formulation {
             system: System {
                 mass: to_abs_rows(&to_abs_cols(&m.mass)),
                 stiffness: to_abs_rows(&to_abs_cols(&m.stiffness)),
+                damping: to_abs_rows(&to_abs_cols(&m.damping)),
             },
             g0: to_abs_rows(&m.g0),
             g2: to_abs_rows(&m.g2),
@@ -239,7 +246,11 @@ impl Formulation {
         let lu = sys.factor(w2, freq_hz)?;
         let a = sys.dynamic(w2, &[0; N]);
         let abs_a: [[f64; N]; N] = std::array::from_fn(|r| {
-            std::array::from_fn(|c| sys.stiffness[r][c].abs_f64() + w2f * sys.mass[r][c].hi.abs())
+            std::array::from_fn(|c| {
+                sys.stiffness[r][c].abs_f64()
+                    + w2f.sqrt() * sys.damping[r][c].hi.abs()
+                    + w2f * sys.mass[r][c].hi.abs()
+            })
         });
         // y = A^-T c = A^-1 c: the dynamic stiffness is (complex) symmetric in both formulations.
         let ys: Vec<[CDd; N]> = request
@@ -312,9 +323,19 @@ impl ReferenceModel {
         &self.m.stiffness_gravity
     }
 
-    /// Complex stiffness `K_gravity + K_elastic (1 + i phi)`.
+    /// Complex stiffness `K_gravity + K_elastic (1 + i phi)` plus the fibres' swing loss.
     pub fn stiffness(&self) -> &[[CDd; 8]; 8] {
         &self.m.stiffness
+    }
+
+    /// Viscous damping matrix `C` (the dynamic stiffness is `K_c + i w C - w^2 M`).
+    pub fn damping(&self) -> &[[Dd; 8]; 8] {
+        &self.m.damping
+    }
+
+    /// True when the parameters have a nonzero viscous coefficient.
+    pub fn has_viscous(&self) -> bool {
+        self.m.damping.iter().flatten().any(|d| !d.is_zero())
     }
 
     /// Zeroth-order generalized forces per unit force/torque (8x12, columns F_a.xyz, F_b.xyz,
@@ -422,17 +443,22 @@ impl ReferenceModel {
 }
 
 impl System {
-    /// `S (K_c - w^2 M) S` with the power-of-two scaling `S = diag(2^scale)` (exact).
+    /// `S (K_c + i w C - w^2 M) S` with the power-of-two scaling `S = diag(2^scale)` (exact).
     fn dynamic(&self, w2: Dd, scale: &[i32; N]) -> [[CDd; N]; N] {
+        let w = w2.sqrt();
         std::array::from_fn(|r| {
             std::array::from_fn(|c| {
                 let k = self.stiffness[r][c];
                 let m = self.mass[r][c];
-                let a = if m.is_zero() || w2.is_zero() {
+                let mut a = if m.is_zero() || w2.is_zero() {
                     k
                 } else {
                     k - CDd::real(m * w2)
                 };
+                let d = self.damping[r][c];
+                if !d.is_zero() && !w2.is_zero() {
+                    a += CDd::new(Dd::ZERO, d * w);
+                }
                 a.ldexp(scale[r] + scale[c])
             })
         })
@@ -444,7 +470,9 @@ impl System {
         // order one whatever the units, so pivot sizes measure closeness to a resonance.
         let w2f = w2.to_f64();
         let scale: [i32; N] = std::array::from_fn(|i| {
-            let diag = self.stiffness[i][i].abs_f64() + w2f * self.mass[i][i].to_f64();
+            let diag = self.stiffness[i][i].abs_f64()
+                + w2f.sqrt() * self.damping[i][i].to_f64().abs()
+                + w2f * self.mass[i][i].to_f64();
             if diag > 0.0 && diag.is_finite() {
                 -((0.5 * diag.log2()).round() as i32)
             } else {

@@ -15,7 +15,7 @@
 //! the same floating-point operations as the direct method's 8x8 LU (whose multipliers across
 //! blocks are exactly zero), so the results agree with it to the last bit or nearly so.
 
-use super::direct::{forcing_columns, omega_sq, EquilibratedLu};
+use super::direct::{forcing_columns, omega_sq, with_viscous, EquilibratedLu};
 use super::{Method, Request, TransferFunction};
 use crate::error::TfError;
 use crate::model::{Block, Coord, Model};
@@ -31,6 +31,8 @@ pub struct BlockReduced {
 /// One decoupled block's share of a request, in the block's coordinates ([`Block::coords`]).
 struct BlockSystem {
     stiffness: Matrix4<Complex64>,
+    /// Viscous damping matrix of the block, if any.
+    damping: Option<Matrix4<f64>>,
     mass: Matrix4<f64>,
     /// Inputs that force the block: column in the request, rows of G0 and of G2.
     inputs: Vec<(usize, Vector4<f64>, Vector4<f64>)>,
@@ -69,6 +71,9 @@ fn block_systems(model: &Model, request: &Request) -> Vec<BlockSystem> {
                 .collect();
             (!inputs.is_empty() && !outputs.is_empty()).then(|| BlockSystem {
                 stiffness: Matrix4::from_fn(|r, c| stiffness[(idx[r], idx[c])]),
+                damping: model
+                    .has_viscous()
+                    .then(|| Model::block_of(model.damping(), block)),
                 mass: Model::block_of(model.mass(), block),
                 inputs,
                 outputs,
@@ -86,7 +91,13 @@ impl BlockSystem {
         n_in: usize,
         out: &mut [Complex64],
     ) -> Result<(), TfError> {
-        let lu = EquilibratedLu::factor(&self.stiffness, &self.mass, w2, freq_hz)?;
+        let lu = match &self.damping {
+            Some(c) => {
+                let k = with_viscous(&self.stiffness, c, w2.sqrt());
+                EquilibratedLu::factor(&k, &self.mass, w2, freq_hz)?
+            }
+            None => EquilibratedLu::factor(&self.stiffness, &self.mass, w2, freq_hz)?,
+        };
         for (col, g0, g2) in &self.inputs {
             let mut y = Vector4::from_fn(|r, _| Complex64::from(g0[r] + w2 * g2[r]));
             lu.solve_mut(&mut y)?;

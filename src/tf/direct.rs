@@ -29,7 +29,7 @@ use num_complex::Complex64;
 pub const SINGULAR_RCOND: f64 = 1e3 * 8.0 * f64::EPSILON;
 
 /// Checks that `freq_hz` can be evaluated and returns `w^2` (rad^2/s^2).
-pub(super) fn omega_sq(freq_hz: f64) -> Result<f64, TfError> {
+pub(crate) fn omega_sq(freq_hz: f64) -> Result<f64, TfError> {
     if !(freq_hz.is_finite() && freq_hz >= 0.0) {
         return Err(FreqError::Invalid {
             value: freq_hz,
@@ -42,7 +42,8 @@ pub(super) fn omega_sq(freq_hz: f64) -> Result<f64, TfError> {
 
 /// LU factorization of the symmetrically equilibrated dynamic stiffness `K_c - w^2 M` (N x N),
 /// with the singularity check of the module docs. Solves take and return unscaled vectors.
-pub(super) struct EquilibratedLu<const N: usize>
+/// With viscous damping pass `K_c + i w C` as the stiffness.
+pub(crate) struct EquilibratedLu<const N: usize>
 where
     Const<N>: DimMin<Const<N>, Output = Const<N>>,
 {
@@ -57,7 +58,7 @@ where
 {
     /// Factors `stiffness - w2 mass`; fails with [`TfError::Singular`] when the equilibrated
     /// matrix has a reciprocal condition number below [`SINGULAR_RCOND`] (or NaN).
-    pub(super) fn factor(
+    pub(crate) fn factor(
         stiffness: &SMatrix<Complex64, N, N>,
         mass: &SMatrix<f64, N, N>,
         w2: f64,
@@ -80,7 +81,7 @@ where
     }
 
     /// Overwrites `x` (a generalized force) with `(K_c - w^2 M)^-1 x`.
-    pub(super) fn solve_mut(&self, x: &mut SVector<Complex64, N>) -> Result<(), TfError> {
+    pub(crate) fn solve_mut(&self, x: &mut SVector<Complex64, N>) -> Result<(), TfError> {
         for (v, s) in x.iter_mut().zip(self.scale) {
             *v *= s;
         }
@@ -97,6 +98,17 @@ where
     }
 }
 
+/// `K_c + i w C` for a viscous damping matrix `C` and angular frequency `w` (rad/s).
+pub(crate) fn with_viscous<const N: usize>(
+    stiffness: &SMatrix<Complex64, N, N>,
+    damping: &SMatrix<f64, N, N>,
+    omega: f64,
+) -> SMatrix<Complex64, N, N> {
+    SMatrix::<Complex64, N, N>::from_fn(|r, c| {
+        stiffness[(r, c)] + Complex64::new(0.0, omega * damping[(r, c)])
+    })
+}
+
 fn one_norm<const N: usize>(m: &SMatrix<Complex64, N, N>) -> f64 {
     (0..N)
         .map(|c| m.column(c).iter().map(|z| z.norm()).sum::<f64>())
@@ -107,6 +119,9 @@ fn one_norm<const N: usize>(m: &SMatrix<Complex64, N, N>) -> f64 {
 pub struct Direct {
     request: Request,
     stiffness: CMat8,
+    /// Viscous damping matrix C (zero when there is none).
+    damping: Mat8,
+    viscous: bool,
     mass: Mat8,
     /// Forcing independent of frequency (8 x inputs).
     forcing0: DMatrix<f64>,
@@ -145,12 +160,38 @@ impl Direct {
         });
         Direct {
             stiffness: model.stiffness_complex(),
+            damping: *model.damping(),
+            viscous: model.has_viscous(),
             mass: *model.mass(),
             forcing0,
             forcing2,
             observe,
             request,
         }
+    }
+}
+
+impl Direct {
+    /// Responses `x = D^-1 v` of the coordinates to generalized forces `v` (one per entry of
+    /// `forces`, overwritten by its response), `D = K_c + i w C - w^2 M`, with the
+    /// equilibration and singularity check of [`Direct`]. Units: coordinate per unit
+    /// generalized force. The thermal-noise module solves `D y = c` with observation rows.
+    pub fn solve_generalized(
+        &self,
+        freq_hz: f64,
+        forces: &mut [SVector<Complex64, 8>],
+    ) -> Result<(), TfError> {
+        let w2 = omega_sq(freq_hz)?;
+        let lu = if self.viscous {
+            let k = with_viscous(&self.stiffness, &self.damping, w2.sqrt());
+            EquilibratedLu::factor(&k, &self.mass, w2, freq_hz)?
+        } else {
+            EquilibratedLu::factor(&self.stiffness, &self.mass, w2, freq_hz)?
+        };
+        for x in forces.iter_mut() {
+            lu.solve_mut(x)?;
+        }
+        Ok(())
     }
 }
 
@@ -165,7 +206,12 @@ impl TransferFunction for Direct {
 
     fn eval_into(&self, freq_hz: f64, out: &mut [Complex64]) -> Result<(), TfError> {
         let w2 = omega_sq(freq_hz)?;
-        let lu = EquilibratedLu::factor(&self.stiffness, &self.mass, w2, freq_hz)?;
+        let lu = if self.viscous {
+            let k = with_viscous(&self.stiffness, &self.damping, w2.sqrt());
+            EquilibratedLu::factor(&k, &self.mass, w2, freq_hz)?
+        } else {
+            EquilibratedLu::factor(&self.stiffness, &self.mass, w2, freq_hz)?
+        };
         let n_in = self.request.inputs.len();
         for i in 0..n_in {
             let mut y = SVector::<Complex64, 8>::from_fn(|r, _| {

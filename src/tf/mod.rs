@@ -191,6 +191,31 @@ pub trait TransferFunction: Send + Sync {
     /// `outputs.len() * inputs.len()`. `freq_hz` must be finite and >= 0.
     fn eval_into(&self, freq_hz: f64, out: &mut [Complex64]) -> Result<(), TfError>;
 
+    /// Writes `H` at every frequency of `freqs_hz` into `out`, `[freq][output][input]`
+    /// row-major (the layout of [`TransferMatrix::values`]), whose length must be
+    /// `freqs_hz.len() * outputs.len() * inputs.len()`. Returns the error of the first
+    /// frequency (in grid order) at which [`TransferFunction::eval_into`] fails; `out` is then
+    /// unspecified. The default calls `eval_into` point by point; a method with a faster
+    /// batch evaluation ([`Method::PoleZero`]) overrides it with the same values and errors.
+    ///
+    /// # Panics
+    ///
+    /// If `out` has the wrong length.
+    fn eval_grid_into(&self, freqs_hz: &[f64], out: &mut [Complex64]) -> Result<(), TfError> {
+        let block = check_grid_len(self.request(), freqs_hz, out);
+        if block == 0 {
+            // Nothing to write; each frequency is still checked.
+            let mut none: [Complex64; 0] = [];
+            return freqs_hz
+                .iter()
+                .try_for_each(|&f| self.eval_into(f, &mut none));
+        }
+        for (&f, h) in freqs_hz.iter().zip(out.chunks_exact_mut(block)) {
+            self.eval_into(f, h)?;
+        }
+        Ok(())
+    }
+
     /// Allocating convenience wrapper around [`TransferFunction::eval_into`].
     fn eval(&self, freq_hz: f64) -> Result<Vec<Complex64>, TfError> {
         let r = self.request();
@@ -208,6 +233,16 @@ pub fn plan(
     request: &Request,
     method: Method,
 ) -> Result<Box<dyn TransferFunction>, PlanError> {
+    if model.has_viscous() && matches!(method, Method::Modal | Method::Torsion2 | Method::PoleZero)
+    {
+        return Err(PlanError::Unsupported {
+            method,
+            item: "viscous damping".into(),
+            reason: "this method solves only structural damping (the complex stiffness K_c); \
+                     `direct`, `block` and `split` solve K_c + i w C - w^2 M with viscous terms"
+                .into(),
+        });
+    }
     Ok(match method {
         Method::Direct => Box::new(Direct::new(model, request.clone())),
         Method::Block => Box::new(BlockReduced::new(model, request.clone())),
@@ -261,14 +296,63 @@ impl TransferMatrix {
     }
 }
 
-/// Evaluates a plan on every frequency of a grid. Stops at the first singular frequency.
+/// Values per frequency of `request`; panics unless `out` holds that many per frequency of
+/// `freqs_hz` (the contract of [`TransferFunction::eval_grid_into`]).
+pub(crate) fn check_grid_len(request: &Request, freqs_hz: &[f64], out: &[Complex64]) -> usize {
+    let block = request.outputs.len() * request.inputs.len();
+    assert_eq!(
+        out.len(),
+        freqs_hz.len() * block,
+        "eval_grid_into: output buffer of {} values for {} frequencies x {block} values",
+        out.len(),
+        freqs_hz.len()
+    );
+    block
+}
+
+/// [`TransferFunction::eval_grid_into`] with the grid cut into `threads` contiguous parts,
+/// one per thread (`std::thread::scope`; the first part on the calling thread). The values do
+/// not depend on `threads` (every point is evaluated independently); the error is the one of
+/// the first failing frequency in grid order, as with one thread. `threads = 0` means 1.
+///
+/// # Panics
+///
+/// If `out` has the wrong length.
+pub fn eval_grid_threads(
+    tf: &dyn TransferFunction,
+    freqs_hz: &[f64],
+    out: &mut [Complex64],
+    threads: usize,
+) -> Result<(), TfError> {
+    let block = check_grid_len(tf.request(), freqs_hz, out);
+    let part = freqs_hz.len().div_ceil(threads.max(1)).max(1);
+    if part >= freqs_hz.len() || block == 0 {
+        return tf.eval_grid_into(freqs_hz, out);
+    }
+    let mut parts = freqs_hz.chunks(part).zip(out.chunks_mut(part * block));
+    let (f0, o0) = parts.next().expect("at least two parts");
+    std::thread::scope(|scope| {
+        let others: Vec<_> = parts
+            .map(|(f, o)| scope.spawn(move || tf.eval_grid_into(f, o)))
+            .collect();
+        let first = tf.eval_grid_into(f0, o0);
+        // In grid order: the first part's error, else the first failing other part's.
+        others.into_iter().fold(first, |acc, h| {
+            let r = h
+                .join()
+                .expect("transfer-function evaluation thread panicked");
+            acc.and(r)
+        })
+    })
+}
+
+/// Evaluates a plan on every frequency of a grid ([`TransferFunction::eval_grid_into`], one
+/// thread). Stops at the first singular frequency.
 pub fn evaluate(tf: &dyn TransferFunction, freqs_hz: &[f64]) -> Result<TransferMatrix, TfError> {
     let r = tf.request();
     let block = r.outputs.len() * r.inputs.len();
     let mut values = vec![Complex64::new(0.0, 0.0); block * freqs_hz.len()];
-    for (&f, out) in freqs_hz.iter().zip(values.chunks_exact_mut(block.max(1))) {
-        tf.eval_into(f, out)?;
-    }
+    tf.eval_grid_into(freqs_hz, &mut values)?;
     Ok(TransferMatrix {
         freqs_hz: freqs_hz.to_vec(),
         outputs: r.outputs.clone(),

@@ -25,27 +25,40 @@
 //!
 //! the second form with `1 / z_j` rounded once to `f64`, in real arithmetic for undamped blocks
 //! whose zeros are all real, in complex arithmetic otherwise (damped blocks, or complex zeros).
-//! `power + #zeros <= 4`, so every entry is four factors `a + b s` (`s`, `1 - s / z`, or 1 for
-//! padding), evaluated four entries at a time in straight-line code. Every factor is relatively
-//! accurate: the relative error of an entry is a few `eps (1 + sum |z| / |z - s| + sum |lambda|
-//! / |lambda - s|)`, about `1e2 eps` at 1 % from a pole or zero and `~eps` elsewhere, with no
-//! cancellation at low or high frequency (`tests/polezero.rs` measures 3e-14 at most outside the
-//! 1 % zones). Entries whose observation row or forcing column misses a block get nothing from
-//! it; entries no block reaches are exactly 0.0.
+//! `power + #zeros <= 4`, so every entry is at most four factors `a + b s` (`s` or
+//! `1 - s / z`). Every factor is relatively accurate: the relative error of an entry is a few
+//! `eps (1 + sum |z| / |z - s| + sum |lambda| / |lambda - s|)`, about `1e2 eps` at 1 % from a
+//! pole or zero and `~eps` elsewhere, with no cancellation at low or high frequency
+//! (`tests/polezero.rs` measures 3e-14 at most outside the 1 % zones against the reference;
+//! `tests/polezero_batch.rs` checks the f64 evaluation against the same product form in
+//! double-double within this bound, from 0 Hz to 1e5 Hz). Entries whose observation row or
+//! forcing column misses a block get nothing from it; entries no block reaches are exactly 0.0.
 //!
-//! Evaluation does not depend on the CPU's features for its results: an AVX build of the same
-//! code (no fused multiply-add) is used when the CPU has AVX.
+//! Evaluation (`kernel`): a grid ([`TransferFunction::eval_grid_into`], and so
+//! [`super::evaluate`]) is evaluated eight frequencies at a time in vector lanes, each block's
+//! denominator and its reciprocal once per frequency, each entry a few multiplications; the
+//! output is written in one sequential pass (non-temporal stores for outputs larger than the
+//! cache). [`TransferFunction::eval_into`] is the same code on a grid of one point, and the
+//! results are bit-identical whatever the grid, the lane, the number of threads
+//! ([`super::eval_grid_threads`]) or the CPU (AVX, chosen at run time, or portable: the same
+//! IEEE operations in the same order, no fused multiply-add). Measured on Table I, 7x3 tilt
+//! matrix, 1e5 points (`benches/methods.rs`, `scripts/bench/README.md`): 13 to 15 ns per point
+//! on one thread, about 100x `numpy.linalg.solve`; about 12.5 ns of it is writing the 336
+//! bytes of each point to memory.
 //!
 //! Singularity: an undamped block with `|lambda_k - s| < SINGULAR_RCOND lambda_k` (the rounding
 //! of `s` and of `lambda_k` then leaves fewer than three digits of the factor) is reported as
 //! [`TfError::Singular`] with `rcond = |lambda_k - s| / lambda_k`.
 
-use super::direct::{omega_sq, SINGULAR_RCOND};
+mod kernel;
+mod lanes;
+
 use super::{Input, Method, Request, TransferFunction};
 use crate::error::TfError;
 use crate::model::{Block, Coord, Model};
 use crate::params::Params;
 use crate::reference::{CDd, Dd, ReferenceModel, DD_EPS};
+use kernel::{BlockForm, ComplexEntry, Kernel, RealEntry};
 use num_complex::Complex64;
 
 /// A coefficient smaller than this times the sum of its terms' magnitudes is a structural
@@ -56,67 +69,16 @@ const ZERO_REL: f64 = 1e3 * DD_EPS;
 /// Plan of the pole-zero method.
 pub struct PoleZero {
     request: Request,
-    blocks: Vec<BlockForm>,
-    /// The CPU has AVX (checked at plan time): the same operations, four lanes per instruction.
-    avx: bool,
+    kernel: Kernel,
 }
 
-/// The product forms of one block's entries.
-enum BlockForm {
-    /// Undamped, every zero real: real arithmetic.
-    Real(RealBlock),
-    /// Damped (or complex zeros): complex arithmetic.
-    Complex(ComplexBlock),
-}
+/// An entry ready for its block: position in the output, gain, factors `(a, b)` (the first
+/// `count` of them not padding), `count`.
+type Prepared = (usize, CDd, [(CDd, CDd); 4], usize);
 
-/// Entries per chunk: each chunk is evaluated lane by lane in straight-line code that the
-/// compiler vectorizes.
-const LANES: usize = 4;
-
-/// Up to [`LANES`] entries of one block, each `gain prod_k (a_k + b_k s) / prod(lambda - s)`
-/// with exactly four factors: `s` for a zero at the origin (`a = 0, b = 1`), `1 - s / z` for a
-/// zero `z` (`a = 1, b = -1 / z`, and `z` moved into the gain), 1 for padding (`a = 1, b = 0`).
-/// The numerator has degree <= 4, so four factors always suffice. A padding lane has gain 0
-/// and adds its exact 0.0 to the chunk's first entry, so that no lane needs a branch.
-#[derive(Clone, Copy)]
-struct RealChunk {
-    at: [usize; LANES],
-    gain: [f64; LANES],
-    a: [[f64; LANES]; 4],
-    b: [[f64; LANES]; 4],
-}
-
-struct RealBlock {
-    poles: [f64; 4],
-    /// `SINGULAR_RCOND lambda_k`.
-    thresholds: [f64; 4],
-    chunks: Vec<RealChunk>,
-}
-
-/// [`RealChunk`] with complex gains and factors (real and imaginary parts apart).
-#[derive(Clone, Copy)]
-struct ComplexChunk {
-    at: [usize; LANES],
-    gain_re: [f64; LANES],
-    gain_im: [f64; LANES],
-    a_re: [[f64; LANES]; 4],
-    a_im: [[f64; LANES]; 4],
-    b_re: [[f64; LANES]; 4],
-    b_im: [[f64; LANES]; 4],
-}
-
-struct ComplexBlock {
-    poles: [Complex64; 4],
-    /// `(SINGULAR_RCOND |lambda_k|)^2`.
-    thresholds: [f64; 4],
-    chunks: Vec<ComplexChunk>,
-}
-
-/// An entry ready for a chunk: position in the output, gain, factors `(a, b)`.
-type Prepared = (usize, CDd, [(CDd, CDd); 4]);
-
-/// The four factors `(a, b)` and the gain of one entry, in double-double.
-fn entry_factors(f: &EntryFactors) -> (CDd, [(CDd, CDd); 4]) {
+/// The four factors `(a, b)` (padded with `(1, 0)`), the gain and the number of factors that
+/// are not padding, of one entry, in double-double.
+fn entry_factors(f: &EntryFactors) -> (CDd, [(CDd, CDd); 4], usize) {
     let one = CDd::real(Dd::ONE);
     let mut gain = f.gain;
     let mut factors = [(one, CDd::ZERO); 4];
@@ -130,7 +92,7 @@ fn entry_factors(f: &EntryFactors) -> (CDd, [(CDd, CDd); 4]) {
         gain = gain * *z;
         k += 1;
     }
-    (gain, factors)
+    (gain, factors, k)
 }
 
 /// One entry's factored form in double-double (exposed for the tests).
@@ -393,77 +355,44 @@ impl PoleZero {
                 let prepared: Vec<Prepared> = fs
                     .iter()
                     .map(|f| {
-                        let (g, fac) = entry_factors(f);
-                        (f.output * n_in + f.input, g, fac)
+                        let (g, fac, count) = entry_factors(f);
+                        (f.output * n_in + f.input, g, fac, count)
                     })
                     .collect();
                 Some(if real {
-                    let poles: [f64; 4] = std::array::from_fn(|k| first.poles[k].re.to_f64());
-                    let chunks = prepared
-                        .chunks(LANES)
-                        .map(|group| {
-                            let mut c = RealChunk {
-                                at: [group[0].0; LANES],
-                                gain: [0.0; LANES],
-                                a: [[1.0; LANES]; 4],
-                                b: [[0.0; LANES]; 4],
-                            };
-                            for (l, (at, g, fac)) in group.iter().enumerate() {
-                                c.at[l] = *at;
-                                c.gain[l] = g.re.to_f64();
-                                for (k, (a, b)) in fac.iter().enumerate() {
-                                    c.a[k][l] = a.re.to_f64();
-                                    c.b[k][l] = b.re.to_f64();
-                                }
-                            }
-                            c
+                    let entries = prepared
+                        .iter()
+                        .map(|(at, g, fac, count)| RealEntry {
+                            at: *at,
+                            first_re: false,
+                            factors: *count,
+                            gain: g.re.to_f64(),
+                            a: fac.map(|(a, _)| a.re.to_f64()),
+                            b: fac.map(|(_, b)| b.re.to_f64()),
                         })
                         .collect();
-                    BlockForm::Real(RealBlock {
-                        poles,
-                        thresholds: poles.map(|l| SINGULAR_RCOND * l),
-                        chunks,
-                    })
+                    BlockForm::real(std::array::from_fn(|k| first.poles[k].re.to_f64()), entries)
                 } else {
-                    let poles: [Complex64; 4] = std::array::from_fn(|k| first.poles[k].to_c64());
-                    let chunks = prepared
-                        .chunks(LANES)
-                        .map(|group| {
-                            let mut c = ComplexChunk {
-                                at: [group[0].0; LANES],
-                                gain_re: [0.0; LANES],
-                                gain_im: [0.0; LANES],
-                                a_re: [[1.0; LANES]; 4],
-                                a_im: [[0.0; LANES]; 4],
-                                b_re: [[0.0; LANES]; 4],
-                                b_im: [[0.0; LANES]; 4],
-                            };
-                            for (l, (at, g, fac)) in group.iter().enumerate() {
-                                c.at[l] = *at;
-                                c.gain_re[l] = g.re.to_f64();
-                                c.gain_im[l] = g.im.to_f64();
-                                for (k, (a, b)) in fac.iter().enumerate() {
-                                    c.a_re[k][l] = a.re.to_f64();
-                                    c.a_im[k][l] = a.im.to_f64();
-                                    c.b_re[k][l] = b.re.to_f64();
-                                    c.b_im[k][l] = b.im.to_f64();
-                                }
-                            }
-                            c
+                    let entries = prepared
+                        .iter()
+                        .map(|(at, g, fac, count)| ComplexEntry {
+                            at: *at,
+                            first_re: false,
+                            first_im: false,
+                            factors: *count,
+                            gain: g.to_c64(),
+                            a: fac.map(|(a, _)| a.to_c64()),
+                            b: fac.map(|(_, b)| b.to_c64()),
                         })
                         .collect();
-                    BlockForm::Complex(ComplexBlock {
-                        poles,
-                        thresholds: poles.map(|l| (SINGULAR_RCOND * l.norm()).powi(2)),
-                        chunks,
-                    })
+                    BlockForm::complex(std::array::from_fn(|k| first.poles[k].to_c64()), entries)
                 })
             })
             .collect();
+        let n_values = request.outputs.len() * n_in;
         PoleZero {
             request,
-            blocks,
-            avx: avx_available(),
+            kernel: Kernel::new(blocks, n_values),
         }
     }
 
@@ -599,125 +528,6 @@ impl PoleZero {
     }
 }
 
-impl RealBlock {
-    // Lane loops index several arrays in step: written for the vectorizer.
-    #[allow(clippy::needless_range_loop)]
-    #[inline(always)]
-    fn eval(&self, s: f64, freq_hz: f64, out: &mut [Complex64]) -> Result<(), TfError> {
-        let d: [f64; 4] = std::array::from_fn(|k| self.poles[k] - s);
-        if (0..4).any(|k| d[k].abs() < self.thresholds[k]) {
-            return Err(self.singular(s, freq_hz));
-        }
-        let inv = 1.0 / ((d[0] * d[1]) * (d[2] * d[3]));
-        for c in &self.chunks {
-            // 1 - s / z: relative error ~ 1.5 eps |z| / |z - s| (the rounding of 1 / z and of
-            // the product), as z - s with z rounded to f64.
-            // The numerator first, the denominator's reciprocal last: its division overlaps.
-            let mut h: [f64; LANES] = c.gain;
-            for k in 0..4 {
-                for l in 0..LANES {
-                    h[l] *= c.a[k][l] + c.b[k][l] * s;
-                }
-            }
-            for l in 0..LANES {
-                h[l] *= inv;
-            }
-            for l in 0..LANES {
-                out[c.at[l]].re += h[l];
-            }
-        }
-        Ok(())
-    }
-
-    #[cold]
-    fn singular(&self, s: f64, freq_hz: f64) -> TfError {
-        let rcond = self
-            .poles
-            .iter()
-            .map(|&l| (l - s).abs() / l)
-            .fold(f64::INFINITY, f64::min);
-        TfError::Singular { freq_hz, rcond }
-    }
-}
-
-impl ComplexBlock {
-    #[allow(clippy::needless_range_loop)]
-    #[inline(always)]
-    fn eval(&self, s: f64, freq_hz: f64, out: &mut [Complex64]) -> Result<(), TfError> {
-        let d: [Complex64; 4] = std::array::from_fn(|k| self.poles[k] - s);
-        if (0..4).any(|k| d[k].norm_sqr() < self.thresholds[k]) {
-            return Err(self.singular(s, freq_hz));
-        }
-        let den = (d[0] * d[1]) * (d[2] * d[3]);
-        let inv = den.conj() / den.norm_sqr();
-        for c in &self.chunks {
-            let mut re: [f64; LANES] = c.gain_re;
-            let mut im: [f64; LANES] = c.gain_im;
-            for k in 0..4 {
-                for l in 0..LANES {
-                    let fr = c.a_re[k][l] + c.b_re[k][l] * s;
-                    let fi = c.a_im[k][l] + c.b_im[k][l] * s;
-                    let r = re[l] * fr - im[l] * fi;
-                    im[l] = re[l] * fi + im[l] * fr;
-                    re[l] = r;
-                }
-            }
-            for l in 0..LANES {
-                let r = re[l] * inv.re - im[l] * inv.im;
-                im[l] = re[l] * inv.im + im[l] * inv.re;
-                re[l] = r;
-            }
-            for l in 0..LANES {
-                out[c.at[l]] += Complex64::new(re[l], im[l]);
-            }
-        }
-        Ok(())
-    }
-
-    #[cold]
-    fn singular(&self, s: f64, freq_hz: f64) -> TfError {
-        let rcond = self
-            .poles
-            .iter()
-            .map(|&l| (l - s).norm() / l.norm())
-            .fold(f64::INFINITY, f64::min);
-        TfError::Singular { freq_hz, rcond }
-    }
-}
-
-fn avx_available() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
-
-impl PoleZero {
-    #[inline(always)]
-    fn eval_blocks(&self, s: f64, freq_hz: f64, out: &mut [Complex64]) -> Result<(), TfError> {
-        out.fill(Complex64::new(0.0, 0.0));
-        for b in &self.blocks {
-            match b {
-                BlockForm::Real(r) => r.eval(s, freq_hz, out)?,
-                BlockForm::Complex(c) => c.eval(s, freq_hz, out)?,
-            }
-        }
-        Ok(())
-    }
-
-    /// [`PoleZero::eval_blocks`] compiled for AVX: the same operations in the same order (no
-    /// fused multiply-add), so the results are bit-identical to the baseline build's.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx")]
-    fn eval_blocks_avx(&self, s: f64, freq_hz: f64, out: &mut [Complex64]) -> Result<(), TfError> {
-        self.eval_blocks(s, freq_hz, out)
-    }
-}
-
 impl TransferFunction for PoleZero {
     fn method(&self) -> Method {
         Method::PoleZero
@@ -728,12 +538,13 @@ impl TransferFunction for PoleZero {
     }
 
     fn eval_into(&self, freq_hz: f64, out: &mut [Complex64]) -> Result<(), TfError> {
-        let s = omega_sq(freq_hz)?;
-        #[cfg(target_arch = "x86_64")]
-        if self.avx {
-            // SAFETY: `avx` is true only when the running CPU supports AVX (checked in `new`).
-            return unsafe { self.eval_blocks_avx(s, freq_hz, out) };
-        }
-        self.eval_blocks(s, freq_hz, out)
+        self.eval_grid_into(std::slice::from_ref(&freq_hz), out)
+    }
+
+    /// The whole grid in chunks of frequencies (see the module docs): the same values, bit
+    /// for bit, as [`TransferFunction::eval_into`] at each point, and the same error.
+    fn eval_grid_into(&self, freqs_hz: &[f64], out: &mut [Complex64]) -> Result<(), TfError> {
+        super::check_grid_len(&self.request, freqs_hz, out);
+        self.kernel.eval_grid(freqs_hz, out)
     }
 }

@@ -80,10 +80,21 @@
 //! 1e-11 relative at 100 Hz, growing as f^2; an absolute vertical coordinate of the test mass
 //! would remove it).
 //!
+//! # Damping
+//!
+//! With swing loss (`Im(K_c)` on theta, eta) or viscous damping (`D = K_c + i w C - w^2 M`),
+//! `K_c S = K_gravity S` no longer holds. Exactly,
+//! `G0 + w^2 G2 = D S + w^2 R - i (Im(K_c) + w C) S`, so each tilt form above gains the term
+//! `-C D^-1 i (Im(K_c) + w C) S`, and the high forms use `K_c + i w C` where they used `K_c`
+//! (`D^-1 (K_c + i w C) M^-1 R = M^-1 R + w^2 D^-1 R`). The extra forcing has exact zeros on
+//! the phi rows (it lives on theta, eta), so the phi entries keep their relative accuracy; with
+//! swing loss phi/eta_t falls as `phi f^2` instead of `f^4` at low frequency (physics, not
+//! rounding). Undamped or torsion/bounce-only structural damping takes the original path.
+//!
 //! Entries across blocks are never computed and are exactly 0.0. Per frequency: one 4x4 LU per
 //! needed block and one solve per input, with no allocation.
 
-use super::direct::{omega_sq, EquilibratedLu};
+use super::direct::{omega_sq, with_viscous, EquilibratedLu};
 use super::{Input, Method, Request, TransferFunction};
 use crate::error::TfError;
 use crate::model::{Block, Coord, ForceInput, Model, TiltAxis};
@@ -166,6 +177,8 @@ struct AbsoluteBlock {
     stiffness: Matrix4<Complex64>,
     /// `M_u = T^-T M T^-1`.
     mass: Matrix4<f64>,
+    /// `C_u = T^-T C T^-1`, when there is viscous damping.
+    damping: Option<Matrix4<f64>>,
     /// Below this `w^2` the low-frequency forms are used (see the module docs).
     crossover_w2: f64,
     /// Outputs that read the block: row in the request, `C_u` row.
@@ -181,7 +194,9 @@ struct Column {
     high: Form,
 }
 
-/// `H_o = offset_o + sign w^(2 p) C_u,o D_u^-1 forcing`, with `p` 1 or 0.
+/// `H_o = offset_o + C_u,o D_u^-1 (sign w^(2 p) forcing + damped + i w damped_w)`, with `p`
+/// 1 or 0; `damped` and `damped_w` are the damping terms of the module docs (zero without
+/// swing loss or viscous damping, and then skipped).
 #[derive(Clone)]
 struct Form {
     /// Per block output.
@@ -189,6 +204,32 @@ struct Form {
     forcing: Vector4<Complex64>,
     sign: f64,
     times_w2: bool,
+    damped: Vector4<Complex64>,
+    damped_w: Vector4<f64>,
+    has_damped: bool,
+}
+
+impl Form {
+    fn new(offset: Vec<f64>, forcing: Vector4<Complex64>, sign: f64, times_w2: bool) -> Form {
+        Form {
+            offset,
+            forcing,
+            sign,
+            times_w2,
+            damped: Vector4::zeros(),
+            damped_w: Vector4::zeros(),
+            has_damped: false,
+        }
+    }
+
+    /// Adds the damping terms `damped + i w damped_w` to the forcing.
+    fn with_damping(mut self, damped: Vector4<Complex64>, damped_w: Vector4<f64>) -> Form {
+        self.has_damped =
+            damped.iter().any(|z| z.norm() != 0.0) || damped_w.iter().any(|&v| v != 0.0);
+        self.damped = damped;
+        self.damped_w = damped_w;
+        self
+    }
 }
 
 impl AbsoluteBlock {
@@ -234,6 +275,14 @@ impl AbsoluteBlock {
         let stiffness_q = Matrix4::from_fn(|r, c| k[(idx[r], idx[c])]);
         let mass = t.congruence(&mass_q);
         let stiffness = t.congruence(&stiffness_q);
+        let damping_q = Model::block_of(model.damping(), block);
+        let damping = model.has_viscous().then(|| t.congruence(&damping_q));
+        // Per tilt column `a`: T^-T i Im(K_c) e_a and T^-T C e_a (the damping terms).
+        let loss_column = |a: usize| -> Vector4<Complex64> {
+            t.force(&stiffness_q.column(a).map(|z| Complex64::new(0.0, z.im)))
+        };
+        let viscous_column =
+            |a: usize| -> Vector4<f64> { t.force(&damping_q.column(a).into_owned()) };
         let outputs: Vec<(usize, RowVector4<f64>)> = obs_q
             .iter()
             .map(|(row, c)| (*row, t.observation(c)))
@@ -247,12 +296,12 @@ impl AbsoluteBlock {
             .map(|(col, input)| {
                 let (low, high) = match input {
                     Input::Force(f) => {
-                        let form = Form {
-                            offset: vec![0.0; outputs.len()],
-                            forcing: t.force(&force_q(f)).map(Complex64::from),
-                            sign: 1.0,
-                            times_w2: false,
-                        };
+                        let form = Form::new(
+                            vec![0.0; outputs.len()],
+                            t.force(&force_q(f)).map(Complex64::from),
+                            1.0,
+                            false,
+                        );
                         (form.clone(), form)
                     }
                     Input::Tilt(axis @ (TiltAxis::ThetaT | TiltAxis::EtaT)) => {
@@ -273,38 +322,34 @@ impl AbsoluteBlock {
                             .zip(&outputs)
                             .map(|(s, (_, c))| s - c.dot(&y0.transpose()))
                             .collect();
+                        let (loss, visc) = (-loss_column(a), -viscous_column(a));
+                        let c_y0 = match &damping {
+                            Some(c) => c * y0,
+                            None => Vector4::zeros(),
+                        };
                         (
-                            Form {
-                                offset: static_part,
-                                forcing: r_u.map(Complex64::from),
-                                sign: 1.0,
-                                times_w2: true,
-                            },
-                            Form {
-                                offset: high_offset,
-                                forcing: stiffness * y0.map(Complex64::from),
-                                sign: 1.0,
-                                times_w2: false,
-                            },
+                            Form::new(static_part, r_u.map(Complex64::from), 1.0, true)
+                                .with_damping(loss, visc),
+                            Form::new(high_offset, stiffness * y0.map(Complex64::from), 1.0, false)
+                                .with_damping(loss, visc + c_y0),
                         )
                     }
                     Input::Tilt(axis) => {
                         let a = local(tilt_coord(axis)).expect("filtered above");
                         (
-                            Form {
-                                offset: vec![0.0; outputs.len()],
-                                forcing: t
-                                    .force(&mass_q.column(a).into_owned())
-                                    .map(Complex64::from),
-                                sign: -1.0,
-                                times_w2: true,
-                            },
-                            Form {
-                                offset: observed_column(a),
-                                forcing: t.force(&stiffness_q.column(a).into_owned()),
-                                sign: -1.0,
-                                times_w2: false,
-                            },
+                            Form::new(
+                                vec![0.0; outputs.len()],
+                                t.force(&mass_q.column(a).into_owned()).map(Complex64::from),
+                                -1.0,
+                                true,
+                            ),
+                            Form::new(
+                                observed_column(a),
+                                t.force(&stiffness_q.column(a).into_owned()),
+                                -1.0,
+                                false,
+                            )
+                            .with_damping(Vector4::zeros(), -viscous_column(a)),
                         )
                     }
                 };
@@ -322,6 +367,7 @@ impl AbsoluteBlock {
         Some(AbsoluteBlock {
             stiffness,
             mass,
+            damping,
             crossover_w2: (lo * hi).sqrt(),
             outputs,
             columns,
@@ -335,20 +381,34 @@ impl AbsoluteBlock {
         n_in: usize,
         out: &mut [Complex64],
     ) -> Result<(), TfError> {
-        let lu = EquilibratedLu::factor(&self.stiffness, &self.mass, w2, freq_hz)?;
+        let lu = match &self.damping {
+            Some(c) => {
+                let k = with_viscous(&self.stiffness, c, w2.sqrt());
+                EquilibratedLu::factor(&k, &self.mass, w2, freq_hz)?
+            }
+            None => EquilibratedLu::factor(&self.stiffness, &self.mass, w2, freq_hz)?,
+        };
         for column in &self.columns {
             let form = if w2 <= self.crossover_w2 {
                 &column.low
             } else {
                 &column.high
             };
-            let mut x = form.forcing;
-            lu.solve_mut(&mut x)?;
-            let factor = if form.times_w2 {
+            let scale = if form.times_w2 {
                 form.sign * w2
             } else {
                 form.sign
             };
+            let (mut x, factor) = if form.has_damped {
+                let w = w2.sqrt();
+                let y = form.forcing * Complex64::from(scale)
+                    + form.damped
+                    + form.damped_w.map(|v| Complex64::new(0.0, w * v));
+                (y, 1.0)
+            } else {
+                (form.forcing, scale)
+            };
+            lu.solve_mut(&mut x)?;
             for ((row, c), offset) in self.outputs.iter().zip(&form.offset) {
                 let cx: Complex64 = (0..4).map(|j| x[j] * c[j]).sum();
                 out[row * n_in + column.col] = offset + cx * factor;

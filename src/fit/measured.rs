@@ -1,0 +1,246 @@
+//! Measured normal-mode frequencies: the CSV format of `--measured`, the embedded Table II
+//! example, and the default measurement sigma taken from the printed digits.
+//!
+//! Format (documented for users in `docs/fit.md`): `#` starts a comment line; the first other
+//! line is the header `mode,frequency_hz` or `mode,frequency_hz,sigma_hz`; then one row per
+//! measured mode, in any order, any subset of the eight modes. `mode` is the rank 1..8 (the
+//! paper's nu_k, modes sorted by frequency); `frequency_hz` is finite and > 0; `sigma_hz`, when
+//! present and not empty, is the one-standard-deviation error in Hz (finite and > 0). When it is
+//! absent the sigma is half a unit of the last printed digit of `frequency_hz` (`0.4065` ->
+//! `0.00005`; `1.331e-3` -> `0.0005e-3`): the rounding error of a value reported to that many
+//! digits, the only error information Table II carries.
+
+use super::FitError;
+
+/// The measured column of Table II of the paper, in the format above.
+pub const TABLE_II_MEASURED_CSV: &str = include_str!("table2_measured.csv");
+
+/// Where a default sigma came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SigmaSource {
+    /// Given in the `sigma_hz` column.
+    File,
+    /// Half a unit of the last printed digit of the frequency.
+    Digits,
+}
+
+/// One measured mode frequency.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasuredMode {
+    /// Rank of the mode, 1..=8 (nu_1 is the lowest frequency).
+    pub mode: usize,
+    /// Measured frequency (Hz).
+    pub frequency_hz: f64,
+    /// One-standard-deviation error (Hz), > 0.
+    pub sigma_hz: f64,
+    /// Where `sigma_hz` came from.
+    pub sigma_source: SigmaSource,
+}
+
+/// A set of measured modes, sorted by mode rank, each rank at most once.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Measured {
+    /// The modes, sorted by `mode`.
+    pub modes: Vec<MeasuredMode>,
+    /// Where they came from (file name or `embedded Table II`).
+    pub origin: String,
+}
+
+impl Measured {
+    /// The embedded example: Table II's measured column, sigmas from the printed digits.
+    pub fn table_ii() -> Measured {
+        Measured::parse(TABLE_II_MEASURED_CSV, "embedded Table II")
+            .expect("the embedded Table II file is valid")
+    }
+
+    /// Reads and validates a measured-frequency file.
+    pub fn from_file(path: &std::path::Path) -> Result<Measured, FitError> {
+        let text = std::fs::read_to_string(path).map_err(|e| FitError::Measured {
+            origin: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        Measured::parse(&text, &path.display().to_string())
+    }
+
+    /// Parses and validates the CSV text; `origin` names it in error messages.
+    pub fn parse(text: &str, origin: &str) -> Result<Measured, FitError> {
+        let fail = |line: usize, message: String| FitError::Measured {
+            origin: format!("{origin}, line {line}"),
+            message,
+        };
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .map(|(i, l)| (i + 1, l.trim()))
+            .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+        let (hline, header) = lines.next().ok_or_else(|| FitError::Measured {
+            origin: origin.to_string(),
+            message: "no header line; expected `mode,frequency_hz[,sigma_hz]`".into(),
+        })?;
+        let columns: Vec<&str> = header.split(',').map(str::trim).collect();
+        let with_sigma = match columns.as_slice() {
+            ["mode", "frequency_hz"] => false,
+            ["mode", "frequency_hz", "sigma_hz"] => true,
+            _ => {
+                return Err(fail(
+                    hline,
+                    format!("header `{header}`; allowed: `mode,frequency_hz` or `mode,frequency_hz,sigma_hz`"),
+                ))
+            }
+        };
+        let mut modes: Vec<MeasuredMode> = Vec::new();
+        for (n, line) in lines {
+            let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+            if cells.len() != columns.len() {
+                return Err(fail(
+                    n,
+                    format!(
+                        "`{line}` has {} fields, the header has {}",
+                        cells.len(),
+                        columns.len()
+                    ),
+                ));
+            }
+            let mode: usize = cells[0]
+                .parse()
+                .ok()
+                .filter(|m| (1..=8).contains(m))
+                .ok_or_else(|| {
+                    fail(
+                        n,
+                        format!(
+                            "mode `{}` is not allowed: must be an integer 1..8",
+                            cells[0]
+                        ),
+                    )
+                })?;
+            if modes.iter().any(|m| m.mode == mode) {
+                return Err(fail(
+                    n,
+                    format!("mode {mode} is listed twice; give each mode once"),
+                ));
+            }
+            let frequency_hz = parse_positive(cells[1]).ok_or_else(|| {
+                fail(
+                    n,
+                    format!(
+                        "frequency_hz `{}` of mode {mode} is not allowed: must be finite and > 0",
+                        cells[1]
+                    ),
+                )
+            })?;
+            let (sigma_hz, sigma_source) = match with_sigma && !cells[2].is_empty() {
+                true => (
+                    parse_positive(cells[2]).ok_or_else(|| {
+                        fail(n, format!("sigma_hz `{}` of mode {mode} is not allowed: must be finite and > 0 (or empty: half the last digit)", cells[2]))
+                    })?,
+                    SigmaSource::File,
+                ),
+                false => (half_last_digit(cells[1]), SigmaSource::Digits),
+            };
+            modes.push(MeasuredMode {
+                mode,
+                frequency_hz,
+                sigma_hz,
+                sigma_source,
+            });
+        }
+        if modes.is_empty() {
+            return Err(FitError::Measured {
+                origin: origin.to_string(),
+                message: "no measured mode; need at least one row `mode,frequency_hz`".into(),
+            });
+        }
+        modes.sort_by_key(|m| m.mode);
+        Ok(Measured {
+            modes,
+            origin: origin.to_string(),
+        })
+    }
+}
+
+fn parse_positive(cell: &str) -> Option<f64> {
+    cell.parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite() && *v > 0.0)
+}
+
+/// Half a unit of the last printed digit of a decimal number that already parsed as a finite
+/// f64: `0.4065` -> 5e-5, `7.926` -> 5e-4, `12` -> 0.5, `1.331e-3` -> 5e-7.
+pub fn half_last_digit(text: &str) -> f64 {
+    let lower = text.to_ascii_lowercase();
+    let (mantissa, exponent) = match lower.split_once('e') {
+        Some((m, e)) => (m, e.parse::<i32>().unwrap_or(0)),
+        None => (lower.as_str(), 0),
+    };
+    let decimals = mantissa
+        .split_once('.')
+        .map_or(0, |(_, frac)| frac.len() as i32);
+    0.5 * 10f64.powi(exponent - decimals)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn half_last_digit_of_printed_values() {
+        // Compared in units of the expected value: powi and the decimal literals round
+        // differently, so equality holds to a few ulps, not exactly.
+        const ULPS: f64 = 4.0 * f64::EPSILON;
+        for (text, want) in [
+            ("0.001331", 5e-7),
+            ("1.331e-3", 5e-7),
+            ("0.4065", 5e-5),
+            ("0.6170", 5e-5),
+            ("0.58815", 5e-6),
+            ("10.393", 5e-4),
+            ("12", 0.5),
+            ("1E2", 50.0),
+        ] {
+            let got = half_last_digit(text);
+            assert!(
+                (got - want).abs() <= ULPS * want,
+                "{text}: {got:e} vs {want:e}"
+            );
+        }
+    }
+
+    #[test]
+    fn embedded_table_ii() {
+        let m = Measured::table_ii();
+        assert_eq!(m.modes.len(), 8);
+        assert_eq!(m.modes[0].frequency_hz, 1.331e-3);
+        assert_eq!(m.modes[7].frequency_hz, 10.393);
+        assert!(m
+            .modes
+            .iter()
+            .all(|x| x.sigma_source == SigmaSource::Digits));
+    }
+
+    #[test]
+    fn subset_with_sigma_and_errors() {
+        let ok = Measured::parse(
+            "mode,frequency_hz,sigma_hz\n7,7.9,0.1\n1,0.00133,\n",
+            "t.csv",
+        )
+        .unwrap();
+        assert_eq!(ok.modes.iter().map(|m| m.mode).collect::<Vec<_>>(), [1, 7]);
+        assert_eq!(ok.modes[1].sigma_hz, 0.1);
+        assert_eq!(ok.modes[0].sigma_source, SigmaSource::Digits);
+        for (text, needle) in [
+            ("mode,frequency_hz\n9,1.0\n", "mode `9`"),
+            ("mode,frequency_hz\n1,1.0\n1,2.0\n", "listed twice"),
+            ("mode,frequency_hz\n1,-1.0\n", "frequency_hz `-1.0`"),
+            ("mode,frequency_hz\n1,nan\n", "frequency_hz `nan`"),
+            ("mode,frequency_hz\n1,inf\n", "must be finite and > 0"),
+            ("mode,frequency_hz,sigma_hz\n1,1.0,0\n", "sigma_hz `0`"),
+            ("mode,freq\n1,1.0\n", "header"),
+            ("mode,frequency_hz\n1\n", "has 1 fields"),
+            ("mode,frequency_hz\n", "no measured mode"),
+        ] {
+            let e = Measured::parse(text, "t.csv").unwrap_err().to_string();
+            assert!(e.contains(needle) && e.contains("t.csv"), "{text:?}: {e}");
+        }
+    }
+}

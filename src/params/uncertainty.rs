@@ -1,0 +1,521 @@
+//! The error model of the parameters: the optional `[uncertainty]` table of a parameter file, its
+//! defaults, and its validation.
+//!
+//! ```toml
+//! [uncertainty]
+//! "mass.m_a_kg" = { rel_sigma = 0.03, distribution = "uniform" }
+//! "length.h_m" = { rel_sigma = 0.0 }          # exact
+//! ```
+//!
+//! * Keys are the dotted keys of [`Params::fields`]; quoted (`"mass.m_a_kg"`) or bare dotted
+//!   (`mass.m_a_kg`) TOML keys both work.
+//! * `rel_sigma` is the relative standard deviation (0.03 = 3 %) of the parameter, relative to
+//!   its own value; 0 makes it exact. `distribution` is `gaussian` (the default) or `uniform`
+//!   (flat on `+/- sqrt(3) rel_sigma`: the same standard deviation).
+//! * Entries override [`default_uncertainties`]: Gaussian, 2.5 % on masses, inertias and lengths
+//!   (except `length.h_m`), 10 % on the torsion and bouncing constants, everything else exact.
+//! * An error bar may not make the parameter non-physical within its range: the relative factor
+//!   `1 + rel_sigma z` must stay positive. For a Gaussian, 4 sigma must stay below 100 %
+//!   (`rel_sigma <` [`MAX_REL_SIGMA`]); for a uniform draw the whole range `+/- sqrt(3) sigma`
+//!   must (`rel_sigma <` [`MAX_REL_SIGMA_UNIFORM`] = 1/sqrt(3)).
+//!
+//! This module depends only on its parent [`crate::params`]; the Monte Carlo (`crate::mc`) and the
+//! fit use it, never the other way round.
+
+use super::Params;
+use serde::de::Error as _;
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use std::sync::OnceLock;
+
+/// Largest relative standard deviation of a Gaussian error (exclusive): 4 sigma must stay below
+/// 100 %, so that a draw is non-physical with probability below 3e-5.
+pub const MAX_REL_SIGMA: f64 = 0.25;
+
+/// Largest relative standard deviation of a uniform error (exclusive), 1/sqrt(3): the range
+/// `+/- sqrt(3) rel_sigma` must stay below 100 %.
+pub const MAX_REL_SIGMA_UNIFORM: f64 = 0.577_350_269_189_625_8;
+
+/// Default relative standard deviation on masses, lengths and inertias (the paper: 2-3 %).
+pub const DEFAULT_REL_SIGMA_GEOMETRY: f64 = 0.025;
+
+/// Default relative standard deviation on the torsion and bouncing constants (the paper: 10 %).
+pub const DEFAULT_REL_SIGMA_SPRINGS: f64 = 0.10;
+
+/// Names accepted for `distribution`, as shown in error messages.
+pub const ALLOWED_DISTRIBUTIONS: &str = "gaussian, uniform";
+
+/// Shape of the distribution of a parameter's relative error.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Distribution {
+    /// Gaussian with standard deviation `rel_sigma`.
+    #[default]
+    Gaussian,
+    /// Uniform on `+/- sqrt(3) rel_sigma` (the same standard deviation).
+    Uniform,
+}
+
+impl Distribution {
+    /// The name used in parameter files and outputs: `gaussian` or `uniform`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Distribution::Gaussian => "gaussian",
+            Distribution::Uniform => "uniform",
+        }
+    }
+
+    /// The distribution called `name` in a parameter file.
+    pub fn from_name(name: &str) -> Option<Distribution> {
+        match name {
+            "gaussian" => Some(Distribution::Gaussian),
+            "uniform" => Some(Distribution::Uniform),
+            _ => None,
+        }
+    }
+
+    /// Largest relative standard deviation accepted (exclusive): [`MAX_REL_SIGMA`] or
+    /// [`MAX_REL_SIGMA_UNIFORM`].
+    pub fn max_rel_sigma(self) -> f64 {
+        match self {
+            Distribution::Gaussian => MAX_REL_SIGMA,
+            Distribution::Uniform => MAX_REL_SIGMA_UNIFORM,
+        }
+    }
+
+    /// Why larger values are refused, for error messages.
+    fn limit_reason(self) -> &'static str {
+        match self {
+            Distribution::Gaussian => "4 sigma would reach zero",
+            Distribution::Uniform => "the range +/- sqrt(3) sigma would reach zero",
+        }
+    }
+}
+
+/// The error of one parameter.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Uncertainty {
+    /// Dotted parameter key, as in the parameter file (e.g. `mass.m_a_kg`).
+    pub key: String,
+    /// Relative standard deviation (0.025 = 2.5 %), relative to the parameter's own value.
+    pub rel_sigma: f64,
+    /// Distribution shape.
+    pub distribution: Distribution,
+}
+
+/// An error model that cannot be used. Every message names the key, the value and what is
+/// allowed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum UncertaintyError {
+    /// A key that is not a parameter.
+    #[error("[uncertainty]: unknown parameter key `{key}`; allowed keys: {allowed}")]
+    UnknownKey {
+        /// The key given.
+        key: String,
+        /// Every valid key.
+        allowed: String,
+    },
+    /// The same key listed twice.
+    #[error("[uncertainty]: parameter `{key}` has more than one uncertainty; give each key once")]
+    DuplicateKey {
+        /// The repeated key.
+        key: String,
+    },
+    /// A relative sigma that is negative or not finite.
+    #[error(
+        "[uncertainty]: rel_sigma of `{key}` = {rel_sigma} is not allowed: must be finite and >= 0"
+    )]
+    InvalidSigma {
+        /// The parameter.
+        key: String,
+        /// The value given.
+        rel_sigma: f64,
+    },
+    /// A relative sigma so large that draws would be non-physical.
+    #[error(
+        "[uncertainty]: rel_sigma of `{key}` = {rel_sigma} ({percent} %, {dist}) can make the \
+         parameter non-physical ({reason}): must be < {max:.4} ({max_percent:.1} %)",
+        percent = rel_sigma * 100.0,
+        dist = distribution.name(),
+        reason = distribution.limit_reason(),
+        max = distribution.max_rel_sigma(),
+        max_percent = distribution.max_rel_sigma() * 100.0
+    )]
+    NonPhysical {
+        /// The parameter.
+        key: String,
+        /// The value given.
+        rel_sigma: f64,
+        /// Its distribution.
+        distribution: Distribution,
+    },
+    /// A distribution name that is not known.
+    #[error(
+        "[uncertainty]: distribution of `{key}` = \"{name}\" is not known; allowed: {allowed}",
+        allowed = ALLOWED_DISTRIBUTIONS
+    )]
+    UnknownDistribution {
+        /// The parameter.
+        key: String,
+        /// The name given.
+        name: String,
+    },
+    /// An entry that is not `{ rel_sigma = ..., distribution = ... }`.
+    #[error(
+        "[uncertainty]: entry `{key}`: {message}; expected e.g. \
+         `\"{key}\" = {{ rel_sigma = 0.03, distribution = \"gaussian\" }}`"
+    )]
+    Malformed {
+        /// The key of the entry.
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// The `[uncertainty]` table of a parameter file: the entries that override
+/// [`default_uncertainties`]. Validated when read (see [`check`]); empty when the file has none.
+///
+/// In TOML it is written as one sub-table per key, sorted by key; it reads back unchanged.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct UncertaintyTable {
+    /// The entries, at most one per key.
+    pub entries: Vec<Uncertainty>,
+}
+
+impl UncertaintyTable {
+    /// No entry: every parameter has its default error.
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+
+    /// [`check`] against `keys`, the keys of [`Params::fields`].
+    pub fn validate(&self, keys: &[&str]) -> Result<(), UncertaintyError> {
+        check(&self.entries, keys)
+    }
+}
+
+/// The keys of [`Params::fields`] (they do not depend on the values), for the deserializer,
+/// which has no `Params` at hand. Built from the embedded Table I, which has no `[uncertainty]`
+/// table, so building it never comes back here.
+fn parameter_keys() -> &'static [&'static str] {
+    static KEYS: OnceLock<Vec<&'static str>> = OnceLock::new();
+    KEYS.get_or_init(|| Params::table_i().fields().iter().map(|f| f.key).collect())
+}
+
+/// Checks an error model: every key is one of `keys` and appears once, every `rel_sigma` is
+/// finite, >= 0 and below its distribution's [`Distribution::max_rel_sigma`].
+pub fn check(list: &[Uncertainty], keys: &[&str]) -> Result<(), UncertaintyError> {
+    for (i, u) in list.iter().enumerate() {
+        if !keys.contains(&u.key.as_str()) {
+            return Err(UncertaintyError::UnknownKey {
+                key: u.key.clone(),
+                allowed: keys.join(", "),
+            });
+        }
+        if list[..i].iter().any(|v| v.key == u.key) {
+            return Err(UncertaintyError::DuplicateKey { key: u.key.clone() });
+        }
+        if !(u.rel_sigma.is_finite() && u.rel_sigma >= 0.0) {
+            return Err(UncertaintyError::InvalidSigma {
+                key: u.key.clone(),
+                rel_sigma: u.rel_sigma,
+            });
+        }
+        if u.rel_sigma >= u.distribution.max_rel_sigma() {
+            return Err(UncertaintyError::NonPhysical {
+                key: u.key.clone(),
+                rel_sigma: u.rel_sigma,
+                distribution: u.distribution,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The default error model, one entry per parameter in [`Params::fields`] order: Gaussian, 2.5 %
+/// on every `mass.*`, `inertia.*` (I^a_23 too, relative to its own value) and `length.*` except
+/// `length.h_m`; 10 % on `torsion.*` and `bouncing.*`; `rel_sigma = 0` (exact) for
+/// `length.h_m`, `environment.g_m_per_s2` and `loss.*` (only g of these enters the modes).
+pub fn default_uncertainties(params: &Params) -> Vec<Uncertainty> {
+    params
+        .fields()
+        .iter()
+        .map(|f| {
+            let section = f.key.split('.').next().unwrap_or("");
+            let rel_sigma = match section {
+                "mass" | "inertia" => DEFAULT_REL_SIGMA_GEOMETRY,
+                "length" if f.key != "length.h_m" => DEFAULT_REL_SIGMA_GEOMETRY,
+                "torsion" | "bouncing" => DEFAULT_REL_SIGMA_SPRINGS,
+                _ => 0.0,
+            };
+            Uncertainty {
+                key: f.key.to_string(),
+                rel_sigma,
+                distribution: Distribution::Gaussian,
+            }
+        })
+        .collect()
+}
+
+impl Params {
+    /// The effective error model: [`default_uncertainties`] with the entries of the
+    /// `[uncertainty]` table replacing the defaults of their keys. One entry per parameter, in
+    /// [`Params::fields`] order; exact parameters have `rel_sigma = 0`.
+    pub fn effective_uncertainties(&self) -> Vec<Uncertainty> {
+        let mut list = default_uncertainties(self);
+        for u in &mut list {
+            if let Some(e) = self.uncertainty.entries.iter().find(|e| e.key == u.key) {
+                *u = e.clone();
+            }
+        }
+        list
+    }
+
+    /// The effective error model as TOML comments (one `# "key" = { ... }` line per parameter
+    /// that is not exact, then the exact ones), for `tiltnoise params`.
+    pub fn uncertainty_comment(&self) -> String {
+        let list = self.effective_uncertainties();
+        let mut text = String::from(
+            "\n# Effective error model (defaults of tiltnoise, overridden by [uncertainty] above);\n\
+             # rel_sigma is the relative standard deviation, uniform is flat on +/- sqrt(3) sigma:\n",
+        );
+        for u in list.iter().filter(|u| u.rel_sigma > 0.0) {
+            text.push_str(&format!(
+                "#   \"{}\" = {{ rel_sigma = {:?}, distribution = \"{}\" }}\n",
+                u.key,
+                u.rel_sigma,
+                u.distribution.name()
+            ));
+        }
+        let exact: Vec<&str> = list
+            .iter()
+            .filter(|u| u.rel_sigma == 0.0)
+            .map(|u| u.key.as_str())
+            .collect();
+        if exact.is_empty() {
+            return text;
+        }
+        let mut line = String::from("#   exact:");
+        for key in exact {
+            if line.len() + key.len() > 96 {
+                text.push_str(&line);
+                text.push('\n');
+                line = String::from("#         ");
+            }
+            line.push(' ');
+            line.push_str(key);
+        }
+        text.push_str(&line);
+        text.push('\n');
+        text
+    }
+}
+
+/// One entry as written in TOML.
+#[derive(Serialize)]
+struct EntryOut {
+    rel_sigma: f64,
+    distribution: &'static str,
+}
+
+impl Serialize for UncertaintyTable {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut sorted: Vec<&Uncertainty> = self.entries.iter().collect();
+        sorted.sort_by(|a, b| a.key.cmp(&b.key));
+        let mut map = serializer.serialize_map(Some(sorted.len()))?;
+        for u in sorted {
+            map.serialize_entry(
+                &u.key,
+                &EntryOut {
+                    rel_sigma: u.rel_sigma,
+                    distribution: u.distribution.name(),
+                },
+            )?;
+        }
+        map.end()
+    }
+}
+
+impl<'de> Deserialize<'de> for UncertaintyTable {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let table = toml::Table::deserialize(deserializer)?;
+        let mut entries = Vec::new();
+        flatten("", &table, &mut entries).map_err(|e| D::Error::custom(e.to_string()))?;
+        check(&entries, parameter_keys()).map_err(|e| D::Error::custom(e.to_string()))?;
+        Ok(UncertaintyTable { entries })
+    }
+}
+
+/// Collects the entries of `table`, whose keys follow `prefix`: a sub-table with `rel_sigma` or
+/// `distribution` is an entry, any other sub-table continues the dotted key (so that the bare
+/// dotted key `mass.m_a_kg = {...}` reads like the quoted `"mass.m_a_kg" = {...}`).
+fn flatten(
+    prefix: &str,
+    table: &toml::Table,
+    out: &mut Vec<Uncertainty>,
+) -> Result<(), UncertaintyError> {
+    for (name, value) in table {
+        let key = match prefix {
+            "" => name.clone(),
+            _ => format!("{prefix}.{name}"),
+        };
+        let malformed = |message: String| UncertaintyError::Malformed {
+            key: key.clone(),
+            message,
+        };
+        let toml::Value::Table(t) = value else {
+            return Err(malformed(format!("value {value} is not a table")));
+        };
+        if !(t.contains_key("rel_sigma") || t.contains_key("distribution")) {
+            flatten(&key, t, out)?;
+            continue;
+        }
+        if let Some(field) = t
+            .keys()
+            .find(|k| !matches!(k.as_str(), "rel_sigma" | "distribution"))
+        {
+            return Err(malformed(format!(
+                "unknown field `{field}`; allowed fields: rel_sigma, distribution"
+            )));
+        }
+        let rel_sigma = match t.get("rel_sigma") {
+            Some(toml::Value::Float(x)) => *x,
+            Some(toml::Value::Integer(n)) => *n as f64,
+            Some(other) => {
+                return Err(malformed(format!("rel_sigma = {other} is not a number")));
+            }
+            None => return Err(malformed("rel_sigma is missing".to_string())),
+        };
+        let distribution = match t.get("distribution") {
+            None => Distribution::Gaussian,
+            Some(toml::Value::String(name)) => Distribution::from_name(name).ok_or_else(|| {
+                UncertaintyError::UnknownDistribution {
+                    key: key.clone(),
+                    name: name.clone(),
+                }
+            })?,
+            Some(other) => {
+                return Err(UncertaintyError::UnknownDistribution {
+                    key: key.clone(),
+                    name: other.to_string(),
+                });
+            }
+        };
+        out.push(Uncertainty {
+            key,
+            rel_sigma,
+            distribution,
+        });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TABLE: &str = "\n[uncertainty]\n\
+        \"mass.m_a_kg\" = { rel_sigma = 0.03, distribution = \"uniform\" }\n\
+        \"length.h_m\" = { rel_sigma = 0 }\n\
+        torsion.k_b_n_m_per_rad = { rel_sigma = 0.2 }\n";
+
+    fn with_table(table: &str) -> Result<Params, String> {
+        Params::from_toml_str(&format!("{}{table}", super::super::TABLE_I_TOML), "t.toml")
+            .map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn uniform_limit_is_one_over_sqrt_3() {
+        assert!((MAX_REL_SIGMA_UNIFORM * 3f64.sqrt() - 1.0).abs() <= f64::EPSILON);
+    }
+
+    #[test]
+    fn table_overrides_defaults_and_round_trips() {
+        let p = with_table(TABLE).unwrap();
+        let eff = p.effective_uncertainties();
+        assert_eq!(eff.len(), p.fields().len());
+        let get = |k: &str| eff.iter().find(|u| u.key == k).unwrap().clone();
+        assert_eq!(
+            (
+                get("mass.m_a_kg").rel_sigma,
+                get("mass.m_a_kg").distribution
+            ),
+            (0.03, Distribution::Uniform)
+        );
+        assert_eq!(get("length.h_m").rel_sigma, 0.0);
+        assert_eq!(get("torsion.k_b_n_m_per_rad").rel_sigma, 0.2);
+        // Untouched keys keep their defaults.
+        assert_eq!(get("mass.m_b_kg").rel_sigma, DEFAULT_REL_SIGMA_GEOMETRY);
+        assert_eq!(get("environment.g_m_per_s2").rel_sigma, 0.0);
+        let back = Params::from_toml_str(&p.to_toml(), "round trip").unwrap();
+        assert_eq!(back, p);
+        // And through --set, which goes through a TOML table.
+        assert_eq!(p.with_override("length.d_m=0.15").unwrap(), p);
+    }
+
+    #[test]
+    fn bad_entries_name_key_value_and_what_is_allowed() {
+        let cases = [
+            (
+                "\"mass.m_c_kg\" = { rel_sigma = 0.01 }",
+                &["mass.m_c_kg", "mass.m_a_kg"][..],
+            ),
+            (
+                "\"mass.m_a_kg\" = { rel_sigma = -0.01 }",
+                &["mass.m_a_kg", "-0.01", ">= 0"],
+            ),
+            (
+                "\"mass.m_a_kg\" = { rel_sigma = nan }",
+                &["mass.m_a_kg", "NaN", ">= 0"],
+            ),
+            (
+                "\"mass.m_a_kg\" = { rel_sigma = 0.25 }",
+                &["mass.m_a_kg", "0.25", "< 0.2500", "gaussian"],
+            ),
+            (
+                "\"mass.m_a_kg\" = { rel_sigma = 0.6, distribution = \"uniform\" }",
+                &["mass.m_a_kg", "0.6", "< 0.5774", "sqrt(3)"],
+            ),
+            (
+                "\"mass.m_a_kg\" = { rel_sigma = 0.1, distribution = \"lognormal\" }",
+                &["mass.m_a_kg", "lognormal", "gaussian, uniform"],
+            ),
+            (
+                "\"mass.m_a_kg\" = { rel_sigma = 0.1, sigma = 2 }",
+                &["mass.m_a_kg", "sigma", "rel_sigma, distribution"],
+            ),
+            (
+                "\"mass.m_a_kg\" = { distribution = \"uniform\" }",
+                &["mass.m_a_kg", "rel_sigma is missing"],
+            ),
+            (
+                "\"mass.m_a_kg\" = 0.1",
+                &["mass.m_a_kg", "0.1", "not a table"],
+            ),
+        ];
+        for (entry, needles) in cases {
+            let e = with_table(&format!("\n[uncertainty]\n{entry}\n")).unwrap_err();
+            assert!(e.contains("t.toml"), "{e}");
+            for n in needles {
+                assert!(e.contains(n), "`{n}` missing in: {e}");
+            }
+        }
+        // Just below the limits is accepted.
+        assert!(with_table("\n[uncertainty]\n\"mass.m_a_kg\" = { rel_sigma = 0.249 }\n").is_ok());
+        assert!(with_table(
+            "\n[uncertainty]\n\"mass.m_a_kg\" = { rel_sigma = 0.577, distribution = \"uniform\" }\n"
+        )
+        .is_ok());
+    }
+
+    #[test]
+    fn check_refuses_duplicates() {
+        let u = Uncertainty {
+            key: "mass.m_a_kg".into(),
+            rel_sigma: 0.01,
+            distribution: Distribution::Gaussian,
+        };
+        let e = check(&[u.clone(), u], parameter_keys()).unwrap_err();
+        assert!(matches!(e, UncertaintyError::DuplicateKey { .. }), "{e}");
+    }
+}

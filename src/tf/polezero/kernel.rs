@@ -1,0 +1,483 @@
+//! The pole-zero method's evaluation over a frequency grid: `f64` arithmetic on the plan's
+//! product forms (built in the parent module), nothing else.
+//!
+//! The grid is cut into chunks of [`LANES`] (8) frequencies, one per lane of a [`Lanes`]
+//! value (two AVX registers when the CPU has AVX, chosen at run time; a portable array
+//! otherwise). In a chunk, each block forms its shared denominator `prod_k (lambda_k - s)` and
+//! its reciprocal once per frequency, then each of its entries `gain prod_k (a_k + b_k s)`
+//! times that reciprocal: the loops are over blocks, entries and factors, the lanes are
+//! frequencies. The chunk's values go into a small buffer that stays in L1 cache and holds
+//! the structural zeros (zeroed once, never written: each entry's first block stores its
+//! value, later blocks add theirs), and the buffer is copied into the output in one
+//! sequential pass, with non-temporal stores for outputs larger than the cache
+//! ([`STREAM_MIN_BYTES`]). One point alone ([`TransferFunction::eval_into`]) is written in
+//! place into the zeroed output.
+//!
+//! [`TransferFunction::eval_into`]: super::super::TransferFunction::eval_into
+//!
+//! Every lane does the same IEEE operations (multiplication, addition, subtraction, division;
+//! no fused multiply-add, no reassociation) in the same order, so a value depends neither on
+//! the chunk nor the lane it falls in, nor on the number of threads, nor on the CPU: AVX and
+//! portable lanes give bit-identical results, and so do [`Kernel::eval_grid`] on a grid and
+//! on each of its points alone.
+//!
+//! A chunk with a frequency that is not finite and >= 0, or on which a block is singular, is
+//! handed to a scalar pass over its points in order ([`Kernel::first_error`]) that returns the
+//! error of the first such point: the error a point-by-point evaluation of the grid reports.
+
+use super::super::direct::{omega_sq, SINGULAR_RCOND};
+#[cfg(target_arch = "x86_64")]
+use super::lanes::Avx;
+use super::lanes::{stream_fence, Lanes, Portable, LANES};
+use crate::error::TfError;
+use num_complex::Complex64;
+
+/// Outputs of at least this many bytes are written with non-temporal stores
+/// ([`Lanes::stream_copy`]): well above a core's L2 (1 to 2 MiB), about where the output stops
+/// fitting in a typical L3 next to other work. Below it, ordinary stores leave the output in
+/// the cache for the caller. At 1e5 points of 21 values (34 MB) on the 2-core EPYC VM of
+/// `scripts/bench/README.md`, a copy test alone: 12.5 ns per point with non-temporal stores,
+/// 18 to 22 with ordinary ones (which read each line before writing it).
+const STREAM_MIN_BYTES: usize = 8 << 20;
+
+/// One entry of an undamped block: `gain prod_k (a_k + b_k s)` times the block's
+/// `1 / prod(lambda - s)`, added at `out[at]`. Factors: `s` for a zero at the origin
+/// (`a = 0, b = 1`), `1 - s / z` for a zero `z` (`a = 1, b = -1 / z`, `z` moved into the
+/// gain); the first `factors` of the four, the others padding (`a = 1, b = 0`), skipped (an
+/// exact 1 for every finite `s`).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct RealEntry {
+    pub at: usize,
+    /// The first block to write the real part of `out[at]`: it stores `0.0 + h` (what
+    /// adding to a zeroed output gives) instead of adding (set by [`Kernel::new`]). Real
+    /// blocks leave the imaginary part alone.
+    pub first_re: bool,
+    pub factors: usize,
+    pub gain: f64,
+    pub a: [f64; 4],
+    pub b: [f64; 4],
+}
+
+/// [`RealEntry`] with complex gain and factors (damped blocks, or complex zeros).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct ComplexEntry {
+    pub at: usize,
+    /// As [`RealEntry::first_re`].
+    pub first_re: bool,
+    /// The first block to write the imaginary part of `out[at]`.
+    pub first_im: bool,
+    pub factors: usize,
+    pub gain: Complex64,
+    pub a: [Complex64; 4],
+    pub b: [Complex64; 4],
+}
+
+/// A block with real poles (undamped) whose entries are all real.
+pub(super) struct RealBlock {
+    poles: [f64; 4],
+    /// `SINGULAR_RCOND lambda_k`.
+    thresholds: [f64; 4],
+    entries: Vec<RealEntry>,
+}
+
+/// A block in complex arithmetic.
+pub(super) struct ComplexBlock {
+    poles: [Complex64; 4],
+    /// `(SINGULAR_RCOND |lambda_k|)^2`.
+    thresholds: [f64; 4],
+    entries: Vec<ComplexEntry>,
+}
+
+/// One block's product forms.
+pub(super) enum BlockForm {
+    /// Undamped, every zero real: real arithmetic.
+    Real(RealBlock),
+    /// Damped (or complex zeros): complex arithmetic.
+    Complex(ComplexBlock),
+}
+
+impl BlockForm {
+    /// A block in real arithmetic with eigenvalues `poles` (`s`, rad^2/s^2).
+    pub fn real(poles: [f64; 4], entries: Vec<RealEntry>) -> BlockForm {
+        BlockForm::Real(RealBlock {
+            poles,
+            thresholds: poles.map(|l| SINGULAR_RCOND * l),
+            entries,
+        })
+    }
+
+    /// A block in complex arithmetic with eigenvalues `poles`.
+    pub fn complex(poles: [Complex64; 4], entries: Vec<ComplexEntry>) -> BlockForm {
+        BlockForm::Complex(ComplexBlock {
+            poles,
+            thresholds: poles.map(|l| (SINGULAR_RCOND * l.norm()).powi(2)),
+            entries,
+        })
+    }
+
+    /// Adds the block's entries at the chunk's first `n` frequencies (`s` per lane) to `out`
+    /// (`n` points of `n_values` values); false, with `out` partly written, if the block is
+    /// singular in some lane.
+    #[inline(always)]
+    fn add_chunk<V: Lanes>(&self, s: V, n: usize, n_values: usize, out: &mut [Complex64]) -> bool {
+        match self {
+            BlockForm::Real(b) => b.add_chunk(s, n, n_values, out),
+            BlockForm::Complex(b) => b.add_chunk(s, n, n_values, out),
+        }
+    }
+
+    fn is_singular(&self, s: f64) -> bool {
+        match self {
+            BlockForm::Real(b) => (0..4).any(|k| b.is_singular(k, b.poles[k] - s)),
+            BlockForm::Complex(b) => (0..4).any(|k| b.is_singular(k, b.poles[k] - s)),
+        }
+    }
+
+    /// The error at a frequency where [`BlockForm::is_singular`] holds.
+    #[cold]
+    fn singular(&self, s: f64, freq_hz: f64) -> TfError {
+        let rcond = match self {
+            BlockForm::Real(b) => b
+                .poles
+                .iter()
+                .map(|&l| (l - s).abs() / l)
+                .fold(f64::INFINITY, f64::min),
+            BlockForm::Complex(b) => b
+                .poles
+                .iter()
+                .map(|&l| (l - s).norm() / l.norm())
+                .fold(f64::INFINITY, f64::min),
+        };
+        TfError::Singular { freq_hz, rcond }
+    }
+}
+
+// The kernels below use plain loops, no iterator adaptors with closures around the lane
+// operations: those could be compiled outside the AVX entry point and lose its instructions.
+
+impl RealBlock {
+    /// `|lambda_k - s| < SINGULAR_RCOND lambda_k`, with `d = lambda_k - s`.
+    fn is_singular(&self, k: usize, d: f64) -> bool {
+        d.abs() < self.thresholds[k]
+    }
+
+    #[inline(always)]
+    fn add_chunk<V: Lanes>(&self, s: V, n: usize, n_values: usize, out: &mut [Complex64]) -> bool {
+        let p = self.poles;
+        let d = [
+            V::splat(p[0]).sub(s),
+            V::splat(p[1]).sub(s),
+            V::splat(p[2]).sub(s),
+            V::splat(p[3]).sub(s),
+        ];
+        let mut singular = false;
+        for (dk, &t) in d.iter().zip(&self.thresholds) {
+            singular |= dk.abs().any_lt(V::splat(t));
+        }
+        if singular {
+            return false;
+        }
+        let inv = V::splat(1.0).div(d[0].mul(d[1]).mul(d[2].mul(d[3])));
+        for e in &self.entries {
+            // 1 - s / z: relative error ~ 1.5 eps |z| / |z - s| (the rounding of 1 / z and of
+            // the product), as z - s with z rounded to f64.
+            let mut h = V::splat(e.gain);
+            for k in 0..e.factors {
+                h = h.mul(V::splat(e.a[k]).add(V::splat(e.b[k]).mul(s)));
+            }
+            put(out, e.at, n_values, n, e.first_re, h.mul(inv), Part::Re);
+        }
+        true
+    }
+}
+
+/// A part of a complex value.
+#[derive(Clone, Copy)]
+enum Part {
+    Re,
+    Im,
+}
+
+/// Lane `l < n` of `v` into part `part` of `out[l * n_values + at]`: stored as `0.0 + v` if
+/// `first` (what adding to a zeroed output gives: +0.0 for -0.0), else added.
+#[inline(always)]
+fn put<V: Lanes>(
+    out: &mut [Complex64],
+    at: usize,
+    n_values: usize,
+    n: usize,
+    first: bool,
+    v: V,
+    part: Part,
+) {
+    let v = if first { V::splat(0.0).add(v) } else { v }.to_array();
+    // One bounds check for the column, none per lane (when `n == LANES`, the usual case, the
+    // loop below has a constant count and is unrolled).
+    let column = &mut out[at..=at + (n - 1) * n_values];
+    let mut one = |l: usize| {
+        let o = &mut column[l * n_values];
+        let x = match part {
+            Part::Re => &mut o.re,
+            Part::Im => &mut o.im,
+        };
+        if first {
+            *x = v[l];
+        } else {
+            *x += v[l];
+        }
+    };
+    if n == LANES {
+        for l in 0..LANES {
+            one(l);
+        }
+    } else {
+        for l in 0..n {
+            one(l);
+        }
+    }
+}
+
+/// `(a_re + i a_im) (b_re + i b_im)` in lanes, num_complex's formula.
+#[inline(always)]
+fn cmul<V: Lanes>((ar, ai): (V, V), (br, bi): (V, V)) -> (V, V) {
+    (ar.mul(br).sub(ai.mul(bi)), ar.mul(bi).add(ai.mul(br)))
+}
+
+impl ComplexBlock {
+    /// `|lambda_k - s|^2 < (SINGULAR_RCOND |lambda_k|)^2`, with `d = lambda_k - s`.
+    fn is_singular(&self, k: usize, d: Complex64) -> bool {
+        d.norm_sqr() < self.thresholds[k]
+    }
+
+    #[inline(always)]
+    fn add_chunk<V: Lanes>(&self, s: V, n: usize, n_values: usize, out: &mut [Complex64]) -> bool {
+        let p = self.poles;
+        let d = [
+            (V::splat(p[0].re).sub(s), V::splat(p[0].im)),
+            (V::splat(p[1].re).sub(s), V::splat(p[1].im)),
+            (V::splat(p[2].re).sub(s), V::splat(p[2].im)),
+            (V::splat(p[3].re).sub(s), V::splat(p[3].im)),
+        ];
+        let mut singular = false;
+        for (&(re, im), &t) in d.iter().zip(&self.thresholds) {
+            singular |= re.mul(re).add(im.mul(im)).any_lt(V::splat(t));
+        }
+        if singular {
+            return false;
+        }
+        // 1 / den = conj(den) / |den|^2; the conjugation is folded into the last product.
+        let (re, im) = cmul(cmul(d[0], d[1]), cmul(d[2], d[3]));
+        let t = re.mul(re).add(im.mul(im));
+        let (inv_re, inv_im_neg) = (re.div(t), im.div(t));
+        for e in &self.entries {
+            let mut h = (V::splat(e.gain.re), V::splat(e.gain.im));
+            for k in 0..e.factors {
+                let f_re = V::splat(e.a[k].re).add(V::splat(e.b[k].re).mul(s));
+                let f_im = V::splat(e.a[k].im).add(V::splat(e.b[k].im).mul(s));
+                h = cmul(h, (f_re, f_im));
+            }
+            let (h_re, h_im) = h;
+            // (h_re + i h_im) (inv_re - i inv_im_neg).
+            let re = h_re.mul(inv_re).add(h_im.mul(inv_im_neg));
+            let im = h_im.mul(inv_re).sub(h_re.mul(inv_im_neg));
+            put(out, e.at, n_values, n, e.first_re, re, Part::Re);
+            put(out, e.at, n_values, n, e.first_im, im, Part::Im);
+        }
+        true
+    }
+}
+
+/// The evaluation side of a pole-zero plan.
+pub(super) struct Kernel {
+    blocks: Vec<BlockForm>,
+    /// Values per frequency (`outputs x inputs`).
+    n_values: usize,
+    /// The CPU has AVX (checked at plan time): the same operations, four lanes per instruction.
+    avx: bool,
+}
+
+impl Kernel {
+    pub fn new(mut blocks: Vec<BlockForm>, n_values: usize) -> Kernel {
+        let (mut re_written, mut im_written) = (vec![false; n_values], vec![false; n_values]);
+        for b in &mut blocks {
+            match b {
+                BlockForm::Real(b) => {
+                    for e in &mut b.entries {
+                        e.first_re = !std::mem::replace(&mut re_written[e.at], true);
+                    }
+                }
+                BlockForm::Complex(b) => {
+                    for e in &mut b.entries {
+                        e.first_re = !std::mem::replace(&mut re_written[e.at], true);
+                        e.first_im = !std::mem::replace(&mut im_written[e.at], true);
+                    }
+                }
+            }
+        }
+        Kernel {
+            blocks,
+            n_values,
+            avx: avx_available(),
+        }
+    }
+
+    /// `H` at every frequency of `freqs_hz` into `out` (`[freq][output][input]`, length
+    /// `freqs_hz.len() * n_values`, checked by the caller). On error the contents of `out`
+    /// are unspecified.
+    pub fn eval_grid(&self, freqs_hz: &[f64], out: &mut [Complex64]) -> Result<(), TfError> {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx {
+            // SAFETY: `avx` is true only when the running CPU supports AVX (checked in `new`).
+            return unsafe { self.eval_grid_avx(freqs_hz, out) };
+        }
+        self.eval_grid_with::<Portable>(freqs_hz, out)
+    }
+
+    /// The kernel in AVX registers: the same operations in the same order as the portable
+    /// lanes (no fused multiply-add), so the results are bit-identical.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn eval_grid_avx(&self, freqs_hz: &[f64], out: &mut [Complex64]) -> Result<(), TfError> {
+        self.eval_grid_with::<Avx>(freqs_hz, out)
+    }
+
+    #[inline(always)]
+    fn eval_grid_with<V: Lanes>(
+        &self,
+        freqs_hz: &[f64],
+        out: &mut [Complex64],
+    ) -> Result<(), TfError> {
+        let nv = self.n_values;
+        if nv == 0 {
+            // Nothing to write; the frequencies are still checked, as point by point.
+            return freqs_hz.iter().try_for_each(|&f| omega_sq(f).map(drop));
+        }
+        if let [_] = freqs_hz {
+            // One point (`eval_into`): written in place.
+            out.fill(Complex64::new(0.0, 0.0));
+            return self.eval_chunk::<V>(freqs_hz, out);
+        }
+        // A chunk is written into `chunk` (in L1 cache), then copied into `out` in one
+        // sequential pass. The structural zeros of `chunk` are never written: zeroed once.
+        let mut chunk = vec![Complex64::new(0.0, 0.0); LANES * nv];
+        let stream = std::mem::size_of_val(out) >= STREAM_MIN_BYTES;
+        let mut result = Ok(());
+        for (fc, oc) in freqs_hz.chunks(LANES).zip(out.chunks_mut(LANES * nv)) {
+            result = self.eval_chunk::<V>(fc, &mut chunk);
+            if result.is_err() {
+                break;
+            }
+            if stream {
+                V::stream_copy(oc, &chunk[..oc.len()]);
+            } else {
+                oc.copy_from_slice(&chunk[..oc.len()]);
+            }
+        }
+        if stream {
+            stream_fence();
+        }
+        result
+    }
+
+    /// `H` at the (at most [`LANES`]) frequencies `fc` into `dst` (`fc.len()` points of
+    /// `n_values`), whose structural zeros must already be zero.
+    #[inline(always)]
+    fn eval_chunk<V: Lanes>(&self, fc: &[f64], dst: &mut [Complex64]) -> Result<(), TfError> {
+        // A short chunk repeats its last frequency in the unused lanes.
+        let last = fc.len() - 1;
+        let f = V::from_array(std::array::from_fn(|l| fc[l.min(last)]));
+        let valid = f.all_finite_nonneg();
+        // `omega_sq`'s arithmetic: (2 pi f)^2, two roundings.
+        let w = V::splat(std::f64::consts::TAU).mul(f);
+        let s = w.mul(w);
+        let mut ok = valid;
+        for b in &self.blocks {
+            ok = ok && b.add_chunk(s, fc.len(), self.n_values, dst);
+        }
+        if ok {
+            Ok(())
+        } else {
+            Err(self.first_error(fc))
+        }
+    }
+
+    /// The error of the first point of `freqs_hz` that is invalid or singular, checking the
+    /// points in order and, at a point, the blocks in order.
+    #[cold]
+    #[inline(never)]
+    fn first_error(&self, freqs_hz: &[f64]) -> TfError {
+        for &f in freqs_hz {
+            let s = match omega_sq(f) {
+                Ok(s) => s,
+                Err(e) => return e,
+            };
+            if let Some(b) = self.blocks.iter().find(|b| b.is_singular(s)) {
+                return b.singular(s, f);
+            }
+        }
+        unreachable!("a chunk failed its checks but none of its points does")
+    }
+}
+
+fn avx_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::model::Model;
+    use crate::params::Params;
+    use crate::tf::{PoleZero, Request};
+    use num_complex::Complex64;
+
+    /// AVX and portable lanes on the same grid, bit for bit: undamped and damped (real and
+    /// complex blocks), a grid small enough for ordinary stores and one large enough for the
+    /// non-temporal ones, with a short last chunk. Skipped on a CPU without AVX.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx_and_portable_lanes_agree_bit_for_bit() {
+        if !std::arch::is_x86_feature_detected!("avx") {
+            return;
+        }
+        let mut damped = Params::table_i();
+        for key in ["torsion_a_rad", "bouncing_b_rad"] {
+            damped = damped.with_override(&format!("loss.{key}=1e-3")).unwrap();
+        }
+        for params in [Params::table_i(), damped] {
+            let pz = PoleZero::new(&Model::new(&params).unwrap(), Request::all_tilt());
+            let nv = pz.kernel.n_values;
+            // 0 Hz, then log-spaced to 1e5 Hz; 30 001 points of 21 values exceed
+            // STREAM_MIN_BYTES.
+            for n in [1001, 30_001] {
+                let freqs: Vec<f64> = (0..n)
+                    .map(|k| match k {
+                        0 => 0.0,
+                        _ => 1e-6 * 1e11_f64.powf(k as f64 / (n - 1) as f64),
+                    })
+                    .collect();
+                let mut portable = vec![Complex64::new(f64::NAN, 0.0); n * nv];
+                let mut avx = portable.clone();
+                pz.kernel
+                    .eval_grid_with::<super::Portable>(&freqs, &mut portable)
+                    .unwrap();
+                // SAFETY: the CPU has AVX (checked above).
+                unsafe { pz.kernel.eval_grid_avx(&freqs, &mut avx) }.unwrap();
+                for (k, (a, p)) in avx.iter().zip(&portable).enumerate() {
+                    assert!(
+                        a.re.to_bits() == p.re.to_bits() && a.im.to_bits() == p.im.to_bits(),
+                        "value {} at {} Hz: AVX {a} vs portable {p}",
+                        k % nv,
+                        freqs[k / nv]
+                    );
+                }
+            }
+        }
+    }
+}
