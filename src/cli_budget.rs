@@ -7,7 +7,7 @@ use crate::budget::{
 use crate::cli::{AverageArg, BudgetArgs};
 use crate::freq;
 use crate::input::{read_tilt, InputFormat, ReadOptions, TiltInput, TiltSeriesSource};
-use crate::io::{save_budget, InputMeta, OutputKind, RunMeta, TOOL_VERSION};
+use crate::io::{save_budget, InputMeta, OutputKind, RunMeta};
 use crate::model::{Model, Observable};
 use crate::modes::NormalModes;
 use crate::noise::{BudgetReport, Readout};
@@ -20,30 +20,37 @@ use std::io::IsTerminal;
 /// Frequencies (Hz) at which the terminal summary reads the budget.
 const SUMMARY_FREQS_HZ: [f64; 3] = [1e-3, 2e-3, 5e-3];
 
+/// One `--readout OBS=ASD` item (also used by `simulate`): the observable and its white
+/// readout noise, one-sided ASD in the observable's unit/sqrt(Hz), finite and >= 0.
+pub(crate) fn parse_readout_item(item: &str) -> Result<(Observable, f64)> {
+    let (name, value) = item
+        .split_once('=')
+        .ok_or_else(|| anyhow!("--readout {item}: expected OBS=ASD, e.g. X=9e-9"))?;
+    let o = Observable::ALL
+        .into_iter()
+        .find(|o| o.name() == name.trim())
+        .ok_or_else(|| {
+            anyhow!(
+                "--readout {item}: unknown observable `{name}`; allowed: X, Y, Z, theta, eta, phi, phi_a"
+            )
+        })?;
+    let asd: f64 = value
+        .trim()
+        .parse()
+        .map_err(|_| anyhow!("--readout {item}: `{value}` is not a number"))?;
+    if !(asd.is_finite() && asd >= 0.0) {
+        bail!(
+            "--readout {item}: ASD {asd} {}/sqrt(Hz) is not allowed: must be finite and >= 0",
+            o.unit()
+        );
+    }
+    Ok((o, asd))
+}
+
 fn parse_readout(items: &[String]) -> Result<Readout> {
     let mut readout = Readout::default();
     for item in items {
-        let (name, value) = item
-            .split_once('=')
-            .ok_or_else(|| anyhow!("--readout {item}: expected OBS=ASD, e.g. X=9e-9"))?;
-        let o = Observable::ALL
-            .into_iter()
-            .find(|o| o.name() == name.trim())
-            .ok_or_else(|| {
-                anyhow!(
-                    "--readout {item}: unknown observable `{name}`; allowed: X, Y, Z, theta, eta, phi, phi_a"
-                )
-            })?;
-        let asd: f64 = value
-            .trim()
-            .parse()
-            .map_err(|_| anyhow!("--readout {item}: `{value}` is not a number"))?;
-        if !(asd.is_finite() && asd >= 0.0) {
-            bail!(
-                "--readout {item}: ASD {asd} {}/sqrt(Hz) is not allowed: must be finite and >= 0",
-                o.unit()
-            );
-        }
+        let (o, asd) = parse_readout_item(item)?;
         readout.asd.retain(|(x, _)| *x != o);
         if asd > 0.0 {
             readout.asd.push((o, asd));
@@ -186,16 +193,7 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs) -> Result<()> {
         println!("input: {note}");
     }
     print!("{}", summary(&report));
-    let meta = RunMeta {
-        tool_version: TOOL_VERSION.to_string(),
-        params_toml: params.to_toml(),
-        command_line: std::env::args().collect::<Vec<_>>().join(" "),
-        modes: NormalModes::new(&model)
-            .modes
-            .iter()
-            .map(|m| (m.index, m.frequency_hz))
-            .collect(),
-    };
+    let meta = RunMeta::of_this_run(params, Some(&NormalModes::new(&model)));
     let input = InputMeta {
         path: provenance.path.display().to_string(),
         format: provenance.format.name().to_string(),

@@ -3,7 +3,7 @@
 //! (PNG/SVG) and HDF5 with `--save`.
 
 use crate::error::OutputError;
-use crate::io::{write_mc_hdf5, RunMeta, TOOL_VERSION};
+use crate::io::{write_mc_hdf5, RunMeta};
 use crate::mc::{McConfig, McResult};
 use crate::model::Model;
 use crate::modes::NormalModes;
@@ -86,12 +86,7 @@ pub(crate) fn run_mc(params: &Params, opts: McOptions) -> Result<()> {
     if opts.save.is_empty() {
         return Ok(());
     }
-    let meta = RunMeta {
-        tool_version: TOOL_VERSION.to_string(),
-        params_toml: params.to_toml(),
-        command_line: std::env::args().collect::<Vec<_>>().join(" "),
-        modes: Vec::new(),
-    };
+    let meta = RunMeta::of_this_run(params, None);
     let caption = caption(&result, &cfg);
     for (path, kind) in opts.save.iter().zip(kinds) {
         match kind {

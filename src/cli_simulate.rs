@@ -3,9 +3,7 @@
 //! and the outputs (HDF5 series + ASDs, CSV ASDs, Figure 3, Figures 4/5). Owns the progress
 //! bar (only when stderr is a terminal and the run is long). Documented in `docs/simulate.md`.
 
-use crate::io::{
-    write_observable_series_hdf5, OutputKind, RunMeta, SeriesAsd, SimulationMeta, TOOL_VERSION,
-};
+use crate::io::{write_observable_series_hdf5, OutputKind, RunMeta, SeriesAsd, SimulationMeta};
 use crate::model::{Coord, Model, Observable};
 use crate::modes::NormalModes;
 use crate::params::Params;
@@ -91,31 +89,10 @@ pub(crate) struct SimulateArgs {
     save_time: Vec<PathBuf>,
 }
 
-fn observable_named(name: &str) -> Option<Observable> {
-    Observable::ALL.into_iter().find(|o| o.name() == name)
-}
-
 fn parse_readout(items: &[String]) -> Result<Vec<(Observable, f64)>> {
     let mut readout = vec![(Observable::X, DEFAULT_X_READOUT_ASD_M)];
     for item in items {
-        let (name, value) = item
-            .split_once('=')
-            .ok_or_else(|| anyhow!("--readout {item}: expected OBS=ASD, e.g. X=9e-9"))?;
-        let o = observable_named(name.trim()).ok_or_else(|| {
-            anyhow!(
-                "--readout {item}: unknown observable `{name}`; allowed: X, Y, Z, theta, eta, phi, phi_a"
-            )
-        })?;
-        let asd: f64 = value
-            .trim()
-            .parse()
-            .map_err(|_| anyhow!("--readout {item}: `{value}` is not a number"))?;
-        if !(asd.is_finite() && asd >= 0.0) {
-            bail!(
-                "--readout {item}: ASD {asd} {}/sqrt(Hz) is not allowed: must be finite and >= 0",
-                o.unit()
-            );
-        }
+        let (o, asd) = crate::cli_budget::parse_readout_item(item)?;
         readout.retain(|(x, _)| *x != o);
         if asd > 0.0 {
             readout.push((o, asd));
@@ -340,16 +317,7 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs) -> Result<()> {
 
     let freqs_hz = psds[0].1.freqs_hz.clone();
     let asd: Vec<(Observable, Vec<f64>)> = psds.iter().map(|(o, p)| (*o, p.asd())).collect();
-    let meta = RunMeta {
-        tool_version: TOOL_VERSION.to_string(),
-        params_toml: params.to_toml(),
-        command_line: std::env::args().collect::<Vec<_>>().join(" "),
-        modes: modes
-            .modes
-            .iter()
-            .map(|m| (m.index, m.frequency_hz))
-            .collect(),
-    };
+    let meta = RunMeta::of_this_run(params, Some(&modes));
     let caption = vec![
         format!(
             "{} samples at {} s ({} s), exact modal propagation of the undamped model; initial \

@@ -10,7 +10,7 @@
 
 use crate::cli::MethodArg;
 use crate::freq;
-use crate::io::{save_tf, RunMeta, TOOL_VERSION};
+use crate::io::{save_tf, RunMeta};
 use crate::model::{ForceInput, Model, Observable};
 use crate::modes::NormalModes;
 use crate::params::Params;
@@ -180,16 +180,7 @@ pub fn run_tf(params: &Params, args: TfArgs) -> Result<()> {
         return Ok(());
     }
     let modes = NormalModes::new(&model);
-    let meta = RunMeta {
-        tool_version: TOOL_VERSION.to_string(),
-        params_toml: params.to_toml(),
-        command_line: std::env::args().collect::<Vec<_>>().join(" "),
-        modes: modes
-            .modes
-            .iter()
-            .map(|m| (m.index, m.frequency_hz))
-            .collect(),
-    };
+    let meta = RunMeta::of_this_run(params, Some(&modes));
     print!("{}", crate::report::modes_table(&modes));
     if request.inputs.iter().any(|i| matches!(i, Input::Tilt(_))) {
         println!();

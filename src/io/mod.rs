@@ -47,6 +47,24 @@ pub struct RunMeta {
     pub modes: Vec<(usize, f64)>,
 }
 
+impl RunMeta {
+    /// The provenance of the running process: this tool's version, `params` as TOML, the
+    /// command line, and the frequencies of `modes` when given.
+    pub fn of_this_run(
+        params: &crate::params::Params,
+        modes: Option<&crate::modes::NormalModes>,
+    ) -> RunMeta {
+        RunMeta {
+            tool_version: TOOL_VERSION.to_string(),
+            params_toml: params.to_toml(),
+            command_line: std::env::args().collect::<Vec<_>>().join(" "),
+            modes: modes
+                .map(|m| m.modes.iter().map(|m| (m.index, m.frequency_hz)).collect())
+                .unwrap_or_default(),
+        }
+    }
+}
+
 /// Provenance of the tilt input of a budget run, stored in the budget's HDF5 file and shown in
 /// its figure. Plain strings, so that this module does not depend on [`crate::input`]; the
 /// caller fills it from the reader's `crate::input::Provenance`.
