@@ -1,7 +1,9 @@
 //! Transfer functions from inputs (tilt angles, forces, torques) to observables.
 //!
-//! `H(w) = C (K_c - w^2 M)^-1 G(w)`, with `K_c` the complex stiffness (loss angles), `G` the
-//! tilt forcing `G0 + w^2 G2` (columns per tilt angle, see [`crate::model::tilt`]) or the
+//! `H(w) = C (K_c + i w D - w^2 M)^-1 G(w)`, with `K_c` the complex stiffness (structural loss
+//! angles, [`crate::model::Model::stiffness_complex`]), `D` the viscous damping matrix (zero
+//! unless the parameter file has `[viscous]` coefficients; methods that cannot represent it refuse
+//! it at plan time), `G` the tilt forcing `G0 + w^2 G2` (columns per tilt angle, see [`crate::model::tilt`]) or the
 //! zeroth-order force matrix (columns per force/torque component). Units of an entry: the
 //! observable's unit per the input's unit (m/rad, rad/rad, m/N, rad/(N m), ...). The response
 //! is the complex amplitude for `e^{+i w t}` time dependence.
