@@ -26,10 +26,7 @@ pub(crate) fn parse_readout_item(item: &str) -> Result<(Observable, f64)> {
     let (name, value) = item
         .split_once('=')
         .ok_or_else(|| anyhow!("--readout {item}: expected OBS=ASD, e.g. X=9e-9"))?;
-    let o = Observable::ALL
-        .into_iter()
-        .find(|o| o.name() == name.trim())
-        .ok_or_else(|| {
+    let o = Observable::from_name(name.trim()).ok_or_else(|| {
             anyhow!(
                 "--readout {item}: unknown observable `{name}`; allowed: X, Y, Z, theta, eta, phi, phi_a"
             )

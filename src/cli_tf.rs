@@ -113,7 +113,7 @@ pub fn parse_outputs(specs: &[String]) -> Result<Vec<Observable>> {
     }
     let mut outputs = Vec::new();
     for name in split_names("--output", specs)? {
-        let Some(o) = Observable::ALL.into_iter().find(|o| o.name() == name) else {
+        let Some(o) = Observable::from_name(name) else {
             let allowed: Vec<&str> = Observable::ALL.iter().map(|o| o.name()).collect();
             bail!(
                 "--output: unknown observable {name:?}; allowed: {}",

@@ -150,6 +150,27 @@ pub(crate) fn str_attr(
 }
 
 /// Names of the datasets directly under the root, in HDF5's (alphabetical) order.
+/// The root attribute `sample_rate_hz` of a time-series file (Hz, finite and > 0), required.
+pub(crate) fn sample_rate_hz(path: &Path, file: &hdf5::File) -> Result<f64, InputError> {
+    const RATE_ALLOWED: &str = "the sample rate in Hz: a finite number > 0";
+    match attr(path, file, "/", "sample_rate_hz")? {
+        None => Err(InputError::MissingAttribute {
+            path: path.to_path_buf(),
+            object: "/".to_string(),
+            attribute: "sample_rate_hz",
+            expected: RATE_ALLOWED,
+        }),
+        Some(AttrValue::Num(v)) if v.is_finite() && v > 0.0 => Ok(v),
+        Some(other) => Err(InputError::BadAttribute {
+            path: path.to_path_buf(),
+            object: "/".to_string(),
+            attribute: "sample_rate_hz",
+            value: other.describe(),
+            allowed: RATE_ALLOWED,
+        }),
+    }
+}
+
 pub(crate) fn root_datasets(path: &Path, file: &hdf5::File) -> Result<Vec<String>, InputError> {
     let names = file.member_names().map_err(h5err(path, "root group /"))?;
     Ok(names

@@ -63,10 +63,6 @@ pub fn read_measured_input(path: &Path) -> Result<MeasuredInput, InputError> {
     }
 }
 
-fn observable_named(name: &str) -> Option<Observable> {
-    Observable::ALL.into_iter().find(|o| o.name() == name)
-}
-
 const OBSERVABLE_UNITS: &str =
     "the observable's SI unit: m for X, Y, Z; rad for theta, eta, phi, phi_a";
 
@@ -87,30 +83,10 @@ fn read_series_hdf5(path: &Path) -> Result<MeasuredSeries, InputError> {
             })
         }
     }
-    const RATE_ALLOWED: &str = "the sample rate in Hz: a finite number > 0";
-    let sample_rate_hz = match h5::attr(path, &file, "/", "sample_rate_hz")? {
-        None => {
-            return Err(InputError::MissingAttribute {
-                path: path.to_path_buf(),
-                object: "/".to_string(),
-                attribute: "sample_rate_hz",
-                expected: RATE_ALLOWED,
-            })
-        }
-        Some(AttrValue::Num(v)) if v.is_finite() && v > 0.0 => v,
-        Some(other) => {
-            return Err(InputError::BadAttribute {
-                path: path.to_path_buf(),
-                object: "/".to_string(),
-                attribute: "sample_rate_hz",
-                value: other.describe(),
-                allowed: RATE_ALLOWED,
-            })
-        }
-    };
+    let sample_rate_hz = h5::sample_rate_hz(path, &file)?;
     let mut channels: Vec<(Observable, Vec<f64>)> = Vec::new();
     for name in h5::root_datasets(path, &file)? {
-        let Some(o) = observable_named(&name) else {
+        let Some(o) = Observable::from_name(&name) else {
             continue;
         };
         let object = format!("dataset /{name}");
@@ -203,7 +179,7 @@ fn read_series_csv(
     };
     let mut observables = Vec::new();
     for name in &header[1..] {
-        let o = observable_named(name).ok_or_else(|| {
+        let o = Observable::from_name(name).ok_or_else(|| {
             csv_err(
                 header_line,
                 format!(
@@ -304,18 +280,15 @@ pub fn read_measured(path: &Path) -> Result<MeasuredSpectra, InputError> {
     }
     let mut observables = Vec::new();
     for name in &prelude.header[1..] {
-        let o = Observable::ALL
-            .into_iter()
-            .find(|o| o.name() == name)
-            .ok_or_else(|| {
-                csv_err(
-                    prelude.header_line,
-                    format!(
-                        "measured spectrum: unknown column `{name}`; allowed: X, Y, Z, theta, \
+        let o = Observable::from_name(name).ok_or_else(|| {
+            csv_err(
+                prelude.header_line,
+                format!(
+                    "measured spectrum: unknown column `{name}`; allowed: X, Y, Z, theta, \
                          eta, phi, phi_a"
-                    ),
-                )
-            })?;
+                ),
+            )
+        })?;
         observables.push(o);
     }
     let mut freqs: Vec<f64> = Vec::new();

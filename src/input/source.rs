@@ -83,27 +83,7 @@ impl TiltSeriesSource {
         file: hdf5::File,
         opts: &ReadOptions,
     ) -> Result<Self, InputError> {
-        const RATE_ALLOWED: &str = "the sample rate in Hz: a finite number > 0";
-        let sample_rate_hz = match h5::attr(path, &file, "/", "sample_rate_hz")? {
-            None => {
-                return Err(InputError::MissingAttribute {
-                    path: path.to_path_buf(),
-                    object: "/".to_string(),
-                    attribute: "sample_rate_hz",
-                    expected: RATE_ALLOWED,
-                })
-            }
-            Some(AttrValue::Num(v)) if v.is_finite() && v > 0.0 => v,
-            Some(other) => {
-                return Err(InputError::BadAttribute {
-                    path: path.to_path_buf(),
-                    object: "/".to_string(),
-                    attribute: "sample_rate_hz",
-                    value: other.describe(),
-                    allowed: RATE_ALLOWED,
-                })
-            }
-        };
+        let sample_rate_hz = h5::sample_rate_hz(path, &file)?;
         let mut notes = Vec::new();
         let start_time = h5::start_and_description(path, &file, &mut notes)?;
         let file_map = h5::axis_map(path, &file)?;

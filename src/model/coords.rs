@@ -109,6 +109,11 @@ impl Observable {
             _ => "rad",
         }
     }
+
+    /// Looks an observable up by its name ([`Observable::name`], case-sensitive).
+    pub fn from_name(name: &str) -> Option<Observable> {
+        Observable::ALL.into_iter().find(|o| o.name() == name)
+    }
 }
 
 /// Floor tilt angles. Sign convention: see [`crate::model::tilt`]. Positive `theta_t` makes the
