@@ -9,14 +9,17 @@
 //!   second half evaluated on a thread spawned with `std::thread::scope` per iteration, the
 //!   first on the calling thread (the spawn, tens of microseconds, is included and is
 //!   negligible against the milliseconds of a grid);
-//! * `polezero_batch/1t`: `TransferFunction::eval_grid_into` on the whole grid into the
-//!   preallocated buffer: what `tf::evaluate` does for `auto` (which picks `polezero` for the
-//!   7x3 tilt matrix), minus the allocation of the result. The output is the full complex 7x3
-//!   matrix at every point, structural zeros included, as NumPy's;
-//! * `polezero_evaluate/1t`: `tf::evaluate` itself, which also allocates the `TransferMatrix`
-//!   (34 MB of fresh pages at 1e5 points) and copies the grid;
-//! * `polezero_batch/2t`: `tf::eval_grid_threads(.., 2)`, the library's two-thread split of the
-//!   same call (a scoped thread per call, included).
+//! * `polezero_matrix/1t`, `polezero_matrix/2t`: [`tf::evaluate_into`] into a reused
+//!   `TransferMatrix`, one and two threads: what `tf::evaluate` (and so `auto`, which picks
+//!   `polezero` for the 7x3 tilt matrix) computes, minus the allocation of the result. The
+//!   matrix is in the plan's layout: the 11 entries of the 7x3 tilt matrix that are not
+//!   structural zeros, real for the undamped Table I (88 bytes per point);
+//! * `polezero_batch/1t`, `polezero_batch/2t`: `TransferFunction::eval_grid_into` (one thread)
+//!   and `tf::eval_grid_threads(.., 2)`: the same values as the dense complex 7x3 matrix,
+//!   structural zeros and zero imaginary parts included, as NumPy's H (336 bytes per point),
+//!   into a reused buffer (huge pages advised, as `tf::evaluate` does);
+//! * `polezero_evaluate/1t`: `tf::evaluate` itself, which also allocates its result (fresh
+//!   pages: 8.8 MB at 1e5 points) and copies the grid.
 //!
 //! The plan (`tf::plan`: normal modes, block matrices, forcing forms) is built once, outside the
 //! timing; it is amortized over the grid. Throughput is in grid points, so ns per point is the
@@ -87,7 +90,8 @@ fn methods(c: &mut Criterion) {
         "methods bench: 7x3 tilt matrix, {n} log-spaced points {F_LO_HZ:e}..{F_HI_HZ} Hz \
          ({POINTS_VAR}={n})"
     );
-    let mut out = vec![Complex64::new(0.0, 0.0); block * n];
+    // Huge pages advised, as for a result of `tf::evaluate` (src/tf/buffer.rs).
+    let mut out = tf::zeroed_complex(block * n);
 
     let mut g = c.benchmark_group("methods_7x3_tilt");
     g.sample_size(10)
@@ -133,6 +137,17 @@ fn methods(c: &mut Criterion) {
                         .expect("no singular frequency on the grid")
                 })
             });
+            // What `auto` hands the user: the plan's own layout (11 real entries of the 7x3
+            // tilt matrix, the structural zeros implicit), into a reused `TransferMatrix`.
+            let mut m = tf::evaluate(plan, &grid).expect("no singular frequency");
+            for threads in [1, 2] {
+                g.bench_function(format!("{}_matrix/{threads}t", method.name()), |b| {
+                    b.iter(|| {
+                        tf::evaluate_into(plan, black_box(&grid), threads, black_box(&mut m))
+                            .expect("no singular frequency on the grid")
+                    })
+                });
+            }
         }
     }
     g.finish();

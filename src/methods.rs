@@ -4,14 +4,15 @@
 //! Accuracy: the worst relative error over every structurally nonzero entry and every grid
 //! point farther than 1 % from a normal mode (a structural zero must be exactly zero, else the
 //! error is infinite). Cost: wall time of evaluating the whole grid with
-//! [`crate::tf::TransferFunction::eval_grid_into`] into a reused buffer, repeated until at
-//! least [`MIN_TIMING_S`] has passed, divided by the points evaluated; single thread.
+//! [`crate::tf::evaluate_into`] into a reused matrix (the plan's own layout, as
+//! [`crate::tf::evaluate`] stores it), repeated until at least [`MIN_TIMING_S`] has passed,
+//! divided by the points evaluated; single thread.
 
 use crate::model::Model;
 use crate::modes::NormalModes;
 use crate::reference::{relative_errors, ReferenceModel};
 use crate::scene::POLE_EXCLUSION;
-use crate::tf::{plan, Method, Request};
+use crate::tf::{evaluate_into, plan, Method, Request, TransferMatrix};
 use num_complex::Complex64;
 use std::time::Instant;
 
@@ -88,14 +89,14 @@ pub fn methods_table(model: &Model, request: &Request, grid: &[f64]) -> Vec<Meth
                     }
                 }
             }
-            let mut out = vec![Complex64::new(0.0, 0.0); grid.len() * request.outputs.len() * ni];
+            // The whole grid into a reused matrix in the plan's layout, as `tf::evaluate` does
+            // minus the allocation of its result. A point on a pole is an error for LU methods;
+            // timing does not need the values.
+            let mut out = TransferMatrix::from_dense(Vec::new(), vec![], vec![], method, &[]);
             let start = Instant::now();
             let mut points = 0usize;
             while start.elapsed().as_secs_f64() < MIN_TIMING_S || points == 0 {
-                // The whole grid into a reused buffer, as `tf::evaluate` does minus the
-                // allocation of its result. A point on a pole is an error for LU methods;
-                // timing does not need the values.
-                let _ = tf.eval_grid_into(grid, &mut out);
+                let _ = evaluate_into(tf.as_ref(), grid, 1, &mut out);
                 points += grid.len();
             }
             MethodRow {

@@ -330,7 +330,7 @@ fn failed_write_does_not_clobber_an_existing_file() {
 
     // A real writer failing (inconsistent matrix) leaves the old file alone too.
     let mut bad = table_i_tf(&[1.0, 2.0]);
-    bad.values.pop();
+    bad.freqs_hz.push(3.0);
     let err = write_tf_hdf5(&path, &bad, &meta()).unwrap_err();
     assert!(matches!(err, OutputError::Write { .. }), "{err:?}");
     assert_eq!(std::fs::read(&path).unwrap(), b"precious");

@@ -5,7 +5,9 @@
 //! * Batch = per point, bit for bit, on grids with f = 0, points at 1e-9 and 1e-6 relative from
 //!   every pole and zero, points up to 1e5 Hz, every grid length up to three chunks (short
 //!   last chunks) and every offset; also on two and three threads ([`eval_grid_threads`]).
-//!   Undamped, damped, tilt and force requests.
+//!   Undamped, damped, tilt and force requests. The same values in the plan's compact layout
+//!   ([`evaluate`], [`evaluate_into`] on 1 to 3 threads, into a reused matrix), whose stored
+//!   entries are exactly those the plan has factors for.
 //! * The batch values against `gain s^p prod(z_j - s) / prod(lambda_k - s)` in double-double
 //!   (the plan's own factors, at the same `s`): within the rounding bound of the f64 product
 //!   form (derived below), structural zeros exactly 0.0.
@@ -19,7 +21,8 @@ use tiltnoise::model::{ForceInput, Model, Observable};
 use tiltnoise::params::Params;
 use tiltnoise::reference::{CDd, Dd};
 use tiltnoise::tf::{
-    eval_grid_threads, evaluate, plan, Input, Method, PoleZero, Request, TransferFunction,
+    eval_grid_threads, evaluate, evaluate_into, plan, Input, Method, PoleZero, Request,
+    TransferFunction,
 };
 
 const LOSS: f64 = 1e-3;
@@ -149,14 +152,25 @@ fn batch_equals_per_point_bit_for_bit() {
                 &want,
             );
         }
+        // The plan's own layout (structural zeros not stored, real values when every block
+        // is real): the same values bit for bit, on 1, 2 and 3 threads, into a fresh matrix
+        // and into a reused one that held another request on a longer grid.
         let m = evaluate(tf.as_ref(), &freqs).unwrap();
+        assert_layout_matches_structure(name, &params, &request, &m);
         assert_bit_identical(
             &format!("{name}, evaluate"),
             &request,
             &freqs,
-            &m.values,
+            &m.dense_values(),
             &want,
         );
+        let other = plan(&model, &Request::all_tilt(), Method::Direct).unwrap();
+        let long: Vec<f64> = freqs.iter().chain(&freqs).copied().collect();
+        for threads in [1, 2, 3] {
+            let mut reused = evaluate(other.as_ref(), &long).unwrap();
+            evaluate_into(tf.as_ref(), &freqs, threads, &mut reused).unwrap();
+            assert_eq!(reused, m, "{name}, evaluate_into on {threads} threads");
+        }
         // Every length up to three chunks of 8 and every offset: full and short chunks, each
         // point in every lane.
         let nv = request.outputs.len() * request.inputs.len();
@@ -175,6 +189,72 @@ fn batch_equals_per_point_bit_for_bit() {
                 );
             }
         }
+    }
+}
+
+/// The layout of a pole-zero matrix: an entry is stored exactly when the plan has factors for
+/// it (some block reaches it), and the layout is real exactly when every factor is real.
+fn assert_layout_matches_structure(
+    name: &str,
+    params: &Params,
+    request: &Request,
+    m: &tiltnoise::tf::TransferMatrix,
+) {
+    let factors = PoleZero::factors(params, request);
+    let ni = request.inputs.len();
+    let layout = m.layout();
+    assert_eq!(layout.n_entries(), request.outputs.len() * ni, "{name}");
+    for entry in 0..layout.n_entries() {
+        let has = factors.iter().any(|f| f.output * ni + f.input == entry);
+        assert_eq!(
+            layout.is_structural_zero(entry),
+            !has,
+            "{name}: entry {entry}"
+        );
+    }
+    let real = factors.iter().all(|f| {
+        f.gain.im.is_zero()
+            && f.poles.iter().all(|p| p.im.is_zero())
+            && f.zeros.iter().all(|z| z.im.is_zero())
+    });
+    assert_eq!(layout.is_real(), real, "{name}");
+}
+
+/// Table I's 7x3 tilt matrix in the pole-zero layout: 11 of the 21 entries stored, real (88
+/// bytes per frequency against 336 dense); damped: the same 11, complex.
+#[test]
+fn tilt_layout_of_table_i() {
+    for (params, real) in [(Params::table_i(), true), (damped(), false)] {
+        let model = Model::new(&params).unwrap();
+        let tf = plan(&model, &Request::all_tilt(), Method::PoleZero).unwrap();
+        let layout = tf.layout();
+        assert_eq!(layout.n_stored(), 11);
+        assert_eq!(layout.is_real(), real);
+        assert_eq!(layout.stride(), if real { 11 } else { 22 });
+        // The structural zeros are those of the model's block structure: X, eta, phi, phi_a
+        // from theta_t; Y, Z, theta from eta_t and phi_t.
+        let zeros: Vec<String> = (0..21)
+            .filter(|&e| layout.is_structural_zero(e))
+            .map(|e| {
+                let r = tf.request();
+                format!("{}/{}", r.outputs[e / 3].name(), r.inputs[e % 3].name())
+            })
+            .collect();
+        assert_eq!(
+            zeros,
+            [
+                "X/theta_t",
+                "Y/eta_t",
+                "Y/phi_t",
+                "Z/eta_t",
+                "Z/phi_t",
+                "theta/eta_t",
+                "theta/phi_t",
+                "eta/theta_t",
+                "phi/theta_t",
+                "phi_a/theta_t"
+            ]
+        );
     }
 }
 
@@ -314,6 +394,17 @@ fn assert_same_error(name: &str, tf: &dyn TransferFunction, freqs: &[f64]) {
         describe(&want),
         "{name}, evaluate: {got} vs {want}"
     );
+    let mut m = evaluate(tf, &[1e-3]).unwrap();
+    for threads in [1, 2, 3] {
+        let Err(got) = evaluate_into(tf, freqs, threads, &mut m) else {
+            panic!("{name}, {threads} threads: evaluate_into must fail too");
+        };
+        assert_eq!(
+            describe(&got),
+            describe(&want),
+            "{name}, evaluate_into on {threads} threads: {got} vs {want}"
+        );
+    }
 }
 
 #[test]

@@ -18,7 +18,13 @@ it shares with `build_model` are checked to be identical.
 
 Timed (time.perf_counter, after one untimed warm-up; the median of `--runs` runs is reported):
 
-* `solve`: `numpy.linalg.solve(D, G)` followed by `C @ X` (the benchmark's figure);
+* `solve`: `numpy.linalg.solve(D, G)` followed by `C @ X`, each allocating its result (what
+  a NumPy user writes);
+* `solve_out`: the same arithmetic into preallocated arrays: the gufunc behind
+  `numpy.linalg.solve` (`numpy.linalg._umath_linalg.solve`, which takes `out=`; private, so
+  checked here against `solve` bit for bit) and `numpy.matmul(C, X, out=H)`. NumPy without
+  the page faults of fresh results: the baseline against which a Rust evaluation into a
+  reused buffer is compared;
 * `stack`: building D and G from w^2 (reported for information; not in `solve`);
 * `solve_real`: the same solve on real float64 D and G, only when every loss angle is 0 (an
   undamped model is real; for information: what a NumPy user could do for Table I).
@@ -117,6 +123,15 @@ def main():
         nonlocal H
         H = C @ np.linalg.solve(D, G)
 
+    from numpy.linalg import _umath_linalg
+
+    X_out = np.empty((n, 8, G.shape[2]), complex)
+    H_out = np.empty((n, C.shape[0], G.shape[2]), complex)
+
+    def solve_out():
+        _umath_linalg.solve(D, G, out=X_out, signature="DD->D")
+        np.matmul(C, X_out, out=H_out)
+
     result = {
         "points": n,
         "threads": ARGS.threads,
@@ -128,6 +143,10 @@ def main():
     med, all_runs = median_ns_per_point(solve, ARGS.runs, n)
     result["shape_H"] = list(H.shape)
     result["solve_ns_per_point"], result["solve_runs"] = med, all_runs
+    med, all_runs = median_ns_per_point(solve_out, ARGS.runs, n)
+    if not np.array_equal(H_out, H):
+        sys.exit("solve_out (preallocated) differs from C @ numpy.linalg.solve(D, G)")
+    result["solve_out_ns_per_point"], result["solve_out_runs"] = med, all_runs
     med, all_runs = median_ns_per_point(stack, ARGS.runs, n)
     result["stack_ns_per_point"], result["stack_runs"] = med, all_runs
     if not np.any(K.imag):

@@ -42,13 +42,14 @@ pub fn write_tf_hdf5(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> Result
 
 fn write_file(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> hdf5::Result<()> {
     let (nf, no, ni) = (tf.freqs_hz.len(), tf.outputs.len(), tf.inputs.len());
-    if tf.values.len() != nf * no * ni {
+    if tf.n_stored_freqs() != nf {
         return Err(format!(
-            "transfer matrix has {} values, expected {nf} x {no} x {ni}",
-            tf.values.len()
+            "transfer matrix holds values at {} frequencies, expected {nf}",
+            tf.n_stored_freqs()
         )
         .into());
     }
+    // The file is dense whatever the matrix's layout: structural zeros as 0.
     let file = hdf5::File::create(path)?;
 
     str_attr(&file, "schema", SCHEMA_TF)?;
@@ -70,7 +71,8 @@ fn write_file(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> hdf5::Result<
     let freq = dataset(&file, "frequency_hz", &tf.freqs_hz)?;
     str_attr(&freq, "units", "Hz")?;
 
-    let values = ArrayView3::from_shape((nf, no, ni), &tf.values).map_err(|e| e.to_string())?;
+    let dense = tf.dense_values();
+    let values = ArrayView3::from_shape((nf, no, ni), &dense).map_err(|e| e.to_string())?;
     let transfer = file
         .new_dataset_builder()
         .with_data(values)

@@ -58,7 +58,9 @@ pub fn add_equivalent_response(budget: &mut Budget, model: &Model) -> Result<(),
         };
         let plan = tf::plan(model, &request, Method::Split).expect("split plans every request");
         let h = tf::evaluate(plan.as_ref(), &budget.freqs_hz)?;
-        let psd = h.values.iter().map(|z| (z * factor).norm_sqr()).collect();
+        let psd = (0..h.freqs_hz.len())
+            .map(|k| (h.get(k, 0, 0) * factor).norm_sqr())
+            .collect();
         // Before `total`, which stays last.
         let at = ob
             .terms

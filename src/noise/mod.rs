@@ -299,13 +299,13 @@ mod tests {
     use crate::tf::Method;
 
     fn toy_tf(h: [[Complex64; 2]; 1]) -> TransferMatrix {
-        TransferMatrix {
-            freqs_hz: vec![1e-3],
-            outputs: vec![Observable::X],
-            inputs: vec![Input::Tilt(TiltAxis::ThetaT), Input::Tilt(TiltAxis::EtaT)],
-            values: h[0].to_vec(),
-            method: Method::Direct,
-        }
+        TransferMatrix::from_dense(
+            vec![1e-3],
+            vec![Observable::X],
+            vec![Input::Tilt(TiltAxis::ThetaT), Input::Tilt(TiltAxis::EtaT)],
+            Method::Direct,
+            &h[0],
+        )
     }
 
     #[test]

@@ -26,7 +26,10 @@
 //! its rounding model and prints these numbers.
 
 mod block;
+mod buffer;
 mod direct;
+mod grid;
+mod matrix;
 mod modal;
 mod polezero;
 mod split;
@@ -37,7 +40,11 @@ use crate::model::{ForceInput, Model, Observable, TiltAxis};
 use num_complex::Complex64;
 
 pub use block::BlockReduced;
+pub use buffer::{zeroed_complex, zeroed_f64, HUGE_PAGE_MIN_BYTES};
 pub use direct::{Direct, SINGULAR_RCOND};
+pub(crate) use grid::check_grid_len;
+pub use grid::{eval_grid_threads, evaluate, evaluate_into};
+pub use matrix::{Layout, TransferMatrix};
 pub use modal::Modal;
 pub use polezero::{EntryFactors, PoleZero};
 pub use split::Split;
@@ -194,7 +201,7 @@ pub trait TransferFunction: Send + Sync {
     fn eval_into(&self, freq_hz: f64, out: &mut [Complex64]) -> Result<(), TfError>;
 
     /// Writes `H` at every frequency of `freqs_hz` into `out`, `[freq][output][input]`
-    /// row-major (the layout of [`TransferMatrix::values`]), whose length must be
+    /// row-major (the dense [`Layout`]), whose length must be
     /// `freqs_hz.len() * outputs.len() * inputs.len()`. Returns the error of the first
     /// frequency (in grid order) at which [`TransferFunction::eval_into`] fails; `out` is then
     /// unspecified. The default calls `eval_into` point by point; a method with a faster
@@ -216,6 +223,26 @@ pub trait TransferFunction: Send + Sync {
             self.eval_into(f, h)?;
         }
         Ok(())
+    }
+
+    /// The layout [`evaluate`] stores this plan's values in: [`Layout::dense`] unless the plan
+    /// knows its structural zeros (or that its values are real) and overrides this together
+    /// with [`TransferFunction::eval_grid_layout_into`].
+    fn layout(&self) -> Layout {
+        let r = self.request();
+        Layout::dense(r.outputs.len() * r.inputs.len())
+    }
+
+    /// Writes `H` at every frequency of `freqs_hz` into `out` in [`TransferFunction::layout`]
+    /// (`layout().stride()` values per frequency): the values of
+    /// [`TransferFunction::eval_grid_into`], stored differently, and the same errors. The
+    /// default (dense layout) is `eval_grid_into` itself.
+    ///
+    /// # Panics
+    ///
+    /// If `out` has the wrong length.
+    fn eval_grid_layout_into(&self, freqs_hz: &[f64], out: &mut [f64]) -> Result<(), TfError> {
+        self.eval_grid_into(freqs_hz, buffer::as_complex_mut(out))
     }
 
     /// Allocating convenience wrapper around [`TransferFunction::eval_into`].
@@ -252,114 +279,5 @@ pub fn plan(
         Method::Split => Box::new(Split::new(model, request.clone())),
         Method::Torsion2 => Box::new(Torsion2::new(model, request.clone())?),
         Method::PoleZero => Box::new(PoleZero::new(model, request.clone())),
-    })
-}
-
-/// Transfer functions on a frequency grid.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TransferMatrix {
-    /// Frequencies (Hz).
-    pub freqs_hz: Vec<f64>,
-    /// Row labels.
-    pub outputs: Vec<Observable>,
-    /// Column labels.
-    pub inputs: Vec<Input>,
-    /// Values, `[freq][output][input]` row-major; see [`TransferMatrix::get`].
-    pub values: Vec<Complex64>,
-    /// The method that produced the values.
-    pub method: Method,
-}
-
-impl TransferMatrix {
-    /// `H_{o,i}(f_k)`.
-    pub fn get(&self, k: usize, o: usize, i: usize) -> Complex64 {
-        let (no, ni) = (self.outputs.len(), self.inputs.len());
-        self.values[(k * no + o) * ni + i]
-    }
-
-    /// Unit of entry (o, i): output unit per input unit.
-    pub fn unit(&self, o: usize, i: usize) -> String {
-        let input = self.inputs[i].unit();
-        if input.contains(' ') {
-            format!("{}/({input})", self.outputs[o].unit())
-        } else {
-            format!("{}/{input}", self.outputs[o].unit())
-        }
-    }
-
-    /// Position of an observable among the rows.
-    pub fn output_index(&self, o: Observable) -> Option<usize> {
-        self.outputs.iter().position(|&x| x == o)
-    }
-
-    /// Position of an input among the columns.
-    pub fn input_index(&self, i: Input) -> Option<usize> {
-        self.inputs.iter().position(|&x| x == i)
-    }
-}
-
-/// Values per frequency of `request`; panics unless `out` holds that many per frequency of
-/// `freqs_hz` (the contract of [`TransferFunction::eval_grid_into`]).
-pub(crate) fn check_grid_len(request: &Request, freqs_hz: &[f64], out: &[Complex64]) -> usize {
-    let block = request.outputs.len() * request.inputs.len();
-    assert_eq!(
-        out.len(),
-        freqs_hz.len() * block,
-        "eval_grid_into: output buffer of {} values for {} frequencies x {block} values",
-        out.len(),
-        freqs_hz.len()
-    );
-    block
-}
-
-/// [`TransferFunction::eval_grid_into`] with the grid cut into `threads` contiguous parts,
-/// one per thread (`std::thread::scope`; the first part on the calling thread). The values do
-/// not depend on `threads` (every point is evaluated independently); the error is the one of
-/// the first failing frequency in grid order, as with one thread. `threads = 0` means 1.
-///
-/// # Panics
-///
-/// If `out` has the wrong length.
-pub fn eval_grid_threads(
-    tf: &dyn TransferFunction,
-    freqs_hz: &[f64],
-    out: &mut [Complex64],
-    threads: usize,
-) -> Result<(), TfError> {
-    let block = check_grid_len(tf.request(), freqs_hz, out);
-    let part = freqs_hz.len().div_ceil(threads.max(1)).max(1);
-    if part >= freqs_hz.len() || block == 0 {
-        return tf.eval_grid_into(freqs_hz, out);
-    }
-    let mut parts = freqs_hz.chunks(part).zip(out.chunks_mut(part * block));
-    let (f0, o0) = parts.next().expect("at least two parts");
-    std::thread::scope(|scope| {
-        let others: Vec<_> = parts
-            .map(|(f, o)| scope.spawn(move || tf.eval_grid_into(f, o)))
-            .collect();
-        let first = tf.eval_grid_into(f0, o0);
-        // In grid order: the first part's error, else the first failing other part's.
-        others.into_iter().fold(first, |acc, h| {
-            let r = h
-                .join()
-                .expect("transfer-function evaluation thread panicked");
-            acc.and(r)
-        })
-    })
-}
-
-/// Evaluates a plan on every frequency of a grid ([`TransferFunction::eval_grid_into`], one
-/// thread). Stops at the first singular frequency.
-pub fn evaluate(tf: &dyn TransferFunction, freqs_hz: &[f64]) -> Result<TransferMatrix, TfError> {
-    let r = tf.request();
-    let block = r.outputs.len() * r.inputs.len();
-    let mut values = vec![Complex64::new(0.0, 0.0); block * freqs_hz.len()];
-    tf.eval_grid_into(freqs_hz, &mut values)?;
-    Ok(TransferMatrix {
-        freqs_hz: freqs_hz.to_vec(),
-        outputs: r.outputs.clone(),
-        inputs: r.inputs.clone(),
-        values,
-        method: tf.method(),
     })
 }

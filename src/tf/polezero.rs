@@ -53,7 +53,7 @@
 mod kernel;
 mod lanes;
 
-use super::{Input, Method, Request, TransferFunction};
+use super::{Input, Layout, Method, Request, TransferFunction};
 use crate::error::TfError;
 use crate::model::{Block, Coord, Model};
 use crate::params::Params;
@@ -69,7 +69,12 @@ const ZERO_REL: f64 = 1e3 * DD_EPS;
 /// Plan of the pole-zero method.
 pub struct PoleZero {
     request: Request,
+    /// Writes the dense complex layout ([`TransferFunction::eval_grid_into`]).
     kernel: Kernel,
+    /// Writes [`PoleZero::layout`]: only the entries some block reaches, real when every
+    /// block is.
+    compact: Kernel,
+    layout: Layout,
 }
 
 /// An entry ready for its block: position in the output, gain, factors `(a, b)` (the first
@@ -343,7 +348,35 @@ impl PoleZero {
     pub fn new(model: &Model, request: Request) -> PoleZero {
         let factors = Self::factors(model.params(), &request);
         let n_in = request.inputs.len();
-        let blocks = Block::ALL
+        let n_values = request.outputs.len() * n_in;
+        let dense = Self::blocks(&factors, n_in, &|at| (2 * at, 2 * at + 1));
+        let mut nonzero = vec![false; n_values];
+        for f in &factors {
+            nonzero[f.output * n_in + f.input] = true;
+        }
+        let all_real = dense.iter().all(|b| matches!(b, BlockForm::Real(_)));
+        let layout = Layout::compact(&nonzero, all_real);
+        let compact = Self::blocks(&factors, n_in, &|at| match layout.position(at) {
+            // A real layout has only real blocks, which never write the imaginary part.
+            (Some(re), im) => (re, im.unwrap_or(usize::MAX)),
+            (None, _) => unreachable!("entry {at} has factors, so a slot"),
+        });
+        PoleZero {
+            kernel: Kernel::new(dense, 2 * n_values),
+            compact: Kernel::new(compact, layout.stride()),
+            layout,
+            request,
+        }
+    }
+
+    /// The kernel's blocks for `factors`, entry `at = output * n_in + input` written at the
+    /// `f64` positions `position(at) = (re, im)` of each point.
+    fn blocks(
+        factors: &[EntryFactors],
+        n_in: usize,
+        position: &dyn Fn(usize) -> (usize, usize),
+    ) -> Vec<BlockForm> {
+        Block::ALL
             .into_iter()
             .filter_map(|block| {
                 let fs: Vec<&EntryFactors> = factors.iter().filter(|f| f.block == block).collect();
@@ -363,7 +396,7 @@ impl PoleZero {
                     let entries = prepared
                         .iter()
                         .map(|(at, g, fac, count)| RealEntry {
-                            at: *at,
+                            re: position(*at).0,
                             first_re: false,
                             factors: *count,
                             gain: g.re.to_f64(),
@@ -376,7 +409,8 @@ impl PoleZero {
                     let entries = prepared
                         .iter()
                         .map(|(at, g, fac, count)| ComplexEntry {
-                            at: *at,
+                            re: position(*at).0,
+                            im: position(*at).1,
                             first_re: false,
                             first_im: false,
                             factors: *count,
@@ -388,12 +422,7 @@ impl PoleZero {
                     BlockForm::complex(std::array::from_fn(|k| first.poles[k].to_c64()), entries)
                 })
             })
-            .collect();
-        let n_values = request.outputs.len() * n_in;
-        PoleZero {
-            request,
-            kernel: Kernel::new(blocks, n_values),
-        }
+            .collect()
     }
 
     /// The factored form in double-double of every entry (and block) of `request` that is not
@@ -545,6 +574,35 @@ impl TransferFunction for PoleZero {
     /// for bit, as [`TransferFunction::eval_into`] at each point, and the same error.
     fn eval_grid_into(&self, freqs_hz: &[f64], out: &mut [Complex64]) -> Result<(), TfError> {
         super::check_grid_len(&self.request, freqs_hz, out);
-        self.kernel.eval_grid(freqs_hz, out)
+        self.kernel.eval_grid(freqs_hz, as_f64_mut(out))
     }
+
+    /// Only the entries some block reaches, in entry order; real (one `f64` per entry) when
+    /// every block is real (undamped, real zeros). The 7x3 tilt matrix of Table I: 11 real
+    /// entries, 88 bytes per frequency.
+    fn layout(&self) -> Layout {
+        self.layout.clone()
+    }
+
+    /// The same operations as [`TransferFunction::eval_grid_into`] (bit-identical values, the
+    /// same errors), stored in [`PoleZero::layout`].
+    fn eval_grid_layout_into(&self, freqs_hz: &[f64], out: &mut [f64]) -> Result<(), TfError> {
+        assert_eq!(
+            out.len(),
+            freqs_hz.len() * self.layout.stride(),
+            "eval_grid_layout_into: output buffer of {} values for {} frequencies x {}",
+            out.len(),
+            freqs_hz.len(),
+            self.layout.stride()
+        );
+        self.compact.eval_grid(freqs_hz, out)
+    }
+}
+
+/// The `re, im` pairs of `z` as consecutive `f64`.
+fn as_f64_mut(z: &mut [Complex64]) -> &mut [f64] {
+    // SAFETY: `Complex64` is `repr(C)` `{re: f64, im: f64}` (size 16, alignment 8, no
+    // padding): `z` is `2 z.len()` initialized, 8-byte aligned `f64`, any value of which is a
+    // valid `Complex64` part; the result borrows `z` mutably for its lifetime.
+    unsafe { std::slice::from_raw_parts_mut(z.as_mut_ptr().cast::<f64>(), 2 * z.len()) }
 }

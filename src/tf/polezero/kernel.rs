@@ -41,14 +41,15 @@ use num_complex::Complex64;
 const STREAM_MIN_BYTES: usize = 8 << 20;
 
 /// One entry of an undamped block: `gain prod_k (a_k + b_k s)` times the block's
-/// `1 / prod(lambda - s)`, added at `out[at]`. Factors: `s` for a zero at the origin
+/// `1 / prod(lambda - s)`, added at `out[re]` of each point (its real part). Factors: `s` for a zero at the origin
 /// (`a = 0, b = 1`), `1 - s / z` for a zero `z` (`a = 1, b = -1 / z`, `z` moved into the
 /// gain); the first `factors` of the four, the others padding (`a = 1, b = 0`), skipped (an
 /// exact 1 for every finite `s`).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct RealEntry {
-    pub at: usize,
-    /// The first block to write the real part of `out[at]`: it stores `0.0 + h` (what
+    /// Position of the real part in a point's `f64` values.
+    pub re: usize,
+    /// The first block to write `out[re]`: it stores `0.0 + h` (what
     /// adding to a zeroed output gives) instead of adding (set by [`Kernel::new`]). Real
     /// blocks leave the imaginary part alone.
     pub first_re: bool,
@@ -61,10 +62,12 @@ pub(super) struct RealEntry {
 /// [`RealEntry`] with complex gain and factors (damped blocks, or complex zeros).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct ComplexEntry {
-    pub at: usize,
+    /// Positions of the real and imaginary parts in a point's `f64` values.
+    pub re: usize,
+    pub im: usize,
     /// As [`RealEntry::first_re`].
     pub first_re: bool,
-    /// The first block to write the imaginary part of `out[at]`.
+    /// The first block to write `out[im]`.
     pub first_im: bool,
     pub factors: usize,
     pub gain: Complex64,
@@ -116,13 +119,13 @@ impl BlockForm {
     }
 
     /// Adds the block's entries at the chunk's first `n` frequencies (`s` per lane) to `out`
-    /// (`n` points of `n_values` values); false, with `out` partly written, if the block is
-    /// singular in some lane.
+    /// (`n` points of `stride` `f64` values); false, with `out` partly written, if the block
+    /// is singular in some lane.
     #[inline(always)]
-    fn add_chunk<V: Lanes>(&self, s: V, n: usize, n_values: usize, out: &mut [Complex64]) -> bool {
+    fn add_chunk<V: Lanes>(&self, s: V, n: usize, stride: usize, out: &mut [f64]) -> bool {
         match self {
-            BlockForm::Real(b) => b.add_chunk(s, n, n_values, out),
-            BlockForm::Complex(b) => b.add_chunk(s, n, n_values, out),
+            BlockForm::Real(b) => b.add_chunk(s, n, stride, out),
+            BlockForm::Complex(b) => b.add_chunk(s, n, stride, out),
         }
     }
 
@@ -162,7 +165,7 @@ impl RealBlock {
     }
 
     #[inline(always)]
-    fn add_chunk<V: Lanes>(&self, s: V, n: usize, n_values: usize, out: &mut [Complex64]) -> bool {
+    fn add_chunk<V: Lanes>(&self, s: V, n: usize, stride: usize, out: &mut [f64]) -> bool {
         let p = self.poles;
         let d = [
             V::splat(p[0]).sub(s),
@@ -185,41 +188,22 @@ impl RealBlock {
             for k in 0..e.factors {
                 h = h.mul(V::splat(e.a[k]).add(V::splat(e.b[k]).mul(s)));
             }
-            put(out, e.at, n_values, n, e.first_re, h.mul(inv), Part::Re);
+            put(out, e.re, stride, n, e.first_re, h.mul(inv));
         }
         true
     }
 }
 
-/// A part of a complex value.
-#[derive(Clone, Copy)]
-enum Part {
-    Re,
-    Im,
-}
-
-/// Lane `l < n` of `v` into part `part` of `out[l * n_values + at]`: stored as `0.0 + v` if
-/// `first` (what adding to a zeroed output gives: +0.0 for -0.0), else added.
+/// Lane `l < n` of `v` into `out[l * stride + at]`: stored as `0.0 + v` if `first` (what
+/// adding to a zeroed output gives: +0.0 for -0.0), else added.
 #[inline(always)]
-fn put<V: Lanes>(
-    out: &mut [Complex64],
-    at: usize,
-    n_values: usize,
-    n: usize,
-    first: bool,
-    v: V,
-    part: Part,
-) {
+fn put<V: Lanes>(out: &mut [f64], at: usize, stride: usize, n: usize, first: bool, v: V) {
     let v = if first { V::splat(0.0).add(v) } else { v }.to_array();
     // One bounds check for the column, none per lane (when `n == LANES`, the usual case, the
     // loop below has a constant count and is unrolled).
-    let column = &mut out[at..=at + (n - 1) * n_values];
+    let column = &mut out[at..=at + (n - 1) * stride];
     let mut one = |l: usize| {
-        let o = &mut column[l * n_values];
-        let x = match part {
-            Part::Re => &mut o.re,
-            Part::Im => &mut o.im,
-        };
+        let x = &mut column[l * stride];
         if first {
             *x = v[l];
         } else {
@@ -250,7 +234,7 @@ impl ComplexBlock {
     }
 
     #[inline(always)]
-    fn add_chunk<V: Lanes>(&self, s: V, n: usize, n_values: usize, out: &mut [Complex64]) -> bool {
+    fn add_chunk<V: Lanes>(&self, s: V, n: usize, stride: usize, out: &mut [f64]) -> bool {
         let p = self.poles;
         let d = [
             (V::splat(p[0].re).sub(s), V::splat(p[0].im)),
@@ -280,8 +264,8 @@ impl ComplexBlock {
             // (h_re + i h_im) (inv_re - i inv_im_neg).
             let re = h_re.mul(inv_re).add(h_im.mul(inv_im_neg));
             let im = h_im.mul(inv_re).sub(h_re.mul(inv_im_neg));
-            put(out, e.at, n_values, n, e.first_re, re, Part::Re);
-            put(out, e.at, n_values, n, e.first_im, im, Part::Im);
+            put(out, e.re, stride, n, e.first_re, re);
+            put(out, e.im, stride, n, e.first_im, im);
         }
         true
     }
@@ -290,41 +274,45 @@ impl ComplexBlock {
 /// The evaluation side of a pole-zero plan.
 pub(super) struct Kernel {
     blocks: Vec<BlockForm>,
-    /// Values per frequency (`outputs x inputs`).
-    n_values: usize,
+    /// `f64` values per frequency: `2 outputs x inputs` in the dense complex layout, fewer in
+    /// a compact one (see [`super::super::Layout`]).
+    stride: usize,
     /// The CPU has AVX (checked at plan time): the same operations, four lanes per instruction.
     avx: bool,
 }
 
 impl Kernel {
-    pub fn new(mut blocks: Vec<BlockForm>, n_values: usize) -> Kernel {
-        let (mut re_written, mut im_written) = (vec![false; n_values], vec![false; n_values]);
+    /// The kernel of `blocks`, whose entries write at positions below `stride` in each
+    /// point's `f64` values.
+    pub fn new(mut blocks: Vec<BlockForm>, stride: usize) -> Kernel {
+        let mut written = vec![false; stride];
+        let mut first = |at: usize| !std::mem::replace(&mut written[at], true);
         for b in &mut blocks {
             match b {
                 BlockForm::Real(b) => {
                     for e in &mut b.entries {
-                        e.first_re = !std::mem::replace(&mut re_written[e.at], true);
+                        e.first_re = first(e.re);
                     }
                 }
                 BlockForm::Complex(b) => {
                     for e in &mut b.entries {
-                        e.first_re = !std::mem::replace(&mut re_written[e.at], true);
-                        e.first_im = !std::mem::replace(&mut im_written[e.at], true);
+                        e.first_re = first(e.re);
+                        e.first_im = first(e.im);
                     }
                 }
             }
         }
         Kernel {
             blocks,
-            n_values,
+            stride,
             avx: avx_available(),
         }
     }
 
-    /// `H` at every frequency of `freqs_hz` into `out` (`[freq][output][input]`, length
-    /// `freqs_hz.len() * n_values`, checked by the caller). On error the contents of `out`
-    /// are unspecified.
-    pub fn eval_grid(&self, freqs_hz: &[f64], out: &mut [Complex64]) -> Result<(), TfError> {
+    /// `H` at every frequency of `freqs_hz` into `out` (`stride` values per frequency,
+    /// length `freqs_hz.len() * stride`, checked by the caller). On error the contents of
+    /// `out` are unspecified.
+    pub fn eval_grid(&self, freqs_hz: &[f64], out: &mut [f64]) -> Result<(), TfError> {
         #[cfg(target_arch = "x86_64")]
         if self.avx {
             // SAFETY: `avx` is true only when the running CPU supports AVX (checked in `new`).
@@ -337,29 +325,25 @@ impl Kernel {
     /// lanes (no fused multiply-add), so the results are bit-identical.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    unsafe fn eval_grid_avx(&self, freqs_hz: &[f64], out: &mut [Complex64]) -> Result<(), TfError> {
+    unsafe fn eval_grid_avx(&self, freqs_hz: &[f64], out: &mut [f64]) -> Result<(), TfError> {
         self.eval_grid_with::<Avx>(freqs_hz, out)
     }
 
     #[inline(always)]
-    fn eval_grid_with<V: Lanes>(
-        &self,
-        freqs_hz: &[f64],
-        out: &mut [Complex64],
-    ) -> Result<(), TfError> {
-        let nv = self.n_values;
+    fn eval_grid_with<V: Lanes>(&self, freqs_hz: &[f64], out: &mut [f64]) -> Result<(), TfError> {
+        let nv = self.stride;
         if nv == 0 {
             // Nothing to write; the frequencies are still checked, as point by point.
             return freqs_hz.iter().try_for_each(|&f| omega_sq(f).map(drop));
         }
         if let [_] = freqs_hz {
             // One point (`eval_into`): written in place.
-            out.fill(Complex64::new(0.0, 0.0));
+            out.fill(0.0);
             return self.eval_chunk::<V>(freqs_hz, out);
         }
         // A chunk is written into `chunk` (in L1 cache), then copied into `out` in one
         // sequential pass. The structural zeros of `chunk` are never written: zeroed once.
-        let mut chunk = vec![Complex64::new(0.0, 0.0); LANES * nv];
+        let mut chunk = vec![0.0; LANES * nv];
         let stream = std::mem::size_of_val(out) >= STREAM_MIN_BYTES;
         let mut result = Ok(());
         for (fc, oc) in freqs_hz.chunks(LANES).zip(out.chunks_mut(LANES * nv)) {
@@ -380,9 +364,9 @@ impl Kernel {
     }
 
     /// `H` at the (at most [`LANES`]) frequencies `fc` into `dst` (`fc.len()` points of
-    /// `n_values`), whose structural zeros must already be zero.
+    /// `stride`), whose structural zeros must already be zero.
     #[inline(always)]
-    fn eval_chunk<V: Lanes>(&self, fc: &[f64], dst: &mut [Complex64]) -> Result<(), TfError> {
+    fn eval_chunk<V: Lanes>(&self, fc: &[f64], dst: &mut [f64]) -> Result<(), TfError> {
         // A short chunk repeats its last frequency in the unused lanes.
         let last = fc.len() - 1;
         let f = V::from_array(std::array::from_fn(|l| fc[l.min(last)]));
@@ -392,7 +376,7 @@ impl Kernel {
         let s = w.mul(w);
         let mut ok = valid;
         for b in &self.blocks {
-            ok = ok && b.add_chunk(s, fc.len(), self.n_values, dst);
+            ok = ok && b.add_chunk(s, fc.len(), self.stride, dst);
         }
         if ok {
             Ok(())
@@ -435,11 +419,11 @@ mod tests {
     use crate::model::Model;
     use crate::params::Params;
     use crate::tf::{PoleZero, Request};
-    use num_complex::Complex64;
 
     /// AVX and portable lanes on the same grid, bit for bit: undamped and damped (real and
-    /// complex blocks), a grid small enough for ordinary stores and one large enough for the
-    /// non-temporal ones, with a short last chunk. Skipped on a CPU without AVX.
+    /// complex blocks), the dense and the compact kernel, a grid small enough for ordinary
+    /// stores and one large enough for the non-temporal ones, with a short last chunk.
+    /// Skipped on a CPU without AVX.
     #[cfg(target_arch = "x86_64")]
     #[test]
     fn avx_and_portable_lanes_agree_bit_for_bit() {
@@ -452,30 +436,32 @@ mod tests {
         }
         for params in [Params::table_i(), damped] {
             let pz = PoleZero::new(&Model::new(&params).unwrap(), Request::all_tilt());
-            let nv = pz.kernel.n_values;
-            // 0 Hz, then log-spaced to 1e5 Hz; 30 001 points of 21 values exceed
-            // STREAM_MIN_BYTES.
-            for n in [1001, 30_001] {
-                let freqs: Vec<f64> = (0..n)
-                    .map(|k| match k {
-                        0 => 0.0,
-                        _ => 1e-6 * 1e11_f64.powf(k as f64 / (n - 1) as f64),
-                    })
-                    .collect();
-                let mut portable = vec![Complex64::new(f64::NAN, 0.0); n * nv];
-                let mut avx = portable.clone();
-                pz.kernel
-                    .eval_grid_with::<super::Portable>(&freqs, &mut portable)
-                    .unwrap();
-                // SAFETY: the CPU has AVX (checked above).
-                unsafe { pz.kernel.eval_grid_avx(&freqs, &mut avx) }.unwrap();
-                for (k, (a, p)) in avx.iter().zip(&portable).enumerate() {
-                    assert!(
-                        a.re.to_bits() == p.re.to_bits() && a.im.to_bits() == p.im.to_bits(),
-                        "value {} at {} Hz: AVX {a} vs portable {p}",
-                        k % nv,
-                        freqs[k / nv]
-                    );
+            for kernel in [&pz.kernel, &pz.compact] {
+                let stride = kernel.stride;
+                // 0 Hz, then log-spaced to 1e5 Hz; the second grid exceeds STREAM_MIN_BYTES.
+                let big = super::STREAM_MIN_BYTES / (8 * stride) + 1001;
+                for n in [1001, big] {
+                    let freqs: Vec<f64> = (0..n)
+                        .map(|k| match k {
+                            0 => 0.0,
+                            _ => 1e-6 * 1e11_f64.powf(k as f64 / (n - 1) as f64),
+                        })
+                        .collect();
+                    let mut portable = vec![f64::NAN; n * stride];
+                    let mut avx = portable.clone();
+                    kernel
+                        .eval_grid_with::<super::Portable>(&freqs, &mut portable)
+                        .unwrap();
+                    // SAFETY: the CPU has AVX (checked above).
+                    unsafe { kernel.eval_grid_avx(&freqs, &mut avx) }.unwrap();
+                    for (k, (a, p)) in avx.iter().zip(&portable).enumerate() {
+                        assert!(
+                            a.to_bits() == p.to_bits(),
+                            "stride {stride}, value {} at {} Hz: AVX {a} vs portable {p}",
+                            k % stride,
+                            freqs[k / stride]
+                        );
+                    }
                 }
             }
         }

@@ -9,8 +9,6 @@
 //! four: the per-entry work that does not depend on the frequency (loading the factors,
 //! loop control) is shared by twice as many frequencies.
 
-use num_complex::Complex64;
-
 /// Lanes per [`Lanes`] value: frequencies per chunk of the kernel.
 pub(super) const LANES: usize = 8;
 
@@ -33,7 +31,7 @@ pub(super) trait Lanes: Copy {
     /// being read first and without evicting the cache, for outputs much larger than the
     /// cache, where ordinary stores first read every line from memory. Call [`stream_fence`]
     /// before the data is handed over.
-    fn stream_copy(dst: &mut [Complex64], src: &[Complex64]);
+    fn stream_copy(dst: &mut [f64], src: &[f64]);
 }
 
 /// Portable lanes: plain `f64` arithmetic.
@@ -82,21 +80,25 @@ impl Lanes for Portable {
         self.0.iter().all(|&x| (0.0..f64::INFINITY).contains(&x))
     }
     #[inline(always)]
-    fn stream_copy(dst: &mut [Complex64], src: &[Complex64]) {
+    fn stream_copy(dst: &mut [f64], src: &[f64]) {
         assert_eq!(dst.len(), src.len());
         #[cfg(target_arch = "x86_64")]
         if (dst.as_ptr() as usize) % 16 == 0 {
             use std::arch::x86_64::{_mm_loadu_pd, _mm_stream_pd};
-            for (d, s) in dst.iter_mut().zip(src) {
-                // SAFETY: SSE2 is part of x86_64. `d` is valid for writes of two f64
-                // (`Complex64` is `repr(C)` `{re, im}`) and 16-byte aligned (the first element
-                // is, and the size is 16); `s` is valid for reads of two f64 (unaligned load).
+            let (pairs, rest) = (dst.len() / 2, dst.len() % 2);
+            for k in 0..pairs {
+                // SAFETY: SSE2 is part of x86_64. `dst[2k..2k + 2]` is valid for writes and
+                // 16-byte aligned (`dst` is, and the offset is a multiple of 16 bytes);
+                // `src[2k..2k + 2]` is valid for reads (unaligned load).
                 unsafe {
                     _mm_stream_pd(
-                        std::ptr::from_mut(d).cast::<f64>(),
-                        _mm_loadu_pd(std::ptr::from_ref(s).cast::<f64>()),
+                        dst.as_mut_ptr().add(2 * k),
+                        _mm_loadu_pd(src.as_ptr().add(2 * k)),
                     );
                 }
+            }
+            if rest == 1 {
+                dst[2 * pairs] = src[2 * pairs];
             }
             return;
         }
@@ -110,7 +112,6 @@ pub(super) use avx::Avx;
 #[cfg(target_arch = "x86_64")]
 mod avx {
     use super::{Lanes, LANES};
-    use num_complex::Complex64;
     use std::arch::x86_64::{
         __m256d, _mm256_add_pd, _mm256_and_pd, _mm256_andnot_pd, _mm256_cmp_pd, _mm256_div_pd,
         _mm256_loadu_pd, _mm256_movemask_pd, _mm256_mul_pd, _mm256_or_pd, _mm256_set1_pd,
@@ -198,18 +199,18 @@ mod avx {
             unsafe { _mm256_movemask_pd(_mm256_and_pd(ok.0, ok.1)) == 0b1111 }
         }
         #[inline(always)]
-        fn stream_copy(dst: &mut [Complex64], src: &[Complex64]) {
+        fn stream_copy(dst: &mut [f64], src: &[f64]) {
             assert_eq!(dst.len(), src.len());
-            let d = dst.as_mut_ptr().cast::<f64>();
+            let d = dst.as_mut_ptr();
             if (d as usize) % 16 != 0 {
                 dst.copy_from_slice(src);
                 return;
             }
-            let s = src.as_ptr().cast::<f64>();
-            let n = 2 * dst.len();
+            let s = src.as_ptr();
+            let n = dst.len();
             let mut k = 0;
-            // SAFETY: `d` and `s` are valid for `n` f64 (`Complex64` is `repr(C)` `{re, im}`);
-            // `k + 2 <= n`, `k + 4 <= n` or `k + 8 <= n` before each access; the 16-byte stores are at
+            // SAFETY: `d` and `s` are valid for `n` f64; `k < n`, `k + 2 <= n`, `k + 4 <= n` or
+            // `k + 8 <= n` before each access; the 16-byte stores are at
             // 16-byte aligned addresses (`d` is, and `k` is even), the 32-byte ones at 32-byte
             // aligned addresses (after the first 16-byte store if `d` is not).
             unsafe {
@@ -229,6 +230,11 @@ mod avx {
                 }
                 if k + 2 <= n {
                     _mm_stream_pd(d.add(k), _mm_loadu_pd(s.add(k)));
+                    k += 2;
+                }
+                if k < n {
+                    // An odd length's last value (a compact real layout).
+                    *d.add(k) = *s.add(k);
                 }
             }
         }

@@ -1,0 +1,322 @@
+//! Transfer functions on a frequency grid: [`TransferMatrix`], and the [`Layout`] of its values.
+//!
+//! A plan knows which entries of its matrix are structurally zero (an observable that no block
+//! reaching the input moves, e.g. X from theta_t) and, for the pole-zero method on an
+//! undamped model, that every entry is real (real poles, zeros and gains). It stores only what
+//! can be nonzero: at each frequency one slot per possibly-nonzero entry, two `f64` (re, im) or
+//! one (real layouts). The 7x3 tilt matrix of Table I has 11 such entries of 21: 88 bytes per
+//! frequency instead of the 336 of a dense complex matrix. [`TransferMatrix::get`] returns
+//! exact zeros for the others (and `im = 0.0` in a real layout): the values are those of the
+//! dense matrix, bit for bit; only the storage differs. Methods without that knowledge (direct,
+//! block, split, modal, torsion2) use the dense complex layout, `[freq][output][input]`.
+
+use super::{Input, Method};
+use crate::model::Observable;
+use num_complex::Complex64;
+
+/// Where each entry of an `outputs x inputs` matrix is stored at one frequency.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Layout {
+    /// Per entry (`o * n_inputs + i`): its slot, or `None` for a structural zero.
+    slots: Vec<Option<usize>>,
+    /// Number of slots.
+    n_slots: usize,
+    /// One `f64` per slot (the real part; the imaginary part is exactly 0) instead of two.
+    real: bool,
+}
+
+impl Layout {
+    /// Every one of `n_entries` entries complex, in entry order: `[output][input]` row-major
+    /// complex values, the layout of `numpy.ndarray` of complex128.
+    pub fn dense(n_entries: usize) -> Layout {
+        Layout {
+            slots: (0..n_entries).map(Some).collect(),
+            n_slots: n_entries,
+            real: false,
+        }
+    }
+
+    /// Slots for the entries with `nonzero[entry]`, in entry order; the others structural
+    /// zeros. `real`: one `f64` per slot.
+    pub fn compact(nonzero: &[bool], real: bool) -> Layout {
+        let mut n_slots = 0;
+        let slots = nonzero
+            .iter()
+            .map(|&nz| {
+                nz.then(|| {
+                    n_slots += 1;
+                    n_slots - 1
+                })
+            })
+            .collect();
+        Layout {
+            slots,
+            n_slots,
+            real,
+        }
+    }
+
+    /// Number of entries (`outputs x inputs`).
+    pub fn n_entries(&self) -> usize {
+        self.slots.len()
+    }
+
+    /// Number of stored (possibly nonzero) entries.
+    pub fn n_stored(&self) -> usize {
+        self.n_slots
+    }
+
+    /// Every stored entry is real (imaginary parts exactly 0, not stored).
+    pub fn is_real(&self) -> bool {
+        self.real
+    }
+
+    /// Entry `entry` is exactly zero at every frequency (not stored).
+    pub fn is_structural_zero(&self, entry: usize) -> bool {
+        self.slots[entry].is_none()
+    }
+
+    /// `f64` values per frequency.
+    pub fn stride(&self) -> usize {
+        if self.real {
+            self.n_slots
+        } else {
+            2 * self.n_slots
+        }
+    }
+
+    /// Positions of entry `entry`'s real and imaginary parts among a frequency's `f64` values
+    /// (`None` where not stored: a structural zero, or the imaginary part in a real layout).
+    pub fn position(&self, entry: usize) -> (Option<usize>, Option<usize>) {
+        match (self.slots[entry], self.real) {
+            (None, _) => (None, None),
+            (Some(s), true) => (Some(s), None),
+            (Some(s), false) => (Some(2 * s), Some(2 * s + 1)),
+        }
+    }
+
+    /// Whether this is [`Layout::dense`].
+    pub fn is_dense(&self) -> bool {
+        !self.real && self.n_slots == self.slots.len()
+    }
+}
+
+/// Transfer functions on a frequency grid: `H_{o,i}(f_k)`, stored in a [`Layout`] (see the
+/// module docs); read with [`TransferMatrix::get`] or [`TransferMatrix::dense_values`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct TransferMatrix {
+    /// Frequencies (Hz).
+    pub freqs_hz: Vec<f64>,
+    /// Row labels.
+    pub outputs: Vec<Observable>,
+    /// Column labels.
+    pub inputs: Vec<Input>,
+    /// The method that produced the values.
+    pub method: Method,
+    layout: Layout,
+    /// `layout.stride()` values per frequency.
+    data: Vec<f64>,
+}
+
+impl TransferMatrix {
+    /// A matrix from dense complex values, `[freq][output][input]` row-major.
+    ///
+    /// # Panics
+    ///
+    /// If `values` does not hold `freqs_hz.len() x outputs.len() x inputs.len()` values.
+    pub fn from_dense(
+        freqs_hz: Vec<f64>,
+        outputs: Vec<Observable>,
+        inputs: Vec<Input>,
+        method: Method,
+        values: &[Complex64],
+    ) -> TransferMatrix {
+        let n = outputs.len() * inputs.len();
+        assert_eq!(
+            values.len(),
+            freqs_hz.len() * n,
+            "{} values for {} frequencies x {n} entries",
+            values.len(),
+            freqs_hz.len()
+        );
+        TransferMatrix {
+            freqs_hz,
+            outputs,
+            inputs,
+            method,
+            layout: Layout::dense(n),
+            data: values.iter().flat_map(|z| [z.re, z.im]).collect(),
+        }
+    }
+
+    /// A matrix of `layout` whose `data` (`layout.stride()` per frequency) the caller fills.
+    pub(super) fn from_parts(
+        freqs_hz: Vec<f64>,
+        outputs: Vec<Observable>,
+        inputs: Vec<Input>,
+        method: Method,
+        layout: Layout,
+        data: Vec<f64>,
+    ) -> TransferMatrix {
+        debug_assert_eq!(layout.n_entries(), outputs.len() * inputs.len());
+        TransferMatrix {
+            freqs_hz,
+            outputs,
+            inputs,
+            method,
+            layout,
+            data,
+        }
+    }
+
+    /// The storage, for [`super::evaluate_into`] to refill in place.
+    pub(super) fn parts_mut(&mut self) -> (&mut Layout, &mut Vec<f64>) {
+        (&mut self.layout, &mut self.data)
+    }
+
+    /// `H_{o,i}(f_k)`.
+    pub fn get(&self, k: usize, o: usize, i: usize) -> Complex64 {
+        let entry = o * self.inputs.len() + i;
+        let base = k * self.layout.stride();
+        match self.layout.position(entry) {
+            (None, _) => Complex64::new(0.0, 0.0),
+            (Some(re), None) => Complex64::new(self.data[base + re], 0.0),
+            (Some(re), Some(im)) => Complex64::new(self.data[base + re], self.data[base + im]),
+        }
+    }
+
+    /// How the values are stored.
+    pub fn layout(&self) -> &Layout {
+        &self.layout
+    }
+
+    /// Number of frequencies the stored values cover (`freqs_hz.len()` unless the matrix was
+    /// modified inconsistently).
+    pub fn n_stored_freqs(&self) -> usize {
+        match self.layout.stride() {
+            0 => self.freqs_hz.len(),
+            stride => self.data.len() / stride,
+        }
+    }
+
+    /// Every value, dense: `[freq][output][input]` row-major complex, over the stored
+    /// frequencies ([`TransferMatrix::n_stored_freqs`]).
+    pub fn dense_values(&self) -> Vec<Complex64> {
+        let (no, ni) = (self.outputs.len(), self.inputs.len());
+        let mut out = Vec::with_capacity(self.n_stored_freqs() * no * ni);
+        for k in 0..self.n_stored_freqs() {
+            for o in 0..no {
+                for i in 0..ni {
+                    out.push(self.get(k, o, i));
+                }
+            }
+        }
+        out
+    }
+
+    /// Unit of entry (o, i): output unit per input unit.
+    pub fn unit(&self, o: usize, i: usize) -> String {
+        let input = self.inputs[i].unit();
+        if input.contains(' ') {
+            format!("{}/({input})", self.outputs[o].unit())
+        } else {
+            format!("{}/{input}", self.outputs[o].unit())
+        }
+    }
+
+    /// Position of an observable among the rows.
+    pub fn output_index(&self, o: Observable) -> Option<usize> {
+        self.outputs.iter().position(|&x| x == o)
+    }
+
+    /// Position of an input among the columns.
+    pub fn input_index(&self, i: Input) -> Option<usize> {
+        self.inputs.iter().position(|&x| x == i)
+    }
+
+    /// The same matrix restricted to the rows `rows` (indices into `outputs`, in that order),
+    /// dense.
+    pub fn select_outputs(&self, rows: &[usize]) -> TransferMatrix {
+        let ni = self.inputs.len();
+        let mut values = Vec::with_capacity(self.n_stored_freqs() * rows.len() * ni);
+        for k in 0..self.n_stored_freqs() {
+            for &o in rows {
+                for i in 0..ni {
+                    values.push(self.get(k, o, i));
+                }
+            }
+        }
+        TransferMatrix::from_dense(
+            self.freqs_hz[..self.n_stored_freqs()].to_vec(),
+            rows.iter().map(|&o| self.outputs[o]).collect(),
+            self.inputs.clone(),
+            self.method,
+            &values,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::TiltAxis;
+
+    #[test]
+    fn compact_layouts_read_back_as_dense() {
+        let outputs = vec![Observable::X, Observable::Phi];
+        let inputs = vec![Input::Tilt(TiltAxis::ThetaT), Input::Tilt(TiltAxis::EtaT)];
+        // Entries (X, theta_t) and (phi, eta_t) stored; real and complex.
+        let nonzero = [false, true, false, true];
+        for real in [true, false] {
+            let layout = Layout::compact(&nonzero, real);
+            assert_eq!(layout.n_stored(), 2);
+            assert_eq!(layout.stride(), if real { 2 } else { 4 });
+            let data: Vec<f64> = (0..2 * layout.stride()).map(|k| k as f64 + 1.0).collect();
+            let m = TransferMatrix::from_parts(
+                vec![1.0, 2.0],
+                outputs.clone(),
+                inputs.clone(),
+                Method::PoleZero,
+                layout,
+                data,
+            );
+            let dense = m.dense_values();
+            assert_eq!(dense.len(), 8);
+            for k in 0..2 {
+                for e in 0..4 {
+                    let z = dense[k * 4 + e];
+                    assert_eq!(z, m.get(k, e / 2, e % 2));
+                    if !nonzero[e] {
+                        assert_eq!((z.re.to_bits(), z.im.to_bits()), (0, 0));
+                    } else if real {
+                        assert_eq!(z.im.to_bits(), 0);
+                    }
+                }
+            }
+            // Slot 1 of point 1 is entry (phi, eta_t).
+            let want = if real { 4.0 } else { 7.0 };
+            assert_eq!(m.get(1, 1, 1).re, want);
+            let rows = m.select_outputs(&[1]);
+            assert!(rows.layout().is_dense());
+            assert_eq!(rows.get(1, 0, 1), m.get(1, 1, 1));
+            assert_eq!(rows.get(0, 0, 0), Complex64::new(0.0, 0.0));
+        }
+    }
+
+    #[test]
+    fn dense_round_trip() {
+        let values: Vec<Complex64> = (0..6)
+            .map(|k| Complex64::new(k as f64, -(k as f64)))
+            .collect();
+        let m = TransferMatrix::from_dense(
+            vec![0.5, 1.5],
+            vec![Observable::X],
+            Input::all_tilts(),
+            Method::Direct,
+            &values,
+        );
+        assert!(m.layout().is_dense());
+        assert_eq!(m.dense_values(), values);
+        assert_eq!(m.get(1, 0, 2), values[5]);
+    }
+}
