@@ -230,7 +230,7 @@ fn tilt_layout_of_table_i() {
         let layout = tf.layout();
         assert_eq!(layout.n_stored(), 11);
         assert_eq!(layout.is_real(), real);
-        assert_eq!(layout.stride(), if real { 11 } else { 22 });
+        assert_eq!(layout.n_planes(), if real { 11 } else { 22 });
         // The structural zeros are those of the model's block structure: X, eta, phi, phi_a
         // from theta_t; Y, Z, theta from eta_t and phi_t.
         let zeros: Vec<String> = (0..21)

@@ -52,23 +52,6 @@ pub fn zeroed_complex(len: usize) -> Vec<Complex64> {
     unsafe { Vec::from_raw_parts(v.as_mut_ptr().cast::<Complex64>(), len, len) }
 }
 
-/// `x` as complex values: `x[2k] + i x[2k + 1]`.
-///
-/// # Panics
-///
-/// If `x` has an odd length.
-pub(crate) fn as_complex_mut(x: &mut [f64]) -> &mut [Complex64] {
-    assert!(
-        x.len() % 2 == 0,
-        "{} f64 are not whole complex values",
-        x.len()
-    );
-    // SAFETY: `Complex64` is `repr(C)` `{re: f64, im: f64}`: size 16, alignment 8 (that of
-    // `f64`), no padding, every bit pattern valid. `x` covers `x.len() / 2` of them at an
-    // 8-byte aligned address, and the returned slice borrows `x` mutably for its lifetime.
-    unsafe { std::slice::from_raw_parts_mut(x.as_mut_ptr().cast::<Complex64>(), x.len() / 2) }
-}
-
 /// `madvise(MADV_HUGEPAGE)` on the whole 2 MiB pages inside `[ptr, ptr + bytes)`; a refusal
 /// (no THP in this kernel, policy `never`) is ignored: the pages stay ordinary.
 #[cfg(target_os = "linux")]
@@ -124,14 +107,5 @@ mod tests {
             v.push(Complex64::new(1.0, -1.0));
             assert_eq!(v[len], Complex64::new(1.0, -1.0));
         }
-    }
-
-    #[test]
-    fn complex_view_pairs_consecutive_values() {
-        let mut x = [1.0, 2.0, 3.0, 4.0];
-        let z = as_complex_mut(&mut x);
-        assert_eq!(z, &[Complex64::new(1.0, 2.0), Complex64::new(3.0, 4.0)]);
-        z[1].im = -4.0;
-        assert_eq!(x[3], -4.0);
     }
 }

@@ -21,29 +21,21 @@ pub(crate) fn check_grid_len(request: &Request, freqs_hz: &[f64], out: &[Complex
     block
 }
 
-/// Evaluates part of a grid into its part of an output buffer.
-type EvalPart<'a, T> = dyn Fn(&[f64], &mut [T]) -> Result<(), TfError> + Sync + 'a;
+/// Evaluates part of a grid into its part of the output (`J`).
+type EvalPart<'a, J> = dyn Fn(&[f64], J) -> Result<(), TfError> + Sync + 'a;
 
-/// `eval(part of freqs_hz, its part of out)` on `threads` contiguous parts of the grid, one
-/// per thread (`std::thread::scope`; the first part on the calling thread); `per_freq` values
-/// of `out` per frequency. The error of the first failing part in grid order.
-fn on_threads<T: Send>(
-    freqs_hz: &[f64],
-    out: &mut [T],
-    per_freq: usize,
-    threads: usize,
-    eval: &EvalPart<'_, T>,
+/// `eval` on each `(part of the grid, its part of the output)` of `jobs`, one thread per
+/// job (`std::thread::scope`; the first job on the calling thread). The error of the first
+/// failing job in grid order.
+fn on_threads<'f, J: Send>(
+    mut jobs: impl Iterator<Item = (&'f [f64], J)>,
+    eval: &EvalPart<'_, J>,
 ) -> Result<(), TfError> {
-    let part = freqs_hz.len().div_ceil(threads.max(1)).max(1);
-    if part >= freqs_hz.len() || per_freq == 0 {
-        return eval(freqs_hz, out);
-    }
-    let mut parts = freqs_hz.chunks(part).zip(out.chunks_mut(part * per_freq));
-    let (f0, o0) = parts.next().expect("at least two parts");
+    let Some((f0, o0)) = jobs.next() else {
+        return Ok(());
+    };
     std::thread::scope(|scope| {
-        let others: Vec<_> = parts
-            .map(|(f, o)| scope.spawn(move || eval(f, o)))
-            .collect();
+        let others: Vec<_> = jobs.map(|(f, o)| scope.spawn(move || eval(f, o))).collect();
         let first = eval(f0, o0);
         // In grid order: the first part's error, else the first failing other part's.
         others.into_iter().fold(first, |acc, h| {
@@ -53,6 +45,11 @@ fn on_threads<T: Send>(
             acc.and(r)
         })
     })
+}
+
+/// Grid points per thread: `threads` parts (0 means 1), at least one point each.
+fn part_len(n_freqs: usize, threads: usize) -> usize {
+    n_freqs.div_ceil(threads.max(1)).max(1)
 }
 
 /// [`TransferFunction::eval_grid_into`] (dense `[freq][output][input]` complex values) with
@@ -70,16 +67,19 @@ pub fn eval_grid_threads(
     threads: usize,
 ) -> Result<(), TfError> {
     let block = check_grid_len(tf.request(), freqs_hz, out);
-    on_threads(freqs_hz, out, block, threads, &|f, o| {
-        tf.eval_grid_into(f, o)
-    })
+    if block == 0 || freqs_hz.is_empty() {
+        return tf.eval_grid_into(freqs_hz, out);
+    }
+    let part = part_len(freqs_hz.len(), threads);
+    let jobs = freqs_hz.chunks(part).zip(out.chunks_mut(part * block));
+    on_threads(jobs, &|f, o| tf.eval_grid_into(f, o))
 }
 
 /// Evaluates a plan on every frequency of a grid, on one thread, into a new matrix in the
 /// plan's [`Layout`] ([`TransferFunction::layout`]). Stops at the first singular frequency.
 pub fn evaluate(tf: &dyn TransferFunction, freqs_hz: &[f64]) -> Result<TransferMatrix, TfError> {
     let layout = tf.layout();
-    let data = zeroed_f64(layout.stride() * freqs_hz.len());
+    let data = zeroed_f64(layout.n_planes() * freqs_hz.len());
     let r = tf.request();
     let mut m = TransferMatrix::from_parts(
         Vec::new(),
@@ -111,14 +111,27 @@ pub fn evaluate_into(
     out.method = tf.method();
     let (layout, data) = out.parts_mut();
     *layout = tf.layout();
-    let stride = layout.stride();
-    let len = stride * freqs_hz.len();
+    let (n_planes, nf) = (layout.n_planes(), freqs_hz.len());
+    let len = n_planes * nf;
     if data.capacity() < len {
         *data = zeroed_f64(len);
     } else {
         data.resize(len, 0.0);
     }
-    on_threads(freqs_hz, data, stride, threads, &|f, o| {
-        tf.eval_grid_layout_into(f, o)
+    if n_planes == 0 || nf == 0 {
+        // Nothing to write; each frequency is still checked.
+        return tf.eval_grid_layout_into(freqs_hz, &mut []);
+    }
+    // Each thread gets its part of the grid and the same part of every plane.
+    let part = part_len(nf, threads);
+    let mut parts: Vec<Vec<&mut [f64]>> = (0..nf.div_ceil(part)).map(|_| Vec::new()).collect();
+    for plane in data.chunks_exact_mut(nf) {
+        for (t, piece) in plane.chunks_mut(part).enumerate() {
+            parts[t].push(piece);
+        }
+    }
+    let jobs = freqs_hz.chunks(part).zip(parts);
+    on_threads(jobs, &|f, mut p: Vec<&mut [f64]>| {
+        tf.eval_grid_layout_into(f, &mut p)
     })
 }

@@ -1,33 +1,36 @@
 //! Transfer functions on a frequency grid: [`TransferMatrix`], and the [`Layout`] of its values.
 //!
+//! Values are stored in planes: one `f64` array over the grid per stored part (the real or the
+//! imaginary part of an entry), so each entry's frequency series is contiguous.
+//!
 //! A plan knows which entries of its matrix are structurally zero (an observable that no block
 //! reaching the input moves, e.g. X from theta_t) and, for the pole-zero method on an
 //! undamped model, that every entry is real (real poles, zeros and gains). It stores only what
-//! can be nonzero: at each frequency one slot per possibly-nonzero entry, two `f64` (re, im) or
-//! one (real layouts). The 7x3 tilt matrix of Table I has 11 such entries of 21: 88 bytes per
-//! frequency instead of the 336 of a dense complex matrix. [`TransferMatrix::get`] returns
-//! exact zeros for the others (and `im = 0.0` in a real layout): the values are those of the
-//! dense matrix, bit for bit; only the storage differs. Methods without that knowledge (direct,
-//! block, split, modal, torsion2) use the dense complex layout, `[freq][output][input]`.
+//! can be nonzero: one plane per possibly-nonzero entry and part, two per entry (re, im) or one
+//! (real layouts). The 7x3 tilt matrix of Table I has 11 such entries of 21: 11 planes, 88
+//! bytes per frequency, instead of the 336 of a dense complex matrix. [`TransferMatrix::get`]
+//! returns exact zeros for the others (and `im = 0.0` in a real layout): the values are those
+//! of the dense matrix, bit for bit; only the storage differs. Methods without that knowledge
+//! (direct, block, split, modal, torsion2) use the dense layout, two planes per entry.
 
 use super::{Input, Method};
 use crate::model::Observable;
 use num_complex::Complex64;
 
-/// Where each entry of an `outputs x inputs` matrix is stored at one frequency.
+/// Which planes hold each entry of an `outputs x inputs` matrix.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Layout {
     /// Per entry (`o * n_inputs + i`): its slot, or `None` for a structural zero.
     slots: Vec<Option<usize>>,
     /// Number of slots.
     n_slots: usize,
-    /// One `f64` per slot (the real part; the imaginary part is exactly 0) instead of two.
+    /// One plane per slot (the real part; the imaginary part is exactly 0) instead of two.
     real: bool,
 }
 
 impl Layout {
-    /// Every one of `n_entries` entries complex, in entry order: `[output][input]` row-major
-    /// complex values, the layout of `numpy.ndarray` of complex128.
+    /// Every one of `n_entries` entries complex, in entry order (`[output][input]` row-major):
+    /// planes `2 e` and `2 e + 1` hold entry `e`'s real and imaginary parts.
     pub fn dense(n_entries: usize) -> Layout {
         Layout {
             slots: (0..n_entries).map(Some).collect(),
@@ -37,7 +40,7 @@ impl Layout {
     }
 
     /// Slots for the entries with `nonzero[entry]`, in entry order; the others structural
-    /// zeros. `real`: one `f64` per slot.
+    /// zeros. `real`: one plane per slot.
     pub fn compact(nonzero: &[bool], real: bool) -> Layout {
         let mut n_slots = 0;
         let slots = nonzero
@@ -76,8 +79,8 @@ impl Layout {
         self.slots[entry].is_none()
     }
 
-    /// `f64` values per frequency.
-    pub fn stride(&self) -> usize {
+    /// Number of planes (`f64` values per frequency).
+    pub fn n_planes(&self) -> usize {
         if self.real {
             self.n_slots
         } else {
@@ -85,8 +88,8 @@ impl Layout {
         }
     }
 
-    /// Positions of entry `entry`'s real and imaginary parts among a frequency's `f64` values
-    /// (`None` where not stored: a structural zero, or the imaginary part in a real layout).
+    /// Planes of entry `entry`'s real and imaginary parts (`None` where not stored: a
+    /// structural zero, or the imaginary part in a real layout).
     pub fn position(&self, entry: usize) -> (Option<usize>, Option<usize>) {
         match (self.slots[entry], self.real) {
             (None, _) => (None, None),
@@ -114,7 +117,7 @@ pub struct TransferMatrix {
     /// The method that produced the values.
     pub method: Method,
     layout: Layout,
-    /// `layout.stride()` values per frequency.
+    /// `layout.n_planes()` planes of `n_stored_freqs()` values, one after the other.
     data: Vec<f64>,
 }
 
@@ -139,17 +142,27 @@ impl TransferMatrix {
             values.len(),
             freqs_hz.len()
         );
+        let nf = freqs_hz.len();
+        let mut data = vec![0.0; 2 * n * nf];
+        if n > 0 {
+            for (k, point) in values.chunks_exact(n).enumerate() {
+                for (e, z) in point.iter().enumerate() {
+                    data[2 * e * nf + k] = z.re;
+                    data[(2 * e + 1) * nf + k] = z.im;
+                }
+            }
+        }
         TransferMatrix {
             freqs_hz,
             outputs,
             inputs,
             method,
             layout: Layout::dense(n),
-            data: values.iter().flat_map(|z| [z.re, z.im]).collect(),
+            data,
         }
     }
 
-    /// A matrix of `layout` whose `data` (`layout.stride()` per frequency) the caller fills.
+    /// A matrix of `layout` whose `data` (`layout.n_planes()` planes) the caller fills.
     pub(super) fn from_parts(
         freqs_hz: Vec<f64>,
         outputs: Vec<Observable>,
@@ -177,12 +190,22 @@ impl TransferMatrix {
     /// `H_{o,i}(f_k)`.
     pub fn get(&self, k: usize, o: usize, i: usize) -> Complex64 {
         let entry = o * self.inputs.len() + i;
-        let base = k * self.layout.stride();
+        let n = self.n_stored_freqs();
+        assert!(k < n, "frequency index {k} of {n}");
         match self.layout.position(entry) {
             (None, _) => Complex64::new(0.0, 0.0),
-            (Some(re), None) => Complex64::new(self.data[base + re], 0.0),
-            (Some(re), Some(im)) => Complex64::new(self.data[base + re], self.data[base + im]),
+            (Some(re), None) => Complex64::new(self.data[re * n + k], 0.0),
+            (Some(re), Some(im)) => Complex64::new(self.data[re * n + k], self.data[im * n + k]),
         }
+    }
+
+    /// The stored values of entry (o, i) over the grid, `(re, im)` (`None` where not stored:
+    /// a structural zero, or the imaginary part in a real layout, exactly 0).
+    pub fn planes(&self, o: usize, i: usize) -> (Option<&[f64]>, Option<&[f64]>) {
+        let n = self.n_stored_freqs();
+        let plane = |p: Option<usize>| p.map(|p| &self.data[p * n..(p + 1) * n]);
+        let (re, im) = self.layout.position(o * self.inputs.len() + i);
+        (plane(re), plane(im))
     }
 
     /// How the values are stored.
@@ -193,9 +216,9 @@ impl TransferMatrix {
     /// Number of frequencies the stored values cover (`freqs_hz.len()` unless the matrix was
     /// modified inconsistently).
     pub fn n_stored_freqs(&self) -> usize {
-        match self.layout.stride() {
+        match self.layout.n_planes() {
             0 => self.freqs_hz.len(),
-            stride => self.data.len() / stride,
+            planes => self.data.len() / planes,
         }
     }
 
@@ -270,8 +293,8 @@ mod tests {
         for real in [true, false] {
             let layout = Layout::compact(&nonzero, real);
             assert_eq!(layout.n_stored(), 2);
-            assert_eq!(layout.stride(), if real { 2 } else { 4 });
-            let data: Vec<f64> = (0..2 * layout.stride()).map(|k| k as f64 + 1.0).collect();
+            assert_eq!(layout.n_planes(), if real { 2 } else { 4 });
+            let data: Vec<f64> = (0..2 * layout.n_planes()).map(|k| k as f64 + 1.0).collect();
             let m = TransferMatrix::from_parts(
                 vec![1.0, 2.0],
                 outputs.clone(),
@@ -293,9 +316,12 @@ mod tests {
                     }
                 }
             }
-            // Slot 1 of point 1 is entry (phi, eta_t).
-            let want = if real { 4.0 } else { 7.0 };
+            // Slot 1 is entry (phi, eta_t): plane 1 (real) or 2 (complex), point 1.
+            let want = if real { 4.0 } else { 6.0 };
             assert_eq!(m.get(1, 1, 1).re, want);
+            assert_eq!(m.planes(1, 1).0.unwrap(), [want - 1.0, want]);
+            assert_eq!(m.planes(1, 1).1.is_none(), real);
+            assert_eq!(m.planes(0, 0), (None, None));
             let rows = m.select_outputs(&[1]);
             assert!(rows.layout().is_dense());
             assert_eq!(rows.get(1, 0, 1), m.get(1, 1, 1));

@@ -233,16 +233,30 @@ pub trait TransferFunction: Send + Sync {
         Layout::dense(r.outputs.len() * r.inputs.len())
     }
 
-    /// Writes `H` at every frequency of `freqs_hz` into `out` in [`TransferFunction::layout`]
-    /// (`layout().stride()` values per frequency): the values of
+    /// Writes `H` at every frequency of `freqs_hz` into `planes`, one per plane of
+    /// [`TransferFunction::layout`], each as long as the grid: the values of
     /// [`TransferFunction::eval_grid_into`], stored differently, and the same errors. The
-    /// default (dense layout) is `eval_grid_into` itself.
+    /// default (dense layout) evaluates point by point with `eval_into`.
     ///
     /// # Panics
     ///
-    /// If `out` has the wrong length.
-    fn eval_grid_layout_into(&self, freqs_hz: &[f64], out: &mut [f64]) -> Result<(), TfError> {
-        self.eval_grid_into(freqs_hz, buffer::as_complex_mut(out))
+    /// If the number or the lengths of `planes` are wrong.
+    fn eval_grid_layout_into(
+        &self,
+        freqs_hz: &[f64],
+        planes: &mut [&mut [f64]],
+    ) -> Result<(), TfError> {
+        let n = self.layout().n_entries();
+        assert_eq!(planes.len(), 2 * n, "two planes per entry (dense layout)");
+        let mut h = vec![Complex64::new(0.0, 0.0); n];
+        for (k, &f) in freqs_hz.iter().enumerate() {
+            self.eval_into(f, &mut h)?;
+            for (e, z) in h.iter().enumerate() {
+                planes[2 * e][k] = z.re;
+                planes[2 * e + 1][k] = z.im;
+            }
+        }
+        Ok(())
     }
 
     /// Allocating convenience wrapper around [`TransferFunction::eval_into`].

@@ -363,7 +363,7 @@ impl PoleZero {
         });
         PoleZero {
             kernel: Kernel::new(dense, 2 * n_values),
-            compact: Kernel::new(compact, layout.stride()),
+            compact: Kernel::new(compact, layout.n_planes()),
             layout,
             request,
         }
@@ -586,16 +586,12 @@ impl TransferFunction for PoleZero {
 
     /// The same operations as [`TransferFunction::eval_grid_into`] (bit-identical values, the
     /// same errors), stored in [`PoleZero::layout`].
-    fn eval_grid_layout_into(&self, freqs_hz: &[f64], out: &mut [f64]) -> Result<(), TfError> {
-        assert_eq!(
-            out.len(),
-            freqs_hz.len() * self.layout.stride(),
-            "eval_grid_layout_into: output buffer of {} values for {} frequencies x {}",
-            out.len(),
-            freqs_hz.len(),
-            self.layout.stride()
-        );
-        self.compact.eval_grid(freqs_hz, out)
+    fn eval_grid_layout_into(
+        &self,
+        freqs_hz: &[f64],
+        planes: &mut [&mut [f64]],
+    ) -> Result<(), TfError> {
+        self.compact.eval_planes(freqs_hz, planes)
     }
 }
 

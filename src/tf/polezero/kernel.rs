@@ -122,10 +122,16 @@ impl BlockForm {
     /// (`n` points of `stride` `f64` values); false, with `out` partly written, if the block
     /// is singular in some lane.
     #[inline(always)]
-    fn add_chunk<V: Lanes>(&self, s: V, n: usize, stride: usize, out: &mut [f64]) -> bool {
+    fn add_chunk<V: Lanes, const PLANAR: bool>(
+        &self,
+        s: V,
+        n: usize,
+        stride: usize,
+        out: &mut [f64],
+    ) -> bool {
         match self {
-            BlockForm::Real(b) => b.add_chunk(s, n, stride, out),
-            BlockForm::Complex(b) => b.add_chunk(s, n, stride, out),
+            BlockForm::Real(b) => b.add_chunk::<V, PLANAR>(s, n, stride, out),
+            BlockForm::Complex(b) => b.add_chunk::<V, PLANAR>(s, n, stride, out),
         }
     }
 
@@ -165,7 +171,13 @@ impl RealBlock {
     }
 
     #[inline(always)]
-    fn add_chunk<V: Lanes>(&self, s: V, n: usize, stride: usize, out: &mut [f64]) -> bool {
+    fn add_chunk<V: Lanes, const PLANAR: bool>(
+        &self,
+        s: V,
+        n: usize,
+        stride: usize,
+        out: &mut [f64],
+    ) -> bool {
         let p = self.poles;
         let d = [
             V::splat(p[0]).sub(s),
@@ -188,16 +200,36 @@ impl RealBlock {
             for k in 0..e.factors {
                 h = h.mul(V::splat(e.a[k]).add(V::splat(e.b[k]).mul(s)));
             }
-            put(out, e.re, stride, n, e.first_re, h.mul(inv));
+            put::<V, PLANAR>(out, e.re, stride, n, e.first_re, h.mul(inv));
         }
         true
     }
 }
 
-/// Lane `l < n` of `v` into `out[l * stride + at]`: stored as `0.0 + v` if `first` (what
-/// adding to a zeroed output gives: +0.0 for -0.0), else added.
+/// Lane `l < n` of `v` into `out[l * stride + at]` (interleaved: a point's values together),
+/// or every lane into `out[at * LANES + l]` (`PLANAR`: a value's lanes together): stored as
+/// `0.0 + v` if `first` (what adding to a zeroed output gives: +0.0 for -0.0), else added.
 #[inline(always)]
-fn put<V: Lanes>(out: &mut [f64], at: usize, stride: usize, n: usize, first: bool, v: V) {
+fn put<V: Lanes, const PLANAR: bool>(
+    out: &mut [f64],
+    at: usize,
+    stride: usize,
+    n: usize,
+    first: bool,
+    v: V,
+) {
+    if PLANAR {
+        let lanes: &mut [f64; LANES] = (&mut out[at * LANES..(at + 1) * LANES])
+            .try_into()
+            .expect("LANES values");
+        let v = if first {
+            V::splat(0.0).add(v)
+        } else {
+            V::load(lanes).add(v)
+        };
+        v.store(lanes);
+        return;
+    }
     let v = if first { V::splat(0.0).add(v) } else { v }.to_array();
     // One bounds check for the column, none per lane (when `n == LANES`, the usual case, the
     // loop below has a constant count and is unrolled).
@@ -234,7 +266,13 @@ impl ComplexBlock {
     }
 
     #[inline(always)]
-    fn add_chunk<V: Lanes>(&self, s: V, n: usize, stride: usize, out: &mut [f64]) -> bool {
+    fn add_chunk<V: Lanes, const PLANAR: bool>(
+        &self,
+        s: V,
+        n: usize,
+        stride: usize,
+        out: &mut [f64],
+    ) -> bool {
         let p = self.poles;
         let d = [
             (V::splat(p[0].re).sub(s), V::splat(p[0].im)),
@@ -264,8 +302,8 @@ impl ComplexBlock {
             // (h_re + i h_im) (inv_re - i inv_im_neg).
             let re = h_re.mul(inv_re).add(h_im.mul(inv_im_neg));
             let im = h_im.mul(inv_re).sub(h_re.mul(inv_im_neg));
-            put(out, e.re, stride, n, e.first_re, re);
-            put(out, e.im, stride, n, e.first_im, im);
+            put::<V, PLANAR>(out, e.re, stride, n, e.first_re, re);
+            put::<V, PLANAR>(out, e.im, stride, n, e.first_im, im);
         }
         true
     }
@@ -339,7 +377,7 @@ impl Kernel {
         if let [_] = freqs_hz {
             // One point (`eval_into`): written in place.
             out.fill(0.0);
-            return self.eval_chunk::<V>(freqs_hz, out);
+            return self.eval_chunk::<V, false>(freqs_hz, out);
         }
         // A chunk is written into `chunk` (in L1 cache), then copied into `out` in one
         // sequential pass. The structural zeros of `chunk` are never written: zeroed once.
@@ -347,7 +385,7 @@ impl Kernel {
         let stream = std::mem::size_of_val(out) >= STREAM_MIN_BYTES;
         let mut result = Ok(());
         for (fc, oc) in freqs_hz.chunks(LANES).zip(out.chunks_mut(LANES * nv)) {
-            result = self.eval_chunk::<V>(fc, &mut chunk);
+            result = self.eval_chunk::<V, false>(fc, &mut chunk);
             if result.is_err() {
                 break;
             }
@@ -363,10 +401,83 @@ impl Kernel {
         result
     }
 
-    /// `H` at the (at most [`LANES`]) frequencies `fc` into `dst` (`fc.len()` points of
-    /// `stride`), whose structural zeros must already be zero.
+    /// `H` at every frequency of `freqs_hz` into `planes` (`stride` of them, each as long as
+    /// the grid): value `v` of frequency `k` at `planes[v][k]`. On error the contents of
+    /// `planes` are unspecified.
+    pub fn eval_planes(&self, freqs_hz: &[f64], planes: &mut [&mut [f64]]) -> Result<(), TfError> {
+        assert_eq!(planes.len(), self.stride, "one plane per value");
+        for p in planes.iter() {
+            assert_eq!(p.len(), freqs_hz.len(), "planes as long as the grid");
+        }
+        #[cfg(target_arch = "x86_64")]
+        if self.avx {
+            // SAFETY: `avx` is true only when the running CPU supports AVX (checked in `new`).
+            return unsafe { self.eval_planes_avx(freqs_hz, planes) };
+        }
+        self.eval_planes_with::<Portable>(freqs_hz, planes)
+    }
+
+    /// [`Kernel::eval_planes`] in AVX registers (see [`Kernel::eval_grid_avx`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    unsafe fn eval_planes_avx(
+        &self,
+        freqs_hz: &[f64],
+        planes: &mut [&mut [f64]],
+    ) -> Result<(), TfError> {
+        self.eval_planes_with::<Avx>(freqs_hz, planes)
+    }
+
     #[inline(always)]
-    fn eval_chunk<V: Lanes>(&self, fc: &[f64], dst: &mut [f64]) -> Result<(), TfError> {
+    fn eval_planes_with<V: Lanes>(
+        &self,
+        freqs_hz: &[f64],
+        planes: &mut [&mut [f64]],
+    ) -> Result<(), TfError> {
+        let np = self.stride;
+        if np == 0 {
+            return freqs_hz.iter().try_for_each(|&f| omega_sq(f).map(drop));
+        }
+        // A chunk's values go into `chunk`, each value's lanes together (in L1 cache), then
+        // each value's lanes into its plane with ordinary stores. Values no block writes stay
+        // zero. No non-temporal stores here: a chunk writes 64 bytes to each plane, a whole
+        // cache line only if the plane is 64-byte aligned, and partial lines written
+        // non-temporally cost ~30 ns per point on the VM of `scripts/bench/README.md`
+        // (ordinary stores: ~1.3 ns per point of 11 planes in a copy test); and a compact
+        // result is small enough to stay in L3 (8.8 MB at 1e5 points of Table I's tilt matrix).
+        let mut chunk = vec![0.0; LANES * np];
+        let mut result = Ok(());
+        for (c, fc) in freqs_hz.chunks(LANES).enumerate() {
+            result = self.eval_chunk::<V, true>(fc, &mut chunk);
+            if result.is_err() {
+                break;
+            }
+            let (k0, n) = (c * LANES, fc.len());
+            for (p, plane) in planes.iter_mut().enumerate() {
+                let (dst, src) = (&mut plane[k0..k0 + n], &chunk[p * LANES..p * LANES + n]);
+                if let (Ok(d), Ok(s)) = (
+                    <&mut [f64; LANES]>::try_from(&mut *dst),
+                    <&[f64; LANES]>::try_from(src),
+                ) {
+                    // A full chunk: a fixed-size copy (vector moves, no call to memcpy).
+                    V::load(s).store(d);
+                } else {
+                    dst.copy_from_slice(src);
+                }
+            }
+        }
+        result
+    }
+
+    /// `H` at the (at most [`LANES`]) frequencies `fc` into `dst` (`fc.len()` points of
+    /// `stride`, or `stride` values of [`LANES`] lanes if `PLANAR`), whose structural zeros
+    /// must already be zero.
+    #[inline(always)]
+    fn eval_chunk<V: Lanes, const PLANAR: bool>(
+        &self,
+        fc: &[f64],
+        dst: &mut [f64],
+    ) -> Result<(), TfError> {
         // A short chunk repeats its last frequency in the unused lanes.
         let last = fc.len() - 1;
         let f = V::from_array(std::array::from_fn(|l| fc[l.min(last)]));
@@ -376,7 +487,7 @@ impl Kernel {
         let s = w.mul(w);
         let mut ok = valid;
         for b in &self.blocks {
-            ok = ok && b.add_chunk(s, fc.len(), self.stride, dst);
+            ok = ok && b.add_chunk::<V, PLANAR>(s, fc.len(), self.stride, dst);
         }
         if ok {
             Ok(())
@@ -421,8 +532,9 @@ mod tests {
     use crate::tf::{PoleZero, Request};
 
     /// AVX and portable lanes on the same grid, bit for bit: undamped and damped (real and
-    /// complex blocks), the dense and the compact kernel, a grid small enough for ordinary
-    /// stores and one large enough for the non-temporal ones, with a short last chunk.
+    /// complex blocks), the dense and the compact kernel, interleaved and planar, a grid small
+    /// enough for ordinary stores and one large enough for the non-temporal ones, with a short
+    /// last chunk.
     /// Skipped on a CPU without AVX.
     #[cfg(target_arch = "x86_64")]
     #[test]
@@ -461,6 +573,31 @@ mod tests {
                             k % stride,
                             freqs[k / stride]
                         );
+                    }
+                    // The planar path (what `evaluate` uses) of the same kernel.
+                    let mut planes_of = |avx: bool| {
+                        let mut data = vec![f64::NAN; n * stride];
+                        let mut planes: Vec<&mut [f64]> = data.chunks_exact_mut(n).collect();
+                        if avx {
+                            // SAFETY: the CPU has AVX (checked above).
+                            unsafe { kernel.eval_planes_avx(&freqs, &mut planes) }.unwrap();
+                        } else {
+                            kernel
+                                .eval_planes_with::<super::Portable>(&freqs, &mut planes)
+                                .unwrap();
+                        }
+                        data
+                    };
+                    let (pa, pp) = (planes_of(true), planes_of(false));
+                    for (k, (a, p)) in pa.iter().zip(&pp).enumerate() {
+                        assert!(
+                            a.to_bits() == p.to_bits(),
+                            "planes: plane {} at {} Hz: AVX {a} vs portable {p}",
+                            k / n,
+                            freqs[k % n]
+                        );
+                        // The same values as the interleaved path.
+                        assert_eq!(a.to_bits(), avx[(k % n) * stride + k / n].to_bits());
                     }
                 }
             }

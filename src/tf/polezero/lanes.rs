@@ -17,6 +17,8 @@ pub(super) trait Lanes: Copy {
     fn splat(x: f64) -> Self;
     fn from_array(a: [f64; LANES]) -> Self;
     fn to_array(self) -> [f64; LANES];
+    fn load(src: &[f64; LANES]) -> Self;
+    fn store(self, dst: &mut [f64; LANES]);
     fn add(self, o: Self) -> Self;
     fn sub(self, o: Self) -> Self;
     fn mul(self, o: Self) -> Self;
@@ -50,6 +52,14 @@ impl Lanes for Portable {
     #[inline(always)]
     fn to_array(self) -> [f64; LANES] {
         self.0
+    }
+    #[inline(always)]
+    fn load(src: &[f64; LANES]) -> Self {
+        Portable(*src)
+    }
+    #[inline(always)]
+    fn store(self, dst: &mut [f64; LANES]) {
+        *dst = self.0;
     }
     #[inline(always)]
     fn add(self, o: Self) -> Self {
@@ -159,6 +169,18 @@ mod avx {
                 _mm256_storeu_pd(a.as_mut_ptr().add(4), self.1);
             }
             a
+        }
+        #[inline(always)]
+        fn load(src: &[f64; LANES]) -> Self {
+            Self::from_array(*src)
+        }
+        #[inline(always)]
+        fn store(self, dst: &mut [f64; LANES]) {
+            // SAFETY: `dst` is eight writable f64 (unaligned stores).
+            unsafe {
+                _mm256_storeu_pd(dst.as_mut_ptr(), self.0);
+                _mm256_storeu_pd(dst.as_mut_ptr().add(4), self.1);
+            }
         }
         #[inline(always)]
         fn add(self, o: Self) -> Self {
