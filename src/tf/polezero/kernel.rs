@@ -575,7 +575,7 @@ mod tests {
                         );
                     }
                     // The planar path (what `evaluate` uses) of the same kernel.
-                    let mut planes_of = |avx: bool| {
+                    let planes_of = |avx: bool| {
                         let mut data = vec![f64::NAN; n * stride];
                         let mut planes: Vec<&mut [f64]> = data.chunks_exact_mut(n).collect();
                         if avx {
