@@ -1,8 +1,9 @@
 //! Result buffers for transfer-function grids: zeroed `f64` vectors whose large allocations
 //! are backed by transparent huge pages where the OS offers them.
 //!
-//! A grid result is written once, sequentially, and is large (336 bytes per point for the
-//! 7x3 tilt matrix: 34 MB at 1e5 points), so its cost is dominated by memory, not arithmetic.
+//! A grid result is written once, sequentially, and can be large (88 bytes per point for the
+//! 7x3 tilt matrix in the pole-zero layout, 336 dense: 8.8 or 34 MB at 1e5 points), so memory
+//! is a large part of its cost.
 //! With 4 KiB pages every 4 KiB of output costs a TLB miss (a two-level page walk on a
 //! virtual machine) and, on first touch, a page fault; with 2 MiB pages both happen 512 times
 //! less often. On Linux, [`zeroed_f64`] asks for huge pages on the 2 MiB-aligned interior of
@@ -11,9 +12,13 @@
 //! the same for its large arrays. Elsewhere, or when the advice is refused, the buffer is an
 //! ordinary zeroed vector: the advice changes speed only, never values.
 //!
-//! Measured on the 2-core EPYC VM of `scripts/bench/README.md` (34 MB written with ordinary
-//! AVX stores, best of 15): 12.0-12.8 ns per point of 336 bytes into 4 KiB pages, 8.1-9.8 into
-//! huge pages.
+//! Measured on the 2-core EPYC VM of `scripts/bench/README.md` (`benches/methods.rs`, Table
+//! I's 7x3 tilt matrix, with and without the advice, alternating runs): `tf::evaluate` at 1e6
+//! points (an 88 MB result, mapped afresh by the allocator at every call) 17.1 to 18.6 ns per
+//! point with the advice, 50.5 to 50.8 without (fresh 4 KiB pages cost about 2.6 us each to
+//! fault in here); at 1e5 points (8.8 MB) 8.8 against 8.9: glibc keeps a freed block of that
+//! size for the next call, so no page is new; the dense complex output (34 MB) into a reused
+//! buffer 11.7 to 12.0 against 12.5 to 12.9 (fewer TLB misses).
 
 use num_complex::Complex64;
 

@@ -1,5 +1,5 @@
 //! Evaluation of a plan on a frequency grid: into a caller's dense buffer
-//! ([`eval_grid_threads`]), or into a [`TransferMatrix`] in the plan's own [`Layout`]
+//! ([`eval_grid_threads`]), or into a [`TransferMatrix`] in the plan's own [`Layout`](super::Layout)
 //! ([`evaluate`], [`evaluate_into`]), on one or more threads.
 
 use super::buffer::zeroed_f64;
@@ -76,7 +76,7 @@ pub fn eval_grid_threads(
 }
 
 /// Evaluates a plan on every frequency of a grid, on one thread, into a new matrix in the
-/// plan's [`Layout`] ([`TransferFunction::layout`]). Stops at the first singular frequency.
+/// plan's [`Layout`](super::Layout) ([`TransferFunction::layout`]). Stops at the first singular frequency.
 pub fn evaluate(tf: &dyn TransferFunction, freqs_hz: &[f64]) -> Result<TransferMatrix, TfError> {
     let layout = tf.layout();
     let data = zeroed_f64(layout.n_planes() * freqs_hz.len());

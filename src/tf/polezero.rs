@@ -34,17 +34,21 @@
 //! double-double within this bound, from 0 Hz to 1e5 Hz). Entries whose observation row or
 //! forcing column misses a block get nothing from it; entries no block reaches are exactly 0.0.
 //!
-//! Evaluation (`kernel`): a grid ([`TransferFunction::eval_grid_into`], and so
-//! [`super::evaluate`]) is evaluated eight frequencies at a time in vector lanes, each block's
-//! denominator and its reciprocal once per frequency, each entry a few multiplications; the
-//! output is written in one sequential pass (non-temporal stores for outputs larger than the
-//! cache). [`TransferFunction::eval_into`] is the same code on a grid of one point, and the
-//! results are bit-identical whatever the grid, the lane, the number of threads
-//! ([`super::eval_grid_threads`]) or the CPU (AVX, chosen at run time, or portable: the same
-//! IEEE operations in the same order, no fused multiply-add). Measured on Table I, 7x3 tilt
-//! matrix, 1e5 points (`benches/methods.rs`, `scripts/bench/README.md`): 13 to 15 ns per point
-//! on one thread, about 100x `numpy.linalg.solve`; about 12.5 ns of it is writing the 336
-//! bytes of each point to memory.
+//! Evaluation (`kernel`): a grid is evaluated eight frequencies at a time in vector lanes, each
+//! block's denominator and its reciprocal once per frequency, each entry a few
+//! multiplications. Two outputs: [`super::evaluate`] stores the plan's own [`Layout`] (planes
+//! of only the entries some block reaches, real when every block is: 11 real planes, 88 bytes
+//! per frequency, for Table I's 7x3 tilt matrix), each chunk's lanes stored with vector moves;
+//! [`TransferFunction::eval_grid_into`] writes the dense complex matrix, a point's values
+//! together (non-temporal stores for outputs larger than the cache).
+//! [`TransferFunction::eval_into`] is the dense path on a grid of one point. The results are
+//! bit-identical whatever the output, the grid, the lane, the number of threads
+//! ([`super::evaluate_into`], [`super::eval_grid_threads`]) or the CPU (AVX, chosen at run
+//! time, or portable: the same IEEE operations in the same order, no fused multiply-add).
+//! Measured on Table I, 7x3 tilt matrix, 1e5 points (`benches/methods.rs`,
+//! `scripts/bench/README.md`): 7.7 ns per point into a reused matrix on one thread (about
+//! 150x NumPy), 12 ns for the dense complex output, which is at the memory floor of its 336
+//! bytes per point.
 //!
 //! Singularity: an undamped block with `|lambda_k - s| < SINGULAR_RCOND lambda_k` (the rounding
 //! of `s` and of `lambda_k` then leaves fewer than three digits of the factor) is reported as

@@ -7,11 +7,17 @@
 //! its reciprocal once per frequency, then each of its entries `gain prod_k (a_k + b_k s)`
 //! times that reciprocal: the loops are over blocks, entries and factors, the lanes are
 //! frequencies. The chunk's values go into a small buffer that stays in L1 cache and holds
-//! the structural zeros (zeroed once, never written: each entry's first block stores its
-//! value, later blocks add theirs), and the buffer is copied into the output in one
-//! sequential pass, with non-temporal stores for outputs larger than the cache
-//! ([`STREAM_MIN_BYTES`]). One point alone ([`TransferFunction::eval_into`]) is written in
-//! place into the zeroed output.
+//! the values no block writes (zeroed once, never written: each entry's first block stores
+//! its value, later blocks add theirs); then the buffer goes to the output. Two outputs:
+//!
+//! * interleaved ([`Kernel::eval_grid`], the dense complex matrix, a point's values
+//!   together): each lane's values are scattered into the buffer, which is copied in one
+//!   sequential pass, with non-temporal stores for outputs larger than the cache
+//!   ([`STREAM_MIN_BYTES`]); one point alone ([`TransferFunction::eval_into`]) is written in
+//!   place into the zeroed output;
+//! * planar ([`Kernel::eval_planes`], a plane per value over the grid, the layout of
+//!   `tf::evaluate`): a value's eight lanes are stored together with vector moves, and copied
+//!   to its plane the same way.
 //!
 //! [`TransferFunction::eval_into`]: super::super::TransferFunction::eval_into
 //!
@@ -19,7 +25,7 @@
 //! no fused multiply-add, no reassociation) in the same order, so a value depends neither on
 //! the chunk nor the lane it falls in, nor on the number of threads, nor on the CPU: AVX and
 //! portable lanes give bit-identical results, and so do [`Kernel::eval_grid`] on a grid and
-//! on each of its points alone.
+//! on each of its points alone, and [`Kernel::eval_planes`].
 //!
 //! A chunk with a frequency that is not finite and >= 0, or on which a block is singular, is
 //! handed to a scalar pass over its points in order ([`Kernel::first_error`]) that returns the
@@ -32,7 +38,7 @@ use super::lanes::{stream_fence, Lanes, Portable, LANES};
 use crate::error::TfError;
 use num_complex::Complex64;
 
-/// Outputs of at least this many bytes are written with non-temporal stores
+/// Interleaved outputs of at least this many bytes are written with non-temporal stores
 /// ([`Lanes::stream_copy`]): well above a core's L2 (1 to 2 MiB), about where the output stops
 /// fitting in a typical L3 next to other work. Below it, ordinary stores leave the output in
 /// the cache for the caller. At 1e5 points of 21 values (34 MB) on the 2-core EPYC VM of
@@ -41,7 +47,7 @@ use num_complex::Complex64;
 const STREAM_MIN_BYTES: usize = 8 << 20;
 
 /// One entry of an undamped block: `gain prod_k (a_k + b_k s)` times the block's
-/// `1 / prod(lambda - s)`, added at `out[re]` of each point (its real part). Factors: `s` for a zero at the origin
+/// `1 / prod(lambda - s)`, added at value `re` (its real part). Factors: `s` for a zero at the origin
 /// (`a = 0, b = 1`), `1 - s / z` for a zero `z` (`a = 1, b = -1 / z`, `z` moved into the
 /// gain); the first `factors` of the four, the others padding (`a = 1, b = 0`), skipped (an
 /// exact 1 for every finite `s`).
