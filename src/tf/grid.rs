@@ -118,7 +118,10 @@ pub fn evaluate_into(
     } else {
         data.resize(len, 0.0);
     }
-    if n_planes == 0 || nf == 0 {
+    if nf == 0 {
+        return Ok(());
+    }
+    if n_planes == 0 {
         // Nothing to write; each frequency is still checked.
         return tf.eval_grid_layout_into(freqs_hz, &mut []);
     }
@@ -134,4 +137,36 @@ pub fn evaluate_into(
     on_threads(jobs, &|f, mut p: Vec<&mut [f64]>| {
         tf.eval_grid_layout_into(f, &mut p)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::Model;
+    use crate::params::Params;
+    use crate::tf::{plan, Method};
+
+    /// An empty grid gives an empty matrix with the plan's labels; an empty request still
+    /// checks every frequency.
+    #[test]
+    fn empty_grids_and_requests() {
+        let model = Model::new(&Params::table_i()).unwrap();
+        for method in [Method::Direct, Method::PoleZero] {
+            let tf = plan(&model, &Request::all_tilt(), method).unwrap();
+            let m = evaluate(tf.as_ref(), &[]).unwrap();
+            assert_eq!((m.n_stored_freqs(), m.outputs.len()), (0, 7));
+            assert!(m.dense_values().is_empty());
+            let empty = Request {
+                outputs: vec![],
+                inputs: Request::all_tilt().inputs,
+            };
+            let tf = plan(&model, &empty, method).unwrap();
+            let m = evaluate(tf.as_ref(), &[1e-3, 1.0]).unwrap();
+            assert_eq!(m.n_stored_freqs(), 2);
+            assert!(matches!(
+                evaluate(tf.as_ref(), &[1e-3, -1.0]),
+                Err(TfError::Freq(_))
+            ));
+        }
+    }
 }
