@@ -3,8 +3,9 @@
 //! on a log-spaced grid from 1e-5 to 100 Hz.
 //!
 //! Group `methods_7x3_tilt`, one benchmark per method and thread count:
-//! * `direct/1t`, `block/1t`, `split/1t`, `polezero/1t`, `modal/1t`: one thread, `eval_into`
-//!   at every grid point into a preallocated `[freq][output][input]` buffer (point by point);
+//! * `direct/1t`, `block/1t`, `split/1t`, `polezero/1t`, `modal/1t`, `statespace/1t`: one
+//!   thread, `eval_into` at every grid point into a preallocated `[freq][output][input]`
+//!   buffer (point by point);
 //! * `block/2t`, `split/2t`, `polezero/2t`: the same with the grid cut into two halves, the
 //!   second half evaluated on a thread spawned with `std::thread::scope` per iteration, the
 //!   first on the calling thread (the spawn, tens of microseconds, is included and is
@@ -105,6 +106,7 @@ fn methods(c: &mut Criterion) {
         Method::Split,
         Method::PoleZero,
         Method::Modal,
+        Method::StateSpace,
     ] {
         let plan = tf::plan(&model, &request, method).expect("full-model methods plan 7x3 tilt");
         let plan = plan.as_ref();

@@ -164,6 +164,9 @@ pub(crate) enum MethodArg {
     Polezero,
     /// Modal superposition (fast; loses accuracy where modal terms cancel).
     Modal,
+    /// First-order state space as python-control and scipy.signal evaluate it (comparison;
+    /// loses accuracy where the tilt forcing cancels).
+    Statespace,
     /// The 2-DoF torsional model of section IV.C (no tilt inputs).
     Torsion2,
 }
@@ -178,6 +181,7 @@ impl MethodArg {
             MethodArg::Split => Some(Method::Split),
             MethodArg::Polezero => Some(Method::PoleZero),
             MethodArg::Modal => Some(Method::Modal),
+            MethodArg::Statespace => Some(Method::StateSpace),
             MethodArg::Torsion2 => Some(Method::Torsion2),
         }
     }

@@ -236,7 +236,12 @@ fn methods_without_viscous_support_refuse_it_at_plan_time() {
         outputs: vec![Observable::Phi],
         inputs: vec![Input::Force(ForceInput::from_name("M_b.z").unwrap())],
     };
-    for method in [Method::Modal, Method::Torsion2, Method::PoleZero] {
+    for method in [
+        Method::Modal,
+        Method::Torsion2,
+        Method::PoleZero,
+        Method::StateSpace,
+    ] {
         match plan(&model, &req, method) {
             Err(PlanError::Unsupported { item, reason, .. }) => {
                 assert!(

@@ -8,8 +8,8 @@ What is compared: the 7x3 tilt matrix of Table I at --points log-spaced frequenc
 100 Hz, in ns per frequency point.
 
 * Rust: the criterion benchmark `benches/methods.rs` (group `methods_7x3_tilt`: direct, block,
-  split, polezero, modal point by point on one thread; block, split and polezero also on two
-  threads, the grid cut in halves; the pole-zero grid evaluations on one and two threads:
+  split, polezero, modal, statespace point by point on one thread; block, split and polezero
+  also on two threads, the grid cut in halves; the pole-zero grid evaluations on one and two threads:
   polezero_matrix, `tf::evaluate_into` into a reused `TransferMatrix` in the plan's own
   layout, what `auto` hands the user (the 11 entries of the 7x3 tilt matrix that are not
   structural zeros, real for the undamped Table I: 88 bytes per point); polezero_batch,
@@ -60,7 +60,7 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
 METHODS = ("direct", "block", "split", "polezero", "polezero_batch", "polezero_matrix",
-           "polezero_evaluate", "modal")
+           "polezero_evaluate", "modal", "statespace")
 TWO_THREAD = ("block", "split", "polezero", "polezero_batch", "polezero_matrix")
 ACCURATE = "polezero_matrix"
 ALLOCATING = "polezero_evaluate"

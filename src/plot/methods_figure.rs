@@ -42,7 +42,8 @@ impl Figure for MethodsChart {
         let floor = 1e-17;
         let (x0, x1) = decade_bounds(self.points.iter().map(|p| p.1));
         let (_, y1) = decade_bounds(self.points.iter().map(|p| p.2.max(floor)));
-        let y1 = y1.max(1.0);
+        // Six decades of headroom above the worst point: the legend's place (upper left).
+        let y1 = y1.max(1.0) * 1e6;
         let mut chart = ChartBuilder::on(root)
             .caption(&self.title, (FONT_FAMILY, 22))
             .margin(20)
@@ -88,7 +89,7 @@ impl Figure for MethodsChart {
         }
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
+            .position(SeriesLabelPosition::UpperLeft)
             .background_style(WHITE.mix(0.9))
             .border_style(BLACK.mix(0.4))
             .label_font((FONT_FAMILY, 14))

@@ -357,54 +357,13 @@ impl Kernel {
     /// length `freqs_hz.len() * stride`, checked by the caller). On error the contents of
     /// `out` are unspecified.
     pub fn eval_grid(&self, freqs_hz: &[f64], out: &mut [f64]) -> Result<(), TfError> {
-        #[cfg(target_arch = "x86_64")]
-        if self.avx {
-            // SAFETY: `avx` is true only when the running CPU supports AVX (checked in `new`).
-            return unsafe { self.eval_grid_avx(freqs_hz, out) };
-        }
-        self.eval_grid_with::<Portable>(freqs_hz, out)
-    }
-
-    /// The kernel in AVX registers: the same operations in the same order as the portable
-    /// lanes (no fused multiply-add), so the results are bit-identical.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx")]
-    unsafe fn eval_grid_avx(&self, freqs_hz: &[f64], out: &mut [f64]) -> Result<(), TfError> {
-        self.eval_grid_with::<Avx>(freqs_hz, out)
-    }
-
-    #[inline(always)]
-    fn eval_grid_with<V: Lanes>(&self, freqs_hz: &[f64], out: &mut [f64]) -> Result<(), TfError> {
-        let nv = self.stride;
-        if nv == 0 {
-            // Nothing to write; the frequencies are still checked, as point by point.
-            return freqs_hz.iter().try_for_each(|&f| omega_sq(f).map(drop));
-        }
-        if let [_] = freqs_hz {
+        if self.stride > 0 && freqs_hz.len() == 1 {
             // One point (`eval_into`): written in place.
             out.fill(0.0);
-            return self.eval_chunk::<V, false>(freqs_hz, out);
+            return self.dispatch(freqs_hz, out, &mut InPlace);
         }
-        // A chunk is written into `chunk` (in L1 cache), then copied into `out` in one
-        // sequential pass. The structural zeros of `chunk` are never written: zeroed once.
-        let mut chunk = vec![0.0; LANES * nv];
-        let stream = std::mem::size_of_val(out) >= STREAM_MIN_BYTES;
-        let mut result = Ok(());
-        for (fc, oc) in freqs_hz.chunks(LANES).zip(out.chunks_mut(LANES * nv)) {
-            result = self.eval_chunk::<V, false>(fc, &mut chunk);
-            if result.is_err() {
-                break;
-            }
-            if stream {
-                V::stream_copy(oc, &chunk[..oc.len()]);
-            } else {
-                oc.copy_from_slice(&chunk[..oc.len()]);
-            }
-        }
-        if stream {
-            stream_fence();
-        }
-        result
+        let mut chunk = self.chunk_buffer();
+        self.dispatch(freqs_hz, &mut chunk, &mut Interleaved::new(out))
     }
 
     /// `H` at every frequency of `freqs_hz` into `planes` (`stride` of them, each as long as
@@ -415,63 +374,69 @@ impl Kernel {
         for p in planes.iter() {
             assert_eq!(p.len(), freqs_hz.len(), "planes as long as the grid");
         }
+        let mut chunk = self.chunk_buffer();
+        self.dispatch(freqs_hz, &mut chunk, &mut Planar(planes))
+    }
+
+    /// A chunk's values, zeroed: the values no block writes stay zero.
+    fn chunk_buffer(&self) -> Vec<f64> {
+        vec![0.0; LANES * self.stride]
+    }
+
+    /// [`Kernel::eval_with`] in AVX registers when the CPU has AVX, portable lanes otherwise.
+    fn dispatch<S: Sink>(
+        &self,
+        freqs_hz: &[f64],
+        chunk: &mut [f64],
+        sink: &mut S,
+    ) -> Result<(), TfError> {
         #[cfg(target_arch = "x86_64")]
         if self.avx {
             // SAFETY: `avx` is true only when the running CPU supports AVX (checked in `new`).
-            return unsafe { self.eval_planes_avx(freqs_hz, planes) };
+            return unsafe { self.eval_avx(freqs_hz, chunk, sink) };
         }
-        self.eval_planes_with::<Portable>(freqs_hz, planes)
+        self.eval_with::<Portable, S>(freqs_hz, chunk, sink)
     }
 
-    /// [`Kernel::eval_planes`] in AVX registers (see [`Kernel::eval_grid_avx`]).
+    /// The kernel in AVX registers: the same operations in the same order as the portable
+    /// lanes (no fused multiply-add), so the results are bit-identical.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    unsafe fn eval_planes_avx(
+    unsafe fn eval_avx<S: Sink>(
         &self,
         freqs_hz: &[f64],
-        planes: &mut [&mut [f64]],
+        chunk: &mut [f64],
+        sink: &mut S,
     ) -> Result<(), TfError> {
-        self.eval_planes_with::<Avx>(freqs_hz, planes)
+        self.eval_with::<Avx, S>(freqs_hz, chunk, sink)
     }
 
+    /// The grid chunk by chunk: each chunk's values into `chunk` (a buffer that stays in L1
+    /// cache, whose values no block writes are zero), then handed to `sink`.
     #[inline(always)]
-    fn eval_planes_with<V: Lanes>(
+    fn eval_with<V: Lanes, S: Sink>(
         &self,
         freqs_hz: &[f64],
-        planes: &mut [&mut [f64]],
+        chunk: &mut [f64],
+        sink: &mut S,
     ) -> Result<(), TfError> {
-        let np = self.stride;
-        if np == 0 {
+        if self.stride == 0 {
+            // Nothing to write; the frequencies are still checked, as point by point.
             return freqs_hz.iter().try_for_each(|&f| omega_sq(f).map(drop));
         }
-        // A chunk's values go into `chunk`, each value's lanes together (in L1 cache), then
-        // each value's lanes into its plane with ordinary stores. Values no block writes stay
-        // zero. No non-temporal stores here: a chunk writes 64 bytes to each plane, a whole
-        // cache line only if the plane is 64-byte aligned, and partial lines written
-        // non-temporally cost ~30 ns per point on the VM of `scripts/bench/README.md`
-        // (ordinary stores: ~1.3 ns per point of 11 planes in a copy test); and a compact
-        // result is small enough to stay in L3 (8.8 MB at 1e5 points of Table I's tilt matrix).
-        let mut chunk = vec![0.0; LANES * np];
         let mut result = Ok(());
         for (c, fc) in freqs_hz.chunks(LANES).enumerate() {
-            result = self.eval_chunk::<V, true>(fc, &mut chunk);
+            result = if S::PLANAR {
+                self.eval_chunk::<V, true>(fc, chunk)
+            } else {
+                self.eval_chunk::<V, false>(fc, chunk)
+            };
             if result.is_err() {
                 break;
             }
-            let (k0, n) = (c * LANES, fc.len());
-            for (p, plane) in planes.iter_mut().enumerate() {
-                let (dst, src) = (&mut plane[k0..k0 + n], &chunk[p * LANES..p * LANES + n]);
-                if let (Ok(d), Ok(s)) = (
-                    <&mut [f64; LANES]>::try_from(&mut *dst),
-                    <&[f64; LANES]>::try_from(src),
-                ) {
-                    // A full chunk: a fixed-size copy (vector moves, no call to memcpy).
-                    V::load(s).store(d);
-                } else {
-                    dst.copy_from_slice(src);
-                }
-            }
+            sink.take::<V>(c * LANES, fc.len(), self.stride, chunk);
         }
+        sink.finish();
         result
     }
 
@@ -517,6 +482,88 @@ impl Kernel {
             }
         }
         unreachable!("a chunk failed its checks but none of its points does")
+    }
+}
+
+/// Where [`Kernel::eval_with`] puts each chunk of values.
+trait Sink {
+    /// Each value's lanes together in the chunk buffer (else each point's values together).
+    const PLANAR: bool;
+
+    /// The chunk of `n` points starting at point `first` (`stride` values each), from `chunk`.
+    fn take<V: Lanes>(&mut self, first: usize, n: usize, stride: usize, chunk: &[f64]);
+
+    /// After the last chunk.
+    fn finish(&mut self) {}
+}
+
+/// A single point evaluated directly in the (zeroed) output, which is the chunk buffer.
+struct InPlace;
+
+impl Sink for InPlace {
+    const PLANAR: bool = false;
+    fn take<V: Lanes>(&mut self, _: usize, _: usize, _: usize, _: &[f64]) {}
+}
+
+/// A point's values together: each chunk copied in one sequential pass, with non-temporal
+/// stores when `stream`.
+struct Interleaved<'a> {
+    out: &'a mut [f64],
+    stream: bool,
+}
+
+impl<'a> Interleaved<'a> {
+    /// Non-temporal stores for outputs of [`STREAM_MIN_BYTES`] or more.
+    fn new(out: &'a mut [f64]) -> Self {
+        let stream = std::mem::size_of_val(out) >= STREAM_MIN_BYTES;
+        Interleaved { out, stream }
+    }
+}
+
+impl Sink for Interleaved<'_> {
+    const PLANAR: bool = false;
+    #[inline(always)]
+    fn take<V: Lanes>(&mut self, first: usize, n: usize, stride: usize, chunk: &[f64]) {
+        let dst = &mut self.out[first * stride..(first + n) * stride];
+        if self.stream {
+            V::stream_copy(dst, &chunk[..dst.len()]);
+        } else {
+            dst.copy_from_slice(&chunk[..dst.len()]);
+        }
+    }
+    fn finish(&mut self) {
+        if self.stream {
+            stream_fence();
+        }
+    }
+}
+
+/// One plane per value. Ordinary stores: a chunk writes 64 bytes to each plane, a whole
+/// cache line only if the plane is 64-byte aligned, and partial lines written non-temporally
+/// cost ~30 ns per point on the VM of `scripts/bench/README.md` (ordinary stores: ~1.3 ns per
+/// point of 11 planes in a copy test); a compact result is also small enough to stay in L3
+/// (8.8 MB at 1e5 points of Table I's tilt matrix).
+struct Planar<'a, 'p>(&'a mut [&'p mut [f64]]);
+
+impl Sink for Planar<'_, '_> {
+    const PLANAR: bool = true;
+    #[inline(always)]
+    fn take<V: Lanes>(&mut self, first: usize, n: usize, _: usize, chunk: &[f64]) {
+        for (p, plane) in self.0.iter_mut().enumerate() {
+            let (dst, src) = (
+                &mut plane[first..first + n],
+                &chunk[p * LANES..p * LANES + n],
+            );
+            if let (Ok(d), Ok(s)) = (
+                <&mut [f64; LANES]>::try_from(&mut *dst),
+                <&[f64; LANES]>::try_from(src),
+            ) {
+                // A full chunk: a fixed-size copy (vector moves, no call to memcpy).
+                V::load(s).store(d);
+            } else {
+                dst.copy_from_slice(src);
+            }
+        }
     }
 }
 
@@ -567,11 +614,18 @@ mod tests {
                         .collect();
                     let mut portable = vec![f64::NAN; n * stride];
                     let mut avx = portable.clone();
+                    let mut chunk = kernel.chunk_buffer();
                     kernel
-                        .eval_grid_with::<super::Portable>(&freqs, &mut portable)
+                        .eval_with::<super::Portable, _>(
+                            &freqs,
+                            &mut chunk,
+                            &mut super::Interleaved::new(&mut portable),
+                        )
                         .unwrap();
+                    let mut chunk = kernel.chunk_buffer();
+                    let mut sink = super::Interleaved::new(&mut avx);
                     // SAFETY: the CPU has AVX (checked above).
-                    unsafe { kernel.eval_grid_avx(&freqs, &mut avx) }.unwrap();
+                    unsafe { kernel.eval_avx(&freqs, &mut chunk, &mut sink) }.unwrap();
                     for (k, (a, p)) in avx.iter().zip(&portable).enumerate() {
                         assert!(
                             a.to_bits() == p.to_bits(),
@@ -584,12 +638,14 @@ mod tests {
                     let planes_of = |avx: bool| {
                         let mut data = vec![f64::NAN; n * stride];
                         let mut planes: Vec<&mut [f64]> = data.chunks_exact_mut(n).collect();
+                        let mut sink = super::Planar(&mut planes);
+                        let mut chunk = kernel.chunk_buffer();
                         if avx {
                             // SAFETY: the CPU has AVX (checked above).
-                            unsafe { kernel.eval_planes_avx(&freqs, &mut planes) }.unwrap();
+                            unsafe { kernel.eval_avx(&freqs, &mut chunk, &mut sink) }.unwrap();
                         } else {
                             kernel
-                                .eval_planes_with::<super::Portable>(&freqs, &mut planes)
+                                .eval_with::<super::Portable, _>(&freqs, &mut chunk, &mut sink)
                                 .unwrap();
                         }
                         data
