@@ -62,11 +62,12 @@ fn n_points() -> usize {
     }
 }
 
-/// `tf` at every frequency of `grid`, into `out` (`grid.len()` blocks of `block` values).
+/// `tf` at every frequency of `grid`, into `out` (`grid.len()` blocks of `block` values). A
+/// point the method reports singular costs what it costs and is skipped (the untimed pass in
+/// `methods` allows such points only for `statespace`, a comparison method, and counts them).
 fn eval_grid(tf: &dyn TransferFunction, grid: &[f64], block: usize, out: &mut [Complex64]) {
     for (&f, h) in grid.iter().zip(out.chunks_exact_mut(block)) {
-        tf.eval_into(f, h)
-            .expect("no singular frequency on the grid");
+        let _ = tf.eval_into(f, h);
     }
 }
 
@@ -110,8 +111,24 @@ fn methods(c: &mut Criterion) {
     ] {
         let plan = tf::plan(&model, &request, method).expect("full-model methods plan 7x3 tilt");
         let plan = plan.as_ref();
-        // One untimed pass: fails loudly if a grid point is singular for this method.
-        eval_grid(plan, &grid, block, &mut out);
+        // One untimed pass: fails loudly if a grid point is singular for a method that should
+        // evaluate the whole grid; counts the state-space method's refusals.
+        let singular = grid
+            .iter()
+            .zip(out.chunks_exact_mut(block))
+            .map(|(&f, h)| plan.eval_into(f, h))
+            .filter(Result::is_err)
+            .count();
+        if method == Method::StateSpace {
+            eprintln!("methods bench: statespace reports {singular} of {n} points singular");
+        } else {
+            assert_eq!(
+                singular,
+                0,
+                "{}: singular points on the grid",
+                method.name()
+            );
+        }
         g.bench_function(format!("{}/1t", method.name()), |b| {
             b.iter(|| eval_grid(plan, black_box(&grid), block, black_box(&mut out)))
         });

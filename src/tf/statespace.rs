@@ -14,9 +14,11 @@
 //! (force inputs: `G2 = 0`, `B0` the force columns, `D = 0`). As a NumPy user would build it:
 //! `M^-1` applied by an LU of `M` in `f64`, and at every frequency an LU with partial pivoting
 //! of the 16x16 complex `i w I - A`, no equilibration. One addition of ours, which the Python
-//! tools do not make: the reciprocal 1-norm condition number of `i w I - A` (from its explicit
-//! inverse) below [`SINGULAR_RCOND`] is reported as singular, so that an exact resonance gives
-//! an error rather than a large wrong number. Structural loss angles enter through the complex
+//! tools do not make: the singularity check of every other method (the equilibrated 8x8
+//! `K_c - w^2 M`, whose determinant vanishes exactly where that of `i w I - A` does; see
+//! [`super::direct`]), so that an exact resonance gives an error rather than a large wrong
+//! number. The state-space solve itself is not checked: near a resonance it returns what the
+//! Python tools return. Structural loss angles enter through the complex
 //! `K_c` (exact, as in the direct method); viscous damping is refused (its tilt forcing has a
 //! `w C M^-1 G2` term that this form does not carry).
 //!
@@ -32,10 +34,10 @@
 //!   unequilibrated form: its condition number, not just the distance to a resonance, sets
 //!   the LU's error.
 
-use super::direct::{forcing_columns, omega_sq};
-use super::{Method, Request, TransferFunction, SINGULAR_RCOND};
+use super::direct::{forcing_columns, omega_sq, EquilibratedLu};
+use super::{Method, Request, TransferFunction};
 use crate::error::TfError;
-use crate::model::Model;
+use crate::model::{CMat8, Mat8, Model};
 use nalgebra::{DMatrix, SMatrix};
 use num_complex::Complex64;
 
@@ -53,6 +55,9 @@ pub struct StateSpace {
     c: DMatrix<f64>,
     /// `D = -C M^-1 G2` (outputs x inputs).
     d: DMatrix<f64>,
+    /// `K_c` and `M`, for the singularity check.
+    stiffness: CMat8,
+    mass: Mat8,
 }
 
 impl StateSpace {
@@ -103,6 +108,8 @@ impl StateSpace {
             b,
             c,
             d,
+            stiffness: k_c,
+            mass: *model.mass(),
         }
     }
 }
@@ -117,39 +124,32 @@ impl TransferFunction for StateSpace {
     }
 
     fn eval_into(&self, freq_hz: f64, out: &mut [Complex64]) -> Result<(), TfError> {
-        let w = omega_sq(freq_hz)?.sqrt();
-        let singular = |rcond: f64| TfError::Singular { freq_hz, rcond };
+        let w2 = omega_sq(freq_hz)?;
+        EquilibratedLu::factor(&self.stiffness, &self.mass, w2, freq_hz)?;
+        let singular = TfError::Singular {
+            freq_hz,
+            rcond: 0.0,
+        };
         let mut s_minus_a = -self.a;
         for k in 0..N {
-            s_minus_a[(k, k)] += Complex64::new(0.0, w);
+            s_minus_a[(k, k)] += Complex64::new(0.0, w2.sqrt());
         }
         let lu = s_minus_a.lu();
-        let inverse = lu.try_inverse().ok_or_else(|| singular(0.0))?;
-        let rcond = 1.0 / (one_norm(&s_minus_a) * one_norm(&inverse));
-        if rcond.is_nan() || rcond < SINGULAR_RCOND {
-            return Err(singular(rcond));
-        }
         let n_in = self.request.inputs.len();
         for i in 0..n_in {
             let mut x = nalgebra::SVector::<Complex64, N>::from_fn(|r, _| self.b[(r, i)]);
             if !lu.solve_mut(&mut x) {
-                return Err(singular(0.0));
+                return Err(singular);
             }
             for o in 0..self.request.outputs.len() {
                 let h: Complex64 =
                     (0..8).map(|k| x[k] * self.c[(o, k)]).sum::<Complex64>() + self.d[(o, i)];
                 if !(h.re.is_finite() && h.im.is_finite()) {
-                    return Err(singular(rcond));
+                    return Err(singular);
                 }
                 out[o * n_in + i] = h;
             }
         }
         Ok(())
     }
-}
-
-fn one_norm(m: &SMatrix<Complex64, N, N>) -> f64 {
-    (0..N)
-        .map(|c| m.column(c).iter().map(|z| z.norm()).sum::<f64>())
-        .fold(0.0, f64::max)
 }
