@@ -8,12 +8,12 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum ParamError {
     /// The file could not be read at all.
-    #[error("cannot read parameter file {path}: {source}")]
+    #[error("cannot read parameter file {path}: {reason}")]
     Read {
         /// The file that was asked for.
         path: PathBuf,
-        /// What the operating system said.
-        source: std::io::Error,
+        /// What the operating system said (in the message, so not also a `source()`).
+        reason: std::io::Error,
     },
     /// The text is not valid TOML, or has unknown/missing keys or a value of the wrong type.
     #[error("invalid parameter file {origin}: {message}")]

@@ -317,6 +317,77 @@ fn csv_header_and_values_round_trip() {
     assert_eq!(c, header.len());
 }
 
+/// With the response to the equivalent input in the budget (damped models), the CSV ends with
+/// `OBS.equivalent.TERM` columns: `sqrt(S_o / |R_o|^2)` for every noise term but `measured`
+/// and `residual`, bit for bit, after the columns of the undamped layout (which keep their
+/// places); the response itself is no column.
+#[test]
+fn csv_equivalent_columns_follow_the_bands() {
+    let plain = synthetic_report();
+    let mut report = synthetic_report();
+    let n = report.budget.freqs_hz.len();
+    let response: Vec<f64> = (0..n).map(|k| 1e-6 * (k as f64 + 1.5)).collect();
+    let x = &mut report.budget.observables[0];
+    x.terms.insert(4, term("measured", vec![1e-16; n]));
+    x.terms.insert(5, term("response.F_b.x", response.clone()));
+    let text = budget_csv_string(&report).unwrap();
+    let plain_header = budget_csv_string(&plain)
+        .unwrap()
+        .lines()
+        .next()
+        .unwrap()
+        .to_string();
+    let header: Vec<String> = text
+        .lines()
+        .next()
+        .unwrap()
+        .split(',')
+        .map(String::from)
+        .collect();
+    // The undamped columns, `X.measured` among the terms, then the referred ones.
+    let expected_front: Vec<String> = plain_header
+        .split(',')
+        .flat_map(|c| {
+            if c == "X.total" {
+                vec!["X.measured".to_string(), c.to_string()]
+            } else {
+                vec![c.to_string()]
+            }
+        })
+        .collect();
+    assert_eq!(header[..expected_front.len()], expected_front[..]);
+    let referred: Vec<&str> = header[expected_front.len()..]
+        .iter()
+        .map(String::as_str)
+        .collect();
+    assert_eq!(
+        referred,
+        [
+            "X.equivalent.tilt",
+            "X.equivalent.tilt.theta_t",
+            "X.equivalent.tilt.eta_t",
+            "X.equivalent.readout",
+            "X.equivalent.total"
+        ]
+    );
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    for (c, name) in header.iter().enumerate().skip(expected_front.len()) {
+        let term = name.trim_start_matches("X.equivalent.");
+        let psd = &report.budget.observables[0].term(term).unwrap().psd;
+        let want: Vec<f64> = psd
+            .iter()
+            .zip(&response)
+            .map(|(p, r)| (p / r).sqrt())
+            .collect();
+        let got: Vec<f64> = rows.iter().map(|r| r[c]).collect();
+        assert_bits(&got, &want, name);
+    }
+}
+
 #[test]
 fn csv_percentile_names_follow_the_band() {
     let mut report = synthetic_report();

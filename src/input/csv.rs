@@ -54,9 +54,9 @@ fn unquote(s: &str) -> &str {
 
 impl CsvFile {
     pub fn open(path: &Path) -> Result<CsvFile, InputError> {
-        let file = File::open(path).map_err(|source| InputError::Io {
+        let file = File::open(path).map_err(|reason| InputError::Io {
             path: path.to_path_buf(),
-            source,
+            reason,
         })?;
         Ok(CsvFile {
             path: path.to_path_buf(),
@@ -89,7 +89,7 @@ impl CsvFile {
             } else {
                 InputError::Io {
                     path: self.path.clone(),
-                    source: e,
+                    reason: e,
                 }
             }
         })?;

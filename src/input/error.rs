@@ -1,4 +1,5 @@
-//! [`InputError`]: everything that can be wrong with a floor-tilt input file.
+//! [`InputError`]: everything that can be wrong with an input file (floor tilt, or a measured
+//! series or spectrum for the budget).
 //!
 //! Every message names the file, the dataset, column, attribute or key, the offending value or
 //! index, the unit where there is one, and what is allowed. Sample indices are 0-based (the
@@ -14,21 +15,21 @@ fn at_line(line: &Option<usize>) -> String {
     }
 }
 
-/// A floor-tilt input (time series or spectra) that cannot be read or is not valid.
+/// An input file (floor tilt, or a measured series or spectrum) that cannot be read or is not valid.
 #[derive(Debug, thiserror::Error)]
 pub enum InputError {
     /// The file could not be opened or read.
-    #[error("cannot read tilt input {path}: {source}")]
+    #[error("cannot read input file {path}: {reason}")]
     Io {
         /// The file.
         path: PathBuf,
-        /// What the operating system said.
-        source: std::io::Error,
+        /// What the operating system said (in the message, so not also a `source()`).
+        reason: std::io::Error,
     },
 
     /// The extension names no supported format.
     #[error(
-        "tilt input {path}: extension `{extension}` is not supported; allowed: .h5 or .hdf5 \
+        "input file {path}: extension `{extension}` is not supported; allowed: .h5 or .hdf5 \
          (HDF5), .csv (comma-separated text)"
     )]
     Extension {
@@ -39,7 +40,7 @@ pub enum InputError {
     },
 
     /// The HDF5 library failed (not an HDF5 file, corrupt file, unreadable object).
-    #[error("tilt input {path}: HDF5 error reading {object}: {message}")]
+    #[error("input file {path}: HDF5 error reading {object}: {message}")]
     Hdf5 {
         /// The file.
         path: PathBuf,
@@ -50,7 +51,7 @@ pub enum InputError {
     },
 
     /// The content matches none of the accepted layouts.
-    #[error("tilt input {path} ({format}): {found}; accepted layouts: {accepted}")]
+    #[error("input file {path} ({format}): {found}; accepted layouts: {accepted}")]
     UnknownLayout {
         /// The file.
         path: PathBuf,
@@ -63,7 +64,7 @@ pub enum InputError {
     },
 
     /// A time series was asked for and the file holds spectra, or the other way round.
-    #[error("tilt input {path}: expected {expected} but the file holds {found}")]
+    #[error("input file {path}: expected {expected} but the file holds {found}")]
     WrongKind {
         /// The file.
         path: PathBuf,
@@ -74,7 +75,7 @@ pub enum InputError {
     },
 
     /// A required HDF5 attribute is absent.
-    #[error("tilt input {path}: required attribute `{attribute}` of {object} is missing; expected {expected}")]
+    #[error("input file {path}: required attribute `{attribute}` of {object} is missing; expected {expected}")]
     MissingAttribute {
         /// The file.
         path: PathBuf,
@@ -87,7 +88,7 @@ pub enum InputError {
     },
 
     /// An HDF5 attribute (or CSV metadata key) with a value or type that is not allowed.
-    #[error("tilt input {path}: attribute `{attribute}` of {object} = {value} is not allowed: must be {allowed}")]
+    #[error("input file {path}: attribute `{attribute}` of {object} = {value} is not allowed: must be {allowed}")]
     BadAttribute {
         /// The file.
         path: PathBuf,
@@ -102,7 +103,7 @@ pub enum InputError {
     },
 
     /// A required HDF5 dataset is absent.
-    #[error("tilt input {path}: required dataset `{dataset}` is missing; expected {expected}")]
+    #[error("input file {path}: required dataset `{dataset}` is missing; expected {expected}")]
     MissingDataset {
         /// The file.
         path: PathBuf,
@@ -113,7 +114,7 @@ pub enum InputError {
     },
 
     /// An HDF5 dataset of the wrong type or shape.
-    #[error("tilt input {path}: dataset `{dataset}` has {found}; allowed: {allowed}")]
+    #[error("input file {path}: dataset `{dataset}` has {found}; allowed: {allowed}")]
     BadDataset {
         /// The file.
         path: PathBuf,
@@ -127,7 +128,7 @@ pub enum InputError {
 
     /// A NaN or infinite sample while gaps are rejected.
     #[error(
-        "tilt input {path}: channel `{channel}` sample index {index}{} is {value:?} {unit}; \
+        "input file {path}: channel `{channel}` sample index {index}{} is {value:?} {unit}; \
          allowed: finite values (or select gap interpolation to bridge interior gaps linearly)",
         at_line(.line)
     )]
@@ -149,7 +150,7 @@ pub enum InputError {
     /// A run of non-finite samples touching the start or the end of a channel, which linear
     /// interpolation cannot bridge.
     #[error(
-        "tilt input {path}: channel `{channel}` has a {edge} gap of non-finite samples at \
+        "input file {path}: channel `{channel}` has a {edge} gap of non-finite samples at \
          indices {first}..={last} (of {len} samples, unit {unit}); gap interpolation needs a \
          finite sample on both sides: trim the series"
     )]
@@ -172,7 +173,7 @@ pub enum InputError {
 
     /// Two channels of different lengths.
     #[error(
-        "tilt input {path}: channel `{channel_a}` has {len_a} samples but `{channel_b}` has \
+        "input file {path}: channel `{channel_a}` has {len_a} samples but `{channel_b}` has \
          {len_b}; all channels must have the same length"
     )]
     LengthMismatch {
@@ -189,7 +190,7 @@ pub enum InputError {
     },
 
     /// Too few samples or frequencies.
-    #[error("tilt input {path}: {what} has {len} {unit}; at least {min} required")]
+    #[error("input file {path}: {what} has {len} {unit}; at least {min} required")]
     TooShort {
         /// The file.
         path: PathBuf,
@@ -222,7 +223,7 @@ pub enum InputError {
 
     /// The axis map names a channel that the file does not have.
     #[error(
-        "tilt input {path}: the axis map assigns {target} to {kind} `{source_name}`, which the \
+        "input file {path}: the axis map assigns {target} to {kind} `{source_name}`, which the \
          file does not have; available {kind}s: {available}"
     )]
     AxisMapSource {
@@ -240,7 +241,7 @@ pub enum InputError {
 
     /// No channel could be assigned to a tilt axis.
     #[error(
-        "tilt input {path}: no tilt channel found among {kind}s {found}; allowed without an \
+        "input file {path}: no tilt channel found among {kind}s {found}; allowed without an \
          axis map: theta_t, eta_t, phi_t (used as they are) or the rotation channels E, N, Z \
          (or SEED rotation codes ?JE, ?JN, ?JZ; default mapping theta_t=-E, eta_t=-N, \
          phi_t=-Z); otherwise give an axis map such as theta_t=-E,eta_t=-N"
@@ -256,7 +257,7 @@ pub enum InputError {
 
     /// Several channels qualify for the same axis under the default mapping.
     #[error(
-        "tilt input {path}: {kind}s {candidates} all qualify for {axis} under the default \
+        "input file {path}: {kind}s {candidates} all qualify for {axis} under the default \
          mapping; allowed: exactly one, so give an explicit axis map (e.g. {axis}=-{first})"
     )]
     AmbiguousAxis {
@@ -273,7 +274,7 @@ pub enum InputError {
     },
 
     /// A unit string that is not understood.
-    #[error("tilt input {path}: {location} has units `{value}`; allowed: {allowed}")]
+    #[error("input file {path}: {location} has units `{value}`; allowed: {allowed}")]
     Units {
         /// The file.
         path: PathBuf,
@@ -287,7 +288,7 @@ pub enum InputError {
 
     /// Channels with different quantities (angle and rate) in one file.
     #[error(
-        "tilt input {path}: channel `{channel_a}` is in {unit_a} but `{channel_b}` is in \
+        "input file {path}: channel `{channel_a}` is in {unit_a} but `{channel_b}` is in \
          {unit_b}; allowed: all channels in rad (angle) or all in rad/s (rate), or an \
          explicit quantity override"
     )]
@@ -306,7 +307,7 @@ pub enum InputError {
 
     /// A structural CSV problem: missing header, wrong number of fields, duplicate column,
     /// unexpected column, malformed metadata line.
-    #[error("tilt input {path}, line {line}: {message}")]
+    #[error("input file {path}, line {line}: {message}")]
     Csv {
         /// The file.
         path: PathBuf,
@@ -318,7 +319,7 @@ pub enum InputError {
 
     /// A CSV field that is not a number.
     #[error(
-        "tilt input {path}, line {line}: column `{column}` = `{text}` is not a number \
+        "input file {path}, line {line}: column `{column}` = `{text}` is not a number \
          ({unit}); allowed: a decimal floating-point number{}",
         if *.empty_allowed { " (an empty field is a gap)" } else { "" }
     )]
@@ -339,7 +340,7 @@ pub enum InputError {
 
     /// The time column is not strictly increasing.
     #[error(
-        "tilt input {path}, line {line} (sample index {index}): time_s = {value:?} s is not \
+        "input file {path}, line {line} (sample index {index}): time_s = {value:?} s is not \
          greater than the previous {previous:?} s; allowed: strictly increasing, uniformly \
          sampled times"
     )]
@@ -358,7 +359,7 @@ pub enum InputError {
 
     /// The time column is not uniformly sampled.
     #[error(
-        "tilt input {path}, line {line} (sample index {index}): time_s = {value:?} s deviates \
+        "input file {path}, line {line} (sample index {index}): time_s = {value:?} s deviates \
          from the uniform grid t0 + index * dt = {expected:?} s by {deviation:.3e} s; allowed: \
          at most {tolerance:.3e} s (relative {relative:.1e} of dt = {dt:?} s, from the printed \
          precision of the times)"
@@ -386,7 +387,7 @@ pub enum InputError {
 
     /// A frequency that is not positive, not finite, or not strictly increasing.
     #[error(
-        "tilt input {path}: {location}: frequency {value:?} Hz is not allowed: must be {allowed}"
+        "input file {path}: {location}: frequency {value:?} Hz is not allowed: must be {allowed}"
     )]
     Frequency {
         /// The file.
@@ -400,7 +401,7 @@ pub enum InputError {
     },
 
     /// A negative or non-finite amplitude spectral density.
-    #[error("tilt input {path}: {location}, column `{column}`: ASD {value:?} {unit} is not allowed: must be finite and >= 0")]
+    #[error("input file {path}: {location}, column `{column}`: ASD {value:?} {unit} is not allowed: must be finite and >= 0")]
     Asd {
         /// The file.
         path: PathBuf,
@@ -416,7 +417,7 @@ pub enum InputError {
 
     /// A cross-spectral density matrix that is not Hermitian positive semidefinite within
     /// tolerance, or has non-finite entries.
-    #[error("tilt input {path}: /csd[{index}, {i}, {j}] at {freq_hz:?} Hz ({pair}): {problem}")]
+    #[error("input file {path}: /csd[{index}, {i}, {j}] at {freq_hz:?} Hz ({pair}): {problem}")]
     Csd {
         /// The file.
         path: PathBuf,
@@ -437,7 +438,7 @@ pub enum InputError {
 
     /// A chunk request outside the series.
     #[error(
-        "tilt input {path}: chunk of {len} samples starting at sample index {start} is out of \
+        "input file {path}: chunk of {len} samples starting at sample index {start} is out of \
          range; allowed: start + len <= {available} (the series length)"
     )]
     ChunkOutOfRange {

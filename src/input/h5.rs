@@ -27,10 +27,10 @@ pub(crate) fn h5err(
 
 /// Opens `path` read-only.
 pub(crate) fn open(path: &Path) -> Result<hdf5::File, InputError> {
-    if let Err(source) = std::fs::metadata(path) {
+    if let Err(reason) = std::fs::metadata(path) {
         return Err(InputError::Io {
             path: path.to_path_buf(),
-            source,
+            reason,
         });
     }
     hdf5::File::open(path).map_err(h5err(path, "file (is it an HDF5 file?)"))

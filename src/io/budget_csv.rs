@@ -13,9 +13,13 @@ use std::path::Path;
 /// One header line, `freq_hz` followed by `OBS.TERM` for every observable `OBS` and term `TERM`
 /// in the report's order (`X.tilt,X.tilt.eta_t,X.readout,X.total,phi.tilt,...`), then, if the
 /// report has segment bands, `OBS.tilt.median,OBS.tilt.pLO,OBS.tilt.pHI` per band (`LO`, `HI`:
-/// the percentiles, e.g. `X.tilt.p10`). Then one line per frequency. Every value is an ASD,
-/// `sqrt(PSD)` in the observable's unit/sqrt(Hz), written so that it parses back to exactly the
-/// same `f64` ([`format_f64`]). No comment lines: the file loads directly into pandas or NumPy.
+/// the percentiles, e.g. `X.tilt.p10`), then, for observables whose budget carries the response
+/// to their equivalent input (damped models), `OBS.equivalent.TERM` for the terms referred to
+/// that input (`X`: test-mass acceleration, m s^-2/sqrt(Hz); `phi`, `phi_a`: torque, N
+/// m/sqrt(Hz); see [`crate::noise::equivalent`]). Then one line per frequency. Every value is
+/// an ASD, `sqrt(PSD)`, in the observable's unit/sqrt(Hz) except the `equivalent` columns,
+/// written so that it parses back to exactly the same `f64` ([`format_f64`]). No comment lines:
+/// the file loads directly into pandas or NumPy.
 ///
 /// # Errors
 ///
@@ -83,6 +87,17 @@ fn asd_columns(report: &BudgetReport) -> (Vec<String>, Vec<Vec<f64>>) {
         columns.push(sqrt(&band.lower));
         names.push(format!("{o}.tilt.p{}", format_f64(band.upper_pct)));
         columns.push(sqrt(&band.upper));
+    }
+    // Last, so that the columns above keep their places: the noise referred to the test
+    // mass's actuation input (damped models), in that input's unit.
+    for ob in &report.budget.observables {
+        let Some(referred) = crate::noise::equivalent::referred_terms(ob) else {
+            continue;
+        };
+        for (name, psd) in &referred.terms {
+            names.push(format!("{}.equivalent.{name}", ob.observable.name()));
+            columns.push(psd.iter().map(|p| p.sqrt()).collect());
+        }
     }
     (names, columns)
 }

@@ -5,7 +5,8 @@ use super::h5util::{dataset, scalar_attr, str_attr, strs_attr};
 use super::{InputMeta, RunMeta, SIGN_CONVENTION};
 use crate::atomic::write_atomic;
 use crate::error::OutputError;
-use crate::noise::{is_response, BudgetReport, SpectralSource, RESPONSE_PREFIX};
+use crate::noise::equivalent::referred_terms;
+use crate::noise::{is_response, BudgetReport, SpectralSource};
 use std::path::Path;
 
 /// Value of the root attribute `schema`.
@@ -132,13 +133,12 @@ fn write_file(
             scalar_attr(&group, "readout_asd", asd)?;
             str_attr(&group, "readout_asd_units", &asd_unit(unit))?;
         }
-        let response = ob.terms.iter().find(|t| is_response(&t.name));
         for term in ob.terms.iter().filter(|t| !is_response(&t.name)) {
             let g = group.create_group(&term.name)?;
             write_psd_asd(&g, "psd", "asd", &term.psd, unit)?;
         }
-        if let Some(response) = response {
-            write_equivalent(&group, ob, response, unit)?;
+        if let Some(referred) = referred_terms(ob) {
+            write_equivalent(&group, &referred, unit)?;
         }
     }
 
@@ -181,41 +181,21 @@ fn write_file(
 /// [`crate::noise::equivalent`]), `psd = S_o / |R_o|^2`, plus `response_abs = |R_o|`.
 fn write_equivalent(
     group: &hdf5::Group,
-    ob: &crate::noise::ObservableBudget,
-    response: &crate::noise::NoiseTerm,
+    referred: &crate::noise::equivalent::Referred<'_>,
     unit: &str,
 ) -> hdf5::Result<()> {
-    let input = response.name.trim_start_matches(RESPONSE_PREFIX);
-    let (eq_unit, what) = match ob.observable {
-        crate::model::Observable::X => (
-            "m s^-2",
-            "acceleration of the test mass along x (F_b.x / m_b)",
-        ),
-        _ => ("N m", "torque on the test mass about z (M_b.z)"),
-    };
     let g = group.create_group("equivalent")?;
-    str_attr(&g, "input", input)?;
-    str_attr(&g, "quantity", what)?;
-    str_attr(&g, "unit", eq_unit)?;
-    let terms: Vec<&str> = ob
-        .terms
-        .iter()
-        .filter(|t| !is_response(&t.name) && t.name != "measured" && t.name != "residual")
-        .map(|t| t.name.as_str())
-        .collect();
-    strs_attr(&g, "terms", &terms)?;
-    let abs: Vec<f64> = response.psd.iter().map(|p| p.sqrt()).collect();
+    str_attr(&g, "input", referred.input)?;
+    str_attr(&g, "quantity", referred.quantity)?;
+    str_attr(&g, "unit", referred.unit)?;
+    let names: Vec<&str> = referred.terms.iter().map(|(name, _)| *name).collect();
+    strs_attr(&g, "terms", &names)?;
+    let abs: Vec<f64> = referred.response_psd.iter().map(|p| p.sqrt()).collect();
     let d = dataset(&g, "response_abs", &abs)?;
-    str_attr(&d, "units", &format!("{unit}/({eq_unit})"))?;
-    for term in ob.terms.iter().filter(|t| terms.contains(&t.name.as_str())) {
-        let psd: Vec<f64> = term
-            .psd
-            .iter()
-            .zip(&response.psd)
-            .map(|(p, r)| p / r)
-            .collect();
-        let t = g.create_group(&term.name)?;
-        write_psd_asd(&t, "psd", "asd", &psd, eq_unit)?;
+    str_attr(&d, "units", &format!("{unit}/({})", referred.unit))?;
+    for (name, psd) in &referred.terms {
+        let t = g.create_group(name)?;
+        write_psd_asd(&t, "psd", "asd", psd, referred.unit)?;
     }
     Ok(())
 }

@@ -26,22 +26,71 @@ pub fn equivalent_input(
     model: &Model,
     o: Observable,
 ) -> Option<(ForceInput, f64, &'static str, &'static str)> {
-    let m_b = model.params().mass.m_b_kg;
+    let (input, unit, what) = equivalent_quantity(o)?;
+    let factor = match o {
+        Observable::X => model.params().mass.m_b_kg,
+        _ => 1.0,
+    };
+    Some((input, factor, unit, what))
+}
+
+/// The equivalent input of an observable, its unit and a description (see the module docs).
+fn equivalent_quantity(o: Observable) -> Option<(ForceInput, &'static str, &'static str)> {
     match o {
         Observable::X => Some((
             ForceInput::from_name("F_b.x").expect("F_b.x is a force input"),
-            m_b,
             "m s^-2",
             "acceleration of the test mass along x (F_b.x / m_b)",
         )),
         Observable::Phi | Observable::PhiA => Some((
             ForceInput::from_name("M_b.z").expect("M_b.z is a force input"),
-            1.0,
             "N m",
             "torque on the test mass about z (M_b.z)",
         )),
         _ => None,
     }
+}
+
+/// An observable's noise terms referred to its equivalent input: what the budget files store
+/// (HDF5 `/<OBS>/equivalent`, CSV `OBS.equivalent.TERM` columns).
+pub struct Referred<'a> {
+    /// The input's name (`F_b.x`, `M_b.z`).
+    pub input: &'static str,
+    /// Unit of the input (`m s^-2`, `N m`); the PSDs are in unit^2/Hz.
+    pub unit: &'static str,
+    /// What the input is.
+    pub quantity: &'static str,
+    /// `|R_o|^2` at each frequency ((observable unit / input unit)^2).
+    pub response_psd: &'a [f64],
+    /// Every noise term but `measured` and `residual` (which are not referred), in budget
+    /// order: `(name, S_o / |R_o|^2)`, one-sided PSD in unit^2/Hz.
+    pub terms: Vec<(&'a str, Vec<f64>)>,
+}
+
+/// The terms of `ob` referred to its equivalent input, if it has one and the budget carries
+/// its response (the `response.<input>` term of [`add_equivalent_response`]).
+pub fn referred_terms(ob: &super::ObservableBudget) -> Option<Referred<'_>> {
+    let (input, unit, quantity) = equivalent_quantity(ob.observable)?;
+    let response = ob
+        .terms
+        .iter()
+        .find(|t| t.name == format!("{RESPONSE_PREFIX}{}", input.name()))?;
+    let terms = ob
+        .terms
+        .iter()
+        .filter(|t| !is_response(&t.name) && t.name != "measured" && t.name != "residual")
+        .map(|t| {
+            let psd = t.psd.iter().zip(&response.psd).map(|(p, r)| p / r);
+            (t.name.as_str(), psd.collect())
+        })
+        .collect();
+    Some(Referred {
+        input: input.name(),
+        unit,
+        quantity,
+        response_psd: &response.psd,
+        terms,
+    })
 }
 
 /// Adds the `response.<input>` term (`|R_o|^2`, see the module docs) to every observable of

@@ -277,9 +277,9 @@ impl Params {
 
     /// Reads, parses and validates a TOML parameter file.
     pub fn from_file(path: &Path) -> Result<Params, ParamError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ParamError::Read {
+        let text = std::fs::read_to_string(path).map_err(|reason| ParamError::Read {
             path: path.to_path_buf(),
-            source,
+            reason,
         })?;
         Params::from_toml_str(&text, &path.display().to_string())
     }

@@ -8,6 +8,7 @@ use super::save_figure;
 use crate::error::OutputError;
 use crate::io::InputMeta;
 use crate::model::{Observable, TiltAxis};
+use crate::noise::equivalent::referred_terms;
 use crate::noise::{is_response, BudgetReport, NoiseTerm, Readout, SegmentBand, SpectralSource};
 use plotters::style::RGBColor;
 use std::path::Path;
@@ -247,44 +248,42 @@ fn equivalent_panel(report: &BudgetReport, options: &BudgetFigureOptions) -> Opt
         .observables
         .iter()
         .find(|b| b.observable == Observable::X)?;
-    let response = ob.terms.iter().find(|t| is_response(&t.name))?;
+    let referred = referred_terms(ob)?;
     let mut panel = Panel::new(
         "Test-mass acceleration noise equivalent to X",
         ("frequency", "Hz"),
         ("ASD of aₓ", "m s⁻²/√Hz"),
     );
     panel.max_decades = Some(options.max_decades);
-    let mut terms: Vec<&NoiseTerm> = ob
+    let mut terms: Vec<&(&str, Vec<f64>)> = referred
         .terms
         .iter()
-        .filter(|t| ["total", "tilt", "thermal", "readout"].contains(&t.name.as_str()))
+        .filter(|(name, _)| ["total", "tilt", "thermal", "readout"].contains(name))
         .collect();
-    terms.sort_by_key(|t| draw_rank(&t.name));
+    terms.sort_by_key(|(name, _)| draw_rank(name));
     // The response has zeros (antiresonances), where every equivalent term peaks: scale the y
     // axis on the floor of the total instead, from a decade below its minimum up 6 decades.
-    let total = ob.term("total")?;
+    let (_, total) = referred.terms.iter().find(|(name, _)| *name == "total")?;
     let floor = total
-        .psd
         .iter()
-        .zip(&response.psd)
-        .map(|(p, r)| (p / r).sqrt())
+        .map(|p| p.sqrt())
         .filter(|v| v.is_finite() && *v > 0.0)
         .fold(f64::INFINITY, f64::min);
     if floor.is_finite() {
         let lo = 10f64.powf(floor.log10().floor() - 1.0);
         panel.y_range = Some((lo, lo * 1e6));
     }
-    for term in terms {
-        let (label, style) = term_style(&term.name, None)?;
-        if term.psd.iter().all(|&p| p == 0.0) {
+    for (name, psd) in terms {
+        let (label, style) = term_style(name, None)?;
+        if ob.term(name)?.psd.iter().all(|&p| p == 0.0) {
             continue;
         }
         let points = report
             .budget
             .freqs_hz
             .iter()
-            .zip(term.psd.iter().zip(&response.psd))
-            .map(|(&f, (p, r))| (f, (p / r).sqrt()))
+            .zip(psd)
+            .map(|(&f, p)| (f, p.sqrt()))
             .collect();
         panel.traces.push(Trace::new(label, points, style));
     }
