@@ -36,6 +36,25 @@ fn bad_parameter_input_is_refused() {
         &["--params", "/nonexistent/p.toml", "modes"],
         &["/nonexistent/p.toml"],
     );
+    // The operating system's reason, once (it is in the message, not also a chained source).
+    for (args, what) in [
+        (
+            &["--params", "/nonexistent/p.toml", "modes"][..],
+            "parameter file",
+        ),
+        (&["budget", "--tilt", "/nonexistent/t.h5"][..], "input file"),
+        (
+            &["budget", "--tilt", "/nonexistent/t.csv"][..],
+            "input file",
+        ),
+    ] {
+        let err = stderr(&tiltnoise(args));
+        assert!(
+            err.contains(&format!("cannot read {what} /nonexistent/")),
+            "{err}"
+        );
+        assert_eq!(err.matches("os error").count(), 1, "{err}");
+    }
     assert_fails(
         &["--set", "inertia.a11_kg_m2=-0.1", "modes"],
         &["inertia.a11_kg_m2", "-0.1", "kg m^2", "> 0"],
