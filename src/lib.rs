@@ -47,6 +47,7 @@ pub mod params;
 pub mod plot;
 pub mod reference;
 pub mod report;
+pub mod rng;
 pub mod scene;
 pub mod simulate;
 pub mod spectral;

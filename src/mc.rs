@@ -27,6 +27,7 @@ use crate::error::ParamError;
 use crate::model::{Block, Model};
 use crate::params::uncertainty::{check, UncertaintyError};
 use crate::params::Params;
+use crate::rng::Rng;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 pub use crate::params::uncertainty::{
@@ -249,7 +250,7 @@ impl Plan {
 
     /// Draw number `index`: its frequencies, or `None` if rejected.
     fn draw(&self, index: usize) -> Option<[f64; 8]> {
-        let mut rng = Rng::for_sample(self.seed, index as u64);
+        let mut rng = Rng::stream(self.seed, index as u64);
         let mut p = self.nominal.clone();
         for &(field, rel_sigma, dist) in &self.draws {
             let z = match dist {
@@ -294,63 +295,6 @@ fn modal_field(key: &str) -> Option<FieldMut> {
         _ => return None,
     };
     Some(f)
-}
-
-/// SplitMix64 finalizer: a bijective 64-bit mix.
-fn mix64(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-/// xoshiro256** with a cached second Box-Muller variate. One per sample.
-struct Rng {
-    s: [u64; 4],
-    spare: Option<f64>,
-}
-
-impl Rng {
-    /// Independent stream for sample `index` of run `seed`: SplitMix64 seeded by a mix of both.
-    fn for_sample(seed: u64, index: u64) -> Rng {
-        let mut x = mix64(seed ^ mix64(index ^ 0x6A09_E667_F3BC_C909));
-        let mut next = || {
-            x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            mix64(x)
-        };
-        let s = [next(), next(), next(), next()];
-        Rng { s, spare: None }
-    }
-
-    fn next_u64(&mut self) -> u64 {
-        let s = &mut self.s;
-        let result = s[1].wrapping_mul(5).rotate_left(7).wrapping_mul(9);
-        let t = s[1] << 17;
-        s[2] ^= s[0];
-        s[3] ^= s[1];
-        s[1] ^= s[2];
-        s[0] ^= s[3];
-        s[2] ^= t;
-        s[3] = s[3].rotate_left(45);
-        result
-    }
-
-    /// Uniform on [0, 1) with 53 random bits.
-    fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-
-    /// Standard Gaussian (Box-Muller).
-    fn gaussian(&mut self) -> f64 {
-        if let Some(z) = self.spare.take() {
-            return z;
-        }
-        let u1 = 1.0 - self.uniform(); // (0, 1]: ln is finite
-        let u2 = self.uniform();
-        let r = (-2.0 * u1.ln()).sqrt();
-        let (s, c) = (std::f64::consts::TAU * u2).sin_cos();
-        self.spare = Some(r * s);
-        r * c
-    }
 }
 
 #[cfg(test)]
@@ -398,26 +342,5 @@ mod tests {
             let other = mode_frequencies_hz(&Model::new(&q).unwrap()).unwrap();
             assert_eq!(other, base, "{}", f.key);
         }
-    }
-
-    #[test]
-    fn gaussian_moments() {
-        let n = 200_000;
-        let (mut s1, mut s2) = (0.0, 0.0);
-        for i in 0..n / 2 {
-            let mut r = Rng::for_sample(7, i as u64);
-            for _ in 0..2 {
-                let z = r.gaussian();
-                s1 += z;
-                s2 += z * z;
-            }
-        }
-        let mean = s1 / n as f64;
-        let var = s2 / n as f64 - mean * mean;
-        assert!(mean.abs() < 5.0 / (n as f64).sqrt(), "mean {mean}");
-        assert!(
-            (var - 1.0).abs() < 5.0 * (2.0 / n as f64).sqrt(),
-            "var {var}"
-        );
     }
 }

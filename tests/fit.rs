@@ -169,24 +169,6 @@ fn recovers_known_parameters_from_exact_frequencies() {
     assert!(r.params.iter().all(|q| !q.poorly_constrained));
 }
 
-/// A deterministic standard-normal stream (SplitMix64 + Box-Muller) for the noise draws.
-struct Normal(u64);
-
-impl Normal {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn next(&mut self) -> f64 {
-        let (u1, u2) = (1.0 - self.uniform(), self.uniform());
-        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-    }
-}
-
 /// Noisy synthetic data: each fitted parameter within a few fitted sigmas of the truth, and
 /// over an ensemble each parameter's normalized deviations `(p_fit - p_true) / sigma_fit` have
 /// unit variance (the reported covariance describes the scatter).
@@ -198,12 +180,12 @@ fn noisy_fits_scatter_as_the_reported_covariance() {
     let keys = DEFAULT_FREE;
     let truth_u = [0.3, -0.2, 0.2, -0.1, 0.1, -0.2, 0.2, -0.1];
     let truth = shifted(&p, &keys, &truth_u);
-    let mut rng = Normal(42);
+    let mut rng = tiltnoise::rng::Rng::stream(42, 0);
     const RUNS: usize = 400;
     let mut sum_z2 = [0.0; 8];
     let mut sum_chi2 = 0.0;
     for run in 0..RUNS {
-        let noise: Vec<f64> = (0..8).map(|_| rng.next()).collect();
+        let noise: Vec<f64> = (0..8).map(|_| rng.gaussian()).collect();
         let r = fit(&p, &synthetic(&truth, &ALL_MODES, &noise), &config(&keys)).unwrap();
         sum_chi2 += r.chi2;
         for (j, (q, want)) in r.params.iter().zip(truth_u).enumerate() {
