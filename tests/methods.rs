@@ -30,6 +30,8 @@
 //! every method.
 //! Run with `--nocapture` to see the methods table (the maxima measured here).
 
+mod common;
+
 use nalgebra::{Matrix2, RowVector2, SMatrix, SVector, Vector2};
 use num_complex::Complex64;
 use std::sync::OnceLock;
@@ -85,25 +87,15 @@ impl Case {
     }
 }
 
-fn table_i_damped() -> Params {
-    let mut p = Params::table_i();
-    for key in [
-        "torsion_a_rad",
-        "torsion_b_rad",
-        "bouncing_a_rad",
-        "bouncing_b_rad",
-    ] {
-        p = p.with_override(&format!("loss.{key}={LOSS}")).unwrap();
-    }
-    p
-}
-
 fn cases() -> &'static [Case] {
     static CASES: OnceLock<Vec<Case>> = OnceLock::new();
     CASES.get_or_init(|| {
         vec![
             Case::new("Table I", Params::table_i()),
-            Case::new("Table I, loss 1e-3", table_i_damped()),
+            Case::new(
+                "Table I, loss 1e-3",
+                common::with_torsion_and_bouncing_loss(Params::table_i(), LOSS),
+            ),
         ]
     })
 }

@@ -11,6 +11,8 @@
 //!
 //! Run with `cargo test --release --test polezero -- --nocapture` to see the numbers.
 
+mod common;
+
 use num_complex::Complex64;
 use tiltnoise::error::TfError;
 use tiltnoise::model::{ForceInput, Model, Observable, TiltAxis};
@@ -22,19 +24,6 @@ const TARGET_REL: f64 = 1e-9;
 const EXCLUSION: f64 = 0.01;
 const LOSS: f64 = 1e-3;
 
-fn damped(p: Params) -> Params {
-    let mut p = p;
-    for key in [
-        "torsion_a_rad",
-        "torsion_b_rad",
-        "bouncing_a_rad",
-        "bouncing_b_rad",
-    ] {
-        p = p.with_override(&format!("loss.{key}={LOSS}")).unwrap();
-    }
-    p
-}
-
 fn heavy_crossbar() -> Params {
     Params::table_i().with_override("mass.m_a_kg=1.3").unwrap()
 }
@@ -45,13 +34,13 @@ fn cases() -> Vec<(&'static str, Params, Params)> {
         ("Table I", Params::table_i(), Params::table_i()),
         (
             "Table I, loss 1e-3",
-            damped(Params::table_i()),
+            common::with_torsion_and_bouncing_loss(Params::table_i(), LOSS),
             Params::table_i(),
         ),
         ("m_a = 1.3 kg", heavy_crossbar(), heavy_crossbar()),
         (
             "m_a = 1.3 kg, loss 1e-3",
-            damped(heavy_crossbar()),
+            common::with_torsion_and_bouncing_loss(heavy_crossbar(), LOSS),
             heavy_crossbar(),
         ),
     ]

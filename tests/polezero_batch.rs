@@ -15,6 +15,8 @@
 //!   chunk, the other thread's half) gives the per-point path's error, the first in grid order,
 //!   with the same frequency and rcond; likewise a negative, NaN or infinite frequency.
 
+mod common;
+
 use num_complex::Complex64;
 use tiltnoise::error::TfError;
 use tiltnoise::model::{ForceInput, Model, Observable};
@@ -28,16 +30,7 @@ use tiltnoise::tf::{
 const LOSS: f64 = 1e-3;
 
 fn damped() -> Params {
-    let mut p = Params::table_i();
-    for key in [
-        "torsion_a_rad",
-        "torsion_b_rad",
-        "bouncing_a_rad",
-        "bouncing_b_rad",
-    ] {
-        p = p.with_override(&format!("loss.{key}={LOSS}")).unwrap();
-    }
-    p
+    common::with_torsion_and_bouncing_loss(Params::table_i(), LOSS)
 }
 
 fn force_request() -> Request {

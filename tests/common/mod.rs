@@ -142,3 +142,21 @@ pub fn disable_hdf5_file_locking() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| std::env::set_var("HDF5_USE_FILE_LOCKING", "FALSE"));
 }
+
+/// `p` with loss angle `loss_rad` on both torsions and both bouncings (the damped test model
+/// of the transfer-function tests).
+pub fn with_torsion_and_bouncing_loss(
+    p: tiltnoise::params::Params,
+    loss_rad: f64,
+) -> tiltnoise::params::Params {
+    let mut p = p;
+    for key in [
+        "torsion_a_rad",
+        "torsion_b_rad",
+        "bouncing_a_rad",
+        "bouncing_b_rad",
+    ] {
+        p = p.with_override(&format!("loss.{key}={loss_rad}")).unwrap();
+    }
+    p
+}
