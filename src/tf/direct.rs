@@ -172,6 +172,18 @@ impl Direct {
 }
 
 impl Direct {
+    /// The equilibrated LU of `D = K_c + i w C - w^2 M` at `freq_hz`, and `w^2`.
+    fn factor(&self, freq_hz: f64) -> Result<(EquilibratedLu<8>, f64), TfError> {
+        let w2 = omega_sq(freq_hz)?;
+        let lu = if self.viscous {
+            let k = with_viscous(&self.stiffness, &self.damping, w2.sqrt());
+            EquilibratedLu::factor(&k, &self.mass, w2, freq_hz)?
+        } else {
+            EquilibratedLu::factor(&self.stiffness, &self.mass, w2, freq_hz)?
+        };
+        Ok((lu, w2))
+    }
+
     /// Responses `x = D^-1 v` of the coordinates to generalized forces `v` (one per entry of
     /// `forces`, overwritten by its response), `D = K_c + i w C - w^2 M`, with the
     /// equilibration and singularity check of [`Direct`]. Units: coordinate per unit
@@ -181,13 +193,7 @@ impl Direct {
         freq_hz: f64,
         forces: &mut [SVector<Complex64, 8>],
     ) -> Result<(), TfError> {
-        let w2 = omega_sq(freq_hz)?;
-        let lu = if self.viscous {
-            let k = with_viscous(&self.stiffness, &self.damping, w2.sqrt());
-            EquilibratedLu::factor(&k, &self.mass, w2, freq_hz)?
-        } else {
-            EquilibratedLu::factor(&self.stiffness, &self.mass, w2, freq_hz)?
-        };
+        let (lu, _) = self.factor(freq_hz)?;
         for x in forces.iter_mut() {
             lu.solve_mut(x)?;
         }
@@ -205,13 +211,7 @@ impl TransferFunction for Direct {
     }
 
     fn eval_into(&self, freq_hz: f64, out: &mut [Complex64]) -> Result<(), TfError> {
-        let w2 = omega_sq(freq_hz)?;
-        let lu = if self.viscous {
-            let k = with_viscous(&self.stiffness, &self.damping, w2.sqrt());
-            EquilibratedLu::factor(&k, &self.mass, w2, freq_hz)?
-        } else {
-            EquilibratedLu::factor(&self.stiffness, &self.mass, w2, freq_hz)?
-        };
+        let (lu, w2) = self.factor(freq_hz)?;
         let n_in = self.request.inputs.len();
         for i in 0..n_in {
             let mut y = SVector::<Complex64, 8>::from_fn(|r, _| {
