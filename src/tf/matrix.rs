@@ -187,7 +187,8 @@ impl TransferMatrix {
         (&mut self.layout, &mut self.data)
     }
 
-    /// `H_{o,i}(f_k)`.
+    /// `H_{o,i}(f_k)`, in [`TransferMatrix::unit`] (output unit per input unit), for
+    /// `e^{+i w t}` time dependence.
     pub fn get(&self, k: usize, o: usize, i: usize) -> Complex64 {
         let entry = o * self.inputs.len() + i;
         let n = self.n_stored_freqs();
@@ -200,7 +201,8 @@ impl TransferMatrix {
     }
 
     /// The stored values of entry (o, i) over the grid, `(re, im)` (`None` where not stored:
-    /// a structural zero, or the imaginary part in a real layout, exactly 0).
+    /// a structural zero, or the imaginary part in a real layout, exactly 0). Units as
+    /// [`TransferMatrix::get`]: [`TransferMatrix::unit`].
     pub fn planes(&self, o: usize, i: usize) -> (Option<&[f64]>, Option<&[f64]>) {
         let n = self.n_stored_freqs();
         let plane = |p: Option<usize>| p.map(|p| &self.data[p * n..(p + 1) * n]);

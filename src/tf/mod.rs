@@ -43,7 +43,7 @@ use crate::model::{ForceInput, Model, Observable, TiltAxis};
 use num_complex::Complex64;
 
 pub use block::BlockReduced;
-pub use buffer::{zeroed_complex, zeroed_f64, HUGE_PAGE_MIN_BYTES};
+pub use buffer::{zeroed_complex, zeroed_f64};
 pub use direct::{Direct, SINGULAR_RCOND};
 pub(crate) use grid::check_grid_len;
 pub use grid::{eval_grid_threads, evaluate, evaluate_into};
