@@ -31,7 +31,7 @@ const HUGE_PAGE_BYTES: usize = 2 << 20;
 
 /// A vector of `len` zeros. `vec![0.0; len]` takes zeroed memory from the allocator (for a
 /// large vector, fresh pages that nothing has touched yet); a large one
-/// ([`HUGE_PAGE_MIN_BYTES`]) is then advised, on Linux, to use transparent huge pages before
+/// (4 MiB or more) is then advised, on Linux, to use transparent huge pages before
 /// the first write (see the module docs).
 pub fn zeroed_f64(len: usize) -> Vec<f64> {
     let v = vec![0.0; len];
