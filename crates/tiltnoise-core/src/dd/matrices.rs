@@ -1,0 +1,302 @@
+//! The model's matrices in double-double, written from the paper's formulas (Appendix A,
+//! eqs. (def_I) and (EM), the zeroth-order generalized forces, section II.D and section IV.B)
+//! and the parameter values. Deliberately shares nothing with `crate::model` (the `f64` model) but the
+//! coordinate order, which is fixed by the paper and restated here.
+
+use super::complex::CDd;
+use super::real::Dd;
+use crate::params::Params;
+
+/// q = (theta_a, eta_a, phi_a, delta_a, theta_b, eta_b, phi_b, delta_b): the paper's order,
+/// which is also [`crate::model::Coord::ALL`].
+pub const TA: usize = 0;
+pub const EA: usize = 1;
+pub const PA: usize = 2;
+pub const DA: usize = 3;
+pub const TB: usize = 4;
+pub const EB: usize = 5;
+pub const PB: usize = 6;
+pub const DB: usize = 7;
+
+/// Columns of the force matrix: F_a.xyz, F_b.xyz, M_a.xyz, M_b.xyz.
+const FAX: usize = 0;
+const FAY: usize = 1;
+const FAZ: usize = 2;
+const FBX: usize = 3;
+const FBY: usize = 4;
+const FBZ: usize = 5;
+const MAX: usize = 6;
+const MAY: usize = 7;
+const MAZ: usize = 8;
+const MBX: usize = 9;
+const MBY: usize = 10;
+const MBZ: usize = 11;
+
+/// Rows of the observation matrix: X, Y, Z, theta, eta, phi, phi_a.
+pub const OBS_X: usize = 0;
+pub const OBS_Y: usize = 1;
+pub const OBS_Z: usize = 2;
+pub const OBS_THETA: usize = 3;
+pub const OBS_ETA: usize = 4;
+pub const OBS_PHI: usize = 5;
+pub const OBS_PHI_A: usize = 6;
+
+/// All matrices of the linear model in double-double.
+#[derive(Debug, Clone)]
+pub struct Matrices {
+    /// Mass matrix M (kg, kg m, kg m^2 by coordinate pair).
+    pub mass: [[Dd; 8]; 8],
+    /// Gravity (swing) part of the stiffness, real.
+    pub stiffness_gravity: [[Dd; 8]; 8],
+    /// K_gravity + K_elastic (1 + i phi) + i phi_swing (each fibre's share of K_gravity).
+    pub stiffness: [[CDd; 8]; 8],
+    /// Viscous damping matrix C (the dynamic stiffness is K_c + i w C - w^2 M).
+    pub damping: [[Dd; 8]; 8],
+    /// Generalized forces of the 12 force and torque components (columns F_a.xyz, F_b.xyz,
+    /// M_a.xyz, M_b.xyz).
+    pub force: [[Dd; 12]; 8],
+    /// Tilt forcing, frequency-independent part G0 (columns theta_t, eta_t, phi_t).
+    pub g0: [[Dd; 3]; 8],
+    /// Tilt forcing, part multiplying w^2 (G2).
+    pub g2: [[Dd; 3]; 8],
+    /// Observation matrix C (rows X, Y, Z, theta, eta, phi, phi_a).
+    pub observation: [[Dd; 8]; 7],
+}
+
+fn dd(x: f64) -> Dd {
+    Dd::from_f64(x)
+}
+
+fn cross(a: [Dd; 3], b: [Dd; 3]) -> [Dd; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+pub fn build(p: &Params) -> Matrices {
+    let (m_a, m_b) = (dd(p.mass.m_a_kg), dd(p.mass.m_b_kg));
+    let i = &p.inertia;
+    let (a11, a22, a33, a23) = (
+        dd(i.a11_kg_m2),
+        dd(i.a22_kg_m2),
+        dd(i.a33_kg_m2),
+        dd(i.a23_kg_m2),
+    );
+    let (b11, b22, b33) = (dd(i.b11_kg_m2), dd(i.b22_kg_m2), dd(i.b33_kg_m2));
+    let l = &p.length;
+    let (d, h_c, z, z_a, z_b, h) = (
+        dd(l.d_m),
+        dd(l.h_c_m),
+        dd(l.z_m),
+        dd(l.z_a_m),
+        dd(l.z_b_m),
+        dd(l.h_m),
+    );
+    let g = dd(p.environment.g_m_per_s2);
+
+    // Section II.A: the crossbar's centre of mass balances the test mass on the upper fibre.
+    let y_a = d * m_b / m_a;
+    let zza = z + z_a;
+    let zzb = z + z_b;
+
+    // Appendix A, eq. (def_I), with I^b_22 for rotations of the test mass about its y axis.
+    let ia1 = a11 + m_a * (zza.sqr() + y_a.sqr());
+    let ib1 = b11 + m_b * (zzb.sqr() + d.sqr());
+    let ia2 = a22 + m_a * zza.sqr();
+    let ib2 = b22 + m_b * zzb.sqr();
+    let ia3 = a33 + m_a * y_a.sqr();
+    let ib3 = b33 + m_b * d.sqr();
+    let ia4 = a23 + m_b * d * (z_a - z_b);
+    let ib4_theta = b11 + m_b * z_b.sqr();
+    let ib4_eta = b22 + m_b * z_b.sqr();
+    let ib5_theta = b11 + m_b * z_b * zzb;
+    let ib5_eta = b22 + m_b * z_b * zzb;
+    let c1 = m_b * zzb + m_a * zza;
+
+    // Eq. (EM): coefficients of the second derivatives.
+    let mut mass = [[Dd::ZERO; 8]; 8];
+    {
+        let mut sym = |r: usize, c: usize, v: Dd| {
+            mass[r][c] = v;
+            mass[c][r] = v;
+        };
+        sym(TA, TA, ia1 + ib1);
+        sym(TA, TB, ib5_theta);
+        sym(TA, DB, m_b * d);
+        sym(EA, EA, ia2 + ib2);
+        sym(EA, PA, ia4);
+        sym(EA, EB, ib5_eta);
+        sym(PA, PA, ia3 + ib3);
+        sym(PA, PB, b33);
+        sym(PA, EB, -(m_b * d * z_b));
+        sym(DA, DA, m_a + m_b);
+        sym(DA, DB, m_b);
+        sym(TB, TB, ib4_theta);
+        sym(EB, EB, ib4_eta);
+        sym(PB, PB, b33);
+        sym(DB, DB, m_b);
+    }
+
+    // Eq. (EM): gravity stiffness (lossless) ...
+    let mut kg = [[Dd::ZERO; 8]; 8];
+    for (a, b) in [(TA, TB), (EA, EB)] {
+        kg[a][a] = g * c1;
+        kg[a][b] = m_b * g * z_b;
+        kg[b][a] = m_b * g * z_b;
+        kg[b][b] = m_b * g * z_b;
+    }
+    // ... and the fibres' elastic stiffness with structural damping k (1 + i phi).
+    let mut stiffness = kg.map(|row| row.map(CDd::real));
+    let lp = &p.loss;
+    for (c, k, phi) in [
+        (PA, p.torsion.k_a_n_m_per_rad, lp.torsion_a_rad),
+        (PB, p.torsion.k_b_n_m_per_rad, lp.torsion_b_rad),
+        (DA, p.bouncing.kappa_a_n_per_m, lp.bouncing_a_rad),
+        (DB, p.bouncing.kappa_b_n_per_m, lp.bouncing_b_rad),
+    ] {
+        stiffness[c][c] += CDd::new(dd(k), Dd::mul_f64_exact(k, phi));
+    }
+    // Swing: the gravity potential is a sum over the fibres' pendulums,
+    // 1/2 g [m_a (Z + Z_a) + m_b Z] theta_a^2 (upper fibre: both bodies, the test mass's weight
+    // at the lower suspension point) + 1/2 m_b g Z_b (theta_a + theta_b)^2 (lower fibre: the
+    // test mass about the lower suspension point), and likewise for eta; each fibre's share
+    // gets its diluted loss angle, phi_swing = phi_bending / D.
+    let k_ga = g * (m_a * zza + m_b * z);
+    let k_gb = m_b * g * z_b;
+    let phi_a = dd(lp.bending_a_rad) / dd(lp.dilution_a);
+    let phi_b = dd(lp.bending_b_rad) / dd(lp.dilution_b);
+    let (im_a, im_b) = (phi_a * k_ga, phi_b * k_gb);
+    for (a, b) in [(TA, TB), (EA, EB)] {
+        stiffness[a][a] += CDd::new(Dd::ZERO, im_a + im_b);
+        stiffness[a][b] += CDd::new(Dd::ZERO, im_b);
+        stiffness[b][a] += CDd::new(Dd::ZERO, im_b);
+        stiffness[b][b] += CDd::new(Dd::ZERO, im_b);
+    }
+    // Viscous damping on the same coordinates (swing of fibre b on the absolute angles).
+    let v = &p.viscous;
+    let mut damping = [[Dd::ZERO; 8]; 8];
+    for (c, coef) in [
+        (PA, v.torsion_a_n_m_s_per_rad),
+        (PB, v.torsion_b_n_m_s_per_rad),
+        (DA, v.bouncing_a_n_s_per_m),
+        (DB, v.bouncing_b_n_s_per_m),
+    ] {
+        damping[c][c] = dd(coef);
+    }
+    let (c_a, c_b) = (dd(v.swing_a_n_m_s_per_rad), dd(v.swing_b_n_m_s_per_rad));
+    for (a, b) in [(TA, TB), (EA, EB)] {
+        damping[a][a] = c_a + c_b;
+        damping[a][b] = c_b;
+        damping[b][a] = c_b;
+        damping[b][b] = c_b;
+    }
+
+    // Zeroth-order generalized forces (Appendix A, last display).
+    let one = Dd::ONE;
+    let mut force = [[Dd::ZERO; 12]; 8];
+    let rows: [(usize, Vec<(usize, Dd)>); 8] = [
+        (
+            TA,
+            vec![
+                (FBY, zzb),
+                (FAY, zza),
+                (MAX, one),
+                (MBX, one),
+                (FAZ, y_a),
+                (FBZ, -d),
+            ],
+        ),
+        (EA, vec![(FBX, -zzb), (FAX, -zza), (MAY, one), (MBY, one)]),
+        (PA, vec![(FAX, -y_a), (FBX, d), (MAZ, one), (MBZ, one)]),
+        (DA, vec![(FAZ, -one), (FBZ, -one)]),
+        (TB, vec![(FBY, z_b), (MBX, one)]),
+        (EB, vec![(FBX, -z_b), (MBY, one)]),
+        (PB, vec![(MBZ, one)]),
+        (DB, vec![(FBZ, -one)]),
+    ];
+    for (row, entries) in rows {
+        for (col, v) in entries {
+            force[row][col] = v;
+        }
+    }
+
+    // Tilt forcing (section IV.B, crate convention: t takes the floor frame to the inertial
+    // frame). G0: the potential is evaluated at theta_a - theta_t, eta_a - eta_t, so the tilt
+    // columns are K_gravity's theta_a and eta_a columns; phi_t does not enter the potential.
+    let mut g0 = [[Dd::ZERO; 3]; 8];
+    for r in 0..8 {
+        g0[r][0] = kg[r][TA];
+        g0[r][1] = kg[r][EA];
+    }
+    // G2: apparent forces and torques per unit t'' (frame angular acceleration w' = -t'').
+    let zero = Dd::ZERO;
+    let inertia_a = [[a11, zero, zero], [zero, a22, a23], [zero, a23, a33]];
+    let inertia_b = [[b11, zero, zero], [zero, b22, zero], [zero, zero, b33]];
+    let r_ga0 = [zero, y_a, -zza];
+    let r_gb0 = [zero, -d, -zzb];
+    let mut g2 = [[Dd::ZERO; 3]; 8];
+    for axis in 0..3 {
+        let mut w_dot = [zero; 3];
+        w_dot[axis] = -one;
+        let r_s = cross(w_dot, [zero, zero, h]);
+        let apparent_force = |m: Dd, r_g: [Dd; 3]| {
+            let rot = cross(w_dot, r_g);
+            [0, 1, 2].map(|k| -(m * (r_s[k] + rot[k])))
+        };
+        let apparent_torque = |inertia: [[Dd; 3]; 3]| {
+            [0, 1, 2].map(|k| {
+                -(inertia[k][0] * w_dot[0] + inertia[k][1] * w_dot[1] + inertia[k][2] * w_dot[2])
+            })
+        };
+        let [fa, fb, ma, mb] = [
+            apparent_force(m_a, r_ga0),
+            apparent_force(m_b, r_gb0),
+            apparent_torque(inertia_a),
+            apparent_torque(inertia_b),
+        ];
+        let loads: Vec<Dd> = [fa, fb, ma, mb].concat();
+        for r in 0..8 {
+            let mut q = Dd::ZERO;
+            for (c, &load) in loads.iter().enumerate() {
+                if !force[r][c].is_zero() && !load.is_zero() {
+                    q += force[r][c] * load;
+                }
+            }
+            // Q per unit t''; a harmonic tilt has t'' = -w^2 t, so G2 = -Q.
+            g2[r][axis] = -q;
+        }
+    }
+
+    // Observation rows (section II.D).
+    let lever = z + z_b + h_c;
+    let lower = h_c + z_b;
+    let mut observation = [[Dd::ZERO; 8]; 7];
+    observation[OBS_X][EA] = -lever;
+    observation[OBS_X][EB] = -lower;
+    observation[OBS_X][PA] = d;
+    observation[OBS_Y][TA] = lever;
+    observation[OBS_Y][TB] = lower;
+    observation[OBS_Z][DA] = -one;
+    observation[OBS_Z][DB] = -one;
+    observation[OBS_Z][TA] = -d;
+    observation[OBS_THETA][TA] = one;
+    observation[OBS_THETA][TB] = one;
+    observation[OBS_ETA][EA] = one;
+    observation[OBS_ETA][EB] = one;
+    observation[OBS_PHI][PA] = one;
+    observation[OBS_PHI][PB] = one;
+    observation[OBS_PHI_A][PA] = one;
+
+    Matrices {
+        mass,
+        stiffness_gravity: kg,
+        stiffness,
+        damping,
+        force,
+        g0,
+        g2,
+        observation,
+    }
+}

@@ -1,0 +1,526 @@
+//! Constrained least-squares fit of chosen parameters to measured normal-mode frequencies (the
+//! paper's validation: "a least square fit, constrained within the experimental error bars,
+//! then adjusts the mechanical parameters in order to best match the observed normal mode
+//! frequencies", Table II).
+//!
+//! * **Variables.** Each free parameter `p` is fitted in the scaled variable
+//!   `u = (p - p0) / sigma_p`, with `p0` the nominal value and `sigma_p = rel_sigma |p0|` its
+//!   error bar from [`crate::mc::uncertainties`] (the Monte Carlo's error model, overridable in
+//!   the parameter file). Parameters without an error bar (g, h, loss angles) cannot be free.
+//! * **Objective.** `chi^2 = sum_k ((f_k(p) - f_k,meas) / sigma_k)^2` over the measured modes,
+//!   mode identity by rank (sorted frequencies, as in Table II). "Constrained within the error
+//!   bars" is read literally: a hard box `|u| <= n` (`n` = [`FitConfig::bound_sigmas`], 1 by
+//!   default). Optionally ([`FitConfig::prior`]) the Gaussian prior `sum u^2` is added, which
+//!   turns the fit into a maximum a-posteriori estimate that also works for parameters the data
+//!   cannot pin down; the box still applies.
+//! * **Solver.** Levenberg-Marquardt with an active set on the box ([`lm`]), analytic Jacobian
+//!   from eigenvalue perturbation theory ([`jacobian`]).
+//! * **Uncertainties.** Linearized covariance `(J^T J)^-1` of the scaled variables at the
+//!   solution (`J` = weighted Jacobian, with the prior rows when the prior is on), over the free
+//!   parameters *not* on a bound; a parameter on a bound is flagged and has no sigma (the
+//!   linearization does not describe a truncated distribution). Not rescaled by `chi^2 / dof`.
+//! * **Poorly constrained** ("prior-dominated"): a free parameter whose data-only sigma,
+//!   `sqrt((J_d^T J_d)^-1_ii)` in units of its error bar, is >= 1: the measured frequencies
+//!   determine it no better than its error bar did. The singular values `s < 1` of the data
+//!   Jacobian `J_d` and their right singular vectors are reported as the weak directions (a
+//!   combination `v . u` is determined to `1 / s` error bars).
+//!
+//! Pure numerics: depends on `params`, `model`, `modes`, `mc` (the error model); no I/O.
+
+pub mod jacobian;
+pub mod lm;
+pub mod measured;
+
+pub use measured::{Measured, MeasuredMode, SigmaSource};
+
+use crate::error::ParamError;
+use crate::params::Params;
+use nalgebra::{DMatrix, DVector};
+
+/// Default free parameters: for each mode, or pair of nearly degenerate modes, the parameter
+/// its frequency is most sensitive to per error bar (`docs/fit.md` has the table):
+/// k_a (nu_1), k_b (nu_2), kappa_a and kappa_b (nu_7, nu_8), Z (the crossbar swing pair
+/// nu_3, nu_4), I^a_22 (nu_4 alone: the nu_3/nu_4 splitting), Z_b (the test-mass swing pair
+/// nu_5, nu_6) and d (nu_6 alone, through the crossbar's centre-of-mass offset: the nu_5/nu_6
+/// splitting). Eight parameters for eight modes with linearly independent sensitivity
+/// patterns, so the weighted Jacobian of the Table II example has full rank.
+pub const DEFAULT_FREE: [&str; 8] = [
+    "torsion.k_a_n_m_per_rad",
+    "torsion.k_b_n_m_per_rad",
+    "bouncing.kappa_a_n_per_m",
+    "bouncing.kappa_b_n_per_m",
+    "length.z_m",
+    "inertia.a22_kg_m2",
+    "length.z_b_m",
+    "length.d_m",
+];
+
+/// Projected-gradient tolerance of the solver, in units of `chi^2 / 2` per error bar.
+pub const GTOL: f64 = 1e-10;
+/// Iteration limit of the solver.
+pub const MAX_ITERATIONS: usize = 200;
+
+/// Singular values of the weighted Jacobian below `s_max * RANK_TOL` count as zero when
+/// inverting `J^T J` (sigma reported infinite): `RANK_TOL` is `eps` times a generous bound on
+/// the matrix dimension, the usual numerical-rank threshold.
+pub const RANK_TOL: f64 = 16.0 * f64::EPSILON;
+
+/// What to fit and how.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitConfig {
+    /// Dotted keys of the free parameters (each once, each with an error bar).
+    pub free: Vec<String>,
+    /// Half-width of the box in error bars, `|p - p0| <= bound_sigmas sigma_p` (finite, > 0).
+    pub bound_sigmas: f64,
+    /// Add the Gaussian prior `sum ((p - p0) / sigma_p)^2` to the objective.
+    pub prior: bool,
+}
+
+impl Default for FitConfig {
+    fn default() -> FitConfig {
+        FitConfig {
+            free: DEFAULT_FREE.iter().map(|k| k.to_string()).collect(),
+            bound_sigmas: 1.0,
+            prior: false,
+        }
+    }
+}
+
+/// Which bound a parameter ended on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Bound {
+    /// `p = p0 - n sigma_p`.
+    Lower,
+    /// `p = p0 + n sigma_p`.
+    Upper,
+}
+
+impl Bound {
+    /// `lower` or `upper`, as in the fit's files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Bound::Lower => "lower",
+            Bound::Upper => "upper",
+        }
+    }
+}
+
+/// One fitted parameter.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FittedParam {
+    /// Dotted key.
+    pub key: String,
+    /// SI unit.
+    pub unit: String,
+    /// Nominal value p0.
+    pub nominal: f64,
+    /// Fitted value.
+    pub fitted: f64,
+    /// Error bar sigma_p = rel_sigma |p0| (the prior sigma).
+    pub prior_sigma: f64,
+    /// Linearized posterior sigma at the solution; `None` on a bound, infinite if the
+    /// parameter lies in the null space of the Jacobian.
+    pub fitted_sigma: Option<f64>,
+    /// The bound the parameter ended on, if any.
+    pub at_bound: Option<Bound>,
+    /// Data-only sigma in units of the error bar, `sqrt((J_d^T J_d)^-1_ii)`.
+    pub data_sigma_rel: f64,
+    /// `data_sigma_rel >= 1`: the data determine it no better than its error bar.
+    pub poorly_constrained: bool,
+}
+
+/// One measured mode at the nominal and the fitted parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModeFit {
+    /// The measurement.
+    pub measured: MeasuredMode,
+    /// Model frequency at the nominal parameters (Hz).
+    pub nominal_hz: f64,
+    /// Model frequency at the fitted parameters (Hz).
+    pub fitted_hz: f64,
+}
+
+impl ModeFit {
+    /// Fitted minus measured (Hz).
+    pub fn residual_hz(&self) -> f64 {
+        self.fitted_hz - self.measured.frequency_hz
+    }
+
+    /// Fitted minus measured, in measurement sigmas.
+    pub fn residual_sigmas(&self) -> f64 {
+        self.residual_hz() / self.measured.sigma_hz
+    }
+}
+
+/// A combination of free parameters the data determine poorly.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WeakDirection {
+    /// Singular value of the data Jacobian (< 1): the combination is known to `1 / s` error bars.
+    pub singular_value: f64,
+    /// Unit vector in scaled variables, one component per free parameter (key, component).
+    pub direction: Vec<(String, f64)>,
+}
+
+/// The outcome of a fit.
+#[derive(Debug, Clone)]
+pub struct FitResult {
+    /// The free parameters, in the order given.
+    pub params: Vec<FittedParam>,
+    /// The measured modes, by rank.
+    pub modes: Vec<ModeFit>,
+    /// The full fitted parameter set.
+    pub fitted_params: Params,
+    /// Data chi^2 at the nominal parameters.
+    pub chi2_nominal: f64,
+    /// Data chi^2 at the solution.
+    pub chi2: f64,
+    /// Prior term `sum u^2` at the solution (0 when the prior is off).
+    pub prior_term: f64,
+    /// Degrees of freedom: measured modes minus free parameters (box only), or measured modes
+    /// (with the prior, which adds one pseudo-measurement per parameter).
+    pub dof: usize,
+    /// Singular values of the data Jacobian in scaled variables, largest first.
+    pub singular_values: Vec<f64>,
+    /// Singular directions with `s < 1`.
+    pub weak_directions: Vec<WeakDirection>,
+    /// Solver summary.
+    pub iterations: usize,
+    /// Model evaluations (frequencies plus Jacobian).
+    pub evaluations: usize,
+    /// Why the solver stopped.
+    pub stop: lm::Stop,
+    /// Projected gradient of `chi^2 / 2` at the solution (per error bar).
+    pub projected_gradient: f64,
+    /// The configuration used.
+    pub config: FitConfig,
+}
+
+/// A fit that cannot be run.
+#[derive(Debug, thiserror::Error)]
+pub enum FitError {
+    /// A malformed measured-frequency file.
+    #[error("measured frequencies {origin}: {message}")]
+    Measured {
+        /// File (and line).
+        origin: String,
+        /// What is wrong and what is allowed.
+        message: String,
+    },
+    /// No free parameter.
+    #[error("fit: no free parameter; give at least one with --free KEY,...")]
+    NoFree,
+    /// More free parameters than measured modes.
+    #[error(
+        "fit: {free} free parameters but only {measured} measured modes; at most as many free \
+         parameters as measured modes are allowed (drop some from --free or measure more modes)"
+    )]
+    TooManyFree {
+        /// Number of free parameters.
+        free: usize,
+        /// Number of measured modes.
+        measured: usize,
+    },
+    /// A free key that is not a parameter.
+    #[error("fit: unknown parameter key `{key}` in --free; allowed keys: {allowed}")]
+    UnknownKey {
+        /// The key given.
+        key: String,
+        /// The keys that can be free.
+        allowed: String,
+    },
+    /// A free key whose parameter has no error bar.
+    #[error(
+        "fit: parameter `{key}` in --free is exact (error bar 0), so it cannot move; allowed \
+         keys (with an error bar): {allowed}"
+    )]
+    ExactKey {
+        /// The key given.
+        key: String,
+        /// The keys that can be free.
+        allowed: String,
+    },
+    /// The same key twice.
+    #[error("fit: parameter `{key}` is listed twice in --free; give each key once")]
+    DuplicateKey {
+        /// The key.
+        key: String,
+    },
+    /// A box width that is not a positive finite number.
+    #[error("fit: --bound-sigmas {value} is not allowed: must be finite and > 0")]
+    BoundSigmas {
+        /// The value given.
+        value: f64,
+    },
+    /// The box reaches non-physical values of a parameter.
+    #[error(
+        "fit: the box {lower:e}..{upper:e} {unit} of `{key}` (nominal +/- {n} error bars) reaches \
+         non-physical values ({reason}); reduce --bound-sigmas or the parameter's error bar"
+    )]
+    BoxNotPhysical {
+        /// The parameter.
+        key: String,
+        /// Box edges.
+        lower: f64,
+        /// Box edges.
+        upper: f64,
+        /// Unit.
+        unit: String,
+        /// Box half-width in error bars.
+        n: f64,
+        /// The validation error at the edge.
+        reason: String,
+    },
+    /// The nominal or a derived parameter set is not physical.
+    #[error(transparent)]
+    Params(ParamError),
+}
+
+/// Weighted residuals, their Jacobian in `u` and the eight model frequencies (Hz).
+type Evaluation = (DVector<f64>, DMatrix<f64>, [f64; 8]);
+
+/// One free parameter's setup.
+struct Free {
+    key: String,
+    unit: String,
+    nominal: f64,
+    sigma: f64,
+}
+
+/// Fits `config.free` of `params` to `measured`.
+pub fn fit(
+    params: &Params,
+    measured: &Measured,
+    config: &FitConfig,
+) -> Result<FitResult, FitError> {
+    let free = check_config(params, measured, config)?;
+    let n = config.bound_sigmas;
+    let keys: Vec<String> = free.iter().map(|f| f.key.clone()).collect();
+    let m = measured.modes.len();
+    let ranks: Vec<usize> = measured.modes.iter().map(|x| x.mode - 1).collect();
+    let at = |u: &DVector<f64>| -> Result<Params, FitError> {
+        free.iter()
+            .zip(u.iter())
+            .try_fold(params.clone(), |p, (f, &ui)| {
+                jacobian::with_value(&p, &f.key, f.nominal + ui * f.sigma)
+            })
+    };
+    // Data rows, then (with the prior) one row u_j per parameter.
+    let residuals = |u: &DVector<f64>| -> Result<Evaluation, FitError> {
+        let (freqs, dfdp) = jacobian::frequencies_and_jacobian(&at(u)?, &keys)?;
+        let rows = m + if config.prior { free.len() } else { 0 };
+        let mut r = DVector::zeros(rows);
+        let mut jac = DMatrix::zeros(rows, free.len());
+        for (i, (x, &k)) in measured.modes.iter().zip(&ranks).enumerate() {
+            r[i] = (freqs[k] - x.frequency_hz) / x.sigma_hz;
+            for (j, f) in free.iter().enumerate() {
+                jac[(i, j)] = dfdp[(k, j)] * f.sigma / x.sigma_hz;
+            }
+        }
+        if config.prior {
+            for j in 0..free.len() {
+                r[m + j] = u[j];
+                jac[(m + j, j)] = 1.0;
+            }
+        }
+        Ok((r, jac, freqs))
+    };
+    let u0 = DVector::zeros(free.len());
+    let (r0, _, nominal_freqs) = residuals(&u0)?;
+    let opts = lm::LmOptions {
+        gtol: GTOL,
+        max_iterations: MAX_ITERATIONS,
+    };
+    let out = lm::minimize(u0, n, &opts, |u| residuals(u).map(|(r, j, _)| (r, j)))?;
+    let fitted_params = at(&out.u)?;
+    let (_, _, fitted_freqs) = residuals(&out.u)?;
+
+    let data_jac = out.jac.rows(0, m).into_owned();
+    let data_sigma_rel = diag_of_inverse(&data_jac);
+    let at_bound: Vec<Option<Bound>> = out
+        .u
+        .iter()
+        .map(|&ui| match ui {
+            x if x >= n => Some(Bound::Upper),
+            x if x <= -n => Some(Bound::Lower),
+            _ => None,
+        })
+        .collect();
+    let inside: Vec<usize> = (0..free.len()).filter(|&j| at_bound[j].is_none()).collect();
+    let posterior = diag_of_inverse(&out.jac.select_columns(&inside));
+    let params_out = free
+        .iter()
+        .enumerate()
+        .map(|(j, f)| FittedParam {
+            key: f.key.clone(),
+            unit: f.unit.clone(),
+            nominal: f.nominal,
+            fitted: f.nominal + out.u[j] * f.sigma,
+            prior_sigma: f.sigma,
+            fitted_sigma: inside
+                .iter()
+                .position(|&i| i == j)
+                .map(|pos| posterior[pos] * f.sigma),
+            at_bound: at_bound[j],
+            data_sigma_rel: data_sigma_rel[j],
+            poorly_constrained: data_sigma_rel[j] >= 1.0,
+        })
+        .collect();
+    let svd = data_jac.clone().svd(false, true);
+    let v_t = svd.v_t.expect("requested");
+    let mut order: Vec<usize> = (0..svd.singular_values.len()).collect();
+    order.sort_by(|&a, &b| svd.singular_values[b].total_cmp(&svd.singular_values[a]));
+    let singular_values: Vec<f64> = order.iter().map(|&i| svd.singular_values[i]).collect();
+    let weak_directions = order
+        .iter()
+        .filter(|&&i| svd.singular_values[i] < 1.0)
+        .map(|&i| WeakDirection {
+            singular_value: svd.singular_values[i],
+            direction: keys
+                .iter()
+                .enumerate()
+                .map(|(j, k)| (k.clone(), v_t[(i, j)]))
+                .collect(),
+        })
+        .collect();
+    let chi2 = |r: &DVector<f64>| r.rows(0, m).norm_squared();
+    Ok(FitResult {
+        params: params_out,
+        modes: measured
+            .modes
+            .iter()
+            .zip(&ranks)
+            .map(|(x, &k)| ModeFit {
+                measured: x.clone(),
+                nominal_hz: nominal_freqs[k],
+                fitted_hz: fitted_freqs[k],
+            })
+            .collect(),
+        fitted_params,
+        chi2_nominal: chi2(&r0),
+        chi2: chi2(&out.r),
+        prior_term: match config.prior {
+            true => out.u.norm_squared(),
+            false => 0.0,
+        },
+        dof: if config.prior { m } else { m - free.len() },
+        singular_values,
+        weak_directions,
+        iterations: out.iterations,
+        evaluations: out.evaluations + 2,
+        stop: out.stop,
+        projected_gradient: out.projected_gradient,
+        config: config.clone(),
+    })
+}
+
+/// `sqrt(diag((J^T J)^-1))` through the SVD of `J`; a parameter with a component along a
+/// numerically zero singular value gets an infinite value.
+fn diag_of_inverse(jac: &DMatrix<f64>) -> Vec<f64> {
+    let cols = jac.ncols();
+    if cols == 0 {
+        return Vec::new();
+    }
+    let svd = jac.clone().svd(false, true);
+    let v_t = svd.v_t.expect("requested");
+    let s_max = svd.singular_values.max();
+    (0..cols)
+        .map(|j| {
+            let mut var = 0.0;
+            for (i, &s) in svd.singular_values.iter().enumerate() {
+                let c = v_t[(i, j)];
+                if s <= s_max * RANK_TOL {
+                    if c != 0.0 {
+                        return f64::INFINITY;
+                    }
+                    continue;
+                }
+                var += (c / s).powi(2);
+            }
+            var.sqrt()
+        })
+        .collect()
+}
+
+/// Checks the configuration against the parameters and the measurements.
+fn check_config(
+    params: &Params,
+    measured: &Measured,
+    config: &FitConfig,
+) -> Result<Vec<Free>, FitError> {
+    let n = config.bound_sigmas;
+    if !(n.is_finite() && n > 0.0) {
+        return Err(FitError::BoundSigmas { value: n });
+    }
+    if config.free.is_empty() {
+        return Err(FitError::NoFree);
+    }
+    let fields = params.fields();
+    let rel_sigma = |key: &str| {
+        crate::mc::uncertainties(params)
+            .into_iter()
+            .find(|u| u.key == key)
+            .map_or(0.0, |u| u.rel_sigma)
+    };
+    let allowed: Vec<&str> = fields
+        .iter()
+        .map(|f| f.key)
+        .filter(|k| rel_sigma(k) > 0.0)
+        .collect();
+    let allowed = allowed.join(", ");
+    let mut out: Vec<Free> = Vec::with_capacity(config.free.len());
+    for key in &config.free {
+        let field = fields
+            .iter()
+            .find(|f| f.key == key)
+            .ok_or_else(|| FitError::UnknownKey {
+                key: key.clone(),
+                allowed: allowed.clone(),
+            })?;
+        if out.iter().any(|f| &f.key == key) {
+            return Err(FitError::DuplicateKey { key: key.clone() });
+        }
+        let sigma = rel_sigma(key) * field.value.abs();
+        if sigma <= 0.0 {
+            return Err(FitError::ExactKey {
+                key: key.clone(),
+                allowed: allowed.clone(),
+            });
+        }
+        let (lower, upper) = (field.value - n * sigma, field.value + n * sigma);
+        // A box edge that changes the sign of the parameter would also make the matrix
+        // derivative step (relative to |p|) vanish; the physical ranges exclude it anyway.
+        let edge_error = [lower, upper].into_iter().find_map(|edge| {
+            let reason = match jacobian::with_value(params, key, edge) {
+                Err(e) => Some(e.to_string()),
+                Ok(_) if edge.signum() != field.value.signum() || edge == 0.0 => {
+                    Some("the parameter changes sign".to_string())
+                }
+                Ok(_) => None,
+            };
+            reason.map(|r| (edge, r))
+        });
+        if let Some((_, reason)) = edge_error {
+            return Err(FitError::BoxNotPhysical {
+                key: key.clone(),
+                lower,
+                upper,
+                unit: field.unit.to_string(),
+                n,
+                reason,
+            });
+        }
+        out.push(Free {
+            key: key.clone(),
+            unit: field.unit.to_string(),
+            nominal: field.value,
+            sigma,
+        });
+    }
+    if out.len() > measured.modes.len() {
+        return Err(FitError::TooManyFree {
+            free: out.len(),
+            measured: measured.modes.len(),
+        });
+    }
+    Ok(out)
+}

@@ -1,0 +1,486 @@
+//! [`InputError`]: everything that can be wrong with an input file (floor tilt, or a measured
+//! series or spectrum for the budget).
+//!
+//! Every message names the file, the dataset, column, attribute or key, the offending value or
+//! index, the unit where there is one, and what is allowed. Sample indices are 0-based (the
+//! sample index in the series); CSV line numbers are 1-based (as shown by an editor).
+
+use std::path::{Path, PathBuf};
+
+/// Formats an optional CSV line number as ` (line N)`.
+fn at_line(line: &Option<usize>) -> String {
+    match line {
+        Some(l) => format!(" (line {l})"),
+        None => String::new(),
+    }
+}
+
+/// An input file (floor tilt, or a measured series or spectrum) that cannot be read or is not valid.
+#[derive(Debug, thiserror::Error)]
+pub enum InputError {
+    /// The file could not be opened or read.
+    #[error("cannot read input file {path}: {reason}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the operating system said (in the message, so not also a `source()`).
+        reason: std::io::Error,
+    },
+
+    /// The extension names no supported format.
+    #[error(
+        "input file {path}: extension `{extension}` is not supported; allowed: .h5 or .hdf5 \
+         (HDF5), .csv (comma-separated text)"
+    )]
+    Extension {
+        /// The file.
+        path: PathBuf,
+        /// The extension found (empty if none).
+        extension: String,
+    },
+
+    /// The HDF5 library failed (not an HDF5 file, corrupt file, unreadable object).
+    #[error("input file {path}: HDF5 error reading {object}: {message}")]
+    Hdf5 {
+        /// The file.
+        path: PathBuf,
+        /// The object being read, e.g. `file`, `dataset /E`, `attribute sample_rate_hz of /`.
+        object: String,
+        /// The library's message.
+        message: String,
+    },
+
+    /// The content matches none of the accepted layouts.
+    #[error("input file {path} ({format}): {found}; accepted layouts: {accepted}")]
+    UnknownLayout {
+        /// The file.
+        path: PathBuf,
+        /// `hdf5` or `csv`.
+        format: &'static str,
+        /// What was found instead.
+        found: String,
+        /// The accepted layouts (see `docs/input_formats.md`).
+        accepted: &'static str,
+    },
+
+    /// A time series was asked for and the file holds spectra, or the other way round.
+    #[error("input file {path}: expected {expected} but the file holds {found}")]
+    WrongKind {
+        /// The file.
+        path: PathBuf,
+        /// `series` or `spectra`.
+        expected: &'static str,
+        /// `series` or `spectra`.
+        found: &'static str,
+    },
+
+    /// A required HDF5 attribute is absent.
+    #[error("input file {path}: required attribute `{attribute}` of {object} is missing; expected {expected}")]
+    MissingAttribute {
+        /// The file.
+        path: PathBuf,
+        /// The object that should carry it, e.g. `/` (root) or `dataset /E`.
+        object: String,
+        /// The attribute name.
+        attribute: &'static str,
+        /// What it should hold, with unit.
+        expected: &'static str,
+    },
+
+    /// An HDF5 attribute (or CSV metadata key) with a value or type that is not allowed.
+    #[error("input file {path}: attribute `{attribute}` of {object} = {value} is not allowed: must be {allowed}")]
+    BadAttribute {
+        /// The file.
+        path: PathBuf,
+        /// The object carrying it, e.g. `/` or `dataset /E`.
+        object: String,
+        /// The attribute name (CSV: the metadata key, e.g. `# start_time:`).
+        attribute: &'static str,
+        /// The offending value (or its type).
+        value: String,
+        /// What is allowed, with unit.
+        allowed: &'static str,
+    },
+
+    /// A required HDF5 dataset is absent.
+    #[error("input file {path}: required dataset `{dataset}` is missing; expected {expected}")]
+    MissingDataset {
+        /// The file.
+        path: PathBuf,
+        /// The dataset path, e.g. `/frequency_hz`.
+        dataset: String,
+        /// What it should hold.
+        expected: String,
+    },
+
+    /// An HDF5 dataset of the wrong type or shape.
+    #[error("input file {path}: dataset `{dataset}` has {found}; allowed: {allowed}")]
+    BadDataset {
+        /// The file.
+        path: PathBuf,
+        /// The dataset path.
+        dataset: String,
+        /// Its type or shape.
+        found: String,
+        /// What is allowed.
+        allowed: String,
+    },
+
+    /// A NaN or infinite sample while gaps are rejected.
+    #[error(
+        "input file {path}: channel `{channel}` sample index {index}{} is {value:?} {unit}; \
+         allowed: finite values (or select gap interpolation to bridge interior gaps linearly)",
+        at_line(.line)
+    )]
+    NonFinite {
+        /// The file.
+        path: PathBuf,
+        /// The source channel (dataset or column name).
+        channel: String,
+        /// 0-based sample index.
+        index: usize,
+        /// The value read.
+        value: f64,
+        /// Unit of the channel.
+        unit: &'static str,
+        /// 1-based CSV line, when the input is CSV.
+        line: Option<usize>,
+    },
+
+    /// A run of non-finite samples touching the start or the end of a channel, which linear
+    /// interpolation cannot bridge.
+    #[error(
+        "input file {path}: channel `{channel}` has a {edge} gap of non-finite samples at \
+         indices {first}..={last} (of {len} samples, unit {unit}); gap interpolation needs a \
+         finite sample on both sides: trim the series"
+    )]
+    EdgeGap {
+        /// The file.
+        path: PathBuf,
+        /// The source channel.
+        channel: String,
+        /// `leading` or `trailing`.
+        edge: &'static str,
+        /// First index of the gap.
+        first: usize,
+        /// Last index of the gap (inclusive).
+        last: usize,
+        /// Length of the channel.
+        len: usize,
+        /// Unit of the channel.
+        unit: &'static str,
+    },
+
+    /// Two channels of different lengths.
+    #[error(
+        "input file {path}: channel `{channel_a}` has {len_a} samples but `{channel_b}` has \
+         {len_b}; all channels must have the same length"
+    )]
+    LengthMismatch {
+        /// The file.
+        path: PathBuf,
+        /// First channel.
+        channel_a: String,
+        /// Its length.
+        len_a: usize,
+        /// Second channel.
+        channel_b: String,
+        /// Its length.
+        len_b: usize,
+    },
+
+    /// Too few samples or frequencies.
+    #[error("input file {path}: {what} has {len} {unit}; at least {min} required")]
+    TooShort {
+        /// The file.
+        path: PathBuf,
+        /// What is short, e.g. `channel E` or `column freq_hz`.
+        what: String,
+        /// Its length.
+        len: usize,
+        /// `samples` or `frequencies`.
+        unit: &'static str,
+        /// The minimum.
+        min: usize,
+    },
+
+    /// A malformed axis-map specification.
+    #[error(
+        "{origin}: axis map `{spec}`, entry `{entry}`: {message}; syntax: \
+         TARGET=[+|-]SOURCE[,TARGET=[+|-]SOURCE...] with TARGET one of theta_t, eta_t, phi_t, \
+         e.g. theta_t=-E,eta_t=-N"
+    )]
+    AxisMapSyntax {
+        /// Where the specification came from: `axis map`, or `<file>, attribute axis_map`.
+        origin: String,
+        /// The whole specification.
+        spec: String,
+        /// The offending entry.
+        entry: String,
+        /// What is wrong.
+        message: String,
+    },
+
+    /// The axis map names a channel that the file does not have.
+    #[error(
+        "input file {path}: the axis map assigns {target} to {kind} `{source_name}`, which the \
+         file does not have; available {kind}s: {available}"
+    )]
+    AxisMapSource {
+        /// The file.
+        path: PathBuf,
+        /// The target axis name (`theta_t`, ...).
+        target: &'static str,
+        /// `dataset` or `column`.
+        kind: &'static str,
+        /// The source name asked for.
+        source_name: String,
+        /// The channels the file has.
+        available: String,
+    },
+
+    /// No channel could be assigned to a tilt axis.
+    #[error(
+        "input file {path}: no tilt channel found among {kind}s {found}; allowed without an \
+         axis map: theta_t, eta_t, phi_t (used as they are) or the rotation channels E, N, Z \
+         (or SEED rotation codes ?JE, ?JN, ?JZ; default mapping theta_t=-E, eta_t=-N, \
+         phi_t=-Z); otherwise give an axis map such as theta_t=-E,eta_t=-N"
+    )]
+    NoAxes {
+        /// The file.
+        path: PathBuf,
+        /// `dataset` or `column`.
+        kind: &'static str,
+        /// The channel names found.
+        found: String,
+    },
+
+    /// Several channels qualify for the same axis under the default mapping.
+    #[error(
+        "input file {path}: {kind}s {candidates} all qualify for {axis} under the default \
+         mapping; allowed: exactly one, so give an explicit axis map (e.g. {axis}=-{first})"
+    )]
+    AmbiguousAxis {
+        /// The file.
+        path: PathBuf,
+        /// `dataset` or `column`.
+        kind: &'static str,
+        /// The target axis name.
+        axis: &'static str,
+        /// The candidates, comma separated.
+        candidates: String,
+        /// One of them, for the hint.
+        first: String,
+    },
+
+    /// A unit string that is not understood.
+    #[error("input file {path}: {location} has units `{value}`; allowed: {allowed}")]
+    Units {
+        /// The file.
+        path: PathBuf,
+        /// Where, e.g. `attribute units of dataset /E` or `line 2 (# units:), column LJN`.
+        location: String,
+        /// The unit string found.
+        value: String,
+        /// The accepted unit strings.
+        allowed: &'static str,
+    },
+
+    /// Channels with different quantities (angle and rate) in one file.
+    #[error(
+        "input file {path}: channel `{channel_a}` is in {unit_a} but `{channel_b}` is in \
+         {unit_b}; allowed: all channels in rad (angle) or all in rad/s (rate), or an \
+         explicit quantity override"
+    )]
+    MixedQuantity {
+        /// The file.
+        path: PathBuf,
+        /// First channel.
+        channel_a: String,
+        /// Its unit (`rad` or `rad/s`).
+        unit_a: &'static str,
+        /// Second channel.
+        channel_b: String,
+        /// Its unit.
+        unit_b: &'static str,
+    },
+
+    /// A structural CSV problem: missing header, wrong number of fields, duplicate column,
+    /// unexpected column, malformed metadata line.
+    #[error("input file {path}, line {line}: {message}")]
+    Csv {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong and what is allowed.
+        message: String,
+    },
+
+    /// A CSV field that is not a number.
+    #[error(
+        "input file {path}, line {line}: column `{column}` = `{text}` is not a number \
+         ({unit}); allowed: a decimal floating-point number{}",
+        if *.empty_allowed { " (an empty field is a gap)" } else { "" }
+    )]
+    CsvNumber {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// Column name.
+        column: String,
+        /// The text found.
+        text: String,
+        /// Unit of the column.
+        unit: &'static str,
+        /// Whether an empty field would have been accepted.
+        empty_allowed: bool,
+    },
+
+    /// The time column is not strictly increasing.
+    #[error(
+        "input file {path}, line {line} (sample index {index}): time_s = {value:?} s is not \
+         greater than the previous {previous:?} s; allowed: strictly increasing, uniformly \
+         sampled times"
+    )]
+    TimeNotIncreasing {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// 0-based sample index.
+        index: usize,
+        /// The time found (s).
+        value: f64,
+        /// The time of the previous row (s).
+        previous: f64,
+    },
+
+    /// The time column is not uniformly sampled.
+    #[error(
+        "input file {path}, line {line} (sample index {index}): time_s = {value:?} s deviates \
+         from the uniform grid t0 + index * dt = {expected:?} s by {deviation:.3e} s; allowed: \
+         at most {tolerance:.3e} s (relative {relative:.1e} of dt = {dt:?} s, from the printed \
+         precision of the times)"
+    )]
+    TimeNotUniform {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// 0-based sample index.
+        index: usize,
+        /// The time found (s).
+        value: f64,
+        /// The uniform-grid time (s).
+        expected: f64,
+        /// `|value - expected|` (s).
+        deviation: f64,
+        /// The tolerance (s).
+        tolerance: f64,
+        /// `tolerance / dt`.
+        relative: f64,
+        /// The mean sampling interval `(t_last - t_0) / (n - 1)` (s).
+        dt: f64,
+    },
+
+    /// A frequency that is not positive, not finite, or not strictly increasing.
+    #[error(
+        "input file {path}: {location}: frequency {value:?} Hz is not allowed: must be {allowed}"
+    )]
+    Frequency {
+        /// The file.
+        path: PathBuf,
+        /// Where, e.g. `line 7 (row 3), column freq_hz` or `/frequency_hz[3]`.
+        location: String,
+        /// The value found (Hz).
+        value: f64,
+        /// What is allowed, e.g. `finite and > 0` or `greater than the previous 0.5 Hz`.
+        allowed: String,
+    },
+
+    /// A negative or non-finite amplitude spectral density.
+    #[error("input file {path}: {location}, column `{column}`: ASD {value:?} {unit} is not allowed: must be finite and >= 0")]
+    Asd {
+        /// The file.
+        path: PathBuf,
+        /// Where, e.g. `line 7 (row 3)` or `/asd[3, 1]`.
+        location: String,
+        /// The axis (column) name.
+        column: String,
+        /// The value found.
+        value: f64,
+        /// Unit of the value.
+        unit: &'static str,
+    },
+
+    /// A cross-spectral density matrix that is not Hermitian positive semidefinite within
+    /// tolerance, or has non-finite entries.
+    #[error("input file {path}: /csd[{index}, {i}, {j}] at {freq_hz:?} Hz ({pair}): {problem}")]
+    Csd {
+        /// The file.
+        path: PathBuf,
+        /// Frequency index.
+        index: usize,
+        /// Frequency (Hz).
+        freq_hz: f64,
+        /// Row.
+        i: usize,
+        /// Column.
+        j: usize,
+        /// The axis names of the row and column, e.g. `theta_t, eta_t`.
+        pair: String,
+        /// What is wrong, with the values and their unit, and what is allowed, with the
+        /// tolerance.
+        problem: String,
+    },
+
+    /// A chunk request outside the series.
+    #[error(
+        "input file {path}: chunk of {len} samples starting at sample index {start} is out of \
+         range; allowed: start + len <= {available} (the series length)"
+    )]
+    ChunkOutOfRange {
+        /// The file.
+        path: PathBuf,
+        /// Requested start index.
+        start: usize,
+        /// Requested length.
+        len: usize,
+        /// Length of the series.
+        available: usize,
+    },
+}
+
+/// Checks that `what` of `path` has at least the 2 `unit` (`samples` or `frequencies`) every
+/// series or spectrum needs; else [`InputError::TooShort`].
+pub fn require_two(
+    path: &Path,
+    what: &str,
+    len: usize,
+    unit: &'static str,
+) -> Result<(), InputError> {
+    if len < 2 {
+        return Err(InputError::TooShort {
+            path: path.to_path_buf(),
+            what: what.to_string(),
+            len,
+            unit,
+            min: 2,
+        });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    /// Callers wrap `InputError` in their own error enums: keep it small enough that the
+    /// wrapper (one more discriminant word) stays below clippy's 128-byte `result_large_err`
+    /// threshold.
+    #[test]
+    fn error_is_small() {
+        let n = std::mem::size_of::<super::InputError>();
+        assert!(n <= 112, "size_of::<InputError>() = {n}");
+    }
+}

@@ -1,0 +1,72 @@
+//! [`SeriesSource`]: what the budget job needs of a tilt time series, so that it can stream a
+//! long record from a file (`tiltnoise-io`'s HDF5 reader) or run on one held in memory
+//! ([`TiltSeries`]) without knowing which.
+
+use super::error::InputError;
+use super::{Provenance, TiltSeries};
+use crate::model::TiltAxis;
+
+/// A tilt time series read in sequential chunks: tilt angle `t` (rad) in the convention of
+/// [`crate::model::tilt`], one channel per axis, uniformly sampled.
+pub trait SeriesSource {
+    /// Sample rate (Hz).
+    fn sample_rate_hz(&self) -> f64;
+
+    /// Number of samples per channel.
+    fn len(&self) -> usize;
+
+    /// Whether there are no samples.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The axes, in canonical order; [`SeriesSource::read_chunk`] returns one vector per entry.
+    fn axes(&self) -> &[TiltAxis];
+
+    /// Where the series came from (for the output files).
+    fn provenance(&self) -> &Provenance;
+
+    /// Samples `start .. start + len` of every axis, tilt angle (rad). Callers read in order
+    /// (a rate source carries its integral from one chunk to the next).
+    ///
+    /// # Errors
+    ///
+    /// [`InputError::ChunkOutOfRange`] if `start + len > self.len()`, or the source's own
+    /// read or validation error.
+    fn read_chunk(&mut self, start: usize, len: usize) -> Result<Vec<Vec<f64>>, InputError>;
+}
+
+impl SeriesSource for TiltSeries {
+    fn sample_rate_hz(&self) -> f64 {
+        self.sample_rate_hz
+    }
+
+    fn len(&self) -> usize {
+        TiltSeries::len(self)
+    }
+
+    fn axes(&self) -> &[TiltAxis] {
+        &self.axes
+    }
+
+    fn provenance(&self) -> &Provenance {
+        &self.provenance
+    }
+
+    fn read_chunk(&mut self, start: usize, len: usize) -> Result<Vec<Vec<f64>>, InputError> {
+        let available = TiltSeries::len(self);
+        if start.checked_add(len).is_none_or(|end| end > available) {
+            return Err(InputError::ChunkOutOfRange {
+                path: self.provenance.path.clone(),
+                start,
+                len,
+                available,
+            });
+        }
+        Ok(self
+            .data
+            .iter()
+            .map(|c| c[start..start + len].to_vec())
+            .collect())
+    }
+}

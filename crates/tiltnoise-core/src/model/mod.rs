@@ -1,0 +1,204 @@
+//! The linearized 8-DoF model of the double torsion pendulum (paper, Appendix A): mass and
+//! stiffness matrices, the zeroth-order generalized-force matrix, the tilt forcing and the
+//! observation matrix. Pure numerics: depends on `params` and `nalgebra`, never on I/O.
+
+mod coords;
+pub mod damping;
+mod matrices;
+mod request;
+pub mod tilt;
+
+pub use coords::{Block, Coord, ForceInput, Observable, TiltAxis};
+pub use damping::{DampingKind, DissipativeElement};
+pub use request::{Input, Request};
+
+use crate::error::ParamError;
+use crate::params::Params;
+use nalgebra::{SMatrix, SVector};
+use num_complex::Complex64;
+
+/// 8x8 real matrix in coordinate order [`Coord::ALL`].
+pub type Mat8 = SMatrix<f64, 8, 8>;
+/// 8x8 complex matrix.
+pub type CMat8 = SMatrix<Complex64, 8, 8>;
+/// Generalized forces per unit external force/torque (8 x 12).
+pub type ForceMatrix = SMatrix<f64, 8, 12>;
+/// Generalized forces per unit tilt angle (8 x 3).
+pub type TiltMatrix = SMatrix<f64, 8, 3>;
+/// Observables per unit coordinate (7 x 8).
+pub type ObservationMatrix = SMatrix<f64, 7, 8>;
+/// A generalized-coordinate vector.
+pub type Vec8 = SVector<f64, 8>;
+
+/// Geometric quantities derived from the parameters (section II.A and Appendix A).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Derived {
+    /// Horizontal offset of the crossbar centre of mass from the upper fibre, y_a = d m_b / m_a (m).
+    pub y_a_m: f64,
+    /// Crossbar centre of mass at equilibrium, relative to the upper suspension point (m).
+    pub r_ga0_m: [f64; 3],
+    /// Test-mass centre of mass at equilibrium, relative to the upper suspension point (m).
+    pub r_gb0_m: [f64; 3],
+    /// Lever arm of the cube centre below the upper suspension point, Z + Z_b + h_c (m):
+    /// the static tilt gain of X and Y.
+    pub lever_m: f64,
+}
+
+/// The linear model built from one validated parameter set. Immutable; cheap to clone.
+#[derive(Debug, Clone)]
+pub struct Model {
+    params: Params,
+    derived: Derived,
+    mass: Mat8,
+    stiffness_gravity: Mat8,
+    stiffness_elastic: Mat8,
+    /// `Im(K_c)`: the sum of the structural elements' matrices.
+    stiffness_imag: Mat8,
+    /// Viscous damping matrix `C`: the sum of the viscous elements' matrices.
+    damping: Mat8,
+    dissipation: Vec<DissipativeElement>,
+    force: ForceMatrix,
+    tilt: tilt::TiltForcing,
+    observation: ObservationMatrix,
+}
+
+impl Model {
+    /// Builds the model. Fails if the mass matrix is not positive definite (possible for
+    /// parameter sets that pass the per-key checks, e.g. a huge negative I^a_23 coupling).
+    pub fn new(params: &Params) -> Result<Model, ParamError> {
+        let derived = matrices::derived(params);
+        let mass = matrices::mass(params, &derived);
+        let (stiffness_gravity, stiffness_elastic) = matrices::stiffness(params);
+        let dissipation = damping::elements(params);
+        let stiffness_imag = damping::total(&dissipation, DampingKind::Structural);
+        let damping = damping::total(&dissipation, DampingKind::Viscous);
+        if mass.cholesky().is_none() {
+            let eig = mass.symmetric_eigenvalues().min();
+            return Err(ParamError::NotPositiveDefinite {
+                what: "mass matrix M",
+                keys: "mass.*, inertia.*, length.*".into(),
+                detail: format!("smallest eigenvalue {eig:e} (mixed units kg, kg m, kg m^2)"),
+            });
+        }
+        let force = matrices::force_matrix(params, &derived);
+        let tilt = tilt::TiltForcing::new(params, &derived, &force, &stiffness_gravity);
+        let observation = matrices::observation(params);
+        Ok(Model {
+            params: params.clone(),
+            derived,
+            mass,
+            stiffness_gravity,
+            stiffness_elastic,
+            stiffness_imag,
+            damping,
+            dissipation,
+            force,
+            tilt,
+            observation,
+        })
+    }
+
+    /// The parameters the model was built from.
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// Derived geometry.
+    pub fn derived(&self) -> &Derived {
+        &self.derived
+    }
+
+    /// Mass matrix M (Appendix A, eq. EM), symmetric positive definite. Units: kg, kg m, kg m^2
+    /// according to the pair of coordinates.
+    pub fn mass(&self) -> &Mat8 {
+        &self.mass
+    }
+
+    /// Undamped stiffness K = gravity part + elastic part.
+    pub fn stiffness(&self) -> Mat8 {
+        self.stiffness_gravity + self.stiffness_elastic
+    }
+
+    /// Gravity part of K (swinging); lossless.
+    pub fn stiffness_gravity(&self) -> &Mat8 {
+        &self.stiffness_gravity
+    }
+
+    /// Elastic part of K (fibre torsion and bouncing), diagonal.
+    pub fn stiffness_elastic(&self) -> &Mat8 {
+        &self.stiffness_elastic
+    }
+
+    /// Complex stiffness with structural damping, `K_c = K + i Im(K_c)`: every structural
+    /// element `k (1 + i phi)` (torsion, bouncing, and the diluted swing of each fibre; see
+    /// [`damping`]). Viscous damping is not in here: see [`Model::damping`].
+    pub fn stiffness_complex(&self) -> CMat8 {
+        CMat8::from_fn(|r, c| {
+            Complex64::new(
+                self.stiffness_gravity[(r, c)] + self.stiffness_elastic[(r, c)],
+                self.stiffness_imag[(r, c)],
+            )
+        })
+    }
+
+    /// `Im(K_c)`, symmetric positive semi-definite (N m/rad, N/m, N m/m by entry).
+    pub fn stiffness_imag(&self) -> &Mat8 {
+        &self.stiffness_imag
+    }
+
+    /// Viscous damping matrix `C` (N m s/rad, N s/m, ...), symmetric positive semi-definite; the
+    /// dynamic stiffness is `K_c + i w C - w^2 M`.
+    pub fn damping(&self) -> &Mat8 {
+        &self.damping
+    }
+
+    /// True when some viscous coefficient is nonzero.
+    pub fn has_viscous(&self) -> bool {
+        self.damping.iter().any(|&c| c != 0.0)
+    }
+
+    /// `K_c + i w C` at angular frequency `w` (rad/s): the dynamic stiffness without the
+    /// inertia term.
+    pub fn stiffness_dynamic(&self, omega_rad_s: f64) -> CMat8 {
+        let mut k = self.stiffness_complex();
+        if self.has_viscous() {
+            for (z, &c) in k.iter_mut().zip(self.damping.iter()) {
+                z.im += omega_rad_s * c;
+            }
+        }
+        k
+    }
+
+    /// Every dissipative element with a nonzero coefficient (structural first). Empty when
+    /// the model is undamped.
+    pub fn dissipative_elements(&self) -> &[DissipativeElement] {
+        &self.dissipation
+    }
+
+    /// True when there is no dissipation at all (every loss angle and viscous coefficient 0).
+    pub fn is_undamped(&self) -> bool {
+        self.dissipation.is_empty()
+    }
+
+    /// Zeroth-order generalized forces per unit force/torque component (Appendix A), columns in
+    /// the order of [`ForceInput::ALL`]. Units: m (force -> torque-like Q), 1 or rad/rad.
+    pub fn force_matrix(&self) -> &ForceMatrix {
+        &self.force
+    }
+
+    /// Tilt forcing `G(w) = G0 + w^2 G2`; see [`tilt`] for the sign convention.
+    pub fn tilt_forcing(&self) -> &tilt::TiltForcing {
+        &self.tilt
+    }
+
+    /// Observation matrix C: observables (X, Y, Z in m; theta, eta, phi, phi_a in rad) from q.
+    pub fn observation(&self) -> &ObservationMatrix {
+        &self.observation
+    }
+
+    /// Principal 4x4 sub-matrix of an 8x8 matrix on one block's coordinates.
+    pub fn block_of(matrix: &Mat8, block: Block) -> SMatrix<f64, 4, 4> {
+        let idx = block.coords().map(Coord::index);
+        SMatrix::<f64, 4, 4>::from_fn(|r, c| matrix[(idx[r], idx[c])])
+    }
+}

@@ -1,0 +1,255 @@
+//! Transfer functions from inputs (tilt angles, forces, torques) to observables.
+//!
+//! `H(w) = C (K_c + i w D - w^2 M)^-1 G(w)`, with `K_c` the complex stiffness (structural loss
+//! angles, [`crate::model::Model::stiffness_complex`]), `D` the viscous damping matrix (zero
+//! unless the parameter file has `[viscous]` coefficients; methods that cannot represent it refuse
+//! it at plan time), `G` the tilt forcing `G0 + w^2 G2` (columns per tilt angle, see [`crate::model::tilt`]) or the
+//! zeroth-order force matrix (columns per force/torque component). Units of an entry: the
+//! observable's unit per the input's unit (m/rad, rad/rad, m/N, rad/(N m), ...). The response
+//! is the complex amplitude for `e^{+i w t}` time dependence.
+//!
+//! Methods are plain data ([`Method`]); [`plan`] builds a [`TransferFunction`] that does the
+//! per-model work once and then evaluates cheaply at many frequencies
+//! (RustFFT's recipe/plan pattern). The direct LU method is the `f64` oracle (slow, obviously
+//! correct); the double-double [`crate::reference`] evaluator is the oracle of the accuracy
+//! tests of every method, the direct one included.
+//!
+//! | method | what it computes | relative error, 7x3 tilt, 1e-5..100 Hz (Table I, measured) |
+//! |---|---|---|
+//! | [`Method::Direct`] | 8x8 LU per frequency | 1e-6: phi/eta_t, phi_a/eta_t grow as f^-2 below the torsion modes, eta/phi_t as f^2 above the swing modes |
+//! | [`Method::Block`] | 4x4 LU per needed block | as direct (the same operations) |
+//! | [`Method::Split`] | static part + translation forcing, absolute test-mass angles | 4e-13 outside 1 % of each entry's poles and zeros |
+//! | [`Method::PoleZero`] | per entry `g s^p prod(z_j - s) / prod(lambda_k - s)`, built once in double-double | 3e-14 outside 1 % of each entry's poles and zeros (`tests/polezero.rs`) |
+//! | [`Method::Modal`] | modal superposition | 1e-9 where modal terms do not cancel (the eigenvalues' error, 1 % from nu_1); none on phi/eta_t, phi_a/eta_t at low frequency (1e2 at 1e-5 Hz); damping approximate |
+//! | [`Method::StateSpace`] | `[C, 0] (i w I - A)^-1 B + D`, 16x16 LU per frequency, as python-control and scipy.signal | 2.4e-5 on forces (phi/F_b.x at 100 Hz); none on phi/eta_t, phi_a/eta_t at low frequency (6e2 at 1e-5 Hz) |
+//! | [`Method::Torsion2`] | the 2-DoF torsional model of section IV.C | a reduced model: 1e-5..1e-3 from the 8-DoF one at 0.5..5 mHz |
+//!
+//! `tests/methods.rs` checks every method against the reference with a tolerance derived from
+//! its rounding model and prints these numbers.
+
+mod block;
+mod buffer;
+mod direct;
+mod grid;
+mod matrix;
+mod modal;
+pub mod planner;
+mod polezero;
+mod split;
+mod statespace;
+mod torsion2;
+
+use crate::error::TfError;
+use crate::model::Model;
+pub use crate::model::{Input, Request};
+use num_complex::Complex64;
+
+pub use block::BlockReduced;
+pub use buffer::{zeroed_complex, zeroed_f64};
+pub use direct::{Direct, SINGULAR_RCOND};
+pub(crate) use grid::check_grid_len;
+pub use grid::{eval_grid_threads, evaluate, evaluate_into};
+pub use matrix::{Layout, TransferMatrix};
+pub use modal::Modal;
+pub use planner::{choose, plan_auto, Choice, Scene, Verdict, DEFAULT_REL_TOL, POLE_EXCLUSION};
+pub use polezero::{EntryFactors, PoleZero};
+pub use split::Split;
+pub use statespace::StateSpace;
+pub use torsion2::Torsion2;
+
+/// Evaluation methods. Plain data: the planner turns one into a [`TransferFunction`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// Per-frequency LU of the full 8x8 dynamic stiffness, with equilibration and a condition
+    /// check. Slow and obviously correct: the oracle for the other methods.
+    Direct,
+    /// Per-frequency 4x4 LU of each decoupled block the request needs ([`crate::model::Block`]),
+    /// with the direct method's equilibration and condition check. Same results as direct.
+    Block,
+    /// Modal superposition over the undamped normal modes. Damping enters as modal loss angles,
+    /// an approximation (see [`Method::exact_for_damping`]); loses all relative accuracy where
+    /// the modal terms cancel (phi/eta_t and phi_a/eta_t at low frequency). A comparison method.
+    Modal,
+    /// Block LU in absolute test-mass angles, with the tilt response split into its exact static
+    /// part and a translation forcing: full relative accuracy on every tilt entry, including the
+    /// f^4 fall of phi/eta_t at low frequency, and on the force entries up to 100 Hz.
+    Split,
+    /// The 2-DoF torsional model of section IV.C (phi_a, phi_b only): a reduced model, valid
+    /// near and below the torsion modes; refuses inputs and outputs it cannot represent.
+    Torsion2,
+    /// Each entry as `g s^p prod(z_j - s) / prod(lambda_k - s)` (`s = w^2`), with its poles,
+    /// zeros and gain found once per plan in double-double from the reference's matrices:
+    /// no solve per frequency. See [`PoleZero`].
+    PoleZero,
+    /// The first-order state-space form `[C, 0] (i w I - A)^-1 B + D` as python-control and
+    /// scipy.signal evaluate it (16x16 LU per frequency, no equilibration): a comparison
+    /// method that loses relative accuracy where the tilt forcing cancels. See [`StateSpace`].
+    StateSpace,
+}
+
+impl Method {
+    /// Every method, the oracle first.
+    pub const ALL: [Method; 7] = [
+        Method::Direct,
+        Method::Block,
+        Method::Split,
+        Method::PoleZero,
+        Method::Modal,
+        Method::StateSpace,
+        Method::Torsion2,
+    ];
+
+    /// Name used on the command line and in files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Direct => "direct",
+            Method::Block => "block",
+            Method::Modal => "modal",
+            Method::Split => "split",
+            Method::Torsion2 => "torsion2",
+            Method::PoleZero => "polezero",
+            Method::StateSpace => "statespace",
+        }
+    }
+
+    /// False when the method treats loss angles approximately (modal loss angles neglect the
+    /// coupling of modes by damping); every other method solves `K_c - w^2 M` with the complex
+    /// stiffness itself.
+    pub fn exact_for_damping(self) -> bool {
+        !matches!(self, Method::Modal)
+    }
+
+    /// False for the reduced 2-DoF model, whose transfer functions differ from the 8-DoF
+    /// model's by the neglected coupling to the swing modes.
+    pub fn full_model(self) -> bool {
+        !matches!(self, Method::Torsion2)
+    }
+}
+
+/// A request that a method cannot evaluate, found at plan time.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum PlanError {
+    /// The method's model has no way to represent an input or an output of the request.
+    #[error("method `{}` cannot evaluate {item}: {reason}", method.name())]
+    Unsupported {
+        /// The method asked for.
+        method: Method,
+        /// The input or output it cannot represent, e.g. `input eta_t`.
+        item: String,
+        /// Why, and what the method supports instead.
+        reason: String,
+    },
+}
+
+/// A planned transfer function: evaluates the `outputs x inputs` matrix at one frequency.
+pub trait TransferFunction: Send + Sync {
+    /// The method behind this plan.
+    fn method(&self) -> Method;
+
+    /// What the plan computes.
+    fn request(&self) -> &Request;
+
+    /// Writes `H(f)` row-major (`out[o * n_inputs + i]`) into `out`, whose length must be
+    /// `outputs.len() * inputs.len()`. `freq_hz` must be finite and >= 0.
+    fn eval_into(&self, freq_hz: f64, out: &mut [Complex64]) -> Result<(), TfError>;
+
+    /// Writes `H` at every frequency of `freqs_hz` into `out`, `[freq][output][input]`
+    /// row-major (the dense [`Layout`]), whose length must be
+    /// `freqs_hz.len() * outputs.len() * inputs.len()`. Returns the error of the first
+    /// frequency (in grid order) at which [`TransferFunction::eval_into`] fails; `out` is then
+    /// unspecified. The default calls `eval_into` point by point; a method with a faster
+    /// batch evaluation ([`Method::PoleZero`]) overrides it with the same values and errors.
+    ///
+    /// # Panics
+    ///
+    /// If `out` has the wrong length.
+    fn eval_grid_into(&self, freqs_hz: &[f64], out: &mut [Complex64]) -> Result<(), TfError> {
+        let block = check_grid_len(self.request(), freqs_hz, out);
+        if block == 0 {
+            // Nothing to write; each frequency is still checked.
+            let mut none: [Complex64; 0] = [];
+            return freqs_hz
+                .iter()
+                .try_for_each(|&f| self.eval_into(f, &mut none));
+        }
+        for (&f, h) in freqs_hz.iter().zip(out.chunks_exact_mut(block)) {
+            self.eval_into(f, h)?;
+        }
+        Ok(())
+    }
+
+    /// The layout [`evaluate`] stores this plan's values in: [`Layout::dense`] unless the plan
+    /// knows its structural zeros (or that its values are real) and overrides this together
+    /// with [`TransferFunction::eval_grid_layout_into`].
+    fn layout(&self) -> Layout {
+        let r = self.request();
+        Layout::dense(r.outputs.len() * r.inputs.len())
+    }
+
+    /// Writes `H` at every frequency of `freqs_hz` into `planes`, one per plane of
+    /// [`TransferFunction::layout`], each as long as the grid: the values of
+    /// [`TransferFunction::eval_grid_into`], stored differently, and the same errors. The
+    /// default (dense layout) evaluates point by point with `eval_into`.
+    ///
+    /// # Panics
+    ///
+    /// If the number or the lengths of `planes` are wrong.
+    fn eval_grid_layout_into(
+        &self,
+        freqs_hz: &[f64],
+        planes: &mut [&mut [f64]],
+    ) -> Result<(), TfError> {
+        let n = self.layout().n_entries();
+        assert_eq!(planes.len(), 2 * n, "two planes per entry (dense layout)");
+        let mut h = vec![Complex64::new(0.0, 0.0); n];
+        for (k, &f) in freqs_hz.iter().enumerate() {
+            self.eval_into(f, &mut h)?;
+            for (e, z) in h.iter().enumerate() {
+                planes[2 * e][k] = z.re;
+                planes[2 * e + 1][k] = z.im;
+            }
+        }
+        Ok(())
+    }
+
+    /// Allocating convenience wrapper around [`TransferFunction::eval_into`].
+    fn eval(&self, freq_hz: f64) -> Result<Vec<Complex64>, TfError> {
+        let r = self.request();
+        let mut out = vec![Complex64::new(0.0, 0.0); r.outputs.len() * r.inputs.len()];
+        self.eval_into(freq_hz, &mut out)?;
+        Ok(out)
+    }
+}
+
+/// Builds the plan for `method` (factorizations and forcing matrices prepared once). Fails
+/// only for a method that cannot represent part of the request ([`Method::Torsion2`]); the
+/// methods of the full model plan every request.
+pub fn plan(
+    model: &Model,
+    request: &Request,
+    method: Method,
+) -> Result<Box<dyn TransferFunction>, PlanError> {
+    if model.has_viscous()
+        && matches!(
+            method,
+            Method::Modal | Method::Torsion2 | Method::PoleZero | Method::StateSpace
+        )
+    {
+        return Err(PlanError::Unsupported {
+            method,
+            item: "viscous damping".into(),
+            reason: "this method solves only structural damping (the complex stiffness K_c); \
+                     `direct`, `block` and `split` solve K_c + i w C - w^2 M with viscous terms"
+                .into(),
+        });
+    }
+    Ok(match method {
+        Method::Direct => Box::new(Direct::new(model, request.clone())),
+        Method::Block => Box::new(BlockReduced::new(model, request.clone())),
+        Method::Modal => Box::new(Modal::new(model, request.clone())),
+        Method::Split => Box::new(Split::new(model, request.clone())),
+        Method::Torsion2 => Box::new(Torsion2::new(model, request.clone())?),
+        Method::PoleZero => Box::new(PoleZero::new(model, request.clone())),
+        Method::StateSpace => Box::new(StateSpace::new(model, request.clone())),
+    })
+}

@@ -1,0 +1,225 @@
+//! Noise budget as HDF5 (schema `tiltnoise.budget`, documented in `docs/schemas.md`).
+
+use super::h5util::{dataset, scalar_attr, str_attr, strs_attr};
+use super::{InputMeta, RunMeta, SIGN_CONVENTION};
+use crate::atomic::write_atomic;
+use std::path::Path;
+use tiltnoise_core::error::OutputError;
+use tiltnoise_core::noise::equivalent::referred_terms;
+use tiltnoise_core::noise::{is_response, BudgetReport, SpectralSource};
+
+/// Value of the root attribute `schema`.
+pub const SCHEMA_BUDGET: &str = "tiltnoise.budget";
+
+/// Value of the root attribute `schema_version`. Bumped on any change that can break a reader.
+pub const SCHEMA_VERSION_BUDGET: i64 = 1;
+
+/// Value of the root attribute `spectral_convention`.
+pub const SPECTRAL_CONVENTION: &str =
+    "one-sided; PSD in unit^2/Hz, ASD = sqrt(PSD) in unit/sqrt(Hz)";
+
+/// Writes a budget report with the run's provenance `meta` and the tilt input's provenance
+/// `input` as an HDF5 file of schema [`SCHEMA_BUDGET`], atomically (see
+/// [`super::write_atomic`]).
+///
+/// Layout: root attributes (schema, provenance, conventions, how the tilt spectra were
+/// obtained); `/frequency_hz`; one group per observable (`/X`, `/phi`, `/phi_a`) holding one
+/// group per term (`/X/tilt`, `/X/tilt.eta_t`, `/X/readout`, `/X/total`, ...) with datasets
+/// `psd` and `asd`; `/segments` with the percentile band of the `tilt` term when the report
+/// has one. A damped budget adds `thermal`, `thermal.<element>` term groups and, per observable,
+/// an `equivalent` group with every term referred to the test mass's acceleration (X) or
+/// torque (phi, phi_a). Every item is described in `docs/schemas.md`.
+///
+/// # Errors
+///
+/// [`OutputError::Write`] naming `path` if the report is inconsistent (a spectrum whose length
+/// differs from the frequency grid) or on any I/O or HDF5 failure; nothing is left at `path`.
+pub fn write_budget_hdf5(
+    path: &Path,
+    report: &BudgetReport,
+    meta: &RunMeta,
+    input: &InputMeta,
+) -> Result<(), OutputError> {
+    write_atomic(path, |temp| {
+        report.check()?;
+        write_file(temp, report, meta, input).map_err(|e| format!("HDF5: {e}"))
+    })
+}
+
+fn write_file(
+    path: &Path,
+    report: &BudgetReport,
+    meta: &RunMeta,
+    input: &InputMeta,
+) -> hdf5::Result<()> {
+    let file = hdf5::File::create(path)?;
+
+    str_attr(&file, "schema", SCHEMA_BUDGET)?;
+    scalar_attr(&file, "schema_version", SCHEMA_VERSION_BUDGET)?;
+    str_attr(&file, "tool_version", &meta.tool_version)?;
+    str_attr(&file, "created_by", &meta.command_line)?;
+    str_attr(&file, "parameters_toml", &meta.params_toml)?;
+    str_attr(&file, "sign_convention", SIGN_CONVENTION)?;
+    str_attr(&file, "spectral_convention", SPECTRAL_CONVENTION)?;
+
+    str_attr(&file, "input_path", &input.path)?;
+    str_attr(&file, "input_format", &input.format)?;
+    str_attr(&file, "input_kind", &input.kind)?;
+    str_attr(&file, "input_quantity", &input.quantity)?;
+    str_attr(&file, "input_axis_map", &input.axis_map)?;
+    if let Some(t) = &input.start_time {
+        str_attr(&file, "input_start_time", t)?;
+    }
+    let notes: Vec<&str> = input
+        .notes
+        .iter()
+        .chain(&report.notes)
+        .map(String::as_str)
+        .collect();
+    strs_attr(&file, "notes", &notes)?;
+
+    match &report.source {
+        SpectralSource::Welch {
+            sample_rate_hz,
+            segment_len,
+            overlap,
+            averaging,
+            n_welch_segments,
+            n_samples,
+        } => {
+            str_attr(&file, "source", "welch")?;
+            scalar_attr(&file, "sample_rate_hz", *sample_rate_hz)?;
+            scalar_attr(&file, "welch_segment_len", int(*segment_len)?)?;
+            scalar_attr(&file, "welch_overlap", int(*overlap)?)?;
+            str_attr(&file, "welch_averaging", averaging)?;
+            scalar_attr(&file, "welch_n_segments", int(*n_welch_segments)?)?;
+            scalar_attr(&file, "n_samples", int(*n_samples)?)?;
+        }
+        SpectralSource::Spectra { data_band_hz } => {
+            str_attr(&file, "source", "spectra")?;
+            let band = [data_band_hz.0, data_band_hz.1];
+            file.new_attr_builder()
+                .with_data(band.as_slice())
+                .create("data_band_hz")?;
+        }
+    }
+    let axes: Vec<&str> = report.axes.iter().map(|a| a.name()).collect();
+    strs_attr(&file, "tilt_axes", &axes)?;
+    let observables: Vec<&str> = report
+        .budget
+        .observables
+        .iter()
+        .map(|b| b.observable.name())
+        .collect();
+    strs_attr(&file, "observables", &observables)?;
+
+    let freq = dataset(&file, "frequency_hz", &report.budget.freqs_hz)?;
+    str_attr(&freq, "units", "Hz")?;
+
+    for ob in &report.budget.observables {
+        let o = ob.observable;
+        let unit = o.unit();
+        let group = file.create_group(o.name())?;
+        str_attr(&group, "unit", unit)?;
+        let terms: Vec<&str> = ob
+            .terms
+            .iter()
+            .filter(|t| !is_response(&t.name))
+            .map(|t| t.name.as_str())
+            .collect();
+        strs_attr(&group, "terms", &terms)?;
+        if let Some(asd) = report.readout.of(o) {
+            scalar_attr(&group, "readout_asd", asd)?;
+            str_attr(&group, "readout_asd_units", &asd_unit(unit))?;
+        }
+        for term in ob.terms.iter().filter(|t| !is_response(&t.name)) {
+            let g = group.create_group(&term.name)?;
+            write_psd_asd(&g, "psd", "asd", &term.psd, unit)?;
+        }
+        if let Some(referred) = referred_terms(ob) {
+            write_equivalent(&group, &referred, unit)?;
+        }
+    }
+
+    if !report.segment_bands.is_empty() {
+        let segments = file.create_group("segments")?;
+        let first = &report.segment_bands[0].1;
+        if let Some(d) = report.segment_duration_s {
+            scalar_attr(&segments, "segment_duration_s", d)?;
+        }
+        scalar_attr(&segments, "n_segments", int(first.n_segments)?)?;
+        scalar_attr(&segments, "lower_pct", first.lower_pct)?;
+        scalar_attr(&segments, "upper_pct", first.upper_pct)?;
+        for (o, band) in &report.segment_bands {
+            let unit = o.unit();
+            let g = segments.create_group(o.name())?;
+            str_attr(&g, "unit", unit)?;
+            scalar_attr(&g, "n_segments", int(band.n_segments)?)?;
+            scalar_attr(&g, "lower_pct", band.lower_pct)?;
+            scalar_attr(&g, "upper_pct", band.upper_pct)?;
+            for (suffix, psd) in [
+                ("median", &band.median),
+                ("lower", &band.lower),
+                ("upper", &band.upper),
+            ] {
+                write_psd_asd(
+                    &g,
+                    &format!("tilt_psd_{suffix}"),
+                    &format!("tilt_asd_{suffix}"),
+                    psd,
+                    unit,
+                )?;
+            }
+        }
+    }
+
+    file.close()
+}
+
+/// `/<obs>/equivalent`: every noise term referred to the equivalent input (see
+/// [`tiltnoise_core::noise::equivalent`]), `psd = S_o / |R_o|^2`, plus `response_abs = |R_o|`.
+fn write_equivalent(
+    group: &hdf5::Group,
+    referred: &tiltnoise_core::noise::equivalent::Referred<'_>,
+    unit: &str,
+) -> hdf5::Result<()> {
+    let g = group.create_group("equivalent")?;
+    str_attr(&g, "input", referred.input)?;
+    str_attr(&g, "quantity", referred.quantity)?;
+    str_attr(&g, "unit", referred.unit)?;
+    let names: Vec<&str> = referred.terms.iter().map(|(name, _)| *name).collect();
+    strs_attr(&g, "terms", &names)?;
+    let abs: Vec<f64> = referred.response_psd.iter().map(|p| p.sqrt()).collect();
+    let d = dataset(&g, "response_abs", &abs)?;
+    str_attr(&d, "units", &format!("{unit}/({})", referred.unit))?;
+    for (name, psd) in &referred.terms {
+        let t = g.create_group(name)?;
+        write_psd_asd(&t, "psd", "asd", psd, referred.unit)?;
+    }
+    Ok(())
+}
+
+/// `m` -> `m/sqrt(Hz)`.
+fn asd_unit(unit: &str) -> String {
+    format!("{unit}/sqrt(Hz)")
+}
+
+/// Datasets `psd_name` (unit^2/Hz) and `asd_name` (sqrt of it, unit/sqrt(Hz)) in `group`.
+fn write_psd_asd(
+    group: &hdf5::Group,
+    psd_name: &str,
+    asd_name: &str,
+    psd: &[f64],
+    unit: &str,
+) -> hdf5::Result<()> {
+    let asd: Vec<f64> = psd.iter().map(|p| p.sqrt()).collect();
+    let d = dataset(group, psd_name, psd)?;
+    str_attr(&d, "units", &format!("{unit}^2/Hz"))?;
+    let d = dataset(group, asd_name, &asd)?;
+    str_attr(&d, "units", &asd_unit(unit))?;
+    Ok(())
+}
+
+fn int(n: usize) -> hdf5::Result<i64> {
+    i64::try_from(n).map_err(|e| e.to_string().into())
+}

@@ -1,0 +1,406 @@
+//! A small, strict CSV reader for the tilt inputs: `#` comment lines (metadata keys
+//! `# units:`, `# axes:`, `# start_time:`, `# description:` before the header), one header
+//! line, then records with exactly as many comma-separated fields as the header. Blank lines
+//! are skipped; fields are trimmed and may be enclosed in double quotes (no embedded commas).
+
+use super::meta::decide_quantity;
+use super::InputError;
+use super::{resolve, MapOrigin, Resolved};
+use std::fs::File;
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+
+/// Metadata keys recognised in `# key: value` lines before the header.
+pub(crate) const META_KEYS: [&str; 4] = ["units", "axes", "start_time", "description"];
+
+/// One `# key: value` line.
+#[derive(Debug, Clone)]
+pub(crate) struct MetaLine {
+    pub key: String,
+    pub value: String,
+    pub line: usize,
+}
+
+/// Everything before the first record.
+#[derive(Debug, Clone)]
+pub(crate) struct Prelude {
+    pub header: Vec<String>,
+    pub header_line: usize,
+    pub meta: Vec<MetaLine>,
+}
+
+impl Prelude {
+    /// The metadata line of key `key` (keys are unique, see [`CsvFile::prelude`]).
+    pub fn meta(&self, key: &str) -> Option<&MetaLine> {
+        self.meta.iter().find(|m| m.key == key)
+    }
+}
+
+/// An open CSV file positioned after its prelude once [`CsvFile::prelude`] has run.
+pub(crate) struct CsvFile {
+    pub path: PathBuf,
+    reader: BufReader<File>,
+    line_no: usize,
+    buf: String,
+}
+
+fn unquote(s: &str) -> &str {
+    let s = s.trim();
+    s.strip_prefix('"')
+        .and_then(|s| s.strip_suffix('"'))
+        .unwrap_or(s)
+        .trim()
+}
+
+impl CsvFile {
+    pub fn open(path: &Path) -> Result<CsvFile, InputError> {
+        let file = File::open(path).map_err(|reason| InputError::Io {
+            path: path.to_path_buf(),
+            reason,
+        })?;
+        Ok(CsvFile {
+            path: path.to_path_buf(),
+            reader: BufReader::with_capacity(1 << 16, file),
+            line_no: 0,
+            buf: String::new(),
+        })
+    }
+
+    fn err(&self, line: usize, message: String) -> InputError {
+        InputError::Csv {
+            path: self.path.clone(),
+            line,
+            message,
+        }
+    }
+
+    /// Reads the next line into `self.buf` (without the line ending); `false` at end of file.
+    fn next_line(&mut self) -> Result<bool, InputError> {
+        self.buf.clear();
+        let n = self.reader.read_line(&mut self.buf).map_err(|e| {
+            if e.kind() == std::io::ErrorKind::InvalidData {
+                InputError::Csv {
+                    path: self.path.clone(),
+                    line: self.line_no + 1,
+                    message: "not UTF-8 text; allowed: a UTF-8 (or ASCII) CSV file (an HDF5 \
+                              file needs the extension .h5 or .hdf5)"
+                        .to_string(),
+                }
+            } else {
+                InputError::Io {
+                    path: self.path.clone(),
+                    reason: e,
+                }
+            }
+        })?;
+        if n == 0 {
+            return Ok(false);
+        }
+        self.line_no += 1;
+        let trimmed = self.buf.trim_end_matches(['\n', '\r']).len();
+        self.buf.truncate(trimmed);
+        if self.line_no == 1 && self.buf.starts_with('\u{feff}') {
+            self.buf.drain(..3);
+        }
+        Ok(true)
+    }
+
+    /// Reads comment/metadata lines and the header.
+    pub fn prelude(&mut self) -> Result<Prelude, InputError> {
+        let mut meta: Vec<MetaLine> = Vec::new();
+        loop {
+            if !self.next_line()? {
+                return Err(self.err(
+                    self.line_no,
+                    "no header line; allowed: optional `#` comment lines, then a header such \
+                     as time_s,theta_t,eta_t or freq_hz,theta_t,eta_t, then data rows"
+                        .to_string(),
+                ));
+            }
+            let line = self.buf.trim();
+            if line.is_empty() {
+                continue;
+            }
+            if let Some(comment) = line.strip_prefix('#') {
+                if let Some((key, value)) = comment.trim_start().split_once(':') {
+                    let key = key.trim();
+                    if META_KEYS.contains(&key) {
+                        if let Some(prev) = meta.iter().find(|m| m.key == key) {
+                            return Err(self.err(
+                                self.line_no,
+                                format!(
+                                    "metadata key `# {key}:` repeated (first on line {}); \
+                                     allowed: once",
+                                    prev.line
+                                ),
+                            ));
+                        }
+                        meta.push(MetaLine {
+                            key: key.to_string(),
+                            value: value.trim().to_string(),
+                            line: self.line_no,
+                        });
+                    }
+                }
+                continue;
+            }
+            let header: Vec<String> = line.split(',').map(|f| unquote(f).to_string()).collect();
+            for (i, name) in header.iter().enumerate() {
+                if name.is_empty() {
+                    return Err(self.err(
+                        self.line_no,
+                        format!(
+                            "header column {} has an empty name; allowed: non-empty names",
+                            i + 1
+                        ),
+                    ));
+                }
+                if let Some(j) = header[..i].iter().position(|n| n == name) {
+                    return Err(self.err(
+                        self.line_no,
+                        format!(
+                            "header column `{name}` appears twice (columns {} and {}); \
+                             allowed: unique names",
+                            j + 1,
+                            i + 1
+                        ),
+                    ));
+                }
+            }
+            return Ok(Prelude {
+                header,
+                header_line: self.line_no,
+                meta,
+            });
+        }
+    }
+
+    /// Calls `f(line_number, fields)` for every record after the prelude. Comment lines and
+    /// blank lines are skipped. Every record must have `n_fields` fields.
+    pub fn for_each_record(
+        &mut self,
+        n_fields: usize,
+        mut f: impl FnMut(usize, &[&str]) -> Result<(), InputError>,
+    ) -> Result<(), InputError> {
+        while self.next_line()? {
+            let line = self.buf.trim();
+            if line.is_empty() || line.starts_with('#') {
+                continue;
+            }
+            let fields: Vec<&str> = line.split(',').map(unquote).collect();
+            if fields.len() != n_fields {
+                return Err(InputError::Csv {
+                    path: self.path.clone(),
+                    line: self.line_no,
+                    message: format!(
+                        "{} fields but the header has {n_fields}; allowed: exactly one field \
+                         per header column",
+                        fields.len()
+                    ),
+                });
+            }
+            f(self.line_no, &fields)?;
+        }
+        Ok(())
+    }
+}
+
+/// Parses a number field. `Ok(None)` for an empty field.
+pub(crate) fn parse_field(text: &str) -> Result<Option<f64>, ()> {
+    if text.is_empty() {
+        return Ok(None);
+    }
+    text.parse::<f64>().map(Some).map_err(|_| ())
+}
+
+/// Resolution of a printed decimal number: the place value of its last digit, e.g. `8191.0` ->
+/// 0.1, `1.25e-3` -> 1e-5, `100` -> 1.
+pub(crate) fn decimal_resolution(text: &str) -> f64 {
+    let (mantissa, exp) = match text.find(['e', 'E']) {
+        Some(i) => (&text[..i], text[i + 1..].parse::<i32>().unwrap_or(0)),
+        None => (text, 0),
+    };
+    let decimals = mantissa
+        .split_once('.')
+        .map_or(0, |(_, frac)| frac.len() as i32);
+    10f64.powi(exp - decimals)
+}
+
+/// The units declared by the `# units:` line for the mapped columns `mapped` (names), either
+/// one unit for every column (`# units: rad/s`) or per column (`# units: LJN=rad/s, LJE=rad/s`).
+/// Returns the declared units and the mapped columns without one.
+fn declared_units(
+    path: &Path,
+    prelude: &Prelude,
+    mapped: &[String],
+    classify: fn(&str) -> Option<super::Quantity>,
+    allowed: &'static str,
+) -> Result<(Vec<super::meta::Declared>, Vec<String>), InputError> {
+    use super::meta::Declared;
+    let Some(m) = prelude.meta("units") else {
+        return Ok((Vec::new(), mapped.to_vec()));
+    };
+    let bad_unit = |column: Option<&str>, value: &str| InputError::Units {
+        path: path.to_path_buf(),
+        location: match column {
+            Some(c) => format!("line {} (# units:), column `{c}`", m.line),
+            None => format!("line {} (# units:)", m.line),
+        },
+        value: value.to_string(),
+        allowed,
+    };
+    let mut declared = Vec::new();
+    if m.value.contains('=') {
+        let mut seen: Vec<&str> = Vec::new();
+        for item in m.value.split(',') {
+            let Some((name, unit)) = item.split_once('=') else {
+                return Err(InputError::Csv {
+                    path: path.to_path_buf(),
+                    line: m.line,
+                    message: format!(
+                        "`# units:` entry `{}` has no `=`; allowed: one unit for all columns \
+                         (e.g. `# units: rad/s`) or COLUMN=UNIT entries separated by commas",
+                        item.trim()
+                    ),
+                });
+            };
+            let (name, unit) = (name.trim(), unit.trim());
+            if !prelude.header[1..].iter().any(|h| h == name) || seen.contains(&name) {
+                return Err(InputError::Csv {
+                    path: path.to_path_buf(),
+                    line: m.line,
+                    message: format!(
+                        "`# units:` names column `{name}`, which is {}; allowed: each data \
+                         column of the header ({}) at most once",
+                        if seen.contains(&name) {
+                            "repeated"
+                        } else {
+                            "not a data column"
+                        },
+                        prelude.header[1..].join(", ")
+                    ),
+                });
+            }
+            seen.push(name);
+            let q = classify(unit).ok_or_else(|| bad_unit(Some(name), unit))?;
+            if mapped.iter().any(|c| c == name) {
+                declared.push(Declared {
+                    channel: name.to_string(),
+                    unit: unit.to_string(),
+                    quantity: q,
+                });
+            }
+        }
+    } else {
+        let q = classify(&m.value).ok_or_else(|| bad_unit(None, &m.value))?;
+        declared.extend(mapped.iter().map(|c| Declared {
+            channel: c.clone(),
+            unit: m.value.clone(),
+            quantity: q,
+        }));
+    }
+    let undeclared = mapped
+        .iter()
+        .filter(|c| !declared.iter().any(|d| &d.channel == *c))
+        .cloned()
+        .collect();
+    Ok((declared, undeclared))
+}
+
+/// The `# axes:` map, if any.
+fn axis_map(
+    path: &Path,
+    prelude: &Prelude,
+) -> Result<Option<(super::AxisMap, String)>, InputError> {
+    let Some(m) = prelude.meta("axes") else {
+        return Ok(None);
+    };
+    let origin = format!("{}, line {} (# axes:)", path.display(), m.line);
+    let map = super::AxisMap::parse_from(&m.value, &origin)?;
+    Ok(Some((
+        map,
+        format!("line {} `# axes:` of the file", m.line),
+    )))
+}
+
+/// What a CSV prelude decides for either reader: the channel mapping, the quantity, the start
+/// time and the provenance notes so far.
+pub(crate) struct Interpreted {
+    /// The axis map resolved against the data columns (`prelude.header[1..]`).
+    pub resolved: Resolved,
+    /// From the explicit quantity, else the `# units:` line, else angle.
+    pub quantity: super::Quantity,
+    /// The validated `# start_time:` value.
+    pub start_time: Option<String>,
+    /// Axis-map, quantity and description notes, in that order.
+    pub notes: Vec<String>,
+}
+
+/// Interprets the prelude of a CSV input: resolves the axis map (explicit, else `# axes:`,
+/// else the default) against the data columns, decides the quantity from the `# units:` line,
+/// whose units `classify` recognises (`allowed` lists them for the error), and reads
+/// `# start_time:` and `# description:`.
+pub(crate) fn interpret(
+    path: &Path,
+    prelude: &Prelude,
+    opts: &super::ReadOptions,
+    classify: fn(&str) -> Option<super::Quantity>,
+    allowed: &'static str,
+) -> Result<Interpreted, InputError> {
+    let file_map = axis_map(path, prelude)?;
+    let origin = match (&opts.axis_map, &file_map) {
+        (Some(m), _) => MapOrigin::Options(m),
+        (None, Some((m, from))) => MapOrigin::File(m, from),
+        (None, None) => MapOrigin::Default,
+    };
+    let resolved = resolve(path, &prelude.header[1..], origin, "column")?;
+    let mut notes = resolved.notes.clone();
+    if let (Some(_), Some((m, from))) = (&opts.axis_map, &file_map) {
+        notes.push(format!(
+            "the explicit axis map overrides the file's map {m} ({from})"
+        ));
+    }
+    let mapped: Vec<String> = resolved.channels.iter().map(|m| m.source.clone()).collect();
+    let (declared, undeclared) = declared_units(path, prelude, &mapped, classify, allowed)?;
+    let quantity = decide_quantity(path, opts.quantity, &declared, &undeclared, &mut notes)?;
+    let start_time = start_time(path, prelude)?;
+    if let Some(d) = prelude.meta("description") {
+        notes.push(format!("description: {}", d.value));
+    }
+    Ok(Interpreted {
+        resolved,
+        quantity,
+        start_time,
+        notes,
+    })
+}
+
+/// The `# start_time:` value, validated.
+fn start_time(path: &Path, prelude: &Prelude) -> Result<Option<String>, InputError> {
+    let Some(m) = prelude.meta("start_time") else {
+        return Ok(None);
+    };
+    if !super::meta::is_iso8601(&m.value) {
+        return Err(InputError::BadAttribute {
+            path: path.to_path_buf(),
+            object: format!("line {}", m.line),
+            attribute: "# start_time:",
+            value: format!("`{}`", m.value),
+            allowed: super::meta::ISO8601_ALLOWED,
+        });
+    }
+    Ok(Some(m.value.clone()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn resolution() {
+        assert_eq!(decimal_resolution("8191.0"), 0.1);
+        assert_eq!(decimal_resolution("100"), 1.0);
+        assert!((decimal_resolution("1.25e-3") - 1e-5).abs() < 1e-20);
+        assert_eq!(decimal_resolution("1e3"), 1000.0);
+    }
+}

@@ -1,0 +1,351 @@
+//! HDF5 helpers: opening, layout detection, typed attribute reading with precise errors.
+
+use super::meta::{is_iso8601, ISO8601_ALLOWED};
+use super::InputError;
+use super::{resolve, MapOrigin, Resolved};
+use super::{
+    AxisMap, InputKind, ReadOptions, ACCEPTED_LAYOUTS, INPUT_SCHEMA_VERSION, SCHEMA_TILT_SERIES,
+    SCHEMA_TILT_SPECTRA,
+};
+use hdf5::types::{FixedAscii, FixedUnicode, TypeDescriptor, VarLenAscii, VarLenUnicode};
+use hdf5::{Attribute, Location, LocationType};
+use std::path::Path;
+
+/// Maps an HDF5 error to [`InputError::Hdf5`] naming `object`.
+pub(crate) fn h5err(
+    path: &Path,
+    object: impl Into<String>,
+) -> impl FnOnce(hdf5::Error) -> InputError {
+    let path = path.to_path_buf();
+    let object = object.into();
+    move |e| InputError::Hdf5 {
+        path,
+        object,
+        message: e.to_string(),
+    }
+}
+
+/// Opens `path` read-only.
+pub(crate) fn open(path: &Path) -> Result<hdf5::File, InputError> {
+    if let Err(reason) = std::fs::metadata(path) {
+        return Err(InputError::Io {
+            path: path.to_path_buf(),
+            reason,
+        });
+    }
+    hdf5::File::open(path).map_err(h5err(path, "file (is it an HDF5 file?)"))
+}
+
+/// A decoded attribute value.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum AttrValue {
+    /// A numeric scalar (or 1-element array).
+    Num(f64),
+    /// A string scalar (or 1-element array).
+    Str(String),
+    /// A 1-D array of several strings.
+    StrList(Vec<String>),
+    /// Anything else, described.
+    Other(String),
+}
+
+impl AttrValue {
+    /// Description for messages.
+    pub fn describe(&self) -> String {
+        match self {
+            AttrValue::Num(v) => format!("{v}"),
+            AttrValue::Str(s) => format!("`{s}`"),
+            AttrValue::StrList(v) => format!("{v:?}"),
+            AttrValue::Other(d) => d.clone(),
+        }
+    }
+}
+
+fn read_strings(a: &Attribute, desc: &TypeDescriptor) -> hdf5::Result<Option<Vec<String>>> {
+    Ok(Some(match desc {
+        TypeDescriptor::VarLenUnicode => a
+            .read_raw::<VarLenUnicode>()?
+            .iter()
+            .map(|s| s.as_str().to_string())
+            .collect(),
+        TypeDescriptor::VarLenAscii => a
+            .read_raw::<VarLenAscii>()?
+            .iter()
+            .map(|s| s.as_str().to_string())
+            .collect(),
+        TypeDescriptor::FixedAscii(_) => a
+            .read_raw::<FixedAscii<4096>>()?
+            .iter()
+            .map(|s| s.as_str().to_string())
+            .collect(),
+        TypeDescriptor::FixedUnicode(_) => a
+            .read_raw::<FixedUnicode<4096>>()?
+            .iter()
+            .map(|s| s.as_str().to_string())
+            .collect(),
+        _ => return Ok(None),
+    }))
+}
+
+/// Reads attribute `name` of `loc` (`None` if absent).
+pub(crate) fn attr(
+    path: &Path,
+    loc: &Location,
+    object: &str,
+    name: &str,
+) -> Result<Option<AttrValue>, InputError> {
+    let what = || format!("attribute `{name}` of {object}");
+    let names = loc.attr_names().map_err(h5err(path, object))?;
+    if !names.iter().any(|n| n == name) {
+        return Ok(None);
+    }
+    let a = loc.attr(name).map_err(h5err(path, what()))?;
+    let desc = a
+        .dtype()
+        .and_then(|t| t.to_descriptor())
+        .map_err(h5err(path, what()))?;
+    let shape = a.shape();
+    let value = match desc {
+        TypeDescriptor::Float(_)
+        | TypeDescriptor::Integer(_)
+        | TypeDescriptor::Unsigned(_)
+        | TypeDescriptor::Boolean => {
+            if a.size() == 1 {
+                AttrValue::Num(a.read_raw::<f64>().map_err(h5err(path, what()))?[0])
+            } else {
+                AttrValue::Other(format!("a numeric array of shape {shape:?}"))
+            }
+        }
+        _ => match read_strings(&a, &desc).map_err(h5err(path, what()))? {
+            Some(mut v) if shape.is_empty() || (shape.len() == 1 && v.len() == 1) => {
+                AttrValue::Str(v.pop().unwrap_or_default())
+            }
+            Some(v) if shape.len() == 1 => AttrValue::StrList(v),
+            Some(_) => AttrValue::Other(format!("a string array of shape {shape:?}")),
+            None => AttrValue::Other(format!("a value of type {desc} and shape {shape:?}")),
+        },
+    };
+    Ok(Some(value))
+}
+
+/// A string attribute; `None` if absent, an error if not a string.
+pub(crate) fn str_attr(
+    path: &Path,
+    loc: &Location,
+    object: &str,
+    name: &'static str,
+    allowed: &'static str,
+) -> Result<Option<String>, InputError> {
+    match attr(path, loc, object, name)? {
+        None => Ok(None),
+        Some(AttrValue::Str(s)) => Ok(Some(s)),
+        Some(other) => Err(InputError::BadAttribute {
+            path: path.to_path_buf(),
+            object: object.to_string(),
+            attribute: name,
+            value: other.describe(),
+            allowed,
+        }),
+    }
+}
+
+/// Names of the datasets directly under the root, in HDF5's (alphabetical) order.
+/// The root attribute `sample_rate_hz` of a time-series file (Hz, finite and > 0), required.
+pub(crate) fn sample_rate_hz(path: &Path, file: &hdf5::File) -> Result<f64, InputError> {
+    const RATE_ALLOWED: &str = "the sample rate in Hz: a finite number > 0";
+    match attr(path, file, "/", "sample_rate_hz")? {
+        None => Err(InputError::MissingAttribute {
+            path: path.to_path_buf(),
+            object: "/".to_string(),
+            attribute: "sample_rate_hz",
+            expected: RATE_ALLOWED,
+        }),
+        Some(AttrValue::Num(v)) if v.is_finite() && v > 0.0 => Ok(v),
+        Some(other) => Err(InputError::BadAttribute {
+            path: path.to_path_buf(),
+            object: "/".to_string(),
+            attribute: "sample_rate_hz",
+            value: other.describe(),
+            allowed: RATE_ALLOWED,
+        }),
+    }
+}
+
+pub(crate) fn root_datasets(path: &Path, file: &hdf5::File) -> Result<Vec<String>, InputError> {
+    let names = file.member_names().map_err(h5err(path, "root group /"))?;
+    Ok(names
+        .into_iter()
+        .filter(|n| matches!(file.loc_type_by_name(n), Ok(LocationType::Dataset)))
+        .collect())
+}
+
+/// Decides series vs spectra: root attribute `schema` if present, else `sample_rate_hz` ->
+/// series, dataset `/frequency_hz` -> spectra, else `fallback` (the kind the caller insists
+/// on, so that its own "missing" error names what is missing) or an
+/// [`InputError::UnknownLayout`]. Also checks `schema_version` if present.
+pub(crate) fn detect_kind(
+    path: &Path,
+    file: &hdf5::File,
+    fallback: Option<InputKind>,
+) -> Result<InputKind, InputError> {
+    const SCHEMA_ALLOWED: &str = "`tiltnoise.tilt_series` or `tiltnoise.tilt_spectra` (or no \
+         schema attribute)";
+    let schema = str_attr(path, file, "/", "schema", SCHEMA_ALLOWED)?;
+    let has_rate = attr(path, file, "/", "sample_rate_hz")?.is_some();
+    let has_freq = root_datasets(path, file)?
+        .iter()
+        .any(|n| n == "frequency_hz");
+    let kind = match schema.as_deref() {
+        Some(SCHEMA_TILT_SERIES) => InputKind::Series,
+        Some(SCHEMA_TILT_SPECTRA) => InputKind::Spectra,
+        Some(other) => {
+            return Err(InputError::BadAttribute {
+                path: path.to_path_buf(),
+                object: "/".to_string(),
+                attribute: "schema",
+                value: format!("`{other}`"),
+                allowed: SCHEMA_ALLOWED,
+            })
+        }
+        None => match (has_rate, has_freq) {
+            (true, false) => InputKind::Series,
+            (false, true) => InputKind::Spectra,
+            (true, true) => {
+                return Err(InputError::UnknownLayout {
+                    path: path.to_path_buf(),
+                    format: "hdf5",
+                    found: "both a root attribute sample_rate_hz (series) and a dataset \
+                            /frequency_hz (spectra), and no schema attribute to decide"
+                        .to_string(),
+                    accepted: ACCEPTED_LAYOUTS,
+                })
+            }
+            (false, false) => match fallback {
+                Some(kind) => kind,
+                None => {
+                    let found = root_datasets(path, file)?;
+                    return Err(InputError::UnknownLayout {
+                        path: path.to_path_buf(),
+                        format: "hdf5",
+                        found: format!(
+                            "neither a root attribute sample_rate_hz (required for a time \
+                             series) nor a dataset /frequency_hz (spectra); root datasets: {}",
+                            if found.is_empty() {
+                                "(none)".to_string()
+                            } else {
+                                found.join(", ")
+                            }
+                        ),
+                        accepted: ACCEPTED_LAYOUTS,
+                    });
+                }
+            },
+        },
+    };
+    match attr(path, file, "/", "schema_version")? {
+        None => {}
+        Some(AttrValue::Num(v)) if v == INPUT_SCHEMA_VERSION as f64 => {}
+        Some(other) => {
+            return Err(InputError::BadAttribute {
+                path: path.to_path_buf(),
+                object: "/".to_string(),
+                attribute: "schema_version",
+                value: other.describe(),
+                allowed: "the integer 1 (the version this reader supports)",
+            })
+        }
+    }
+    Ok(kind)
+}
+
+/// Optional root attributes `start_time` (validated ISO 8601) and `description` (note).
+pub(crate) fn start_and_description(
+    path: &Path,
+    file: &hdf5::File,
+    notes: &mut Vec<String>,
+) -> Result<Option<String>, InputError> {
+    let start = str_attr(path, file, "/", "start_time", ISO8601_ALLOWED)?;
+    if let Some(s) = &start {
+        if !is_iso8601(s) {
+            return Err(InputError::BadAttribute {
+                path: path.to_path_buf(),
+                object: "/".to_string(),
+                attribute: "start_time",
+                value: format!("`{s}`"),
+                allowed: ISO8601_ALLOWED,
+            });
+        }
+    }
+    if let Some(d) = str_attr(path, file, "/", "description", "a string")? {
+        notes.push(format!("description: {d}"));
+    }
+    Ok(start)
+}
+
+/// Optional root attribute `axis_map`, parsed.
+pub(crate) fn axis_map(
+    path: &Path,
+    file: &hdf5::File,
+) -> Result<Option<super::AxisMap>, InputError> {
+    let Some(spec) = str_attr(
+        path,
+        file,
+        "/",
+        "axis_map",
+        "a string such as `theta_t=-E,eta_t=-N`",
+    )?
+    else {
+        return Ok(None);
+    };
+    let origin = format!("{}, root attribute axis_map", path.display());
+    super::AxisMap::parse_from(&spec, &origin).map(Some)
+}
+
+/// Resolves the explicit axis map of `opts`, else the root attribute `axis_map` (`file_map`,
+/// see [`axis_map`]), else the default, against the channels `available` of `path` (`kind`:
+/// `dataset` or `axis name`), and appends the provenance notes to `notes`.
+pub(crate) fn resolve_axes(
+    path: &Path,
+    available: &[String],
+    kind: &'static str,
+    opts: &ReadOptions,
+    file_map: Option<&AxisMap>,
+    notes: &mut Vec<String>,
+) -> Result<Resolved, InputError> {
+    let origin = match (&opts.axis_map, file_map) {
+        (Some(m), _) => MapOrigin::Options(m),
+        (None, Some(m)) => MapOrigin::File(m, "root attribute axis_map of the file"),
+        (None, None) => MapOrigin::Default,
+    };
+    let resolved = resolve(path, available, origin, kind)?;
+    notes.extend(resolved.notes.iter().cloned());
+    if let (Some(_), Some(m)) = (&opts.axis_map, file_map) {
+        notes.push(format!(
+            "the explicit axis map overrides the file's axis_map attribute {m}"
+        ));
+    }
+    Ok(resolved)
+}
+
+/// Whether a dataset holds a floating-point type.
+pub(crate) fn is_float(ds: &hdf5::Dataset) -> hdf5::Result<(bool, String)> {
+    let d = ds.dtype()?.to_descriptor()?;
+    Ok((matches!(d, TypeDescriptor::Float(_)), d.to_string()))
+}
+
+/// Whether a dataset holds a complex type (compound of two floats `r`, `i`, as h5py writes).
+pub(crate) fn is_complex(ds: &hdf5::Dataset) -> hdf5::Result<(bool, String)> {
+    let d = ds.dtype()?.to_descriptor()?;
+    let ok = match &d {
+        TypeDescriptor::Compound(c) => {
+            c.fields.len() == 2
+                && c.fields[0].name == "r"
+                && c.fields[1].name == "i"
+                && c.fields
+                    .iter()
+                    .all(|f| matches!(f.ty, TypeDescriptor::Float(_)))
+        }
+        _ => false,
+    };
+    Ok((ok, d.to_string()))
+}

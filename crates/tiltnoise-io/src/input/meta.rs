@@ -1,0 +1,273 @@
+//! Metadata shared by the readers: unit strings, start times, the quantity decision.
+
+use super::InputError;
+use super::Quantity;
+use std::path::Path;
+
+/// Accepted unit strings of time-series channels, for messages.
+pub(crate) const SERIES_UNITS: &str = "rad (angle) or rad/s (rate)";
+/// Accepted unit strings of ASD columns/datasets, for messages.
+pub(crate) const ASD_UNITS: &str = "rad/sqrt(Hz) (angle) or rad/s/sqrt(Hz) (rate)";
+/// Accepted unit strings of CSD datasets, for messages.
+pub(crate) const CSD_UNITS: &str = "rad^2/Hz (angle) or rad^2/s^2/Hz (rate)";
+
+fn normalize(unit: &str) -> String {
+    unit.chars()
+        .filter(|c| !c.is_whitespace())
+        .collect::<String>()
+        .to_ascii_lowercase()
+        .replace("**", "^")
+        .replace('²', "^2")
+        .replace("√hz", "sqrt(hz)")
+        .replace("hz^0.5", "sqrt(hz)")
+        .replace("hz^(1/2)", "sqrt(hz)")
+}
+
+/// `rad` -> angle, `rad/s` -> rate (case and whitespace ignored).
+pub(crate) fn series_quantity(unit: &str) -> Option<Quantity> {
+    match normalize(unit).as_str() {
+        "rad" => Some(Quantity::Angle),
+        "rad/s" => Some(Quantity::Rate),
+        _ => None,
+    }
+}
+
+/// `rad/sqrt(Hz)` -> angle, `rad/s/sqrt(Hz)` -> rate.
+pub(crate) fn asd_quantity(unit: &str) -> Option<Quantity> {
+    match normalize(unit).as_str() {
+        "rad/sqrt(hz)" => Some(Quantity::Angle),
+        "rad/s/sqrt(hz)" => Some(Quantity::Rate),
+        _ => None,
+    }
+}
+
+/// `rad^2/Hz` -> angle, `rad^2/s^2/Hz` -> rate.
+pub(crate) fn csd_quantity(unit: &str) -> Option<Quantity> {
+    match normalize(unit).as_str() {
+        "rad^2/hz" => Some(Quantity::Angle),
+        "rad^2/s^2/hz" => Some(Quantity::Rate),
+        _ => None,
+    }
+}
+
+/// A declared unit of one channel.
+#[derive(Debug, Clone)]
+pub(crate) struct Declared {
+    pub channel: String,
+    pub unit: String,
+    pub quantity: Quantity,
+}
+
+/// Decides the quantity from the override and the declared units of the mapped channels
+/// (`undeclared`: mapped channels without a unit), appending provenance notes.
+pub(crate) fn decide_quantity(
+    path: &Path,
+    override_q: Option<Quantity>,
+    declared: &[Declared],
+    undeclared: &[String],
+    notes: &mut Vec<String>,
+) -> Result<Quantity, InputError> {
+    let from_file = match declared.first() {
+        None => None,
+        Some(first) => {
+            if let Some(other) = declared.iter().find(|d| d.quantity != first.quantity) {
+                if override_q.is_none() {
+                    return Err(InputError::MixedQuantity {
+                        path: path.to_path_buf(),
+                        channel_a: first.channel.clone(),
+                        unit_a: first.quantity.unit(),
+                        channel_b: other.channel.clone(),
+                        unit_b: other.quantity.unit(),
+                    });
+                }
+            }
+            Some(first)
+        }
+    };
+    match (override_q, from_file) {
+        (Some(q), _) => {
+            notes.push(format!(
+                "quantity: {} ({}) given explicitly",
+                q.name(),
+                q.unit()
+            ));
+            for d in declared.iter().filter(|d| d.quantity != q) {
+                notes.push(format!(
+                    "the explicit quantity {} overrides the file's units `{}` of channel `{}`",
+                    q.name(),
+                    d.unit,
+                    d.channel
+                ));
+            }
+            if q == Quantity::Rate {
+                notes.push(RATE_NOTE.to_string());
+            }
+            Ok(q)
+        }
+        (None, Some(d)) => {
+            notes.push(format!(
+                "quantity: {} (from the file's units `{}`)",
+                d.quantity.name(),
+                d.unit
+            ));
+            if !undeclared.is_empty() {
+                notes.push(format!(
+                    "channels without units, assumed {}: {}",
+                    d.quantity.name(),
+                    undeclared.join(", ")
+                ));
+            }
+            if d.quantity == Quantity::Rate {
+                notes.push(RATE_NOTE.to_string());
+            }
+            Ok(d.quantity)
+        }
+        (None, None) => {
+            notes.push(
+                "quantity: not given in the file or the options; assumed angle (rad)".to_string(),
+            );
+            Ok(Quantity::Angle)
+        }
+    }
+}
+
+const RATE_NOTE: &str = "rate converted to angle: mean removed, trapezoidal integration, \
+     theta[0] = 0 (spectra: divided by (2 pi f)^2)";
+
+/// Whether `s` is an ISO 8601 date or date-time: `YYYY-MM-DD`, optionally followed by `T` (or
+/// a space) and `hh:mm`, `hh:mm:ss` or `hh:mm:ss.fff...`, optionally followed by `Z` or a UTC
+/// offset `+hh:mm`, `-hh:mm`, `+hhmm`, `+hh`. Field ranges are checked (day against the month,
+/// leap years included; second 60 allowed for leap seconds).
+pub(crate) fn is_iso8601(s: &str) -> bool {
+    fn num(s: &str, n: usize) -> Option<u32> {
+        (s.len() == n && s.bytes().all(|b| b.is_ascii_digit()))
+            .then(|| s.parse().ok())
+            .flatten()
+    }
+    let b = s.as_bytes();
+    if b.len() < 10 || b[4] != b'-' || b[7] != b'-' {
+        return false;
+    }
+    let (Some(y), Some(mo), Some(d)) = (num(&s[0..4], 4), num(&s[5..7], 2), num(&s[8..10], 2))
+    else {
+        return false;
+    };
+    let leap = (y % 4 == 0 && y % 100 != 0) || y % 400 == 0;
+    let days = match mo {
+        1 | 3 | 5 | 7 | 8 | 10 | 12 => 31,
+        4 | 6 | 9 | 11 => 30,
+        2 if leap => 29,
+        2 => 28,
+        _ => return false,
+    };
+    if d == 0 || d > days {
+        return false;
+    }
+    let rest = &s[10..];
+    if rest.is_empty() {
+        return true;
+    }
+    let Some(rest) = rest.strip_prefix(['T', ' ']) else {
+        return false;
+    };
+    // Split off the zone designator.
+    let (time, zone) = match rest.find(['Z', '+', '-']) {
+        Some(i) => (&rest[..i], &rest[i..]),
+        None => (rest, ""),
+    };
+    let ok_zone = match zone {
+        "" | "Z" => true,
+        z => {
+            let z = &z[1..];
+            match z.len() {
+                2 => num(z, 2).is_some_and(|h| h <= 23),
+                4 => {
+                    num(&z[..2], 2).is_some_and(|h| h <= 23)
+                        && num(&z[2..], 2).is_some_and(|m| m <= 59)
+                }
+                5 => {
+                    z.as_bytes()[2] == b':'
+                        && num(&z[..2], 2).is_some_and(|h| h <= 23)
+                        && num(&z[3..], 2).is_some_and(|m| m <= 59)
+                }
+                _ => false,
+            }
+        }
+    };
+    if !ok_zone {
+        return false;
+    }
+    let (hms, frac) = match time.split_once(['.', ',']) {
+        Some((hms, frac)) => (hms, Some(frac)),
+        None => (time, None),
+    };
+    if let Some(f) = frac {
+        if f.is_empty() || !f.bytes().all(|b| b.is_ascii_digit()) {
+            return false;
+        }
+    }
+    let parts: Vec<&str> = hms.split(':').collect();
+    match parts.as_slice() {
+        [h, m] => {
+            frac.is_none()
+                && num(h, 2).is_some_and(|h| h <= 23)
+                && num(m, 2).is_some_and(|m| m <= 59)
+        }
+        [h, m, sec] => {
+            num(h, 2).is_some_and(|h| h <= 23)
+                && num(m, 2).is_some_and(|m| m <= 59)
+                && num(sec, 2).is_some_and(|s| s <= 60)
+        }
+        _ => false,
+    }
+}
+
+/// What `start_time` must look like, for messages.
+pub(crate) const ISO8601_ALLOWED: &str = "an ISO 8601 date-time string, e.g. \
+     2018-01-23T09:31:42Z or 2018-01-23T09:31:42.5+01:00";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn iso8601() {
+        for ok in [
+            "2018-01-23",
+            "2018-01-23T09:31",
+            "2018-01-23T09:31:42",
+            "2018-01-23T09:31:42.000000Z",
+            "2018-01-23 09:31:42Z",
+            "2020-02-29T00:00:00+01:00",
+            "2020-02-29T00:00:00-0130",
+            "2016-12-31T23:59:60Z",
+        ] {
+            assert!(is_iso8601(ok), "{ok}");
+        }
+        for bad in [
+            "",
+            "yesterday",
+            "2018-1-23",
+            "2019-02-29",
+            "2018-13-01",
+            "2018-01-23T25:00",
+            "2018-01-23T09:31:42.Z",
+            "2018-01-23T09",
+            "2018-01-23T09:31+1",
+            "2018-01-23X09:31",
+        ] {
+            assert!(!is_iso8601(bad), "{bad}");
+        }
+    }
+
+    #[test]
+    fn units() {
+        assert_eq!(series_quantity(" RAD/s "), Some(Quantity::Rate));
+        assert_eq!(series_quantity("rad"), Some(Quantity::Angle));
+        assert_eq!(series_quantity("deg"), None);
+        assert_eq!(asd_quantity("rad/√Hz"), Some(Quantity::Angle));
+        assert_eq!(asd_quantity("rad/s/sqrt(Hz)"), Some(Quantity::Rate));
+        assert_eq!(csd_quantity("rad²/Hz"), Some(Quantity::Angle));
+        assert_eq!(csd_quantity("rad**2/s**2/Hz"), Some(Quantity::Rate));
+    }
+}

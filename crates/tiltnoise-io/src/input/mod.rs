@@ -1,0 +1,136 @@
+//! Readers for floor-tilt inputs and measured observables: tilt **time series** and tilt
+//! **spectra**, from HDF5 or CSV, with strict validation. The data they return, its
+//! conventions (tilt sign, axis map, quantity, gaps) and its errors are
+//! [`tiltnoise_core::input`]'s; the exact file layouts are documented in
+//! `docs/input_formats.md`.
+//!
+//! # Entry points
+//!
+//! * [`read_tilt`]: decides by extension (`.h5`/`.hdf5` vs `.csv`) and content whether the
+//!   file holds a series or spectra, and returns a [`TiltInput`].
+//! * [`read_tilt_series`] / [`read_tilt_spectra`]: the same, insisting on one kind.
+//! * [`TiltSeriesSource`]: streaming access to an HDF5 series in chunks (bounded memory), with
+//!   results bit-identical to [`read_tilt_series`]; it is a
+//!   [`tiltnoise_core::input::SeriesSource`] for the budget job.
+//! * [`read_measured`], [`read_measured_input`]: measured ASDs or series of the observables.
+
+mod csv;
+mod h5;
+mod measured;
+mod meta;
+mod series_csv;
+mod source;
+mod spectra_csv;
+mod spectra_hdf5;
+
+pub use measured::{
+    read_measured, read_measured_input, MeasuredInput, MeasuredSeries, MeasuredSpectra,
+    SCHEMA_OBSERVABLE_SERIES,
+};
+pub use source::TiltSeriesSource;
+pub use tiltnoise_core::input::*;
+
+use std::path::Path;
+
+/// Reads a tilt input of either kind: the format from the extension (`.h5`/`.hdf5`, `.csv`),
+/// the kind from the content (HDF5: `schema` attribute if present, else root attribute
+/// `sample_rate_hz` -> series, dataset `/frequency_hz` -> spectra; CSV: first header column
+/// `time_s` -> series, `freq_hz` -> spectra).
+///
+/// # Errors
+///
+/// [`InputError::Extension`], [`InputError::UnknownLayout`] (naming the accepted layouts), or
+/// any validation error of the specific reader.
+pub fn read_tilt(path: &Path, opts: &ReadOptions) -> Result<TiltInput, InputError> {
+    match InputFormat::from_path(path)? {
+        InputFormat::Csv => {
+            let mut file = csv::CsvFile::open(path)?;
+            let prelude = file.prelude()?;
+            match csv_kind(path, &prelude)? {
+                InputKind::Series => series_csv::read(file, prelude, opts).map(TiltInput::Series),
+                InputKind::Spectra => {
+                    spectra_csv::read(file, prelude, opts).map(TiltInput::Spectra)
+                }
+            }
+        }
+        InputFormat::Hdf5 => {
+            let file = h5::open(path)?;
+            match h5::detect_kind(path, &file, None)? {
+                InputKind::Series => {
+                    let mut src = TiltSeriesSource::from_file(path, file, opts)?;
+                    src.read_all().map(TiltInput::Series)
+                }
+                InputKind::Spectra => spectra_hdf5::read(path, &file, opts).map(TiltInput::Spectra),
+            }
+        }
+    }
+}
+
+/// Reads a tilt time series (angle, rad), all in memory. For long HDF5 series use
+/// [`TiltSeriesSource`]; the values are bit-identical.
+///
+/// # Errors
+///
+/// [`InputError::WrongKind`] if the file holds spectra; otherwise as [`read_tilt`].
+pub fn read_tilt_series(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputError> {
+    match InputFormat::from_path(path)? {
+        InputFormat::Hdf5 => {
+            let mut src = TiltSeriesSource::open(path, opts)?;
+            src.read_all()
+        }
+        InputFormat::Csv => match read_tilt(path, opts)? {
+            TiltInput::Series(s) => Ok(s),
+            TiltInput::Spectra(_) => Err(wrong_kind(path, InputKind::Series, InputKind::Spectra)),
+        },
+    }
+}
+
+/// Reads tilt spectra (one-sided CSD, rad²/Hz).
+///
+/// # Errors
+///
+/// [`InputError::WrongKind`] if the file holds a time series; otherwise as [`read_tilt`].
+pub fn read_tilt_spectra(path: &Path, opts: &ReadOptions) -> Result<TiltSpectra, InputError> {
+    match InputFormat::from_path(path)? {
+        InputFormat::Hdf5 => {
+            let file = h5::open(path)?;
+            match h5::detect_kind(path, &file, Some(InputKind::Spectra))? {
+                InputKind::Spectra => spectra_hdf5::read(path, &file, opts),
+                InputKind::Series => Err(wrong_kind(path, InputKind::Spectra, InputKind::Series)),
+            }
+        }
+        InputFormat::Csv => {
+            let mut file = csv::CsvFile::open(path)?;
+            let prelude = file.prelude()?;
+            match csv_kind(path, &prelude)? {
+                InputKind::Spectra => spectra_csv::read(file, prelude, opts),
+                InputKind::Series => Err(wrong_kind(path, InputKind::Spectra, InputKind::Series)),
+            }
+        }
+    }
+}
+
+fn wrong_kind(path: &Path, expected: InputKind, found: InputKind) -> InputError {
+    InputError::WrongKind {
+        path: path.to_path_buf(),
+        expected: expected.name(),
+        found: found.name(),
+    }
+}
+
+fn csv_kind(path: &Path, prelude: &csv::Prelude) -> Result<InputKind, InputError> {
+    match prelude.header.first().map(String::as_str) {
+        Some("time_s") => Ok(InputKind::Series),
+        Some("freq_hz") => Ok(InputKind::Spectra),
+        other => Err(InputError::UnknownLayout {
+            path: path.to_path_buf(),
+            format: "csv",
+            found: format!(
+                "the header (line {}) starts with column `{}`, not time_s or freq_hz",
+                prelude.header_line,
+                other.unwrap_or("")
+            ),
+            accepted: ACCEPTED_LAYOUTS,
+        }),
+    }
+}

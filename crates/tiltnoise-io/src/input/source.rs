@@ -1,0 +1,401 @@
+//! [`TiltSeriesSource`]: streaming access to an HDF5 tilt time series (schema
+//! `tiltnoise.tilt_series`), chunk by chunk, in bounded memory.
+
+use super::h5::{self, h5err, AttrValue};
+use super::meta::{decide_quantity, series_quantity, Declared, SERIES_UNITS};
+use super::Mapped;
+use super::{gap_note, ChannelCtx, Gap, GapScanner, Integrator, TiltSeries};
+use super::{require_two, InputError};
+use super::{GapPolicy, InputFormat, InputKind, Provenance, Quantity, ReadOptions, SeriesSource};
+use std::path::{Path, PathBuf};
+use tiltnoise_core::model::TiltAxis;
+
+/// Samples per channel read at a time by the scanning pass at open (2 MiB of `f64`).
+const SCAN_BLOCK: usize = 1 << 18;
+/// Minimum distance between two integration checkpoints (samples).
+const CHECKPOINT_SPACING: usize = 1 << 16;
+
+/// An open HDF5 tilt time series read in chunks.
+///
+/// [`TiltSeriesSource::read_chunk`] returns samples `start .. start + len` of every axis as
+/// tilt angle (rad) in the crate's sign convention: the axis map and sign applied, finiteness
+/// validated (errors name the absolute sample index) or gaps bridged, rates integrated. The
+/// values are **bit-identical** to those of [`super::read_tilt_series`] for any chunking.
+///
+/// # Cost and memory
+///
+/// Opening reads only metadata, except when the quantity is a rate or gaps are interpolated:
+/// then one streaming pass over every mapped channel (in blocks of 2^18 samples) computes the
+/// mean of the rate and records the interior gaps (32 bytes per gap). A chunk costs
+/// `n_axes * len * 8` bytes. For a rate, the running integral is carried from one chunk to the
+/// next; reading chunks in increasing order is the fast path. Any other order is allowed:
+/// the integral is resumed from the nearest checkpoint (kept every >= 2^16 samples of read
+/// positions) before `start`, re-reading at most the samples in between.
+#[derive(Debug)]
+pub struct TiltSeriesSource {
+    path: PathBuf,
+    _file: hdf5::File,
+    datasets: Vec<hdf5::Dataset>,
+    channels: Vec<Mapped>,
+    axes: Vec<TiltAxis>,
+    sample_rate_hz: f64,
+    len: usize,
+    quantity: Quantity,
+    policy: GapPolicy,
+    gaps: Vec<Vec<Gap>>,
+    cursor: Option<(usize, Vec<Integrator>)>,
+    checkpoints: Vec<(usize, Vec<Integrator>)>,
+    provenance: Provenance,
+}
+
+impl TiltSeriesSource {
+    /// Opens an HDF5 tilt time series.
+    ///
+    /// # Errors
+    ///
+    /// [`InputError::Extension`] unless the extension is `.h5`/`.hdf5`;
+    /// [`InputError::WrongKind`] for spectra; [`InputError::MissingAttribute`] without a root
+    /// attribute `sample_rate_hz`; any validation error of the layout (see
+    /// `docs/input_formats.md`); with a rate or gap interpolation, also the errors of the
+    /// scanning pass (non-finite samples, edge gaps).
+    pub fn open(path: &Path, opts: &ReadOptions) -> Result<Self, InputError> {
+        if super::InputFormat::from_path(path)? != InputFormat::Hdf5 {
+            return Err(InputError::UnknownLayout {
+                path: path.to_path_buf(),
+                format: "csv",
+                found: "a CSV file, which cannot be streamed".to_string(),
+                accepted: "HDF5 time series (use read_tilt_series for CSV)",
+            });
+        }
+        let file = h5::open(path)?;
+        match h5::detect_kind(path, &file, Some(InputKind::Series))? {
+            InputKind::Series => Self::from_file(path, file, opts),
+            InputKind::Spectra => Err(InputError::WrongKind {
+                path: path.to_path_buf(),
+                expected: "series",
+                found: "spectra",
+            }),
+        }
+    }
+
+    pub(crate) fn from_file(
+        path: &Path,
+        file: hdf5::File,
+        opts: &ReadOptions,
+    ) -> Result<Self, InputError> {
+        let sample_rate_hz = h5::sample_rate_hz(path, &file)?;
+        let mut notes = Vec::new();
+        let start_time = h5::start_and_description(path, &file, &mut notes)?;
+        let file_map = h5::axis_map(path, &file)?;
+        let available = h5::root_datasets(path, &file)?;
+        let resolved = h5::resolve_axes(
+            path,
+            &available,
+            "dataset",
+            opts,
+            file_map.as_ref(),
+            &mut notes,
+        )?;
+
+        let mut datasets = Vec::new();
+        let mut declared = Vec::new();
+        let mut undeclared = Vec::new();
+        let mut first_len: Option<(String, usize)> = None;
+        for m in &resolved.channels {
+            let name = format!("/{}", m.source);
+            let ds = file
+                .dataset(&m.source)
+                .map_err(h5err(path, format!("dataset {name}")))?;
+            let shape = ds.shape();
+            let (float, dtype) =
+                h5::is_float(&ds).map_err(h5err(path, format!("dataset {name}")))?;
+            if shape.len() != 1 || !float {
+                return Err(InputError::BadDataset {
+                    path: path.to_path_buf(),
+                    dataset: name,
+                    found: format!("type {dtype} and shape {shape:?}"),
+                    allowed: "a 1-D float64 (or float32) dataset, one sample per entry".to_string(),
+                });
+            }
+            match &first_len {
+                None => first_len = Some((m.source.clone(), shape[0])),
+                Some((a, n)) if *n != shape[0] => {
+                    return Err(InputError::LengthMismatch {
+                        path: path.to_path_buf(),
+                        channel_a: a.clone(),
+                        len_a: *n,
+                        channel_b: m.source.clone(),
+                        len_b: shape[0],
+                    })
+                }
+                Some(_) => {}
+            }
+            let object = format!("dataset {name}");
+            match h5::attr(path, &ds, &object, "units")? {
+                None => undeclared.push(m.source.clone()),
+                Some(AttrValue::Str(u)) => match series_quantity(&u) {
+                    Some(q) => declared.push(Declared {
+                        channel: m.source.clone(),
+                        unit: u,
+                        quantity: q,
+                    }),
+                    None => {
+                        return Err(InputError::Units {
+                            path: path.to_path_buf(),
+                            location: format!("attribute `units` of {object}"),
+                            value: u,
+                            allowed: SERIES_UNITS,
+                        })
+                    }
+                },
+                Some(other) => {
+                    return Err(InputError::Units {
+                        path: path.to_path_buf(),
+                        location: format!("attribute `units` of {object}"),
+                        value: other.describe(),
+                        allowed: SERIES_UNITS,
+                    })
+                }
+            }
+            datasets.push(ds);
+        }
+        let quantity = decide_quantity(path, opts.quantity, &declared, &undeclared, &mut notes)?;
+        let (first_name, len) = first_len.unwrap_or_default();
+        require_two(path, &format!("dataset /{first_name}"), len, "samples")?;
+        notes.push(format!(
+            "sample rate {sample_rate_hz} Hz from root attribute sample_rate_hz"
+        ));
+
+        let mut src = TiltSeriesSource {
+            path: path.to_path_buf(),
+            _file: file,
+            datasets,
+            axes: resolved.channels.iter().map(|m| m.axis).collect(),
+            channels: resolved.channels.clone(),
+            sample_rate_hz,
+            len,
+            quantity,
+            policy: opts.gaps,
+            gaps: vec![Vec::new(); resolved.channels.len()],
+            cursor: None,
+            checkpoints: Vec::new(),
+            provenance: Provenance {
+                path: path.to_path_buf(),
+                format: InputFormat::Hdf5,
+                kind: InputKind::Series,
+                quantity,
+                axis_map: resolved.map.to_string(),
+                start_time,
+                notes,
+            },
+        };
+        if quantity == Quantity::Rate || opts.gaps == GapPolicy::Interpolate {
+            src.scan()?;
+        }
+        Ok(src)
+    }
+
+    /// The scanning pass: gaps and means; initialises the integrators for a rate.
+    fn scan(&mut self) -> Result<(), InputError> {
+        let mut integrators = Vec::new();
+        for ch in 0..self.channels.len() {
+            let source = self.channels[ch].source.clone();
+            let ctx = ChannelCtx {
+                path: &self.path,
+                channel: &source,
+                unit: self.quantity.unit(),
+            };
+            let mut scanner = GapScanner::new(self.policy, self.len);
+            let mut pos = 0;
+            while pos < self.len {
+                let n = SCAN_BLOCK.min(self.len - pos);
+                let mut block = self.read_raw(ch, pos, n)?;
+                let s = self.channels[ch].sign.factor();
+                for v in &mut block {
+                    *v *= s;
+                }
+                scanner.push(&block, &ctx)?;
+                pos += n;
+            }
+            let (gaps, mean) = scanner.finish(&ctx)?;
+            let bridged: usize = gaps.iter().map(|g| g.after - g.before - 1).sum();
+            if bridged > 0 {
+                self.provenance.notes.push(gap_note(&source, bridged));
+            }
+            self.gaps[ch] = gaps;
+            integrators.push(Integrator::new(mean, self.sample_rate_hz));
+        }
+        if self.quantity == Quantity::Rate {
+            self.checkpoints = vec![(0, integrators)];
+        }
+        Ok(())
+    }
+
+    /// Raw samples of channel `ch` as stored.
+    fn read_raw(&self, ch: usize, start: usize, len: usize) -> Result<Vec<f64>, InputError> {
+        let arr = self.datasets[ch]
+            .read_slice_1d::<f64, _>(start..start + len)
+            .map_err(h5err(
+                &self.path,
+                format!(
+                    "dataset /{} samples {start}..{}",
+                    self.channels[ch].source,
+                    start + len
+                ),
+            ))?;
+        let (v, offset) = arr.into_raw_vec_and_offset();
+        debug_assert!(offset.unwrap_or(0) == 0);
+        Ok(v)
+    }
+
+    /// Signed, validated or gap-bridged samples of channel `ch` (before integration).
+    fn load(&self, ch: usize, start: usize, len: usize) -> Result<Vec<f64>, InputError> {
+        let mut v = self.read_raw(ch, start, len)?;
+        let s = self.channels[ch].sign.factor();
+        let ctx = ChannelCtx {
+            path: &self.path,
+            channel: &self.channels[ch].source,
+            unit: self.quantity.unit(),
+        };
+        for (i, x) in v.iter_mut().enumerate() {
+            if x.is_finite() {
+                *x *= s;
+            } else {
+                let k = start + i;
+                let gap = match self.policy {
+                    GapPolicy::Reject => None,
+                    GapPolicy::Interpolate => Gap::find(&self.gaps[ch], k),
+                };
+                *x = gap.ok_or_else(|| ctx.non_finite(k, *x, None))?.value(k);
+            }
+        }
+        Ok(v)
+    }
+
+    /// Sample rate (Hz).
+    pub fn sample_rate_hz(&self) -> f64 {
+        self.sample_rate_hz
+    }
+
+    /// Number of samples per channel.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether there are no samples (never true for an open source: at least 2 are required).
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The axes, in canonical order; [`TiltSeriesSource::read_chunk`] returns one vector per
+    /// entry.
+    pub fn axes(&self) -> &[TiltAxis] {
+        &self.axes
+    }
+
+    /// The quantity stored in the file (the output is always angle).
+    pub fn quantity(&self) -> Quantity {
+        self.quantity
+    }
+
+    /// Provenance (the notes include the gaps bridged during the scanning pass).
+    pub fn provenance(&self) -> &Provenance {
+        &self.provenance
+    }
+
+    /// Samples `start .. start + len` of every axis, tilt angle (rad).
+    ///
+    /// # Errors
+    ///
+    /// [`InputError::ChunkOutOfRange`] if `start + len > self.len()`;
+    /// [`InputError::NonFinite`] naming the absolute sample index (gaps rejected);
+    /// [`InputError::Hdf5`] on a read failure.
+    pub fn read_chunk(&mut self, start: usize, len: usize) -> Result<Vec<Vec<f64>>, InputError> {
+        let end = start
+            .checked_add(len)
+            .filter(|&e| e <= self.len)
+            .ok_or_else(|| InputError::ChunkOutOfRange {
+                path: self.path.clone(),
+                start,
+                len,
+                available: self.len,
+            })?;
+        let n = self.channels.len();
+        if len == 0 {
+            return Ok(vec![Vec::new(); n]);
+        }
+        if self.quantity != Quantity::Rate {
+            return (0..n).map(|ch| self.load(ch, start, len)).collect();
+        }
+        // Resume the integral from the latest saved state at or before `start`.
+        let i = self.checkpoints.partition_point(|(p, _)| *p <= start) - 1;
+        let (mut pos, mut state) = self.checkpoints[i].clone();
+        if let Some((p, s)) = &self.cursor {
+            if *p <= start && *p > pos {
+                (pos, state) = (*p, s.clone());
+            }
+        }
+        while pos < start {
+            let b = SCAN_BLOCK.min(start - pos);
+            for (ch, integ) in state.iter_mut().enumerate() {
+                let mut v = self.load(ch, pos, b)?;
+                integ.step_in_place(&mut v);
+            }
+            pos += b;
+        }
+        let mut out = Vec::with_capacity(n);
+        for (ch, integ) in state.iter_mut().enumerate() {
+            let mut v = self.load(ch, start, len)?;
+            integ.step_in_place(&mut v);
+            out.push(v);
+        }
+        let j = self.checkpoints.partition_point(|(p, _)| *p <= end);
+        if end - self.checkpoints[j - 1].0 >= CHECKPOINT_SPACING
+            && self
+                .checkpoints
+                .get(j)
+                .is_none_or(|(p, _)| p - end >= CHECKPOINT_SPACING)
+        {
+            self.checkpoints.insert(j, (end, state.clone()));
+        }
+        self.cursor = Some((end, state));
+        Ok(out)
+    }
+
+    /// Reads the whole series into memory.
+    ///
+    /// # Errors
+    ///
+    /// As [`TiltSeriesSource::read_chunk`].
+    pub fn read_all(&mut self) -> Result<TiltSeries, InputError> {
+        let data = self.read_chunk(0, self.len)?;
+        Ok(TiltSeries {
+            sample_rate_hz: self.sample_rate_hz,
+            axes: self.axes.clone(),
+            data,
+            provenance: self.provenance.clone(),
+        })
+    }
+}
+
+impl SeriesSource for TiltSeriesSource {
+    fn sample_rate_hz(&self) -> f64 {
+        TiltSeriesSource::sample_rate_hz(self)
+    }
+
+    fn len(&self) -> usize {
+        TiltSeriesSource::len(self)
+    }
+
+    fn axes(&self) -> &[TiltAxis] {
+        TiltSeriesSource::axes(self)
+    }
+
+    fn provenance(&self) -> &Provenance {
+        TiltSeriesSource::provenance(self)
+    }
+
+    fn read_chunk(&mut self, start: usize, len: usize) -> Result<Vec<Vec<f64>>, InputError> {
+        TiltSeriesSource::read_chunk(self, start, len)
+    }
+}

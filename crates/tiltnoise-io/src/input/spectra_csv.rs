@@ -1,0 +1,116 @@
+//! Tilt spectra from CSV: header `freq_hz,theta_t,eta_t[,phi_t]`, one-sided ASD per axis in
+//! rad/sqrt(Hz), axes uncorrelated.
+
+use super::csv::{self, parse_field, CsvFile, Prelude};
+use super::meta::{asd_quantity, ASD_UNITS};
+use super::{assemble, TiltSpectra};
+use super::{require_two, InputError};
+use super::{InputFormat, InputKind, Provenance, ReadOptions};
+use num_complex::Complex64;
+
+/// Reads the records of a CSV spectrum whose prelude has been read (`prelude.header[0]` is
+/// `freq_hz`).
+pub(crate) fn read(
+    mut file: CsvFile,
+    prelude: Prelude,
+    opts: &ReadOptions,
+) -> Result<TiltSpectra, InputError> {
+    let path = file.path.clone();
+    let csv::Interpreted {
+        resolved,
+        quantity,
+        start_time,
+        mut notes,
+    } = csv::interpret(&path, &prelude, opts, asd_quantity, ASD_UNITS)?;
+    notes.push("CSV spectra: axes taken as uncorrelated (off-diagonal CSD = 0)".to_string());
+    let unit = quantity.asd_unit();
+
+    let mut freqs: Vec<f64> = Vec::new();
+    // asd[source column index][k]
+    let mut asd: Vec<Vec<f64>> = vec![Vec::new(); prelude.header.len() - 1];
+    file.for_each_record(prelude.header.len(), |line, fields| {
+        let row = freqs.len();
+        let location = || format!("line {line} (row {row}), column freq_hz");
+        let f = match parse_field(fields[0]) {
+            Ok(Some(f)) => f,
+            _ => {
+                return Err(InputError::CsvNumber {
+                    path: path.clone(),
+                    line,
+                    column: "freq_hz".to_string(),
+                    text: fields[0].to_string(),
+                    unit: "Hz",
+                    empty_allowed: false,
+                })
+            }
+        };
+        if !(f.is_finite() && f > 0.0) {
+            return Err(InputError::Frequency {
+                path: path.clone(),
+                location: location(),
+                value: f,
+                allowed: "finite and > 0".to_string(),
+            });
+        }
+        if let Some(&prev) = freqs.last() {
+            if f <= prev {
+                return Err(InputError::Frequency {
+                    path: path.clone(),
+                    location: location(),
+                    value: f,
+                    allowed: format!("strictly increasing: greater than the previous {prev:?} Hz"),
+                });
+            }
+        }
+        freqs.push(f);
+        for m in &resolved.channels {
+            let text = fields[m.index + 1];
+            let v = match parse_field(text) {
+                Ok(Some(v)) => v,
+                _ => {
+                    return Err(InputError::CsvNumber {
+                        path: path.clone(),
+                        line,
+                        column: m.source.clone(),
+                        text: text.to_string(),
+                        unit,
+                        empty_allowed: false,
+                    })
+                }
+            };
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(InputError::Asd {
+                    path: path.clone(),
+                    location: format!("line {line} (row {row})"),
+                    column: m.source.clone(),
+                    value: v,
+                    unit,
+                });
+            }
+            asd[m.index].push(v);
+        }
+        Ok(())
+    })?;
+    require_two(&path, "column freq_hz", freqs.len(), "frequencies")?;
+    let csd = assemble(&freqs, &resolved.channels, quantity, |k, a, b| {
+        if a == b {
+            Complex64::new(asd[a][k] * asd[a][k], 0.0)
+        } else {
+            Complex64::new(0.0, 0.0)
+        }
+    });
+    Ok(TiltSpectra {
+        freqs_hz: freqs,
+        axes: resolved.channels.iter().map(|m| m.axis).collect(),
+        csd,
+        provenance: Provenance {
+            path,
+            format: InputFormat::Csv,
+            kind: InputKind::Spectra,
+            quantity,
+            axis_map: resolved.map.to_string(),
+            start_time,
+            notes,
+        },
+    })
+}

@@ -1,0 +1,120 @@
+//! tiltnoise-io: every file `tiltnoise` reads or writes.
+//!
+//! * [`input`]: floor-tilt inputs and measured observables (HDF5, CSV), validated strictly;
+//!   layouts in `docs/input_formats.md`.
+//! * Writers: transfer functions, noise budgets, Monte Carlo, fit and simulation results as
+//!   HDF5 or CSV (schemas in `docs/schemas.md`).
+//! * [`write_atomic`]: every writer is atomic: a failed write leaves nothing at the target
+//!   path and never clobbers an existing file. Figures (`tiltnoise-plot`) are written through
+//!   it by the caller.
+//!
+//! Depends on `tiltnoise-core` for the data it stores; the numerical core never depends on this
+//! crate, and the figures never do either.
+
+mod asd_csv;
+mod atomic;
+mod budget_csv;
+mod budget_hdf5;
+mod fit_hdf5;
+mod h5util;
+pub mod input;
+mod mc_hdf5;
+mod series_hdf5;
+mod tf_csv;
+mod tf_hdf5;
+
+pub use asd_csv::write_asd_csv;
+pub use atomic::write_atomic;
+pub use budget_csv::{budget_csv_string, write_budget_csv};
+pub use budget_hdf5::{
+    write_budget_hdf5, SCHEMA_BUDGET, SCHEMA_VERSION_BUDGET, SPECTRAL_CONVENTION,
+};
+pub use fit_hdf5::write_fit_hdf5;
+pub use mc_hdf5::{write_mc_hdf5, REJECTED_DRAWS, SCHEMA_MC, SCHEMA_VERSION_MC};
+pub use series_hdf5::{
+    write_observable_series_hdf5, SeriesAsd, SimulationMeta, SCHEMA_OBSERVABLE_SERIES,
+    SCHEMA_VERSION_OBSERVABLE_SERIES,
+};
+pub use tf_csv::{format_f64, tf_csv_string, write_tf_csv};
+pub use tf_hdf5::{write_tf_hdf5, SCHEMA_TF, SCHEMA_VERSION_TF, SIGN_CONVENTION, TIME_DEPENDENCE};
+
+use std::path::Path;
+pub use tiltnoise_core::error::OutputError;
+pub use tiltnoise_core::input::InputMeta;
+
+/// Provenance of a run, stored alongside the results in self-describing formats (HDF5).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RunMeta {
+    /// Version of the tool that wrote the file: [`TOOL_VERSION`].
+    pub tool_version: String,
+    /// The full effective parameter set as TOML text ([`tiltnoise_core::params::Params::to_toml`]).
+    pub params_toml: String,
+    /// The command line that produced the file.
+    pub command_line: String,
+    /// Normal modes to record: `(index, frequency in Hz)`. The index is stored unchanged; by
+    /// convention it is the mode's `index` from the `modes` module (1-based, in order of
+    /// increasing frequency: the paper's nu_1 ... nu_8). Empty: no `/modes` group is written.
+    pub modes: Vec<(usize, f64)>,
+}
+
+impl RunMeta {
+    /// The provenance of the running process: this tool's version, `params` as TOML, the
+    /// command line, and the frequencies of `modes` when given.
+    pub fn of_this_run(
+        params: &tiltnoise_core::params::Params,
+        modes: Option<&tiltnoise_core::modes::NormalModes>,
+    ) -> RunMeta {
+        RunMeta {
+            tool_version: TOOL_VERSION.to_string(),
+            params_toml: params.to_toml(),
+            command_line: std::env::args().collect::<Vec<_>>().join(" "),
+            modes: modes
+                .map(|m| m.modes.iter().map(|m| (m.index, m.frequency_hz)).collect())
+                .unwrap_or_default(),
+        }
+    }
+}
+
+/// This crate's version, `env!("CARGO_PKG_VERSION")`, for [`RunMeta::tool_version`].
+pub const TOOL_VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// Extensions accepted by [`OutputKind::from_path`], as shown in error messages.
+pub const ALLOWED_EXTENSIONS: &str = ".h5, .hdf5, .csv, .png, .svg";
+
+/// Output format, chosen by the file extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum OutputKind {
+    /// HDF5 (`.h5`, `.hdf5`): the self-describing archive format.
+    Hdf5,
+    /// Comma-separated text (`.csv`).
+    Csv,
+    /// PNG bitmap figure (`.png`).
+    Png,
+    /// SVG vector figure (`.svg`).
+    Svg,
+}
+
+impl OutputKind {
+    /// The format named by the extension of `path`, compared case-insensitively.
+    ///
+    /// # Errors
+    ///
+    /// [`OutputError::UnknownFormat`] naming `path` and [`ALLOWED_EXTENSIONS`] when the
+    /// extension is missing or not supported.
+    pub fn from_path(path: &Path) -> Result<OutputKind, OutputError> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("h5" | "hdf5") => Ok(OutputKind::Hdf5),
+            Some("csv") => Ok(OutputKind::Csv),
+            Some("png") => Ok(OutputKind::Png),
+            Some("svg") => Ok(OutputKind::Svg),
+            _ => Err(OutputError::UnknownFormat {
+                path: path.to_path_buf(),
+                allowed: ALLOWED_EXTENSIONS,
+            }),
+        }
+    }
+}

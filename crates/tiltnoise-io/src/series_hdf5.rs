@@ -1,0 +1,151 @@
+//! Simulated observable time series as HDF5 (schema `tiltnoise.observable_series`, documented in
+//! `docs/schemas.md` and `docs/simulate.md`).
+//!
+//! The layout is the budget's time-series input layout (`tiltnoise.tilt_series`: root attribute
+//! `sample_rate_hz`, one 1-D float64 dataset per channel with a `units` attribute) under its own
+//! schema name, because the channels are the pendulum's observables (m, rad), not floor tilt:
+//! `tiltnoise budget --measured` reads it (the budget's comparison with a measured record), and
+//! `--tilt` refuses it by its schema. Everything else (ASDs, initial state, parameters) lives in
+//! groups, which series readers ignore.
+
+use super::h5util::{dataset, scalar_attr, str_attr, strs_attr};
+use super::{RunMeta, SPECTRAL_CONVENTION};
+use crate::atomic::write_atomic;
+use std::path::Path;
+use tiltnoise_core::error::OutputError;
+use tiltnoise_core::model::{Coord, Observable};
+use tiltnoise_core::simulate::{InitialState, Simulation};
+
+/// Value of the root attribute `schema` of a simulated (or measured) observable time series.
+pub const SCHEMA_OBSERVABLE_SERIES: &str = "tiltnoise.observable_series";
+
+/// Value of the root attribute `schema_version`.
+pub const SCHEMA_VERSION_OBSERVABLE_SERIES: i64 = 1;
+
+/// One-sided Welch ASDs of the observables, stored in the group `/asd`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeriesAsd {
+    /// Frequencies (Hz), `k fs / segment_len`, `k = 0 ..= segment_len / 2`.
+    pub freqs_hz: Vec<f64>,
+    /// `(observable, one-sided ASD in unit/sqrt(Hz))`.
+    pub asd: Vec<(Observable, Vec<f64>)>,
+    /// Welch segment length (samples).
+    pub segment_len: usize,
+    /// Welch overlap (samples).
+    pub overlap: usize,
+    /// `mean` or `median`.
+    pub averaging: String,
+    /// Segments averaged.
+    pub n_segments: usize,
+}
+
+/// Provenance of a simulation run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimulationMeta {
+    /// Tool version, parameters, command line, mode frequencies.
+    pub run: RunMeta,
+    /// Free text stored as the root attribute `description`.
+    pub description: String,
+    /// ISO 8601 start time of the record, if any.
+    pub start_time: Option<String>,
+    /// Seed of the readout-noise generator.
+    pub seed: u64,
+    /// The initial state (SI units, crate coordinate order).
+    pub init: InitialState,
+    /// How the initial state was chosen (e.g. `equal energy 1e-12 J per mode`).
+    pub init_source: String,
+    /// White readout noise per observable: one-sided ASD (unit/sqrt(Hz)); others noiseless.
+    pub readout_asd: Vec<(Observable, f64)>,
+    /// Requested duration (s).
+    pub duration_s: f64,
+}
+
+/// Writes the seven observable series of `sim` (with their readout noise), the ASDs and the
+/// run's provenance to `path`, atomically (nothing is left at `path` on error).
+///
+/// # Errors
+///
+/// [`OutputError::Write`] naming `path` on any I/O or HDF5 failure, or if an ASD's length
+/// differs from its frequency grid.
+pub fn write_observable_series_hdf5(
+    path: &Path,
+    sim: &Simulation,
+    asd: &SeriesAsd,
+    meta: &SimulationMeta,
+) -> Result<(), OutputError> {
+    write_atomic(path, |temp| {
+        if let Some((o, a)) = asd.asd.iter().find(|(_, a)| a.len() != asd.freqs_hz.len()) {
+            return Err(format!(
+                "ASD of {} has {} values but the frequency grid {}",
+                o.name(),
+                a.len(),
+                asd.freqs_hz.len()
+            ));
+        }
+        write_file(temp, sim, asd, meta).map_err(|e| format!("HDF5: {e}"))
+    })
+}
+
+fn write_file(
+    path: &Path,
+    sim: &Simulation,
+    asd: &SeriesAsd,
+    meta: &SimulationMeta,
+) -> hdf5::Result<()> {
+    let file = hdf5::File::create(path)?;
+    str_attr(&file, "schema", SCHEMA_OBSERVABLE_SERIES)?;
+    scalar_attr(&file, "schema_version", SCHEMA_VERSION_OBSERVABLE_SERIES)?;
+    scalar_attr(&file, "sample_rate_hz", sim.fs_hz())?;
+    scalar_attr(&file, "dt_s", sim.dt_s)?;
+    scalar_attr(&file, "duration_s", meta.duration_s)?;
+    str_attr(&file, "description", &meta.description)?;
+    if let Some(t) = &meta.start_time {
+        str_attr(&file, "start_time", t)?;
+    }
+    str_attr(&file, "tool_version", &meta.run.tool_version)?;
+    str_attr(&file, "created_by", &meta.run.command_line)?;
+    str_attr(&file, "parameters_toml", &meta.run.params_toml)?;
+    scalar_attr(&file, "seed", meta.seed)?;
+    str_attr(&file, "spectral_convention", SPECTRAL_CONVENTION)?;
+
+    for (o, series) in &sim.observables {
+        let ds = dataset(&file, o.name(), series)?;
+        str_attr(&ds, "units", o.unit())?;
+        let r = meta
+            .readout_asd
+            .iter()
+            .find(|(x, _)| x == o)
+            .map_or(0.0, |r| r.1);
+        scalar_attr(&ds, "readout_asd", r)?;
+        str_attr(&ds, "readout_asd_units", &format!("{}/sqrt(Hz)", o.unit()))?;
+    }
+
+    let g = file.create_group("asd")?;
+    str_attr(&g, "spectral_convention", SPECTRAL_CONVENTION)?;
+    str_attr(&g, "window", "hann (periodic)")?;
+    scalar_attr(&g, "segment_len", asd.segment_len as u64)?;
+    scalar_attr(&g, "overlap", asd.overlap as u64)?;
+    str_attr(&g, "averaging", &asd.averaging)?;
+    scalar_attr(&g, "n_segments", asd.n_segments as u64)?;
+    dataset(&g, "frequency_hz", &asd.freqs_hz)?;
+    for (o, a) in &asd.asd {
+        let ds = dataset(&g, o.name(), a)?;
+        str_attr(&ds, "units", &format!("{}/sqrt(Hz)", o.unit()))?;
+    }
+
+    let g = file.create_group("initial_state")?;
+    str_attr(&g, "source", &meta.init_source)?;
+    strs_attr(&g, "coordinates", Coord::ALL.iter().map(|c| c.name()))?;
+    strs_attr(&g, "units", Coord::ALL.iter().map(|c| c.unit()))?;
+    dataset(&g, "q", &meta.init.q)?;
+    dataset(&g, "qdot", &meta.init.qdot)?;
+
+    if !meta.run.modes.is_empty() {
+        let g = file.create_group("modes")?;
+        let index: Vec<u64> = meta.run.modes.iter().map(|m| m.0 as u64).collect();
+        let f: Vec<f64> = meta.run.modes.iter().map(|m| m.1).collect();
+        dataset(&g, "index", &index)?;
+        dataset(&g, "frequency_hz", &f)?;
+    }
+    Ok(())
+}

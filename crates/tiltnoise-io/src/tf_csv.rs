@@ -1,0 +1,115 @@
+//! Transfer matrix as CSV (schema `docs/schemas.md`, section "Transfer functions, CSV").
+
+use crate::atomic::write_atomic;
+use std::fmt::Write as _;
+use std::io::{BufWriter, Write as _};
+use std::path::Path;
+use tiltnoise_core::error::OutputError;
+use tiltnoise_core::tf::TransferMatrix;
+
+/// Writes `tf` as CSV, atomically (see [`super::write_atomic`]).
+///
+/// One header line, `freq_hz` followed by `OUT.IN.re,OUT.IN.im` for every output `OUT` (in the
+/// matrix's row order) and input `IN` (column order, innermost), then one line per frequency.
+/// Every number is written so that it parses back to exactly the same `f64`; see
+/// [`format_f64`].
+///
+/// # Errors
+///
+/// [`OutputError::Write`] naming `path` on any I/O failure; nothing is left at `path`.
+pub fn write_tf_csv(path: &Path, tf: &TransferMatrix) -> Result<(), OutputError> {
+    write_atomic(path, |temp| {
+        let file = std::fs::File::create(temp).map_err(|e| e.to_string())?;
+        let mut out = BufWriter::new(file);
+        let text = tf_csv_string(tf);
+        out.write_all(text.as_bytes())
+            .and_then(|()| out.flush())
+            .map_err(|e| e.to_string())
+    })
+}
+
+/// The CSV text of [`write_tf_csv`] (also what `tiltnoise tf` prints without `--save`).
+pub fn tf_csv_string(tf: &TransferMatrix) -> String {
+    let (nf, no, ni) = (tf.freqs_hz.len(), tf.outputs.len(), tf.inputs.len());
+    let mut s = String::with_capacity((nf + 1) * (1 + 2 * no * ni) * 24);
+    s.push_str("freq_hz");
+    for o in &tf.outputs {
+        for i in &tf.inputs {
+            let (o, i) = (o.name(), i.name());
+            let _ = write!(s, ",{o}.{i}.re,{o}.{i}.im");
+        }
+    }
+    s.push('\n');
+    for (k, &f) in tf.freqs_hz.iter().enumerate() {
+        push_f64(&mut s, f);
+        for o in 0..no {
+            for i in 0..ni {
+                let h = tf.get(k, o, i);
+                s.push(',');
+                push_f64(&mut s, h.re);
+                s.push(',');
+                push_f64(&mut s, h.im);
+            }
+        }
+        s.push('\n');
+    }
+    s
+}
+
+fn push_f64(s: &mut String, x: f64) {
+    s.push_str(&format_f64(x));
+}
+
+/// Formats `x` for text files so that it parses back (Rust `str::parse::<f64>`, Python
+/// `float`, NumPy, C `strtod`) to exactly the same value, bit for bit.
+///
+/// * `0` for `+0.0` and `-0` for `-0.0` (the sign of zero survives the round trip);
+/// * plain decimal for `1e-4 <= |x| < 1e16` (`0.5`, `123.25`, `1234567`), scientific notation
+///   otherwise (`1.2345e-7`, `6.02e23`); both with the fewest digits that round-trip;
+/// * `NaN`, `inf`, `-inf` for non-finite values.
+pub fn format_f64(x: f64) -> String {
+    if x == 0.0 {
+        return if x.is_sign_negative() { "-0" } else { "0" }.to_string();
+    }
+    let a = x.abs();
+    if !x.is_finite() || (1e-4..1e16).contains(&a) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::format_f64;
+
+    #[test]
+    fn format_round_trips_and_is_short() {
+        for (x, s) in [
+            (0.0, "0"),
+            (-0.0, "-0"),
+            (1.0, "1"),
+            (0.1, "0.1"),
+            (-2.5e-7, "-2.5e-7"),
+            (1e16, "1e16"),
+            (123456.75, "123456.75"),
+            (f64::MIN_POSITIVE, "2.2250738585072014e-308"),
+            (f64::INFINITY, "inf"),
+        ] {
+            assert_eq!(format_f64(x), s);
+        }
+        let mut v = 0x3ff0_0000_0000_0001_u64;
+        for _ in 0..10_000 {
+            v = v
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let x = f64::from_bits(v);
+            if x.is_nan() {
+                continue;
+            }
+            let back: f64 = format_f64(x).parse().unwrap();
+            assert_eq!(back.to_bits(), x.to_bits(), "{x:e}");
+        }
+        assert!(format_f64(f64::NAN).parse::<f64>().unwrap().is_nan());
+    }
+}

@@ -1,0 +1,111 @@
+//! Transfer matrix as HDF5 (schema `tiltnoise.tf`, documented in `docs/schemas.md`).
+
+use super::h5util::{dataset, scalar_attr, str_attr, strings, strs_attr};
+use super::RunMeta;
+use crate::atomic::write_atomic;
+use ndarray::ArrayView3;
+use std::path::Path;
+use tiltnoise_core::error::OutputError;
+use tiltnoise_core::tf::TransferMatrix;
+
+/// Value of the root attribute `schema`.
+pub const SCHEMA_TF: &str = "tiltnoise.tf";
+
+/// Value of the root attribute `schema_version`. Bumped on any change that can break a reader.
+pub const SCHEMA_VERSION_TF: i64 = 1;
+
+/// Value of the root attribute `sign_convention` (see [`tiltnoise_core::model::tilt`]).
+pub const SIGN_CONVENTION: &str = "tilt t = small right-handed rotation taking the floor frame \
+     to the inertial frame; X -> -eta_t (Z+Z_b+h_c), Y -> +theta_t (Z+Z_b+h_c) as f -> 0";
+
+/// Value of the root attribute `time_dependence`: values are complex amplitudes of
+/// `exp(+i w t)`.
+pub const TIME_DEPENDENCE: &str = "exp(+i w t)";
+
+/// Writes `tf` and the run's provenance `meta` as an HDF5 file of schema [`SCHEMA_TF`],
+/// atomically (see [`super::write_atomic`]).
+///
+/// Layout: root attributes `schema`, `schema_version`, `tool_version`, `created_by`, `method`,
+/// `parameters_toml`, `sign_convention`, `time_dependence`; datasets `/frequency_hz`,
+/// `/transfer` (complex, `[n_freq, n_outputs, n_inputs]`), `/outputs`, `/inputs`,
+/// `/output_units`, `/input_units`, and `/modes/{index,frequency_hz}` when `meta.modes` is not
+/// empty. Every item is described in `docs/schemas.md`.
+///
+/// # Errors
+///
+/// [`OutputError::Write`] naming `path` on any I/O or HDF5 failure; nothing is left at `path`.
+pub fn write_tf_hdf5(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> Result<(), OutputError> {
+    write_atomic(path, |temp| {
+        write_file(temp, tf, meta).map_err(|e| format!("HDF5: {e}"))
+    })
+}
+
+fn write_file(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> hdf5::Result<()> {
+    let (nf, no, ni) = (tf.freqs_hz.len(), tf.outputs.len(), tf.inputs.len());
+    if tf.n_stored_freqs() != nf {
+        return Err(format!(
+            "transfer matrix holds values at {} frequencies, expected {nf}",
+            tf.n_stored_freqs()
+        )
+        .into());
+    }
+    // The file is dense whatever the matrix's layout: structural zeros as 0.
+    let file = hdf5::File::create(path)?;
+
+    str_attr(&file, "schema", SCHEMA_TF)?;
+    scalar_attr(&file, "schema_version", SCHEMA_VERSION_TF)?;
+    str_attr(&file, "tool_version", &meta.tool_version)?;
+    str_attr(&file, "created_by", &meta.command_line)?;
+    str_attr(&file, "method", tf.method.name())?;
+    str_attr(&file, "parameters_toml", &meta.params_toml)?;
+    str_attr(&file, "sign_convention", SIGN_CONVENTION)?;
+    str_attr(&file, "time_dependence", TIME_DEPENDENCE)?;
+
+    let output_names: Vec<&str> = tf.outputs.iter().map(|o| o.name()).collect();
+    let input_names: Vec<&str> = tf.inputs.iter().map(|i| i.name()).collect();
+    let units: Vec<String> = (0..no)
+        .flat_map(|o| (0..ni).map(move |i| (o, i)))
+        .map(|(o, i)| tf.unit(o, i))
+        .collect();
+
+    let freq = dataset(&file, "frequency_hz", &tf.freqs_hz)?;
+    str_attr(&freq, "units", "Hz")?;
+
+    let dense = tf.dense_values();
+    let values = ArrayView3::from_shape((nf, no, ni), &dense).map_err(|e| e.to_string())?;
+    let transfer = file
+        .new_dataset_builder()
+        .with_data(values)
+        .create("transfer")?;
+    strs_attr(&transfer, "outputs", output_names.iter().copied())?;
+    strs_attr(&transfer, "inputs", input_names.iter().copied())?;
+    strs_attr(&transfer, "units", units.iter().map(String::as_str))?;
+
+    dataset(&file, "outputs", &strings(output_names.iter().copied())?)?;
+    dataset(&file, "inputs", &strings(input_names.iter().copied())?)?;
+    dataset(
+        &file,
+        "output_units",
+        &strings(tf.outputs.iter().map(|o| o.unit()))?,
+    )?;
+    dataset(
+        &file,
+        "input_units",
+        &strings(tf.inputs.iter().map(|i| i.unit()))?,
+    )?;
+
+    if !meta.modes.is_empty() {
+        let modes = file.create_group("modes")?;
+        let index: Vec<i64> = meta
+            .modes
+            .iter()
+            .map(|&(n, _)| i64::try_from(n).map_err(|e| e.to_string()))
+            .collect::<Result<_, _>>()?;
+        let freqs: Vec<f64> = meta.modes.iter().map(|&(_, f)| f).collect();
+        dataset(&modes, "index", &index)?;
+        let mf = dataset(&modes, "frequency_hz", &freqs)?;
+        str_attr(&mf, "units", "Hz")?;
+    }
+
+    file.close()
+}

@@ -1,0 +1,556 @@
+//! Noise-budget figure in the style of gravitational-wave noise budgets (pygwinc): one log-log
+//! panel of amplitude spectral densities per observable, one curve per noise term, the total
+//! thick and black, the spread of the tilt noise across segments as a shaded band.
+
+use super::chart::{Band, Dash, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
+use super::labels::{observable_symbol, observable_title, tilt_symbol};
+use super::{render, DrawError, ImageFormat};
+use plotters::style::RGBColor;
+use std::path::Path;
+use tiltnoise_core::input::InputMeta;
+use tiltnoise_core::model::{Observable, TiltAxis};
+use tiltnoise_core::noise::equivalent::referred_terms;
+use tiltnoise_core::noise::{
+    is_response, BudgetReport, NoiseTerm, Readout, SegmentBand, SpectralSource,
+};
+
+/// Options of [`budget_figure_with`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct BudgetFigureOptions {
+    /// Image size in pixels.
+    pub size: (u32, u32),
+    /// Appended to the figure title in parentheses.
+    pub note: Option<String>,
+    /// The tilt input, named in the caption.
+    pub input: Option<InputMeta>,
+    /// Decades shown below the top of each panel's y axis (default 8). Noise budgets span
+    /// fewer decades than transfer functions; terms far below the total are cut off.
+    pub max_decades: f64,
+}
+
+impl Default for BudgetFigureOptions {
+    fn default() -> Self {
+        BudgetFigureOptions {
+            size: (1400, 1100),
+            note: None,
+            input: None,
+            max_decades: 8.0,
+        }
+    }
+}
+
+/// Draws the noise budget of `report` as a PNG or SVG file's bytes: one panel per observable
+/// (in the report's order, e.g. X, φ, φₐ), ASD versus frequency, log-log. Terms: `total` thick
+/// black, `tilt` solid, `tilt.<axis>` (each axis alone) thin dashed, `readout` grey, `measured`
+/// black thin, `residual` dotted, and the segment band of the tilt ASD (lower to upper
+/// percentile, with its median as a thin line) shaded. Terms that are exactly zero at every
+/// frequency are listed in the legend as identically 0 instead of drawn.
+///
+/// # Errors
+///
+/// [`DrawError`] for an empty or inconsistent report or any drawing failure.
+pub fn budget_figure(report: &BudgetReport, format: ImageFormat) -> Result<Vec<u8>, DrawError> {
+    budget_figure_with(report, format, &BudgetFigureOptions::default())
+}
+
+/// [`budget_figure`] with a different size, title note, y depth, or the input named in the
+/// caption.
+pub fn budget_figure_with(
+    report: &BudgetReport,
+    format: ImageFormat,
+    options: &BudgetFigureOptions,
+) -> Result<Vec<u8>, DrawError> {
+    let figure = build_budget_figure(report, options).map_err(DrawError)?;
+    render(format, &figure)
+}
+
+/// Colour of the whole tilt term and of its segment band.
+const TILT_COLOR: RGBColor = PALETTE[0];
+/// Grey of the readout term.
+const READOUT_COLOR: RGBColor = RGBColor(128, 128, 128);
+/// Black of `total` and `measured`.
+const BLACK: RGBColor = PALETTE[6];
+/// Red of the `thermal` term.
+const THERMAL_COLOR: RGBColor = RGBColor(200, 30, 30);
+/// Element names, for a stable colour per element of `thermal.<element>`.
+const THERMAL_ELEMENTS: [&str; 6] = [
+    "torsion_a",
+    "torsion_b",
+    "bouncing_a",
+    "bouncing_b",
+    "swing_a",
+    "swing_b",
+];
+
+/// Legend label and style of a term; `None` for the colour cycle of unknown terms.
+fn term_style(name: &str, readout: Option<(f64, Observable)>) -> Option<(String, TraceStyle)> {
+    let style = |c, d, w| TraceStyle::new(c, d, w);
+    Some(match name {
+        "total" => ("total".to_string(), style(BLACK, Dash::Solid, 4)),
+        "tilt" => ("tilt".to_string(), style(TILT_COLOR, Dash::Solid, 2)),
+        "readout" => {
+            let label = match readout {
+                Some((asd, o)) => format!("readout, {}", si_asd(asd, o.unit())),
+                None => "readout".to_string(),
+            };
+            (label, style(READOUT_COLOR, Dash::Solid, 2))
+        }
+        "measured" => ("measured".to_string(), style(BLACK, Dash::Solid, 1)),
+        "residual" => ("residual".to_string(), style(PALETTE[3], Dash::Dotted, 2)),
+        "thermal" => (
+            "thermal (FDT)".to_string(),
+            style(THERMAL_COLOR, Dash::Solid, 2),
+        ),
+        _ if name.starts_with("thermal.") => {
+            let element = name.trim_start_matches("thermal.");
+            let k = THERMAL_ELEMENTS
+                .iter()
+                .position(|e| element.starts_with(e))
+                .unwrap_or(0);
+            let dash = if element.ends_with("_viscous") {
+                Dash::Dashed
+            } else {
+                Dash::Dotted
+            };
+            (
+                format!("thermal, {}", element.replace('_', " ")),
+                style(OTHER_COLORS[k % OTHER_COLORS.len()], dash, 2),
+            )
+        }
+        _ => {
+            let axis = name.strip_prefix("tilt.")?;
+            let axis = TiltAxis::ALL.into_iter().find(|a| a.name() == axis)?;
+            let color = match axis {
+                TiltAxis::ThetaT => PALETTE[5],
+                TiltAxis::EtaT => PALETTE[1],
+                TiltAxis::PhiT => PALETTE[2],
+            };
+            (
+                format!("tilt, {} alone", tilt_symbol(axis)),
+                style(color, Dash::Dashed, 2),
+            )
+        }
+    })
+}
+
+/// Drawing order (and legend order): total first, so that the terms lie on top of it where
+/// they dominate, as in pygwinc.
+fn draw_rank(name: &str) -> u8 {
+    match name {
+        "total" => 0,
+        "measured" => 1,
+        "residual" => 2,
+        "tilt" => 3,
+        n if n.starts_with("tilt.") => 4,
+        "readout" => 5,
+        "thermal" => 6,
+        n if n.starts_with("thermal.") => 7,
+        _ => 8,
+    }
+}
+
+/// Extra colours for terms this figure does not know, and for the thermal elements.
+const OTHER_COLORS: [RGBColor; 6] = [
+    PALETTE[4], PALETTE[2], PALETTE[3], PALETTE[5], PALETTE[1], PALETTE[0],
+];
+
+/// The figure as data, ready for [`render`]; errors are plain messages.
+pub fn build_budget_figure(
+    report: &BudgetReport,
+    options: &BudgetFigureOptions,
+) -> Result<LogLogFigure, String> {
+    report.check()?;
+    let freqs = &report.budget.freqs_hz;
+    if report.budget.observables.is_empty() {
+        return Err("the budget has no observable to draw".to_string());
+    }
+    let mut panels = Vec::new();
+    for ob in &report.budget.observables {
+        let o = ob.observable;
+        let unit = o.unit();
+        let mut panel = Panel::new(
+            observable_title(o),
+            ("frequency", "Hz"),
+            (
+                &format!("ASD of {}", observable_symbol(o)),
+                &format!("{unit}/√Hz"),
+            ),
+        );
+        panel.max_decades = Some(options.max_decades);
+        let mut terms: Vec<&NoiseTerm> =
+            ob.terms.iter().filter(|t| !is_response(&t.name)).collect();
+        terms.sort_by_key(|t| draw_rank(&t.name));
+        let mut other = 0;
+        for term in terms {
+            let readout = report.readout.of(o).map(|a| (a, o));
+            let (label, style) = term_style(&term.name, readout).unwrap_or_else(|| {
+                let c = OTHER_COLORS[other % OTHER_COLORS.len()];
+                other += 1;
+                (term.name.clone(), TraceStyle::new(c, Dash::Solid, 2))
+            });
+            if term.psd.iter().all(|&p| p == 0.0) {
+                // An element of the other block: exactly 0 by the model's structure, not news.
+                if term.name.starts_with("thermal.") {
+                    continue;
+                }
+                let short = label.strip_prefix("tilt, ").unwrap_or(&label);
+                panel.notes.push(format!("{short}: identically 0"));
+                continue;
+            }
+            let points = freqs.iter().zip(term.asd()).map(|(&f, a)| (f, a)).collect();
+            panel.traces.push(Trace::new(label, points, style));
+        }
+        if let Some((_, band)) = report.segment_bands.iter().find(|(b, _)| *b == o) {
+            let (band, median) = segment_band(freqs, band, report.segment_duration_s);
+            panel.band = Some(band);
+            panel.traces.push(median);
+        }
+        panels.push(panel);
+    }
+    if let Some(panel) = equivalent_panel(report, options) {
+        panels.push(panel);
+    }
+    let damped = report
+        .budget
+        .observables
+        .iter()
+        .any(|b| b.term("thermal").is_some());
+    let mut title = if damped {
+        "Noise budget (tilt, thermal, readout): one-sided amplitude spectral densities"
+    } else {
+        "Tilt noise budget: one-sided amplitude spectral densities"
+    }
+    .to_string();
+    if let Some(note) = &options.note {
+        title.push_str(&format!(" ({note})"));
+    }
+    Ok(LogLogFigure {
+        size: options.size,
+        title: Some(title),
+        panels,
+        columns: 2,
+        caption: caption(report, options.input.as_ref()),
+    })
+}
+
+/// With a damped model (a `response.F_b.x` term on X), the X budget referred to the test
+/// mass's acceleration, `S_X / |m_b H_X,F_b.x|^2` (m s^-2/sqrt(Hz)): the free-fall figure of
+/// merit, in the fourth slot of the 2x2 grid. Terms as in the X panel, without the measured
+/// ones and the per-axis or per-element breakdown.
+fn equivalent_panel(report: &BudgetReport, options: &BudgetFigureOptions) -> Option<Panel> {
+    let ob = report
+        .budget
+        .observables
+        .iter()
+        .find(|b| b.observable == Observable::X)?;
+    let referred = referred_terms(ob)?;
+    let mut panel = Panel::new(
+        "Test-mass acceleration noise equivalent to X",
+        ("frequency", "Hz"),
+        ("ASD of aₓ", "m s⁻²/√Hz"),
+    );
+    panel.max_decades = Some(options.max_decades);
+    let mut terms: Vec<&(&str, Vec<f64>)> = referred
+        .terms
+        .iter()
+        .filter(|(name, _)| ["total", "tilt", "thermal", "readout"].contains(name))
+        .collect();
+    terms.sort_by_key(|(name, _)| draw_rank(name));
+    // The response has zeros (antiresonances), where every equivalent term peaks: scale the y
+    // axis on the floor of the total instead, from a decade below its minimum up 6 decades.
+    let (_, total) = referred.terms.iter().find(|(name, _)| *name == "total")?;
+    let floor = total
+        .iter()
+        .map(|p| p.sqrt())
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    if floor.is_finite() {
+        let lo = 10f64.powf(floor.log10().floor() - 1.0);
+        panel.y_range = Some((lo, lo * 1e6));
+    }
+    for (name, psd) in terms {
+        let (label, style) = term_style(name, None)?;
+        if ob.term(name)?.psd.iter().all(|&p| p == 0.0) {
+            continue;
+        }
+        let points = report
+            .budget
+            .freqs_hz
+            .iter()
+            .zip(psd)
+            .map(|(&f, p)| (f, p.sqrt()))
+            .collect();
+        panel.traces.push(Trace::new(label, points, style));
+    }
+    Some(panel)
+}
+
+/// The shaded band between the lower and upper percentile of the tilt ASD and the median line.
+fn segment_band(freqs: &[f64], band: &SegmentBand, duration_s: Option<f64>) -> (Band, Trace) {
+    let asd = |v: &[f64]| -> Vec<(f64, f64)> {
+        freqs.iter().zip(v).map(|(&f, &p)| (f, p.sqrt())).collect()
+    };
+    let per = segment_adjective(duration_s);
+    let label = format!(
+        "tilt, {per} {}–{} %",
+        compact(band.lower_pct),
+        compact(band.upper_pct)
+    );
+    let mut shaded = Band::new(label, asd(&band.lower), asd(&band.upper), TILT_COLOR);
+    shaded.opacity = 0.22;
+    let median = Trace::new(
+        format!("tilt, {per} median"),
+        asd(&band.median),
+        TraceStyle::new(TILT_COLOR, Dash::Solid, 1),
+    );
+    (shaded, median)
+}
+
+/// `hourly`, `daily`, `per-minute`, or `per 4 h segment`, `per 90 s segment`.
+pub fn segment_adjective(duration_s: Option<f64>) -> String {
+    let Some(d) = duration_s.filter(|d| d.is_finite() && *d > 0.0) else {
+        return "per segment".to_string();
+    };
+    match d {
+        60.0 => "per-minute".to_string(),
+        3600.0 => "hourly".to_string(),
+        86400.0 => "daily".to_string(),
+        _ => format!("per {} segment", duration(d)),
+    }
+}
+
+/// A duration in the largest unit that keeps it short: `4 h`, `90 min`, `2 d`, `1638 s`,
+/// `27.8 h` (whole minutes below 2 h are shown in minutes; 3 significant digits).
+pub fn duration(d: f64) -> String {
+    let whole = |x: f64| (x - x.round()).abs() < 1e-9 * x.abs().max(1.0);
+    if d >= 86400.0 && whole(d / 86400.0) {
+        format!("{} d", compact(d / 86400.0))
+    } else if d >= 3600.0 && whole(d / 3600.0) {
+        format!("{} h", compact(d / 3600.0))
+    } else if d >= 60.0 && whole(d / 60.0) && d < 7200.0 {
+        format!("{} min", compact(d / 60.0))
+    } else if d >= 7200.0 {
+        format!("{} h", significant(d / 3600.0, 3))
+    } else {
+        format!("{} s", significant(d, 4))
+    }
+}
+
+/// A number with at most 4 significant digits and no trailing zeros: `10`, `2.5`, `0.001`,
+/// `1.5e-7`.
+fn compact(v: f64) -> String {
+    significant(v, 4)
+}
+
+/// `v` rounded to `digits` significant digits, without trailing zeros; plain decimal from 1e-3
+/// to below 1e6, else scientific (`1.5e-7`).
+fn significant(v: f64, digits: i32) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let e = v.abs().log10().floor() as i32;
+    let trim = |s: &str| -> String {
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s.to_string()
+        }
+    };
+    if (-3..6).contains(&e) {
+        let decimals = (digits - 1 - e).max(0) as usize;
+        trim(&format!("{v:.decimals$}"))
+    } else {
+        let decimals = (digits - 1).max(0) as usize;
+        let s = format!("{v:.decimals$e}");
+        let (m, x) = s.split_once('e').unwrap_or((&s, "0"));
+        format!("{}e{x}", trim(m))
+    }
+}
+
+/// A number for prose: `0.25`, `30`, `5·10⁻⁵`, `10⁻⁴` (powers of ten outside 1e-3..1e6).
+fn pretty(v: f64) -> String {
+    if !(v.is_finite() && v > 0.0) {
+        return compact(v);
+    }
+    let e = v.log10().floor() as i32;
+    if (-3..6).contains(&e) {
+        return compact(v);
+    }
+    let m = significant(v / 10f64.powi(e), 4);
+    if m == "1" {
+        super::chart::pow10_label(e)
+    } else if m == "10" {
+        super::chart::pow10_label(e + 1)
+    } else {
+        format!("{m}·{}", super::chart::pow10_label(e))
+    }
+}
+
+/// An ASD with an SI prefix: `9 nm/√Hz`, `1.5 nrad/√Hz`, `20 µrad/√Hz`.
+pub fn si_asd(value: f64, unit: &str) -> String {
+    const PREFIXES: [(i32, &str); 7] = [
+        (-18, "a"),
+        (-15, "f"),
+        (-12, "p"),
+        (-9, "n"),
+        (-6, "µ"),
+        (-3, "m"),
+        (0, ""),
+    ];
+    if !(value.is_finite() && value > 0.0) {
+        return format!("{} {unit}/√Hz", compact(value));
+    }
+    let e3 = ((value.log10() + 1e-9).floor() as i32).div_euclid(3) * 3;
+    match PREFIXES.iter().find(|(p, _)| *p == e3) {
+        Some(&(p, prefix)) => {
+            let scaled = value / 10f64.powi(p);
+            format!("{} {prefix}{unit}/√Hz", compact(scaled))
+        }
+        None => format!("{} {unit}/√Hz", compact(value)),
+    }
+}
+
+/// Caption paragraphs: input, spectral estimate, segments, readout, conventions, notes.
+fn caption(report: &BudgetReport, input: Option<&InputMeta>) -> Vec<String> {
+    let mut out = Vec::new();
+    if let Some(i) = input {
+        let name = Path::new(&i.path)
+            .file_name()
+            .map_or_else(|| i.path.clone(), |n| n.to_string_lossy().into_owned());
+        let mut s = format!("Input: {name} ({} {}, {}", i.format, i.kind, i.quantity);
+        if !i.axis_map.is_empty() {
+            s.push_str(&format!("; {}", i.axis_map));
+        }
+        s.push(')');
+        if let Some(t) = &i.start_time {
+            s.push_str(&format!(", start {t}"));
+        }
+        s.push('.');
+        out.push(s);
+    }
+    let axes: Vec<&str> = report.axes.iter().map(|&a| tilt_symbol(a)).collect();
+    let axes = axes.join(", ");
+    out.push(match &report.source {
+        SpectralSource::Welch {
+            sample_rate_hz,
+            segment_len,
+            overlap,
+            averaging,
+            n_welch_segments,
+            n_samples,
+        } => {
+            let fs = *sample_rate_hz;
+            format!(
+                "Tilt ({axes}): Welch estimate at {} Hz, {} segments of {segment_len} samples \
+                 ({}), overlap {overlap}, {averaging} averaging; {n_samples} samples ({}).",
+                compact(fs),
+                n_welch_segments,
+                duration(*segment_len as f64 / fs),
+                duration(*n_samples as f64 / fs),
+            )
+        }
+        SpectralSource::Spectra { data_band_hz } => format!(
+            "Tilt ({axes}): spectra given from {} to {} Hz, interpolated log-log onto the model \
+             grid.",
+            pretty(data_band_hz.0),
+            pretty(data_band_hz.1)
+        ),
+    });
+    if let Some((_, band)) = report.segment_bands.first() {
+        let per = match report.segment_duration_s {
+            Some(d) => format!("{} segments of {}", band.n_segments, duration(d)),
+            None => format!("{} segments", band.n_segments),
+        };
+        out.push(format!(
+            "Band: {}th to {}th percentile of the tilt ASD over {per}; thin line: median.",
+            compact(band.lower_pct),
+            compact(band.upper_pct)
+        ));
+    }
+    out.push(readout_sentence(&report.readout, report));
+    out.push(
+        if report
+            .budget
+            .observables
+            .iter()
+            .any(|b| b.term("thermal").is_some())
+        {
+            "All curves are one-sided ASDs (√PSD). tilt: all axes with their cross-spectra; \
+             “alone”: one axis, for diagnosis; thermal: fluctuation-dissipation theorem, sum over \
+             the dissipative elements (dotted: each element alone); total: quadrature sum of \
+             tilt, thermal and readout."
+                .to_string()
+        } else {
+            "All curves are one-sided ASDs (√PSD). tilt: all axes with their cross-spectra; \
+             “alone”: one axis, for diagnosis; total: quadrature sum of tilt and readout."
+                .to_string()
+        },
+    );
+    out.extend(report.notes.iter().map(|n| {
+        let n = n.trim();
+        let end = if n.ends_with(['.', '!', '?']) {
+            ""
+        } else {
+            "."
+        };
+        format!("Note: {n}{end}")
+    }));
+    out
+}
+
+fn readout_sentence(readout: &Readout, report: &BudgetReport) -> String {
+    let mut with = Vec::new();
+    let mut without = Vec::new();
+    for ob in &report.budget.observables {
+        let o = ob.observable;
+        match readout.of(o) {
+            Some(a) => with.push(format!("{} {}", observable_symbol(o), si_asd(a, o.unit()))),
+            None => without.push(observable_symbol(o)),
+        }
+    }
+    let mut s = String::from("Readout noise (white, assumed): ");
+    if with.is_empty() {
+        s.push_str("none");
+    } else {
+        s.push_str(&with.join(", "));
+    }
+    if !without.is_empty() && !with.is_empty() {
+        s.push_str(&format!("; none on {}", without.join(", ")));
+    }
+    s.push('.');
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn durations_and_adjectives() {
+        assert_eq!(segment_adjective(Some(3600.0)), "hourly");
+        assert_eq!(segment_adjective(Some(86400.0)), "daily");
+        assert_eq!(segment_adjective(Some(4.0 * 3600.0)), "per 4 h segment");
+        assert_eq!(segment_adjective(Some(5400.0)), "per 90 min segment");
+        assert_eq!(segment_adjective(Some(90.0)), "per 90 s segment");
+        assert_eq!(segment_adjective(None), "per segment");
+        assert_eq!(duration(1638.4), "1638 s");
+        assert_eq!(duration(2.0 * 86400.0), "2 d");
+        assert_eq!(duration(100_000.0), "27.8 h");
+        assert_eq!(duration(10_000.0), "2.78 h");
+        assert_eq!(duration(2.5), "2.5 s");
+        assert_eq!(compact(1.5e-7), "1.5e-7");
+        assert_eq!(compact(97.5), "97.5");
+        assert_eq!(pretty(5e-5), "5·10⁻⁵");
+        assert_eq!(pretty(1e-4), "10⁻⁴");
+        assert_eq!(pretty(0.5), "0.5");
+    }
+
+    #[test]
+    fn si_prefixes() {
+        assert_eq!(si_asd(9e-9, "m"), "9 nm/√Hz");
+        assert_eq!(si_asd(1.5e-9, "rad"), "1.5 nrad/√Hz");
+        assert_eq!(si_asd(2e-5, "rad"), "20 µrad/√Hz");
+        assert_eq!(si_asd(1e-9, "m"), "1 nm/√Hz");
+        assert_eq!(si_asd(3.0, "m"), "3 m/√Hz");
+    }
+}

@@ -1,0 +1,1218 @@
+//! Reusable log-log line charts: panels of traces with legend, decade ticks and grid, arranged in
+//! a grid with an optional title and caption.
+//!
+//! The data model is plain: a [`Trace`] is a label, `(x, y)` points and a [`TraceStyle`]; a
+//! [`Band`] is a shaded area between two curves (e.g. a percentile band of a noise budget); a
+//! [`Panel`] holds traces, an optional band, legend-only notes and axis labels with units; a
+//! [`LogLogFigure`] arranges panels and implements [`Figure`] so that
+//! [`render`](super::render) can draw it as PNG or SVG.
+//!
+//! Points with a non-finite or non-positive coordinate cannot be shown on log axes: the line is
+//! broken there. Automatic axis ranges cover the finite positive data, the y range is padded to
+//! whole decades and limited to [`Panel::max_decades`] below its top, and lines are clipped at
+//! the frame (not flattened onto it).
+
+use super::{DrawError, Figure, FONT_FAMILY};
+use plotters::coord::Shift;
+use plotters::element::{Circle, DashedPathElement, DottedPathElement, PathElement, Polygon};
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+/// Okabe-Ito colours, distinguishable with the common forms of colour blindness and in grey
+/// scale print when combined with dash styles.
+pub const PALETTE: [RGBColor; 7] = [
+    RGBColor(0, 114, 178),   // blue
+    RGBColor(213, 94, 0),    // vermillion
+    RGBColor(0, 158, 115),   // bluish green
+    RGBColor(204, 121, 167), // reddish purple
+    RGBColor(230, 159, 0),   // orange
+    RGBColor(86, 180, 233),  // sky blue
+    RGBColor(0, 0, 0),       // black
+];
+
+/// Line pattern of a trace.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Dash {
+    /// Continuous line.
+    Solid,
+    /// Dashes about four line widths long.
+    Dashed,
+    /// Round dots.
+    Dotted,
+}
+
+/// How a trace is drawn.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TraceStyle {
+    /// Line colour.
+    pub color: RGBColor,
+    /// Line pattern.
+    pub dash: Dash,
+    /// Line width in pixels (>= 1).
+    pub width: u32,
+}
+
+impl TraceStyle {
+    /// A style from its parts.
+    pub fn new(color: RGBColor, dash: Dash, width: u32) -> TraceStyle {
+        TraceStyle {
+            color,
+            dash,
+            width: width.max(1),
+        }
+    }
+}
+
+/// One curve of a panel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trace {
+    /// Legend text.
+    pub label: String,
+    /// `(x, y)` in axis units, ordered along the curve (usually by increasing x). Points with a
+    /// non-finite or non-positive coordinate break the line.
+    pub points: Vec<(f64, f64)>,
+    /// Colour, pattern, width.
+    pub style: TraceStyle,
+}
+
+impl Trace {
+    /// A trace from its parts.
+    pub fn new(label: impl Into<String>, points: Vec<(f64, f64)>, style: TraceStyle) -> Trace {
+        Trace {
+            label: label.into(),
+            points,
+            style,
+        }
+    }
+}
+
+/// A shaded area between two curves, drawn below all traces.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Band {
+    /// Legend text.
+    pub label: String,
+    /// Lower boundary `(x, y)`, increasing x. Values below the axis range (including zero and
+    /// negative values) shade down to the bottom of the frame.
+    pub lower: Vec<(f64, f64)>,
+    /// Upper boundary `(x, y)`, increasing x; need not share the x values of `lower`.
+    pub upper: Vec<(f64, f64)>,
+    /// Fill colour.
+    pub color: RGBColor,
+    /// Fill opacity in `0..=1`.
+    pub opacity: f64,
+}
+
+impl Band {
+    /// A band in `color` at 25 % opacity.
+    pub fn new(
+        label: impl Into<String>,
+        lower: Vec<(f64, f64)>,
+        upper: Vec<(f64, f64)>,
+        color: RGBColor,
+    ) -> Band {
+        Band {
+            label: label.into(),
+            lower,
+            upper,
+            color,
+            opacity: 0.25,
+        }
+    }
+}
+
+/// One log-log chart.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Panel {
+    /// Title above the frame.
+    pub title: String,
+    /// Quantity on the x axis, e.g. `frequency`.
+    pub x_label: String,
+    /// Unit of the x axis, e.g. `Hz`; shown as `frequency (Hz)`. Empty for dimensionless.
+    pub x_unit: String,
+    /// Quantity on the y axis, e.g. `|H|`.
+    pub y_label: String,
+    /// Unit of the y axis, e.g. `m/rad`.
+    pub y_unit: String,
+    /// Curves, drawn in order (later ones on top).
+    pub traces: Vec<Trace>,
+    /// Optional shaded band, drawn first.
+    pub band: Option<Band>,
+    /// Legend lines without a curve, e.g. `θₜ: identically 0`.
+    pub notes: Vec<String>,
+    /// Fixed x range; `None`: the extent of the finite positive data.
+    pub x_range: Option<(f64, f64)>,
+    /// Fixed y range; `None`: the finite positive data padded to whole decades.
+    pub y_range: Option<(f64, f64)>,
+    /// With an automatic y range: at most this many decades below the top, so exact zeros,
+    /// rounding noise or deep notches do not squash the curves. `None`: no limit.
+    pub max_decades: Option<f64>,
+    /// Where the legend goes.
+    pub legend: LegendPlacement,
+}
+
+impl Panel {
+    /// An empty panel with at most 12 decades on the automatic y axis.
+    pub fn new(
+        title: impl Into<String>,
+        (x_label, x_unit): (&str, &str),
+        (y_label, y_unit): (&str, &str),
+    ) -> Panel {
+        Panel {
+            title: title.into(),
+            x_label: x_label.to_string(),
+            x_unit: x_unit.to_string(),
+            y_label: y_label.to_string(),
+            y_unit: y_unit.to_string(),
+            traces: Vec::new(),
+            band: None,
+            notes: Vec::new(),
+            x_range: None,
+            y_range: None,
+            max_decades: Some(12.0),
+            legend: LegendPlacement::Auto,
+        }
+    }
+
+    /// The x range that will be drawn: [`Panel::x_range`] or the data extent.
+    pub fn resolved_x_range(&self) -> (f64, f64) {
+        if let Some(r) = self.x_range.filter(|r| valid_range(*r)) {
+            return r;
+        }
+        let xs = self.all_points().map(|p| p.0).filter(|x| positive(*x));
+        match min_max(xs) {
+            Some((lo, hi)) if hi > lo => (lo, hi),
+            Some((v, _)) => (v / 10.0, v * 10.0),
+            None => (1.0, 10.0),
+        }
+    }
+
+    /// The y range that will be drawn: [`Panel::y_range`] or the finite positive y values
+    /// (within the x range) padded to whole decades and limited by [`Panel::max_decades`].
+    pub fn resolved_y_range(&self) -> (f64, f64) {
+        if let Some(r) = self.y_range.filter(|r| valid_range(*r)) {
+            return r;
+        }
+        let (x0, x1) = self.resolved_x_range();
+        let ys = self
+            .all_points()
+            .filter(|p| p.0 >= x0 && p.0 <= x1)
+            .map(|p| p.1)
+            .filter(|y| positive(*y));
+        let Some((lo, hi)) = min_max(ys) else {
+            return (0.1, 10.0);
+        };
+        let top = hi.log10().ceil();
+        let mut bottom = lo.log10().floor();
+        if let Some(d) = self.max_decades.filter(|d| d.is_finite() && *d >= 1.0) {
+            bottom = bottom.max(top - d.floor());
+        }
+        if bottom >= top {
+            bottom = top - 1.0;
+        }
+        (10f64.powf(bottom), 10f64.powf(top))
+    }
+
+    fn all_points(&self) -> impl Iterator<Item = &(f64, f64)> {
+        let band = self
+            .band
+            .iter()
+            .flat_map(|b| b.lower.iter().chain(b.upper.iter()));
+        self.traces.iter().flat_map(|t| t.points.iter()).chain(band)
+    }
+}
+
+/// Several panels in a grid, with an optional figure title and caption.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogLogFigure {
+    /// Size in pixels.
+    pub size: (u32, u32),
+    /// Title across the top; `None` for none.
+    pub title: Option<String>,
+    /// Panels, filling the grid row by row.
+    pub panels: Vec<Panel>,
+    /// Number of grid columns (>= 1); rows follow from the number of cells needed.
+    pub columns: usize,
+    /// Caption paragraphs, word-wrapped. Drawn in the first free grid cell if there is one,
+    /// else in a strip below the grid.
+    pub caption: Vec<String>,
+}
+
+impl Figure for LogLogFigure {
+    fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
+        let (w, h) = root.dim_in_pixel();
+        let ts = TextSizes::for_figure(w, h);
+        let mut area = root.clone();
+        if let Some(title) = &self.title {
+            let (top, rest) = area.split_vertically((ts.title * 2.0).round() as u32);
+            let style = text_style(ts.title, &BLACK).pos(Pos::new(HPos::Center, VPos::Center));
+            let (tw, th) = top.dim_in_pixel();
+            top.draw_text(title, &style, (tw as i32 / 2, th as i32 / 2))?;
+            area = rest;
+        }
+        let columns = self.columns.max(1);
+        let n = self.panels.len();
+        let caption_in_cell = !self.caption.is_empty() && n % columns != 0;
+        let rows = (n + usize::from(caption_in_cell)).div_ceil(columns).max(1);
+        if !self.caption.is_empty() && !caption_in_cell {
+            let margin = ts.caption * 1.5;
+            let lines = wrap_lines(&area, &self.caption, ts.caption, w as f64 - 2.0 * margin)?;
+            let strip = (lines.len() as f64 * ts.caption * 1.45 + 1.5 * margin).ceil() as u32;
+            let height = area.dim_in_pixel().1;
+            let (upper, lower) = area.split_vertically(height.saturating_sub(strip));
+            draw_caption(&lower, &self.caption, ts.caption, margin * 0.5)?;
+            area = upper;
+        }
+        let cells = area.split_evenly((rows, columns));
+        for (panel, cell) in self.panels.iter().zip(cells.iter()) {
+            draw_panel(cell, panel, &ts)?;
+        }
+        if caption_in_cell {
+            draw_caption(&cells[n], &self.caption, ts.caption, ts.caption * 1.5)?;
+        }
+        Ok(())
+    }
+}
+
+/// Text sizes in plotters units (about the pixel height of a line of text).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TextSizes {
+    /// Figure title.
+    pub title: f64,
+    /// Panel titles.
+    pub panel_title: f64,
+    /// Axis titles.
+    pub axis: f64,
+    /// Tick labels.
+    pub ticks: f64,
+    /// Legend entries.
+    pub legend: f64,
+    /// Caption text.
+    pub caption: f64,
+}
+
+impl TextSizes {
+    /// Sizes for a figure of `w` x `h` pixels: 17 px tick labels up to 1200 x 1000, scaled up
+    /// for larger (high-resolution) figures and down to 75 % for small ones.
+    pub fn for_figure(w: u32, h: u32) -> TextSizes {
+        let s = (w as f64 / 1200.0).max(h as f64 / 1000.0).clamp(0.75, 4.0);
+        TextSizes {
+            title: 26.0 * s,
+            panel_title: 20.0 * s,
+            axis: 18.0 * s,
+            ticks: 17.0 * s,
+            legend: 16.0 * s,
+            caption: 17.0 * s,
+        }
+    }
+}
+
+fn text_style(size: f64, color: &RGBColor) -> TextStyle<'static> {
+    (FONT_FAMILY, size).into_font().color(color)
+}
+
+/// Where a panel's legend goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum LegendPlacement {
+    /// Inside the frame in the corner (or top/bottom centre) that hides the fewest curve
+    /// pixels; outside on the right if every inside position would hide curves.
+    #[default]
+    Auto,
+    /// Inside the frame at the least obstructive position, even if it hides curves.
+    Inside,
+    /// To the right of the frame, top-aligned (the frame gets narrower).
+    OutsideRight,
+    /// No legend.
+    Hidden,
+}
+
+/// Size of a plotting rectangle; positions are relative to its top-left corner.
+#[derive(Debug, Clone, Copy)]
+struct PlotRect {
+    width: f64,
+    height: f64,
+}
+
+impl PlotRect {
+    /// Pixel position (relative to the plotting rectangle) of a data point.
+    fn map(&self, (x, y): (f64, f64), (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> (f64, f64) {
+        let fx = (x.log10() - x0.log10()) / (x1.log10() - x0.log10());
+        let fy = (y.log10() - y0.log10()) / (y1.log10() - y0.log10());
+        (fx * (self.width - 1.0), (1.0 - fy) * (self.height - 1.0))
+    }
+}
+
+/// Draws one panel into `area` (its whole extent: title, axes, frame, curves, legend).
+pub fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    panel: &Panel,
+    ts: &TextSizes,
+) -> Result<(), DrawError> {
+    let xr = panel.resolved_x_range();
+    let yr = panel.resolved_y_range();
+    let body = if panel.title.is_empty() {
+        area.clone()
+    } else {
+        let spaced = area.margin((0.3 * ts.panel_title) as u32, 0, 0, 0);
+        spaced.titled(&panel.title, text_style(ts.panel_title, &BLACK))?
+    };
+    let (w, h) = body.dim_in_pixel();
+    let (w, h) = (w as f64, h as f64);
+
+    let tick_style = text_style(ts.ticks, &BLACK);
+    let axis_style = text_style(ts.axis, &BLACK);
+    let text_h = |style: &TextStyle| -> Result<f64, DrawError> {
+        Ok(body.estimate_text_size("10⁰", style)?.1 as f64)
+    };
+    let (tick_h, axis_h) = (text_h(&tick_style)?, text_h(&axis_style)?);
+    const TICK: i32 = 5; // tick mark length; plotters puts labels 2 * TICK from the axis
+    let x_label_area = (tick_h + 2.0 * TICK as f64 + 9.0 + axis_h + 4.0).ceil();
+    let (m_top, m_bottom, m_left) = ((0.6 * tick_h).ceil(), 4.0, 4.0);
+    let m_right = (1.4 * tick_h).ceil();
+    let plot_h = (h - m_top - m_bottom - x_label_area).max(10.0);
+
+    let y_ticks = decade_ticks(yr.0, yr.1, plot_h, 2.5 * tick_h);
+    let mut y_label_w: f64 = 0.0;
+    for v in &y_ticks.major {
+        y_label_w =
+            y_label_w.max(body.estimate_text_size(&y_ticks.label(*v), &tick_style)?.0 as f64);
+    }
+    let y_label_area = (y_label_w + 2.0 * TICK as f64 + 8.0 + axis_h + 2.0).ceil();
+
+    // Curves in data space, clipped to the frame; bands as polygons.
+    let lines: Vec<(Vec<(f64, f64)>, TraceStyle)> = panel
+        .traces
+        .iter()
+        .flat_map(|t| {
+            clip_loglog(&t.points, xr, yr)
+                .into_iter()
+                .map(|l| (l, t.style))
+        })
+        .collect();
+    let band_outline = panel.band.as_ref().and_then(|b| band_outline(b, xr, yr));
+
+    let legend = match panel.legend {
+        LegendPlacement::Hidden => None,
+        _ => LegendBox::measure(&body, panel, ts.legend)?,
+    };
+    let inside_rect = PlotRect {
+        width: (w - m_left - y_label_area - m_right).max(10.0),
+        height: plot_h,
+    };
+    let outside = match (&legend, panel.legend) {
+        (None, _) => false,
+        (Some(_), LegendPlacement::OutsideRight) => true,
+        (Some(lb), LegendPlacement::Auto) => {
+            let obstacles = Obstacles::new(&lines, &band_outline, &inside_rect, xr, yr);
+            let (_, cost) = lb.best_inside(&inside_rect, &obstacles);
+            cost > AUTO_INSIDE_MAX_COST
+        }
+        _ => false,
+    };
+    let outside_w = match (&legend, outside) {
+        (Some(lb), true) => lb.width as f64 + 12.0,
+        _ => 0.0,
+    };
+    let rect = PlotRect {
+        width: (inside_rect.width - outside_w).max(10.0),
+        ..inside_rect
+    };
+    let x_ticks = decade_ticks(
+        xr.0,
+        xr.1,
+        rect.width,
+        x_label_spacing(&body, xr, &tick_style)?,
+    );
+
+    let mut chart = ChartBuilder::on(&body)
+        .margin_top(m_top as u32)
+        .margin_bottom(m_bottom as u32)
+        .margin_left(m_left as u32)
+        .margin_right((m_right + outside_w) as u32)
+        .x_label_area_size(x_label_area as u32)
+        .y_label_area_size(y_label_area as u32)
+        .build_cartesian_2d(
+            (xr.0..xr.1)
+                .log_scale()
+                .with_key_points(x_ticks.major.clone())
+                .with_light_points(x_ticks.minor.clone()),
+            (yr.0..yr.1)
+                .log_scale()
+                .with_key_points(y_ticks.major.clone())
+                .with_light_points(y_ticks.minor.clone()),
+        )?;
+    let x_fmt = |v: &f64| x_ticks.label(*v);
+    let y_fmt = |v: &f64| y_ticks.label(*v);
+    chart
+        .configure_mesh()
+        .bold_line_style(RGBColor(205, 205, 205).stroke_width(1))
+        .light_line_style(RGBColor(236, 236, 236).stroke_width(1))
+        .axis_style(BLACK.stroke_width(1))
+        .set_all_tick_mark_size(TICK)
+        .label_style(tick_style.clone())
+        .axis_desc_style(axis_style.clone())
+        .x_desc(axis_title(&panel.x_label, &panel.x_unit))
+        .y_desc(axis_title(&panel.y_label, &panel.y_unit))
+        .x_label_formatter(&x_fmt)
+        .y_label_formatter(&y_fmt)
+        .draw()?;
+
+    if let Some(band) = &panel.band {
+        let fill = band.color.mix(band.opacity.clamp(0.0, 1.0)).filled();
+        if let Some((upper, lower)) = &band_outline {
+            let poly: Vec<_> = upper.iter().chain(lower.iter().rev()).copied().collect();
+            chart.draw_series(std::iter::once(Polygon::new(poly, fill)))?;
+        }
+    }
+    for (line, style) in &lines {
+        let line = decimate(line, &rect, xr, yr, 1.5);
+        for run in split_at_reversals(&line, &rect, xr, yr) {
+            draw_polyline(&mut chart, run, *style)?;
+        }
+    }
+
+    // Close the frame: plotters draws only the left and bottom axes.
+    let plot = chart.plotting_area();
+    let (px, py) = plot.get_pixel_range();
+    let frame = plot.strip_coord_spec();
+    let (fw, fh) = frame.dim_in_pixel();
+    let (fw, fh) = (fw as i32, fh as i32);
+    frame.draw(&PathElement::new(
+        vec![(0, 0), (fw - 1, 0), (fw - 1, fh - 1)],
+        BLACK.stroke_width(1),
+    ))?;
+
+    if let Some(lb) = legend {
+        if outside {
+            let (bx, by) = body.get_base_pixel();
+            let pos = (px.end - bx + 12, py.start - by);
+            lb.draw(&body, pos)?;
+        } else {
+            let actual = PlotRect {
+                width: fw as f64,
+                height: fh as f64,
+            };
+            let obstacles = Obstacles::new(&lines, &band_outline, &actual, xr, yr);
+            let (pos, _) = lb.best_inside(&actual, &obstacles);
+            lb.draw(&frame, pos)?;
+        }
+    }
+    Ok(())
+}
+
+/// With [`LegendPlacement::Auto`], the legend goes inside only if it hides at most this much
+/// (about one pixel of curve per unit, band area counts 1 % per pixel).
+const AUTO_INSIDE_MAX_COST: f64 = 12.0;
+
+/// Minimum distance between x tick labels: the widest label plus a gap.
+fn x_label_spacing<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (x0, x1): (f64, f64),
+    style: &TextStyle,
+) -> Result<f64, DrawError> {
+    let mut widest: f64 = 0.0;
+    let (e0, e1) = (x0.log10().floor() as i32, x1.log10().ceil() as i32);
+    for e in e0..=e1 {
+        widest = widest.max(area.estimate_text_size(&pow10_label(e), style)?.0 as f64);
+    }
+    Ok(widest + style.font.get_size() * 1.2)
+}
+
+fn axis_title(label: &str, unit: &str) -> String {
+    if unit.is_empty() {
+        label.to_string()
+    } else {
+        format!("{label} ({unit})")
+    }
+}
+
+fn draw_polyline<DB: DrawingBackend, X, Y>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<X, Y>>,
+    line: Vec<(f64, f64)>,
+    style: TraceStyle,
+) -> Result<(), DrawError>
+where
+    X: plotters::coord::ranged1d::Ranged<ValueType = f64>,
+    Y: plotters::coord::ranged1d::Ranged<ValueType = f64>,
+{
+    let w = style.width.max(1);
+    let shape = style.color.stroke_width(w);
+    match style.dash {
+        Dash::Solid => {
+            chart.draw_series(std::iter::once(PathElement::new(line, shape)))?;
+        }
+        Dash::Dashed => {
+            let (dash, gap) = dash_pattern(w);
+            chart.draw_series(std::iter::once(DashedPathElement::new(
+                line, dash, gap, shape,
+            )))?;
+        }
+        Dash::Dotted => {
+            let (radius, spacing) = dot_pattern(w);
+            let color = style.color;
+            chart.draw_series(std::iter::once(DottedPathElement::new(
+                line,
+                0,
+                spacing,
+                move |c| Circle::new(c, radius, color.filled()),
+            )))?;
+        }
+    }
+    Ok(())
+}
+
+/// Dash length and gap (px) for a line width.
+fn dash_pattern(width: u32) -> (i32, i32) {
+    let w = width as i32;
+    (5 * w + 4, 3 * w + 3)
+}
+
+/// Dot radius and spacing (px) for a line width.
+fn dot_pattern(width: u32) -> (i32, i32) {
+    let w = width as i32;
+    ((w + 2) / 2, 3 * w + 3)
+}
+
+/// Decade tick positions of a log axis and which of them carry a label.
+#[derive(Debug, Clone, PartialEq)]
+struct Ticks {
+    /// Decades inside the range (grid lines and tick marks).
+    major: Vec<f64>,
+    /// 2..9 times each decade, when there is room for them (light grid lines).
+    minor: Vec<f64>,
+    /// Label every `step`-th decade (exponents divisible by `step`).
+    step: i32,
+}
+
+impl Ticks {
+    fn label(&self, v: f64) -> String {
+        let e = v.log10().round() as i32;
+        if e.rem_euclid(self.step) == 0 {
+            pow10_label(e)
+        } else {
+            String::new()
+        }
+    }
+}
+
+/// Ticks for `[lo, hi]` on an axis `pixels` long, labels at least `min_spacing` px apart.
+fn decade_ticks(lo: f64, hi: f64, pixels: f64, min_spacing: f64) -> Ticks {
+    let (e0, e1) = (lo.log10(), hi.log10());
+    let first = (e0 - 1e-9).ceil() as i32;
+    let last = (e1 + 1e-9).floor() as i32;
+    let major: Vec<f64> = (first..=last).map(|e| 10f64.powi(e)).collect();
+    let per_decade = pixels.max(1.0) / (e1 - e0).max(1e-9);
+    let step = (1..=12)
+        .find(|&k| per_decade * k as f64 >= min_spacing)
+        .unwrap_or(12);
+    let mut minor = Vec::new();
+    if per_decade >= 45.0 {
+        for e in (first - 1)..=last {
+            for m in 2..=9 {
+                let v = m as f64 * 10f64.powi(e);
+                if v > lo && v < hi {
+                    minor.push(v);
+                }
+            }
+        }
+    }
+    Ticks { major, minor, step }
+}
+
+/// `10ⁿ` with a Unicode superscript exponent (`10⁻⁴`, `10⁰`, `10¹`).
+pub fn pow10_label(exponent: i32) -> String {
+    const SUP: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+    let mut s = String::from("10");
+    if exponent < 0 {
+        s.push('⁻');
+    }
+    for d in exponent.unsigned_abs().to_string().bytes() {
+        s.push(SUP[(d - b'0') as usize]);
+    }
+    s
+}
+
+fn positive(v: f64) -> bool {
+    v.is_finite() && v > 0.0
+}
+
+fn valid_range((a, b): (f64, f64)) -> bool {
+    positive(a) && positive(b) && b > a
+}
+
+fn min_max(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
+    values.fold(None, |acc, v| match acc {
+        None => Some((v, v)),
+        Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
+    })
+}
+
+/// Splits `points` into polylines that lie inside `[x0, x1] x [y0, y1]`, in log-log space:
+/// points with a non-finite or non-positive coordinate break the line, segments leaving the box
+/// are cut at its edge (interpolated in log coordinates).
+pub fn clip_loglog(
+    points: &[(f64, f64)],
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Vec<Vec<(f64, f64)>> {
+    let bx = (x0.log10(), x1.log10());
+    let by = (y0.log10(), y1.log10());
+    let mut out: Vec<Vec<(f64, f64)>> = Vec::new();
+    let mut current: Vec<(f64, f64)> = Vec::new();
+    let mut prev: Option<(f64, f64)> = None;
+    let flush = |current: &mut Vec<(f64, f64)>, out: &mut Vec<Vec<(f64, f64)>>| {
+        if current.len() >= 2 {
+            out.push(std::mem::take(current));
+        } else {
+            current.clear();
+        }
+    };
+    for &(x, y) in points {
+        if !(positive(x) && positive(y)) {
+            flush(&mut current, &mut out);
+            prev = None;
+            continue;
+        }
+        let p = (x.log10(), y.log10());
+        if let Some(q) = prev {
+            match clip_segment(q, p, bx, by) {
+                Some((a, b, entered, left)) => {
+                    if entered || current.is_empty() {
+                        flush(&mut current, &mut out);
+                        current.push(a);
+                    }
+                    current.push(b);
+                    if left {
+                        flush(&mut current, &mut out);
+                    }
+                }
+                None => flush(&mut current, &mut out),
+            }
+        }
+        prev = Some(p);
+    }
+    flush(&mut current, &mut out);
+    out.into_iter()
+        .map(|l| {
+            l.into_iter()
+                .map(|(lx, ly)| (10f64.powf(lx), 10f64.powf(ly)))
+                .collect()
+        })
+        .collect()
+}
+
+/// Liang-Barsky: the part of segment `p -> q` inside the box, with flags "start was cut" and
+/// "end was cut".
+#[allow(clippy::type_complexity)]
+fn clip_segment(
+    p: (f64, f64),
+    q: (f64, f64),
+    (xa, xb): (f64, f64),
+    (ya, yb): (f64, f64),
+) -> Option<((f64, f64), (f64, f64), bool, bool)> {
+    let (dx, dy) = (q.0 - p.0, q.1 - p.1);
+    let mut t0: f64 = 0.0;
+    let mut t1: f64 = 1.0;
+    for (den, num) in [
+        (-dx, p.0 - xa),
+        (dx, xb - p.0),
+        (-dy, p.1 - ya),
+        (dy, yb - p.1),
+    ] {
+        if den == 0.0 {
+            if num < 0.0 {
+                return None;
+            }
+        } else {
+            let t = num / den;
+            if den < 0.0 {
+                t0 = t0.max(t);
+            } else {
+                t1 = t1.min(t);
+            }
+        }
+    }
+    if t0 > t1 {
+        return None;
+    }
+    let a = (p.0 + t0 * dx, p.1 + t0 * dy);
+    let b = (p.0 + t1 * dx, p.1 + t1 * dy);
+    Some((a, b, t0 > 0.0, t1 < 1.0))
+}
+
+/// A band's boundaries clamped into the axis range (non-positive lower values shade to the
+/// bottom), NaN points dropped: `(upper, lower)`, both by increasing x. `None` if either has
+/// fewer than two points.
+#[allow(clippy::type_complexity)]
+fn band_outline(
+    band: &Band,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Option<(Vec<(f64, f64)>, Vec<(f64, f64)>)> {
+    let clamp = |&(x, y): &(f64, f64)| -> Option<(f64, f64)> {
+        if x.is_nan() || y.is_nan() || x <= 0.0 {
+            return None;
+        }
+        let y = if y > 0.0 { y } else { y0 };
+        Some((x.clamp(x0, x1), y.clamp(y0, y1)))
+    };
+    let upper: Vec<_> = band.upper.iter().filter_map(clamp).collect();
+    let lower: Vec<_> = band.lower.iter().filter_map(clamp).collect();
+    (upper.len() >= 2 && lower.len() >= 2).then_some((upper, lower))
+}
+
+/// What hides behind a legend: curve pixels (sampled every ~2 px) and per pixel column the
+/// vertical extent of the band, in plotting-rectangle pixels.
+struct Obstacles {
+    curve: Vec<(f64, f64)>,
+    band: Vec<Option<(f64, f64)>>,
+}
+
+impl Obstacles {
+    #[allow(clippy::type_complexity)]
+    fn new(
+        lines: &[(Vec<(f64, f64)>, TraceStyle)],
+        band: &Option<(Vec<(f64, f64)>, Vec<(f64, f64)>)>,
+        rect: &PlotRect,
+        xr: (f64, f64),
+        yr: (f64, f64),
+    ) -> Obstacles {
+        let mut curve = Vec::new();
+        for (line, style) in lines {
+            let px: Vec<_> = line.iter().map(|&p| rect.map(p, xr, yr)).collect();
+            // A thick line hides more: count it once per pixel of width.
+            let weight = style.width.max(1) as usize;
+            for s in px.windows(2) {
+                let (a, b) = (s[0], s[1]);
+                let steps = ((b.0 - a.0).hypot(b.1 - a.1) / 2.0).ceil().max(1.0) as usize;
+                for k in 0..steps {
+                    let t = k as f64 / steps as f64;
+                    let p = (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
+                    curve.extend(std::iter::repeat_n(p, weight));
+                }
+            }
+        }
+        let columns = rect.width.max(1.0) as usize;
+        let mut band_cols = vec![None; columns];
+        if let Some((upper, lower)) = band {
+            let up = column_profile(upper, rect, xr, yr, columns);
+            let lo = column_profile(lower, rect, xr, yr, columns);
+            for (c, slot) in band_cols.iter_mut().enumerate() {
+                if let (Some(a), Some(b)) = (up[c], lo[c]) {
+                    *slot = Some((a.min(b), a.max(b)));
+                }
+            }
+        }
+        Obstacles {
+            curve,
+            band: band_cols,
+        }
+    }
+
+    /// Cost of covering the box `[x, x + w] x [y, y + h]` (3 px clearance around it).
+    fn cost(&self, (x, y): (f64, f64), (w, h): (f64, f64)) -> f64 {
+        let (x0, x1, y0, y1) = (x - 3.0, x + w + 3.0, y - 3.0, y + h + 3.0);
+        let curve = self
+            .curve
+            .iter()
+            .filter(|p| p.0 >= x0 && p.0 <= x1 && p.1 >= y0 && p.1 <= y1)
+            .count() as f64;
+        let mut band = 0.0;
+        let c0 = x0.max(0.0) as usize;
+        let c1 = (x1.max(0.0) as usize).min(self.band.len());
+        for (top, bottom) in self.band[c0.min(c1)..c1].iter().flatten() {
+            band += (bottom.min(y1) - top.max(y0)).max(0.0);
+        }
+        curve + 0.01 * band
+    }
+}
+
+/// y pixel of a polyline at each pixel column (linear interpolation), `None` outside it.
+fn column_profile(
+    line: &[(f64, f64)],
+    rect: &PlotRect,
+    xr: (f64, f64),
+    yr: (f64, f64),
+    columns: usize,
+) -> Vec<Option<f64>> {
+    let mut out = vec![None; columns];
+    let px: Vec<_> = line.iter().map(|&p| rect.map(p, xr, yr)).collect();
+    for s in px.windows(2) {
+        let (a, b) = if s[0].0 <= s[1].0 {
+            (s[0], s[1])
+        } else {
+            (s[1], s[0])
+        };
+        let c0 = a.0.ceil().max(0.0) as usize;
+        let c1 = (b.0.floor().max(0.0) as usize).min(columns.saturating_sub(1));
+        for (c, slot) in out.iter_mut().enumerate().take(c1 + 1).skip(c0) {
+            let t = if b.0 > a.0 {
+                (c as f64 - a.0) / (b.0 - a.0)
+            } else {
+                0.0
+            };
+            *slot = Some(a.1 + t * (b.1 - a.1));
+        }
+    }
+    out
+}
+
+/// Drops points closer than `min_px` pixels to the previously kept one (the last point is
+/// always kept): dense curves then rasterise without integer-rounding zigzags, and SVG output
+/// stays small.
+fn decimate(
+    line: &[(f64, f64)],
+    rect: &PlotRect,
+    xr: (f64, f64),
+    yr: (f64, f64),
+    min_px: f64,
+) -> Vec<(f64, f64)> {
+    let mut out: Vec<(f64, f64)> = Vec::with_capacity(line.len());
+    let mut last_px = (f64::NAN, f64::NAN);
+    for (k, &p) in line.iter().enumerate() {
+        let q = rect.map(p, xr, yr);
+        // NaN distance (first point) counts as far.
+        let near = (q.0 - last_px.0).hypot(q.1 - last_px.1) < min_px;
+        if !near || k + 1 == line.len() {
+            out.push(p);
+            last_px = q;
+        }
+    }
+    out
+}
+
+/// Cuts a polyline where it turns back on itself by more than 90 degrees in pixel space (the two
+/// sides of a resonance peak drawn in one pixel column): a thick plotters path joins such a
+/// U-turn with a degenerate miter and drops the segments around it, so an undamped peak would
+/// look capped far below its height. Consecutive runs share the turning vertex.
+fn split_at_reversals(
+    line: &[(f64, f64)],
+    rect: &PlotRect,
+    xr: (f64, f64),
+    yr: (f64, f64),
+) -> Vec<Vec<(f64, f64)>> {
+    let px: Vec<(f64, f64)> = line.iter().map(|&p| rect.map(p, xr, yr)).collect();
+    let mut runs = Vec::new();
+    let mut current: Vec<(f64, f64)> = line.iter().take(1).copied().collect();
+    for k in 1..line.len() {
+        if k >= 2 {
+            let a = (px[k - 1].0 - px[k - 2].0, px[k - 1].1 - px[k - 2].1);
+            let b = (px[k].0 - px[k - 1].0, px[k].1 - px[k - 1].1);
+            if a.0 * b.0 + a.1 * b.1 < 0.0 {
+                runs.push(std::mem::replace(&mut current, vec![line[k - 1]]));
+            }
+        }
+        current.push(line[k]);
+    }
+    if current.len() >= 2 {
+        runs.push(current);
+    }
+    runs
+}
+
+/// Legend rows: a sample (line, band swatch or nothing) and text.
+enum Sample {
+    Line(TraceStyle),
+    Swatch(RGBColor, f64),
+    None,
+}
+
+/// A measured legend.
+struct LegendBox {
+    rows: Vec<(Sample, String)>,
+    font: f64,
+    width: i32,
+    height: i32,
+    pad: i32,
+    sample_len: i32,
+    row_h: i32,
+    text_x: i32,
+}
+
+impl LegendBox {
+    /// Rows for the panel's traces, band and notes; `None` if there is nothing to list.
+    fn measure<DB: DrawingBackend>(
+        area: &DrawingArea<DB, Shift>,
+        panel: &Panel,
+        font: f64,
+    ) -> Result<Option<LegendBox>, DrawError> {
+        let mut rows: Vec<(Sample, String)> = Vec::new();
+        for t in &panel.traces {
+            rows.push((Sample::Line(t.style), t.label.clone()));
+        }
+        if let Some(b) = &panel.band {
+            rows.push((Sample::Swatch(b.color, b.opacity), b.label.clone()));
+        }
+        for n in &panel.notes {
+            rows.push((Sample::None, n.clone()));
+        }
+        if rows.is_empty() {
+            return Ok(None);
+        }
+        let style = text_style(font, &BLACK);
+        let pad = (font * 0.5).round() as i32;
+        let sample_len = (font * 2.4).round() as i32;
+        let row_h = (font * 1.3).round() as i32;
+        let has_samples = rows.iter().any(|r| !matches!(r.0, Sample::None));
+        let text_x = pad + if has_samples { sample_len + pad } else { 0 };
+        let mut text_w = 0;
+        for (_, text) in &rows {
+            text_w = text_w.max(area.estimate_text_size(text, &style)?.0 as i32);
+        }
+        Ok(Some(LegendBox {
+            width: text_x + text_w + pad + 2,
+            height: 2 * pad + row_h * rows.len() as i32 - pad / 2,
+            rows,
+            font,
+            pad,
+            sample_len,
+            row_h,
+            text_x,
+        }))
+    }
+
+    /// The least obstructive inside position (top-left corner, plotting-rectangle pixels) and
+    /// its cost; ties go to the earlier of upper right, upper left, lower left, lower right,
+    /// upper centre, lower centre.
+    fn best_inside(&self, rect: &PlotRect, obstacles: &Obstacles) -> ((i32, i32), f64) {
+        let (fw, fh) = (rect.width as i32, rect.height as i32);
+        let (bw, bh) = (self.width, self.height);
+        let m = 8;
+        let candidates = [
+            (fw - m - bw, m),
+            (m, m),
+            (m, fh - m - bh),
+            (fw - m - bw, fh - m - bh),
+            ((fw - bw) / 2, m),
+            ((fw - bw) / 2, fh - m - bh),
+        ];
+        let mut best = (candidates[0], f64::INFINITY);
+        for c in candidates {
+            let cost = obstacles.cost((c.0 as f64, c.1 as f64), (bw as f64, bh as f64));
+            if cost < best.1 {
+                best = (c, cost);
+            }
+        }
+        best
+    }
+
+    /// Draws the legend with its top-left corner at `(bx, by)` of `area`.
+    fn draw<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        (bx, by): (i32, i32),
+    ) -> Result<(), DrawError> {
+        let corners = [(bx, by), (bx + self.width, by + self.height)];
+        area.draw(&Rectangle::new(corners, WHITE.mix(0.9).filled()))?;
+        area.draw(&Rectangle::new(
+            corners,
+            RGBColor(160, 160, 160).stroke_width(1),
+        ))?;
+        let style = text_style(self.font, &BLACK).pos(Pos::new(HPos::Left, VPos::Center));
+        let note_style =
+            text_style(self.font, &RGBColor(85, 85, 85)).pos(Pos::new(HPos::Left, VPos::Center));
+        for (i, (sample, text)) in self.rows.iter().enumerate() {
+            let cy = by + self.pad + self.row_h * i as i32 + self.row_h / 2;
+            let sx = bx + self.pad;
+            let len = self.sample_len;
+            match sample {
+                Sample::Line(s) => {
+                    let pts = vec![(sx, cy), (sx + len, cy)];
+                    let w = s.width.max(1);
+                    let shape = s.color.stroke_width(w);
+                    match s.dash {
+                        Dash::Solid => area.draw(&PathElement::new(pts, shape))?,
+                        Dash::Dashed => {
+                            // Shorter dashes so that at least two show in the sample.
+                            let (d, g) = dash_pattern(w);
+                            area.draw(&DashedPathElement::new(
+                                pts,
+                                d.min(len * 2 / 5),
+                                g.min(len / 5),
+                                shape,
+                            ))?
+                        }
+                        Dash::Dotted => {
+                            let (r, sp) = dot_pattern(w);
+                            let color = s.color;
+                            area.draw(&DottedPathElement::new(pts, 0, sp, move |c| {
+                                Circle::new(c, r, color.filled())
+                            }))?
+                        }
+                    }
+                }
+                Sample::Swatch(color, opacity) => {
+                    let hh = self.row_h / 3;
+                    area.draw(&Rectangle::new(
+                        [(sx, cy - hh), (sx + len, cy + hh)],
+                        color.mix(opacity.clamp(0.0, 1.0)).filled(),
+                    ))?;
+                }
+                Sample::None => {}
+            }
+            let st = if matches!(sample, Sample::None) {
+                &note_style
+            } else {
+                &style
+            };
+            area.draw_text(text, st, (bx + self.text_x, cy))?;
+        }
+        Ok(())
+    }
+}
+
+/// Word-wraps paragraphs to `width` pixels; an empty line separates paragraphs.
+fn wrap_lines<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    paragraphs: &[String],
+    fs: f64,
+    width: f64,
+) -> Result<Vec<String>, DrawError> {
+    let style = text_style(fs, &BLACK);
+    let mut lines = Vec::new();
+    for (i, para) in paragraphs.iter().enumerate() {
+        if i > 0 {
+            lines.push(String::new());
+        }
+        let mut line = String::new();
+        for word in para.split_whitespace() {
+            let candidate = if line.is_empty() {
+                word.to_string()
+            } else {
+                format!("{line} {word}")
+            };
+            if !line.is_empty() && area.estimate_text_size(&candidate, &style)?.0 as f64 > width {
+                lines.push(std::mem::replace(&mut line, word.to_string()));
+            } else {
+                line = candidate;
+            }
+        }
+        lines.push(line);
+    }
+    Ok(lines)
+}
+
+/// Caption text, word-wrapped, top-left aligned with `margin` pixels all round.
+fn draw_caption<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    paragraphs: &[String],
+    fs: f64,
+    margin: f64,
+) -> Result<(), DrawError> {
+    let (w, _) = area.dim_in_pixel();
+    let lines = wrap_lines(area, paragraphs, fs, w as f64 - 2.0 * margin)?;
+    let style = text_style(fs, &BLACK).pos(Pos::new(HPos::Left, VPos::Top));
+    let line_h = fs * 1.45;
+    for (i, line) in lines.iter().enumerate() {
+        if !line.is_empty() {
+            let y = margin + line_h * i as f64;
+            area.draw_text(line, &style, (margin as i32, y as i32))?;
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pow10_labels() {
+        assert_eq!(pow10_label(-4), "10⁻⁴");
+        assert_eq!(pow10_label(0), "10⁰");
+        assert_eq!(pow10_label(12), "10¹²");
+    }
+
+    #[test]
+    fn clip_breaks_at_invalid_and_cuts_at_box() {
+        let pts = vec![
+            (1.0, 1.0),
+            (2.0, 2.0),
+            (3.0, f64::NAN),
+            (4.0, 1.0),
+            (5.0, 0.0),
+            (6.0, 1.0),
+            (7.0, 1e-30),
+            (8.0, 1.0),
+        ];
+        let lines = clip_loglog(&pts, (0.5, 10.0), (1e-3, 10.0));
+        // [1,2] | [4] dropped (single point) | [6 -> cut at 1e-3] | [cut -> 8]
+        assert_eq!(lines.len(), 3);
+        assert_eq!(lines[0].len(), 2);
+        let last_of_second = *lines[1].last().unwrap();
+        assert!((last_of_second.1 - 1e-3).abs() < 1e-12);
+        let first_of_third = lines[2][0];
+        assert!((first_of_third.1 - 1e-3).abs() < 1e-12);
+        assert!((lines[2][1].0 - 8.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn reversals_split_peaks_and_keep_monotone_lines_whole() {
+        let rect = PlotRect {
+            width: 500.0,
+            height: 300.0,
+        };
+        let (xr, yr) = ((1e-3, 2e-3), (1e2, 1e11));
+        // An undamped peak: up and back down within one pixel column.
+        let peak = [
+            (1.3e-3, 1e5),
+            (1.31e-3, 1e10),
+            (1.3100001e-3, 1e9),
+            (1.4e-3, 1e5),
+        ];
+        let runs = split_at_reversals(&peak, &rect, xr, yr);
+        assert_eq!(runs.len(), 2);
+        assert_eq!(runs[0], peak[..2].to_vec());
+        assert_eq!(runs[1], peak[1..].to_vec());
+        let rising = [(1e-3, 1e3), (1.2e-3, 1e4), (1.5e-3, 1e6), (2e-3, 1e7)];
+        assert_eq!(
+            split_at_reversals(&rising, &rect, xr, yr),
+            vec![rising.to_vec()]
+        );
+    }
+
+    #[test]
+    fn clip_keeps_inside_lines_whole() {
+        let pts: Vec<_> = (1..=10).map(|k| (k as f64, k as f64)).collect();
+        let lines = clip_loglog(&pts, (1.0, 10.0), (1.0, 10.0));
+        assert_eq!(lines.len(), 1);
+        assert_eq!(lines[0].len(), 10);
+    }
+
+    #[test]
+    fn auto_y_range_pads_to_decades_and_limits_depth() {
+        let mut p = Panel::new("t", ("f", "Hz"), ("y", "m"));
+        p.traces.push(Trace::new(
+            "a",
+            vec![
+                (1.0, 3e-3),
+                (2.0, 0.0),
+                (3.0, 1e-30),
+                (4.0, 40.0),
+                (5.0, f64::NAN),
+            ],
+            TraceStyle::new(PALETTE[0], Dash::Solid, 2),
+        ));
+        assert_eq!(p.resolved_x_range(), (1.0, 5.0));
+        let (lo, hi) = p.resolved_y_range();
+        assert!((hi - 100.0).abs() < 1e-9);
+        assert!((lo - 1e-10).abs() < 1e-22, "{lo}");
+        p.max_decades = None;
+        let (lo, _) = p.resolved_y_range();
+        assert!((lo - 1e-30).abs() < 1e-42);
+    }
+
+    #[test]
+    fn ticks_thin_out_labels() {
+        let t = decade_ticks(1e-10, 1e2, 300.0, 36.0);
+        assert_eq!(t.major.len(), 13);
+        assert!(t.step >= 2);
+        assert!(t.minor.is_empty());
+        let t = decade_ticks(1e-4, 30.0, 500.0, 60.0);
+        assert_eq!(t.step, 1);
+        assert_eq!(t.label(1e-4), "10⁻⁴");
+    }
+}

@@ -1,0 +1,198 @@
+//! tiltnoise-plot: figures as PNG or SVG, drawn in pure Rust (plotters with an embedded font,
+//! no system font libraries).
+//!
+//! Every figure is one drawing routine, [`Figure::draw`], generic over the plotters
+//! [`DrawingBackend`]; [`render`] runs it on a [`BitMapBackend`] (PNG) or an [`SVGBackend`]
+//! (SVG) and returns the file's bytes. This crate writes no file and does not depend on
+//! `tiltnoise-io`: the caller writes the bytes atomically (`tiltnoise_io::write_atomic`), so on
+//! error nothing is left at the target path.
+//!
+//! The module consumes plain data: [`chart`] has the reusable log-log chart
+//! ([`chart::LogLogFigure`] of [`chart::Panel`]s of [`chart::Trace`]s and an optional
+//! [`chart::Band`]), [`tf_figure()`] builds the paper's Figure 5 from a
+//! [`TransferMatrix`](tiltnoise_core::tf::TransferMatrix), [`budget_figure()`] a noise budget from a
+//! [`BudgetReport`](tiltnoise_core::noise::BudgetReport).
+//!
+//! Text is rendered with DejaVu Sans (`assets/DejaVuSans.ttf`, licence in
+//! `assets/DejaVuSans-LICENSE.txt`), embedded in the binary and registered with plotters once
+//! under the family name `sans-serif`. PNG text goes through [`GlyphPlacement`], which fixes
+//! plotters' glyph spacing. In SVG output text stays text (`<text font-family="sans-serif">`),
+//! so the viewer's sans-serif font is used there.
+
+pub mod budget_figure;
+pub mod chart;
+mod labels;
+pub mod mc_figure;
+pub mod methods_figure;
+pub mod simulate_figure;
+mod text;
+pub mod tf_figure;
+
+pub use budget_figure::{budget_figure, budget_figure_with, BudgetFigureOptions};
+pub use chart::{Band, Dash, LegendPlacement, LogLogFigure, Panel, TextSizes, Trace, TraceStyle};
+pub use text::GlyphPlacement;
+pub use tf_figure::{tf_figure, tf_figure_with, TfFigureOptions};
+
+use image::ImageEncoder;
+use plotters::coord::Shift;
+use plotters::prelude::{BitMapBackend, DrawingArea, DrawingAreaErrorKind, DrawingBackend};
+use plotters::prelude::{IntoDrawingArea, SVGBackend};
+use std::path::Path;
+use std::sync::OnceLock;
+use tiltnoise_core::error::OutputError;
+
+/// The embedded font (DejaVu Sans 2.37, Bitstream Vera / DejaVu licence).
+static FONT_BYTES: &[u8] = include_bytes!("../../../assets/DejaVuSans.ttf");
+
+/// Family name under which the embedded font is registered; plotters' default styles use it.
+pub const FONT_FAMILY: &str = "sans-serif";
+
+/// Supported image formats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ImageFormat {
+    /// Raster image, 8-bit RGB, lossless.
+    Png,
+    /// Vector image; text stays selectable text.
+    Svg,
+}
+
+impl ImageFormat {
+    /// Extensions accepted by [`ImageFormat::from_path`], for messages.
+    pub const ALLOWED: &'static str = ".png, .svg";
+
+    /// Chooses the format from the extension of `path` (case-insensitive).
+    pub fn from_path(path: &Path) -> Result<ImageFormat, OutputError> {
+        match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref()
+        {
+            Some("png") => Ok(ImageFormat::Png),
+            Some("svg") => Ok(ImageFormat::Svg),
+            _ => Err(OutputError::UnknownFormat {
+                path: path.to_path_buf(),
+                allowed: Self::ALLOWED,
+            }),
+        }
+    }
+
+    /// The canonical extension, without the dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            ImageFormat::Png => "png",
+            ImageFormat::Svg => "svg",
+        }
+    }
+}
+
+/// A failure while drawing: a backend error, a font that cannot be used, or data that cannot be
+/// plotted. The caller turns it into an error naming the file.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DrawError(pub String);
+
+impl std::fmt::Display for DrawError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for DrawError {}
+
+impl<E: std::error::Error + Send + Sync> From<DrawingAreaErrorKind<E>> for DrawError {
+    fn from(e: DrawingAreaErrorKind<E>) -> Self {
+        DrawError(format!("drawing failed: {e}"))
+    }
+}
+
+/// A figure: its pixel size and one drawing routine that serves every backend.
+///
+/// Closures cannot be generic, so the "draw function generic over the backend" is this trait's
+/// method. Implementations draw everything onto `root` (already cleared to white) and must not
+/// call `present`; [`render`] does that and reports its errors.
+pub trait Figure {
+    /// Width and height in pixels (SVG: user units of the same size).
+    fn size(&self) -> (u32, u32);
+
+    /// Draws the figure.
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError>;
+}
+
+/// Registers the embedded font with plotters, once per process. Every later call returns the
+/// first call's result. [`render`] calls it; call it yourself only when drawing onto a
+/// backend of your own.
+pub fn ensure_font() -> Result<(), DrawError> {
+    static REGISTERED: OnceLock<Result<(), DrawError>> = OnceLock::new();
+    REGISTERED
+        .get_or_init(|| {
+            plotters::style::register_font(
+                FONT_FAMILY,
+                plotters::style::FontStyle::Normal,
+                FONT_BYTES,
+            )
+            .map_err(|_| {
+                DrawError(
+                    "the embedded font assets/DejaVuSans.ttf is not a usable TrueType font \
+                     (rebuild with an intact assets/ directory)"
+                        .to_string(),
+                )
+            })
+        })
+        .clone()
+}
+
+/// Draws `figure` and returns the bytes of a PNG or SVG file. Writing them is the caller's job
+/// (atomically, through `tiltnoise-io`'s `write_atomic`): this crate touches no file.
+///
+/// PNG: 8-bit RGB, encoded with the `image` crate's default PNG settings (the same bytes
+/// plotters writes to a file). SVG: UTF-8 text.
+///
+/// # Errors
+///
+/// [`DrawError`] if the font cannot be registered, drawing fails or the PNG cannot be encoded.
+pub fn render(format: ImageFormat, figure: &impl Figure) -> Result<Vec<u8>, DrawError> {
+    ensure_font()?;
+    let (w, h) = figure.size();
+    match format {
+        ImageFormat::Png => {
+            let n = (w as usize)
+                .checked_mul(h as usize)
+                .and_then(|n| n.checked_mul(3))
+                .ok_or_else(|| DrawError(format!("a {w} x {h} pixel image is too large")))?;
+            let mut rgb = vec![0u8; n];
+            {
+                let root = GlyphPlacement::new(BitMapBackend::with_buffer(&mut rgb, (w, h)))
+                    .into_drawing_area();
+                draw_on(&root, figure)?;
+                root.present()
+                    .map_err(|e| DrawError(format!("cannot finish the bitmap: {e}")))?;
+            }
+            let mut png = Vec::new();
+            image::codecs::png::PngEncoder::new(&mut png)
+                .write_image(&rgb, w, h, image::ColorType::Rgb8)
+                .map_err(|e| DrawError(format!("cannot encode PNG: {e}")))?;
+            Ok(png)
+        }
+        ImageFormat::Svg => {
+            let mut text = String::new();
+            {
+                let root = SVGBackend::with_string(&mut text, (w, h)).into_drawing_area();
+                draw_on(&root, figure)?;
+                root.present()
+                    .map_err(|e| DrawError(format!("cannot finish SVG: {e}")))?;
+            }
+            Ok(text.into_bytes())
+        }
+    }
+}
+
+fn draw_on<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    figure: &impl Figure,
+) -> Result<(), DrawError> {
+    root.fill(&plotters::style::WHITE)?;
+    figure.draw(root)
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,337 @@
+//! Figures of `tiltnoise simulate`: the paper's Figure 3 (one-sided ASDs of the simulated
+//! observables X, Y, Z and theta, eta, phi, with the mode frequencies marked) and Figures 4 and 5
+//! (time series of phi and X, e.g. after the X kick).
+//!
+//! Plain data in ([`SimAsdData`], [`TimeSeriesData`]), a [`Figure`] out; written by
+//! [`render`] (PNG or SVG bytes).
+
+use super::chart::{Dash, LegendPlacement, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
+use super::labels::{observable_symbol, observable_title};
+use super::{render, DrawError, Figure, ImageFormat, TextSizes, FONT_FAMILY};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use tiltnoise_core::model::Observable;
+
+/// The observables of Figure 3, in panel order (two rows of three).
+pub const FIGURE3_OBSERVABLES: [Observable; 6] = [
+    Observable::X,
+    Observable::Y,
+    Observable::Z,
+    Observable::Theta,
+    Observable::Eta,
+    Observable::Phi,
+];
+
+/// A mode to mark on the ASD panels.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModeMark {
+    /// 1-based mode index.
+    pub index: usize,
+    /// Mode frequency (Hz).
+    pub frequency_hz: f64,
+    /// Where it appears in the sampled record (Hz): aliased if above Nyquist.
+    pub apparent_frequency_hz: f64,
+    /// Observables the observability table says see the mode.
+    pub seen_by: Vec<Observable>,
+}
+
+/// Input of the ASD figure.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimAsdData {
+    /// Welch frequencies (Hz), with DC first (skipped on the log axis).
+    pub freqs_hz: Vec<f64>,
+    /// One-sided ASD per observable (unit/sqrt(Hz)).
+    pub asd: Vec<(Observable, Vec<f64>)>,
+    /// White readout ASD per observable (unit/sqrt(Hz)); others noiseless.
+    pub readout_asd: Vec<(Observable, f64)>,
+    /// The normal modes.
+    pub modes: Vec<ModeMark>,
+    /// Caption lines (run description).
+    pub caption: Vec<String>,
+}
+
+const ASD_COLOR: RGBColor = PALETTE[0];
+const SEEN_COLOR: RGBColor = PALETTE[1];
+const OTHER_MODE_COLOR: RGBColor = RGBColor(170, 170, 170);
+const READOUT_COLOR: RGBColor = PALETTE[2];
+
+/// Vertical marker lines at `xs` spanning `(lo, hi)`, as one broken trace.
+fn markers(xs: &[f64], (lo, hi): (f64, f64)) -> Vec<(f64, f64)> {
+    let mut pts = Vec::new();
+    for &x in xs {
+        pts.extend([(x, lo), (x, hi), (f64::NAN, f64::NAN)]);
+    }
+    pts
+}
+
+fn mode_list(marks: &[&ModeMark]) -> String {
+    marks
+        .iter()
+        .map(|m| {
+            if (m.apparent_frequency_hz - m.frequency_hz).abs() > 1e-9 * m.frequency_hz {
+                format!("ν{} (alias)", m.index)
+            } else {
+                format!("ν{}", m.index)
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Builds Figure 3: one panel per observable of [`FIGURE3_OBSERVABLES`], ASD on log-log axes,
+/// dotted lines at the modes the panel's observable sees (vermillion) and at the others (grey),
+/// at their apparent (aliased) frequencies, and the readout level where there is one.
+pub fn build_asd_figure(data: &SimAsdData) -> Result<LogLogFigure, String> {
+    let mut panels = Vec::new();
+    for o in FIGURE3_OBSERVABLES {
+        let Some((_, asd)) = data.asd.iter().find(|(x, _)| *x == o) else {
+            return Err(format!("no ASD of {} to draw", o.name()));
+        };
+        if asd.len() != data.freqs_hz.len() || asd.len() < 3 {
+            return Err(format!(
+                "ASD of {} has {} values and the grid {} (at least 3 needed)",
+                o.name(),
+                asd.len(),
+                data.freqs_hz.len()
+            ));
+        }
+        let unit = o.unit();
+        let mut panel = Panel::new(
+            observable_title(o),
+            ("frequency", "Hz"),
+            (
+                &format!("ASD of {}", observable_symbol(o)),
+                &format!("{unit}/√Hz"),
+            ),
+        );
+        let points: Vec<(f64, f64)> = data
+            .freqs_hz
+            .iter()
+            .zip(asd)
+            .skip(1)
+            .map(|(&f, &a)| (f, a))
+            .collect();
+        panel.traces.push(Trace::new(
+            "simulated",
+            points,
+            TraceStyle::new(ASD_COLOR, Dash::Solid, 1),
+        ));
+        // The legend goes inside: the full-height mode markers would otherwise push it out.
+        panel.legend = LegendPlacement::Inside;
+        let last = data.freqs_hz.len() - 1;
+        panel.x_range = Some((data.freqs_hz[1], data.freqs_hz[last]));
+        let readout = data
+            .readout_asd
+            .iter()
+            .find(|(x, _)| *x == o)
+            .map(|r| r.1)
+            .filter(|&r| r > 0.0);
+        let x_range = panel.resolved_x_range();
+        if let Some(r) = readout {
+            panel.traces.push(Trace::new(
+                format!("readout {r:.1e}"),
+                vec![(x_range.0, r), (x_range.1, r)],
+                TraceStyle::new(READOUT_COLOR, Dash::Dashed, 2),
+            ));
+        }
+        let y_range = panel.resolved_y_range();
+        panel.y_range = Some(y_range);
+        let seen: Vec<&ModeMark> = data
+            .modes
+            .iter()
+            .filter(|m| m.seen_by.contains(&o))
+            .collect();
+        let other: Vec<&ModeMark> = data
+            .modes
+            .iter()
+            .filter(|m| !m.seen_by.contains(&o))
+            .collect();
+        if !other.is_empty() {
+            let xs: Vec<f64> = other.iter().map(|m| m.apparent_frequency_hz).collect();
+            panel.traces.insert(
+                0,
+                Trace::new(
+                    "other modes (not seen)",
+                    markers(&xs, y_range),
+                    TraceStyle::new(OTHER_MODE_COLOR, Dash::Dotted, 1),
+                ),
+            );
+        }
+        if !seen.is_empty() {
+            let xs: Vec<f64> = seen.iter().map(|m| m.apparent_frequency_hz).collect();
+            panel.traces.insert(
+                0,
+                Trace::new(
+                    format!("seen: {}", mode_list(&seen)),
+                    markers(&xs, y_range),
+                    TraceStyle::new(SEEN_COLOR, Dash::Dotted, 2),
+                ),
+            );
+        }
+        panels.push(panel);
+    }
+    Ok(LogLogFigure {
+        size: (1800, 1150),
+        title: Some(
+            "Simulated free motion: one-sided amplitude spectral densities (Figure 3)".to_string(),
+        ),
+        panels,
+        columns: 3,
+        caption: data.caption.clone(),
+    })
+}
+
+/// Draws Figure 3 as a PNG or SVG file's bytes.
+///
+/// # Errors
+///
+/// [`DrawError`] for inconsistent data or any drawing failure.
+pub fn asd_figure(data: &SimAsdData, format: ImageFormat) -> Result<Vec<u8>, DrawError> {
+    let figure = build_asd_figure(data).map_err(DrawError)?;
+    render(format, &figure)
+}
+
+/// One time-series panel: `(t_s, value)` samples of one observable.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimePanel {
+    /// Panel title.
+    pub title: String,
+    /// The observable (for the axis label and unit).
+    pub observable: Observable,
+    /// Sampling step (s); sample `i` is at `t0_s + i dt_s`.
+    pub dt_s: f64,
+    /// Time of the first sample (s).
+    pub t0_s: f64,
+    /// Samples (m or rad).
+    pub values: Vec<f64>,
+}
+
+/// Input of the time-series figure (Figures 4 and 5): panels stacked vertically.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TimeSeriesData {
+    /// Figure title.
+    pub title: String,
+    /// Panels, top to bottom.
+    pub panels: Vec<TimePanel>,
+}
+
+/// Most points drawn per panel: the series is reduced to the minimum and maximum of each of
+/// `MAX_COLUMNS / 2` time bins, which keeps the envelope of oscillations faster than a pixel.
+const MAX_COLUMNS: usize = 4000;
+
+/// Min/max decimation (see [`MAX_COLUMNS`]).
+fn decimate(p: &TimePanel) -> Vec<(f64, f64)> {
+    let n = p.values.len();
+    let t = |i: usize| p.t0_s + i as f64 * p.dt_s;
+    if n <= MAX_COLUMNS {
+        return (0..n).map(|i| (t(i), p.values[i])).collect();
+    }
+    let bins = MAX_COLUMNS / 2;
+    let mut out = Vec::with_capacity(MAX_COLUMNS);
+    for b in 0..bins {
+        let (lo, hi) = (b * n / bins, ((b + 1) * n / bins).max(b * n / bins + 1));
+        let (mut imin, mut imax) = (lo, lo);
+        for i in lo..hi {
+            if p.values[i] < p.values[imin] {
+                imin = i;
+            }
+            if p.values[i] > p.values[imax] {
+                imax = i;
+            }
+        }
+        let (a, c) = if imin <= imax {
+            (imin, imax)
+        } else {
+            (imax, imin)
+        };
+        out.push((t(a), p.values[a]));
+        out.push((t(c), p.values[c]));
+    }
+    out
+}
+
+impl Figure for TimeSeriesData {
+    fn size(&self) -> (u32, u32) {
+        (1400, 450 * self.panels.len().max(1) as u32 + 60)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
+        let (w, h) = root.dim_in_pixel();
+        let ts = TextSizes::for_figure(w, h);
+        let (top, rest) = root.split_vertically((ts.title * 2.0).round() as u32);
+        let style = (FONT_FAMILY, ts.title).into_font().color(&BLACK).pos(
+            plotters::style::text_anchor::Pos::new(
+                plotters::style::text_anchor::HPos::Center,
+                plotters::style::text_anchor::VPos::Center,
+            ),
+        );
+        let (tw, th) = top.dim_in_pixel();
+        top.draw_text(&self.title, &style, (tw as i32 / 2, th as i32 / 2))?;
+        let cells = rest.split_evenly((self.panels.len().max(1), 1));
+        for (p, cell) in self.panels.iter().zip(cells.iter()) {
+            let pts = decimate(p);
+            if pts.is_empty() {
+                return Err(DrawError(format!("panel `{}` has no samples", p.title)));
+            }
+            let (x0, x1) = (pts[0].0, pts[pts.len() - 1].0.max(pts[0].0 + p.dt_s));
+            let (mut y0, mut y1) = pts
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
+                    (a.min(q.1), b.max(q.1))
+                });
+            if !(y0.is_finite() && y1.is_finite()) {
+                return Err(DrawError(format!(
+                    "panel `{}` has non-finite samples",
+                    p.title
+                )));
+            }
+            let pad = if y1 > y0 {
+                0.05 * (y1 - y0)
+            } else {
+                y0.abs().max(1e-30)
+            };
+            y0 -= pad;
+            y1 += pad;
+            let mut chart = ChartBuilder::on(cell)
+                .caption(&p.title, (FONT_FAMILY, ts.panel_title))
+                .margin(12)
+                .x_label_area_size((ts.axis * 3.0) as u32)
+                .y_label_area_size((ts.axis * 6.0) as u32)
+                .build_cartesian_2d(x0..x1, y0..y1)?;
+            chart
+                .configure_mesh()
+                .x_desc("time (s)")
+                .y_desc(format!(
+                    "{} ({})",
+                    observable_symbol(p.observable),
+                    p.observable.unit()
+                ))
+                .axis_desc_style((FONT_FAMILY, ts.axis))
+                .label_style((FONT_FAMILY, ts.ticks))
+                .y_label_formatter(&|v| {
+                    // A tick at zero computed as a tiny rounding residue prints as 0.
+                    if v.abs() < 1e-9 * (y1 - y0) {
+                        "0".to_string()
+                    } else {
+                        format!("{v:.2e}")
+                    }
+                })
+                .light_line_style(RGBColor(235, 235, 235))
+                .draw()?;
+            chart.draw_series(LineSeries::new(pts, ASD_COLOR.stroke_width(2)))?;
+        }
+        Ok(())
+    }
+}
+
+/// Draws the time-series figure as a PNG or SVG file's bytes.
+///
+/// # Errors
+///
+/// [`DrawError`] for any drawing failure.
+pub fn time_series_figure(
+    data: &TimeSeriesData,
+    format: ImageFormat,
+) -> Result<Vec<u8>, DrawError> {
+    render(format, data)
+}

@@ -1,0 +1,340 @@
+//! The paper's Figure 5: moduli of the transfer functions from the floor tilt angles
+//! (θₜ solid, ηₜ dashed, φₜ dotted) to the soft-DoF observables X, φ and φₐ; and the same
+//! layout for force and torque inputs (one panel per observable and kind of input, so each panel
+//! has one unit: m/N, rad/(N m), ...).
+
+use super::chart::{Dash, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
+// Re-exported: `plot::tf_figure::observable_symbol` is a public path.
+pub use super::labels::observable_symbol;
+use super::labels::{observable_title, tilt_symbol};
+use super::{render, DrawError, ImageFormat};
+use tiltnoise_core::model::{ForceInput, Input, Observable, TiltAxis};
+use tiltnoise_core::tf::TransferMatrix;
+
+/// Options of [`tf_figure_with`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct TfFigureOptions {
+    /// Image size in pixels.
+    pub size: (u32, u32),
+    /// Appended to the figure title in parentheses, e.g. `undamped, Table I parameters`.
+    pub note: Option<String>,
+    /// Observables to draw, one panel each, in this order; those absent from the matrix are
+    /// skipped.
+    pub observables: Vec<Observable>,
+}
+
+impl Default for TfFigureOptions {
+    fn default() -> Self {
+        TfFigureOptions {
+            size: (1200, 1000),
+            note: None,
+            observables: vec![Observable::X, Observable::Phi, Observable::PhiA],
+        }
+    }
+}
+
+/// Draws Figure 5 of the paper as a PNG or SVG file's bytes: |H| of X (m/rad), φ (rad/rad)
+/// and φₐ (rad/rad) per floor tilt angle versus frequency, log-log. Entries that are exactly
+/// zero at every frequency are not drawn but listed in the legend as identically 0. Panels for
+/// observables absent from `tf` are skipped. Force and torque inputs get panels of their own
+/// (m/N, rad/N, m/(N m), rad/(N m)) beside the tilt panels.
+///
+/// # Errors
+///
+/// [`DrawError`] for a transfer matrix that cannot be drawn or any drawing failure.
+pub fn tf_figure(tf: &TransferMatrix, format: ImageFormat) -> Result<Vec<u8>, DrawError> {
+    tf_figure_with(tf, format, &TfFigureOptions::default())
+}
+
+/// [`tf_figure`] with a different size, title note or set of observables.
+pub fn tf_figure_with(
+    tf: &TransferMatrix,
+    format: ImageFormat,
+    options: &TfFigureOptions,
+) -> Result<Vec<u8>, DrawError> {
+    let figure = build_tf_figure(tf, options).map_err(DrawError)?;
+    render(format, &figure)
+}
+
+/// Display name and line style of a tilt axis: θₜ solid, ηₜ dashed, φₜ dotted (as in the paper).
+pub fn tilt_symbol_style(t: TiltAxis) -> (&'static str, TraceStyle) {
+    let style = match t {
+        TiltAxis::ThetaT => TraceStyle::new(PALETTE[0], Dash::Solid, 2),
+        TiltAxis::EtaT => TraceStyle::new(PALETTE[1], Dash::Dashed, 2),
+        TiltAxis::PhiT => TraceStyle::new(PALETTE[2], Dash::Dotted, 3),
+    };
+    (tilt_symbol(t), style)
+}
+
+/// The kinds of input a panel groups: one panel per observable and kind, since the units differ.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum InputKind {
+    /// Floor tilt angles (rad).
+    Tilt,
+    /// Force components (N).
+    Force,
+    /// Torque components (N m).
+    Torque,
+}
+
+impl InputKind {
+    fn of(input: Input) -> InputKind {
+        match input {
+            Input::Tilt(_) => InputKind::Tilt,
+            Input::Force(f) if f.unit() == "N" => InputKind::Force,
+            Input::Force(_) => InputKind::Torque,
+        }
+    }
+
+    /// `(y-axis symbol of the input, unit of the response per unit input, title suffix)`.
+    fn labels(self, o: Observable) -> (&'static str, String, &'static str) {
+        match self {
+            InputKind::Tilt => ("tilt", format!("{}/rad", o.unit()), ""),
+            InputKind::Force => ("F", format!("{}/N", o.unit()), ", per force"),
+            InputKind::Torque => ("M", format!("{}/(N m)", o.unit()), ", per torque"),
+        }
+    }
+}
+
+/// Display name (the command-line name, e.g. `F_b.x`) and line style of a force or torque
+/// component: colour by axis (x, y, z), solid on the test mass (`b`), dashed on the crossbar (`a`).
+pub fn force_symbol_style(f: ForceInput) -> (String, TraceStyle) {
+    let name = f.name();
+    let axis = match name.as_bytes()[name.len() - 1] {
+        b'x' => 0,
+        b'y' => 1,
+        _ => 2,
+    };
+    let on_test_mass = name.as_bytes()[2] == b'b';
+    let dash = if on_test_mass {
+        Dash::Solid
+    } else {
+        Dash::Dashed
+    };
+    (name.to_string(), TraceStyle::new(PALETTE[axis], dash, 2))
+}
+
+/// The figure as data, ready for [`render`]; errors are plain messages.
+///
+/// One panel per requested observable and kind of input present (tilt in rad, forces in N,
+/// torques in N m), so every panel has a single unit; a tilt-only matrix gives the paper's
+/// Figure 5 layout.
+pub fn build_tf_figure(
+    tf: &TransferMatrix,
+    options: &TfFigureOptions,
+) -> Result<LogLogFigure, String> {
+    let kinds: Vec<InputKind> = [InputKind::Tilt, InputKind::Force, InputKind::Torque]
+        .into_iter()
+        .filter(|&k| tf.inputs.iter().any(|&i| InputKind::of(i) == k))
+        .collect();
+    if kinds.is_empty() {
+        return Err("the transfer matrix has no input".to_string());
+    }
+    let mut panels = Vec::new();
+    for &o in &options.observables {
+        let Some(oi) = tf.output_index(o) else {
+            continue;
+        };
+        for &kind in &kinds {
+            let (input_symbol, unit, suffix) = kind.labels(o);
+            let mut panel = Panel::new(
+                format!("{}{suffix}", observable_title(o)),
+                ("frequency", "Hz"),
+                (
+                    &format!("|{} / {input_symbol}|", observable_symbol(o)),
+                    &unit,
+                ),
+            );
+            // Undamped peaks reach 1e6 while phi/eta_t falls as f^4 to 1e-10 at 0.1 mHz: show
+            // 18 decades so the low-frequency cancellation stays visible.
+            panel.max_decades = Some(18.0);
+            for (ii, &input) in tf.inputs.iter().enumerate() {
+                if InputKind::of(input) != kind {
+                    continue;
+                }
+                let (name, style) = match input {
+                    Input::Tilt(t) => {
+                        let (name, style) = tilt_symbol_style(t);
+                        (name.to_string(), style)
+                    }
+                    Input::Force(f) => force_symbol_style(f),
+                };
+                let identically_zero =
+                    (0..tf.freqs_hz.len()).all(|k| tf.get(k, oi, ii).norm() == 0.0);
+                if identically_zero {
+                    panel.notes.push(format!("{name}: identically 0"));
+                    continue;
+                }
+                let points = tf
+                    .freqs_hz
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &f)| (f, tf.get(k, oi, ii).norm()))
+                    .collect();
+                panel.traces.push(Trace::new(name, points, style));
+            }
+            panels.push(panel);
+        }
+    }
+    if panels.is_empty() {
+        let names: Vec<&str> = options.observables.iter().map(|o| o.name()).collect();
+        return Err(format!(
+            "the transfer matrix has none of the observables {}",
+            names.join(", ")
+        ));
+    }
+    let has_tilt = kinds.contains(&InputKind::Tilt);
+    let has_forces = kinds.len() > usize::from(has_tilt);
+    let what = match (has_tilt, has_forces) {
+        (true, false) => "Floor tilt",
+        (false, _) => "Forces and torques",
+        (true, true) => "Floor tilt, forces and torques",
+    };
+    let mut title = format!("{what} → observables: |H(f)|, method {}", tf.method.name());
+    if let Some(note) = &options.note {
+        title.push_str(&format!(" ({note})"));
+    }
+    let mut caption = Vec::new();
+    if has_tilt {
+        caption.extend([
+            "Tilt lines: θₜ solid, ηₜ dashed, φₜ dotted. |H| is the modulus of the complex \
+             response per radian of floor tilt."
+                .to_string(),
+            "Sign convention: tilt t = small rotation taking the floor frame to the inertial \
+             frame (the floor turns by −t); observables are read in the enclosure frame."
+                .to_string(),
+            "Quasi-static limit f → 0: X → −ηₜ (Z + Z_b + h_c), Y → θₜ (Z + Z_b + h_c); the \
+             other entries shown tend to 0 (φ/ηₜ and φₐ/ηₜ as f⁴)."
+                .to_string(),
+        ]);
+    }
+    if has_forces {
+        caption.push(
+            "Forces F (N) act at the centres of mass, torques M (N m) about them, inertial axes \
+             (Appendix A, zeroth order). Colour: x, y, z component; solid: on the test mass (b), \
+             dashed: on the crossbar (a)."
+                .to_string(),
+        );
+    }
+    if let (Some(first), Some(last)) = (tf.freqs_hz.first(), tf.freqs_hz.last()) {
+        caption.push(format!(
+            "Evaluated at {} frequencies from {} to {} Hz. Without loss angles the resonance \
+             peaks are limited only by the frequency grid.",
+            tf.freqs_hz.len(),
+            compact_number(*first),
+            compact_number(*last)
+        ));
+    }
+    Ok(LogLogFigure {
+        size: options.size,
+        title: Some(title),
+        panels,
+        columns: 2,
+        caption,
+    })
+}
+
+/// A frequency for prose: `10⁻⁴` for exact powers of ten, else 3 significant digits.
+fn compact_number(v: f64) -> String {
+    if !(v.is_finite() && v > 0.0) {
+        return format!("{v}");
+    }
+    let e = v.log10();
+    if (e - e.round()).abs() < 1e-9 {
+        return super::chart::pow10_label(e.round() as i32);
+    }
+    if (1e-3..1e4).contains(&v) {
+        let decimals = (2 - e.floor() as i32).max(0) as usize;
+        let s = format!("{v:.decimals$}");
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tiltnoise_core::model::Model;
+    use tiltnoise_core::params::Params;
+    use tiltnoise_core::tf::{evaluate, plan, Method, Request};
+
+    fn matrix() -> TransferMatrix {
+        let model = Model::new(&Params::table_i()).unwrap();
+        let tf = plan(&model, &Request::all_tilt(), Method::Direct).unwrap();
+        let freqs: Vec<f64> = (0..4).map(|k| 10f64.powi(k - 3)).collect();
+        evaluate(&*tf, &freqs).unwrap()
+    }
+
+    #[test]
+    fn structural_zero_goes_to_legend_note() {
+        let tf = matrix();
+        let fig = build_tf_figure(&tf, &TfFigureOptions::default()).unwrap();
+        assert_eq!(fig.panels.len(), 3);
+        let x = &fig.panels[0];
+        assert!(x.y_unit == "m/rad");
+        let total = x.traces.len() + x.notes.len();
+        assert_eq!(total, 3);
+        // X does not respond to theta_t (the 4-DoF blocks decouple).
+        assert!(x.notes.iter().any(|n| n.starts_with("θₜ")), "{:?}", x.notes);
+    }
+
+    #[test]
+    fn force_inputs_get_their_own_panels_and_units() {
+        let model = Model::new(&Params::table_i()).unwrap();
+        let mut request = Request::all_tilt();
+        request.inputs.truncate(2);
+        for name in ["F_b.x", "M_b.z", "M_a.z"] {
+            request
+                .inputs
+                .push(Input::Force(ForceInput::from_name(name).unwrap()));
+        }
+        request.outputs = vec![Observable::X, Observable::Phi];
+        let tf = plan(&model, &request, Method::Direct).unwrap();
+        let tf = evaluate(&*tf, &[1e-3, 1e-2, 1.0]).unwrap();
+        let fig = build_tf_figure(&tf, &TfFigureOptions::default()).unwrap();
+        // 2 observables x (tilt, force, torque).
+        assert_eq!(fig.panels.len(), 6);
+        let units: Vec<&str> = fig.panels.iter().map(|p| p.y_unit.as_str()).collect();
+        assert_eq!(
+            units,
+            ["m/rad", "m/N", "m/(N m)", "rad/rad", "rad/N", "rad/(N m)"]
+        );
+        // The torque panel of phi has both torques drawn, the force panel F_b.x only.
+        assert_eq!(fig.panels[5].traces.len(), 2);
+        assert_eq!(fig.panels[4].traces.len(), 1);
+        assert!(fig
+            .title
+            .as_deref()
+            .unwrap()
+            .starts_with("Floor tilt, forces and torques"));
+        // Styles: test-mass torque solid, crossbar torque dashed, same z colour.
+        let (_, b) = force_symbol_style(ForceInput::from_name("M_b.z").unwrap());
+        let (_, a) = force_symbol_style(ForceInput::from_name("M_a.z").unwrap());
+        assert_ne!(a, b);
+    }
+
+    #[test]
+    fn compact_numbers() {
+        assert_eq!(compact_number(1e-4), "10⁻⁴");
+        assert_eq!(compact_number(30.0), "30");
+        assert_eq!(compact_number(0.0123456), "0.0123");
+        assert_eq!(compact_number(2.5e-6), "2.50e-6");
+    }
+
+    #[test]
+    fn absent_observables_are_skipped() {
+        let tf = matrix();
+        let keep = tf.output_index(Observable::Phi).unwrap();
+        let mut tf = tf.select_outputs(&[keep]);
+        assert_eq!(tf.outputs, vec![Observable::Phi]);
+        let fig = build_tf_figure(&tf, &TfFigureOptions::default()).unwrap();
+        assert_eq!(fig.panels.len(), 1);
+        tf.outputs = vec![Observable::Z];
+        assert!(build_tf_figure(&tf, &TfFigureOptions::default()).is_err());
+    }
+}

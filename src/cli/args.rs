@@ -1,0 +1,84 @@
+//! Value types shared by several subcommands: the method, averaging and output-format
+//! choices, and the `--readout OBS=ASD` item.
+
+use anyhow::{anyhow, bail, Result};
+use clap::ValueEnum;
+use tiltnoise_core::model::Observable;
+use tiltnoise_core::tf::Method;
+
+/// Welch averaging.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum AverageArg {
+    Mean,
+    Median,
+}
+
+/// Output format on the terminal.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Format {
+    Table,
+    Json,
+}
+
+/// Evaluation method of the transfer functions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MethodArg {
+    /// Smallest model and cheapest method meeting 1e-9 relative on the grid's band, verified
+    /// against the double-double reference (see --explain).
+    Auto,
+    /// Per-frequency LU of the full 8x8 model (the oracle of the fast methods).
+    Direct,
+    /// Per-frequency LU of the decoupled 4x4 blocks the request needs.
+    Block,
+    /// Block LU in absolute angles with the static / mass-line split: full relative accuracy.
+    Split,
+    /// Pole-zero product form per entry, built once in double-double: accurate and fastest.
+    Polezero,
+    /// Modal superposition (fast; loses accuracy where modal terms cancel).
+    Modal,
+    /// First-order state space as python-control and scipy.signal evaluate it (comparison;
+    /// loses accuracy where the tilt forcing cancels).
+    Statespace,
+    /// The 2-DoF torsional model of section IV.C (no tilt inputs).
+    Torsion2,
+}
+
+impl MethodArg {
+    /// The fixed method, or `None` for `auto`.
+    pub fn fixed(self) -> Option<Method> {
+        match self {
+            MethodArg::Auto => None,
+            MethodArg::Direct => Some(Method::Direct),
+            MethodArg::Block => Some(Method::Block),
+            MethodArg::Split => Some(Method::Split),
+            MethodArg::Polezero => Some(Method::PoleZero),
+            MethodArg::Modal => Some(Method::Modal),
+            MethodArg::Statespace => Some(Method::StateSpace),
+            MethodArg::Torsion2 => Some(Method::Torsion2),
+        }
+    }
+}
+
+/// One `--readout OBS=ASD` item (also used by `simulate`): the observable and its white
+/// readout noise, one-sided ASD in the observable's unit/sqrt(Hz), finite and >= 0.
+pub fn parse_readout_item(item: &str) -> Result<(Observable, f64)> {
+    let (name, value) = item
+        .split_once('=')
+        .ok_or_else(|| anyhow!("--readout {item}: expected OBS=ASD, e.g. X=9e-9"))?;
+    let o = Observable::from_name(name.trim()).ok_or_else(|| {
+            anyhow!(
+                "--readout {item}: unknown observable `{name}`; allowed: X, Y, Z, theta, eta, phi, phi_a"
+            )
+        })?;
+    let asd: f64 = value
+        .trim()
+        .parse()
+        .map_err(|_| anyhow!("--readout {item}: `{value}` is not a number"))?;
+    if !(asd.is_finite() && asd >= 0.0) {
+        bail!(
+            "--readout {item}: ASD {asd} {}/sqrt(Hz) is not allowed: must be finite and >= 0",
+            o.unit()
+        );
+    }
+    Ok((o, asd))
+}

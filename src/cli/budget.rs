@@ -1,0 +1,360 @@
+//! The `budget` subcommand: validated options -> the budget job -> files and a terminal summary.
+//! Owns the progress bar (only when stderr is a terminal).
+
+use super::args::{parse_readout_item, AverageArg};
+use super::output::save_budget;
+use anyhow::{anyhow, bail, Context, Result};
+use clap::Args;
+use std::fmt::Write as _;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use tiltnoise_core::budget::{budget_from_series, budget_from_spectra, loglog_at, BudgetOptions};
+use tiltnoise_core::freq;
+use tiltnoise_core::model::{Model, Observable};
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::noise::{BudgetReport, Readout};
+use tiltnoise_core::params::Params;
+use tiltnoise_core::spectral::Averaging;
+use tiltnoise_io::input::{read_tilt, InputFormat, ReadOptions, TiltInput, TiltSeriesSource};
+use tiltnoise_io::{InputMeta, OutputKind, RunMeta};
+
+/// Arguments of `tiltnoise budget`.
+#[derive(Debug, Args)]
+pub struct BudgetArgs {
+    /// Tilt input: HDF5 or CSV time series (angle or rate) or spectra; see docs/input_formats.md.
+    #[arg(long, value_name = "FILE")]
+    pub tilt: PathBuf,
+    /// Axis map, e.g. `theta_t=-E,eta_t=-N` (default: from the file, else theta_t=-E, eta_t=-N).
+    #[arg(long, value_name = "MAP")]
+    pub axes: Option<String>,
+    /// Quantity of the channels: angle (rad) or rate (rad/s); default from the file, else angle.
+    #[arg(long, value_name = "angle|rate")]
+    pub quantity: Option<String>,
+    /// Non-finite samples: reject (default) or interpolate linearly across interior gaps.
+    #[arg(long, value_name = "reject|interpolate", default_value = "reject")]
+    pub gaps: String,
+    /// Welch segment length in samples (default 2^14, or the largest power of two <= N/4).
+    #[arg(long, value_name = "N")]
+    pub nperseg: Option<usize>,
+    /// Welch overlap as a fraction of the segment.
+    #[arg(long, value_name = "FRACTION", default_value_t = 0.5)]
+    pub overlap: f64,
+    /// Welch averaging: mean, or median (with scipy's bias correction).
+    #[arg(long, value_enum, default_value_t = AverageArg::Mean)]
+    pub average: AverageArg,
+    /// Split the record into segments of this many seconds (e.g. 3600) for a percentile band.
+    #[arg(long, value_name = "SECONDS")]
+    pub segment_duration: Option<f64>,
+    /// Percentiles of the band across segments, LOWER,UPPER.
+    #[arg(long, value_name = "LO,HI", default_value = "10,90")]
+    pub percentiles: String,
+    /// White readout noise OBS=ASD in the observable's unit/sqrt(Hz) (repeatable; default
+    /// X=9e-9 m/sqrt(Hz) from the paper; OBS=0 removes it).
+    #[arg(long, value_name = "OBS=ASD")]
+    pub readout: Vec<String>,
+    /// Model grid for spectra input, FLO:N:FHI (default 1e-4:2000:30 plus resonance points);
+    /// restricted to the band the data cover.
+    #[arg(long, value_name = "FLO:N:FHI")]
+    pub freq: Option<String>,
+    /// Measured record of the observables for comparison: CSV `freq_hz,X[,phi,phi_a]` of
+    /// one-sided ASDs (m/sqrt(Hz), rad/sqrt(Hz)), or a time series (HDF5 as written by
+    /// `tiltnoise simulate`, or CSV `time_s,X,...` in m, rad) turned into ASDs with the
+    /// budget's Welch settings; adds the terms `measured` and `residual`.
+    #[arg(long, value_name = "FILE")]
+    pub measured: Option<PathBuf>,
+    /// Output file (.h5, .csv, .png, .svg), repeatable.
+    #[arg(long, value_name = "PATH")]
+    pub save: Vec<PathBuf>,
+}
+
+/// Frequencies (Hz) at which the terminal summary reads the budget.
+const SUMMARY_FREQS_HZ: [f64; 3] = [1e-3, 2e-3, 5e-3];
+
+fn parse_readout(items: &[String]) -> Result<Readout> {
+    let mut readout = Readout::default();
+    for item in items {
+        let (o, asd) = parse_readout_item(item)?;
+        readout.asd.retain(|(x, _)| *x != o);
+        if asd > 0.0 {
+            readout.asd.push((o, asd));
+        }
+    }
+    Ok(readout)
+}
+
+fn parse_percentiles(text: &str) -> Result<(f64, f64)> {
+    let err =
+        || anyhow!("--percentiles {text}: expected LOWER,UPPER with 0 <= LOWER < UPPER <= 100");
+    let (a, b) = text.split_once(',').ok_or_else(err)?;
+    let (a, b): (f64, f64) = (
+        a.trim().parse().map_err(|_| err())?,
+        b.trim().parse().map_err(|_| err())?,
+    );
+    if !(0.0 <= a && a < b && b <= 100.0) {
+        return Err(err());
+    }
+    Ok((a, b))
+}
+
+fn read_options(args: &BudgetArgs) -> Result<ReadOptions> {
+    Ok(ReadOptions {
+        axis_map: args
+            .axes
+            .as_deref()
+            .map(tiltnoise_io::input::AxisMap::parse)
+            .transpose()?,
+        quantity: args
+            .quantity
+            .as_deref()
+            .map(str::parse)
+            .transpose()
+            .map_err(|e: String| anyhow!("--quantity: {e}"))?,
+        gaps: args
+            .gaps
+            .parse()
+            .map_err(|e: String| anyhow!("--gaps: {e}"))?,
+    })
+}
+
+fn summary(report: &BudgetReport) -> String {
+    let mut s = String::from("noise budget (one-sided ASD):\n");
+    let b = &report.budget;
+    let damped = b.observables.iter().any(|ob| ob.term("thermal").is_some());
+    for ob in &b.observables {
+        let unit = format!("{}/sqrt(Hz)", ob.observable.unit());
+        for f in SUMMARY_FREQS_HZ {
+            let at = |name: &str| {
+                ob.term(name)
+                    .and_then(|t| loglog_at(&b.freqs_hz, &t.psd, f))
+                    .map(f64::sqrt)
+            };
+            if let (Some(t), Some(tot)) = (at("tilt"), at("total")) {
+                let thermal = at("thermal")
+                    .map(|th| format!("thermal {th:.3e}  "))
+                    .unwrap_or_default();
+                let _ = writeln!(
+                    s,
+                    "  {:<6} at {:>4} mHz: tilt {t:.3e}  {thermal}total {tot:.3e} {unit}",
+                    ob.observable.name(),
+                    f * 1e3,
+                );
+            }
+        }
+    }
+    if !damped {
+        s.push_str(
+            "thermal: none (undamped model: every loss angle and viscous coefficient is 0; \
+             see docs/damping.md)\n",
+        );
+    }
+    for note in &report.notes {
+        let _ = writeln!(s, "note: {note}");
+    }
+    s
+}
+
+/// Runs `tiltnoise budget`.
+pub(crate) fn run_budget(params: &Params, args: BudgetArgs) -> Result<()> {
+    let model = Model::new(params)?;
+    for path in &args.save {
+        OutputKind::from_path(path)?;
+    }
+    let opts = BudgetOptions {
+        welch_segment_len: args.nperseg,
+        welch_overlap_fraction: args.overlap,
+        averaging: match args.average {
+            AverageArg::Mean => Averaging::Mean,
+            AverageArg::Median => Averaging::Median,
+        },
+        segment_duration_s: args.segment_duration,
+        percentiles: parse_percentiles(&args.percentiles)?,
+        readout: parse_readout(&args.readout)?,
+        spectra_grid_hz: match &args.freq {
+            Some(spec) => freq::parse_spec(spec)?,
+            None => freq::default_grid(&model),
+        },
+        ..BudgetOptions::default()
+    };
+    let ropts = read_options(&args)?;
+    let path = &args.tilt;
+    // HDF5 time series stream from disk; everything else is read at once.
+    let streamable = InputFormat::from_path(path)? == InputFormat::Hdf5
+        && TiltSeriesSource::open(path, &ropts).is_ok();
+    let (report, provenance) = if streamable {
+        let mut source = TiltSeriesSource::open(path, &ropts)?;
+        let provenance = source.provenance().clone();
+        let bar = progress_bar(source.len() as u64);
+        let report = budget_from_series(&model, &mut source, &opts, &mut |done, _| {
+            bar.as_ref().map_or((), |b| b.set_position(done))
+        });
+        if let Some(b) = bar {
+            b.finish_and_clear();
+        }
+        (report, provenance)
+    } else {
+        match read_tilt(path, &ropts)? {
+            TiltInput::Series(mut series) => {
+                let provenance = series.provenance.clone();
+                let report = budget_from_series(&model, &mut series, &opts, &mut |_, _| {});
+                (report, provenance)
+            }
+            TiltInput::Spectra(spectra) => {
+                let provenance = spectra.provenance.clone();
+                (budget_from_spectra(&model, &spectra, &opts), provenance)
+            }
+        }
+    };
+    let mut report = report.with_context(|| format!("budget of {}", path.display()))?;
+    if let Some(measured) = &args.measured {
+        add_measured_file(&mut report, measured)?;
+    }
+    for note in &provenance.notes {
+        println!("input: {note}");
+    }
+    print!("{}", summary(&report));
+    let meta = RunMeta::of_this_run(params, Some(&NormalModes::new(&model)));
+    let input = InputMeta::from(&provenance);
+    for out in &args.save {
+        save_budget(out, &report, &meta, &input)?;
+        println!("wrote {}", out.display());
+    }
+    Ok(())
+}
+
+/// Adds the `measured` and `residual` terms from `--measured FILE`: a CSV of ASDs is
+/// interpolated log-log onto the budget grid (NaN where it does not reach); a time series of
+/// the observables (HDF5 from `tiltnoise simulate`, or CSV `time_s,...`) is first turned into
+/// one-sided PSDs by [`measured_series_psd`].
+fn add_measured_file(report: &mut BudgetReport, path: &std::path::Path) -> Result<()> {
+    use tiltnoise_io::input::MeasuredInput;
+    let (freqs_hz, psds, what) = match tiltnoise_io::input::read_measured_input(path)? {
+        MeasuredInput::Spectra(m) => {
+            let psds = m
+                .asd
+                .iter()
+                .map(|(o, asd)| (*o, asd.iter().map(|a| a * a).collect()))
+                .collect();
+            (m.freqs_hz, psds, "measured spectrum".to_string())
+        }
+        MeasuredInput::Series(series) => measured_series_psd(&series, &report.source)
+            .with_context(|| format!("--measured {}", path.display()))?,
+    };
+    let grid = report.budget.freqs_hz.clone();
+    // Same grid when the budget's bins are bins 1.. of the measured Welch grid (the budget
+    // drops DC): compared to 4 eps relative, the rounding of k fs / N computed two ways.
+    let same_grid = freqs_hz.len() > grid.len()
+        && grid
+            .iter()
+            .zip(&freqs_hz[1..])
+            .all(|(a, b)| (a - b).abs() <= 4.0 * f64::EPSILON * a.abs());
+    let mut used = Vec::new();
+    for (o, psd) in &psds {
+        if report.budget.observable(*o).is_none() {
+            continue;
+        }
+        let on_grid = if same_grid {
+            psd[1..=grid.len()].to_vec()
+        } else {
+            grid.iter()
+                .map(|&f| loglog_at(&freqs_hz, psd, f).unwrap_or(f64::NAN))
+                .collect()
+        };
+        tiltnoise_core::noise::add_measured(&mut report.budget, *o, on_grid);
+        used.push(o.name());
+    }
+    let (lo, hi) = (freqs_hz[0], freqs_hz[freqs_hz.len() - 1]);
+    report.notes.push(format!(
+        "{what} {} ({}) covers {lo:e} .. {hi:e} Hz (NaN outside); {}",
+        path.display(),
+        if used.is_empty() {
+            "no budgeted observable".to_string()
+        } else {
+            used.join(", ")
+        },
+        if same_grid {
+            "on the budget's own grid"
+        } else {
+            "interpolated log-log onto the budget grid"
+        }
+    ));
+    Ok(())
+}
+
+/// A measured record on its own grid: frequencies (Hz), one-sided PSD per observable
+/// (unit^2/Hz), and a description for the budget's notes.
+type MeasuredPsds = (Vec<f64>, Vec<(Observable, Vec<f64>)>, String);
+
+/// One-sided PSDs (unit^2/Hz) of a measured time series with the budget's own Welch settings:
+/// the same segment duration (`segment_len * fs_measured / fs_budget` samples, rounded), the
+/// same overlap fraction and averaging, periodic Hann, constant detrend. For a budget from
+/// spectra (no Welch settings): the budget's default segment for the series' length, 50 %
+/// overlap, mean. Returns the Welch grid (with DC), the PSDs and a description for the notes.
+fn measured_series_psd(
+    series: &tiltnoise_io::input::MeasuredSeries,
+    source: &tiltnoise_core::noise::SpectralSource,
+) -> Result<MeasuredPsds> {
+    use tiltnoise_core::spectral::{welch, WelchConfig};
+    let fs = series.sample_rate_hz;
+    let n = series.channels[0].1.len();
+    let cfg = match source {
+        tiltnoise_core::noise::SpectralSource::Welch {
+            sample_rate_hz,
+            segment_len,
+            overlap,
+            averaging,
+            ..
+        } => {
+            let seg = (*segment_len as f64 * fs / sample_rate_hz).round() as usize;
+            let ov = (*overlap as f64 / *segment_len as f64 * seg as f64).round() as usize;
+            if seg < 2 || seg > n {
+                bail!(
+                    "the measured series has {n} samples ({:.6e} s at {fs} Hz): the budget's \
+                     Welch segment of {:.6e} s needs {seg} samples at this rate; use a longer \
+                     record or a shorter --nperseg",
+                    n as f64 / fs,
+                    *segment_len as f64 / sample_rate_hz
+                );
+            }
+            WelchConfig::new(seg)
+                .with_overlap(ov.min(seg - 1))
+                .with_averaging(if averaging == "median" {
+                    Averaging::Median
+                } else {
+                    Averaging::Mean
+                })
+        }
+        tiltnoise_core::noise::SpectralSource::Spectra { .. } => {
+            WelchConfig::new(tiltnoise_core::budget::default_segment_len(n))
+        }
+    };
+    let mut freqs = Vec::new();
+    let mut psds = Vec::new();
+    let mut n_segments = 0;
+    for (o, x) in &series.channels {
+        let p = welch(x, fs, &cfg)?;
+        freqs = p.freqs_hz;
+        n_segments = p.n_segments;
+        psds.push((*o, p.psd));
+    }
+    let what = format!(
+        "measured series at {fs} Hz (Welch: {} samples per segment, overlap {}, {} segments)",
+        cfg.segment_len, cfg.overlap, n_segments
+    );
+    Ok((freqs, psds, what))
+}
+
+/// A progress bar on stderr when it is a terminal and the input is long enough to wait for.
+fn progress_bar(total: u64) -> Option<indicatif::ProgressBar> {
+    const WORTH_A_BAR: u64 = 1 << 22;
+    if total < WORTH_A_BAR || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new(total);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{spinner} {wide_bar} {pos}/{len} samples ({percent}%, eta {eta})",
+        )
+        .expect("valid template"),
+    );
+    Some(bar)
+}

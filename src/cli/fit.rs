@@ -1,0 +1,266 @@
+//! `tiltnoise fit`: the command line of the constrained least-squares fit of parameters to
+//! measured mode frequencies ([`tiltnoise_core::fit`]): argument parsing, the table and JSON reports and
+//! the `--save` writers (.json, .h5; written atomically, checked before the fit runs).
+
+use anyhow::Result;
+use clap::{Args, ValueEnum};
+use std::path::{Path, PathBuf};
+use tiltnoise_core::error::OutputError;
+use tiltnoise_core::fit::{self, Bound, FitConfig, FitResult, Measured, SigmaSource};
+use tiltnoise_core::params::Params;
+use tiltnoise_io::{write_atomic, write_fit_hdf5};
+
+/// Arguments of `tiltnoise fit`.
+#[derive(Debug, Args)]
+pub(crate) struct FitArgs {
+    /// Measured frequencies: CSV `mode,frequency_hz[,sigma_hz]` (any subset of modes 1..8; see
+    /// docs/fit.md). Default: the measured column of Table II.
+    #[arg(long, value_name = "FILE")]
+    measured: Option<PathBuf>,
+    /// Free parameters, comma-separated dotted keys (default: k_a, k_b, kappa_a, kappa_b, Z,
+    /// I^a_22, Z_b, d; see docs/fit.md).
+    #[arg(long, value_name = "KEY,KEY,...", value_delimiter = ',')]
+    free: Option<Vec<String>>,
+    /// Box half-width in error bars: |p - p0| <= N sigma_p.
+    #[arg(long, value_name = "N", default_value_t = 1.0)]
+    bound_sigmas: f64,
+    /// Add the Gaussian prior sum ((p - p0) / sigma_p)^2 to chi^2 (the box still applies).
+    #[arg(long)]
+    prior: bool,
+    /// Output format on the terminal.
+    #[arg(long, value_enum, default_value_t = FitFormat::Table)]
+    format: FitFormat,
+    /// Output file: .json (the JSON report) or .h5; repeatable.
+    #[arg(long, value_name = "PATH")]
+    save: Vec<PathBuf>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum FitFormat {
+    Table,
+    Json,
+}
+
+/// Runs `tiltnoise fit`.
+pub(crate) fn run_fit(params: &Params, args: FitArgs) -> Result<()> {
+    for path in &args.save {
+        save_kind(path)?;
+    }
+    let measured = match &args.measured {
+        Some(path) => Measured::from_file(path)?,
+        None => Measured::table_ii(),
+    };
+    let config = FitConfig {
+        free: args
+            .free
+            .clone()
+            .map(|keys| keys.into_iter().map(|k| k.trim().to_string()).collect())
+            .unwrap_or_else(|| FitConfig::default().free),
+        bound_sigmas: args.bound_sigmas,
+        prior: args.prior,
+    };
+    let result = fit::fit(params, &measured, &config)?;
+    let json = fit_json(&result, &measured.origin);
+    match args.format {
+        FitFormat::Json => println!("{}", serde_json::to_string_pretty(&json)?),
+        FitFormat::Table => print!("{}", fit_table(&result, &measured.origin)),
+    }
+    for path in &args.save {
+        match save_kind(path)? {
+            SaveKind::Json => {
+                let text = serde_json::to_string_pretty(&json)? + "\n";
+                write_atomic(path, |tmp| {
+                    std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
+                })?
+            }
+            SaveKind::Hdf5 => write_fit_hdf5(path, &result, &measured.origin)?,
+        }
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+enum SaveKind {
+    Json,
+    Hdf5,
+}
+
+fn save_kind(path: &Path) -> Result<SaveKind, OutputError> {
+    match path.extension().and_then(|e| e.to_str()) {
+        Some("json") => Ok(SaveKind::Json),
+        Some("h5" | "hdf5") => Ok(SaveKind::Hdf5),
+        _ => Err(OutputError::UnknownFormat {
+            path: path.to_path_buf(),
+            allowed: ".json, .h5, .hdf5",
+        }),
+    }
+}
+
+fn bound_name(b: Option<Bound>) -> &'static str {
+    b.map_or("", Bound::name)
+}
+
+/// JSON number, or `null` for a non-finite value (JSON has no infinity).
+fn num(x: f64) -> serde_json::Value {
+    serde_json::Number::from_f64(x).map_or(serde_json::Value::Null, serde_json::Value::Number)
+}
+
+/// The JSON report (also the content of a saved .json file).
+fn fit_json(r: &FitResult, origin: &str) -> serde_json::Value {
+    use serde_json::json;
+    json!({
+        "measured_origin": origin,
+        "bound_sigmas": r.config.bound_sigmas,
+        "prior": r.config.prior,
+        "chi2_nominal": num(r.chi2_nominal),
+        "chi2": num(r.chi2),
+        "prior_term": num(r.prior_term),
+        "dof": r.dof,
+        "iterations": r.iterations,
+        "evaluations": r.evaluations,
+        "stop": r.stop.describe(),
+        "projected_gradient": num(r.projected_gradient),
+        "parameters": r.params.iter().map(|p| json!({
+            "key": p.key,
+            "unit": p.unit,
+            "nominal": p.nominal,
+            "fitted": p.fitted,
+            "fitted_sigma": p.fitted_sigma.map_or(serde_json::Value::Null, num),
+            "prior_sigma": p.prior_sigma,
+            "at_bound": p.at_bound.map(|b| bound_name(Some(b))),
+            "data_sigma_rel": num(p.data_sigma_rel),
+            "poorly_constrained": p.poorly_constrained,
+        })).collect::<Vec<_>>(),
+        "modes": r.modes.iter().map(|m| json!({
+            "index": m.measured.mode,
+            "measured_hz": m.measured.frequency_hz,
+            "sigma_hz": m.measured.sigma_hz,
+            "sigma_source": match m.measured.sigma_source {
+                SigmaSource::File => "file",
+                SigmaSource::Digits => "digits",
+            },
+            "nominal_hz": m.nominal_hz,
+            "fitted_hz": m.fitted_hz,
+            "residual_hz": m.residual_hz(),
+            "residual_sigmas": m.residual_sigmas(),
+        })).collect::<Vec<_>>(),
+        "singular_values": r.singular_values.iter().map(|&s| num(s)).collect::<Vec<_>>(),
+        "weak_directions": r.weak_directions.iter().map(|w| json!({
+            "singular_value": num(w.singular_value),
+            "direction": w.direction.iter()
+                .map(|(k, c)| (k.clone(), num(*c)))
+                .collect::<serde_json::Map<_, _>>(),
+        })).collect::<Vec<_>>(),
+        "fitted_params_toml": r.fitted_params.to_toml(),
+    })
+}
+
+/// The terminal report.
+fn fit_table(r: &FitResult, origin: &str) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let box_kind = match r.config.prior {
+        true => "box + Gaussian prior",
+        false => "box",
+    };
+    let _ = writeln!(
+        s,
+        "Fit of {} parameters to {} measured modes ({origin}); {box_kind} |p - p0| <= {} sigma_p",
+        r.params.len(),
+        r.modes.len(),
+        r.config.bound_sigmas
+    );
+    let _ = writeln!(
+        s,
+        "chi^2: nominal {:.4e} -> fitted {:.4e}, dof {}; {} iterations, stop: {} (projected \
+         gradient {:.1e})",
+        r.chi2_nominal,
+        r.chi2,
+        r.dof,
+        r.iterations,
+        r.stop.describe(),
+        r.projected_gradient
+    );
+    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
+        "{:<26} {:>12} {:>12} {:>11} {:>11} {:>6} {:>6}  unit",
+        "parameter", "nominal", "fitted", "fit sigma", "prior sig", "bound", "poor"
+    );
+    for p in &r.params {
+        let sigma = p
+            .fitted_sigma
+            .map_or("-".to_string(), |x| format!("{x:.3e}"));
+        let _ = writeln!(
+            s,
+            "{:<26} {:>12.5e} {:>12.5e} {:>11} {:>11.3e} {:>6} {:>6}  {}",
+            p.key,
+            p.nominal,
+            p.fitted,
+            sigma,
+            p.prior_sigma,
+            bound_name(p.at_bound),
+            if p.poorly_constrained { "yes" } else { "" },
+            p.unit
+        );
+    }
+    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
+        "{:<5} {:>13} {:>11} {:>13} {:>13} {:>12} {:>10}",
+        "mode", "measured Hz", "sigma Hz", "nominal Hz", "fitted Hz", "resid Hz", "resid/sig"
+    );
+    for m in &r.modes {
+        let _ = writeln!(
+            s,
+            "nu_{:<2} {:>13.6e} {:>11.1e} {:>13.6e} {:>13.6e} {:>12.3e} {:>10.2}",
+            m.measured.mode,
+            m.measured.frequency_hz,
+            m.measured.sigma_hz,
+            m.nominal_hz,
+            m.fitted_hz,
+            m.residual_hz(),
+            m.residual_sigmas()
+        );
+    }
+    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
+        "bound: the parameter ended on the box (no sigma: the linearized covariance does not \
+         apply there)."
+    );
+    let _ = writeln!(
+        s,
+        "poor: the data alone determine it no better than its error bar (data sigma >= prior \
+         sigma)."
+    );
+    match r.weak_directions.is_empty() {
+        true => {
+            let _ = writeln!(
+                s,
+                "No weak direction: every singular value of the weighted Jacobian is >= 1 \
+                 (smallest {:.3e}).",
+                r.singular_values.last().copied().unwrap_or(f64::NAN)
+            );
+        }
+        false => {
+            for w in &r.weak_directions {
+                let mut comps: Vec<&(String, f64)> = w.direction.iter().collect();
+                comps.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+                let text: Vec<String> = comps
+                    .iter()
+                    .filter(|(_, c)| c.abs() >= 0.1)
+                    .map(|(k, c)| format!("{c:+.2} {k}"))
+                    .collect();
+                let _ = writeln!(
+                    s,
+                    "weak direction (singular value {:.3e} < 1, known to {:.2} error bars): {}",
+                    w.singular_value,
+                    1.0 / w.singular_value,
+                    text.join(" ")
+                );
+            }
+        }
+    }
+    s
+}

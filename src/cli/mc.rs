@@ -1,0 +1,175 @@
+//! `tiltnoise mc`: Monte Carlo of the normal modes over the parameter errors (the error model of
+//! the parameter file, see [`tiltnoise_core::params::uncertainty`]); a table or JSON on stdout, histograms
+//! (PNG/SVG) and HDF5 with `--save`.
+
+use anyhow::Result;
+use std::path::{Path, PathBuf};
+use tiltnoise_core::error::OutputError;
+use tiltnoise_core::mc::{McConfig, McResult};
+use tiltnoise_core::model::Model;
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::params::Params;
+use tiltnoise_io::{write_mc_hdf5, RunMeta};
+
+/// Extensions `tiltnoise mc --save` accepts, for messages.
+const MC_EXTENSIONS: &str = ".h5, .hdf5, .png, .svg";
+
+/// The options of `tiltnoise mc`.
+pub(crate) struct McOptions {
+    /// Number of draws.
+    pub(crate) samples: usize,
+    /// Seed of the random streams.
+    pub(crate) seed: u64,
+    /// Worker threads (0: all cores).
+    pub(crate) threads: usize,
+    /// JSON instead of the table on stdout.
+    pub(crate) json: bool,
+    /// Output files (format from the extension).
+    pub(crate) save: Vec<PathBuf>,
+}
+
+/// What `--save PATH` writes.
+#[derive(Clone, Copy)]
+enum McOutput {
+    Hdf5,
+    Figure,
+}
+
+fn output_kind(path: &Path) -> Result<McOutput, OutputError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("h5" | "hdf5") => Ok(McOutput::Hdf5),
+        Some("png" | "svg") => Ok(McOutput::Figure),
+        _ => Err(OutputError::UnknownFormat {
+            path: path.to_path_buf(),
+            allowed: MC_EXTENSIONS,
+        }),
+    }
+}
+
+/// Runs `tiltnoise mc`. Every `--save` format is checked before computing.
+pub(crate) fn run_mc(params: &Params, opts: McOptions) -> Result<()> {
+    use std::io::IsTerminal;
+    let kinds = opts
+        .save
+        .iter()
+        .map(|p| output_kind(p))
+        .collect::<Result<Vec<_>, _>>()?;
+    let cfg = McConfig {
+        samples: opts.samples,
+        seed: opts.seed,
+        threads: opts.threads,
+        ..McConfig::default_for(params)
+    };
+    let bar = (std::io::stderr().is_terminal() && opts.samples >= 10_000)
+        .then(|| indicatif::ProgressBar::new(opts.samples as u64));
+    let result = tiltnoise_core::mc::run(params, &cfg, &|done| {
+        if let Some(b) = &bar {
+            b.set_position(done as u64);
+        }
+    })?;
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let nominal: [f64; 8] = NormalModes::new(&Model::new(params)?)
+        .frequencies_hz()
+        .try_into()
+        .map_err(|v: Vec<f64>| anyhow::anyhow!("expected 8 modes, got {}", v.len()))?;
+    if opts.json {
+        println!("{}", json(&result, &nominal, opts.seed)?);
+    } else {
+        print!("{}", table(&result, &nominal, opts.seed));
+    }
+    if opts.save.is_empty() {
+        return Ok(());
+    }
+    let meta = RunMeta::of_this_run(params, None);
+    let caption = caption(&result, &cfg);
+    for (path, kind) in opts.save.iter().zip(kinds) {
+        match kind {
+            McOutput::Hdf5 => write_mc_hdf5(path, &result, &cfg, &nominal, &meta)?,
+            McOutput::Figure => super::output::save_image(path, |format| {
+                tiltnoise_plot::mc_figure::mc_figure(&result, &nominal, &caption, format)
+            })?,
+        }
+        // The table goes to stdout; keep JSON on stdout parseable.
+        if opts.json {
+            eprintln!("wrote {}", path.display());
+        } else {
+            println!("wrote {}", path.display());
+        }
+    }
+    Ok(())
+}
+
+/// The figure's caption: what is marked, counts, seed and the error model, grouped by error.
+fn caption(result: &McResult, cfg: &McConfig) -> String {
+    let mut groups: Vec<(f64, &str, Vec<&str>)> = Vec::new();
+    for u in cfg.uncertainties.iter().filter(|u| u.rel_sigma > 0.0) {
+        let name = u.key.split_once('.').map_or(u.key.as_str(), |(_, n)| n);
+        let shape = u.distribution.name();
+        match groups
+            .iter_mut()
+            .find(|g| g.0 == u.rel_sigma && g.1 == shape)
+        {
+            Some(g) => g.2.push(name),
+            None => groups.push((u.rel_sigma, shape, vec![name])),
+        }
+    }
+    let model: Vec<String> = groups
+        .iter()
+        .map(|(s, shape, names)| format!("{} % {shape} on {}", s * 100.0, names.join(", ")))
+        .collect();
+    format!(
+        "Black dashed: nominal parameters; orange: mean; shaded: mean ± 1 std. {} draws, {} \
+         rejected as non-physical, seed {}. Relative errors (1 std): {}; all other parameters \
+         exact.",
+        result.samples,
+        result.rejected,
+        cfg.seed,
+        model.join("; ")
+    )
+}
+
+fn json(result: &McResult, nominal: &[f64; 8], seed: u64) -> Result<String> {
+    let modes: Vec<_> = (0..8)
+        .map(|k| {
+            serde_json::json!({
+                "index": k + 1,
+                "nominal_hz": nominal[k],
+                "mean_hz": result.mean_hz[k],
+                "std_hz": result.std_hz[k],
+            })
+        })
+        .collect();
+    Ok(serde_json::to_string_pretty(&serde_json::json!({
+        "samples": result.samples,
+        "rejected": result.rejected,
+        "seed": seed,
+        "modes": modes,
+    }))?)
+}
+
+fn table(result: &McResult, nominal: &[f64; 8], seed: u64) -> String {
+    let mut s = format!(
+        "Monte Carlo of the normal modes: {} draws ({} rejected as non-physical), seed {seed}\n",
+        result.samples, result.rejected
+    );
+    s.push_str(&format!(
+        "{:<5} {:>14} {:>14} {:>12}\n",
+        "mode", "nominal (Hz)", "mean (Hz)", "std (Hz)"
+    ));
+    for (k, f0) in nominal.iter().enumerate() {
+        s.push_str(&format!(
+            "nu_{:<2} {:>14.6e} {:>14.6e} {:>12.3e}\n",
+            k + 1,
+            f0,
+            result.mean_hz[k],
+            result.std_hz[k]
+        ));
+    }
+    s
+}

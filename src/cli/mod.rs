@@ -1,0 +1,143 @@
+//! Command-line interface: clap derive for the raw arguments, then conversion to validated
+//! library inputs and the run of each subcommand. `main.rs` only maps the result to an exit code.
+//! Everything printed goes to stdout; errors are returned to `main`.
+
+mod args;
+mod budget;
+mod fit;
+mod mc;
+mod methods;
+mod output;
+mod report;
+mod simulate;
+mod tf;
+
+use anyhow::Result;
+use args::Format;
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+use tiltnoise_core::model::Model;
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::params::Params;
+
+/// Tilt-noise budgets for double torsion pendulums (the 8-DoF PETER model of
+/// De Marchi et al., Phys. Rev. D 87, 122006, 2013).
+#[derive(Debug, Parser)]
+#[command(name = "tiltnoise", version, about, long_about = None)]
+pub struct Cli {
+    #[command(flatten)]
+    params: ParamArgs,
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// Parameter selection, shared by every subcommand.
+#[derive(Debug, Args)]
+struct ParamArgs {
+    /// TOML parameter file (default: the embedded Table I set; see `tiltnoise params`).
+    #[arg(long, global = true, value_name = "FILE")]
+    params: Option<PathBuf>,
+    /// Override one parameter, e.g. `--set length.h_m=1.5` (repeatable; SI units as in the key).
+    #[arg(long = "set", global = true, value_name = "KEY=VALUE")]
+    set: Vec<String>,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Print the effective parameter set as TOML (edit it and pass it back with --params).
+    Params,
+    /// Normal modes (Table II): frequencies, dominant coordinates, observables that see them.
+    Modes {
+        /// Output format.
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+    },
+    /// Transfer functions from floor tilt (theta_t, eta_t, phi_t) and/or forces and torques
+    /// (F_a.x .. M_b.z) to the observables.
+    Tf(tf::TfArgs),
+    /// Noise budget of X, phi, phi_a from measured floor tilt (time series or spectra).
+    Budget(budget::BudgetArgs),
+    /// Free motion of the undamped model (exact modal propagation, 12 h at 0.1 s by default)
+    /// with readout noise: ASDs as in Figure 3, the resonance check against the mode
+    /// observability table, the X kick of Figures 4 and 5, HDF5 series the budget reads.
+    Simulate(simulate::SimulateArgs),
+    /// Constrained least-squares fit of chosen parameters, within their error bars, to measured
+    /// mode frequencies (default: Table II's measured column).
+    Fit(fit::FitArgs),
+    /// Monte Carlo of the normal modes over the parameter uncertainties (default: Gaussian,
+    /// 2.5 % on masses, lengths, inertias; 10 % on torsion and bouncing constants; g, h exact).
+    Mc {
+        /// Number of draws.
+        #[arg(long, default_value_t = 10_000)]
+        samples: usize,
+        /// Seed of the random streams (results do not depend on the thread count).
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Worker threads (0: all cores).
+        #[arg(long, default_value_t = 0)]
+        threads: usize,
+        /// Output format on the terminal.
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+        /// Histograms (.png, .svg) or all draws (.h5), repeatable; see docs/schemas.md.
+        #[arg(long, value_name = "PATH")]
+        save: Vec<PathBuf>,
+    },
+    /// Every evaluation method's worst error against the double-double reference and its time
+    /// per point, for the 7x3 tilt matrix on the given grid (table, JSON, chart).
+    Methods(methods::MethodsArgs),
+}
+
+impl ParamArgs {
+    fn resolve(&self) -> Result<Params> {
+        let mut params = match &self.params {
+            Some(path) => Params::from_file(path)?,
+            None => Params::table_i(),
+        };
+        for assignment in &self.set {
+            params = params.with_override(assignment)?;
+        }
+        Ok(params)
+    }
+}
+
+/// Runs the parsed command line.
+pub fn run(cli: Cli) -> Result<()> {
+    let params = cli.params.resolve()?;
+    match cli.command {
+        Command::Params => {
+            print!("{}", params.to_toml());
+            Ok(())
+        }
+        Command::Modes { format } => {
+            let model = Model::new(&params)?;
+            let modes = NormalModes::new(&model);
+            match format {
+                Format::Table => print!("{}", report::modes_table(&modes)),
+                Format::Json => println!("{}", report::modes_json(&modes)),
+            }
+            Ok(())
+        }
+        Command::Tf(args) => tf::run_tf(&params, args),
+        Command::Budget(args) => budget::run_budget(&params, args),
+        Command::Simulate(args) => simulate::run_simulate(&params, args),
+        Command::Fit(args) => fit::run_fit(&params, args),
+        Command::Methods(args) => methods::run_methods(&params, args),
+        Command::Mc {
+            samples,
+            seed,
+            threads,
+            format,
+            save,
+        } => mc::run_mc(
+            &params,
+            mc::McOptions {
+                samples,
+                seed,
+                threads,
+                json: format == Format::Json,
+                save,
+            },
+        ),
+    }
+}

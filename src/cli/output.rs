@@ -1,0 +1,79 @@
+//! Output files by extension: HDF5 and CSV through `tiltnoise-io`, figures drawn by
+//! `tiltnoise-plot` and written through `tiltnoise-io`'s atomic writer. The only place where the
+//! two crates meet.
+
+use std::path::Path;
+use tiltnoise_core::error::OutputError;
+use tiltnoise_core::input::InputMeta;
+use tiltnoise_core::noise::BudgetReport;
+use tiltnoise_core::tf::TransferMatrix;
+use tiltnoise_io::{
+    write_atomic, write_budget_csv, write_budget_hdf5, write_tf_csv, write_tf_hdf5,
+};
+use tiltnoise_io::{OutputKind, RunMeta};
+use tiltnoise_plot::{DrawError, ImageFormat};
+
+/// Draws a figure in the format named by the extension of `path` and writes it atomically.
+///
+/// # Errors
+///
+/// [`OutputError::UnknownFormat`] for an extension other than `.png`/`.svg` (nothing is drawn),
+/// [`OutputError::Write`] naming `path` for a drawing or write failure (nothing is left there).
+pub fn save_image(
+    path: &Path,
+    draw: impl FnOnce(ImageFormat) -> Result<Vec<u8>, DrawError>,
+) -> Result<(), OutputError> {
+    let format = ImageFormat::from_path(path)?;
+    let bytes = draw(format).map_err(|e| OutputError::Write {
+        path: path.to_path_buf(),
+        message: e.0,
+    })?;
+    write_atomic(path, |temp| {
+        std::fs::write(temp, &bytes).map_err(|e| e.to_string())
+    })
+}
+
+/// Saves a transfer matrix in the format named by the extension of `path`: HDF5 (with
+/// `meta`), CSV (`meta` is not stored), or a PNG/SVG figure.
+///
+/// # Errors
+///
+/// [`OutputError::UnknownFormat`] for an unsupported extension (nothing is written), or the
+/// writer's [`OutputError::Write`].
+pub fn save_tf(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> Result<(), OutputError> {
+    match OutputKind::from_path(path)? {
+        OutputKind::Hdf5 => write_tf_hdf5(path, tf, meta),
+        OutputKind::Csv => write_tf_csv(path, tf),
+        OutputKind::Png | OutputKind::Svg => {
+            save_image(path, |format| tiltnoise_plot::tf_figure(tf, format))
+        }
+    }
+}
+
+/// Saves a noise budget in the format named by the extension of `path`: HDF5 (with `meta` and
+/// `input`), CSV (ASDs only), or a PNG/SVG figure with the input named in the caption.
+///
+/// # Errors
+///
+/// [`OutputError::UnknownFormat`] for an unsupported extension (nothing is written), or the
+/// writer's [`OutputError::Write`].
+pub fn save_budget(
+    path: &Path,
+    report: &BudgetReport,
+    meta: &RunMeta,
+    input: &InputMeta,
+) -> Result<(), OutputError> {
+    match OutputKind::from_path(path)? {
+        OutputKind::Hdf5 => write_budget_hdf5(path, report, meta, input),
+        OutputKind::Csv => write_budget_csv(path, report),
+        OutputKind::Png | OutputKind::Svg => {
+            let options = tiltnoise_plot::BudgetFigureOptions {
+                input: Some(input.clone()),
+                ..tiltnoise_plot::BudgetFigureOptions::default()
+            };
+            save_image(path, |format| {
+                tiltnoise_plot::budget_figure_with(report, format, &options)
+            })
+        }
+    }
+}

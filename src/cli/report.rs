@@ -1,0 +1,127 @@
+//! Text and JSON renderings of results for the terminal (tables, summaries). Sits above the
+//! numerics: it reads `modes` and `tf`, and nothing numeric depends on it.
+
+use serde_json::json;
+use std::fmt::Write;
+use tiltnoise_core::model::{Model, Observable, TiltAxis};
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::tf::{self, Input, Method, Request};
+
+/// Share of modal kinetic energy above which a coordinate is listed as dominant.
+const DOMINANT_SHARE: f64 = 0.05;
+
+/// A frequency with an SI prefix chosen for reading: `1.310 mHz`, `0.4149 Hz`.
+pub fn format_hz(f: f64) -> String {
+    if f < 1.0 && f > 0.0 && f < 0.1 {
+        format!("{:.4} mHz", f * 1e3)
+    } else {
+        format!("{:.4} Hz", f)
+    }
+}
+
+/// The Table II-like table of normal modes.
+pub fn modes_table(modes: &NormalModes) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{:<5} {:>12} {:>10}  {:<16} {:<34} seen by",
+        "mode", "frequency", "Q", "block", "dominant coordinates (energy share)"
+    );
+    for (k, m) in modes.modes.iter().enumerate() {
+        let dominant = m
+            .dominant_coords(DOMINANT_SHARE)
+            .iter()
+            .map(|(c, share)| format!("{} {:.2}", c.name(), share))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let seen = modes
+            .observables_seeing(k)
+            .iter()
+            .map(|o| o.name())
+            .collect::<Vec<_>>()
+            .join(" ");
+        let _ = writeln!(
+            s,
+            "nu_{:<3} {:>12} {:>10}  {:<16} {:<34} {}",
+            m.index,
+            format_hz(m.frequency_hz),
+            format_q(m.quality_factor),
+            m.block.name(),
+            dominant,
+            seen
+        );
+    }
+    s
+}
+
+/// A quality factor for the table: `inf` when undamped, else 4 significant digits.
+pub fn format_q(q: f64) -> String {
+    if q.is_infinite() {
+        "inf".into()
+    } else if (1e-2..1e6).contains(&q) {
+        // 4 significant digits.
+        let decimals = (3 - q.log10().floor() as i32).max(0) as usize;
+        format!("{q:.decimals$}")
+    } else {
+        format!("{q:.3e}")
+    }
+}
+
+/// `{"modes": [{"index": 1, "frequency_hz": ..., ...}, ...]}`.
+pub fn modes_json(modes: &NormalModes) -> String {
+    let list: Vec<_> = modes
+        .modes
+        .iter()
+        .enumerate()
+        .map(|(k, m)| {
+            json!({
+                "index": m.index,
+                "frequency_hz": m.frequency_hz,
+                "omega_sq_rad2_per_s2": m.omega_sq,
+                "block": m.block.name(),
+                // JSON has no infinity: "inf" (a string) when undamped, as in the table.
+                "quality_factor": if m.quality_factor.is_finite() {
+                    json!(m.quality_factor)
+                } else {
+                    json!("inf")
+                },
+                "loss_angle_rad": m.loss_angle,
+                "dominant_coordinates": m.dominant_coords(DOMINANT_SHARE).iter()
+                    .map(|(c, share)| json!({"coordinate": c.name(), "energy_share": share}))
+                    .collect::<Vec<_>>(),
+                "seen_by": modes.observables_seeing(k).iter().map(|o| o.name()).collect::<Vec<_>>(),
+                "observable_amplitude": Observable::ALL.iter()
+                    .map(|o| (o.name().to_string(), json!(m.observable_amplitude[o.index()])))
+                    .collect::<serde_json::Map<_, _>>(),
+            })
+        })
+        .collect();
+    serde_json::to_string_pretty(&json!({ "modes": list })).expect("JSON of finite numbers")
+}
+
+/// The quasi-static (f = 0) tilt response next to the paper's stated limits.
+pub fn static_limits(model: &Model) -> String {
+    let plan =
+        tf::plan(model, &Request::all_tilt(), Method::Direct).expect("direct plans every request");
+    let h = plan
+        .eval(0.0)
+        .expect("K is positive definite: f = 0 is never singular");
+    let lever = model.derived().lever_m;
+    let entry = |o: Observable, t: TiltAxis| h[o.index() * 3 + t.index()].re;
+    let mut s = String::from("quasi-static tilt response (f = 0):\n");
+    for (o, t, expected, label) in [
+        (Observable::X, TiltAxis::EtaT, -lever, "-(Z+Z_b+h_c)"),
+        (Observable::Y, TiltAxis::ThetaT, lever, "+(Z+Z_b+h_c)"),
+    ] {
+        let _ = writeln!(
+            s,
+            "  {}/{} = {:+.6} m/rad   (paper: {} = {:+.6} m/rad)",
+            o.name(),
+            Input::Tilt(t).name(),
+            entry(o, t),
+            label,
+            expected
+        );
+    }
+    s
+}

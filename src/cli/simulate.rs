@@ -1,0 +1,497 @@
+//! The `simulate` subcommand: free motion of the undamped model (exact modal propagation),
+//! readout noise, one-sided Welch ASDs, the resonance check against the observability table,
+//! and the outputs (HDF5 series + ASDs, CSV ASDs, Figure 3, Figures 4/5). Owns the progress
+//! bar (only when stderr is a terminal and the run is long). Documented in `docs/simulate.md`.
+
+use super::output::save_image;
+use anyhow::{anyhow, bail, Context, Result};
+use clap::Args;
+use std::fmt::Write as _;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use tiltnoise_core::model::{Coord, Model, Observable};
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::params::Params;
+use tiltnoise_core::simulate::resonance::check_resonances;
+use tiltnoise_core::simulate::{
+    aliased_frequency_hz, equal_energy_init, kick_x, simulate_with_progress, InitialState,
+    ModalPropagator, SimConfig, Simulation, DEFAULT_MODE_ENERGY_J, MAX_SAMPLES,
+};
+use tiltnoise_core::spectral::{welch, WelchConfig};
+use tiltnoise_io::{write_observable_series_hdf5, OutputKind, RunMeta, SeriesAsd, SimulationMeta};
+use tiltnoise_plot::simulate_figure::{
+    asd_figure, time_series_figure, ModeMark, SimAsdData, TimePanel, TimeSeriesData,
+};
+
+/// Default readout: the paper's 9 nm/sqrt(Hz) on X (the angles are noiseless unless given).
+const DEFAULT_X_READOUT_ASD_M: f64 = 9e-9;
+
+/// Runs with at least this many samples get a progress bar on a terminal (about 2 s of work).
+const WORTH_A_BAR: usize = 1 << 23;
+
+/// Options of `tiltnoise simulate`.
+#[derive(Debug, Args)]
+pub(crate) struct SimulateArgs {
+    /// Length of the record (s); default 12 h like the paper.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 43_200.0,
+        allow_negative_numbers = true
+    )]
+    duration: f64,
+    /// Sampling step (s); default the paper's 0.1 s.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 0.1,
+        allow_negative_numbers = true
+    )]
+    step: f64,
+    /// Initial coordinates in crate names, e.g. `theta_a=1e-5,phi_b=0.01` (rad; delta_a,
+    /// delta_b in m); repeatable; unlisted coordinates start at 0. Replaces the default
+    /// excitation (equal energy in every mode).
+    #[arg(long, value_name = "COORD=VALUE,...", allow_hyphen_values = true)]
+    init: Vec<String>,
+    /// Initial velocities, same syntax (rad/s, m/s).
+    #[arg(
+        long = "init-rate",
+        value_name = "COORD=RATE,...",
+        allow_hyphen_values = true
+    )]
+    init_rate: Vec<String>,
+    /// The paper's kick test: the test mass displaced statically along X by this many metres
+    /// (a static force on the test mass along x) and released from rest.
+    #[arg(long = "kick-x", value_name = "METRES", allow_negative_numbers = true,
+          conflicts_with_all = ["init", "init_rate"])]
+    kick_x: Option<f64>,
+    /// Energy per mode (J) of the default excitation (no --init, --init-rate, --kick-x).
+    #[arg(long, value_name = "JOULES", default_value_t = DEFAULT_MODE_ENERGY_J,
+          allow_negative_numbers = true)]
+    mode_energy: f64,
+    /// White readout noise OBS=ASD in the observable's unit/sqrt(Hz) (repeatable; default
+    /// X=9e-9 m/sqrt(Hz) from the paper, angles noiseless; OBS=0 removes it).
+    #[arg(long, value_name = "OBS=ASD", allow_hyphen_values = true)]
+    readout: Vec<String>,
+    /// Seed of the readout-noise generator.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Welch segment length in samples for the ASDs (default: the largest power of two that
+    /// fits three times into the record, 2^17 for 12 h at 0.1 s; 50 % overlap, mean).
+    #[arg(long, value_name = "N")]
+    nperseg: Option<usize>,
+    /// Output (repeatable): .h5/.hdf5 time series + ASDs + run (the budget's --measured reads
+    /// it), .csv ASDs (freq_hz,X,...), .png/.svg Figure 3 (ASDs).
+    #[arg(long, value_name = "PATH")]
+    save: Vec<PathBuf>,
+    /// Time-series figure (.png/.svg, repeatable): phi over the whole run and X over the first
+    /// quarter of the nu_1 period, as the paper's Figures 4 and 5 for --kick-x.
+    #[arg(long = "save-time", value_name = "PATH")]
+    save_time: Vec<PathBuf>,
+}
+
+fn parse_readout(items: &[String]) -> Result<Vec<(Observable, f64)>> {
+    let mut readout = vec![(Observable::X, DEFAULT_X_READOUT_ASD_M)];
+    for item in items {
+        let (o, asd) = super::args::parse_readout_item(item)?;
+        readout.retain(|(x, _)| *x != o);
+        if asd > 0.0 {
+            readout.push((o, asd));
+        }
+    }
+    readout.sort_by_key(|(o, _)| o.index());
+    Ok(readout)
+}
+
+/// Parses `COORD=VALUE,...` lists into `out` (SI units).
+fn parse_coords(option: &str, items: &[String], out: &mut [f64; 8]) -> Result<()> {
+    let names: Vec<&str> = Coord::ALL.iter().map(|c| c.name()).collect();
+    let mut given = [false; 8];
+    for item in items {
+        for entry in item.split(',').map(str::trim).filter(|e| !e.is_empty()) {
+            let (name, value) = entry.split_once('=').ok_or_else(|| {
+                anyhow!("{option} {entry}: expected COORD=VALUE, e.g. phi_b=0.01")
+            })?;
+            let c = Coord::ALL
+                .into_iter()
+                .find(|c| c.name() == name.trim())
+                .ok_or_else(|| {
+                    anyhow!(
+                        "{option} {entry}: unknown coordinate `{}`; allowed: {}",
+                        name.trim(),
+                        names.join(", ")
+                    )
+                })?;
+            let unit = if option == "--init" {
+                c.unit().to_string()
+            } else {
+                format!("{}/s", c.unit())
+            };
+            let v: f64 = value
+                .trim()
+                .parse()
+                .map_err(|_| anyhow!("{option} {entry}: `{}` is not a number", value.trim()))?;
+            if !v.is_finite() {
+                bail!("{option} {entry}: {v} {unit} is not allowed: must be finite");
+            }
+            if given[c.index()] {
+                bail!("{option} {entry}: coordinate `{}` is given twice", c.name());
+            }
+            given[c.index()] = true;
+            out[c.index()] = v;
+        }
+    }
+    Ok(())
+}
+
+/// Default Welch segment: the largest power of two <= n / 3 (at least 5 half-overlapping
+/// segments), at least 2.
+fn default_nperseg(n: usize) -> usize {
+    let third = (n / 3).max(2);
+    1 << third.ilog2()
+}
+
+/// The run's initial state and a description of where it came from.
+fn initial_state(model: &Model, args: &SimulateArgs) -> Result<(InitialState, String)> {
+    if let Some(x) = args.kick_x {
+        if !(x.is_finite() && x != 0.0) {
+            bail!("--kick-x {x}: the displacement (m) must be finite and non-zero");
+        }
+        let init = kick_x(model, x);
+        if init.q.iter().any(|v| !v.is_finite()) {
+            bail!(
+                "--kick-x {x}: X does not respond statically to a force on the test mass along \
+                 x for these parameters, so the kick is undefined"
+            );
+        }
+        return Ok((
+            init,
+            format!("kick: static X displacement of {x:e} m released from rest"),
+        ));
+    }
+    if !args.init.is_empty() || !args.init_rate.is_empty() {
+        let mut init = InitialState {
+            q: [0.0; 8],
+            qdot: [0.0; 8],
+        };
+        parse_coords("--init", &args.init, &mut init.q)?;
+        parse_coords("--init-rate", &args.init_rate, &mut init.qdot)?;
+        if init.q.iter().chain(&init.qdot).all(|&v| v == 0.0) {
+            bail!("--init/--init-rate: every coordinate and rate is 0: nothing moves");
+        }
+        let mut text = String::from("given:");
+        for c in Coord::ALL {
+            let (q, v) = (init.q[c.index()], init.qdot[c.index()]);
+            if q != 0.0 || v != 0.0 {
+                let _ = write!(
+                    text,
+                    " {}={q:e} {}, rate {v:e} {}/s;",
+                    c.name(),
+                    c.unit(),
+                    c.unit()
+                );
+            }
+        }
+        return Ok((init, text.trim_end_matches(';').to_string()));
+    }
+    let e = args.mode_energy;
+    if !(e.is_finite() && e > 0.0) {
+        bail!("--mode-energy {e}: the energy per mode (J) must be finite and > 0");
+    }
+    Ok((
+        equal_energy_init(model, e),
+        format!("equal energy {e:e} J in each of the 8 modes, phases 0.7 + 1.3 k rad"),
+    ))
+}
+
+/// Runs `tiltnoise simulate`.
+pub(crate) fn run_simulate(params: &Params, args: SimulateArgs) -> Result<()> {
+    let model = Model::new(params)?;
+    if !model.is_undamped() {
+        bail!(
+            "tiltnoise simulate supports only the undamped model (exact modal propagation of \
+             free motion); the parameters have non-zero loss angles in [loss]: set every \
+             loss.*_rad to 0, e.g. with --set"
+        );
+    }
+    if !(args.step.is_finite() && args.step > 0.0) {
+        bail!(
+            "--step {}: the sampling step (s) must be finite and > 0",
+            args.step
+        );
+    }
+    if !(args.duration.is_finite() && args.duration > 0.0) {
+        bail!(
+            "--duration {}: the duration (s) must be finite and > 0",
+            args.duration
+        );
+    }
+    let n_f = (args.duration / args.step * (1.0 + 1e-9)).floor();
+    if n_f < 2.0 {
+        bail!(
+            "--duration {} s at --step {} s gives {n_f} sample(s): at least 2 are needed",
+            args.duration,
+            args.step
+        );
+    }
+    if n_f > MAX_SAMPLES as f64 {
+        bail!(
+            "--duration {} s at --step {} s gives {n_f:e} samples: at most {MAX_SAMPLES} are \
+             allowed (increase --step or shorten --duration)",
+            args.duration,
+            args.step
+        );
+    }
+    let n = n_f as usize;
+    let nperseg = args.nperseg.unwrap_or_else(|| default_nperseg(n));
+    if nperseg < 16 {
+        bail!("--nperseg {nperseg}: the Welch segment must have at least 16 samples");
+    }
+    if nperseg > n {
+        bail!(
+            "--duration {} s at --step {} s gives {n} samples, shorter than one Welch segment \
+             (--nperseg {nperseg} = {} s): lengthen --duration or lower --nperseg",
+            args.duration,
+            args.step,
+            nperseg as f64 * args.step
+        );
+    }
+    for path in &args.save {
+        OutputKind::from_path(path)?;
+    }
+    for path in &args.save_time {
+        tiltnoise_plot::ImageFormat::from_path(path)?;
+    }
+    let readout = parse_readout(&args.readout)?;
+    let (init, init_source) = initial_state(&model, &args)?;
+    let cfg = SimConfig {
+        dt_s: args.step,
+        duration_s: args.duration,
+        readout_asd: readout.clone(),
+        seed: args.seed,
+    };
+
+    let bar = (n >= WORTH_A_BAR && std::io::stderr().is_terminal()).then(|| {
+        let b = indicatif::ProgressBar::new(n as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{spinner} {wide_bar} {pos}/{len} samples ({percent}%, eta {eta})",
+            )
+            .expect("valid template"),
+        );
+        b
+    });
+    let sim = simulate_with_progress(&model, &init, &cfg, &mut |done, _| {
+        if let Some(b) = &bar {
+            b.set_position(done as u64);
+        }
+    })?;
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+
+    let fs = sim.fs_hz();
+    let wcfg = WelchConfig::new(nperseg);
+    let mut psds = Vec::new();
+    for (o, x) in &sim.observables {
+        psds.push((*o, welch(x, fs, &wcfg)?));
+    }
+    let modes = NormalModes::new(&model);
+    let prop = ModalPropagator::new(&model, &init, cfg.dt_s)?;
+    let (u0, v0) = prop.initial_modal_state();
+    let amplitude: [f64; 8] = std::array::from_fn(|k| u0[k].hypot(v0[k]));
+    let check = check_resonances(&modes, &amplitude, &psds, fs, nperseg, &readout);
+
+    print!(
+        "{}",
+        summary(
+            &sim,
+            &modes,
+            &init_source,
+            &readout,
+            args.seed,
+            &wcfg,
+            psds[0].1.n_segments
+        )
+    );
+    print!("{}", check.table());
+
+    let freqs_hz = psds[0].1.freqs_hz.clone();
+    let asd: Vec<(Observable, Vec<f64>)> = psds.iter().map(|(o, p)| (*o, p.asd())).collect();
+    let meta = RunMeta::of_this_run(params, Some(&modes));
+    let caption = vec![
+        format!(
+            "{} samples at {} s ({} s), exact modal propagation of the undamped model; initial \
+             state: {init_source}; readout: {}; seed {}.",
+            sim.len(),
+            sim.dt_s,
+            sim.len() as f64 * sim.dt_s,
+            readout_text(&readout),
+            args.seed
+        ),
+        format!(
+            "One-sided Welch ASDs: periodic Hann, {} samples per segment, 50 % overlap, {} \
+             segments, mean. Modes above Nyquist ({} Hz) are marked at their aliases.",
+            nperseg,
+            psds[0].1.n_segments,
+            fs / 2.0
+        ),
+    ];
+    for path in &args.save {
+        match OutputKind::from_path(path)? {
+            OutputKind::Hdf5 => {
+                let series_asd = SeriesAsd {
+                    freqs_hz: freqs_hz.clone(),
+                    asd: asd.clone(),
+                    segment_len: nperseg,
+                    overlap: wcfg.overlap,
+                    averaging: "mean".to_string(),
+                    n_segments: psds[0].1.n_segments,
+                };
+                let smeta = SimulationMeta {
+                    run: meta.clone(),
+                    description: format!(
+                        "SIMULATED free motion of the double torsion pendulum model (not a \
+                         measurement). {}",
+                        caption[0]
+                    ),
+                    start_time: None,
+                    seed: args.seed,
+                    init,
+                    init_source: init_source.clone(),
+                    readout_asd: readout.clone(),
+                    duration_s: args.duration,
+                };
+                write_observable_series_hdf5(path, &sim, &series_asd, &smeta)?;
+            }
+            OutputKind::Csv => tiltnoise_io::write_asd_csv(path, &freqs_hz, &asd)
+                .with_context(|| format!("writing {}", path.display()))?,
+            OutputKind::Png | OutputKind::Svg => {
+                let data = SimAsdData {
+                    freqs_hz: freqs_hz.clone(),
+                    asd: asd.clone(),
+                    readout_asd: readout.clone(),
+                    modes: modes
+                        .modes
+                        .iter()
+                        .enumerate()
+                        .map(|(k, m)| ModeMark {
+                            index: m.index,
+                            frequency_hz: m.frequency_hz,
+                            apparent_frequency_hz: aliased_frequency_hz(m.frequency_hz, fs),
+                            seen_by: modes.observables_seeing(k),
+                        })
+                        .collect(),
+                    caption: caption.clone(),
+                };
+                save_image(path, |format| asd_figure(&data, format))?;
+            }
+        }
+        println!("wrote {}", path.display());
+    }
+    for path in &args.save_time {
+        let data = time_series_data(&sim, &modes, &init_source);
+        save_image(path, |format| time_series_figure(&data, format))?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+fn readout_text(readout: &[(Observable, f64)]) -> String {
+    if readout.is_empty() {
+        return "none".to_string();
+    }
+    readout
+        .iter()
+        .map(|(o, a)| format!("{} {a:e} {}/sqrt(Hz)", o.name(), o.unit()))
+        .collect::<Vec<_>>()
+        .join(", ")
+        + " (others noiseless)"
+}
+
+fn summary(
+    sim: &Simulation,
+    modes: &NormalModes,
+    init_source: &str,
+    readout: &[(Observable, f64)],
+    seed: u64,
+    wcfg: &WelchConfig,
+    n_segments: usize,
+) -> String {
+    let fs = sim.fs_hz();
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "free motion: {} samples at dt = {} s ({} s), Nyquist {} Hz",
+        sim.len(),
+        sim.dt_s,
+        sim.len() as f64 * sim.dt_s,
+        fs / 2.0
+    );
+    let _ = writeln!(s, "initial state: {init_source}");
+    let _ = writeln!(
+        s,
+        "readout (white, one-sided ASD): {}; seed {seed}",
+        readout_text(readout)
+    );
+    let _ = writeln!(
+        s,
+        "ASDs: one-sided Welch, periodic Hann, {} samples per segment ({} s, df = {:.3e} Hz), \
+         overlap {}, {} segments, mean",
+        wcfg.segment_len,
+        wcfg.segment_len as f64 / fs,
+        fs / wcfg.segment_len as f64,
+        wcfg.overlap,
+        n_segments
+    );
+    for (k, m) in modes.modes.iter().enumerate() {
+        let apparent = aliased_frequency_hz(m.frequency_hz, fs);
+        let alias = if apparent != m.frequency_hz {
+            format!(" (above Nyquist: appears at {apparent:.4e} Hz)")
+        } else {
+            String::new()
+        };
+        let seen: Vec<&str> = modes
+            .observables_seeing(k)
+            .iter()
+            .map(|o| o.name())
+            .collect();
+        let _ = writeln!(
+            s,
+            "  nu_{} {:>11.4e} Hz{alias}  seen by {}",
+            m.index,
+            m.frequency_hz,
+            seen.join(" ")
+        );
+    }
+    s
+}
+
+/// Figures 4 and 5: phi over the whole run, X over the first quarter of the nu_1 period (a
+/// fraction of a torsion period, to show the swinging oscillations).
+fn time_series_data(sim: &Simulation, modes: &NormalModes, init_source: &str) -> TimeSeriesData {
+    let quarter_s = 0.25 / modes.modes[0].frequency_hz;
+    let n_x = ((quarter_s / sim.dt_s).ceil() as usize).clamp(2, sim.len());
+    TimeSeriesData {
+        title: format!("Simulated free motion ({init_source})"),
+        panels: vec![
+            TimePanel {
+                title: "φ: test-mass torsion, whole run (cf. Figure 4)".to_string(),
+                observable: Observable::Phi,
+                dt_s: sim.dt_s,
+                t0_s: 0.0,
+                values: sim.observable(Observable::Phi).to_vec(),
+            },
+            TimePanel {
+                title: format!(
+                    "X: test-mass displacement, first {:.0} s = 1/4 of the ν1 period (cf. Figure 5)",
+                    n_x as f64 * sim.dt_s
+                ),
+                observable: Observable::X,
+                dt_s: sim.dt_s,
+                t0_s: 0.0,
+                values: sim.observable(Observable::X)[..n_x].to_vec(),
+            },
+        ],
+    }
+}

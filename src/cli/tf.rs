@@ -1,0 +1,245 @@
+//! `tiltnoise tf`: transfer functions from floor tilt and from external forces and torques to the
+//! observables, on a frequency grid, with the same outputs (CSV, HDF5, figures) and methods for
+//! every kind of input.
+//!
+//! Inputs are named as in files: the tilt angles `theta_t`, `eta_t`, `phi_t` (rad) and the twelve
+//! components `F_a.x` .. `M_b.z` of the forces (N, applied at the centres of mass) and torques
+//! (N m, about the centres of mass) on the crossbar (`a`) and the test mass (`b`), inertial axes
+//! (Appendix A of the paper, zeroth order). Observables: `X`, `Y`, `Z` (m), `theta`, `eta`, `phi`,
+//! `phi_a` (rad). Entries are complex responses per unit input: m/rad, rad/rad, m/N, rad/(N m), ...
+
+use super::args::MethodArg;
+use super::output::save_tf;
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use std::path::PathBuf;
+use tiltnoise_core::freq;
+use tiltnoise_core::model::{ForceInput, Model, Observable};
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::params::Params;
+use tiltnoise_core::tf::planner::{Scene, DEFAULT_REL_TOL};
+use tiltnoise_core::tf::{self, Input, Request};
+use tiltnoise_io::RunMeta;
+
+/// Arguments of `tiltnoise tf`.
+#[derive(Debug, Args)]
+pub struct TfArgs {
+    /// Log-spaced grid FLO:N:FHI (Hz:count:Hz), e.g. 1e-4:2000:30. Default: 0.1 mHz to 30 Hz,
+    /// 2000 points, plus points around every resonance.
+    #[arg(long, value_name = "FLO:N:FHI", conflicts_with = "freq_file")]
+    freq: Option<String>,
+    /// File with one frequency in Hz per line (# comments allowed).
+    #[arg(long, value_name = "FILE")]
+    freq_file: Option<PathBuf>,
+    /// Inputs (columns), comma-separated and/or repeated: tilt angles theta_t, eta_t, phi_t
+    /// (rad); force components F_a.x, F_a.y, F_a.z, F_b.x, F_b.y, F_b.z (N) and torque components
+    /// M_a.x .. M_b.z (N m) on the crossbar (a) and the test mass (b); the groups `tilt` (the
+    /// three tilt angles) and `forces` (all twelve components). Default: tilt.
+    #[arg(long = "input", value_name = "NAME[,NAME...]")]
+    inputs: Vec<String>,
+    /// Observables (rows), comma-separated and/or repeated: X, Y, Z (m), theta, eta, phi, phi_a
+    /// (rad). Default: all seven.
+    #[arg(long = "output", value_name = "NAME[,NAME...]")]
+    outputs: Vec<String>,
+    /// Output file, format from the extension: .h5 (all numbers), .csv, .png/.svg (|H| per
+    /// observable, one panel per kind of input: tilt, forces, torques; tilt alone is the paper's
+    /// Figure 5). Repeatable. Without --save the CSV goes to stdout.
+    #[arg(long, value_name = "PATH")]
+    save: Vec<PathBuf>,
+    /// Evaluation method.
+    #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
+    method: MethodArg,
+    /// Relative tolerance for `--method auto`: the smallest model and cheapest method whose
+    /// measured error against the double-double reference on the grid's band is at most this.
+    #[arg(long, value_name = "REL", default_value_t = DEFAULT_REL_TOL)]
+    rel_tol: f64,
+    /// Say which method `auto` picked and why (every candidate's measured error).
+    #[arg(long)]
+    explain: bool,
+}
+
+/// Every name `--input` accepts, for error messages.
+fn input_names() -> String {
+    let mut names: Vec<&str> = Input::all_tilts().into_iter().map(Input::name).collect();
+    names.extend(ForceInput::ALL.iter().map(|f| f.name()));
+    format!("{}, or the groups `tilt` and `forces`", names.join(", "))
+}
+
+/// Splits repeated, comma-separated option values into trimmed names.
+fn split_names<'a>(option: &str, specs: &'a [String]) -> Result<Vec<&'a str>> {
+    let mut names = Vec::new();
+    for spec in specs {
+        for name in spec.split(',').map(str::trim) {
+            if name.is_empty() {
+                bail!("{option} {spec:?}: empty name in the list (names are separated by single commas)");
+            }
+            names.push(name);
+        }
+    }
+    Ok(names)
+}
+
+/// Parses `--input` values (see [`TfArgs`]); empty means the three tilt angles.
+pub fn parse_inputs(specs: &[String]) -> Result<Vec<Input>> {
+    if specs.is_empty() {
+        return Ok(Input::all_tilts());
+    }
+    let mut inputs: Vec<Input> = Vec::new();
+    for name in split_names("--input", specs)? {
+        let group: Vec<Input> = match name {
+            "tilt" => Input::all_tilts(),
+            "forces" => ForceInput::ALL.into_iter().map(Input::Force).collect(),
+            _ => match Input::from_name(name) {
+                Some(i) => vec![i],
+                None => bail!(
+                    "--input: unknown input {name:?}; allowed: {}",
+                    input_names()
+                ),
+            },
+        };
+        for i in group {
+            if inputs.contains(&i) {
+                bail!("--input: {} is given twice; name each input once", i.name());
+            }
+            inputs.push(i);
+        }
+    }
+    Ok(inputs)
+}
+
+/// Parses `--output` values (see [`TfArgs`]); empty means all seven observables.
+pub fn parse_outputs(specs: &[String]) -> Result<Vec<Observable>> {
+    if specs.is_empty() {
+        return Ok(Observable::ALL.to_vec());
+    }
+    let mut outputs = Vec::new();
+    for name in split_names("--output", specs)? {
+        let Some(o) = Observable::from_name(name) else {
+            let allowed: Vec<&str> = Observable::ALL.iter().map(|o| o.name()).collect();
+            bail!(
+                "--output: unknown observable {name:?}; allowed: {}",
+                allowed.join(", ")
+            );
+        };
+        if outputs.contains(&o) {
+            bail!("--output: {name} is given twice; name each observable once");
+        }
+        outputs.push(o);
+    }
+    Ok(outputs)
+}
+
+/// Runs `tiltnoise tf`.
+pub fn run_tf(params: &Params, args: TfArgs) -> Result<()> {
+    let request = Request {
+        outputs: parse_outputs(&args.outputs)?,
+        inputs: parse_inputs(&args.inputs)?,
+    };
+    if !(args.rel_tol.is_finite() && args.rel_tol > 0.0 && args.rel_tol < 1.0) {
+        bail!(
+            "--rel-tol {}: the tolerance must be a finite relative error in (0, 1)",
+            args.rel_tol
+        );
+    }
+    let model = Model::new(params)?;
+    let freqs = match (&args.freq, &args.freq_file) {
+        (Some(spec), _) => freq::parse_spec(spec)?,
+        (None, Some(path)) => freq::read_freq_file(path)?,
+        (None, None) => freq::default_grid(&model),
+    };
+    // Check every output's format before computing, so a typo costs nothing.
+    for path in &args.save {
+        tiltnoise_io::OutputKind::from_path(path)?;
+    }
+    let method = match args.method.fixed() {
+        Some(m) => m,
+        None => {
+            let positive: Vec<f64> = freqs.iter().copied().filter(|&f| f > 0.0).collect();
+            let band = match positive.is_empty() {
+                true => (freq::DEFAULT_F_LO_HZ, freq::DEFAULT_F_LO_HZ),
+                false => (
+                    positive.iter().copied().fold(f64::INFINITY, f64::min),
+                    positive.iter().copied().fold(0.0, f64::max),
+                ),
+            };
+            let scene = Scene {
+                request: request.clone(),
+                band_hz: band,
+                rel_tol: args.rel_tol,
+            };
+            let choice =
+                tiltnoise_core::tf::planner::choose(&model, &scene).map_err(anyhow::Error::msg)?;
+            if args.explain {
+                eprintln!("{}", choice.explain());
+            }
+            choice.method
+        }
+    };
+    let plan = tf::plan(&model, &request, method)?;
+    let tf = tf::evaluate(plan.as_ref(), &freqs).context("evaluating the transfer functions")?;
+    if args.save.is_empty() {
+        print!("{}", tiltnoise_io::tf_csv_string(&tf));
+        return Ok(());
+    }
+    let modes = NormalModes::new(&model);
+    let meta = RunMeta::of_this_run(params, Some(&modes));
+    print!("{}", super::report::modes_table(&modes));
+    if request.inputs.iter().any(|i| matches!(i, Input::Tilt(_))) {
+        println!();
+        print!("{}", super::report::static_limits(&model));
+    }
+    for path in &args.save {
+        save_tf(path, &tf, &meta)?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn strings(v: &[&str]) -> Vec<String> {
+        v.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn inputs_parse_lists_groups_and_repeats() {
+        let got = parse_inputs(&strings(&["F_b.x, M_b.z", "theta_t"])).unwrap();
+        let names: Vec<&str> = got.iter().map(|i| i.name()).collect();
+        assert_eq!(names, ["F_b.x", "M_b.z", "theta_t"]);
+        assert_eq!(parse_inputs(&[]).unwrap(), Input::all_tilts());
+        assert_eq!(parse_inputs(&strings(&["forces"])).unwrap().len(), 12);
+        assert_eq!(parse_inputs(&strings(&["tilt,forces"])).unwrap().len(), 15);
+    }
+
+    #[test]
+    fn bad_input_names_are_refused_with_the_allowed_list() {
+        let e = parse_inputs(&strings(&["F_c.x"])).unwrap_err().to_string();
+        assert!(
+            e.contains("\"F_c.x\"") && e.contains("M_b.z") && e.contains("theta_t"),
+            "{e}"
+        );
+        let e = parse_inputs(&strings(&["F_b.x,F_b.x"]))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("twice"), "{e}");
+        let e = parse_inputs(&strings(&["tilt,eta_t"]))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("eta_t is given twice"), "{e}");
+        let e = parse_inputs(&strings(&["F_b.x,,M_b.z"]))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("empty name"), "{e}");
+    }
+
+    #[test]
+    fn outputs_parse_and_refuse_unknown_names() {
+        let got = parse_outputs(&strings(&["phi,X"])).unwrap();
+        assert_eq!(got, [Observable::Phi, Observable::X]);
+        assert_eq!(parse_outputs(&[]).unwrap(), Observable::ALL.to_vec());
+        let e = parse_outputs(&strings(&["x"])).unwrap_err().to_string();
+        assert!(e.contains("\"x\"") && e.contains("phi_a"), "{e}");
+    }
+}
