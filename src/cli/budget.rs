@@ -3,16 +3,19 @@
 
 use super::args::{parse_readout_item, AverageArg};
 use super::output::save_budget;
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, Context, Result};
 use clap::Args;
 use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::PathBuf;
-use tiltnoise_core::budget::{budget_from_series, budget_from_spectra, loglog_at, BudgetOptions};
+use tiltnoise_core::budget::{
+    add_measured, budget_from_series, budget_from_spectra, loglog_at, series_psds, BudgetOptions,
+    MeasuredPsds,
+};
 use tiltnoise_core::freq;
-use tiltnoise_core::model::{Model, Observable};
+use tiltnoise_core::model::Model;
 use tiltnoise_core::modes::NormalModes;
-use tiltnoise_core::noise::{BudgetReport, Readout};
+use tiltnoise_core::noise::{BudgetReport, Readout, TermKind};
 use tiltnoise_core::params::Params;
 use tiltnoise_core::spectral::Averaging;
 use tiltnoise_io::input::{read_tilt, InputFormat, ReadOptions, TiltInput, TiltSeriesSource};
@@ -119,17 +122,18 @@ fn read_options(args: &BudgetArgs) -> Result<ReadOptions> {
 fn summary(report: &BudgetReport) -> String {
     let mut s = String::from("noise budget (one-sided ASD):\n");
     let b = &report.budget;
-    let damped = b.observables.iter().any(|ob| ob.term("thermal").is_some());
+    let damped = b
+        .observables
+        .iter()
+        .any(|ob| ob.term(&TermKind::Thermal).is_some());
     for ob in &b.observables {
         let unit = format!("{}/sqrt(Hz)", ob.observable.unit());
+        let total = ob.total();
         for f in SUMMARY_FREQS_HZ {
-            let at = |name: &str| {
-                ob.term(name)
-                    .and_then(|t| loglog_at(&b.freqs_hz, &t.psd, f))
-                    .map(f64::sqrt)
-            };
-            if let (Some(t), Some(tot)) = (at("tilt"), at("total")) {
-                let thermal = at("thermal")
+            let asd_at = |psd: &[f64]| loglog_at(&b.freqs_hz, psd, f).map(f64::sqrt);
+            let at = |kind: TermKind| ob.term(&kind).and_then(|t| asd_at(&t.psd));
+            if let (Some(t), Some(tot)) = (at(TermKind::Tilt), asd_at(&total)) {
+                let thermal = at(TermKind::Thermal)
                     .map(|th| format!("thermal {th:.3e}  "))
                     .unwrap_or_default();
                 let _ = writeln!(
@@ -224,7 +228,7 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs) -> Result<()> {
 /// Adds the `measured` and `residual` terms from `--measured FILE`: a CSV of ASDs is
 /// interpolated log-log onto the budget grid (NaN where it does not reach); a time series of
 /// the observables (HDF5 from `tiltnoise simulate`, or CSV `time_s,...`) is first turned into
-/// one-sided PSDs by [`measured_series_psd`].
+/// one-sided PSDs by [`series_psds`].
 fn add_measured_file(report: &mut BudgetReport, path: &std::path::Path) -> Result<()> {
     use tiltnoise_io::input::MeasuredInput;
     let (freqs_hz, psds, what) = match tiltnoise_io::input::read_measured_input(path)? {
@@ -236,111 +240,19 @@ fn add_measured_file(report: &mut BudgetReport, path: &std::path::Path) -> Resul
                 .collect();
             (m.freqs_hz, psds, "measured spectrum".to_string())
         }
-        MeasuredInput::Series(series) => measured_series_psd(&series, &report.source)
-            .with_context(|| format!("--measured {}", path.display()))?,
+        MeasuredInput::Series(series) => {
+            let m = series_psds(&series.channels, series.sample_rate_hz, &report.source)
+                .with_context(|| format!("--measured {}", path.display()))?;
+            (m.freqs_hz, m.psds, m.description)
+        }
     };
-    let grid = report.budget.freqs_hz.clone();
-    // Same grid when the budget's bins are bins 1.. of the measured Welch grid (the budget
-    // drops DC): compared to 4 eps relative, the rounding of k fs / N computed two ways.
-    let same_grid = freqs_hz.len() > grid.len()
-        && grid
-            .iter()
-            .zip(&freqs_hz[1..])
-            .all(|(a, b)| (a - b).abs() <= 4.0 * f64::EPSILON * a.abs());
-    let mut used = Vec::new();
-    for (o, psd) in &psds {
-        if report.budget.observable(*o).is_none() {
-            continue;
-        }
-        let on_grid = if same_grid {
-            psd[1..=grid.len()].to_vec()
-        } else {
-            grid.iter()
-                .map(|&f| loglog_at(&freqs_hz, psd, f).unwrap_or(f64::NAN))
-                .collect()
-        };
-        tiltnoise_core::noise::add_measured(&mut report.budget, *o, on_grid);
-        used.push(o.name());
-    }
-    let (lo, hi) = (freqs_hz[0], freqs_hz[freqs_hz.len() - 1]);
-    report.notes.push(format!(
-        "{what} {} ({}) covers {lo:e} .. {hi:e} Hz (NaN outside); {}",
-        path.display(),
-        if used.is_empty() {
-            "no budgeted observable".to_string()
-        } else {
-            used.join(", ")
-        },
-        if same_grid {
-            "on the budget's own grid"
-        } else {
-            "interpolated log-log onto the budget grid"
-        }
-    ));
+    let measured = MeasuredPsds {
+        freqs_hz,
+        psds,
+        description: what,
+    };
+    add_measured(report, &measured, &path.display().to_string());
     Ok(())
-}
-
-/// A measured record on its own grid: frequencies (Hz), one-sided PSD per observable
-/// (unit^2/Hz), and a description for the budget's notes.
-type MeasuredPsds = (Vec<f64>, Vec<(Observable, Vec<f64>)>, String);
-
-/// One-sided PSDs (unit^2/Hz) of a measured time series with the budget's own Welch settings:
-/// the same segment duration (`segment_len * fs_measured / fs_budget` samples, rounded), the
-/// same overlap fraction and averaging, periodic Hann, constant detrend. For a budget from
-/// spectra (no Welch settings): the budget's default segment for the series' length, 50 %
-/// overlap, mean. Returns the Welch grid (with DC), the PSDs and a description for the notes.
-fn measured_series_psd(
-    series: &tiltnoise_io::input::MeasuredSeries,
-    source: &tiltnoise_core::noise::SpectralSource,
-) -> Result<MeasuredPsds> {
-    use tiltnoise_core::spectral::{welch, WelchConfig};
-    let fs = series.sample_rate_hz;
-    let n = series.channels[0].1.len();
-    let cfg = match source {
-        tiltnoise_core::noise::SpectralSource::Welch {
-            sample_rate_hz,
-            segment_len,
-            overlap,
-            averaging,
-            ..
-        } => {
-            let seg = (*segment_len as f64 * fs / sample_rate_hz).round() as usize;
-            let ov = (*overlap as f64 / *segment_len as f64 * seg as f64).round() as usize;
-            if seg < 2 || seg > n {
-                bail!(
-                    "the measured series has {n} samples ({:.6e} s at {fs} Hz): the budget's \
-                     Welch segment of {:.6e} s needs {seg} samples at this rate; use a longer \
-                     record or a shorter --nperseg",
-                    n as f64 / fs,
-                    *segment_len as f64 / sample_rate_hz
-                );
-            }
-            WelchConfig::new(seg)
-                .with_overlap(ov.min(seg - 1))
-                .with_averaging(if averaging == "median" {
-                    Averaging::Median
-                } else {
-                    Averaging::Mean
-                })
-        }
-        tiltnoise_core::noise::SpectralSource::Spectra { .. } => {
-            WelchConfig::new(tiltnoise_core::budget::default_segment_len(n))
-        }
-    };
-    let mut freqs = Vec::new();
-    let mut psds = Vec::new();
-    let mut n_segments = 0;
-    for (o, x) in &series.channels {
-        let p = welch(x, fs, &cfg)?;
-        freqs = p.freqs_hz;
-        n_segments = p.n_segments;
-        psds.push((*o, p.psd));
-    }
-    let what = format!(
-        "measured series at {fs} Hz (Welch: {} samples per segment, overlap {}, {} segments)",
-        cfg.segment_len, cfg.overlap, n_segments
-    );
-    Ok((freqs, psds, what))
 }
 
 /// A progress bar on stderr when it is a terminal and the input is long enough to wait for.

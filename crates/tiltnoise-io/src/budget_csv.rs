@@ -68,14 +68,9 @@ fn asd_columns(report: &BudgetReport) -> (Vec<String>, Vec<Vec<f64>>) {
     let mut names = Vec::new();
     let mut columns = Vec::new();
     for ob in &report.budget.observables {
-        // `response.<input>` is not a noise (see `noise::equivalent`); HDF5 carries it.
-        for term in ob
-            .terms
-            .iter()
-            .filter(|t| !tiltnoise_core::noise::is_response(&t.name))
-        {
-            names.push(format!("{}.{}", ob.observable.name(), term.name));
-            columns.push(term.asd());
+        for (component, psd) in ob.components() {
+            names.push(format!("{}.{}", ob.observable.name(), component.name()));
+            columns.push(psd.iter().map(|p| p.sqrt()).collect());
         }
     }
     for (o, band) in &report.segment_bands {
@@ -94,7 +89,8 @@ fn asd_columns(report: &BudgetReport) -> (Vec<String>, Vec<Vec<f64>>) {
         let Some(referred) = tiltnoise_core::noise::equivalent::referred_terms(ob) else {
             continue;
         };
-        for (name, psd) in &referred.terms {
+        for (component, psd) in &referred.terms {
+            let name = component.name();
             names.push(format!("{}.equivalent.{name}", ob.observable.name()));
             columns.push(psd.iter().map(|p| p.sqrt()).collect());
         }

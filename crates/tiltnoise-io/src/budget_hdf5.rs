@@ -6,7 +6,7 @@ use crate::atomic::write_atomic;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
 use tiltnoise_core::noise::equivalent::referred_terms;
-use tiltnoise_core::noise::{is_response, BudgetReport, SpectralSource};
+use tiltnoise_core::noise::{BudgetReport, SpectralSource};
 
 /// Value of the root attribute `schema`.
 pub const SCHEMA_BUDGET: &str = "tiltnoise.budget";
@@ -121,20 +121,20 @@ fn write_file(
         let unit = o.unit();
         let group = file.create_group(o.name())?;
         str_attr(&group, "unit", unit)?;
-        let terms: Vec<&str> = ob
-            .terms
-            .iter()
-            .filter(|t| !is_response(&t.name))
-            .map(|t| t.name.as_str())
+        let named: Vec<(String, Vec<f64>)> = ob
+            .components()
+            .into_iter()
+            .map(|(c, psd)| (c.name(), psd))
             .collect();
+        let terms: Vec<&str> = named.iter().map(|(n, _)| n.as_str()).collect();
         strs_attr(&group, "terms", &terms)?;
         if let Some(asd) = report.readout.of(o) {
             scalar_attr(&group, "readout_asd", asd)?;
             str_attr(&group, "readout_asd_units", &asd_unit(unit))?;
         }
-        for term in ob.terms.iter().filter(|t| !is_response(&t.name)) {
-            let g = group.create_group(&term.name)?;
-            write_psd_asd(&g, "psd", "asd", &term.psd, unit)?;
+        for (name, psd) in &named {
+            let g = group.create_group(name)?;
+            write_psd_asd(&g, "psd", "asd", psd, unit)?;
         }
         if let Some(referred) = referred_terms(ob) {
             write_equivalent(&group, &referred, unit)?;
@@ -187,13 +187,14 @@ fn write_equivalent(
     str_attr(&g, "input", referred.input)?;
     str_attr(&g, "quantity", referred.quantity)?;
     str_attr(&g, "unit", referred.unit)?;
-    let names: Vec<&str> = referred.terms.iter().map(|(name, _)| *name).collect();
+    let names: Vec<String> = referred.terms.iter().map(|(c, _)| c.name()).collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
     strs_attr(&g, "terms", &names)?;
     let abs: Vec<f64> = referred.response_psd.iter().map(|p| p.sqrt()).collect();
     let d = dataset(&g, "response_abs", &abs)?;
     str_attr(&d, "units", &format!("{unit}/({})", referred.unit))?;
-    for (name, psd) in &referred.terms {
-        let t = g.create_group(name)?;
+    for (component, psd) in &referred.terms {
+        let t = g.create_group(&component.name())?;
         write_psd_asd(&t, "psd", "asd", psd, referred.unit)?;
     }
     Ok(())

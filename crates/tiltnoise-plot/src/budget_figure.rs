@@ -11,7 +11,7 @@ use tiltnoise_core::input::InputMeta;
 use tiltnoise_core::model::{Observable, TiltAxis};
 use tiltnoise_core::noise::equivalent::referred_terms;
 use tiltnoise_core::noise::{
-    is_response, BudgetReport, NoiseTerm, Readout, SegmentBand, SpectralSource,
+    BudgetReport, Component, Readout, SegmentBand, SpectralSource, TermKind,
 };
 
 /// Options of [`budget_figure_with`].
@@ -82,27 +82,29 @@ const THERMAL_ELEMENTS: [&str; 6] = [
     "swing_b",
 ];
 
-/// Legend label and style of a term; `None` for the colour cycle of unknown terms.
-fn term_style(name: &str, readout: Option<(f64, Observable)>) -> Option<(String, TraceStyle)> {
+/// Legend label and style of a budget component: the kind decides, not its name.
+fn term_style(component: &Component, readout: Option<(f64, Observable)>) -> (String, TraceStyle) {
     let style = |c, d, w| TraceStyle::new(c, d, w);
-    Some(match name {
-        "total" => ("total".to_string(), style(BLACK, Dash::Solid, 4)),
-        "tilt" => ("tilt".to_string(), style(TILT_COLOR, Dash::Solid, 2)),
-        "readout" => {
+    let kind = match component {
+        Component::Total => return ("total".to_string(), style(BLACK, Dash::Solid, 4)),
+        Component::Term(kind) => kind,
+    };
+    match kind {
+        TermKind::Tilt => ("tilt".to_string(), style(TILT_COLOR, Dash::Solid, 2)),
+        TermKind::Readout => {
             let label = match readout {
                 Some((asd, o)) => format!("readout, {}", si_asd(asd, o.unit())),
                 None => "readout".to_string(),
             };
             (label, style(READOUT_COLOR, Dash::Solid, 2))
         }
-        "measured" => ("measured".to_string(), style(BLACK, Dash::Solid, 1)),
-        "residual" => ("residual".to_string(), style(PALETTE[3], Dash::Dotted, 2)),
-        "thermal" => (
+        TermKind::Measured => ("measured".to_string(), style(BLACK, Dash::Solid, 1)),
+        TermKind::Residual => ("residual".to_string(), style(PALETTE[3], Dash::Dotted, 2)),
+        TermKind::Thermal => (
             "thermal (FDT)".to_string(),
             style(THERMAL_COLOR, Dash::Solid, 2),
         ),
-        _ if name.starts_with("thermal.") => {
-            let element = name.trim_start_matches("thermal.");
+        TermKind::ThermalElement(element) => {
             let k = THERMAL_ELEMENTS
                 .iter()
                 .position(|e| element.starts_with(e))
@@ -117,39 +119,38 @@ fn term_style(name: &str, readout: Option<(f64, Observable)>) -> Option<(String,
                 style(OTHER_COLORS[k % OTHER_COLORS.len()], dash, 2),
             )
         }
-        _ => {
-            let axis = name.strip_prefix("tilt.")?;
-            let axis = TiltAxis::ALL.into_iter().find(|a| a.name() == axis)?;
+        TermKind::TiltAxis(axis) => {
             let color = match axis {
                 TiltAxis::ThetaT => PALETTE[5],
                 TiltAxis::EtaT => PALETTE[1],
                 TiltAxis::PhiT => PALETTE[2],
             };
             (
-                format!("tilt, {} alone", tilt_symbol(axis)),
+                format!("tilt, {} alone", tilt_symbol(*axis)),
                 style(color, Dash::Dashed, 2),
             )
         }
-    })
+    }
 }
 
 /// Drawing order (and legend order): total first, so that the terms lie on top of it where
 /// they dominate, as in pygwinc.
-fn draw_rank(name: &str) -> u8 {
-    match name {
-        "total" => 0,
-        "measured" => 1,
-        "residual" => 2,
-        "tilt" => 3,
-        n if n.starts_with("tilt.") => 4,
-        "readout" => 5,
-        "thermal" => 6,
-        n if n.starts_with("thermal.") => 7,
-        _ => 8,
+fn draw_rank(component: &Component) -> u8 {
+    match component {
+        Component::Total => 0,
+        Component::Term(kind) => match kind {
+            TermKind::Measured => 1,
+            TermKind::Residual => 2,
+            TermKind::Tilt => 3,
+            TermKind::TiltAxis(_) => 4,
+            TermKind::Readout => 5,
+            TermKind::Thermal => 6,
+            TermKind::ThermalElement(_) => 7,
+        },
     }
 }
 
-/// Extra colours for terms this figure does not know, and for the thermal elements.
+/// Colours of the thermal elements.
 const OTHER_COLORS: [RGBColor; 6] = [
     PALETTE[4], PALETTE[2], PALETTE[3], PALETTE[5], PALETTE[1], PALETTE[0],
 ];
@@ -177,27 +178,25 @@ pub fn build_budget_figure(
             ),
         );
         panel.max_decades = Some(options.max_decades);
-        let mut terms: Vec<&NoiseTerm> =
-            ob.terms.iter().filter(|t| !is_response(&t.name)).collect();
-        terms.sort_by_key(|t| draw_rank(&t.name));
-        let mut other = 0;
-        for term in terms {
+        let mut components = ob.components();
+        components.sort_by_key(|(c, _)| draw_rank(c));
+        for (component, psd) in components {
             let readout = report.readout.of(o).map(|a| (a, o));
-            let (label, style) = term_style(&term.name, readout).unwrap_or_else(|| {
-                let c = OTHER_COLORS[other % OTHER_COLORS.len()];
-                other += 1;
-                (term.name.clone(), TraceStyle::new(c, Dash::Solid, 2))
-            });
-            if term.psd.iter().all(|&p| p == 0.0) {
+            let (label, style) = term_style(&component, readout);
+            if psd.iter().all(|&p| p == 0.0) {
                 // An element of the other block: exactly 0 by the model's structure, not news.
-                if term.name.starts_with("thermal.") {
+                if matches!(component, Component::Term(TermKind::ThermalElement(_))) {
                     continue;
                 }
                 let short = label.strip_prefix("tilt, ").unwrap_or(&label);
                 panel.notes.push(format!("{short}: identically 0"));
                 continue;
             }
-            let points = freqs.iter().zip(term.asd()).map(|(&f, a)| (f, a)).collect();
+            let points = freqs
+                .iter()
+                .zip(&psd)
+                .map(|(&f, p)| (f, p.sqrt()))
+                .collect();
             panel.traces.push(Trace::new(label, points, style));
         }
         if let Some((_, band)) = report.segment_bands.iter().find(|(b, _)| *b == o) {
@@ -214,7 +213,7 @@ pub fn build_budget_figure(
         .budget
         .observables
         .iter()
-        .any(|b| b.term("thermal").is_some());
+        .any(|b| b.term(&TermKind::Thermal).is_some());
     let mut title = if damped {
         "Noise budget (tilt, thermal, readout): one-sided amplitude spectral densities"
     } else {
@@ -250,15 +249,21 @@ fn equivalent_panel(report: &BudgetReport, options: &BudgetFigureOptions) -> Opt
         ("ASD of aₓ", "m s⁻²/√Hz"),
     );
     panel.max_decades = Some(options.max_decades);
-    let mut terms: Vec<&(&str, Vec<f64>)> = referred
+    let mut terms: Vec<&(Component, Vec<f64>)> = referred
         .terms
         .iter()
-        .filter(|(name, _)| ["total", "tilt", "thermal", "readout"].contains(name))
+        .filter(|(c, _)| match c {
+            Component::Total => true,
+            Component::Term(kind) => kind.in_total(),
+        })
         .collect();
-    terms.sort_by_key(|(name, _)| draw_rank(name));
+    terms.sort_by_key(|(c, _)| draw_rank(c));
     // The response has zeros (antiresonances), where every equivalent term peaks: scale the y
     // axis on the floor of the total instead, from a decade below its minimum up 6 decades.
-    let (_, total) = referred.terms.iter().find(|(name, _)| *name == "total")?;
+    let (_, total) = referred
+        .terms
+        .iter()
+        .find(|(c, _)| *c == Component::Total)?;
     let floor = total
         .iter()
         .map(|p| p.sqrt())
@@ -268,9 +273,13 @@ fn equivalent_panel(report: &BudgetReport, options: &BudgetFigureOptions) -> Opt
         let lo = 10f64.powf(floor.log10().floor() - 1.0);
         panel.y_range = Some((lo, lo * 1e6));
     }
-    for (name, psd) in terms {
-        let (label, style) = term_style(name, None)?;
-        if ob.term(name)?.psd.iter().all(|&p| p == 0.0) {
+    for (component, psd) in terms {
+        let (label, style) = term_style(component, None);
+        let identically_zero = match component {
+            Component::Total => ob.total().iter().all(|&p| p == 0.0),
+            Component::Term(kind) => ob.term(kind)?.psd.iter().all(|&p| p == 0.0),
+        };
+        if identically_zero {
             continue;
         }
         let points = report
@@ -473,7 +482,7 @@ fn caption(report: &BudgetReport, input: Option<&InputMeta>) -> Vec<String> {
             .budget
             .observables
             .iter()
-            .any(|b| b.term("thermal").is_some())
+            .any(|b| b.term(&TermKind::Thermal).is_some())
         {
             "All curves are one-sided ASDs (√PSD). tilt: all axes with their cross-spectra; \
              “alone”: one axis, for diagnosis; thermal: fluctuation-dissipation theorem, sum over \

@@ -8,17 +8,24 @@
 //!
 //! `S_equiv = S_o / |R_o|^2` with `R_X = m_b H_X,F_b.x` (the response of X to an acceleration
 //! of the test mass, m per m s^-2) and `R_phi = H_phi,M_b.z`, `R_phi_a = H_phi_a,M_b.z` (rad per
-//! N m), all one-sided PSDs. The responses are stored in a budget as a term named
-//! `response.<input>` (e.g. `response.F_b.x`, just before `total`) whose "PSD" is `|R_o|^2`:
-//! not a noise, excluded from `total`, from the CSV columns and from the drawn traces.
+//! N m), all one-sided PSDs. A budget carries `|R_o|^2` as the [`Calibration`] of the
+//! observable (not as a noise term), in the spirit of pygwinc's `Calibration`: applied to a
+//! budget by [`referred_terms`], it turns a displacement or angle budget into an acceleration or
+//! torque budget.
 
-use super::Budget;
+use super::{Budget, Component};
 use crate::error::TfError;
 use crate::model::{ForceInput, Model, Observable};
 use crate::tf::{self, Input, Request};
 
-/// Prefix of the budget term that carries `|R_o|^2` (see the module docs).
-pub const RESPONSE_PREFIX: &str = "response.";
+/// The calibration of an observable's budget to its equivalent input (see the module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Calibration {
+    /// The equivalent input (`F_b.x` for X, `M_b.z` for phi and phi_a).
+    pub input: ForceInput,
+    /// `|R_o|^2` on the budget's grid ((observable unit / input unit)^2).
+    pub response_psd: Vec<f64>,
+}
 
 /// The equivalent input of an observable: `(input, factor, unit, description)`, with
 /// `R_o = factor * H_o,input`. `None` for observables without one (Y, Z, theta, eta).
@@ -62,38 +69,35 @@ pub struct Referred<'a> {
     pub quantity: &'static str,
     /// `|R_o|^2` at each frequency ((observable unit / input unit)^2).
     pub response_psd: &'a [f64],
-    /// Every noise term but `measured` and `residual` (which are not referred), in budget
-    /// order: `(name, S_o / |R_o|^2)`, one-sided PSD in unit^2/Hz.
-    pub terms: Vec<(&'a str, Vec<f64>)>,
+    /// Every model term (not `measured` or `residual`, which are not referred) in budget order,
+    /// then the total: `(component, S_o / |R_o|^2)`, one-sided PSD in unit^2/Hz.
+    pub terms: Vec<(Component, Vec<f64>)>,
 }
 
 /// The terms of `ob` referred to its equivalent input, if it has one and the budget carries
-/// its response (the `response.<input>` term of [`add_equivalent_response`]).
+/// its [`Calibration`] ([`add_equivalent_response`]).
 pub fn referred_terms(ob: &super::ObservableBudget) -> Option<Referred<'_>> {
-    let (input, unit, quantity) = equivalent_quantity(ob.observable)?;
-    let response = ob
+    let (_, unit, quantity) = equivalent_quantity(ob.observable)?;
+    let calibration = ob.calibration.as_ref()?;
+    let response = &calibration.response_psd;
+    let refer = |psd: &[f64]| psd.iter().zip(response).map(|(p, r)| p / r).collect();
+    let mut terms: Vec<(Component, Vec<f64>)> = ob
         .terms
         .iter()
-        .find(|t| t.name == format!("{RESPONSE_PREFIX}{}", input.name()))?;
-    let terms = ob
-        .terms
-        .iter()
-        .filter(|t| !is_response(&t.name) && t.name != "measured" && t.name != "residual")
-        .map(|t| {
-            let psd = t.psd.iter().zip(&response.psd).map(|(p, r)| p / r);
-            (t.name.as_str(), psd.collect())
-        })
+        .filter(|t| t.kind.is_model())
+        .map(|t| (Component::Term(t.kind.clone()), refer(&t.psd)))
         .collect();
+    terms.push((Component::Total, refer(&ob.total())));
     Some(Referred {
-        input: input.name(),
+        input: calibration.input.name(),
         unit,
         quantity,
-        response_psd: &response.psd,
+        response_psd: response,
         terms,
     })
 }
 
-/// Adds the `response.<input>` term (`|R_o|^2`, see the module docs) to every observable of
+/// Attaches the [`Calibration`] (`|R_o|^2`, see the module docs) to every observable of
 /// `budget` that has an equivalent input, evaluated with the method the planner picks.
 pub fn add_equivalent_response(budget: &mut Budget, model: &Model) -> Result<(), TfError> {
     for ob in budget.observables.iter_mut() {
@@ -106,27 +110,13 @@ pub fn add_equivalent_response(budget: &mut Budget, model: &Model) -> Result<(),
         };
         let (plan, _) = tf::plan_auto(model, &tf::Scene::over_grid(request, &budget.freqs_hz))?;
         let h = tf::evaluate(plan.as_ref(), &budget.freqs_hz)?;
-        let psd = (0..h.freqs_hz.len())
+        let response_psd = (0..h.freqs_hz.len())
             .map(|k| (h.get(k, 0, 0) * factor).norm_sqr())
             .collect();
-        // Before `total`, which stays last.
-        let at = ob
-            .terms
-            .iter()
-            .position(|t| t.name == "total")
-            .unwrap_or(ob.terms.len());
-        ob.terms.insert(
-            at,
-            super::NoiseTerm {
-                name: format!("{RESPONSE_PREFIX}{}", input.name()),
-                psd,
-            },
-        );
+        ob.calibration = Some(Calibration {
+            input,
+            response_psd,
+        });
     }
     Ok(())
-}
-
-/// True for a `response.<input>` term (not a noise).
-pub fn is_response(name: &str) -> bool {
-    name.starts_with(RESPONSE_PREFIX)
 }

@@ -7,21 +7,25 @@
 //! `S_o = sum_ij conj(H_oi) S_ij H_oj` (the diagonal of `conj(H) S H^T`, real and >= 0 for a
 //! positive semi-definite `S`), so correlated tilt axes are handled exactly.
 //!
-//! Terms of each observable: `tilt` (full cross-spectral propagation), `tilt.<axis>` (each axis
-//! alone, `|H_oi|^2 S_ii`: a diagnostic breakdown, which does not add up to `tilt` when the axes are
-//! correlated), `readout` (white, configurable per observable), `thermal` (the sum over the
-//! dissipative elements, [`crate::thermal`]; only for a damped model) with `thermal.<element>`
-//! per element (independent sources: they add up to `thermal`), and `total` = the sum in power
-//! of `tilt`, `readout`, `thermal` and any other independent term (always last). A damped
-//! budget also carries `response.<input>`, the squared response to the equivalent input
-//! ([`equivalent`]), which is not a noise. Pure numerics: depends on `model`, `tf` and
-//! `thermal` only.
+//! Terms of each observable are typed ([`TermKind`]): `tilt` (full cross-spectral
+//! propagation), `tilt.<axis>` (each axis alone, `|H_oi|^2 S_ii`: a diagnostic breakdown, which
+//! does not add up to `tilt` when the axes are correlated), `readout` (white, configurable per
+//! observable), `thermal` (the sum over the dissipative elements, [`crate::thermal`]; only for a
+//! damped model) with `thermal.<element>` per element (independent sources: they add up to
+//! `thermal`), and `measured` / `residual` when a measured spectrum is compared. The total is
+//! never stored: [`ObservableBudget::total`] computes it, the sum in power of the terms whose
+//! kind adds to it ([`TermKind::in_total`]). A damped budget also carries a [`Calibration`] per
+//! observable that has an equivalent input: the squared response that refers every term to
+//! the test mass's acceleration or torque ([`equivalent`]). Pure numerics: depends on `model`,
+//! `tf` and `thermal` only.
 
 pub mod equivalent;
 mod segments;
+mod term;
 
-pub use equivalent::{add_equivalent_response, equivalent_input, is_response, RESPONSE_PREFIX};
+pub use equivalent::{add_equivalent_response, equivalent_input, Calibration};
 pub use segments::{percentile, SegmentBand};
+pub use term::{Component, TermGroup, TermKind};
 
 use crate::model::{Observable, TiltAxis};
 use crate::tf::{Input, TransferMatrix};
@@ -30,16 +34,24 @@ use num_complex::Complex64;
 /// The readout noise of the paper's X channel: 9 nm/sqrt(Hz), white (section III).
 pub const PAPER_X_READOUT_ASD_M: f64 = 9e-9;
 
+/// The key under which the files store the computed total of an observable's budget.
+pub const TOTAL_NAME: &str = "total";
+
 /// One term of a budget: a one-sided PSD on the budget's frequency grid.
 #[derive(Debug, Clone, PartialEq)]
 pub struct NoiseTerm {
-    /// `tilt`, `tilt.theta_t`, `readout`, `total`, ...
-    pub name: String,
+    /// What the term is.
+    pub kind: TermKind,
     /// One-sided PSD, (observable unit)^2/Hz.
     pub psd: Vec<f64>,
 }
 
 impl NoiseTerm {
+    /// The term's key in the files ([`TermKind::name`]).
+    pub fn name(&self) -> String {
+        self.kind.name()
+    }
+
     /// ASD = sqrt(PSD), observable unit/sqrt(Hz).
     pub fn asd(&self) -> Vec<f64> {
         self.psd.iter().map(|p| p.sqrt()).collect()
@@ -51,19 +63,55 @@ impl NoiseTerm {
 pub struct ObservableBudget {
     /// The observable (X in m, phi and phi_a in rad).
     pub observable: Observable,
-    /// Terms in display order; `total` is last.
+    /// Terms in display and file order (the computed total is not one of them).
     pub terms: Vec<NoiseTerm>,
+    /// The calibration to the equivalent input (damped models, observables that have one).
+    pub calibration: Option<Calibration>,
 }
 
 impl ObservableBudget {
-    /// A term by name.
-    pub fn term(&self, name: &str) -> Option<&NoiseTerm> {
-        self.terms.iter().find(|t| t.name == name)
+    /// A budget of `observable` with `terms` and no calibration.
+    pub fn new(observable: Observable, terms: Vec<NoiseTerm>) -> ObservableBudget {
+        ObservableBudget {
+            observable,
+            terms,
+            calibration: None,
+        }
     }
 
-    /// The `total` term.
-    pub fn total(&self) -> &NoiseTerm {
-        self.term("total").expect("every budget has a total")
+    /// The term of a kind, if the budget has it.
+    pub fn term(&self, kind: &TermKind) -> Option<&NoiseTerm> {
+        self.terms.iter().find(|t| &t.kind == kind)
+    }
+
+    /// The term stored under a file key ([`TermKind::name`]), if any.
+    pub fn term_named(&self, name: &str) -> Option<&NoiseTerm> {
+        self.terms.iter().find(|t| t.kind.name() == name)
+    }
+
+    /// The total PSD: the sum in power, in term order, of every term that adds to it
+    /// ([`TermKind::in_total`]), one value per frequency of `n_freqs`.
+    pub fn total(&self) -> Vec<f64> {
+        let n = self.terms.first().map_or(0, |t| t.psd.len());
+        let mut total = vec![0.0; n];
+        for t in self.terms.iter().filter(|t| t.kind.in_total()) {
+            for (s, p) in total.iter_mut().zip(&t.psd) {
+                *s += p;
+            }
+        }
+        total
+    }
+
+    /// Every term and its PSD in file order, the computed total last: what the writers
+    /// store and the figure draws.
+    pub fn components(&self) -> Vec<(Component, Vec<f64>)> {
+        let mut out: Vec<(Component, Vec<f64>)> = self
+            .terms
+            .iter()
+            .map(|t| (Component::Term(t.kind.clone()), t.psd.clone()))
+            .collect();
+        out.push((Component::Total, self.total()));
+        out
     }
 }
 
@@ -176,36 +224,22 @@ pub fn tilt_budget(tf: &TransferMatrix, tilt: &TiltCsd, readout: &Readout) -> Bu
                 }
             }
             let mut terms = vec![NoiseTerm {
-                name: "tilt".into(),
+                kind: TermKind::Tilt,
                 psd: tilt_psd,
             }];
             for (i, psd) in axis_psd.into_iter().enumerate() {
                 terms.push(NoiseTerm {
-                    name: format!("tilt.{}", tilt.axes[i].name()),
+                    kind: TermKind::TiltAxis(tilt.axes[i]),
                     psd,
                 });
             }
             if let Some(asd) = readout.of(observable) {
                 terms.push(NoiseTerm {
-                    name: "readout".into(),
+                    kind: TermKind::Readout,
                     psd: vec![asd * asd; n_f],
                 });
             }
-            let independent = ["tilt", "readout"];
-            let total = (0..n_f)
-                .map(|k| {
-                    terms
-                        .iter()
-                        .filter(|t| independent.contains(&t.name.as_str()))
-                        .map(|t| t.psd[k])
-                        .sum()
-                })
-                .collect();
-            terms.push(NoiseTerm {
-                name: "total".into(),
-                psd: total,
-            });
-            ObservableBudget { observable, terms }
+            ObservableBudget::new(observable, terms)
         })
         .collect();
     Budget {
@@ -215,9 +249,9 @@ pub fn tilt_budget(tf: &TransferMatrix, tilt: &TiltCsd, readout: &Readout) -> Bu
 }
 
 /// Adds the thermal-noise terms of `thermal` (same grid as `budget`) to every observable it
-/// has: `thermal` (sum over the elements) and `thermal.<element>`, inserted before `total`,
-/// and adds `thermal` to `total`. Does nothing when `thermal` has no element (undamped model).
-/// Call it before [`add_measured`], whose residual is taken against `total`.
+/// has: `thermal` (sum over the elements, which adds to the total) and `thermal.<element>`,
+/// after the terms already there. Does nothing when `thermal` has no element (undamped model).
+/// Call it before [`add_measured`], whose residual is taken against the total.
 ///
 /// # Panics
 /// If the grids differ in length.
@@ -234,26 +268,16 @@ pub fn add_thermal(budget: &mut Budget, thermal: &crate::thermal::ThermalNoise) 
         let Some(o) = thermal.outputs.iter().position(|&x| x == b.observable) else {
             continue;
         };
-        let total_thermal = thermal.total_psd(o);
-        let at = b
-            .terms
-            .iter()
-            .position(|t| t.name == "total")
-            .expect("every budget has a total");
-        for (k, p) in b.terms[at].psd.iter_mut().enumerate() {
-            *p += total_thermal[k];
-        }
-        let mut new_terms = vec![NoiseTerm {
-            name: "thermal".into(),
-            psd: total_thermal,
-        }];
+        b.terms.push(NoiseTerm {
+            kind: TermKind::Thermal,
+            psd: thermal.total_psd(o),
+        });
         for e in &thermal.elements {
-            new_terms.push(NoiseTerm {
-                name: format!("thermal.{}", e.name),
+            b.terms.push(NoiseTerm {
+                kind: TermKind::ThermalElement(e.name.clone()),
                 psd: e.psd[o].clone(),
             });
         }
-        b.terms.splice(at..at, new_terms);
     }
 }
 
@@ -266,7 +290,7 @@ pub fn add_measured(budget: &mut Budget, o: Observable, measured_psd: Vec<f64>) 
     };
     let residual = measured_psd
         .iter()
-        .zip(&b.total().psd)
+        .zip(&b.total())
         // f64::max would turn a NaN (not measured there) into 0: keep it NaN.
         .map(|(m, t)| {
             if m.is_nan() {
@@ -276,21 +300,14 @@ pub fn add_measured(budget: &mut Budget, o: Observable, measured_psd: Vec<f64>) 
             }
         })
         .collect();
-    let at = b.terms.len() - 1;
-    b.terms.insert(
-        at,
-        NoiseTerm {
-            name: "measured".into(),
-            psd: measured_psd,
-        },
-    );
-    b.terms.insert(
-        at + 1,
-        NoiseTerm {
-            name: "residual".into(),
-            psd: residual,
-        },
-    );
+    b.terms.push(NoiseTerm {
+        kind: TermKind::Measured,
+        psd: measured_psd,
+    });
+    b.terms.push(NoiseTerm {
+        kind: TermKind::Residual,
+        psd: residual,
+    });
 }
 
 #[cfg(test)]
@@ -328,12 +345,15 @@ mod tests {
         let expected = a.norm_sqr() * s1 + b.norm_sqr() * s2 + 2.0 * (a.conj() * c * b).re;
         // Sums of four products of O(10) numbers: a few ulps of the largest product.
         let tol = 8.0 * f64::EPSILON * 100.0;
-        assert!((x.term("tilt").unwrap().psd[0] - expected).abs() < tol);
-        assert_eq!(x.term("tilt.theta_t").unwrap().psd[0], a.norm_sqr() * s1);
-        assert_eq!(x.term("tilt.eta_t").unwrap().psd[0], b.norm_sqr() * s2);
+        let tilt = x.term(&TermKind::Tilt).unwrap().psd[0];
+        assert!((tilt - expected).abs() < tol);
+        let theta = TermKind::TiltAxis(TiltAxis::ThetaT);
+        assert_eq!(x.term(&theta).unwrap().psd[0], a.norm_sqr() * s1);
+        let eta = TermKind::TiltAxis(TiltAxis::EtaT);
+        assert_eq!(x.term(&eta).unwrap().psd[0], b.norm_sqr() * s2);
         let readout = PAPER_X_READOUT_ASD_M * PAPER_X_READOUT_ASD_M;
-        assert_eq!(x.term("readout").unwrap().psd[0], readout);
-        assert_eq!(x.total().psd[0], x.term("tilt").unwrap().psd[0] + readout);
+        assert_eq!(x.term(&TermKind::Readout).unwrap().psd[0], readout);
+        assert_eq!(x.total()[0], tilt + readout);
     }
 
     #[test]
@@ -356,8 +376,9 @@ mod tests {
         );
         add_measured(&mut budget, Observable::X, vec![5.0]);
         let x = budget.observable(Observable::X).unwrap();
-        assert_eq!(x.term("residual").unwrap().psd[0], 3.0);
-        assert_eq!(x.terms.last().unwrap().name, "total");
+        assert_eq!(x.term(&TermKind::Residual).unwrap().psd[0], 3.0);
+        let last = x.components().pop().map(|(c, _)| c);
+        assert_eq!(last, Some(Component::Total));
     }
 }
 
@@ -420,19 +441,26 @@ impl BudgetReport {
             }
             seen.push(o);
             for term in &ob.terms {
-                let bad = term.name.is_empty() || term.name.contains(['/', ',', '\n']);
+                let name = term.name();
+                let bad = name.is_empty() || name.contains(['/', ',', '\n']);
                 if bad {
                     return Err(format!(
-                    "term name `{}` of {o} is not allowed: must be non-empty, without `/`, `,` \
-                     or line breaks",
-                    term.name
-                ));
+                        "term name `{name}` of {o} is not allowed: must be non-empty, without \
+                         `/`, `,` or line breaks"
+                    ));
                 }
                 if term.psd.len() != n_f {
                     return Err(format!(
-                        "term {o}.{} has {} values, expected {n_f} (one per frequency)",
-                        term.name,
+                        "term {o}.{name} has {} values, expected {n_f} (one per frequency)",
                         term.psd.len()
+                    ));
+                }
+            }
+            if let Some(c) = &ob.calibration {
+                if c.response_psd.len() != n_f {
+                    return Err(format!(
+                        "calibration of {o} has {} values, expected {n_f}",
+                        c.response_psd.len()
                     ));
                 }
             }

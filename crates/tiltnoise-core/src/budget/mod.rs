@@ -8,12 +8,16 @@
 //! Progress is reported through a callback; the library never draws to the terminal.
 //! Conventions: one-sided spectra, PSD in unit^2/Hz (see [`crate::noise`]).
 
+mod measured;
+
+pub use measured::{add_measured, series_psds, MeasuredPsds};
+
 use crate::error::TfError;
 use crate::input::{InputError, SeriesSource, TiltSpectra};
 use crate::model::{Model, Observable, TiltAxis};
 use crate::noise::{
     add_equivalent_response, add_thermal, tilt_budget, Budget, BudgetReport, Readout, SegmentBand,
-    SpectralSource, TiltCsd,
+    SpectralSource, TermKind, TiltCsd,
 };
 use crate::spectral::{Averaging, SpectralError, WelchAccumulator, WelchConfig};
 use crate::tf::{self, Input, Request, TransferMatrix};
@@ -204,7 +208,7 @@ pub fn budget_from_series(
                         &Readout { asd: vec![] },
                     );
                     for (o, ob) in b.observables.iter().enumerate() {
-                        let psd = &ob.term("tilt").expect("tilt term").psd;
+                        let psd = &ob.term(&TermKind::Tilt).expect("tilt term").psd;
                         segment_tilt[o].push(psd.iter().map(|&p| p as f32).collect());
                     }
                 }
