@@ -2,11 +2,21 @@
 
 mod cli;
 
-use clap::Parser;
+use clap::{CommandFactory, FromArgMatches};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    let cli = cli::Cli::parse();
+    // `--version` names the HDF5 library linked in (bundled, static).
+    let version = format!(
+        "{} (HDF5 {}, static)",
+        env!("CARGO_PKG_VERSION"),
+        tiltnoise_io::hdf5_version()
+    );
+    let matches = cli::Cli::command().version(version).get_matches();
+    let cli = match cli::Cli::from_arg_matches(&matches) {
+        Ok(cli) => cli,
+        Err(e) => e.exit(),
+    };
     match cli::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

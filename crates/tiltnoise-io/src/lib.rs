@@ -75,6 +75,13 @@ impl RunMeta {
     }
 }
 
+/// Version of the HDF5 library linked into this build (`major.minor.release`): the one
+/// bundled with `hdf5-metno`, built from source and linked statically.
+pub fn hdf5_version() -> String {
+    let (major, minor, release) = hdf5::library_version();
+    format!("{major}.{minor}.{release}")
+}
+
 /// This crate's version, `env!("CARGO_PKG_VERSION")`, for [`RunMeta::tool_version`].
 pub const TOOL_VERSION: &str = env!("CARGO_PKG_VERSION");
 
