@@ -1,6 +1,7 @@
-//! Readers for floor-tilt inputs: tilt **time series** and tilt **spectra**, from HDF5 or CSV,
-//! with strict validation. Pure input code: no plotting, no command line. The exact file
-//! layouts are documented in `docs/input_formats.md`.
+//! Floor-tilt inputs as data: tilt **time series** and tilt **spectra**, their conventions, the
+//! channel-to-axis map, rate integration, gaps, provenance and the typed [`InputError`]. The
+//! readers that fill them from HDF5 or CSV files are in `tiltnoise-io` (`tiltnoise_io::input`);
+//! this module reads no file. The exact file layouts are documented in `docs/input_formats.md`.
 //!
 //! # Conventions
 //!
@@ -44,15 +45,12 @@
 //! signed channel, before any integration; a run touching either end is an error
 //! ([`InputError::EdgeGap`]). In CSV an empty field is a non-finite sample.
 //!
-//! # Entry points
+//! # What the readers return
 //!
-//! * [`read_tilt`]: decides by extension (`.h5`/`.hdf5` vs `.csv`) and content whether the
-//!   file holds a series or spectra, and returns a [`TiltInput`].
-//! * [`read_tilt_series`] / [`read_tilt_spectra`]: the same, insisting on one kind.
-//! * [`TiltSeriesSource`]: streaming access to an HDF5 series in chunks (bounded memory), with
-//!   results bit-identical to [`read_tilt_series`].
-//!
-//! Every result carries a [`Provenance`] for the output files.
+//! * [`TiltInput`]: a [`TiltSeries`] or [`TiltSpectra`], each with its [`Provenance`] for the
+//!   output files.
+//! * A [`SeriesSource`]: chunked, sequential access to a series (the budget job streams long
+//!   records through it); [`TiltSeries`] is one, held in memory.
 
 mod axis_map;
 mod error;
