@@ -115,9 +115,19 @@ pub fn read_freq_file(path: &Path) -> Result<Vec<f64>, FreqError> {
     parse_freq_text(&text, &origin)
 }
 
+/// Modal loss angles below this are treated as undamped when the grid is built: at the pole of
+/// such a mode the equilibrated dynamic stiffness has a reciprocal condition number of about
+/// `phi_k` times a factor of the mode's shape (down to 1e-3 for the weakly coupled modes of a
+/// partly damped model), which would fall below the solvers' singularity threshold
+/// [`crate::tf::SINGULAR_RCOND`]. Such a mode is bracketed like an undamped one instead: its
+/// peak (of height ~ 1/phi_k > 5e8) is not sampled, only approached to 3e-7 relative.
+pub const NEGLIGIBLE_MODAL_LOSS: f64 = 1e3 * crate::tf::SINGULAR_RCOND;
+
 /// Adds points around every mode of `model` inside `[lo, hi]` of `grid`, then sorts and
 /// removes duplicates. Undamped modes are bracketed by relative offsets down to 3e-7 (never on the
-/// pole); a mode with modal loss angle `phi_k` gets points across its width `f_k phi_k / 2`.
+/// pole); a mode with modal loss angle `phi_k` of at least [`NEGLIGIBLE_MODAL_LOSS`] gets points
+/// across its width `f_k phi_k / 2`, one of them on the peak; a mode with a smaller, negligible
+/// loss angle is bracketed as an undamped one.
 pub fn refine_around_modes(grid: &[f64], model: &Model) -> Vec<f64> {
     let (lo, hi) = grid
         .iter()
@@ -140,7 +150,7 @@ pub fn refine_around_modes(grid: &[f64], model: &Model) -> Vec<f64> {
                 add(-x);
             }
         }
-        if loss > 0.0 {
+        if loss >= NEGLIGIBLE_MODAL_LOSS {
             for w in DAMPED_WIDTHS {
                 add(w * loss / 2.0);
                 add(-w * loss / 2.0);
@@ -219,5 +229,36 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("no frequencies"), "{e}");
+    }
+
+    /// A single loss angle leaves the modes that touch its element only weakly with modal loss
+    /// angles near 1e-13: the default grid must bracket them as undamped instead of sampling
+    /// their unresolvable peaks, so that every method of the full model evaluates it.
+    #[test]
+    fn partly_damped_models_evaluate_on_the_default_grid() {
+        use crate::model::Request;
+        use crate::params::Params;
+        use crate::tf::{evaluate, plan, Method};
+        let keys = [
+            "loss.torsion_a_rad",
+            "loss.torsion_b_rad",
+            "loss.bouncing_a_rad",
+            "loss.bouncing_b_rad",
+            "loss.bending_a_rad",
+            "loss.bending_b_rad",
+        ];
+        for key in keys {
+            let params = Params::table_i()
+                .with_override(&format!("{key}=1e-3"))
+                .unwrap();
+            let model = Model::new(&params).unwrap();
+            let grid = default_grid(&model);
+            for method in [Method::Direct, Method::Split, Method::PoleZero] {
+                let tf = plan(&model, &Request::all_tilt(), method).unwrap();
+                if let Err(e) = evaluate(tf.as_ref(), &grid) {
+                    panic!("{key}=1e-3, {}: {e}", method.name());
+                }
+            }
+        }
     }
 }
