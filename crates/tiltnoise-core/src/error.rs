@@ -45,6 +45,26 @@ pub enum ParamError {
         /// The failing pivot or eigenvalue.
         detail: String,
     },
+    /// The equilibrium the model linearizes about is not stable: a mode has `omega^2 <= 0`.
+    #[error(
+        "the parameters give an unstable equilibrium: the mode dominated by {mode} has \
+         omega^2 = {omega_sq:.3e} rad^2/s^2 (must be > 0; the stiffness K is not positive \
+         definite). Check the lengths (a centre of mass above its suspension point, \
+         length.z_a_m > length.z_m or length.z_b_m too short against length.h_c_m) and the \
+         torsion and bouncing constants"
+    )]
+    Unstable {
+        /// The smallest generalized eigenvalue of (K, M).
+        omega_sq: f64,
+        /// Dominant coordinates of the unstable mode with their energy shares in M.
+        mode: String,
+    },
+    /// A matrix of the model overflows `f64` for the given parameter values.
+    #[error("the parameters cannot be represented: {detail}")]
+    NotFinite {
+        /// What overflowed.
+        detail: String,
+    },
     /// `--set KEY=VALUE` with a malformed assignment or a key that does not exist.
     #[error("--set {assignment}: {message}")]
     Override {

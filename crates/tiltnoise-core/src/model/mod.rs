@@ -44,6 +44,57 @@ pub struct Derived {
     pub lever_m: f64,
 }
 
+/// Refuses a parameter set whose equilibrium is not stable: the undamped stiffness `K` must be
+/// positive definite on the model's coordinates, i.e. every generalized eigenvalue
+/// `omega^2` of `(K, M)` positive. The error names the unstable mode by its dominant
+/// coordinates (e.g. a crossbar centre of mass above the upper suspension point makes the
+/// crossbar's swing unstable).
+fn check_stable(mass: &Mat8, stiffness: &Mat8) -> Result<(), ParamError> {
+    // M = L L^T; L^-1 K L^-T has the generalized eigenvalues of (K, M); M was checked
+    // positive definite before.
+    let Some(chol) = mass.cholesky() else {
+        return Ok(());
+    };
+    let l = chol.l();
+    let Some(l_inv) = l.try_inverse() else {
+        return Ok(());
+    };
+    let a = l_inv * stiffness * l_inv.transpose();
+    let a = (a + a.transpose()) * 0.5;
+    let eig = a.symmetric_eigen();
+    let scale = eig.eigenvalues.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    // Eigenvalues within rounding of zero (n eps ||A||) count as zero, which is not stable
+    // either: a zero-frequency mode has no restoring force.
+    let tol = 8.0 * f64::EPSILON * scale;
+    let (k, &omega_sq) = eig
+        .eigenvalues
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(b.1))
+        .expect("8 eigenvalues");
+    if omega_sq > tol && omega_sq.is_finite() {
+        return Ok(());
+    }
+    // The mode shape in the model's coordinates: q = L^-T y.
+    let q = l_inv.transpose() * eig.eigenvectors.column(k);
+    let energy: Vec<f64> = (0..8).map(|i| q[i] * (mass * q)[i]).collect();
+    let total: f64 = energy.iter().sum();
+    let mut shares: Vec<(Coord, f64)> = Coord::ALL
+        .iter()
+        .map(|&c| (c, energy[c.index()] / total))
+        .collect();
+    shares.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let dominant: Vec<String> = shares
+        .iter()
+        .filter(|(_, s)| *s >= 0.1)
+        .map(|(c, s)| format!("{} {s:.2}", c.name()))
+        .collect();
+    Err(ParamError::Unstable {
+        omega_sq,
+        mode: dominant.join(", "),
+    })
+}
+
 /// The linear model built from one validated parameter set. Immutable; cheap to clone.
 #[derive(Debug, Clone)]
 pub struct Model {
@@ -64,7 +115,9 @@ pub struct Model {
 
 impl Model {
     /// Builds the model. Fails if the mass matrix is not positive definite (possible for
-    /// parameter sets that pass the per-key checks, e.g. a huge negative I^a_23 coupling).
+    /// parameter sets that pass the per-key checks, e.g. a huge negative I^a_23 coupling), if
+    /// the equilibrium is not stable (the stiffness is not positive definite, see
+    /// [`ParamError::Unstable`]), or if a matrix entry overflows.
     pub fn new(params: &Params) -> Result<Model, ParamError> {
         let derived = matrices::derived(params);
         let mass = matrices::mass(params, &derived);
@@ -80,9 +133,27 @@ impl Model {
                 detail: format!("smallest eigenvalue {eig:e} (mixed units kg, kg m, kg m^2)"),
             });
         }
+        check_stable(&mass, &(stiffness_gravity + stiffness_elastic))?;
         let force = matrices::force_matrix(params, &derived);
         let tilt = tilt::TiltForcing::new(params, &derived, &force, &stiffness_gravity);
         let observation = matrices::observation(params);
+        let finite = |m: &[f64]| m.iter().all(|x| x.is_finite());
+        if !(finite(mass.as_slice())
+            && finite(stiffness_gravity.as_slice())
+            && finite(stiffness_elastic.as_slice())
+            && finite(stiffness_imag.as_slice())
+            && finite(damping.as_slice())
+            && finite(force.as_slice())
+            && finite(tilt.g0.as_slice())
+            && finite(tilt.g2.as_slice())
+            && finite(observation.as_slice()))
+        {
+            return Err(ParamError::NotFinite {
+                detail: "an entry of M, K, C, the force, tilt or observation matrix overflows \
+                         f64; the parameter values are far outside a laboratory pendulum's"
+                    .into(),
+            });
+        }
         Ok(Model {
             params: params.clone(),
             derived,
@@ -200,5 +271,33 @@ impl Model {
     pub fn block_of(matrix: &Mat8, block: Block) -> SMatrix<f64, 4, 4> {
         let idx = block.coords().map(Coord::index);
         SMatrix::<f64, 4, 4>::from_fn(|r, c| matrix[(idx[r], idx[c])])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Without the upper fibre's torsion constant the crossbar's torsion has only the negative
+    /// gravity stiffness of its offset centre of mass: an unstable equilibrium, refused with
+    /// the mode named.
+    #[test]
+    fn unstable_equilibrium_is_refused_naming_the_mode() {
+        let params = Params::table_i()
+            .with_override("torsion.k_a_n_m_per_rad=1e-30")
+            .unwrap();
+        let err = Model::new(&params).unwrap_err();
+        match &err {
+            ParamError::Unstable { omega_sq, mode } => {
+                assert!(*omega_sq < 0.0, "{err}");
+                assert!(mode.starts_with("phi_a"), "{err}");
+            }
+            other => panic!("expected Unstable, got {other}"),
+        }
+    }
+
+    #[test]
+    fn table_i_is_stable() {
+        assert!(Model::new(&Params::table_i()).is_ok());
     }
 }
