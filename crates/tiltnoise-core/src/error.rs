@@ -2,7 +2,25 @@
 //! the key or file, the offending value, the unit and what is allowed. The binary adds context
 //! with `anyhow` and maps every error to exit code 2.
 
+use std::fmt;
 use std::path::PathBuf;
+
+/// A number as messages show it: the shortest decimal that reads back to the same `f64`, in
+/// exponent form when it would be long (`|x| >= 1e7` or `|x| < 1e-5`), so that a value such as
+/// `1e300` never turns into 301 digits.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Num(pub f64);
+
+impl fmt::Display for Num {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let x = self.0;
+        if x != 0.0 && x.is_finite() && !(1e-5..1e7).contains(&x.abs()) {
+            write!(f, "{x:e}")
+        } else {
+            write!(f, "{x}")
+        }
+    }
+}
 
 /// A parameter set that cannot describe a physical pendulum, or a parameter file that cannot be read.
 #[derive(Debug, thiserror::Error)]
@@ -24,7 +42,7 @@ pub enum ParamError {
         message: String,
     },
     /// A numeric value outside the physically allowed range.
-    #[error("parameter `{key}` = {value} {unit} is not allowed: must be {allowed}")]
+    #[error("parameter `{key}` = {} {unit} is not allowed: must be {allowed}", Num(*.value))]
     OutOfRange {
         /// Dotted key, e.g. `inertia.a11_kg_m2`.
         key: String,
@@ -79,7 +97,7 @@ pub enum ParamError {
 #[derive(Debug, thiserror::Error)]
 pub enum FreqError {
     /// A frequency that is negative, NaN or infinite.
-    #[error("frequency {value} Hz ({origin}) is not allowed: must be finite and >= 0")]
+    #[error("frequency {} Hz ({origin}) is not allowed: must be finite and >= 0", Num(*.value))]
     Invalid {
         /// The value.
         value: f64,
@@ -102,8 +120,9 @@ pub enum TfError {
     /// The dynamic stiffness `K(1 + i phi) - w^2 M` is singular to working precision: the
     /// frequency sits on an undamped resonance.
     #[error(
-        "dynamic stiffness is singular at {freq_hz} Hz (reciprocal condition {rcond:.1e} after \
-         equilibration): an undamped resonance; add loss angles or move the frequency"
+        "dynamic stiffness is singular at {} Hz (reciprocal condition {rcond:.1e} after \
+         equilibration): an undamped resonance; add loss angles or move the frequency",
+        Num(*.freq_hz)
     )]
     Singular {
         /// The frequency asked for.
@@ -114,6 +133,17 @@ pub enum TfError {
     /// A frequency that is negative or not finite.
     #[error(transparent)]
     Freq(#[from] FreqError),
+    /// A value of the transfer function overflows `f64` (a frequency or parameter values far
+    /// beyond a laboratory pendulum's): refused rather than returned as inf or NaN.
+    #[error(
+        "the transfer function is not finite at {} Hz: the frequency or the parameter \
+         values are beyond the range of f64",
+        Num(*.freq_hz)
+    )]
+    NotFinite {
+        /// The first frequency (in grid order) with a non-finite value.
+        freq_hz: f64,
+    },
     /// The planner found no method that meets the requested tolerance, or cannot plan the
     /// request ([`crate::tf::plan_auto`]).
     #[error("{message}")]

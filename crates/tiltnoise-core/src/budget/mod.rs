@@ -45,6 +45,9 @@ pub enum BudgetError {
     /// Options that contradict each other or the input.
     #[error("{0}")]
     Config(String),
+    /// A spectrum or budget term that overflowed `f64`.
+    #[error("{0}")]
+    NotFinite(String),
 }
 
 /// Options of a budget run.
@@ -223,6 +226,7 @@ pub fn budget_from_series(
         Some(tf) => tf,
         None => tilt_tf(model, &opts.outputs, &axes, grid)?,
     };
+    check_csd_finite(&spectra.data, &axes)?;
     let mut budget = tilt_budget(
         &tf,
         &TiltCsd {
@@ -241,6 +245,7 @@ pub fn budget_from_series(
     }
     let segment_bands = band_per_observable(&opts.outputs, &segment_tilt, opts.percentiles);
     add_damping_terms(model, &mut budget)?;
+    check_budget_finite(&budget)?;
     Ok(BudgetReport {
         budget,
         segment_duration_s: segment_samples
@@ -313,6 +318,7 @@ pub fn budget_from_spectra(
         &opts.readout,
     );
     add_damping_terms(model, &mut budget)?;
+    check_budget_finite(&budget)?;
     Ok(BudgetReport {
         budget,
         segment_bands: Vec::new(),
@@ -324,6 +330,43 @@ pub fn budget_from_spectra(
         readout: opts.readout.clone(),
         notes,
     })
+}
+
+/// Refuses tilt cross-spectra that overflowed `f64` (samples far beyond any tilt angle, e.g.
+/// 1e200 rad, square to infinity), naming the axis.
+fn check_csd_finite(csd: &[num_complex::Complex64], axes: &[TiltAxis]) -> Result<(), BudgetError> {
+    let n = axes.len();
+    if let Some(j) = csd
+        .iter()
+        .position(|z| !(z.re.is_finite() && z.im.is_finite()))
+    {
+        let axis = axes[(j % (n * n)) / n];
+        return Err(BudgetError::NotFinite(format!(
+            "the tilt power spectrum of {} overflows f64: its samples are far too large to be \
+             tilt angles in rad (check the file's units and --quantity)",
+            axis.name()
+        )));
+    }
+    Ok(())
+}
+
+/// Refuses a budget with a non-finite model term: every number the budget reports is finite
+/// (a measured term may hold NaN where the record does not reach, which is documented).
+fn check_budget_finite(budget: &Budget) -> Result<(), BudgetError> {
+    for ob in &budget.observables {
+        for term in &ob.terms {
+            if let Some(k) = term.psd.iter().position(|p| !p.is_finite()) {
+                return Err(BudgetError::NotFinite(format!(
+                    "the {} term of {} is not finite at {} Hz: the input or the parameters are \
+                     beyond the range of f64",
+                    term.kind,
+                    ob.observable.name(),
+                    crate::error::Num(budget.freqs_hz[k])
+                )));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Log-log interpolation of a positive spectrum `(freqs, values)` at `f` (for reading a budget

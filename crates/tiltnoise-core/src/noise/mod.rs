@@ -188,8 +188,9 @@ fn propagate(
         }
         per_axis[i] = h[i].norm_sqr() * s[i * n + i].re;
     }
-    // A positive semi-definite S gives total >= 0; rounding can leave -eps * scale.
-    (total.max(0.0), per_axis)
+    // A positive semi-definite S gives total >= 0; rounding can leave -eps * scale. A NaN (from
+    // an overflow) stays NaN for the budget's finiteness check: `f64::max` would make it 0.
+    (if total < 0.0 { 0.0 } else { total }, per_axis)
 }
 
 /// Builds the budget of every output of `tf` from the tilt cross-spectra (same grid as `tf`)

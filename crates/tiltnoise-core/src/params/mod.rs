@@ -217,7 +217,16 @@ pub enum Allowed {
     LossAngle,
     /// A dilution factor: finite and >= 1.
     AtLeastOne,
+    /// A length of the pendulum: > 0 and at most [`MAX_LENGTH_M`].
+    Length,
+    /// A length that may be 0: >= 0 and at most [`MAX_LENGTH_M`].
+    LengthOrZero,
 }
+
+/// The largest length a parameter may have (m). The model describes a laboratory pendulum;
+/// lengths far beyond one (`length.h_m = 1e300`, say) make the apparent forces `w^2 h` and the
+/// spectra overflow `f64`, so they are refused at the key instead of giving inf or NaN later.
+pub const MAX_LENGTH_M: f64 = 1e3;
 
 impl Allowed {
     fn admits(self, v: f64) -> bool {
@@ -228,6 +237,8 @@ impl Allowed {
                 Allowed::Finite => true,
                 Allowed::LossAngle => (0.0..1.0).contains(&v),
                 Allowed::AtLeastOne => v >= 1.0,
+                Allowed::Length => v > 0.0 && v <= MAX_LENGTH_M,
+                Allowed::LengthOrZero => (0.0..=MAX_LENGTH_M).contains(&v),
             }
     }
 
@@ -239,6 +250,8 @@ impl Allowed {
             Allowed::Finite => "finite",
             Allowed::LossAngle => "finite, >= 0 and < 1",
             Allowed::AtLeastOne => "finite and >= 1",
+            Allowed::Length => "> 0 and <= 1000 (a laboratory pendulum)",
+            Allowed::LengthOrZero => ">= 0 and <= 1000 (a laboratory pendulum)",
         }
     }
 }
@@ -421,12 +434,12 @@ impl Params {
                 "kappa_e,b",
                 Positive,
             ),
-            f("length.d_m", l.d_m, "m", "d", Positive),
-            f("length.h_c_m", l.h_c_m, "m", "h_c", NonNegative),
-            f("length.z_m", l.z_m, "m", "Z", Positive),
-            f("length.z_a_m", l.z_a_m, "m", "Z_a", Positive),
-            f("length.z_b_m", l.z_b_m, "m", "Z_b", Positive),
-            f("length.h_m", l.h_m, "m", "h (assumption)", Positive),
+            f("length.d_m", l.d_m, "m", "d", Length),
+            f("length.h_c_m", l.h_c_m, "m", "h_c", LengthOrZero),
+            f("length.z_m", l.z_m, "m", "Z", Length),
+            f("length.z_a_m", l.z_a_m, "m", "Z_a", Length),
+            f("length.z_b_m", l.z_b_m, "m", "Z_b", Length),
+            f("length.h_m", l.h_m, "m", "h (assumption)", Length),
             f(
                 "environment.g_m_per_s2",
                 self.environment.g_m_per_s2,

@@ -72,7 +72,18 @@ pub fn eval_grid_threads(
     }
     let part = part_len(freqs_hz.len(), threads);
     let jobs = freqs_hz.chunks(part).zip(out.chunks_mut(part * block));
-    on_threads(jobs, &|f, o| tf.eval_grid_into(f, o))
+    on_threads(jobs, &|f, o| {
+        tf.eval_grid_into(f, o)?;
+        match o
+            .iter()
+            .position(|z| !(z.re.is_finite() && z.im.is_finite()))
+        {
+            None => Ok(()),
+            Some(j) => Err(TfError::NotFinite {
+                freq_hz: f[j / block],
+            }),
+        }
+    })
 }
 
 /// Evaluates a plan on every frequency of a grid, on one thread, into a new matrix in the
@@ -135,8 +146,26 @@ pub fn evaluate_into(
     }
     let jobs = freqs_hz.chunks(part).zip(parts);
     on_threads(jobs, &|f, mut p: Vec<&mut [f64]>| {
-        tf.eval_grid_layout_into(f, &mut p)
-    })
+        tf.eval_grid_layout_into(f, &mut p)?;
+        check_finite(f, &p)
+    })?;
+    Ok(())
+}
+
+/// The first frequency of `freqs_hz` at which a value of `planes` (one per plane, as long as
+/// the grid) is not finite, as [`TfError::NotFinite`]: an overflow that no method reports
+/// otherwise (a frequency or parameters beyond the range of `f64`), never a silent NaN.
+fn check_finite(freqs_hz: &[f64], planes: &[&mut [f64]]) -> Result<(), TfError> {
+    let first_bad = planes
+        .iter()
+        .filter_map(|p| p.iter().position(|v| !v.is_finite()))
+        .min();
+    match first_bad {
+        None => Ok(()),
+        Some(k) => Err(TfError::NotFinite {
+            freq_hz: freqs_hz[k],
+        }),
+    }
 }
 
 #[cfg(test)]
