@@ -50,7 +50,7 @@ pub fn frequencies_and_jacobian(
     keys: &[String],
 ) -> Result<([f64; 8], DMatrix<f64>), FitError> {
     let model = Model::new(params).map_err(FitError::Params)?;
-    let modes = NormalModes::new(&model);
+    let modes = NormalModes::new_f64(&model);
     let freqs: [f64; 8] = std::array::from_fn(|k| modes.modes[k].frequency_hz);
     let mut jac = DMatrix::zeros(8, keys.len());
     for (j, key) in keys.iter().enumerate() {

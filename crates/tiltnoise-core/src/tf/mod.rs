@@ -253,3 +253,47 @@ pub fn plan(
         Method::StateSpace => Box::new(StateSpace::new(model, request.clone())),
     })
 }
+
+#[cfg(test)]
+mod resonance_tests {
+    use super::*;
+    use crate::modes::NormalModes;
+    use crate::params::Params;
+
+    /// Every mode frequency as `NormalModes` gives it (refined to the last bit) is an exact
+    /// undamped resonance, which every method of the full model reports as singular; a
+    /// frequency one part in 1e9 away is evaluated.
+    #[test]
+    fn exact_undamped_resonances_are_singular_for_every_method() {
+        let model = Model::new(&Params::table_i()).unwrap();
+        let modes = NormalModes::new(&model);
+        let methods = [
+            Method::Direct,
+            Method::Block,
+            Method::Split,
+            Method::PoleZero,
+            Method::Modal,
+            Method::StateSpace,
+        ];
+        for mode in &modes.modes {
+            let f = mode.frequency_hz;
+            for method in methods {
+                let tf = plan(&model, &Request::all_tilt(), method).unwrap();
+                match tf.eval(f) {
+                    Err(TfError::Singular { .. }) => {}
+                    other => panic!(
+                        "nu_{} = {f:?} Hz, {}: expected singular, got {other:?}",
+                        mode.index,
+                        method.name()
+                    ),
+                }
+                assert!(
+                    tf.eval(f * (1.0 + 1e-9)).is_ok(),
+                    "nu_{} + 1e-9, {}",
+                    mode.index,
+                    method.name()
+                );
+            }
+        }
+    }
+}
