@@ -3,7 +3,7 @@
 
 use super::args::{parse_readout_item, AverageArg};
 use super::output::save_budget;
-use anyhow::{anyhow, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use std::fmt::Write as _;
 use std::io::IsTerminal;
@@ -33,24 +33,26 @@ pub struct BudgetArgs {
     /// Quantity of the channels: angle (rad) or rate (rad/s); default from the file, else angle.
     #[arg(long, value_name = "angle|rate")]
     pub quantity: Option<String>,
-    /// Non-finite samples: reject (default) or interpolate linearly across interior gaps.
-    #[arg(long, value_name = "reject|interpolate", default_value = "reject")]
-    pub gaps: String,
+    /// Non-finite samples of a time series: reject (default) or interpolate linearly across
+    /// interior gaps.
+    #[arg(long, value_name = "reject|interpolate")]
+    pub gaps: Option<String>,
     /// Welch segment length in samples (default 2^14, or the largest power of two <= N/4).
     #[arg(long, value_name = "N")]
     pub nperseg: Option<usize>,
-    /// Welch overlap as a fraction of the segment.
-    #[arg(long, value_name = "FRACTION", default_value_t = 0.5)]
-    pub overlap: f64,
-    /// Welch averaging: mean, or median (with scipy's bias correction).
-    #[arg(long, value_enum, default_value_t = AverageArg::Mean)]
-    pub average: AverageArg,
+    /// Welch overlap as a fraction of the segment (default 0.5).
+    #[arg(long, value_name = "FRACTION", allow_negative_numbers = true)]
+    pub overlap: Option<f64>,
+    /// Welch averaging: mean (default), or median (with scipy's bias correction).
+    #[arg(long, value_enum)]
+    pub average: Option<AverageArg>,
     /// Split the record into segments of this many seconds (e.g. 3600) for a percentile band.
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     pub segment_duration: Option<f64>,
-    /// Percentiles of the band across segments, LOWER,UPPER.
-    #[arg(long, value_name = "LO,HI", default_value = "10,90")]
-    pub percentiles: String,
+    /// Percentiles of the band across segments, LOWER,UPPER (default 10,90; with
+    /// --segment-duration).
+    #[arg(long, value_name = "LO,HI")]
+    pub percentiles: Option<String>,
     /// White readout noise OBS=ASD in the observable's unit/sqrt(Hz) (repeatable; default
     /// X=9e-9 m/sqrt(Hz) from the paper; OBS=0 removes it).
     #[arg(long, value_name = "OBS=ASD")]
@@ -114,6 +116,8 @@ fn read_options(args: &BudgetArgs) -> Result<ReadOptions> {
             .map_err(|e: String| anyhow!("--quantity: {e}"))?,
         gaps: args
             .gaps
+            .as_deref()
+            .unwrap_or("reject")
             .parse()
             .map_err(|e: String| anyhow!("--gaps: {e}"))?,
     })
@@ -157,22 +161,79 @@ fn summary(report: &BudgetReport) -> String {
     s
 }
 
+/// Options of a time series, refused for spectra input rather than ignored.
+fn refuse_series_options(args: &BudgetArgs, path: &std::path::Path) -> Result<()> {
+    let given = [
+        ("--nperseg", args.nperseg.is_some()),
+        ("--overlap", args.overlap.is_some()),
+        ("--average", args.average.is_some()),
+        ("--segment-duration", args.segment_duration.is_some()),
+        ("--gaps", args.gaps.is_some()),
+    ];
+    if let Some((name, _)) = given.iter().find(|(_, g)| *g) {
+        bail!(
+            "{name} applies to time-series input, and {} holds spectra; leave it out (the \
+             model grid of spectra input is set with --freq)",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+/// Options of spectra input, refused for a time series rather than ignored.
+fn refuse_spectra_options(args: &BudgetArgs, path: &std::path::Path) -> Result<()> {
+    if args.freq.is_some() {
+        bail!(
+            "--freq applies to spectra input, and {} holds a time series, whose budget is on \
+             the Welch grid (set its resolution with --nperseg)",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
 /// Runs `tiltnoise budget`.
 pub(crate) fn run_budget(params: &Params, args: BudgetArgs) -> Result<()> {
     let model = Model::new(params)?;
     for path in &args.save {
         OutputKind::from_path(path)?;
     }
+    if args.percentiles.is_some() && args.segment_duration.is_none() {
+        bail!(
+            "--percentiles applies to the per-segment band and needs --segment-duration \
+             (e.g. --segment-duration 3600)"
+        );
+    }
+    let defaults = BudgetOptions::default();
+    let readout = parse_readout(&args.readout)?;
+    for (o, _) in &readout.asd {
+        if !defaults.outputs.contains(o) {
+            bail!(
+                "--readout {}=...: {} is not budgeted; allowed: {}",
+                o.name(),
+                o.name(),
+                defaults
+                    .outputs
+                    .iter()
+                    .map(|o| o.name())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+        }
+    }
     let opts = BudgetOptions {
         welch_segment_len: args.nperseg,
-        welch_overlap_fraction: args.overlap,
-        averaging: match args.average {
+        welch_overlap_fraction: args.overlap.unwrap_or(defaults.welch_overlap_fraction),
+        averaging: match args.average.unwrap_or(AverageArg::Mean) {
             AverageArg::Mean => Averaging::Mean,
             AverageArg::Median => Averaging::Median,
         },
         segment_duration_s: args.segment_duration,
-        percentiles: parse_percentiles(&args.percentiles)?,
-        readout: parse_readout(&args.readout)?,
+        percentiles: match &args.percentiles {
+            Some(text) => parse_percentiles(text)?,
+            None => defaults.percentiles,
+        },
+        readout,
         spectra_grid_hz: match &args.freq {
             Some(spec) => freq::parse_spec(spec)?,
             None => freq::default_grid(&model),
@@ -185,6 +246,7 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs) -> Result<()> {
     let streamable = InputFormat::from_path(path)? == InputFormat::Hdf5
         && TiltSeriesSource::open(path, &ropts).is_ok();
     let (report, provenance) = if streamable {
+        refuse_spectra_options(&args, path)?;
         let mut source = TiltSeriesSource::open(path, &ropts)?;
         let provenance = source.provenance().clone();
         let bar = progress_bar(source.len() as u64);
@@ -198,11 +260,13 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs) -> Result<()> {
     } else {
         match read_tilt(path, &ropts)? {
             TiltInput::Series(mut series) => {
+                refuse_spectra_options(&args, path)?;
                 let provenance = series.provenance.clone();
                 let report = budget_from_series(&model, &mut series, &opts, &mut |_, _| {});
                 (report, provenance)
             }
             TiltInput::Spectra(spectra) => {
+                refuse_series_options(&args, path)?;
                 let provenance = spectra.provenance.clone();
                 (budget_from_spectra(&model, &spectra, &opts), provenance)
             }

@@ -161,6 +161,13 @@ pub fn budget_from_series(
                     seg_len as f64 / fs
                 )));
             }
+            if s > n as f64 {
+                return Err(BudgetError::Config(format!(
+                    "segment duration {d} s is not allowed: it is longer than the record \
+                     ({n} samples = {} s at {fs} Hz), which then has no segment to compare",
+                    crate::error::Num(n as f64 / fs)
+                )));
+            }
             Some(s as usize)
         }
     };
