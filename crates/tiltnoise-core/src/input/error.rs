@@ -50,6 +50,17 @@ pub enum InputError {
         message: String,
     },
 
+    /// A string stored in the file (an attribute's text) is not valid UTF-8.
+    #[error("input file {path}: {object} is not valid text: {detail}")]
+    InvalidText {
+        /// The file.
+        path: PathBuf,
+        /// The object, e.g. `attribute `units` of dataset /E`.
+        object: String,
+        /// The first invalid byte and its offset.
+        detail: String,
+    },
+
     /// The content matches none of the accepted layouts.
     #[error("input file {path} ({format}): {found}; accepted layouts: {accepted}")]
     UnknownLayout {

@@ -61,30 +61,47 @@ impl AttrValue {
     }
 }
 
-fn read_strings(a: &Attribute, desc: &TypeDescriptor) -> hdf5::Result<Option<Vec<String>>> {
+/// The raw bytes of a string attribute's elements; `None` for a non-string type. Bytes, not
+/// `&str`: the library's `as_str()` trusts the file's bytes to be valid UTF-8 (ASCII), which a
+/// damaged or hostile file need not be; [`text`] validates them.
+fn read_strings(a: &Attribute, desc: &TypeDescriptor) -> hdf5::Result<Option<Vec<Vec<u8>>>> {
     Ok(Some(match desc {
         TypeDescriptor::VarLenUnicode => a
             .read_raw::<VarLenUnicode>()?
             .iter()
-            .map(|s| s.as_str().to_string())
+            .map(|s| s.as_bytes().to_vec())
             .collect(),
         TypeDescriptor::VarLenAscii => a
             .read_raw::<VarLenAscii>()?
             .iter()
-            .map(|s| s.as_str().to_string())
+            .map(|s| s.as_bytes().to_vec())
             .collect(),
         TypeDescriptor::FixedAscii(_) => a
             .read_raw::<FixedAscii<4096>>()?
             .iter()
-            .map(|s| s.as_str().to_string())
+            .map(|s| s.as_bytes().to_vec())
             .collect(),
         TypeDescriptor::FixedUnicode(_) => a
             .read_raw::<FixedUnicode<4096>>()?
             .iter()
-            .map(|s| s.as_str().to_string())
+            .map(|s| s.as_bytes().to_vec())
             .collect(),
         _ => return Ok(None),
     }))
+}
+
+/// Validates the bytes of a string read from a file as UTF-8, naming the file, the object
+/// and the first invalid byte otherwise.
+fn text(path: &Path, what: &str, bytes: Vec<u8>) -> Result<String, InputError> {
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let byte = e.as_bytes()[at];
+        InputError::InvalidText {
+            path: path.to_path_buf(),
+            object: what.to_string(),
+            detail: format!("byte 0x{byte:02x} at offset {at} is not valid UTF-8"),
+        }
+    })
 }
 
 /// Reads attribute `name` of `loc` (`None` if absent).
@@ -116,7 +133,15 @@ pub(crate) fn attr(
                 AttrValue::Other(format!("a numeric array of shape {shape:?}"))
             }
         }
-        _ => match read_strings(&a, &desc).map_err(h5err(path, what()))? {
+        _ => match read_strings(&a, &desc)
+            .map_err(h5err(path, what()))?
+            .map(|v| {
+                v.into_iter()
+                    .map(|b| text(path, &what(), b))
+                    .collect::<Result<Vec<String>, InputError>>()
+            })
+            .transpose()?
+        {
             Some(mut v) if shape.is_empty() || (shape.len() == 1 && v.len() == 1) => {
                 AttrValue::Str(v.pop().unwrap_or_default())
             }
