@@ -196,11 +196,19 @@ pub(crate) fn sample_rate_hz(path: &Path, file: &hdf5::File) -> Result<f64, Inpu
     }
 }
 
+/// The members of the root group that are, or may be, datasets: a member whose type cannot
+/// be read (a dangling soft or external link, say) is kept, so that mapping it as a channel
+/// fails when it is opened, naming it, instead of the channel being dropped silently.
 pub(crate) fn root_datasets(path: &Path, file: &hdf5::File) -> Result<Vec<String>, InputError> {
     let names = file.member_names().map_err(h5err(path, "root group /"))?;
     Ok(names
         .into_iter()
-        .filter(|n| matches!(file.loc_type_by_name(n), Ok(LocationType::Dataset)))
+        .filter(|n| {
+            !matches!(
+                file.loc_type_by_name(n),
+                Ok(LocationType::Group | LocationType::NamedDatatype)
+            )
+        })
         .collect())
 }
 
