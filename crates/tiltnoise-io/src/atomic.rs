@@ -1,19 +1,90 @@
-//! Atomic file replacement: write to a temporary file next to the target, then rename. Used by
-//! every writer (HDF5, CSV, figures) so that a failed run never leaves a partial file.
+//! Atomic outputs: every file is written to a temporary file next to its target and renamed
+//! onto it only when complete, so that a failed run never leaves a partial file.
+//!
+//! * [`write_atomic`]: one file.
+//! * [`Staging`]: every output of a run. While a `Staging` is active on the calling thread,
+//!   [`write_atomic`] leaves each finished temporary file in place, and [`Staging::commit`]
+//!   renames them all at the end; if the run fails before, dropping the `Staging` removes them,
+//!   so either every output of the run appears or none does.
+//! * [`remove_temporaries_on_interrupt`]: SIGINT and SIGTERM remove the temporary files that
+//!   exist at that moment before the process ends.
 
+use std::cell::RefCell;
 use std::ffi::OsString;
 use std::fs::{File, OpenOptions};
 use std::io;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use tempfile::TempPath;
 use tiltnoise_core::error::OutputError;
+
+/// The longest file name most file systems accept (bytes).
+const NAME_MAX: usize = 255;
+
+/// Temporary files that exist right now, for the interrupt handler.
+static LIVE_TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+thread_local! {
+    /// The outputs staged by the active [`Staging`] of this thread, if any.
+    static STAGED: RefCell<Option<Vec<Staged>>> = const { RefCell::new(None) };
+}
+
+/// A finished temporary file and the path it is to be renamed to.
+struct Staged {
+    temp: Registered,
+    target: PathBuf,
+}
+
+/// A temporary file known to the interrupt handler for as long as it exists.
+struct Registered(Option<TempPath>);
+
+impl Registered {
+    fn new(temp: TempPath) -> Registered {
+        if let Ok(mut live) = LIVE_TEMPORARIES.lock() {
+            live.push(temp.to_path_buf());
+        }
+        Registered(Some(temp))
+    }
+
+    fn path(&self) -> &Path {
+        self.0.as_deref().expect("present until persisted")
+    }
+
+    fn forget(path: &Path) {
+        if let Ok(mut live) = LIVE_TEMPORARIES.lock() {
+            live.retain(|p| p != path);
+        }
+    }
+
+    /// Renames the file onto `target`; on failure the file is removed (on drop).
+    fn persist(mut self, target: &Path) -> io::Result<()> {
+        let temp = self.0.take().expect("present until persisted");
+        let path = temp.to_path_buf();
+        let result = temp.persist(target).map_err(|e| e.error);
+        Registered::forget(&path);
+        result
+    }
+}
+
+impl Drop for Registered {
+    fn drop(&mut self) {
+        if let Some(temp) = self.0.take() {
+            let path = temp.to_path_buf();
+            drop(temp); // removes the file
+            Registered::forget(&path);
+        }
+    }
+}
 
 /// Writes `path` atomically: `write` receives the path of a fresh, empty temporary file in the
 /// same directory as `path` (so the final rename never crosses a file system), fills it, and the
-/// temporary file is then flushed to disk and renamed onto `path`.
+/// temporary file is then flushed to disk and renamed onto `path` (at once, or by
+/// [`Staging::commit`] when a [`Staging`] is active on this thread).
 ///
-/// The temporary file is named `.<file name>.<random>.<ext>`: it keeps the real extension as
-/// its suffix, for libraries that look at it. `write` may replace the file at that path (HDF5
-/// opens it with `hdf5::File::create`), but must have closed it when it returns.
+/// The temporary file is named `.<file name>.<random>.<ext>`, the file name shortened so that
+/// the whole name fits in 255 bytes: it keeps the real extension as its suffix, for libraries
+/// that look at it. `write` may replace the file at that path (HDF5 opens it with
+/// `hdf5::File::create`), but must have closed it when it returns.
 ///
 /// On any error the temporary file is removed and `path` is left as it was: absent if it did not
 /// exist, untouched if it did. A new file gets the usual permissions (`0o666` minus the umask);
@@ -39,33 +110,81 @@ pub fn write_atomic(
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let mut prefix = OsString::from(".");
-    prefix.push(file_name);
-    prefix.push(".");
     let mut suffix = OsString::new();
     if let Some(ext) = path.extension() {
         suffix.push(".");
         suffix.push(ext);
     }
+    // `.` + name + `.` + 6 random characters + suffix <= NAME_MAX.
+    let room = NAME_MAX.saturating_sub(2 + RANDOM_LEN + suffix.len());
+    let mut prefix = OsString::from(".");
+    prefix.push(shortened(file_name, room));
+    prefix.push(".");
 
     // `make_in` (unlike `tempfile_in`) returns the operating system's error unchanged, and lets
     // the file be created with the ordinary umask-controlled mode instead of 0o600.
     let temp = tempfile::Builder::new()
         .prefix(&prefix)
         .suffix(&suffix)
+        .rand_bytes(RANDOM_LEN)
         .make_in(&dir, create_new)
         .map_err(|e| fail(e.to_string()))?;
     // Close our handle; keep the path, which deletes the file when dropped.
-    let temp = temp.into_temp_path();
+    let temp = Registered::new(temp.into_temp_path());
 
-    write(&temp).map_err(fail)?;
+    write(temp.path()).map_err(fail)?;
     OpenOptions::new()
         .write(true)
-        .open(&temp)
+        .open(temp.path())
         .and_then(|f| f.sync_all())
         .map_err(|e| fail(format!("cannot flush temporary file: {e}")))?;
-    temp.persist(path).map_err(|e| fail(e.error.to_string()))?;
-    Ok(())
+    let staged = STAGED.with(|s| {
+        let mut s = s.borrow_mut();
+        match s.as_mut() {
+            Some(list) => {
+                list.push(Staged {
+                    temp,
+                    target: path.to_path_buf(),
+                });
+                None
+            }
+            None => Some(temp),
+        }
+    });
+    match staged {
+        Some(temp) => temp.persist(path).map_err(|e| fail(e.to_string())),
+        None => Ok(()),
+    }
+}
+
+/// Random characters in a temporary file's name.
+const RANDOM_LEN: usize = 6;
+
+/// At most `max` bytes of `name`, cut at a character boundary when the name is UTF-8.
+fn shortened(name: &std::ffi::OsStr, max: usize) -> OsString {
+    if name.len() <= max {
+        return name.to_os_string();
+    }
+    match name.to_str() {
+        Some(s) => {
+            let mut end = max;
+            while !s.is_char_boundary(end) {
+                end -= 1;
+            }
+            OsString::from(&s[..end])
+        }
+        None => {
+            #[cfg(unix)]
+            {
+                use std::os::unix::ffi::{OsStrExt, OsStringExt};
+                OsString::from_vec(name.as_bytes()[..max].to_vec())
+            }
+            #[cfg(not(unix))]
+            {
+                OsString::from("output")
+            }
+        }
+    }
 }
 
 fn create_new(path: &Path) -> io::Result<File> {
@@ -77,4 +196,183 @@ fn create_new(path: &Path) -> io::Result<File> {
         options.mode(0o666);
     }
     options.open(path)
+}
+
+/// The outputs of one run, written all or none: while it is active, [`write_atomic`] on this
+/// thread writes each output to its temporary file and leaves it there; [`Staging::commit`]
+/// renames them all. Dropping a `Staging` that was not committed (the run failed) removes every
+/// temporary file it holds, so no output of a failed run appears.
+#[must_use = "a Staging that is not committed removes its outputs"]
+pub struct Staging {
+    _not_send: std::marker::PhantomData<*const ()>,
+}
+
+impl Staging {
+    /// Starts staging the outputs of this thread.
+    ///
+    /// # Panics
+    ///
+    /// If a `Staging` is already active on this thread.
+    pub fn begin() -> Staging {
+        STAGED.with(|s| {
+            let mut s = s.borrow_mut();
+            assert!(s.is_none(), "a Staging is already active on this thread");
+            *s = Some(Vec::new());
+        });
+        Staging {
+            _not_send: std::marker::PhantomData,
+        }
+    }
+
+    /// Renames every staged output onto its target, in the order they were written, and ends
+    /// the staging. Returns the targets.
+    ///
+    /// # Errors
+    ///
+    /// [`OutputError::Write`] naming the first target that cannot be renamed; the temporary
+    /// files not yet renamed are removed. (Renames within a directory that took the temporary
+    /// file do not fail in practice; the outputs renamed before stay.)
+    pub fn commit(self) -> Result<Vec<PathBuf>, OutputError> {
+        let staged = STAGED.with(|s| s.borrow_mut().take()).unwrap_or_default();
+        let mut done = Vec::with_capacity(staged.len());
+        let mut rest = staged.into_iter();
+        for s in rest.by_ref() {
+            if let Err(e) = s.temp.persist(&s.target) {
+                return Err(OutputError::Write {
+                    path: s.target,
+                    message: e.to_string(),
+                });
+            }
+            done.push(s.target);
+        }
+        Ok(done)
+    }
+}
+
+impl Drop for Staging {
+    fn drop(&mut self) {
+        // Not committed: the staged temporary files are removed as they drop.
+        STAGED.with(|s| drop(s.borrow_mut().take()));
+    }
+}
+
+/// Removes the temporary files of [`write_atomic`] that exist when the process receives SIGINT
+/// or SIGTERM, prints one line naming the signal, and ends the process with exit code 2. Call
+/// it once, early in `main`, before any thread is started: it blocks both signals in the
+/// calling thread (so in every thread started later) and waits for them in a thread of its
+/// own. Does nothing on platforms without POSIX signals.
+pub fn remove_temporaries_on_interrupt() {
+    #[cfg(unix)]
+    unix::install();
+}
+
+#[cfg(unix)]
+mod unix {
+    use super::LIVE_TEMPORARIES;
+
+    pub(super) fn install() {
+        // SAFETY: `set` is initialised by sigemptyset before use; pthread_sigmask and sigwait
+        // only read it. Blocking SIGINT and SIGTERM here makes every thread started later
+        // inherit the mask, so the signals are delivered only to `sigwait` below.
+        unsafe {
+            let mut set: libc::sigset_t = std::mem::zeroed();
+            libc::sigemptyset(&mut set);
+            libc::sigaddset(&mut set, libc::SIGINT);
+            libc::sigaddset(&mut set, libc::SIGTERM);
+            if libc::pthread_sigmask(libc::SIG_BLOCK, &set, std::ptr::null_mut()) != 0 {
+                return;
+            }
+            let set_addr = set;
+            std::thread::spawn(move || {
+                let set = set_addr;
+                let mut sig: libc::c_int = 0;
+                // SAFETY: as above; `sig` is a valid out-pointer.
+                if libc::sigwait(&set, &mut sig) != 0 {
+                    return;
+                }
+                // Waits for a writer that holds the lock for a moment; nothing else does.
+                let removed = match LIVE_TEMPORARIES.lock() {
+                    Ok(live) => {
+                        for p in live.iter() {
+                            let _ = std::fs::remove_file(p);
+                        }
+                        live.len()
+                    }
+                    Err(_) => 0,
+                };
+                let name = if sig == libc::SIGINT {
+                    "SIGINT"
+                } else {
+                    "SIGTERM"
+                };
+                eprintln!(
+                    "tiltnoise: error: interrupted by {name}; {removed} temporary file(s) \
+                     removed, no output written"
+                );
+                // SAFETY: _exit ends the process at once, without running atexit handlers
+                // (the HDF5 library's would race with a write in progress on another thread).
+                libc::_exit(2);
+            });
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn listing(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
+        write_atomic(path, |t| std::fs::write(t, text).map_err(|e| e.to_string()))
+    }
+
+    #[test]
+    fn a_failed_run_leaves_none_of_its_outputs() {
+        let dir = tempfile::tempdir().unwrap();
+        {
+            let _stage = Staging::begin();
+            write_text(&dir.path().join("a.csv"), "a").unwrap();
+            // Staged, not renamed: only the temporary file exists.
+            assert_eq!(listing(dir.path()).len(), 1);
+            assert!(!dir.path().join("a.csv").exists());
+            let err = write_atomic(&dir.path().join("b.csv"), |_| Err("drawing failed".into()));
+            assert!(err.is_err());
+        } // dropped without commit
+        assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
+    }
+
+    #[test]
+    fn a_committed_run_has_every_output_and_no_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let stage = Staging::begin();
+        write_text(&dir.path().join("a.csv"), "a").unwrap();
+        write_text(&dir.path().join("b.csv"), "b").unwrap();
+        let done = stage.commit().unwrap();
+        assert_eq!(done.len(), 2);
+        assert_eq!(listing(dir.path()), vec!["a.csv", "b.csv"]);
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join("b.csv")).unwrap(),
+            "b"
+        );
+        // Without a Staging, a write is renamed at once.
+        write_text(&dir.path().join("c.csv"), "c").unwrap();
+        assert!(dir.path().join("c.csv").exists());
+    }
+
+    #[test]
+    fn temporary_names_fit_in_255_bytes() {
+        let dir = tempfile::tempdir().unwrap();
+        let name = format!("{}.csv", "n".repeat(251));
+        assert_eq!(name.len(), 255);
+        write_text(&dir.path().join(&name), "x").unwrap();
+        assert_eq!(listing(dir.path()), vec![name]);
+    }
 }

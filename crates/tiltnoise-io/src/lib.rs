@@ -24,7 +24,7 @@ mod tf_csv;
 mod tf_hdf5;
 
 pub use asd_csv::write_asd_csv;
-pub use atomic::write_atomic;
+pub use atomic::{remove_temporaries_on_interrupt, write_atomic, Staging};
 pub use budget_csv::{budget_csv_string, write_budget_csv};
 pub use budget_hdf5::{
     write_budget_hdf5, SCHEMA_BUDGET, SCHEMA_VERSION_BUDGET, SPECTRAL_CONVENTION,
