@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use tiltnoise_core::error::OutputError;
 use tiltnoise_core::fit::{self, Bound, FitConfig, FitResult, Measured, SigmaSource};
 use tiltnoise_core::params::Params;
-use tiltnoise_io::{write_atomic, write_fit_hdf5};
+use tiltnoise_io::{read_measured_modes, write_atomic, write_fit_hdf5};
 
 /// Arguments of `tiltnoise fit`.
 #[derive(Debug, Args)]
@@ -47,7 +47,7 @@ pub(crate) fn run_fit(params: &Params, args: FitArgs) -> Result<()> {
         save_kind(path)?;
     }
     let measured = match &args.measured {
-        Some(path) => Measured::from_file(path)?,
+        Some(path) => read_measured_modes(path)?,
         None => Measured::table_ii(),
     };
     let config = FitConfig {
