@@ -1,6 +1,6 @@
 //! Comma-separated text as every tiltnoise reader takes it, tokenized by the `csv` crate: the
-//! tilt and measured inputs of `tiltnoise-io`, the measured mode frequencies of [`crate::fit`]
-//! (including the embedded Table II) and the frequency files of [`crate::freq`].
+//! measured mode frequencies of [`crate::fit`] (including the embedded Table II), and in
+//! `tiltnoise-io` the tilt and measured inputs and the frequency files.
 //!
 //! The rules on top of the tokenizer, the same for every format:
 //!
@@ -81,8 +81,8 @@ fn strip_bom(text: &str) -> &str {
 }
 
 impl<R: Read> CsvRecords<R> {
-    /// The records of `input`, whose first line has the number `first_line` in the caller's
-    /// file (the lines before it were read by the caller).
+    /// The records of `input`, whose first line has the (1-based) number `first_line` in the
+    /// caller's file (the lines before it were read by the caller).
     pub fn new(input: R, first_line: usize) -> Self {
         let reader = csv::ReaderBuilder::new()
             .has_headers(false)
@@ -96,7 +96,7 @@ impl<R: Read> CsvRecords<R> {
         CsvRecords {
             reader,
             record: csv::ByteRecord::new(),
-            line_offset: first_line - 1,
+            line_offset: first_line.saturating_sub(1),
         }
     }
 
