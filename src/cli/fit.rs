@@ -4,11 +4,13 @@
 
 use anyhow::Result;
 use clap::{Args, ValueEnum};
+use serde::Serialize;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::OutputError;
 use tiltnoise_core::fit::{self, Bound, FitConfig, FitResult, Measured, SigmaSource};
 use tiltnoise_core::params::Params;
-use tiltnoise_io::{write_atomic, write_fit_hdf5};
+use tiltnoise_io::{read_measured_modes, write_atomic, write_fit_hdf5};
 
 /// Arguments of `tiltnoise fit`.
 #[derive(Debug, Args)]
@@ -47,7 +49,7 @@ pub(crate) fn run_fit(params: &Params, args: FitArgs) -> Result<()> {
         save_kind(path)?;
     }
     let measured = match &args.measured {
-        Some(path) => Measured::from_file(path)?,
+        Some(path) => read_measured_modes(path)?,
         None => Measured::table_ii(),
     };
     let config = FitConfig {
@@ -100,59 +102,118 @@ fn bound_name(b: Option<Bound>) -> &'static str {
     b.map_or("", Bound::name)
 }
 
-/// JSON number, or `null` for a non-finite value (JSON has no infinity).
-fn num(x: f64) -> serde_json::Value {
-    serde_json::Number::from_f64(x).map_or(serde_json::Value::Null, serde_json::Value::Number)
+/// The JSON report (also the content of a saved .json file). Non-finite numbers are written
+/// as `null` (JSON has no infinity).
+fn fit_json<'a>(r: &'a FitResult, origin: &'a str) -> FitJson<'a> {
+    FitJson {
+        bound_sigmas: r.config.bound_sigmas,
+        chi2: r.chi2,
+        chi2_nominal: r.chi2_nominal,
+        dof: r.dof,
+        evaluations: r.evaluations,
+        fitted_params_toml: r.fitted_params.to_toml(),
+        iterations: r.iterations,
+        measured_origin: origin,
+        modes: r
+            .modes
+            .iter()
+            .map(|m| ModeJson {
+                fitted_hz: m.fitted_hz,
+                index: m.measured.mode,
+                measured_hz: m.measured.frequency_hz,
+                nominal_hz: m.nominal_hz,
+                residual_hz: m.residual_hz(),
+                residual_sigmas: m.residual_sigmas(),
+                sigma_hz: m.measured.sigma_hz,
+                sigma_source: match m.measured.sigma_source {
+                    SigmaSource::File => "file",
+                    SigmaSource::Digits => "digits",
+                },
+            })
+            .collect(),
+        parameters: r
+            .params
+            .iter()
+            .map(|p| ParamJson {
+                at_bound: p.at_bound.map(Bound::name),
+                data_sigma_rel: p.data_sigma_rel,
+                fitted: p.fitted,
+                fitted_sigma: p.fitted_sigma,
+                key: &p.key,
+                nominal: p.nominal,
+                poorly_constrained: p.poorly_constrained,
+                prior_sigma: p.prior_sigma,
+                unit: &p.unit,
+            })
+            .collect(),
+        prior: r.config.prior,
+        prior_term: r.prior_term,
+        projected_gradient: r.projected_gradient,
+        singular_values: &r.singular_values,
+        stop: r.stop.describe(),
+        weak_directions: r
+            .weak_directions
+            .iter()
+            .map(|w| WeakJson {
+                direction: w.direction.iter().map(|(k, c)| (k.as_str(), *c)).collect(),
+                singular_value: w.singular_value,
+            })
+            .collect(),
+    }
 }
 
-/// The JSON report (also the content of a saved .json file).
-fn fit_json(r: &FitResult, origin: &str) -> serde_json::Value {
-    use serde_json::json;
-    json!({
-        "measured_origin": origin,
-        "bound_sigmas": r.config.bound_sigmas,
-        "prior": r.config.prior,
-        "chi2_nominal": num(r.chi2_nominal),
-        "chi2": num(r.chi2),
-        "prior_term": num(r.prior_term),
-        "dof": r.dof,
-        "iterations": r.iterations,
-        "evaluations": r.evaluations,
-        "stop": r.stop.describe(),
-        "projected_gradient": num(r.projected_gradient),
-        "parameters": r.params.iter().map(|p| json!({
-            "key": p.key,
-            "unit": p.unit,
-            "nominal": p.nominal,
-            "fitted": p.fitted,
-            "fitted_sigma": p.fitted_sigma.map_or(serde_json::Value::Null, num),
-            "prior_sigma": p.prior_sigma,
-            "at_bound": p.at_bound.map(|b| bound_name(Some(b))),
-            "data_sigma_rel": num(p.data_sigma_rel),
-            "poorly_constrained": p.poorly_constrained,
-        })).collect::<Vec<_>>(),
-        "modes": r.modes.iter().map(|m| json!({
-            "index": m.measured.mode,
-            "measured_hz": m.measured.frequency_hz,
-            "sigma_hz": m.measured.sigma_hz,
-            "sigma_source": match m.measured.sigma_source {
-                SigmaSource::File => "file",
-                SigmaSource::Digits => "digits",
-            },
-            "nominal_hz": m.nominal_hz,
-            "fitted_hz": m.fitted_hz,
-            "residual_hz": m.residual_hz(),
-            "residual_sigmas": m.residual_sigmas(),
-        })).collect::<Vec<_>>(),
-        "singular_values": r.singular_values.iter().map(|&s| num(s)).collect::<Vec<_>>(),
-        "weak_directions": r.weak_directions.iter().map(|w| json!({
-            "singular_value": num(w.singular_value),
-            "direction": w.direction.iter()
-                .map(|(k, c)| (k.clone(), num(*c)))
-                .collect::<serde_json::Map<_, _>>(),
-        })).collect::<Vec<_>>(),
-        "fitted_params_toml": r.fitted_params.to_toml(),
-    })
+// Keys in alphabetical order, as the report has always listed them: fields declared in that
+// order, maps as BTreeMaps.
+
+#[derive(Serialize)]
+struct FitJson<'a> {
+    bound_sigmas: f64,
+    chi2: f64,
+    chi2_nominal: f64,
+    dof: usize,
+    evaluations: usize,
+    fitted_params_toml: String,
+    iterations: usize,
+    measured_origin: &'a str,
+    modes: Vec<ModeJson>,
+    parameters: Vec<ParamJson<'a>>,
+    prior: bool,
+    prior_term: f64,
+    projected_gradient: f64,
+    singular_values: &'a [f64],
+    stop: &'static str,
+    weak_directions: Vec<WeakJson<'a>>,
+}
+
+#[derive(Serialize)]
+struct ModeJson {
+    fitted_hz: f64,
+    index: usize,
+    measured_hz: f64,
+    nominal_hz: f64,
+    residual_hz: f64,
+    residual_sigmas: f64,
+    sigma_hz: f64,
+    sigma_source: &'static str,
+}
+
+#[derive(Serialize)]
+struct ParamJson<'a> {
+    at_bound: Option<&'static str>,
+    data_sigma_rel: f64,
+    fitted: f64,
+    fitted_sigma: Option<f64>,
+    key: &'a str,
+    nominal: f64,
+    poorly_constrained: bool,
+    prior_sigma: f64,
+    unit: &'a str,
+}
+
+#[derive(Serialize)]
+struct WeakJson<'a> {
+    direction: BTreeMap<&'a str, f64>,
+    singular_value: f64,
 }
 
 /// The terminal report.
@@ -263,4 +324,19 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
         }
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::report::assert_keys_sorted;
+
+    #[test]
+    fn json_lists_keys_alphabetically() {
+        let measured = Measured::table_ii();
+        let result = fit::fit(&Params::table_i(), &measured, &FitConfig::default()).unwrap();
+        let text = serde_json::to_string_pretty(&fit_json(&result, &measured.origin)).unwrap();
+        let value = assert_keys_sorted(&text);
+        assert_eq!(value["measured_origin"], "embedded Table II");
+    }
 }

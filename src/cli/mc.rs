@@ -3,6 +3,7 @@
 //! (PNG/SVG) and HDF5 with `--save`.
 
 use anyhow::Result;
+use serde::Serialize;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::OutputError;
 use tiltnoise_core::mc::{McConfig, McResult};
@@ -135,22 +136,39 @@ fn caption(result: &McResult, cfg: &McConfig) -> String {
 }
 
 fn json(result: &McResult, nominal: &[f64; 8], seed: u64) -> Result<String> {
-    let modes: Vec<_> = (0..8)
-        .map(|k| {
-            serde_json::json!({
-                "index": k + 1,
-                "nominal_hz": nominal[k],
-                "mean_hz": result.mean_hz[k],
-                "std_hz": result.std_hz[k],
-            })
+    let modes = (0..8)
+        .map(|k| McModeJson {
+            index: k + 1,
+            mean_hz: result.mean_hz[k],
+            nominal_hz: nominal[k],
+            std_hz: result.std_hz[k],
         })
         .collect();
-    Ok(serde_json::to_string_pretty(&serde_json::json!({
-        "samples": result.samples,
-        "rejected": result.rejected,
-        "seed": seed,
-        "modes": modes,
-    }))?)
+    Ok(serde_json::to_string_pretty(&McJson {
+        modes,
+        rejected: result.rejected,
+        samples: result.samples,
+        seed,
+    })?)
+}
+
+// Keys in alphabetical order, as the report has always listed them: fields declared in that
+// order.
+
+#[derive(Serialize)]
+struct McJson {
+    modes: Vec<McModeJson>,
+    rejected: usize,
+    samples: usize,
+    seed: u64,
+}
+
+#[derive(Serialize)]
+struct McModeJson {
+    index: usize,
+    mean_hz: f64,
+    nominal_hz: f64,
+    std_hz: f64,
 }
 
 fn table(result: &McResult, nominal: &[f64; 8], seed: u64) -> String {
@@ -172,4 +190,24 @@ fn table(result: &McResult, nominal: &[f64; 8], seed: u64) -> String {
         ));
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::report::assert_keys_sorted;
+
+    #[test]
+    fn json_lists_keys_alphabetically_and_nan_as_null() {
+        let result = McResult {
+            samples: 2,
+            rejected: 1,
+            freqs_hz: vec![[1.0; 8]],
+            sample_index: vec![0],
+            mean_hz: [1.0; 8],
+            std_hz: [f64::NAN; 8],
+        };
+        let value = assert_keys_sorted(&json(&result, &[1.0; 8], 7).unwrap());
+        assert_eq!(value["modes"][7]["std_hz"], serde_json::Value::Null);
+    }
 }

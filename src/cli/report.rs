@@ -1,7 +1,8 @@
 //! Text and JSON renderings of results for the terminal (tables, summaries). Sits above the
 //! numerics: it reads `modes` and `tf`, and nothing numeric depends on it.
 
-use serde_json::json;
+use serde::Serialize;
+use std::collections::BTreeMap;
 use std::fmt::Write;
 use tiltnoise_core::model::{Model, Observable, TiltAxis};
 use tiltnoise_core::modes::NormalModes;
@@ -69,34 +70,75 @@ pub fn format_q(q: f64) -> String {
 
 /// `{"modes": [{"index": 1, "frequency_hz": ..., ...}, ...]}`.
 pub fn modes_json(modes: &NormalModes) -> String {
-    let list: Vec<_> = modes
+    let list = modes
         .modes
         .iter()
         .enumerate()
-        .map(|(k, m)| {
-            json!({
-                "index": m.index,
-                "frequency_hz": m.frequency_hz,
-                "omega_sq_rad2_per_s2": m.omega_sq,
-                "block": m.block.name(),
-                // JSON has no infinity: "inf" (a string) when undamped, as in the table.
-                "quality_factor": if m.quality_factor.is_finite() {
-                    json!(m.quality_factor)
-                } else {
-                    json!("inf")
-                },
-                "loss_angle_rad": m.loss_angle,
-                "dominant_coordinates": m.dominant_coords(DOMINANT_SHARE).iter()
-                    .map(|(c, share)| json!({"coordinate": c.name(), "energy_share": share}))
-                    .collect::<Vec<_>>(),
-                "seen_by": modes.observables_seeing(k).iter().map(|o| o.name()).collect::<Vec<_>>(),
-                "observable_amplitude": Observable::ALL.iter()
-                    .map(|o| (o.name().to_string(), json!(m.observable_amplitude[o.index()])))
-                    .collect::<serde_json::Map<_, _>>(),
-            })
+        .map(|(k, m)| ModeJson {
+            block: m.block.name(),
+            dominant_coordinates: m
+                .dominant_coords(DOMINANT_SHARE)
+                .into_iter()
+                .map(|(c, energy_share)| CoordinateShare {
+                    coordinate: c.name(),
+                    energy_share,
+                })
+                .collect(),
+            frequency_hz: m.frequency_hz,
+            index: m.index,
+            loss_angle_rad: m.loss_angle,
+            observable_amplitude: Observable::ALL
+                .iter()
+                .map(|o| (o.name(), m.observable_amplitude[o.index()]))
+                .collect(),
+            omega_sq_rad2_per_s2: m.omega_sq,
+            quality_factor: match m.quality_factor.is_finite() {
+                true => QualityFactor::Finite(m.quality_factor),
+                false => QualityFactor::Undamped("inf"),
+            },
+            seen_by: modes
+                .observables_seeing(k)
+                .iter()
+                .map(|o| o.name())
+                .collect(),
         })
         .collect();
-    serde_json::to_string_pretty(&json!({ "modes": list })).expect("JSON of finite numbers")
+    serde_json::to_string_pretty(&ModesJson { modes: list }).expect("JSON of plain data")
+}
+
+// The JSON reports list the keys of every object in alphabetical order (as they always have):
+// the fields of these structs are declared in that order, maps are BTreeMaps.
+
+#[derive(Serialize)]
+struct ModesJson {
+    modes: Vec<ModeJson>,
+}
+
+#[derive(Serialize)]
+struct ModeJson {
+    block: &'static str,
+    dominant_coordinates: Vec<CoordinateShare>,
+    frequency_hz: f64,
+    index: usize,
+    loss_angle_rad: f64,
+    observable_amplitude: BTreeMap<&'static str, f64>,
+    omega_sq_rad2_per_s2: f64,
+    quality_factor: QualityFactor,
+    seen_by: Vec<&'static str>,
+}
+
+#[derive(Serialize)]
+struct CoordinateShare {
+    coordinate: &'static str,
+    energy_share: f64,
+}
+
+/// JSON has no infinity: `"inf"` (a string) when undamped, as in the table.
+#[derive(Serialize)]
+#[serde(untagged)]
+enum QualityFactor {
+    Finite(f64),
+    Undamped(&'static str),
 }
 
 /// The quasi-static (f = 0) tilt response next to the paper's stated limits.
@@ -124,4 +166,27 @@ pub fn static_limits(model: &Model) -> String {
         );
     }
     s
+}
+
+/// Asserts that the JSON `text` lists the keys of every object in alphabetical order, the order
+/// of the JSON reports (and of a `serde_json::Value`, whose objects are sorted maps); returns
+/// the parsed value.
+#[cfg(test)]
+pub(crate) fn assert_keys_sorted(text: &str) -> serde_json::Value {
+    let value: serde_json::Value = serde_json::from_str(text).unwrap();
+    assert_eq!(text, serde_json::to_string_pretty(&value).unwrap());
+    value
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tiltnoise_core::params::Params;
+
+    #[test]
+    fn modes_json_lists_keys_alphabetically() {
+        let modes = NormalModes::new(&Model::new(&Params::table_i()).unwrap());
+        let value = assert_keys_sorted(&modes_json(&modes));
+        assert_eq!(value["modes"][0]["quality_factor"], "inf");
+    }
 }

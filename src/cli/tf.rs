@@ -19,7 +19,7 @@ use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::tf::planner::{Scene, DEFAULT_REL_TOL};
 use tiltnoise_core::tf::{self, Input, Request};
-use tiltnoise_io::RunMeta;
+use tiltnoise_io::{read_freq_file, RunMeta};
 
 /// Arguments of `tiltnoise tf`.
 #[derive(Debug, Args)]
@@ -144,7 +144,7 @@ pub fn run_tf(params: &Params, args: TfArgs) -> Result<()> {
     let model = Model::new(params)?;
     let freqs = match (&args.freq, &args.freq_file) {
         (Some(spec), _) => freq::parse_spec(spec)?,
-        (None, Some(path)) => freq::read_freq_file(path)?,
+        (None, Some(path)) => read_freq_file(path)?,
         (None, None) => freq::default_grid(&model),
     };
     // Check every output's format before computing, so a typo costs nothing.

@@ -1,12 +1,12 @@
-//! Frequency grids: log-spaced grids from `FLO:N:FHI`, frequency files, and the default grid
-//! that adds points around every resonance so that no peak is missed.
+//! Frequency grids: log-spaced grids from `FLO:N:FHI` and the default grid that adds points
+//! around every resonance so that no peak is missed. Frequency files are read by
+//! `tiltnoise_io::read_freq_file`.
 //!
 //! All frequencies are in Hz. Depends on `modes` (for resonance placement) and `error` only.
 
 use crate::error::FreqError;
 use crate::model::Model;
 use crate::modes::NormalModes;
-use std::path::Path;
 
 /// Lower end of the default grid (Hz): 0.1 mHz, below the torsion modes.
 pub const DEFAULT_F_LO_HZ: f64 = 1e-4;
@@ -21,17 +21,6 @@ const UNDAMPED_OFFSETS: [f64; 11] = [
 ];
 /// Points across a damped resonance, in units of its half-width at half power `phi_k / 2`.
 const DAMPED_WIDTHS: [f64; 9] = [0.0, 0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 5.0, 10.0];
-
-fn check(value: f64, origin: impl FnOnce() -> String) -> Result<f64, FreqError> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(value)
-    } else {
-        Err(FreqError::Invalid {
-            value,
-            origin: origin(),
-        })
-    }
-}
 
 /// `n` log-spaced frequencies from `lo` to `hi` inclusive (`n = 1` gives `[lo]`).
 pub fn log_grid(lo: f64, hi: f64, n: usize) -> Result<Vec<f64>, FreqError> {
@@ -79,40 +68,6 @@ pub fn parse_spec(spec: &str) -> Result<Vec<f64>, FreqError> {
         FreqError::Spec { message, .. } => err(&message),
         other => other,
     })
-}
-
-/// Parses a frequency file: one frequency in Hz per line; blank lines and lines starting with
-/// `#` are ignored. Every value must be finite and >= 0; at least one is required.
-pub fn parse_freq_text(text: &str, origin: &str) -> Result<Vec<f64>, FreqError> {
-    let mut freqs = Vec::new();
-    for (n, line) in text.lines().enumerate() {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let value: f64 = line.parse().map_err(|_| FreqError::Spec {
-            origin: format!("{origin}, line {}", n + 1),
-            message: format!("`{line}` is not a number (one frequency in Hz per line)"),
-        })?;
-        freqs.push(check(value, || format!("{origin}, line {}", n + 1))?);
-    }
-    if freqs.is_empty() {
-        return Err(FreqError::Spec {
-            origin: origin.into(),
-            message: "no frequencies (one frequency in Hz per line expected)".into(),
-        });
-    }
-    Ok(freqs)
-}
-
-/// Reads a frequency file (see [`parse_freq_text`]).
-pub fn read_freq_file(path: &Path) -> Result<Vec<f64>, FreqError> {
-    let origin = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| FreqError::Spec {
-        origin: origin.clone(),
-        message: format!("cannot read: {e}"),
-    })?;
-    parse_freq_text(&text, &origin)
 }
 
 /// Modal loss angles below this are treated as undamped when the grid is built: at the pole of
@@ -207,28 +162,6 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("FLO <= FHI"));
-    }
-
-    #[test]
-    fn freq_text_rules() {
-        assert_eq!(
-            parse_freq_text("# f\n0.1\n\n 2 \n", "f.txt").unwrap(),
-            vec![0.1, 2.0]
-        );
-        let e = parse_freq_text("0.1\nabc\n", "f.txt")
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("f.txt, line 2") && e.contains("abc"), "{e}");
-        let e = parse_freq_text("0.1\n-3\n", "f.txt")
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("-3") && e.contains("line 2"), "{e}");
-        let e = parse_freq_text("NaN\n", "f.txt").unwrap_err().to_string();
-        assert!(e.contains("NaN"), "{e}");
-        let e = parse_freq_text("# only a comment\n", "f.txt")
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("no frequencies"), "{e}");
     }
 
     /// A single loss angle leaves the modes that touch its element only weakly with modal loss

@@ -45,6 +45,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 pub mod budget;
+pub mod csv_text;
 pub mod dd;
 pub mod error;
 pub mod fit;

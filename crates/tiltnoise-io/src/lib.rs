@@ -2,6 +2,8 @@
 //!
 //! * [`input`]: floor-tilt inputs and measured observables (HDF5, CSV), validated strictly;
 //!   layouts in `docs/input_formats.md`.
+//! * [`read_measured_modes`] (measured mode frequencies for the fit) and [`read_freq_file`]
+//!   (frequency grids).
 //! * Writers: transfer functions, noise budgets, Monte Carlo, fit and simulation results as
 //!   HDF5 or CSV (schemas in `docs/schemas.md`).
 //! * [`write_atomic`]: every writer is atomic: a failed write leaves nothing at the target
@@ -16,9 +18,11 @@ mod atomic;
 mod budget_csv;
 mod budget_hdf5;
 mod fit_hdf5;
+mod freq_file;
 mod h5util;
 pub mod input;
 mod mc_hdf5;
+mod measured_modes;
 mod series_hdf5;
 mod tf_csv;
 mod tf_hdf5;
@@ -30,7 +34,9 @@ pub use budget_hdf5::{
     write_budget_hdf5, SCHEMA_BUDGET, SCHEMA_VERSION_BUDGET, SPECTRAL_CONVENTION,
 };
 pub use fit_hdf5::write_fit_hdf5;
+pub use freq_file::read_freq_file;
 pub use mc_hdf5::{write_mc_hdf5, REJECTED_DRAWS, SCHEMA_MC, SCHEMA_VERSION_MC};
+pub use measured_modes::read_measured_modes;
 pub use series_hdf5::{
     write_observable_series_hdf5, SeriesAsd, SimulationMeta, SCHEMA_OBSERVABLE_SERIES,
     SCHEMA_VERSION_OBSERVABLE_SERIES,

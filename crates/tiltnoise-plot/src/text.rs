@@ -4,163 +4,50 @@
 //! ignoring the glyph's left side bearing: letters with wide bearings (`i`, `l`, `1`, `t`) sit
 //! too far left and words look unevenly spaced ("iden tically"). [`GlyphPlacement`] wraps a
 //! raster backend and draws text one glyph at a time, each shifted by its left side bearing
-//! read from the embedded font's `hmtx` table; the rasterisation itself stays plotters'.
+//! as ab_glyph reads it from the embedded font; the rasterisation itself stays plotters'.
 //! Vector backends (SVG) keep text as text and do not need it.
 
+use ab_glyph::{Font, FontRef};
 use plotters::backend::DrawingBackend;
 use plotters::style::text_anchor::{HPos, VPos};
 use plotters_backend::{
     BackendColor, BackendCoord, BackendStyle, BackendTextStyle, DrawingErrorKind,
 };
-use std::collections::HashMap;
 use std::sync::OnceLock;
 
 /// Horizontal metrics of one glyph, in font units.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct HMetric {
     /// Advance width.
-    pub advance: u16,
+    pub advance: f64,
     /// Left side bearing.
-    pub lsb: i16,
+    pub lsb: f64,
 }
 
-/// The metrics of a TrueType font needed to lay out a line of text as ab_glyph scales it.
+/// The metrics of a font needed to lay out a line of text as ab_glyph scales it.
 #[derive(Debug, Clone)]
 pub(crate) struct FontMetrics {
-    /// `hhea.ascender - hhea.descender` (font units): ab_glyph's scale is px per this height.
+    font: FontRef<'static>,
+    /// `ascent - descent` (font units): ab_glyph's scale is px per this height.
     pub height: f64,
-    /// Per character.
-    glyphs: HashMap<char, HMetric>,
-    /// `.notdef` (glyph 0), for characters the font lacks.
-    notdef: HMetric,
 }
 
 impl FontMetrics {
-    /// Parses `hhea`, `hmtx` and the Unicode `cmap` subtable (format 4 or 12) of a TrueType
-    /// font. `None` if a table is missing or malformed.
-    pub fn parse(font: &[u8]) -> Option<FontMetrics> {
-        let u16_at = |o: usize| -> Option<u16> {
-            Some(u16::from_be_bytes(font.get(o..o + 2)?.try_into().ok()?))
-        };
-        let u32_at = |o: usize| -> Option<u32> {
-            Some(u32::from_be_bytes(font.get(o..o + 4)?.try_into().ok()?))
-        };
-        let num_tables = u16_at(4)? as usize;
-        let mut table = HashMap::new();
-        for i in 0..num_tables {
-            let rec = 12 + 16 * i;
-            let tag = font.get(rec..rec + 4)?;
-            table.insert(tag.to_vec(), u32_at(rec + 8)? as usize);
-        }
-        let hhea = *table.get(&b"hhea"[..])?;
-        let hmtx = *table.get(&b"hmtx"[..])?;
-        let cmap = *table.get(&b"cmap"[..])?;
-        let maxp = *table.get(&b"maxp"[..])?;
-        let ascender = u16_at(hhea + 4)? as i16 as f64;
-        let descender = u16_at(hhea + 6)? as i16 as f64;
-        let n_hmetrics = u16_at(hhea + 34)? as usize;
-        let n_glyphs = u16_at(maxp + 4)? as usize;
-        if n_hmetrics == 0 {
-            return None;
-        }
-        let metric = |gid: usize| -> Option<HMetric> {
-            if gid < n_hmetrics {
-                Some(HMetric {
-                    advance: u16_at(hmtx + 4 * gid)?,
-                    lsb: u16_at(hmtx + 4 * gid + 2)? as i16,
-                })
-            } else {
-                Some(HMetric {
-                    advance: u16_at(hmtx + 4 * (n_hmetrics - 1))?,
-                    lsb: u16_at(hmtx + 4 * n_hmetrics + 2 * (gid - n_hmetrics))? as i16,
-                })
-            }
-        };
-
-        // Prefer a full-Unicode subtable (3,10) format 12, else BMP (3,1) / (0,x) format 4.
-        let n_sub = u16_at(cmap + 2)? as usize;
-        let mut best: Option<(u8, usize)> = None;
-        for i in 0..n_sub {
-            let rec = cmap + 4 + 8 * i;
-            let (platform, encoding) = (u16_at(rec)?, u16_at(rec + 2)?);
-            let offset = cmap + u32_at(rec + 4)? as usize;
-            let format = u16_at(offset)?;
-            let rank = match (platform, encoding, format) {
-                (3, 10, 12) | (0, 4, 12) | (0, 6, 12) => 2,
-                (3, 1, 4) | (0, _, 4) => 1,
-                _ => continue,
-            };
-            if best.is_none_or(|(r, _)| rank > r) {
-                best = Some((rank, offset));
-            }
-        }
-        let (_, sub) = best?;
-        let mut glyphs = HashMap::new();
-        let mut add = |code: u32, gid: usize| {
-            if gid != 0 && gid < n_glyphs {
-                if let (Some(c), Some(m)) = (char::from_u32(code), metric(gid)) {
-                    glyphs.insert(c, m);
-                }
-            }
-        };
-        match u16_at(sub)? {
-            4 => {
-                let seg_x2 = u16_at(sub + 6)? as usize;
-                let ends = sub + 14;
-                let starts = ends + seg_x2 + 2;
-                let deltas = starts + seg_x2;
-                let ranges = deltas + seg_x2;
-                for s in 0..seg_x2 / 2 {
-                    let end = u16_at(ends + 2 * s)? as u32;
-                    let start = u16_at(starts + 2 * s)? as u32;
-                    let delta = u16_at(deltas + 2 * s)? as u32;
-                    let range = u16_at(ranges + 2 * s)? as usize;
-                    if start > end || start == 0xFFFF {
-                        continue;
-                    }
-                    for code in start..=end {
-                        let gid = if range == 0 {
-                            (code + delta) & 0xFFFF
-                        } else {
-                            let at = ranges + 2 * s + range + 2 * (code - start) as usize;
-                            match u16_at(at)? as u32 {
-                                0 => 0,
-                                g => (g + delta) & 0xFFFF,
-                            }
-                        };
-                        add(code, gid as usize);
-                    }
-                }
-            }
-            12 => {
-                let n_groups = u32_at(sub + 12)? as usize;
-                for g in 0..n_groups {
-                    let rec = sub + 16 + 12 * g;
-                    let (start, end, gid0) = (u32_at(rec)?, u32_at(rec + 4)?, u32_at(rec + 8)?);
-                    if end < start || end - start > 0x10FFFF {
-                        return None;
-                    }
-                    for code in start..=end {
-                        add(code, (gid0 + (code - start)) as usize);
-                    }
-                }
-            }
-            _ => return None,
-        }
-        let height = ascender - descender;
-        if height <= 0.0 {
-            return None;
-        }
-        Some(FontMetrics {
-            height,
-            glyphs,
-            notdef: metric(0)?,
-        })
+    /// The metrics of a TrueType or OpenType font. `None` if ab_glyph cannot read it or its
+    /// height is not positive.
+    pub fn parse(font: &'static [u8]) -> Option<FontMetrics> {
+        let font = FontRef::try_from_slice(font).ok()?;
+        let height = f64::from(font.height_unscaled());
+        (height > 0.0).then_some(FontMetrics { font, height })
     }
 
-    /// Metrics of `c` (`.notdef` if the font lacks it).
+    /// Metrics of `c` (those of `.notdef`, glyph 0, if the font lacks it).
     pub fn get(&self, c: char) -> HMetric {
-        self.glyphs.get(&c).copied().unwrap_or(self.notdef)
+        let id = self.font.glyph_id(c);
+        HMetric {
+            advance: f64::from(self.font.h_advance_unscaled(id)),
+            lsb: f64::from(self.font.h_side_bearing_unscaled(id)),
+        }
     }
 
     /// Ink offsets (px, relative to the start of the line, as plotters rasterises each glyph
@@ -172,8 +59,8 @@ impl FontMetrics {
             .chars()
             .map(|c| {
                 let m = self.get(c);
-                let x = pen.round() as i32 + (m.lsb as f64 * scale).floor() as i32;
-                pen += m.advance as f64 * scale;
+                let x = pen.round() as i32 + (m.lsb * scale).floor() as i32;
+                pen += m.advance * scale;
                 x
             })
             .collect();
@@ -181,7 +68,7 @@ impl FontMetrics {
     }
 }
 
-/// Metrics of the embedded font, parsed once.
+/// Metrics of the embedded font, read once.
 pub(crate) fn embedded_metrics() -> Option<&'static FontMetrics> {
     static METRICS: OnceLock<Option<FontMetrics>> = OnceLock::new();
     METRICS
@@ -369,11 +256,13 @@ mod tests {
         assert_eq!(m.height, 2384.0);
         for c in "0123456789abcdefghijklmnopqrstuvwxyzABCXYZθηφₜₐ⁰¹⁻→−()|/".chars()
         {
-            assert!(m.glyphs.contains_key(&c), "{c:?} missing");
+            assert_ne!(m.font.glyph_id(c).0, 0, "{c:?} missing");
         }
         // `i` and `l` have a wide left bearing, `j` a small one.
-        assert!(m.get('i').lsb > 150);
-        assert!(m.get('l').lsb > 150);
+        assert!(m.get('i').lsb > 150.0);
+        assert!(m.get('l').lsb > 150.0);
+        // A character the font lacks takes the metrics of `.notdef`.
+        assert_eq!(m.get('\u{10FFFD}'), m.get('\u{10FFFE}'));
     }
 
     #[test]

@@ -1,16 +1,18 @@
 //! Measured normal-mode frequencies: the CSV format of `--measured`, the embedded Table II
 //! example, and the default measurement sigma taken from the printed digits.
 //!
-//! Format (documented for users in `docs/fit.md`): `#` starts a comment line; the first other
-//! line is the header `mode,frequency_hz` or `mode,frequency_hz,sigma_hz`; then one row per
-//! measured mode, in any order, any subset of the eight modes. `mode` is the rank 1..8 (the
-//! paper's nu_k, modes sorted by frequency); `frequency_hz` is finite and > 0; `sigma_hz`, when
-//! present and not empty, is the one-standard-deviation error in Hz (finite and > 0). When it is
-//! absent the sigma is half a unit of the last printed digit of `frequency_hz` (`0.4065` ->
-//! `0.00005`; `1.331e-3` -> `0.0005e-3`): the rounding error of a value reported to that many
-//! digits, the only error information Table II carries.
+//! Format (documented for users in `docs/fit.md`), CSV as [`crate::csv_text`] reads it: `#`
+//! starts a comment line; the first other line is the header `mode,frequency_hz` or
+//! `mode,frequency_hz,sigma_hz`; then one row per measured mode, in any order, any subset of the
+//! eight modes. `mode` is the rank 1..8 (the paper's nu_k, modes sorted by frequency);
+//! `frequency_hz` is finite and > 0; `sigma_hz`, when present and not empty, is the
+//! one-standard-deviation error in Hz (finite and > 0). When it is absent the sigma is half a
+//! unit of the last printed digit of `frequency_hz` (`0.4065` -> `0.00005`; `1.331e-3` ->
+//! `0.0005e-3`): the rounding error of a value reported to that many digits, the only error
+//! information Table II carries.
 
 use super::FitError;
+use crate::csv_text::{line_text, CsvRecords};
 
 /// The measured column of Table II of the paper, in the format above.
 pub const TABLE_II_MEASURED_CSV: &str = include_str!("table2_measured.csv");
@@ -53,51 +55,43 @@ impl Measured {
             .expect("the embedded Table II file is valid")
     }
 
-    /// Reads and validates a measured-frequency file.
-    pub fn from_file(path: &std::path::Path) -> Result<Measured, FitError> {
-        let text = std::fs::read_to_string(path).map_err(|e| FitError::Measured {
-            origin: path.display().to_string(),
-            message: e.to_string(),
-        })?;
-        Measured::parse(&text, &path.display().to_string())
-    }
-
-    /// Parses and validates the CSV text; `origin` names it in error messages.
+    /// Parses and validates the CSV text; `origin` names it in error messages. (Files are
+    /// read by `tiltnoise_io::read_measured_modes`.)
     pub fn parse(text: &str, origin: &str) -> Result<Measured, FitError> {
         let fail = |line: usize, message: String| FitError::Measured {
             origin: format!("{origin}, line {line}"),
             message,
         };
-        let mut lines = text
-            .lines()
-            .enumerate()
-            .map(|(i, l)| (i + 1, l.trim()))
-            .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
-        let (hline, header) = lines.next().ok_or_else(|| FitError::Measured {
-            origin: origin.to_string(),
-            message: "no header line; expected `mode,frequency_hz[,sigma_hz]`".into(),
-        })?;
-        let columns: Vec<&str> = header.split(',').map(str::trim).collect();
-        let with_sigma = match columns.as_slice() {
+        let mut records = CsvRecords::from_text(text);
+        let Some((hline, columns)) = next_record(&mut records, origin)? else {
+            return Err(FitError::Measured {
+                origin: origin.to_string(),
+                message: "no header line; expected `mode,frequency_hz[,sigma_hz]`".into(),
+            });
+        };
+        let n_columns = columns.len();
+        let with_sigma = match columns[..] {
             ["mode", "frequency_hz"] => false,
             ["mode", "frequency_hz", "sigma_hz"] => true,
             _ => {
                 return Err(fail(
                     hline,
-                    format!("header `{header}`; allowed: `mode,frequency_hz` or `mode,frequency_hz,sigma_hz`"),
+                    format!(
+                        "header `{}`; allowed: `mode,frequency_hz` or `mode,frequency_hz,sigma_hz`",
+                        line_text(text, hline)
+                    ),
                 ))
             }
         };
         let mut modes: Vec<MeasuredMode> = Vec::new();
-        for (n, line) in lines {
-            let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-            if cells.len() != columns.len() {
+        while let Some((n, cells)) = next_record(&mut records, origin)? {
+            if cells.len() != n_columns {
                 return Err(fail(
                     n,
                     format!(
-                        "`{line}` has {} fields, the header has {}",
+                        "`{}` has {} fields, the header has {n_columns}",
+                        line_text(text, n),
                         cells.len(),
-                        columns.len()
                     ),
                 ));
             }
@@ -157,6 +151,20 @@ impl Measured {
             origin: origin.to_string(),
         })
     }
+}
+
+/// The next record, its error as a [`FitError`].
+fn next_record<'a>(
+    records: &'a mut CsvRecords<&[u8]>,
+    origin: &str,
+) -> Result<Option<(usize, Vec<&'a str>)>, FitError> {
+    records.next_record().map_err(|e| FitError::Measured {
+        origin: match e.line() {
+            Some(line) => format!("{origin}, line {line}"),
+            None => origin.to_string(),
+        },
+        message: e.to_string(),
+    })
 }
 
 fn parse_positive(cell: &str) -> Option<f64> {
@@ -228,6 +236,13 @@ mod tests {
         assert_eq!(ok.modes.iter().map(|m| m.mode).collect::<Vec<_>>(), [1, 7]);
         assert_eq!(ok.modes[1].sigma_hz, 0.1);
         assert_eq!(ok.modes[0].sigma_source, SigmaSource::Digits);
+        // CSV as written by spreadsheets: byte-order mark, quotes, CRLF.
+        let quoted = Measured::parse(
+            "\u{feff}\"mode\",\"frequency_hz\"\r\n\"2\",\"0.002117\"\r\n",
+            "t.csv",
+        )
+        .unwrap();
+        assert_eq!(quoted.modes[0].frequency_hz, 0.002117);
         for (text, needle) in [
             ("mode,frequency_hz\n9,1.0\n", "mode `9`"),
             ("mode,frequency_hz\n1,1.0\n1,2.0\n", "listed twice"),
@@ -238,6 +253,14 @@ mod tests {
             ("mode,freq\n1,1.0\n", "header"),
             ("mode,frequency_hz\n1\n", "has 1 fields"),
             ("mode,frequency_hz\n", "no measured mode"),
+            (
+                "mode,frequency_hz\n1,\"1.0\n",
+                "t.csv, line 2: a double quote",
+            ),
+            (
+                "mode,frequency_hz\n 1 , 1.0 , \n",
+                "`1 , 1.0 ,` has 3 fields",
+            ),
         ] {
             let e = Measured::parse(text, "t.csv").unwrap_err().to_string();
             assert!(e.contains(needle) && e.contains("t.csv"), "{text:?}: {e}");

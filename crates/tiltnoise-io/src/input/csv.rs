@@ -1,17 +1,24 @@
-//! A small, strict CSV reader for the tilt inputs: `#` comment lines (metadata keys
-//! `# units:`, `# axes:`, `# start_time:`, `# description:` before the header), one header
-//! line, then records with exactly as many comma-separated fields as the header. Blank lines
-//! are skipped; fields are trimmed and may be enclosed in double quotes (no embedded commas).
+//! The strict CSV reader of the tilt inputs: `#` comment lines (metadata keys `# units:`,
+//! `# axes:`, `# start_time:`, `# description:` before the header), one header line, then
+//! records with exactly as many fields as the header. The lines before the header are read here
+//! (they carry the metadata); the header and the records are tokenized by
+//! [`tiltnoise_core::csv_text`], whose rules (blank and comment lines skipped, fields trimmed,
+//! double quotes) hold for every CSV file tiltnoise reads.
 
 use super::meta::decide_quantity;
 use super::InputError;
 use super::{resolve, MapOrigin, Resolved};
 use std::fs::File;
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Chain, Cursor, Read};
 use std::path::{Path, PathBuf};
+use tiltnoise_core::csv_text::{CsvRecords, RecordError};
 
 /// Metadata keys recognised in `# key: value` lines before the header.
 pub(crate) const META_KEYS: [&str; 4] = ["units", "axes", "start_time", "description"];
+
+/// What is allowed instead of bytes that are not UTF-8.
+const NOT_UTF8: &str = "not UTF-8 text; allowed: a UTF-8 (or ASCII) CSV file (an HDF5 file \
+                        needs the extension .h5 or .hdf5)";
 
 /// One `# key: value` line.
 #[derive(Debug, Clone)]
@@ -30,65 +37,46 @@ pub(crate) struct Prelude {
 }
 
 impl Prelude {
-    /// The metadata line of key `key` (keys are unique, see [`CsvFile::prelude`]).
+    /// The metadata line of key `key` (keys are unique, see [`CsvFile::open`]).
     pub fn meta(&self, key: &str) -> Option<&MetaLine> {
         self.meta.iter().find(|m| m.key == key)
     }
 }
 
-/// An open CSV file positioned after its prelude once [`CsvFile::prelude`] has run.
+/// An open CSV file positioned after its header.
 pub(crate) struct CsvFile {
     pub path: PathBuf,
+    /// The header line, then the rest of the file.
+    records: CsvRecords<Chain<Cursor<String>, BufReader<File>>>,
+}
+
+/// The lines before the header, one at a time.
+struct Lines<'a> {
+    path: &'a Path,
     reader: BufReader<File>,
     line_no: usize,
+    /// The last line read, with its line ending.
     buf: String,
 }
 
-fn unquote(s: &str) -> &str {
-    let s = s.trim();
-    s.strip_prefix('"')
-        .and_then(|s| s.strip_suffix('"'))
-        .unwrap_or(s)
-        .trim()
-}
-
-impl CsvFile {
-    pub fn open(path: &Path) -> Result<CsvFile, InputError> {
-        let file = File::open(path).map_err(|reason| InputError::Io {
-            path: path.to_path_buf(),
-            reason,
-        })?;
-        Ok(CsvFile {
-            path: path.to_path_buf(),
-            reader: BufReader::with_capacity(1 << 16, file),
-            line_no: 0,
-            buf: String::new(),
-        })
-    }
-
+impl Lines<'_> {
     fn err(&self, line: usize, message: String) -> InputError {
         InputError::Csv {
-            path: self.path.clone(),
+            path: self.path.to_path_buf(),
             line,
             message,
         }
     }
 
-    /// Reads the next line into `self.buf` (without the line ending); `false` at end of file.
+    /// Reads the next line into `self.buf`; `false` at end of file.
     fn next_line(&mut self) -> Result<bool, InputError> {
         self.buf.clear();
         let n = self.reader.read_line(&mut self.buf).map_err(|e| {
             if e.kind() == std::io::ErrorKind::InvalidData {
-                InputError::Csv {
-                    path: self.path.clone(),
-                    line: self.line_no + 1,
-                    message: "not UTF-8 text; allowed: a UTF-8 (or ASCII) CSV file (an HDF5 \
-                              file needs the extension .h5 or .hdf5)"
-                        .to_string(),
-                }
+                self.err(self.line_no + 1, NOT_UTF8.to_string())
             } else {
                 InputError::Io {
-                    path: self.path.clone(),
+                    path: self.path.to_path_buf(),
                     reason: e,
                 }
             }
@@ -97,101 +85,144 @@ impl CsvFile {
             return Ok(false);
         }
         self.line_no += 1;
-        let trimmed = self.buf.trim_end_matches(['\n', '\r']).len();
-        self.buf.truncate(trimmed);
         if self.line_no == 1 && self.buf.starts_with('\u{feff}') {
             self.buf.drain(..3);
         }
         Ok(true)
     }
+}
 
-    /// Reads comment/metadata lines and the header.
-    pub fn prelude(&mut self) -> Result<Prelude, InputError> {
+/// The error of a record that could not be read.
+fn record_error(path: &Path, e: RecordError) -> InputError {
+    match e {
+        RecordError::Io(reason) => InputError::Io {
+            path: path.to_path_buf(),
+            reason,
+        },
+        RecordError::NotUtf8 { line } => InputError::Csv {
+            path: path.to_path_buf(),
+            line,
+            message: NOT_UTF8.to_string(),
+        },
+        e @ RecordError::OpenQuote { line } => InputError::Csv {
+            path: path.to_path_buf(),
+            line,
+            message: e.to_string(),
+        },
+    }
+}
+
+impl CsvFile {
+    /// Opens `path` and reads its comment and metadata lines and its header.
+    pub fn open(path: &Path) -> Result<(CsvFile, Prelude), InputError> {
+        let file = File::open(path).map_err(|reason| InputError::Io {
+            path: path.to_path_buf(),
+            reason,
+        })?;
+        let mut lines = Lines {
+            path,
+            reader: BufReader::with_capacity(1 << 16, file),
+            line_no: 0,
+            buf: String::new(),
+        };
+        let no_header = |line: usize| InputError::Csv {
+            path: path.to_path_buf(),
+            line,
+            message: "no header line; allowed: optional `#` comment lines, then a header such as \
+                 time_s,theta_t,eta_t or freq_hz,theta_t,eta_t, then data rows"
+                .to_string(),
+        };
         let mut meta: Vec<MetaLine> = Vec::new();
         loop {
-            if !self.next_line()? {
-                return Err(self.err(
-                    self.line_no,
-                    "no header line; allowed: optional `#` comment lines, then a header such \
-                     as time_s,theta_t,eta_t or freq_hz,theta_t,eta_t, then data rows"
-                        .to_string(),
-                ));
+            if !lines.next_line()? {
+                return Err(no_header(lines.line_no));
             }
-            let line = self.buf.trim();
+            let line = lines.buf.trim();
             if line.is_empty() {
                 continue;
             }
-            if let Some(comment) = line.strip_prefix('#') {
-                if let Some((key, value)) = comment.trim_start().split_once(':') {
-                    let key = key.trim();
-                    if META_KEYS.contains(&key) {
-                        if let Some(prev) = meta.iter().find(|m| m.key == key) {
-                            return Err(self.err(
-                                self.line_no,
-                                format!(
-                                    "metadata key `# {key}:` repeated (first on line {}); \
-                                     allowed: once",
-                                    prev.line
-                                ),
-                            ));
-                        }
-                        meta.push(MetaLine {
-                            key: key.to_string(),
-                            value: value.trim().to_string(),
-                            line: self.line_no,
-                        });
+            let Some(comment) = line.strip_prefix('#') else {
+                break;
+            };
+            if let Some((key, value)) = comment.trim_start().split_once(':') {
+                let key = key.trim();
+                if META_KEYS.contains(&key) {
+                    if let Some(prev) = meta.iter().find(|m| m.key == key) {
+                        return Err(lines.err(
+                            lines.line_no,
+                            format!(
+                                "metadata key `# {key}:` repeated (first on line {}); allowed: \
+                                 once",
+                                prev.line
+                            ),
+                        ));
                     }
-                }
-                continue;
-            }
-            let header: Vec<String> = line.split(',').map(|f| unquote(f).to_string()).collect();
-            for (i, name) in header.iter().enumerate() {
-                if name.is_empty() {
-                    return Err(self.err(
-                        self.line_no,
-                        format!(
-                            "header column {} has an empty name; allowed: non-empty names",
-                            i + 1
-                        ),
-                    ));
-                }
-                if let Some(j) = header[..i].iter().position(|n| n == name) {
-                    return Err(self.err(
-                        self.line_no,
-                        format!(
-                            "header column `{name}` appears twice (columns {} and {}); \
-                             allowed: unique names",
-                            j + 1,
-                            i + 1
-                        ),
-                    ));
+                    meta.push(MetaLine {
+                        key: key.to_string(),
+                        value: value.trim().to_string(),
+                        line: lines.line_no,
+                    });
                 }
             }
-            return Ok(Prelude {
-                header,
-                header_line: self.line_no,
-                meta,
-            });
         }
+        let header_line = lines.line_no;
+        let rest = Cursor::new(std::mem::take(&mut lines.buf)).chain(lines.reader);
+        let mut file = CsvFile {
+            path: path.to_path_buf(),
+            records: CsvRecords::new(rest, header_line),
+        };
+        let header: Vec<String> = match file.records.next_record() {
+            Ok(Some((_, names))) => names.iter().map(|n| n.to_string()).collect(),
+            Ok(None) => return Err(no_header(header_line)),
+            Err(e) => return Err(record_error(path, e)),
+        };
+        let header_err = |message: String| InputError::Csv {
+            path: path.to_path_buf(),
+            line: header_line,
+            message,
+        };
+        for (i, name) in header.iter().enumerate() {
+            if name.is_empty() {
+                return Err(header_err(format!(
+                    "header column {} has an empty name; allowed: non-empty names",
+                    i + 1
+                )));
+            }
+            if let Some(j) = header[..i].iter().position(|n| n == name) {
+                return Err(header_err(format!(
+                    "header column `{name}` appears twice (columns {} and {}); allowed: unique \
+                     names",
+                    j + 1,
+                    i + 1
+                )));
+            }
+        }
+        Ok((
+            file,
+            Prelude {
+                header,
+                header_line,
+                meta,
+            },
+        ))
     }
 
-    /// Calls `f(line_number, fields)` for every record after the prelude. Comment lines and
-    /// blank lines are skipped. Every record must have `n_fields` fields.
+    /// Calls `f(line_number, fields)` for every record after the header. Every record must have
+    /// `n_fields` fields.
     pub fn for_each_record(
         &mut self,
         n_fields: usize,
         mut f: impl FnMut(usize, &[&str]) -> Result<(), InputError>,
     ) -> Result<(), InputError> {
-        while self.next_line()? {
-            let line = self.buf.trim();
-            if line.is_empty() || line.starts_with('#') {
-                continue;
-            }
-            let fields: Vec<&str> = line.split(',').map(unquote).collect();
+        while let Some((line, fields)) = self
+            .records
+            .next_record()
+            .map_err(|e| record_error(&self.path, e))?
+        {
             if fields.len() != n_fields {
                 return Err(InputError::Csv {
                     path: self.path.clone(),
-                    line: self.line_no,
+                    line,
                     message: format!(
                         "{} fields but the header has {n_fields}; allowed: exactly one field \
                          per header column",
@@ -199,7 +230,7 @@ impl CsvFile {
                     ),
                 });
             }
-            f(self.line_no, &fields)?;
+            f(line, &fields)?;
         }
         Ok(())
     }

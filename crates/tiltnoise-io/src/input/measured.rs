@@ -15,7 +15,7 @@
 //! [`read_measured_input`] reads any of them; the budget turns a series into one-sided ASDs
 //! with its own Welch settings.
 
-use super::csv::{decimal_resolution, parse_field, CsvFile};
+use super::csv::{decimal_resolution, parse_field, CsvFile, Prelude};
 use super::h5::{self, h5err, AttrValue};
 use super::InputError;
 use super::InputFormat;
@@ -51,13 +51,12 @@ pub fn read_measured_input(path: &Path) -> Result<MeasuredInput, InputError> {
     match InputFormat::from_path(path)? {
         InputFormat::Hdf5 => read_series_hdf5(path).map(MeasuredInput::Series),
         InputFormat::Csv => {
-            let mut file = CsvFile::open(path)?;
-            let prelude = file.prelude()?;
+            let (file, prelude) = CsvFile::open(path)?;
             if prelude.header.first().map(String::as_str) == Some("time_s") {
                 read_series_csv(path, file, &prelude.header, prelude.header_line)
                     .map(MeasuredInput::Series)
             } else {
-                read_measured(path).map(MeasuredInput::Spectra)
+                read_spectra_csv(path, file, &prelude).map(MeasuredInput::Spectra)
             }
         }
     }
@@ -263,8 +262,15 @@ pub struct MeasuredSpectra {
 
 /// Reads a measured-spectrum CSV (see the module docs).
 pub fn read_measured(path: &Path) -> Result<MeasuredSpectra, InputError> {
-    let mut file = CsvFile::open(path)?;
-    let prelude = file.prelude()?;
+    let (file, prelude) = CsvFile::open(path)?;
+    read_spectra_csv(path, file, &prelude)
+}
+
+fn read_spectra_csv(
+    path: &Path,
+    mut file: CsvFile,
+    prelude: &Prelude,
+) -> Result<MeasuredSpectra, InputError> {
     let csv_err = |line: usize, message: String| InputError::Csv {
         path: path.to_path_buf(),
         line,

@@ -44,8 +44,7 @@ use std::path::Path;
 pub fn read_tilt(path: &Path, opts: &ReadOptions) -> Result<TiltInput, InputError> {
     match InputFormat::from_path(path)? {
         InputFormat::Csv => {
-            let mut file = csv::CsvFile::open(path)?;
-            let prelude = file.prelude()?;
+            let (file, prelude) = csv::CsvFile::open(path)?;
             match csv_kind(path, &prelude)? {
                 InputKind::Series => series_csv::read(file, prelude, opts).map(TiltInput::Series),
                 InputKind::Spectra => {
@@ -100,8 +99,7 @@ pub fn read_tilt_spectra(path: &Path, opts: &ReadOptions) -> Result<TiltSpectra,
             }
         }
         InputFormat::Csv => {
-            let mut file = csv::CsvFile::open(path)?;
-            let prelude = file.prelude()?;
+            let (file, prelude) = csv::CsvFile::open(path)?;
             match csv_kind(path, &prelude)? {
                 InputKind::Spectra => spectra_csv::read(file, prelude, opts),
                 InputKind::Series => Err(wrong_kind(path, InputKind::Spectra, InputKind::Series)),
