@@ -53,8 +53,8 @@ pub struct AxisMapEntry {
 /// once. Only the mapped axes are read; other channels in the file are ignored.
 ///
 /// ```
-/// use tiltnoise::input::{AxisMap, Sign};
-/// use tiltnoise::model::TiltAxis;
+/// use tiltnoise_core::input::{AxisMap, Sign};
+/// use tiltnoise_core::model::TiltAxis;
 /// let map: AxisMap = "theta_t=-LJE, eta_t=-LJN".parse().unwrap();
 /// assert_eq!(map.entries()[0].target, TiltAxis::ThetaT);
 /// assert_eq!(map.entries()[0].sign, Sign::Minus);
