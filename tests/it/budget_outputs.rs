@@ -2,24 +2,24 @@
 //! are written, failures leave nothing behind. A realistic Table I budget is rendered too; set
 //! `TILTNOISE_PLOT_PREVIEW=<dir>` to keep its files (budget.png, .svg, .h5, .csv) in `<dir>`.
 
-mod common;
+use crate::common;
 
+use crate::output::{save_budget, save_image};
 use common::{listing, str_attr, strs_attr};
 use num_complex::Complex64;
 use std::path::PathBuf;
-use tiltnoise::error::{OutputError, TfError};
-use tiltnoise::io::{
-    budget_csv_string, save_budget, write_budget_hdf5, InputMeta, RunMeta, SCHEMA_BUDGET,
-    TOOL_VERSION,
-};
-use tiltnoise::model::{Model, Observable, TiltAxis};
-use tiltnoise::noise::{
+use tiltnoise_core::error::{OutputError, TfError};
+use tiltnoise_core::model::{Model, Observable, TiltAxis};
+use tiltnoise_core::noise::{
     add_measured, tilt_budget, Budget, BudgetReport, NoiseTerm, ObservableBudget, Readout,
     SegmentBand, SpectralSource, TiltCsd,
 };
-use tiltnoise::params::Params;
-use tiltnoise::plot::budget_figure;
-use tiltnoise::tf::{evaluate, plan, Input, Method, Request, TransferFunction};
+use tiltnoise_core::params::Params;
+use tiltnoise_core::tf::{evaluate, plan, Input, Method, Request, TransferFunction};
+use tiltnoise_io::{
+    budget_csv_string, write_budget_hdf5, InputMeta, RunMeta, SCHEMA_BUDGET, TOOL_VERSION,
+};
+use tiltnoise_plot::budget_figure;
 
 fn term(name: &str, psd: Vec<f64>) -> NoiseTerm {
     NoiseTerm {
@@ -584,9 +584,12 @@ fn realistic_budget_renders() {
     let out = preview_dir();
     for ext in ["png", "svg"] {
         let name = format!("budget_spectra.{ext}");
-        budget_figure(&spectra, &dir.path().join(&name)).unwrap();
+        save_image(&dir.path().join(&name), |format| {
+            budget_figure(&spectra, format)
+        })
+        .unwrap();
         if let Some(out) = &out {
-            budget_figure(&spectra, &out.join(&name)).unwrap();
+            save_image(&out.join(&name), |format| budget_figure(&spectra, format)).unwrap();
         }
     }
     let text = std::fs::read_to_string(dir.path().join("budget_spectra.svg")).unwrap();

@@ -1,7 +1,7 @@
 //! The command line as a user meets it: exit codes, one-line errors naming the problem, no
 //! partial output files, and machine-readable output.
 
-mod common;
+use crate::common;
 
 use common::{assert_fails, stderr, tiltnoise};
 use std::path::Path;
@@ -17,11 +17,11 @@ fn params_prints_toml_that_reads_back() {
     assert!(out.status.success());
     let path = dir.path().join("p.toml");
     std::fs::write(&path, &out.stdout).unwrap();
-    let back = tiltnoise::params::Params::from_file(&path).unwrap();
+    let back = tiltnoise_core::params::Params::from_file(&path).unwrap();
     assert_eq!(back.length.h_m, 1.5);
     assert_eq!(
         back.with_override("length.h_m=2.0").unwrap(),
-        tiltnoise::params::Params::table_i()
+        tiltnoise_core::params::Params::table_i()
     );
 }
 
@@ -122,9 +122,10 @@ fn unwritable_or_unknown_outputs_leave_nothing() {
 #[test]
 fn exact_resonance_in_a_frequency_file_is_an_error_not_garbage() {
     // The Rayleigh-refined nu_8 of the undamped model, written with full precision.
-    let model = tiltnoise::model::Model::new(&tiltnoise::params::Params::table_i()).unwrap();
-    let mode = tiltnoise::modes::NormalModes::new(&model).modes[7].clone();
-    let lambda = tiltnoise::modes::refined_omega_sq(&model, &mode);
+    let model =
+        tiltnoise_core::model::Model::new(&tiltnoise_core::params::Params::table_i()).unwrap();
+    let mode = tiltnoise_core::modes::NormalModes::new(&model).modes[7].clone();
+    let lambda = tiltnoise_core::modes::refined_omega_sq(&model, &mode);
     let f = lambda.sqrt() / std::f64::consts::TAU;
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("f.txt");
@@ -150,8 +151,8 @@ fn modes_json_is_machine_readable() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let modes = v["modes"].as_array().unwrap();
     assert_eq!(modes.len(), 8);
-    let lib = tiltnoise::modes::NormalModes::new(
-        &tiltnoise::model::Model::new(&tiltnoise::params::Params::table_i()).unwrap(),
+    let lib = tiltnoise_core::modes::NormalModes::new(
+        &tiltnoise_core::model::Model::new(&tiltnoise_core::params::Params::table_i()).unwrap(),
     );
     for (j, m) in modes.iter().zip(&lib.modes) {
         assert_eq!(j["index"].as_u64().unwrap() as usize, m.index);
@@ -199,13 +200,13 @@ fn mc_json_reports_every_mode_and_refuses_zero_samples() {
     assert_eq!(v["samples"].as_u64(), Some(2000));
     // The statistics are tested in tests/mc.rs; here the command must reproduce the library's
     // result for the same seed exactly (JSON floats round-trip).
-    let params = tiltnoise::params::Params::table_i();
-    let cfg = tiltnoise::mc::McConfig {
+    let params = tiltnoise_core::params::Params::table_i();
+    let cfg = tiltnoise_core::mc::McConfig {
         samples: 2000,
         seed: 7,
-        ..tiltnoise::mc::McConfig::default_for(&params)
+        ..tiltnoise_core::mc::McConfig::default_for(&params)
     };
-    let lib = tiltnoise::mc::run(&params, &cfg, &|_| {}).unwrap();
+    let lib = tiltnoise_core::mc::run(&params, &cfg, &|_| {}).unwrap();
     for (k, m) in modes.iter().enumerate() {
         assert_eq!(m["index"].as_u64(), Some(k as u64 + 1));
         assert_eq!(m["mean_hz"].as_f64().unwrap(), lib.mean_hz[k], "{m}");

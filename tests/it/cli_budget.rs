@@ -1,7 +1,7 @@
 //! `tiltnoise budget` as a user meets it: the main job on the default input, and every kind of
 //! bad input refused with exit code 2, a message naming the problem, and no output file.
 
-mod common;
+use crate::common;
 
 use common::{assert_fails_without_output, tiltnoise};
 use std::path::Path;

@@ -1,6 +1,10 @@
-//! Helpers shared by integration tests: paths to reference data, a named-tolerance comparison,
-//! running the `tiltnoise` binary, directory listings and HDF5 string attributes.
-#![allow(dead_code)]
+//! Helpers of the command-line, file and figure tests: running the `tiltnoise` binary, directory
+//! listings, HDF5 string attributes and the reference data kept beside the repository; the
+//! helpers every crate's tests share come from `crates/tiltnoise-core/tests/it/common.rs`.
+
+#[path = "../../crates/tiltnoise-core/tests/it/common.rs"]
+mod shared;
+pub use shared::*;
 
 use hdf5::types::VarLenUnicode;
 use std::path::{Path, PathBuf};
@@ -8,45 +12,13 @@ use std::process::{Command, Output};
 
 /// `../shared/tilt_data/<rel>` beside the repository (CI clones with shared/ beside it).
 pub fn shared_tilt_data(rel: &str) -> PathBuf {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/tilt_data")
-        .join(rel);
+    let p = repo("../shared/tilt_data").join(rel);
     assert!(
         p.exists(),
         "reference data {} not found: the tests expect ../shared/ beside the repository",
         p.display()
     );
     p
-}
-
-/// A path inside the repository.
-pub fn repo(rel: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(rel)
-}
-
-/// Reads a JSON fixture.
-pub fn json(rel: &str) -> serde_json::Value {
-    let text = std::fs::read_to_string(repo(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"));
-    serde_json::from_str(&text).unwrap()
-}
-
-/// A JSON array of numbers.
-pub fn floats(v: &serde_json::Value) -> Vec<f64> {
-    v.as_array()
-        .expect("array")
-        .iter()
-        .map(|x| x.as_f64().expect("number"))
-        .collect()
-}
-
-/// `|got - want| <= rel * |want| + abs`, with a message naming what and where.
-pub fn assert_close(what: &str, at: &str, got: f64, want: f64, rel: f64, abs: f64) {
-    let tol = rel * want.abs() + abs;
-    assert!(
-        (got - want).abs() <= tol,
-        "{what} at {at}: got {got:e}, want {want:e} (|diff| {:e} > tol {tol:e})",
-        (got - want).abs()
-    );
 }
 
 /// Runs the `tiltnoise` binary with `args`.
@@ -141,22 +113,4 @@ pub fn strings(c: &hdf5::Container) -> Vec<String> {
 pub fn disable_hdf5_file_locking() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| std::env::set_var("HDF5_USE_FILE_LOCKING", "FALSE"));
-}
-
-/// `p` with loss angle `loss_rad` on both torsions and both bouncings (the damped test model
-/// of the transfer-function tests).
-pub fn with_torsion_and_bouncing_loss(
-    p: tiltnoise::params::Params,
-    loss_rad: f64,
-) -> tiltnoise::params::Params {
-    let mut p = p;
-    for key in [
-        "torsion_a_rad",
-        "torsion_b_rad",
-        "bouncing_a_rad",
-        "bouncing_b_rad",
-    ] {
-        p = p.with_override(&format!("loss.{key}={loss_rad}")).unwrap();
-    }
-    p
 }

@@ -4,17 +4,17 @@
 //! equivalence with structural loss; the quality factor per mode against the complex
 //! eigenvalues of the damped problem; validation of the new keys.
 
-mod common;
+use crate::common;
 
 use common::{assert_fails, tiltnoise};
 use nalgebra::SMatrix;
 use num_complex::Complex64;
-use tiltnoise::model::{ForceInput, Model, Observable};
-use tiltnoise::modes::NormalModes;
-use tiltnoise::params::Params;
-use tiltnoise::reference::ReferenceModel;
-use tiltnoise::tf::{plan, Input, Method, PlanError, Request};
-use tiltnoise::units::angular;
+use tiltnoise_core::model::{ForceInput, Model, Observable};
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::params::Params;
+use tiltnoise_core::reference::ReferenceModel;
+use tiltnoise_core::tf::{plan, Input, Method, PlanError, Request};
+use tiltnoise_core::units::angular;
 
 const EPS: f64 = f64::EPSILON;
 /// `gamma_3n` with n = 8: componentwise backward error of the LU solve, applied to the entry's

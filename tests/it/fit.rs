@@ -3,15 +3,15 @@
 //! the reported covariance checked against the scatter of an ensemble), the box bounds, the
 //! refusals, and the embedded Table II example.
 
-mod common;
+use crate::common;
 
 use common::{assert_fails_without_output, tiltnoise};
-use tiltnoise::fit::jacobian::{frequencies_and_jacobian, value_of, with_value};
-use tiltnoise::fit::{fit, Bound, FitConfig, FitError, FitResult, Measured, MeasuredMode};
-use tiltnoise::fit::{SigmaSource, DEFAULT_FREE};
-use tiltnoise::model::Model;
-use tiltnoise::modes::{refined_omega_sq, NormalModes};
-use tiltnoise::params::Params;
+use tiltnoise_core::fit::jacobian::{frequencies_and_jacobian, value_of, with_value};
+use tiltnoise_core::fit::{fit, Bound, FitConfig, FitError, FitResult, Measured, MeasuredMode};
+use tiltnoise_core::fit::{SigmaSource, DEFAULT_FREE};
+use tiltnoise_core::model::Model;
+use tiltnoise_core::modes::{refined_omega_sq, NormalModes};
+use tiltnoise_core::params::Params;
 
 /// Relative measurement error of the synthetic frequencies: the order of Table II's printed
 /// digits (5e-7 Hz on 1.3 mHz is 4e-4; 5e-6 Hz on 0.588 Hz is 8.5e-6).
@@ -23,7 +23,7 @@ const SYNTH_REL_SIGMA: f64 = 1e-4;
 const EIGEN_REL_ERR: f64 = 1e-11;
 
 fn sigma_p(params: &Params, key: &str) -> f64 {
-    let rel = tiltnoise::mc::uncertainties(params)
+    let rel = tiltnoise_core::mc::uncertainties(params)
         .into_iter()
         .find(|u| u.key == key)
         .map_or(0.0, |u| u.rel_sigma);
@@ -82,7 +82,7 @@ const ALL_MODES: [usize; 8] = [1, 2, 3, 4, 5, 6, 7, 8];
 #[test]
 fn eigenvalue_derivatives_match_finite_differences() {
     let p = Params::table_i();
-    let keys: Vec<String> = tiltnoise::mc::uncertainties(&p)
+    let keys: Vec<String> = tiltnoise_core::mc::uncertainties(&p)
         .into_iter()
         .filter(|u| u.rel_sigma > 0.0)
         .map(|u| u.key)
@@ -180,7 +180,7 @@ fn noisy_fits_scatter_as_the_reported_covariance() {
     let keys = DEFAULT_FREE;
     let truth_u = [0.3, -0.2, 0.2, -0.1, 0.1, -0.2, 0.2, -0.1];
     let truth = shifted(&p, &keys, &truth_u);
-    let mut rng = tiltnoise::rng::Rng::stream(42, 0);
+    let mut rng = tiltnoise_core::rng::Rng::stream(42, 0);
     const RUNS: usize = 400;
     let mut sum_z2 = [0.0; 8];
     let mut sum_chi2 = 0.0;

@@ -10,17 +10,17 @@
 //!   cross responses of two such pairs are equal, in the reference and in the fast methods;
 //! * bad names are refused with exit code 2 and no output.
 
-mod common;
+use crate::common;
 
 use common::{assert_fails_without_output, tiltnoise};
 use num_complex::Complex64;
 use std::path::Path;
-use tiltnoise::model::{ForceInput, Model, Observable};
-use tiltnoise::modes::NormalModes;
-use tiltnoise::params::Params;
-use tiltnoise::reference::{relative_errors, ReferenceModel, DD_EPS};
-use tiltnoise::scene::POLE_EXCLUSION;
-use tiltnoise::tf::{plan, Input, Method, Request};
+use tiltnoise_core::model::{ForceInput, Model, Observable};
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::params::Params;
+use tiltnoise_core::reference::{relative_errors, ReferenceModel, DD_EPS};
+use tiltnoise_core::tf::planner::POLE_EXCLUSION;
+use tiltnoise_core::tf::{plan, Input, Method, Request};
 
 /// The tolerance `auto` is asked to meet by default (issue 4's accuracy target).
 const AUTO_REL_TOL: f64 = 1e-9;

@@ -2,18 +2,18 @@
 //! axis mapping and signs, gap handling, rate integration, streaming == in-memory bit for bit,
 //! log-log interpolation.
 
-mod common;
+use crate::common;
 
 use hdf5::types::{FixedAscii, VarLenUnicode};
 use ndarray::{arr0, Array1, Array2, Array3};
 use num_complex::Complex64;
 use std::f64::consts::TAU;
 use std::path::{Path, PathBuf};
-use tiltnoise::input::{
+use tiltnoise_core::model::TiltAxis;
+use tiltnoise_io::input::{
     read_tilt, read_tilt_series, read_tilt_spectra, AxisMap, GapPolicy, InputError, InputFormat,
     InputKind, Quantity, ReadOptions, Sign, TiltInput, TiltSeriesSource, TiltSpectra,
 };
-use tiltnoise::model::TiltAxis;
 
 // ---------------------------------------------------------------------------------------------
 // Fixture writers
@@ -98,7 +98,7 @@ fn opts(map: Option<&str>, quantity: Option<Quantity>, gaps: GapPolicy) -> ReadO
     }
 }
 
-fn series(path: &Path, o: &ReadOptions) -> tiltnoise::input::TiltSeries {
+fn series(path: &Path, o: &ReadOptions) -> tiltnoise_io::input::TiltSeries {
     read_tilt_series(path, o).unwrap_or_else(|e| panic!("{e}"))
 }
 

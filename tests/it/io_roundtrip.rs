@@ -1,18 +1,17 @@
 //! Output writers: bit-exact round trips through HDF5 and CSV, the documented layout, and the
 //! atomicity guarantees (nothing left behind on failure, existing files never clobbered).
 
-mod common;
+use crate::common;
 
+use crate::output::save_tf;
 use common::{listing, str_attr, strs_attr, strs_dataset};
 use num_complex::Complex64;
 use std::path::Path;
-use tiltnoise::error::OutputError;
-use tiltnoise::io::{
-    save_tf, write_atomic, write_tf_csv, write_tf_hdf5, OutputKind, RunMeta, TOOL_VERSION,
-};
-use tiltnoise::model::Model;
-use tiltnoise::params::Params;
-use tiltnoise::tf::{evaluate, plan, Method, Request, TransferMatrix};
+use tiltnoise_core::error::OutputError;
+use tiltnoise_core::model::Model;
+use tiltnoise_core::params::Params;
+use tiltnoise_core::tf::{evaluate, plan, Method, Request, TransferMatrix};
+use tiltnoise_io::{write_atomic, write_tf_csv, write_tf_hdf5, OutputKind, RunMeta, TOOL_VERSION};
 
 fn freqs() -> Vec<f64> {
     // 0 Hz, then log-spaced 1e-4 .. 10 Hz (irrational-looking values), then a few exact ones.

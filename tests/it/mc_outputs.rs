@@ -3,13 +3,13 @@
 //! independently by finite differences of `NormalModes`), uniform and Gaussian errors give the
 //! same spread, HDF5 reads back, figures are written, and bad input fails cleanly.
 
-mod common;
+use crate::common;
 
 use common::{assert_fails_without_output, str_attr, strs_dataset, tiltnoise};
-use tiltnoise::mc::{run, uncertainties, Distribution, McConfig, McResult};
-use tiltnoise::model::Model;
-use tiltnoise::modes::NormalModes;
-use tiltnoise::params::{Params, TABLE_I_TOML};
+use tiltnoise_core::mc::{run, uncertainties, Distribution, McConfig, McResult};
+use tiltnoise_core::model::Model;
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::params::{Params, TABLE_I_TOML};
 
 /// Central-difference step (relative) of the reference derivatives: truncation ~h^2 (1e-10),
 /// rounding ~1e-15 / h (1e-10) relative to the frequency.

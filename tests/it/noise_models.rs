@@ -3,15 +3,15 @@
 //! tilt spectra, interpolated log-log, and propagated to X. Expected levels come from
 //! `scripts/reference/noise_model_levels.py` (NumPy, independent of this crate).
 
-mod common;
+use crate::common;
 
 use common::{assert_close, floats, json, shared_tilt_data};
-use tiltnoise::budget::{budget_from_spectra, BudgetOptions};
-use tiltnoise::input::{read_tilt_spectra, ReadOptions};
-use tiltnoise::model::{Model, Observable, TiltAxis};
-use tiltnoise::noise::Readout;
-use tiltnoise::params::Params;
-use tiltnoise::tf::{plan, Input, Method, Request};
+use tiltnoise_core::budget::{budget_from_spectra, BudgetOptions};
+use tiltnoise_core::model::{Model, Observable, TiltAxis};
+use tiltnoise_core::noise::Readout;
+use tiltnoise_core::params::Params;
+use tiltnoise_core::tf::{plan, Input, Method, Request};
+use tiltnoise_io::input::{read_tilt_spectra, ReadOptions};
 
 /// Both sides interpolate linearly in log(ASD) against log(f) between the same table rows, so
 /// they differ only by rounding: about ten roundings of relative eps in the conversion chain,

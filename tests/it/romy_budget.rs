@@ -3,13 +3,13 @@
 //! against the independent reference of `scripts/reference/tilt_budget_reference.py` (SciPy for
 //! the spectra, mpmath at 40 digits for the model, built from the paper, not from this crate).
 
-mod common;
+use crate::common;
 
 use common::{assert_close, floats, json, shared_tilt_data};
-use tiltnoise::budget::{budget_from_series, BudgetOptions, SeriesInput};
-use tiltnoise::input::{read_tilt_series, AxisMap, Quantity, ReadOptions};
-use tiltnoise::model::{Model, Observable};
-use tiltnoise::params::Params;
+use tiltnoise_core::budget::{budget_from_series, BudgetOptions};
+use tiltnoise_core::model::{Model, Observable};
+use tiltnoise_core::params::Params;
+use tiltnoise_io::input::{read_tilt_series, AxisMap, Quantity, ReadOptions};
 
 /// Agreement required between the two pipelines, relative per bin: the criterion for
 /// equal results (1e-8). The spectral parts agree with SciPy to ~1e-14 (tests/welch_scipy.rs)
@@ -21,27 +21,21 @@ const PIPELINE_REL: f64 = 1e-8;
 /// can be off by about that fraction of the peak PSD.
 const PEAK_FLOOR: f64 = 1e-11;
 
-fn romy_budget() -> tiltnoise::noise::BudgetReport {
+fn romy_budget() -> tiltnoise_core::noise::BudgetReport {
     let path = shared_tilt_data("romy_6c_teleseism_20180123/ROMY_gulf_of_alaska_teleseism.csv");
     let opts = ReadOptions {
         axis_map: Some(AxisMap::parse("theta_t=-LJE,eta_t=-LJN").unwrap()),
         quantity: Some(Quantity::Rate),
         ..ReadOptions::default()
     };
-    let series = read_tilt_series(&path, &opts).unwrap();
+    let mut series = read_tilt_series(&path, &opts).unwrap();
     assert_eq!((series.len(), series.sample_rate_hz), (8192, 1.0));
     let model = Model::new(&Params::table_i()).unwrap();
     let budget_opts = BudgetOptions {
         welch_segment_len: Some(2048),
         ..BudgetOptions::default()
     };
-    budget_from_series(
-        &model,
-        SeriesInput::Memory(series),
-        &budget_opts,
-        &mut |_, _| {},
-    )
-    .unwrap()
+    budget_from_series(&model, &mut series, &budget_opts, &mut |_, _| {}).unwrap()
 }
 
 #[test]

@@ -2,12 +2,12 @@
 //! the HDF5 layout, the kick figures, and bad input (exit 2, a message naming the option and
 //! value, nothing written).
 
-mod common;
+use crate::common;
 
 use common::{assert_fails_without_output, listing, str_attr, tiltnoise};
 use hdf5::types::VarLenUnicode;
-use tiltnoise::model::{Coord, Observable};
-use tiltnoise::spectral::{welch, WelchConfig};
+use tiltnoise_core::model::{Coord, Observable};
+use tiltnoise_core::spectral::{welch, WelchConfig};
 
 fn stdout(o: &std::process::Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
@@ -53,8 +53,8 @@ fn default_run_agrees_with_the_table_and_writes_the_budget_layout() {
     assert_eq!(str_attr(&f, "schema"), "tiltnoise.observable_series");
     // Writer and reader agree on the schema name.
     assert_eq!(
-        tiltnoise::io::SCHEMA_OBSERVABLE_SERIES,
-        tiltnoise::input::SCHEMA_OBSERVABLE_SERIES
+        tiltnoise_io::SCHEMA_OBSERVABLE_SERIES,
+        tiltnoise_io::input::SCHEMA_OBSERVABLE_SERIES
     );
     let fs: f64 = f.attr("sample_rate_hz").unwrap().read_scalar().unwrap();
     assert_eq!(fs, 10.0);
@@ -96,7 +96,7 @@ fn default_run_agrees_with_the_table_and_writes_the_budget_layout() {
         .unwrap();
     assert_eq!(units.as_str(), "m/sqrt(Hz)");
     // The CSV is the budget's measured-spectrum format.
-    let m = tiltnoise::input::read_measured(&csv).unwrap();
+    let m = tiltnoise_io::input::read_measured(&csv).unwrap();
     assert_eq!(m.asd.len(), 7);
     assert_eq!(m.freqs_hz.len(), want.len() - 1);
 }

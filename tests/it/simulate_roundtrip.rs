@@ -4,7 +4,7 @@
 //! free of resonances, within the statistical error of a K-segment Welch average; the simulated
 //! record is refused as floor tilt.
 
-mod common;
+use crate::common;
 
 use common::{assert_fails_without_output, tiltnoise};
 use realfft::RealFftPlanner;

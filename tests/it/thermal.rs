@@ -4,16 +4,16 @@
 //! section IV.C, (4) the 1/f (structural) and white-force (viscous) shapes; and (item 4) the
 //! budget terms in the HDF5 output (total = sum of the independent terms).
 
-mod common;
+use crate::common;
 
 use common::{assert_fails, repo, tiltnoise};
 use num_complex::Complex64;
-use tiltnoise::model::{Model, Observable};
-use tiltnoise::modes::NormalModes;
-use tiltnoise::params::Params;
-use tiltnoise::reference::ReferenceModel;
-use tiltnoise::thermal::{conjugate_response, thermal_noise, BOLTZMANN_J_PER_K};
-use tiltnoise::units::angular;
+use tiltnoise_core::model::{Model, Observable};
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::params::Params;
+use tiltnoise_core::reference::ReferenceModel;
+use tiltnoise_core::thermal::{conjugate_response, thermal_noise, BOLTZMANN_J_PER_K};
+use tiltnoise_core::units::angular;
 
 const EPS: f64 = f64::EPSILON;
 /// Normwise relative error of the direct method's equilibrated 8x8 LU per unit condition

@@ -16,8 +16,8 @@
 
 use nalgebra::{Matrix4, SMatrix, Vector4};
 use std::ops::{Add, Mul, Neg, Sub};
-use tiltnoise::model::{Coord, ForceInput, Model, Observable, TiltAxis};
-use tiltnoise::params::Params;
+use tiltnoise_core::model::{Coord, ForceInput, Model, Observable, TiltAxis};
+use tiltnoise_core::params::Params;
 
 /// Rounding-bound factor of the comparisons: |lib - ref| <= C_TOL * eps * mag.
 /// Derivation: by running error analysis an entry computed in n floating-point steps is off by at

@@ -1,11 +1,11 @@
 //! The default frequency grid never misses a resonance: undamped poles are bracketed closely
 //! on both sides without being hit; damped peaks get points across their half-power width.
 
-use tiltnoise::freq::{default_grid, DEFAULT_F_HI_HZ, DEFAULT_F_LO_HZ};
-use tiltnoise::model::Model;
-use tiltnoise::modes::NormalModes;
-use tiltnoise::params::Params;
-use tiltnoise::tf::{plan, Method, Request};
+use tiltnoise_core::freq::{default_grid, DEFAULT_F_HI_HZ, DEFAULT_F_LO_HZ};
+use tiltnoise_core::model::Model;
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::params::Params;
+use tiltnoise_core::tf::{plan, Method, Request};
 
 #[test]
 fn undamped_poles_are_bracketed_within_1e_6_and_never_hit() {

@@ -1,12 +1,12 @@
 //! Monte Carlo of the normal modes: reproducibility across thread counts, the zero-sigma limit,
 //! first-order error propagation, Table II's calculated column, refusals and speed.
 
-use tiltnoise::mc::{
+use tiltnoise_core::mc::{
     default_uncertainties, run, Distribution, McConfig, McError, McResult, Uncertainty,
 };
-use tiltnoise::model::Model;
-use tiltnoise::modes::NormalModes;
-use tiltnoise::params::Params;
+use tiltnoise_core::model::Model;
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::params::Params;
 
 /// Table II of the paper, "calculated" column: (value, +/- error) in Hz. Paper data, not output of
 /// this code.

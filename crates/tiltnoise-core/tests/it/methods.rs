@@ -1,5 +1,5 @@
-//! Every evaluation method of `tiltnoise::tf` against the double-double reference evaluator
-//! (`tiltnoise::reference`, about 30 digits) on every test model and every entry point, with one
+//! Every evaluation method of `tiltnoise_core::tf` against the double-double reference evaluator
+//! (`tiltnoise_core::reference`, about 30 digits) on every test model and every entry point, with one
 //! named tolerance per method derived from that method's rounding model (STYLE.md patterns 2, 3).
 //!
 //! * Test models: Table I undamped; Table I with loss angles 1e-3 on both torsions and both
@@ -30,17 +30,17 @@
 //! every method.
 //! Run with `--nocapture` to see the methods table (the maxima measured here).
 
-mod common;
+use crate::common;
 
 use nalgebra::{Matrix2, RowVector2, SMatrix, SVector, Vector2};
 use num_complex::Complex64;
 use std::sync::OnceLock;
-use tiltnoise::model::{Coord, ForceInput, Model, Observable, TiltAxis};
-use tiltnoise::modes::{refined_omega_sq, NormalModes};
-use tiltnoise::params::Params;
-use tiltnoise::reference::{CDd, ReferenceModel};
-use tiltnoise::tf::{plan, Input, Method, PlanError, Request, TransferFunction};
-use tiltnoise::units::angular;
+use tiltnoise_core::model::{Coord, ForceInput, Model, Observable, TiltAxis};
+use tiltnoise_core::modes::{refined_omega_sq, NormalModes};
+use tiltnoise_core::params::Params;
+use tiltnoise_core::reference::{CDd, ReferenceModel};
+use tiltnoise_core::tf::{plan, Input, Method, PlanError, Request, TransferFunction};
+use tiltnoise_core::units::angular;
 
 type CVec8 = SVector<Complex64, 8>;
 type CMat8 = SMatrix<Complex64, 8, 8>;
@@ -1099,7 +1099,7 @@ fn every_method_reports_exact_resonances() {
         let f = lambda.sqrt() / std::f64::consts::TAU;
         let near = tf.eval(f);
         assert!(
-            matches!(near, Err(tiltnoise::error::TfError::Singular { .. })),
+            matches!(near, Err(tiltnoise_core::error::TfError::Singular { .. })),
             "{} at nu_1 = {f} Hz: {near:?}",
             method.name()
         );

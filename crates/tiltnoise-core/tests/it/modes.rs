@@ -2,9 +2,9 @@
 //! decoupled-pendulum limits of section III.
 
 use nalgebra::DMatrix;
-use tiltnoise::model::{Block, Coord, Model, Observable};
-use tiltnoise::modes::{decoupled_swing_estimates_hz, NormalModes};
-use tiltnoise::params::Params;
+use tiltnoise_core::model::{Block, Coord, Model, Observable};
+use tiltnoise_core::modes::{decoupled_swing_estimates_hz, NormalModes};
+use tiltnoise_core::params::Params;
 
 /// Table II of the paper, "calculated" column: (value, +/- error) in Hz. Paper data, not output of
 /// this code.
@@ -25,7 +25,7 @@ fn table_i_modes() -> (Model, NormalModes) {
     (model, modes)
 }
 
-fn block_norm(m: &tiltnoise::model::Mat8, b: Block) -> f64 {
+fn block_norm(m: &tiltnoise_core::model::Mat8, b: Block) -> f64 {
     Model::block_of(m, b).norm()
 }
 

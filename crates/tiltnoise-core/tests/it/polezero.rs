@@ -11,14 +11,14 @@
 //!
 //! Run with `cargo test --release --test polezero -- --nocapture` to see the numbers.
 
-mod common;
+use crate::common;
 
 use num_complex::Complex64;
-use tiltnoise::error::TfError;
-use tiltnoise::model::{ForceInput, Model, Observable, TiltAxis};
-use tiltnoise::params::Params;
-use tiltnoise::reference::{relative_errors, ReferenceModel};
-use tiltnoise::tf::{evaluate, plan, EntryFactors, Input, Method, PoleZero, Request};
+use tiltnoise_core::error::TfError;
+use tiltnoise_core::model::{ForceInput, Model, Observable, TiltAxis};
+use tiltnoise_core::params::Params;
+use tiltnoise_core::reference::{relative_errors, ReferenceModel};
+use tiltnoise_core::tf::{evaluate, plan, EntryFactors, Input, Method, PoleZero, Request};
 
 const TARGET_REL: f64 = 1e-9;
 const EXCLUSION: f64 = 0.01;

@@ -15,14 +15,14 @@
 //!   chunk, the other thread's half) gives the per-point path's error, the first in grid order,
 //!   with the same frequency and rcond; likewise a negative, NaN or infinite frequency.
 
-mod common;
+use crate::common;
 
 use num_complex::Complex64;
-use tiltnoise::error::TfError;
-use tiltnoise::model::{ForceInput, Model, Observable};
-use tiltnoise::params::Params;
-use tiltnoise::reference::{CDd, Dd};
-use tiltnoise::tf::{
+use tiltnoise_core::error::TfError;
+use tiltnoise_core::model::{ForceInput, Model, Observable};
+use tiltnoise_core::params::Params;
+use tiltnoise_core::reference::{CDd, Dd};
+use tiltnoise_core::tf::{
     eval_grid_threads, evaluate, evaluate_into, plan, Input, Method, PoleZero, Request,
     TransferFunction,
 };
@@ -191,7 +191,7 @@ fn assert_layout_matches_structure(
     name: &str,
     params: &Params,
     request: &Request,
-    m: &tiltnoise::tf::TransferMatrix,
+    m: &tiltnoise_core::tf::TransferMatrix,
 ) {
     let factors = PoleZero::factors(params, request);
     let ni = request.inputs.len();
@@ -264,7 +264,7 @@ const U: f64 = f64::EPSILON / 2.0;
 /// error is at most `sqrt(5) u` against `u` for a real one, and a complex sum's `sqrt(2) u`:
 /// a factor 3 covers both. A factor 2 over the first-order sum covers the second-order terms
 /// and the few entries that receive two blocks' contributions.
-fn product_form_bound(e: &tiltnoise::tf::EntryFactors, s: f64, complex: bool) -> f64 {
+fn product_form_bound(e: &tiltnoise_core::tf::EntryFactors, s: f64, complex: bool) -> f64 {
     let zeros: f64 = e
         .zeros
         .iter()

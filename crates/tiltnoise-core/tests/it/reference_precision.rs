@@ -1,4 +1,4 @@
-//! The double-double reference evaluator (`tiltnoise::reference`) against 50-digit mpmath, the
+//! The double-double reference evaluator (`tiltnoise_core::reference`) against 50-digit mpmath, the
 //! 40-digit mpmath fixture of the ROMY budget, the exact quasi-static limits, and the f64 direct
 //! method.
 //!
@@ -19,15 +19,15 @@
 //! where an entry is the small remainder of a cancellation inside the model (phi/eta_t ~ f^4 at
 //! low frequency: kappa ~ 5e5 at 1 mHz; eta/phi_t at 100 Hz: 2e10).
 
-mod common;
+use crate::common;
 
 use common::{floats, json};
 use num_complex::Complex64;
-use tiltnoise::error::{FreqError, TfError};
-use tiltnoise::model::{ForceInput, Model, Observable, TiltAxis};
-use tiltnoise::params::Params;
-use tiltnoise::reference::{relative_errors, CDd, Dd, ReferenceModel, DD_EPS};
-use tiltnoise::tf::{plan, Input, Method, Request};
+use tiltnoise_core::error::{FreqError, TfError};
+use tiltnoise_core::model::{ForceInput, Model, Observable, TiltAxis};
+use tiltnoise_core::params::Params;
+use tiltnoise_core::reference::{relative_errors, CDd, Dd, ReferenceModel, DD_EPS};
+use tiltnoise_core::tf::{plan, Input, Method, Request};
 
 /// Allowed error of a reference entry in units of `DD_EPS kappa` (see the module docs): the
 /// longest chain of double-double operations behind one datum (about 12) plus the solve's

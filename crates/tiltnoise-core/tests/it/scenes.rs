@@ -2,11 +2,11 @@
 //! pick is verified here against the full model and the double-double reference on a fresh grid
 //! (different from the planner's verification grid).
 
-use tiltnoise::model::{ForceInput, Model, Observable, TiltAxis};
-use tiltnoise::params::Params;
-use tiltnoise::reference::ReferenceModel;
-use tiltnoise::scene::{choose, measured_error, scene, Scene};
-use tiltnoise::tf::{plan, Input, Method};
+use tiltnoise_core::model::{ForceInput, Model, Observable, TiltAxis};
+use tiltnoise_core::params::Params;
+use tiltnoise_core::reference::ReferenceModel;
+use tiltnoise_core::tf::planner::{choose, measured_error, scene, Scene};
+use tiltnoise_core::tf::{plan, Input, Method};
 
 fn table_i() -> Model {
     Model::new(&Params::table_i()).unwrap()
@@ -15,7 +15,7 @@ fn table_i() -> Model {
 /// A fresh verification grid: 37 points offset from the planner's 64-point grid, > 1 % away
 /// from every mode.
 fn fresh_grid(model: &Model, (lo, hi): (f64, f64)) -> Vec<f64> {
-    let modes = tiltnoise::modes::NormalModes::new(model).frequencies_hz();
+    let modes = tiltnoise_core::modes::NormalModes::new(model).frequencies_hz();
     (0..37)
         .map(|k| lo * (hi / lo).powf((k as f64 + 0.37) / 37.0))
         .filter(|f| modes.iter().all(|m| ((f - m) / m).abs() > 0.01))

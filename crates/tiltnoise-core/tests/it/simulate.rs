@@ -3,15 +3,15 @@
 //! the X kick, errors and timing.
 
 use nalgebra::SMatrix;
-use tiltnoise::model::{Model, Observable, Vec8};
-use tiltnoise::modes::NormalModes;
-use tiltnoise::params::Params;
-use tiltnoise::simulate::resonance::{check_resonances, Presence, PEAK_FACTOR};
-use tiltnoise::simulate::{
+use tiltnoise_core::model::{Model, Observable, Vec8};
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::params::Params;
+use tiltnoise_core::simulate::resonance::{check_resonances, Presence, PEAK_FACTOR};
+use tiltnoise_core::simulate::{
     aliased_frequency_hz, kick_x, simulate, InitialState, ModalPropagator, SimConfig, SimError,
 };
-use tiltnoise::simulate::{equal_energy_init, DEFAULT_MODE_ENERGY_J};
-use tiltnoise::spectral::{welch, WelchConfig};
+use tiltnoise_core::simulate::{equal_energy_init, DEFAULT_MODE_ENERGY_J};
+use tiltnoise_core::spectral::{welch, WelchConfig};
 
 const EPS: f64 = f64::EPSILON;
 
@@ -361,11 +361,11 @@ fn spectra_show_exactly_the_modes_of_the_observability_table() {
                     o.name(),
                     mode.index
                 );
-                assert!(rel >= 0.85 * tiltnoise::modes::VISIBILITY_THRESHOLD);
+                assert!(rel >= 0.85 * tiltnoise_core::modes::VISIBILITY_THRESHOLD);
             } else {
                 // Not seen within the block: either no peak or one below the threshold.
                 assert!(
-                    ratio < PEAK_FACTOR || rel < tiltnoise::modes::VISIBILITY_THRESHOLD / 0.85,
+                    ratio < PEAK_FACTOR || rel < tiltnoise_core::modes::VISIBILITY_THRESHOLD / 0.85,
                     "{} nu_{}: peak {rel:e} of the channel max",
                     o.name(),
                     mode.index
@@ -592,7 +592,7 @@ fn invalid_settings_are_refused_with_the_value() {
 fn default_run() -> (
     NormalModes,
     [f64; 8],
-    Vec<(Observable, tiltnoise::spectral::Psd)>,
+    Vec<(Observable, tiltnoise_core::spectral::Psd)>,
 ) {
     let model = model();
     let init = equal_energy_init(&model, DEFAULT_MODE_ENERGY_J);
@@ -666,7 +666,7 @@ fn resonance_check_agrees_with_the_table_on_the_default_run() {
             o.name(),
             m.mode_index
         );
-        assert!(m.spectrum_ratio < tiltnoise::modes::VISIBILITY_THRESHOLD);
+        assert!(m.spectrum_ratio < tiltnoise_core::modes::VISIBILITY_THRESHOLD);
     }
 }
 

@@ -28,13 +28,15 @@
 use nalgebra::SVector;
 use num_complex::Complex64;
 use std::f64::consts::TAU;
-use tiltnoise::error::TfError;
-use tiltnoise::model::{Block, Model, Observable, TiltAxis};
-use tiltnoise::modes::{refined_omega_sq, NormalModes};
-use tiltnoise::params::Params;
-use tiltnoise::reference::{CDd, ReferenceModel};
-use tiltnoise::tf::{plan, Input, Method, PlanError, Request, TransferFunction, SINGULAR_RCOND};
-use tiltnoise::units::angular;
+use tiltnoise_core::error::TfError;
+use tiltnoise_core::model::{Block, Model, Observable, TiltAxis};
+use tiltnoise_core::modes::{refined_omega_sq, NormalModes};
+use tiltnoise_core::params::Params;
+use tiltnoise_core::reference::{CDd, ReferenceModel};
+use tiltnoise_core::tf::{
+    plan, Input, Method, PlanError, Request, TransferFunction, SINGULAR_RCOND,
+};
+use tiltnoise_core::units::angular;
 
 type Vec8 = SVector<f64, 8>;
 
@@ -170,7 +172,7 @@ fn modal_bound(case: &Case, o: Observable, axis: TiltAxis, w2: f64) -> f64 {
         .map(|block| {
             let modes = || case.modes.modes.iter().filter(move |m| m.block == block);
             let lambda_max = modes().map(|m| m.omega_sq).fold(0.0, f64::max);
-            let norm = |part: &dyn Fn(&tiltnoise::modes::Mode) -> f64| {
+            let norm = |part: &dyn Fn(&tiltnoise_core::modes::Mode) -> f64| {
                 modes()
                     .map(|m| (part(m) / (m.omega_sq - w2)).powi(2))
                     .sum::<f64>()

@@ -4,11 +4,11 @@
 
 use nalgebra::DMatrix;
 use num_complex::Complex64;
-use tiltnoise::error::TfError;
-use tiltnoise::model::{Model, Observable, TiltAxis};
-use tiltnoise::modes::NormalModes;
-use tiltnoise::params::Params;
-use tiltnoise::tf::{plan, Method, Request, TransferFunction};
+use tiltnoise_core::error::TfError;
+use tiltnoise_core::model::{Model, Observable, TiltAxis};
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::params::Params;
+use tiltnoise_core::tf::{plan, Method, Request, TransferFunction};
 
 use Observable::*;
 use TiltAxis::*;
@@ -181,12 +181,12 @@ fn exact_undamped_resonance_is_reported_singular() {
     let model = Model::new(&Params::table_i()).unwrap();
     let tf = direct(&model);
     for mode in NormalModes::new(&model).modes {
-        let lambda = tiltnoise::modes::refined_omega_sq(&model, &mode);
+        let lambda = tiltnoise_core::modes::refined_omega_sq(&model, &mode);
         let f = lambda.sqrt() / std::f64::consts::TAU;
         match tf.eval(f) {
             Err(TfError::Singular { freq_hz, rcond }) => {
                 assert_eq!(freq_hz, f);
-                assert!(rcond < tiltnoise::tf::SINGULAR_RCOND);
+                assert!(rcond < tiltnoise_core::tf::SINGULAR_RCOND);
             }
             other => panic!(
                 "nu_{} at {f} Hz: expected Singular, got {other:?}",

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 
 use num_complex::Complex64;
 use serde_json::Value;
-use tiltnoise::spectral::{
+use tiltnoise_core::spectral::{
     csd, csd_matrix, hann_periodic, welch, Averaging, Detrend, SpectralError, WelchConfig,
 };
 
@@ -33,7 +33,7 @@ const REL_TOL: f64 = 1e-10;
 const FLOOR_FRAC: f64 = 1e-3;
 
 fn fixture_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/welch")
+    crate::common::repo("tests/fixtures/welch")
 }
 
 fn read_json(name: &str) -> Value {
