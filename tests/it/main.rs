@@ -15,6 +15,7 @@ mod budget_outputs;
 mod cli;
 mod cli_budget;
 mod damping;
+mod figures;
 mod fit;
 mod force_tf;
 mod input_readers;
