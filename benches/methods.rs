@@ -39,10 +39,10 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
 use num_complex::Complex64;
-use tiltnoise::freq::log_grid;
-use tiltnoise::model::Model;
-use tiltnoise::params::Params;
-use tiltnoise::tf::{self, Method, Request, TransferFunction};
+use tiltnoise_core::freq::log_grid;
+use tiltnoise_core::model::Model;
+use tiltnoise_core::params::Params;
+use tiltnoise_core::tf::{self, Method, Request, TransferFunction};
 
 /// Environment variable that overrides the grid size.
 const POINTS_VAR: &str = "TILTNOISE_BENCH_METHODS_POINTS";
