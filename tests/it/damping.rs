@@ -5,6 +5,7 @@
 //! eigenvalues of the damped problem; validation of the new keys.
 
 use crate::common;
+use crate::tolerances::{EPS, LU_GAMMA, TARGET_REL};
 
 use common::{assert_fails, tiltnoise};
 use nalgebra::SMatrix;
@@ -15,13 +16,6 @@ use tiltnoise_core::params::Params;
 use tiltnoise_core::reference::ReferenceModel;
 use tiltnoise_core::tf::{plan, Input, Method, PlanError, Request};
 use tiltnoise_core::units::angular;
-
-const EPS: f64 = f64::EPSILON;
-/// `gamma_3n` with n = 8: componentwise backward error of the LU solve, applied to the entry's
-/// componentwise condition number (as in `tests/stability.rs`).
-const LU_GAMMA: f64 = 3.0 * 8.0 * EPS;
-/// The split method's issue-4 accuracy target (relative, every structurally nonzero entry).
-const SPLIT_TARGET_REL: f64 = 1e-9;
 
 fn with(sets: &[&str]) -> Params {
     sets.iter().fold(Params::table_i(), |p, s| {
@@ -124,7 +118,7 @@ fn check_against_reference(params: &Params, label: &str) {
                 }
                 let err = (g - w).norm() / w.norm();
                 let tol = if accurate {
-                    (LU_GAMMA * k).max(SPLIT_TARGET_REL)
+                    (LU_GAMMA * k).max(TARGET_REL)
                 } else {
                     LU_GAMMA * k
                 };

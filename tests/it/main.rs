@@ -1,6 +1,6 @@
 //! Integration tests of the `tiltnoise` command line and of the files and figures it writes, one
 //! binary (linking dominates a test suite's build). The numerical core's tests are in
-//! `crates/tiltnoise-core/tests/it`, whose helpers this binary shares.
+//! `crates/tiltnoise-core/tests/it`, whose helpers and named tolerances this binary shares.
 
 /// The repository root: fixtures, reference data, examples and committed tilt data.
 const REPO_ROOT: &str = env!("CARGO_MANIFEST_DIR");
@@ -10,6 +10,8 @@ mod common;
 /// its output dispatch compile that module in here.
 #[path = "../../src/cli/output.rs"]
 mod output;
+#[path = "../../crates/tiltnoise-core/tests/it/tolerances.rs"]
+mod tolerances;
 
 mod budget_outputs;
 mod cli;

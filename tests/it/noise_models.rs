@@ -4,6 +4,7 @@
 //! `scripts/reference/noise_model_levels.py` (NumPy, independent of this crate).
 
 use crate::common;
+use crate::tolerances::LOGLOG_REL;
 
 use common::{assert_close, floats, json, shared_tilt_data};
 use tiltnoise_core::budget::{budget_from_spectra, BudgetOptions};
@@ -12,11 +13,6 @@ use tiltnoise_core::noise::Readout;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::tf::{plan, Input, Method, Request};
 use tiltnoise_io::input::{read_tilt_spectra, ReadOptions};
-
-/// Both sides interpolate linearly in log(ASD) against log(f) between the same table rows, so
-/// they differ only by rounding: about ten roundings of relative eps in the conversion chain,
-/// amplified by |ln ASD| (~23 for 1e-10) through exp(ln): 64 eps * 32 ~ 4.5e-13.
-const LOGLOG_REL: f64 = 64.0 * 32.0 * f64::EPSILON;
 
 /// Writes a tiltnoise spectra CSV (same ASD on both axes, uncorrelated).
 fn write_spectra_csv(dir: &std::path::Path, rows: &[(f64, f64)]) -> std::path::PathBuf {

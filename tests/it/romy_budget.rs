@@ -4,22 +4,13 @@
 //! the spectra, mpmath at 40 digits for the model, built from the paper, not from this crate).
 
 use crate::common;
+use crate::tolerances::{PEAK_FLOOR, PIPELINE_REL};
 
 use common::{assert_close, floats, json, shared_tilt_data};
 use tiltnoise_core::budget::{budget_from_series, BudgetOptions};
 use tiltnoise_core::model::{Model, Observable};
 use tiltnoise_core::params::Params;
 use tiltnoise_io::input::{read_tilt_series, AxisMap, Quantity, ReadOptions};
-
-/// Agreement required between the two pipelines, relative per bin: the criterion for
-/// equal results (1e-8). The spectral parts agree with SciPy to ~1e-14 (tests/welch_scipy.rs)
-/// and the budget's transfer functions (the split method) with the reference to ~1e-11
-/// (`tiltnoise methods`), so this leaves a wide margin rather than being tuned to it.
-const PIPELINE_REL: f64 = 1e-8;
-/// Floor for bins far below a spectrum's peak, as a fraction of the peak: the integrated angle
-/// carries the rounding of 8192 trapezoid steps, n eps ~ 2e-12 of its amplitude, so a PSD bin
-/// can be off by about that fraction of the peak PSD.
-const PEAK_FLOOR: f64 = 1e-11;
 
 /// The budget of the ROMY record, or `None` (with the line saying `test` was skipped) when the
 /// record is not beside the repository.

@@ -5,13 +5,13 @@
 //! record is refused as floor tilt.
 
 use crate::common;
+use crate::tolerances::EPS;
 
 use common::{assert_fails_without_output, tiltnoise};
 use realfft::RealFftPlanner;
 use std::f64::consts::PI;
 use std::path::Path;
 
-const EPS: f64 = f64::EPSILON;
 /// The paper's X readout, the simulate default (m/sqrt(Hz)).
 const READOUT_X: f64 = 9e-9;
 

@@ -5,6 +5,7 @@
 //! budget terms in the HDF5 output (total = sum of the independent terms).
 
 use crate::common;
+use crate::tolerances::{EPS, LU_GAMMA};
 
 use common::{assert_fails, repo, tiltnoise};
 use num_complex::Complex64;
@@ -14,11 +15,6 @@ use tiltnoise_core::params::Params;
 use tiltnoise_core::reference::ReferenceModel;
 use tiltnoise_core::thermal::{conjugate_response, thermal_noise, BOLTZMANN_J_PER_K};
 use tiltnoise_core::units::angular;
-
-const EPS: f64 = f64::EPSILON;
-/// Normwise relative error of the direct method's equilibrated 8x8 LU per unit condition
-/// number: `gamma_3n`, n = 8.
-const LU_GAMMA: f64 = 3.0 * 8.0 * EPS;
 
 fn with(base: Params, sets: &[&str]) -> Params {
     sets.iter().fold(base, |p, s| {

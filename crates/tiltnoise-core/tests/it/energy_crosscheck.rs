@@ -14,18 +14,11 @@
 //! it (running error analysis), which gives every entry its own rounding scale, including the
 //! entries where large terms cancel (e.g. m_a g y_a - m_b g d = 0 in K[eta_a, phi_a]).
 
+use crate::tolerances::ENERGY_C_TOL;
 use nalgebra::{Matrix4, SMatrix, Vector4};
 use std::ops::{Add, Mul, Neg, Sub};
 use tiltnoise_core::model::{Coord, ForceInput, Model, Observable, TiltAxis};
 use tiltnoise_core::params::Params;
-
-/// Rounding-bound factor of the comparisons: |lib - ref| <= C_TOL * eps * mag.
-/// Derivation: by running error analysis an entry computed in n floating-point steps is off by at
-/// most n eps mag, mag being the sum of |terms| entering it (tracked in `Hd::m`). A reference entry
-/// takes at most ~40 steps along any path (rotation entry 5, A_b = R_a^T R_b^T 5, position 6,
-/// energy/dot products ~10, Jacobian contractions ~10) and a library entry fewer than ~10, so
-/// n_ref + n_lib < 50 <= 64; a genuine modelling error is O(mag), i.e. 1e13 times larger.
-const C_TOL: f64 = 64.0;
 
 // ------------------------------------------------------------------------------------------------
 // Hyper-dual numbers a + b e1 + c e2 + d e1e2 (e1^2 = e2^2 = 0), with term magnitudes.
@@ -451,12 +444,12 @@ fn assert_close(set: &str, matrix: &str, row: &str, col: &str, lib: f64, referen
         );
         return 0.0;
     }
-    let tol = C_TOL * f64::EPSILON * mag;
+    let tol = ENERGY_C_TOL * f64::EPSILON * mag;
     let diff = (lib - r).abs();
     assert!(
         diff <= tol,
         "[{set}] {matrix}[{row}, {col}]: library = {lib:e}, energy reference = {r:e}, \
-         |diff| = {diff:e} > tol = {tol:e} (= {C_TOL} eps x term magnitude {mag:e})"
+         |diff| = {diff:e} > tol = {tol:e} (= {ENERGY_C_TOL} eps x term magnitude {mag:e})"
     );
     diff / mag
 }
@@ -499,7 +492,7 @@ fn assert_reference_symmetric(set: &str, matrix: &str, a: &[[Hd; 8]; 8]) {
     for i in 0..8 {
         for j in 0..i {
             let (x, y) = (a[i][j], a[j][i]);
-            let tol = C_TOL * f64::EPSILON * x.m[0].max(y.m[0]);
+            let tol = ENERGY_C_TOL * f64::EPSILON * x.m[0].max(y.m[0]);
             assert!(
                 (x.v[0] - y.v[0]).abs() <= tol,
                 "[{set}] reference {matrix} not symmetric at [{}, {}]: {:e} vs {:e}",
@@ -521,7 +514,7 @@ fn crosscheck(set: &str, p: &Params) {
 
     // Equilibrium: y_a = d m_b / m_a and the pre-tension make q = 0 stationary.
     for (i, g) in r.grad.iter().enumerate() {
-        let tol = C_TOL * f64::EPSILON * g.m[0];
+        let tol = ENERGY_C_TOL * f64::EPSILON * g.m[0];
         assert!(
             g.v[0].abs() <= tol,
             "[{set}] reference dU/d({}) = {:e} at q = 0 (tol {tol:e}): not an equilibrium",
@@ -570,7 +563,7 @@ fn crosscheck(set: &str, p: &Params) {
         println!(
             "[{set}] {matrix:>2}: max |lib - ref| / term magnitude = {max_rel:.2e} \
              (tol {:.2e}); structural zeros: {zeros}",
-            C_TOL * f64::EPSILON
+            ENERGY_C_TOL * f64::EPSILON
         );
     }
 }
@@ -661,10 +654,10 @@ fn reference_static_tilt_response_has_paper_sign() {
             let q = k.lu().solve(&rhs).expect("stiffness block is regular");
             let observed: f64 = (0..4).map(|a| r.c[obs.index()][block[a]].v[0] * q[a]).sum();
             // LU is backward stable: relative error <= (few n) eps cond(K) on top of the
-            // O(C_TOL eps) error of the data; C_TOL eps cond covers both.
+            // O(ENERGY_C_TOL eps) error of the data; ENERGY_C_TOL eps cond covers both.
             let eig = ((k + k.transpose()) * 0.5).symmetric_eigenvalues();
             let cond = eig.amax() / eig.iter().fold(f64::INFINITY, |m, x| m.min(x.abs()));
-            let tol = C_TOL * f64::EPSILON * cond * lever;
+            let tol = ENERGY_C_TOL * f64::EPSILON * cond * lever;
             assert!(
                 (observed - expected).abs() <= tol,
                 "static response of {} to unit {}: {observed:e}, expected {expected:e} \
@@ -684,7 +677,7 @@ fn hyper_dual_derivatives_are_exact() {
         let x = Hd::var(x0, e[0], e[1]);
         let y = Hd::var(y0, e[2], e[3]);
         let f = x * x.sin() * y.cos();
-        let tol = C_TOL * f64::EPSILON * f.m[k];
+        let tol = ENERGY_C_TOL * f64::EPSILON * f.m[k];
         assert!((f.v[k] - want).abs() <= tol, "{:e} vs {want:e}", f.v[k]);
     };
     let (sx, cx, sy, cy) = (x0.sin(), x0.cos(), y0.sin(), y0.cos());

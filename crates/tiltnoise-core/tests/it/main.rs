@@ -7,6 +7,7 @@
 const REPO_ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
 
 mod common;
+mod tolerances;
 
 mod energy_crosscheck;
 mod freq_grid;

@@ -31,6 +31,7 @@
 //! Run with `--nocapture` to see the methods table (the maxima measured here).
 
 use crate::common;
+use crate::tolerances::{EIG_GAMMA, EPS, LU_GAMMA, POLE_EXCLUSION, SS_GAMMA, TARGET_REL};
 
 use nalgebra::{Matrix2, RowVector2, SMatrix, SVector, Vector2};
 use num_complex::Complex64;
@@ -45,23 +46,9 @@ use tiltnoise_core::units::angular;
 type CVec8 = SVector<Complex64, 8>;
 type CMat8 = SMatrix<Complex64, 8, 8>;
 
-const EPS: f64 = f64::EPSILON;
-/// The issue-4 accuracy target: relative error of every structurally nonzero entry.
-const TARGET_REL: f64 = 1e-9;
-/// Half-width (relative, in frequency) of the zone around an entry's own poles and zeros that
-/// the target excludes.
-const EXCLUSION: f64 = 0.01;
 const F_LO_HZ: f64 = 1e-5;
 const F_HI_HZ: f64 = 100.0;
 const PER_DECADE: f64 = 40.0;
-/// `gamma_3n` of the LU's componentwise backward error, n = 8 unknowns.
-const GAMMA_LU: f64 = 3.0 * 8.0 * EPS;
-/// `gamma_3n` of the state-space method's LU solves, n = 16 states (also used, generously, for
-/// its 8x8 solves with `M`).
-const GAMMA_SS: f64 = 3.0 * 16.0 * EPS;
-/// Eigenvector error per unit `lambda_max / gap` of the symmetric eigensolver (n = 4 per block,
-/// with the Cholesky reduction's own rounding: 2n).
-const EIG_SHAPE: f64 = 8.0 * EPS;
 /// Loss angle of the damped test model (rad).
 const LOSS: f64 = 1e-3;
 
@@ -136,8 +123,8 @@ fn grid(case: &Case) -> Vec<f64> {
     for m in &case.modes.modes {
         for r in [
             0.95,
-            1.0 / (1.0 + 1.01 * EXCLUSION),
-            1.0 + 1.01 * EXCLUSION,
+            1.0 / (1.0 + 1.01 * POLE_EXCLUSION),
+            1.0 + 1.01 * POLE_EXCLUSION,
             1.05,
         ] {
             f.push(m.frequency_hz * r);
@@ -237,7 +224,7 @@ fn zones(entry_point: &str) -> &'static [Vec<f64>] {
 fn in_zone(f: f64, special: &[f64]) -> bool {
     special
         .iter()
-        .any(|&s| (f - s).abs() <= EXCLUSION * s.min(f))
+        .any(|&s| (f - s).abs() <= POLE_EXCLUSION * s.min(f))
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -269,7 +256,7 @@ fn lu_bound(case: &Case, request: &Request, freq_hz: f64) -> Vec<f64> {
             let abs_x = x.map(|z| z.norm());
             let inner = abs_inv * (abs_d * abs_x + g.abs());
             let row = c.row(o.index()).abs();
-            out.push(GAMMA_LU * ((row * inner)[0] + (row * abs_x)[0]));
+            out.push(LU_GAMMA * ((row * inner)[0] + (row * abs_x)[0]));
         }
     }
     out
@@ -288,13 +275,13 @@ fn lu_bound(case: &Case, request: &Request, freq_hz: f64) -> Vec<f64> {
 /// |dh|  <= g (|C| |x_q| + |C| |y|) + |C| |dx_q| + |C| |dy|
 /// ```
 ///
-/// (`g` = [`GAMMA_SS`]; `|.|` elementwise; the inverses in f64, exact enough for a bound).
+/// (`g` = [`SS_GAMMA`]; `|.|` elementwise; the inverses in f64, exact enough for a bound).
 fn statespace_bound(case: &Case, request: &Request, freq_hz: f64) -> Vec<f64> {
     type CMat16 = SMatrix<Complex64, 16, 16>;
     type Vec16 = SVector<f64, 16>;
     let m = &case.model;
     let w = angular(freq_hz);
-    let g = GAMMA_SS;
+    let g = SS_GAMMA;
     let mass = *m.mass();
     let m_inv = mass.try_inverse().expect("M is positive definite");
     let (abs_m, abs_minv) = (mass.abs(), m_inv.abs());
@@ -425,7 +412,7 @@ fn modal_bound(case: &Case, o: Observable, input: Input, w2: f64) -> f64 {
                 .filter(|m| m.index != modes[k].index)
                 .map(|m| (m.omega_sq - modes[k].omega_sq).abs())
                 .fold(f64::INFINITY, f64::min);
-            let (shape_err, lambda_err) = (EIG_SHAPE * lambda_max / gap, EIG_SHAPE * lambda_max);
+            let (shape_err, lambda_err) = (EIG_GAMMA * lambda_max / gap, EIG_GAMMA * lambda_max);
             let cv = modes[k].observable_amplitude[o.index()].abs();
             let vg = modes[k].shape.dot(&(g0 + g2 * w2)).abs();
             let denom = (modal_eigenvalue(case, k) - w2).norm();

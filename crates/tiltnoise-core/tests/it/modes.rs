@@ -1,6 +1,7 @@
 //! Normal modes: Table II bands, eigen residuals, M-orthonormality, observability, and the
 //! decoupled-pendulum limits of section III.
 
+use crate::tolerances::EIG_RESIDUAL_C;
 use nalgebra::DMatrix;
 use tiltnoise_core::model::{Block, Coord, Model, Observable};
 use tiltnoise_core::modes::{decoupled_swing_estimates_hz, NormalModes};
@@ -48,13 +49,6 @@ fn frequencies_fall_in_table_ii_calculated_bands() {
         );
     }
 }
-
-/// Backward-stability bound of the Cholesky-reduced symmetric eigensolver on a 4x4 block:
-/// the residual `K v - lambda M v` is bounded by `c n eps (|K| + |lambda| |M|) |v|` times the
-/// conditioning of the Cholesky factor, `cond(M_block)^(1/2)`, which the reduction
-/// `L^-1 K L^-T` introduces. `c = 4` covers the three stages (Cholesky, triangular inverse,
-/// symmetric QR) with their small constants; `n = 4`.
-const EIG_RESIDUAL_C: f64 = 4.0;
 
 #[test]
 fn eigen_residuals_and_mass_orthonormality() {

@@ -12,6 +12,7 @@
 //! Run with `cargo test --release --test polezero -- --nocapture` to see the numbers.
 
 use crate::common;
+use crate::tolerances::{POLE_EXCLUSION, TARGET_REL};
 
 use num_complex::Complex64;
 use tiltnoise_core::error::TfError;
@@ -20,8 +21,6 @@ use tiltnoise_core::params::Params;
 use tiltnoise_core::reference::{relative_errors, ReferenceModel};
 use tiltnoise_core::tf::{evaluate, plan, EntryFactors, Input, Method, PoleZero, Request};
 
-const TARGET_REL: f64 = 1e-9;
-const EXCLUSION: f64 = 0.01;
 const LOSS: f64 = 1e-3;
 
 fn heavy_crossbar() -> Params {
@@ -79,7 +78,7 @@ fn zones(params: &Params, request: &Request) -> Vec<Vec<f64>> {
 fn in_zone(f: f64, special: &[f64]) -> bool {
     special
         .iter()
-        .any(|&s| (f - s).abs() <= EXCLUSION * s.min(f))
+        .any(|&s| (f - s).abs() <= POLE_EXCLUSION * s.min(f))
 }
 
 fn grid(special: &[Vec<f64>]) -> Vec<f64> {
@@ -90,8 +89,8 @@ fn grid(special: &[Vec<f64>]) -> Vec<f64> {
         .collect();
     for s in special.iter().flatten() {
         for r in [
-            1.0 / (1.0 + 1.01 * EXCLUSION),
-            1.0 + 1.01 * EXCLUSION,
+            1.0 / (1.0 + 1.01 * POLE_EXCLUSION),
+            1.0 + 1.01 * POLE_EXCLUSION,
             0.95,
             1.05,
         ] {

@@ -16,6 +16,7 @@
 //!   with the same frequency and rcond; likewise a negative, NaN or infinite frequency.
 
 use crate::common;
+use crate::tolerances::U;
 
 use num_complex::Complex64;
 use tiltnoise_core::error::TfError;
@@ -250,9 +251,6 @@ fn tilt_layout_of_table_i() {
         );
     }
 }
-
-/// Unit roundoff of f64.
-const U: f64 = f64::EPSILON / 2.0;
 
 /// Rounding bound of the f64 product form, relative, at `s` (the double-double value uses
 /// the same `s`, so only the kernel's arithmetic is measured). Each factor `1 - s / z` carries

@@ -13,13 +13,14 @@
 //! at most about a dozen such operations, and the reference's solve (LU with partial pivoting
 //! plus one step of iterative refinement) is componentwise backward stable. So the error of an
 //! entry is bounded by a small multiple of `DD_EPS kappa`, where `kappa` is the entry's
-//! componentwise condition number ([`ReferenceModel::entry_condition`]): [`REF_TOL_FACTOR`]
+//! componentwise condition number ([`ReferenceModel::entry_condition`]): [`DD_REF_FACTOR`]
 //! below. `kappa` is 1..1e3 for most entries (about 3e3 at the ROMY bin closest to a mode, so
 //! ~1e-28 there), up to 1e16 exactly on a resonance (rounded to f64, detuning ~1e-16) and large
 //! where an entry is the small remainder of a cancellation inside the model (phi/eta_t ~ f^4 at
 //! low frequency: kappa ~ 5e5 at 1 mHz; eta/phi_t at 100 Hz: 2e10).
 
 use crate::common;
+use crate::tolerances::{DD_REF_FACTOR, DIRECT_TOL_FACTOR};
 
 use common::{floats, json};
 use num_complex::Complex64;
@@ -28,11 +29,6 @@ use tiltnoise_core::model::{ForceInput, Model, Observable, TiltAxis};
 use tiltnoise_core::params::Params;
 use tiltnoise_core::reference::{relative_errors, CDd, Dd, ReferenceModel, DD_EPS};
 use tiltnoise_core::tf::{plan, Input, Method, Request};
-
-/// Allowed error of a reference entry in units of `DD_EPS kappa` (see the module docs): the
-/// longest chain of double-double operations behind one datum (about 12) plus the solve's
-/// componentwise backward error, rounded up. The measured maximum is about 0.2.
-const REF_TOL_FACTOR: f64 = 16.0;
 
 /// mpmath reference values `(freq_hz, output index in crate order (X, Y, Z, theta, eta, phi,
 /// phi_a), input, [re_hi, re_lo, im_hi, im_lo])`, each part `hi + lo` with `hi = float(x)`,
@@ -295,7 +291,7 @@ fn label(o: Observable, i: Input) -> String {
 }
 
 /// Test 1: double-double against 50-digit mpmath, entry by entry, within
-/// `REF_TOL_FACTOR DD_EPS kappa`; entries mpmath finds to be exactly zero are exactly zero.
+/// `DD_REF_FACTOR DD_EPS kappa`; entries mpmath finds to be exactly zero are exactly zero.
 #[test]
 fn reference_matches_mpmath_within_its_condition() {
     let cases = [
@@ -335,7 +331,7 @@ fn reference_matches_mpmath_within_its_condition() {
                         continue;
                     };
                     let err = rel_dd(h[k], cdd(v));
-                    let tol = REF_TOL_FACTOR * DD_EPS * kappa[k].max(1.0);
+                    let tol = DD_REF_FACTOR * DD_EPS * kappa[k].max(1.0);
                     assert!(
                         err <= tol,
                         "{name} {f} Hz {}: relative error {err:.2e} > {tol:.2e} (kappa {:.2e})",
@@ -374,7 +370,7 @@ fn reference_matches_mpmath_within_its_condition() {
 
 /// Test 1 (fixture): the f64 rounding of the reference against every transfer-function value of
 /// the mpmath ROMY fixture (1024 bins x (X, phi, phi_a) x (theta_t, eta_t), written with repr).
-/// The reference's error is below `REF_TOL_FACTOR DD_EPS kappa`, which is checked to be far below
+/// The reference's error is below `DD_REF_FACTOR DD_EPS kappa`, which is checked to be far below
 /// half an ulp, so both are correct roundings of the same number: they are equal, or 1 ulp apart
 /// when the exact value sits within that error of a rounding boundary.
 #[test]
@@ -414,7 +410,7 @@ fn reference_rounds_to_the_romy_fixture() {
                 zeros += 1;
                 continue;
             }
-            max_err_bound = max_err_bound.max(REF_TOL_FACTOR * DD_EPS * kappa[e]);
+            max_err_bound = max_err_bound.max(DD_REF_FACTOR * DD_EPS * kappa[e]);
             let d = ulps(got.re, re[idx]).max(ulps(got.im, im[idx]));
             assert!(
                 d <= 1,
@@ -534,7 +530,7 @@ fn low_frequency_power_laws() {
         println!(
             "slope of {name:12} 1e-6..1e-5 Hz: {slope:.12} (mpmath fixture {want:.12}), reference \
              error bound at 1e-6 Hz {:.0e}",
-            REF_TOL_FACTOR * DD_EPS * kappa[k]
+            DD_REF_FACTOR * DD_EPS * kappa[k]
         );
         assert!((slope - power).abs() < 1e-4, "{name}: slope {slope}");
         assert!(
@@ -674,14 +670,6 @@ fn matrices_agree_with_the_f64_model() {
 fn fixture_modes() -> Vec<f64> {
     floats(&json("scripts/reference/romy_budget_reference.json")["checks"]["mode_frequencies_hz"])
 }
-
-/// Allowed error of the f64 direct method on an entry, in units of `eps kappa_paper` (`eps =
-/// 2^-53`, `kappa_paper` from [`ReferenceModel::entry_condition_paper`]: the direct method works
-/// with the paper's coordinates and f64 data): the LU backward-error constant `gamma_3n = 3n`
-/// (n = 8) times the worst-case growth factor `2^(n-1)` of partial pivoting. Not a rigorous
-/// componentwise bound for an unrefined LU, but the textbook constants; the measured ratio is
-/// about 2 on the tilt grid and about 200 for phi/F_b.x at 10 Hz in the damped case.
-const DIRECT_TOL_FACTOR: f64 = 3.0 * 8.0 * 128.0;
 
 /// Test 4: the f64 direct method against the reference on a log grid 1e-5..100 Hz that avoids
 /// the modes (relative distance >= 1e-3). Prints the direct method's max relative error per entry

@@ -2,6 +2,7 @@
 //! exactness against closed form and matrix exponential, spectra vs the observability table,
 //! the X kick, errors and timing.
 
+use crate::tolerances::EPS;
 use nalgebra::SMatrix;
 use tiltnoise_core::model::{Model, Observable, Vec8};
 use tiltnoise_core::modes::NormalModes;
@@ -12,8 +13,6 @@ use tiltnoise_core::simulate::{
 };
 use tiltnoise_core::simulate::{equal_energy_init, DEFAULT_MODE_ENERGY_J};
 use tiltnoise_core::spectral::{welch, WelchConfig};
-
-const EPS: f64 = f64::EPSILON;
 
 fn model() -> Model {
     Model::new(&Params::table_i()).unwrap()

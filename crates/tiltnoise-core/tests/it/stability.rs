@@ -25,6 +25,7 @@
 //! model for a torque M_b.z near the torsion modes
 //! (`tests/methods.rs::torsion2_matches_the_full_model_to_the_coupling_error`).
 
+use crate::tolerances::{DATA_GAMMA, EIG_GAMMA, EPS, LU_GAMMA, SUM_GAMMA, TARGET_REL};
 use nalgebra::SVector;
 use num_complex::Complex64;
 use std::f64::consts::TAU;
@@ -40,25 +41,6 @@ use tiltnoise_core::units::angular;
 
 type Vec8 = SVector<f64, 8>;
 
-const EPS: f64 = f64::EPSILON;
-/// Unknowns of the full system.
-const N: f64 = 8.0;
-/// `gamma_3n`: componentwise backward error of an LU solve of the n = 8 system (factorization,
-/// two triangular solves), applied to `kappa` of the entry.
-const LU_GAMMA: f64 = 3.0 * N * EPS;
-/// Normwise backward error of the block eigensolver per unit `lambda_max`: `2n eps` with n = 4 per
-/// block (the Cholesky reduction and the symmetric eigensolver). By Weyl it is also the bound on
-/// an eigenvalue's error.
-const EIG_GAMMA: f64 = 8.0 * EPS;
-/// Rounding of the modal sum itself: a projection `v^T G` of length n and a sum over n modes.
-const SUM_GAMMA: f64 = 2.0 * N * EPS;
-/// The issue-4 accuracy target of the split method (relative, every structurally nonzero entry).
-const TARGET_REL: f64 = 1e-9;
-/// Rounding of a scaled parameter set's effect on the model data: each matrix entry is a product
-/// of at most three parameters (`m g L`, `m L^2`, `m L h`), each rounded once (`eps / 2`), summed
-/// with entries of the same scale: at most `4 eps` relative per datum, hence `DATA_GAMMA kappa`
-/// per entry of H (`kappa` from [`ReferenceModel::entry_condition`]).
-const DATA_GAMMA: f64 = 4.0 * EPS;
 /// The methods that factor the dynamic stiffness.
 const LU_METHODS: [Method; 3] = [Method::Direct, Method::Block, Method::Split];
 

@@ -7,30 +7,12 @@
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
+use crate::tolerances::{WELCH_FLOOR_FRAC, WELCH_REL};
 use num_complex::Complex64;
 use serde_json::Value;
 use tiltnoise_core::spectral::{
     csd, csd_matrix, hann_periodic, welch, Averaging, Detrend, SpectralError, WelchConfig,
 };
-
-/// Relative agreement required with scipy (the requirement of the issue).
-///
-/// Both sides compute in double precision but with different FFTs (pocketfft vs rustfft),
-/// different window scaling order and different summation orders. A radix-2/mixed-radix FFT has
-/// a normwise relative error of order `eps * log2(n)` (~2e-16 * 10 for our lengths); a periodogram
-/// value doubles that, and averaging over at most ~40 segments adds at most `n_seg * eps` more.
-/// The expected discrepancy is therefore ~1e-14 at worst, and 1e-10 leaves a wide margin while any
-/// convention error (scale, doubling, window, bias, conjugation) shows up at >= 1e-3.
-/// (Observed: see the `max normalised error` line printed by `scipy_fixtures_match`; about 1e-14.)
-const REL_TOL: f64 = 1e-10;
-
-/// Bins smaller than `FLOOR_FRAC` times the largest magnitude of the same spectrum are compared
-/// against that floor instead of their own magnitude, i.e. with an absolute tolerance of
-/// `REL_TOL * FLOOR_FRAC * max = 1e-13 * max`. FFT rounding errors are absolute (relative to the
-/// norm of the segment, not to the bin), so the relative error of a bin far below the maximum
-/// grows like `sqrt(max / bin)`; cross spectra of weakly correlated channels and their imaginary
-/// parts also pass arbitrarily close to zero. Above `1e-3 * max` the test is purely relative.
-const FLOOR_FRAC: f64 = 1e-3;
 
 fn fixture_dir() -> PathBuf {
     crate::common::repo("tests/fixtures/welch")
@@ -55,11 +37,12 @@ fn usize_of(v: &Value) -> usize {
     v.as_u64().expect("unsigned integer") as usize
 }
 
-/// Largest normalised error `|got - want| / max(|want|, FLOOR_FRAC * max|want|)` of a spectrum.
+/// Largest normalised error `|got - want| / max(|want|, WELCH_FLOOR_FRAC * max|want|)` of a
+/// spectrum.
 fn max_normalised_error(got: &[Complex64], want: &[Complex64]) -> f64 {
     assert_eq!(got.len(), want.len());
     let peak = want.iter().map(|z| z.norm()).fold(0.0, f64::max);
-    let floor = FLOOR_FRAC * peak;
+    let floor = WELCH_FLOOR_FRAC * peak;
     got.iter()
         .zip(want)
         .map(|(g, w)| {
@@ -206,7 +189,10 @@ fn scipy_fixtures_match() {
             );
         }
         println!("{name}: max normalised error {err:.3e}");
-        assert!(err <= REL_TOL, "{name}: error {err:e} exceeds {REL_TOL:e}");
+        assert!(
+            err <= WELCH_REL,
+            "{name}: error {err:e} exceeds {WELCH_REL:e}"
+        );
         if err > worst.0 {
             worst = (err, name.clone());
         }
