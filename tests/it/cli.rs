@@ -198,8 +198,8 @@ fn mc_json_reports_every_mode_and_refuses_zero_samples() {
     let modes = v["modes"].as_array().unwrap();
     assert_eq!(modes.len(), 8);
     assert_eq!(v["samples"].as_u64(), Some(2000));
-    // The statistics are tested in tests/mc.rs; here the command must reproduce the library's
-    // result for the same seed exactly (JSON floats round-trip).
+    // The statistics are tested in crates/tiltnoise-core/tests/it/mc.rs; here the command must
+    // reproduce the library's result for the same seed exactly (JSON floats round-trip).
     let params = tiltnoise_core::params::Params::table_i();
     let cfg = tiltnoise_core::mc::McConfig {
         samples: 2000,

@@ -72,15 +72,15 @@ fn grid(model: &Model) -> Vec<f64> {
     f
 }
 
-/// Direct, block and split against the reference on every entry of the request. LU methods
-/// (tilt inputs): `LU_GAMMA kappa` with `kappa` the entry's condition number in the paper's
-/// coordinates, as in `tests/stability.rs`. Force inputs only for split: in relative angles
-/// the direct and block LU lose relative accuracy on force entries that are differences of
-/// O(1) coordinates (phi/F_b.x above the swing modes, documented in `src/tf/split.rs`; here
-/// 1.2x over `LU_GAMMA kappa` at 5.6 Hz), which is why the budget uses split. Split (absolute
-/// angles, other forms) and pole-zero (structural damping only; its poles and zeros come from
-/// the reference's matrices, swing loss included): the split method's target, or
-/// `LU_GAMMA kappa` in absolute coordinates where that is larger.
+/// Direct, block and split against the reference on every entry of the request. LU methods (tilt
+/// inputs): `LU_GAMMA kappa` with `kappa` the entry's condition number in the paper's coordinates,
+/// as in `crates/tiltnoise-core/tests/it/stability.rs`. Force inputs only for split: in relative
+/// angles the direct and block LU lose relative accuracy on force entries that are differences of
+/// O(1) coordinates (phi/F_b.x above the swing modes, documented in
+/// `crates/tiltnoise-core/src/tf/split.rs`; here 1.2x over `LU_GAMMA kappa` at 5.6 Hz), which is
+/// why the budget uses split. Split (absolute angles, other forms) and pole-zero (structural
+/// damping only; its poles and zeros come from the reference's matrices, swing loss included): the
+/// split method's target, or `LU_GAMMA kappa` in absolute coordinates where that is larger.
 fn check_against_reference(params: &Params, label: &str) {
     let model = Model::new(params).unwrap();
     let reference = ReferenceModel::new(params);

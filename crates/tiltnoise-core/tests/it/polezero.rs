@@ -5,11 +5,12 @@
 //!   excluding 1 % in frequency around the entry's own poles and zeros (taken from the undamped
 //!   model's factors); undamped, damped (loss 1e-3 on torsions and bouncings), and m_a = 1.3 kg.
 //!   The grid is evaluated in one batch (`tf::evaluate`, the path `auto` takes);
-//!   `tests/polezero_batch.rs` checks that it equals the point-by-point path bit for bit.
+//!   `tests/it/polezero_batch.rs` checks that it equals the point-by-point path bit for bit.
 //! * Structure: the zeros at s = 0 and the degree drops found by the plan match the physics.
 //! * Structural zeros are exactly 0.0; f = 0 agrees with the reference.
 //!
-//! Run with `cargo test --release --test polezero -- --nocapture` to see the numbers.
+//! Run with `cargo test --release -p tiltnoise-core --test it polezero:: -- --nocapture` to see the
+//! numbers.
 
 use crate::common;
 use crate::tolerances::{POLE_EXCLUSION, TARGET_REL};

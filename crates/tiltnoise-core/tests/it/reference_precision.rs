@@ -2,9 +2,9 @@
 //! 40-digit mpmath fixture of the ROMY budget, the exact quasi-static limits, and the f64 direct
 //! method.
 //!
-//! Run with `cargo test --release --test reference_precision -- --nocapture` to see the measured
-//! agreement, the direct method's error per entry over 1e-5..100 Hz (the accuracy column of
-//! issue 4's methods table) and the time per reference evaluation.
+//! Run with `cargo test --release -p tiltnoise-core --test it reference_precision -- --nocapture`
+//! to see the measured agreement, the direct method's error per entry over 1e-5..100 Hz (the
+//! accuracy column of issue 4's methods table) and the time per reference evaluation.
 //!
 //! # Tolerances
 //!

@@ -92,7 +92,7 @@ fn tilt_to_x_below_the_swing_modes_needs_only_one_4dof_block() {
 
 #[test]
 fn test_mass_torque_near_the_torsion_modes_uses_the_2dof_model() {
-    // The 2-DoF model's coupling error is ~1.8 (f/f_swing)^2 for M_b.z (tests/methods.rs):
+    // The 2-DoF model's coupling error is ~1.8 (f/f_swing)^2 for M_b.z (tests/it/methods.rs):
     // about 7e-5 at 5 mHz, so a 1e-4 scene over 0.5..5 mHz is within its reach.
     let model = table_i();
     let mut s = scene(

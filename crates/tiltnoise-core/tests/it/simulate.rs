@@ -1,4 +1,4 @@
-//! Exact free-motion simulation (src/simulate.rs): stability against explicit integrators,
+//! Exact free-motion simulation (src/simulate/): stability against explicit integrators,
 //! exactness against closed form and matrix exponential, spectra vs the observability table,
 //! the X kick, errors and timing.
 

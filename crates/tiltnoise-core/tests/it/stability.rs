@@ -11,8 +11,8 @@
 //!   ([`ReferenceModel::entry_condition_paper`]: perturbations of `K`, `w^2 M`, `G0`, `w^2 G2`
 //!   and `C`, so the formation of `K - w^2 M` is included) and `LU_GAMMA = gamma_3n`, n = 8.
 //! * modal: the eigensolver's backward error propagated through the modal sum, plus the sum's own
-//!   rounding ([`modal_bound`]; the same eigensolver model as `tests/methods.rs`, summed over the
-//!   pairs of modes instead of term by term).
+//!   rounding ([`modal_bound`]; the same eigensolver model as `tests/it/methods.rs`, summed over
+//!   the pairs of modes instead of term by term).
 //! * split outside the zones: the issue-4 target, 1e-9 relative.
 //!
 //! Not tested, because not offered: `f32` arithmetic. phi/eta_t and phi_a/eta_t fall as f^4 below
@@ -23,7 +23,7 @@
 //!
 //! Covered elsewhere and referenced, not duplicated: the 2-DoF model's agreement with the full
 //! model for a torque M_b.z near the torsion modes
-//! (`tests/methods.rs::torsion2_matches_the_full_model_to_the_coupling_error`).
+//! (`tests/it/methods.rs::torsion2_matches_the_full_model_to_the_coupling_error`).
 
 use crate::tolerances::{DATA_GAMMA, EIG_GAMMA, EPS, LU_GAMMA, SUM_GAMMA, TARGET_REL};
 use nalgebra::SVector;
@@ -901,7 +901,8 @@ fn modal_fails_on_phi_over_eta_t_at_low_frequency() {
 /// **The 2-DoF model asked for a tilt about a horizontal axis.** `plan(.., Method::Torsion2)` for
 /// theta_t or eta_t fails with [`PlanError::Unsupported`] naming the input and the eta and theta
 /// coordinates the model lacks. (For a torque M_b.z it plans and agrees with the full model near
-/// the torsion modes: `tests/methods.rs::torsion2_matches_the_full_model_to_the_coupling_error`.)
+/// the torsion modes:
+/// `tests/it/methods.rs::torsion2_matches_the_full_model_to_the_coupling_error`.)
 #[test]
 fn torsion2_refuses_horizontal_tilt() {
     let model = Model::new(&Params::table_i()).unwrap();
