@@ -1,4 +1,4 @@
-//! Monte Carlo of the normal modes (issue 5 target: 1e5 samples in at most 5 s on two cores).
+//! Monte Carlo of the normal modes (target: 1e5 samples in at most 5 s on two cores).
 //! Run with `cargo bench --bench mc`; CI only compiles it.
 
 use criterion::{criterion_group, criterion_main, Criterion};

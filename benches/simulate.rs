@@ -1,6 +1,6 @@
-//! Free-motion simulation (issue 5 target: 12 h of all 8 DoF at 0.1 s in at most 0.2 s), and
-//! the default run's Welch ASDs of the seven observables. Run with `cargo bench --bench
-//! simulate`; the CLI end to end is timed with hyperfine (docs/simulate.md).
+//! Free-motion simulation (target: 12 h of all 8 DoF at 0.1 s in at most 0.2 s), and the default
+//! run's Welch ASDs of the seven observables. Run with `cargo bench --bench simulate`; the CLI end
+//! to end is timed with hyperfine (docs/simulate.md).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use tiltnoise_core::model::Model;

@@ -1,8 +1,8 @@
-//! Damping (issue 6, item 2): structural loss on every fibre and motion (torsion, bouncing,
-//! diluted swing) and viscous damping, in every method, against the double-double reference
-//! (which builds both from the parameters independently); viscous against its closed-form
-//! equivalence with structural loss; the quality factor per mode against the complex
-//! eigenvalues of the damped problem; validation of the new keys.
+//! Damping: structural loss on every fibre and motion (torsion, bouncing, diluted swing) and
+//! viscous damping, in every method, against the double-double reference (which builds both from
+//! the parameters independently); viscous against its closed-form equivalence with structural loss;
+//! the quality factor per mode against the complex eigenvalues of the damped problem; validation of
+//! the new keys.
 
 use crate::common;
 use crate::tolerances::{EPS, LU_GAMMA, TARGET_REL};

@@ -1,5 +1,5 @@
-//! Issue 6, item 1: transfer functions from forces and torques (Appendix A generalized forces) to
-//! the observables, through `tiltnoise tf --input ...` with the same outputs and methods as tilt.
+//! Transfer functions from forces and torques (Appendix A generalized forces) to the observables,
+//! through `tiltnoise tf --input ...` with the same outputs and methods as tilt.
 //!
 //! * the CLI's numbers are the double-double reference's to the `auto` tolerance, for force and
 //!   torque inputs on both bodies, damped and undamped, in CSV and HDF5;

@@ -1,8 +1,8 @@
-//! Thermal noise (issue 6, item 3): the fluctuation-dissipation theorem per dissipative element
-//! against (1) the textbook FDT identity `sum_e S_x,e = 4 k_B T |Im H_xx| / w`, (2) the closed
-//! form of a single damped oscillator, (3) the torsion-band thermal floor of the 2-DoF model of
-//! section IV.C, (4) the 1/f (structural) and white-force (viscous) shapes; and (item 4) the
-//! budget terms in the HDF5 output (total = sum of the independent terms).
+//! Thermal noise: the fluctuation-dissipation theorem per dissipative element against (1) the
+//! textbook FDT identity `sum_e S_x,e = 4 k_B T |Im H_xx| / w`, (2) the closed form of a single
+//! damped oscillator, (3) the torsion-band thermal floor of the 2-DoF model of section IV.C, (4)
+//! the 1/f (structural) and white-force (viscous) shapes; and the budget terms in the HDF5 output
+//! (total = sum of the independent terms).
 
 use crate::common;
 use crate::tolerances::{EPS, LU_GAMMA};

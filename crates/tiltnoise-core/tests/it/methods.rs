@@ -14,7 +14,7 @@
 //!   `gamma (|C| |D^-1| (|D| |x| + |G|) + |C| |x|)` with `gamma = 3 n eps`, `n = 8`. It is large
 //!   exactly where an entry is a small difference of O(1) coordinates (phi/eta_t ~ f^4 at low
 //!   frequency, eta/phi_t ~ f^-2 at high frequency, and several force entries).
-//! * split: the issue-4 target, 1e-9 relative, outside 1 % of the entry's own poles and zeros;
+//! * split: the accuracy target, 1e-9 relative, outside 1 % of the entry's own poles and zeros;
 //!   the direct method's bound inside those zones.
 //! * modal: the eigensolver's error carried by every modal term (shape error `8 eps lambda_max /
 //!   gap_k` in the M norm, Davis-Kahan; eigenvalue error `8 eps lambda_max`, Weyl) plus, damped,
@@ -458,7 +458,7 @@ fn modal_tolerance(case: &Case, o: Observable, input: Input, w2: f64) -> f64 {
 enum Tolerance {
     /// Direct and block: the LU bound everywhere.
     Lu,
-    /// Split: the issue-4 target outside the zones, the LU bound inside.
+    /// Split: the accuracy target outside the zones, the LU bound inside.
     Target,
     /// Modal: its eigensolver and damping-coupling bound everywhere.
     Modal,
@@ -583,7 +583,7 @@ fn block_within_the_lu_bound() {
 }
 
 #[test]
-fn split_meets_the_issue_4_target() {
+fn split_meets_the_target() {
     check_method(Method::Split);
 }
 
@@ -781,7 +781,7 @@ fn modal_loses_phi_over_eta_t_at_low_frequency_as_documented() {
     }
 }
 
-/// The state-space form's documented failure, as the issue describes it for the Python tools:
+/// The state-space form's documented failure, the one the Python tools have:
 /// phi/eta_t and phi_a/eta_t at 1e-5 Hz, where `B0 = G0 + K_c M^-1 G2` and `C x - C M^-1 G2`
 /// cancel in f64, come out with a relative error above 1e-3 (measured: of order 1e2), within
 /// the bound of its operations.

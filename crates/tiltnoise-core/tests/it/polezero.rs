@@ -1,6 +1,6 @@
 //! The pole-zero method against the double-double reference evaluator.
 //!
-//! * Accuracy: the issue-4 target, 1e-9 relative on every structurally nonzero entry, on a dense
+//! * Accuracy: the accuracy target, 1e-9 relative on every structurally nonzero entry, on a dense
 //!   log grid 1e-5 .. 100 Hz (2000 points plus points just outside every exclusion zone),
 //!   excluding 1 % in frequency around the entry's own poles and zeros (taken from the undamped
 //!   model's factors); undamped, damped (loss 1e-3 on torsions and bouncings), and m_a = 1.3 kg.
@@ -158,7 +158,7 @@ fn accuracy(params: &Params, zone_params: &Params, request: &Request) -> (f64, S
 }
 
 #[test]
-fn tilt_matrix_meets_the_issue_4_target() {
+fn tilt_matrix_meets_the_target() {
     let request = Request::all_tilt();
     for (name, params, zone_params) in cases() {
         let (err, entry, f, n) = accuracy(&params, &zone_params, &request);
@@ -170,7 +170,7 @@ fn tilt_matrix_meets_the_issue_4_target() {
 }
 
 #[test]
-fn force_entries_meet_the_issue_4_target() {
+fn force_entries_meet_the_target() {
     let request = force_request();
     for (name, params, zone_params) in cases() {
         let (err, entry, f, n) = accuracy(&params, &zone_params, &request);

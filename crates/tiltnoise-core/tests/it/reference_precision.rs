@@ -4,7 +4,7 @@
 //!
 //! Run with `cargo test --release -p tiltnoise-core --test it reference_precision -- --nocapture`
 //! to see the measured agreement, the direct method's error per entry over 1e-5..100 Hz (the
-//! accuracy column of issue 4's methods table) and the time per reference evaluation.
+//! accuracy column of the methods table of `tiltnoise methods`) and the time per reference evaluation.
 //!
 //! # Tolerances
 //!

@@ -1,8 +1,7 @@
-//! Stability at the edges of the numerics (issue 4, item 6): one test per documented behaviour,
-//! each with a named tolerance derived from machine epsilon, the problem's conditioning and its
-//! size (STYLE.md pattern 3). The double-double reference ([`ReferenceModel`], ~30 digits) is the
-//! oracle; its own error (`DD_EPS` times the entry's condition number) is negligible at every point
-//! used here.
+//! Stability at the edges of the numerics: one test per documented behaviour, each with a named
+//! tolerance derived from machine epsilon, the problem's conditioning and its size (STYLE.md
+//! pattern 3). The double-double reference ([`ReferenceModel`], ~30 digits) is the oracle; its own
+//! error (`DD_EPS` times the entry's condition number) is negligible at every point used here.
 //!
 //! The tolerances:
 //!
@@ -13,7 +12,7 @@
 //! * modal: the eigensolver's backward error propagated through the modal sum, plus the sum's own
 //!   rounding ([`modal_bound`]; the same eigensolver model as `tests/it/methods.rs`, summed over
 //!   the pairs of modes instead of term by term).
-//! * split outside the zones: the issue-4 target, 1e-9 relative.
+//! * split outside the zones: the accuracy target, 1e-9 relative.
 //!
 //! Not tested, because not offered: `f32` arithmetic. phi/eta_t and phi_a/eta_t fall as f^4 below
 //! the torsion modes by an exact cancellation of gravity and inertia, and the direct method loses
@@ -408,7 +407,7 @@ fn zero_frequency_gives_the_quasi_static_limits() {
 }
 
 /// **f = 1e4 Hz**, far above the bouncing modes (10.8 Hz), on the mass line. The split method
-/// agrees with the reference to the issue-4 target, 1e-9 relative, on every structurally nonzero
+/// agrees with the reference to the accuracy target, 1e-9 relative, on every structurally nonzero
 /// entry (measured: at most 3.4e-14, on theta/theta_t), and gives exactly 0.0 on the structural
 /// zeros.
 ///
