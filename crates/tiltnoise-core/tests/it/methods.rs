@@ -1,6 +1,7 @@
-//! Every evaluation method of `tiltnoise_core::tf` against the double-double reference evaluator
-//! (`tiltnoise_core::reference`, about 30 digits) on every test model and every entry point, with one
-//! named tolerance per method derived from that method's rounding model (STYLE.md patterns 2, 3).
+//! Every evaluation method of `tiltnoise_core::tf` against the double-double reference
+//! evaluator (`tiltnoise_core::reference`, about 30 digits) on every test model and every entry
+//! point, with one named tolerance per method derived from that method's rounding model (STYLE.md
+//! patterns 2, 3).
 //!
 //! * Test models: Table I undamped; Table I with loss angles 1e-3 on both torsions and both
 //!   bouncings.
@@ -16,6 +17,10 @@
 //!   frequency, eta/phi_t ~ f^-2 at high frequency, and several force entries).
 //! * split: the accuracy target, 1e-9 relative, outside 1 % of the entry's own poles and zeros;
 //!   the direct method's bound inside those zones.
+//! * polezero: the bound of its own product form `g s^p prod(z_j - s) / prod(lambda_k - s)`,
+//!   from the plan's factors: the f64 kernel's rounding, a few `u (1 + |z_j| / |z_j - s| +
+//!   |lambda_k| / |lambda_k - s|)` (derived in `polezero_batch`), plus the rounding of `s = w^2`
+//!   itself; and outside the zones the accuracy target as well.
 //! * modal: the eigensolver's error carried by every modal term (shape error `8 eps lambda_max /
 //!   gap_k` in the M norm, Davis-Kahan; eigenvalue error `8 eps lambda_max`, Weyl) plus, damped,
 //!   twice the first-order effect of the damping coupling between modes that it neglects.
@@ -31,7 +36,10 @@
 //! Run with `--nocapture` to see the methods table (the maxima measured here).
 
 use crate::common;
-use crate::tolerances::{EIG_GAMMA, EPS, LU_GAMMA, POLE_EXCLUSION, SS_GAMMA, TARGET_REL};
+use crate::polezero_batch::product_form_bound;
+use crate::tolerances::{
+    EIG_GAMMA, EPS, LU_GAMMA, OMEGA_SQ_REL, POLE_EXCLUSION, SS_GAMMA, TARGET_REL,
+};
 
 use nalgebra::{Matrix2, RowVector2, SMatrix, SVector, Vector2};
 use num_complex::Complex64;
@@ -39,8 +47,10 @@ use std::sync::OnceLock;
 use tiltnoise_core::model::{Coord, ForceInput, Model, Observable, TiltAxis};
 use tiltnoise_core::modes::{refined_omega_sq, NormalModes};
 use tiltnoise_core::params::Params;
-use tiltnoise_core::reference::{CDd, ReferenceModel};
-use tiltnoise_core::tf::{plan, Input, Method, PlanError, Request, TransferFunction};
+use tiltnoise_core::reference::{CDd, Dd, ReferenceModel};
+use tiltnoise_core::tf::{
+    plan, EntryFactors, Input, Method, PlanError, PoleZero, Request, TransferFunction,
+};
 use tiltnoise_core::units::angular;
 
 type CVec8 = SVector<Complex64, 8>;
@@ -450,6 +460,43 @@ fn modal_tolerance(case: &Case, o: Observable, input: Input, w2: f64) -> f64 {
     modal_bound(case, o, input, w2) + 2.0 * modal_damping_coupling(case, o, input, w2)
 }
 
+/// The pole-zero method's rounding model, per entry (absolute): every block's contribution
+/// `g s^p prod(z_j - s) / prod(lambda_k - s)` to the entry, from the plan's own `factors`, times
+/// its relative error. That is the kernel's f64 arithmetic against the same product in
+/// double-double at the same `s` ([`product_form_bound`], checked on its own in
+/// `polezero_batch`), plus the rounding of `s` itself ([`OMEGA_SQ_REL`]), which moves `s^p` by
+/// `p OMEGA_SQ_REL` and a factor `z - s` by `OMEGA_SQ_REL |s| / |z - s| <= OMEGA_SQ_REL (1 + |z| /
+/// |z - s|)` relative. The factors are polished in double-double: their own error, of order
+/// `DD_EPS` times their condition, is negligible here.
+fn polezero_bound(
+    factors: &[EntryFactors],
+    complex: bool,
+    request: &Request,
+    freq_hz: f64,
+) -> Vec<f64> {
+    let s = angular(freq_hz).powi(2);
+    let sd = CDd::real(Dd::from(s));
+    let n_in = request.inputs.len();
+    let mut out = vec![0.0; request.outputs.len() * n_in];
+    for e in factors {
+        let mut value = e.gain.abs_f64() * s.powi(e.power as i32);
+        let mut moved_by_s = e.power as f64;
+        for z in &e.zeros {
+            let d = (*z - sd).abs_f64();
+            value *= d;
+            moved_by_s += 1.0 + z.abs_f64() / d;
+        }
+        for l in &e.poles {
+            let d = (*l - sd).abs_f64();
+            value /= d;
+            moved_by_s += 1.0 + l.abs_f64() / d;
+        }
+        out[e.output * n_in + e.input] +=
+            value * (product_form_bound(e, s, complex) + OMEGA_SQ_REL * moved_by_s);
+    }
+    out
+}
+
 // ----------------------------------------------------------------------------------------------
 // The shared harness.
 
@@ -460,6 +507,9 @@ enum Tolerance {
     Lu,
     /// Split: the accuracy target outside the zones, the LU bound inside.
     Target,
+    /// Pole-zero: the bound of its own product form everywhere, and the accuracy target outside
+    /// the zones.
+    PoleZero,
     /// Modal: its eigensolver and damping-coupling bound everywhere.
     Modal,
     /// State space: the bound of its own operations everywhere.
@@ -469,7 +519,8 @@ enum Tolerance {
 fn tolerance(method: Method) -> Tolerance {
     match method {
         Method::Direct | Method::Block => Tolerance::Lu,
-        Method::Split | Method::PoleZero => Tolerance::Target,
+        Method::Split => Tolerance::Target,
+        Method::PoleZero => Tolerance::PoleZero,
         Method::Modal => Tolerance::Modal,
         Method::StateSpace => Tolerance::StateSpace,
         Method::Torsion2 => unreachable!("a reduced model; compared separately"),
@@ -515,12 +566,25 @@ fn check(
     let n_in = request.inputs.len();
     let mut measured = Measured::default();
     let mut failures = Vec::new();
+    let factors = match tol {
+        Tolerance::PoleZero => PoleZero::factors(case.model.params(), request),
+        _ => Vec::new(),
+    };
+    // Complex arithmetic in the kernel: damped blocks, or complex gains or zeros.
+    let complex = !case.model.is_undamped()
+        || factors
+            .iter()
+            .any(|e| !e.gain.im.is_zero() || e.zeros.iter().any(|z| !z.im.is_zero()));
     for f in grid(case) {
         let want = case.reference.eval_dd(request, f).unwrap();
         let got = tf.eval(f).unwrap();
         let lu = lu_bound(case, request, f);
         let ss = match tol {
             Tolerance::StateSpace => statespace_bound(case, request, f),
+            _ => Vec::new(),
+        };
+        let pz = match tol {
+            Tolerance::PoleZero => polezero_bound(&factors, complex, request, f),
             _ => Vec::new(),
         };
         let w2 = angular(f).powi(2);
@@ -547,6 +611,8 @@ fn check(
                 Tolerance::Lu => (0.0, lu[j]),
                 Tolerance::Target if zone => (0.0, lu[j]),
                 Tolerance::Target => (TARGET_REL, 0.0),
+                Tolerance::PoleZero if zone => (0.0, pz[j]),
+                Tolerance::PoleZero => (0.0, pz[j].min(TARGET_REL * size)),
                 Tolerance::Modal => (0.0, modal_tolerance(case, output, input, w2)),
                 Tolerance::StateSpace => (0.0, ss[j]),
             };
@@ -585,6 +651,11 @@ fn block_within_the_lu_bound() {
 #[test]
 fn split_meets_the_target() {
     check_method(Method::Split);
+}
+
+#[test]
+fn polezero_within_its_product_form_bound_and_the_target() {
+    check_method(Method::PoleZero);
 }
 
 #[test]
@@ -812,8 +883,9 @@ fn statespace_loses_phi_over_eta_t_at_low_frequency_as_documented() {
     }
 }
 
-/// Direct, block, split, modal and statespace give exactly 0.0 on the structural zeros (the entries
-/// across the two blocks, where the reference is exactly 0 at every frequency), including f = 0.
+/// Direct, block, split, polezero, modal and statespace give exactly 0.0 on the structural zeros
+/// (the entries across the two blocks, where the reference is exactly 0 at every frequency),
+/// including f = 0.
 #[test]
 fn structural_zeros_are_exact() {
     let freqs = [0.0, 1e-5, 1e-3, 0.5, 10.0, 100.0];
@@ -831,6 +903,7 @@ fn structural_zeros_are_exact() {
                 Method::Direct,
                 Method::Block,
                 Method::Split,
+                Method::PoleZero,
                 Method::Modal,
                 Method::StateSpace,
             ] {
@@ -854,16 +927,23 @@ fn structural_zeros_are_exact() {
 
 /// At f = 0 some entries vanish by an exact cancellation rather than by structure (phi/eta_t,
 /// phi_a/eta_t, eta/phi_t; Z/M_b.x and theta/F_b.z, where the gravity stiffness is diagonal in
-/// absolute angles): the reference is exactly 0 there. The split method gives exactly 0.0 on
-/// all of them; direct and block on the tilt entries but not on the force entries, where they
-/// leave rounding noise within their LU bound; modal leaves noise within its eigensolver bound.
+/// absolute angles): the reference is exactly 0 there. The split and pole-zero methods give
+/// exactly 0.0 on all of them (pole-zero through its factor `s^p`); direct and block on the tilt
+/// entries but not on the force entries, where they leave rounding noise within their LU bound;
+/// modal leaves noise within its eigensolver bound.
 #[test]
 fn static_zeros() {
     for case in cases() {
         for (entry_point, request) in entry_points() {
             let want = case.reference.eval_dd(&request, 0.0).unwrap();
             let lu = lu_bound(case, &request, 0.0);
-            for method in [Method::Direct, Method::Block, Method::Split, Method::Modal] {
+            for method in [
+                Method::Direct,
+                Method::Block,
+                Method::Split,
+                Method::PoleZero,
+                Method::Modal,
+            ] {
                 let got = plan(&case.model, &request, method)
                     .unwrap()
                     .eval(0.0)

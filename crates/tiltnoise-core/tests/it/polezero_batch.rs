@@ -262,7 +262,11 @@ fn tilt_layout_of_table_i() {
 /// error is at most `sqrt(5) u` against `u` for a real one, and a complex sum's `sqrt(2) u`:
 /// a factor 3 covers both. A factor 2 over the first-order sum covers the second-order terms
 /// and the few entries that receive two blocks' contributions.
-fn product_form_bound(e: &tiltnoise_core::tf::EntryFactors, s: f64, complex: bool) -> f64 {
+pub(crate) fn product_form_bound(
+    e: &tiltnoise_core::tf::EntryFactors,
+    s: f64,
+    complex: bool,
+) -> f64 {
     let zeros: f64 = e
         .zeros
         .iter()

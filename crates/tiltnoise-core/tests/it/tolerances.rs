@@ -18,6 +18,12 @@ pub const EPS: f64 = f64::EPSILON;
 /// operation.
 pub const U: f64 = EPS / 2.0;
 
+/// Relative error of `s = w^2 = (2 pi f)^2` formed in f64 from the f64 `2 pi` (as the pole-zero
+/// kernel forms it), against the exact `s` of the reference: the rounding of `2 pi` (0.35 u)
+/// and of the product with `f` (u) each count twice through the square, the square's own rounding
+/// once: `3.7 u`, rounded up to `4 u`.
+pub const OMEGA_SQ_REL: f64 = 4.0 * U;
+
 /// Unknowns of the full system: the 8 coordinates of the pendulum.
 pub const N_DOF: f64 = 8.0;
 
