@@ -46,11 +46,13 @@
 //!
 //! # Entry points
 //!
-//! * [`read_tilt`]: decides by extension (`.h5`/`.hdf5` vs `.csv`) and content whether the
+//! The readers are in `tiltnoise-io` (this crate reads no files), module `input`:
+//!
+//! * `read_tilt`: decides by extension (`.h5`/`.hdf5` vs `.csv`) and content whether the
 //!   file holds a series or spectra, and returns a [`TiltInput`].
-//! * [`read_tilt_series`] / [`read_tilt_spectra`]: the same, insisting on one kind.
-//! * [`TiltSeriesSource`]: streaming access to an HDF5 series in chunks (bounded memory), with
-//!   results bit-identical to [`read_tilt_series`].
+//! * `read_tilt_series` / `read_tilt_spectra`: the same, insisting on one kind.
+//! * `TiltSeriesSource`: streaming access to an HDF5 series in chunks (bounded memory), with
+//!   results bit-identical to `read_tilt_series`; it is a [`SeriesSource`].
 //!
 //! Every result carries a [`Provenance`] for the output files.
 
