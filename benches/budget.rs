@@ -10,7 +10,7 @@
 //! * `tf`: `tf::plan` + `tf::evaluate` with `Method::Direct`, outputs X, phi, phi_a from the
 //!   three tilt inputs, on the Welch grid without DC (throughput in frequencies);
 //! * `tilt_budget`: `noise::tilt_budget` on that grid (throughput in frequencies);
-//! * `budget_from_series`: the whole library job with `SeriesInput::Memory` (Welch -> TF ->
+//! * `budget_from_series`: the whole library job on a `TiltSeries` in memory (Welch -> TF ->
 //!   budget), once for the whole record and once split into two half-hour segments (per-segment
 //!   Welch accumulators, tilt PSD and percentile band).
 //!
@@ -22,13 +22,13 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
-use tiltnoise::budget::{budget_from_series, BudgetOptions, SeriesInput};
-use tiltnoise::input::{InputFormat, InputKind, Provenance, Quantity, TiltSeries};
-use tiltnoise::model::{Model, Observable, TiltAxis};
-use tiltnoise::noise::{tilt_budget, Readout, TiltCsd};
-use tiltnoise::params::Params;
-use tiltnoise::spectral::{csd_matrix, CrossSpectra, WelchConfig};
-use tiltnoise::tf::{self, Input, Method, Request, TransferMatrix};
+use tiltnoise_core::budget::{budget_from_series, BudgetOptions};
+use tiltnoise_core::input::{InputFormat, InputKind, Provenance, Quantity, TiltSeries};
+use tiltnoise_core::model::{Model, Observable, TiltAxis};
+use tiltnoise_core::noise::{tilt_budget, Readout, TiltCsd};
+use tiltnoise_core::params::Params;
+use tiltnoise_core::spectral::{csd_matrix, CrossSpectra, WelchConfig};
+use tiltnoise_core::tf::{self, Input, Method, Request, TransferMatrix};
 
 const FS_HZ: f64 = 10.0;
 const N_SAMPLES: usize = 3600 * 10;
@@ -169,8 +169,8 @@ fn stages(c: &mut Criterion) {
         };
         g.bench_function(name, |b| {
             b.iter_batched(
-                || SeriesInput::Memory(input.clone()),
-                |s| budget_from_series(&model, s, &opts, &mut |_, _| {}).expect("budget"),
+                || input.clone(),
+                |mut s| budget_from_series(&model, &mut s, &opts, &mut |_, _| {}).expect("budget"),
                 BatchSize::LargeInput,
             )
         });

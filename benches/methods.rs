@@ -1,6 +1,6 @@
-//! Speed of each transfer-function method (issue 4, item 4): the full 7x3 tilt matrix
-//! ([`Request::all_tilt`]: X, Y, Z, theta, eta, phi, phi_a from theta_t, eta_t, phi_t) of Table I
-//! on a log-spaced grid from 1e-5 to 100 Hz.
+//! Speed of each transfer-function method: the full 7x3 tilt matrix ([`Request::all_tilt`]: X, Y,
+//! Z, theta, eta, phi, phi_a from theta_t, eta_t, phi_t) of Table I on a log-spaced grid from 1e-5
+//! to 100 Hz.
 //!
 //! Group `methods_7x3_tilt`, one benchmark per method and thread count:
 //! * `direct/1t`, `block/1t`, `split/1t`, `polezero/1t`, `modal/1t`, `statespace/1t`: one
@@ -27,7 +27,7 @@
 //! time per iteration divided by the grid size.
 //!
 //! The grid has 1e4 points by default; `TILTNOISE_BENCH_METHODS_POINTS` changes that
-//! (`scripts/bench/compare_methods.py` sets 1e5, the issue's grid). Sampling is flat with 10
+//! (`scripts/bench/compare_methods.py` sets 1e5, the target's grid). Sampling is flat with 10
 //! samples, 0.3 s warm-up and 1 s measurement: a run takes about 10 s at 1e4 points and 10 to
 //! 20 s at 1e5 (criterion then stretches the measurement of the slow methods and says so).
 //!
@@ -39,10 +39,10 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
 use num_complex::Complex64;
-use tiltnoise::freq::log_grid;
-use tiltnoise::model::Model;
-use tiltnoise::params::Params;
-use tiltnoise::tf::{self, Method, Request, TransferFunction};
+use tiltnoise_core::freq::log_grid;
+use tiltnoise_core::model::Model;
+use tiltnoise_core::params::Params;
+use tiltnoise_core::tf::{self, Method, Request, TransferFunction};
 
 /// Environment variable that overrides the grid size.
 const POINTS_VAR: &str = "TILTNOISE_BENCH_METHODS_POINTS";

@@ -39,8 +39,8 @@ medians (NumPy ns/point over Rust ns/point at the same thread count), and the pe
 median and range.
 
 Target (issue 4): what `auto` does for the user (polezero_matrix: the pole-zero method, which
-meets the 1e-9 relative accuracy target of tests/polezero.rs and tests/methods.rs, evaluating
-the whole grid into its result) at least --target-ratio (100) times faster per point than
+meets the 1e-9 relative accuracy target of crates/tiltnoise-core/tests/it/polezero.rs and
+crates/tiltnoise-core/tests/it/methods.rs, evaluating the whole grid into its result) at least --target-ratio (100) times faster per point than
 NumPy into preallocated arrays, single thread. Exit code 0 if met, 1 if missed, 2 if a run
 failed. Raw figures go to DIR/compare_methods.json.
 """

@@ -95,6 +95,8 @@ impl NormalModes {
             let omega_sq = k / mm;
             if omega_sq.to_f64() > 0.0 {
                 mode.omega_sq = omega_sq.to_f64();
+                mode.loss_angle = modal_loss_angle(model, &mode.shape, mode.omega_sq);
+                mode.quality_factor = 1.0 / mode.loss_angle;
                 let pi = crate::dd::Dd::from_f64(crate::dd::PI_HI)
                     + crate::dd::Dd::from_f64(crate::dd::PI_LO);
                 let two_pi = pi + pi;

@@ -32,7 +32,7 @@
 //! closeness to a resonance (at most `1 / SINGULAR_RCOND`; 1e2 .. 1e4 on a budget grid away
 //! from the modes, the inverse of the modal loss angle on a damped mode). The sum of the
 //! elements equals `4 k_B T |Im H_xx| / w` exactly (`Im D^-1 = -D^-1 Im(D) D^-H`), which
-//! `tests/thermal.rs` checks.
+//! the `tiltnoise` package's `tests/it/thermal.rs` checks.
 //!
 //! Pure numerics: depends on `model` and `tf`.
 

@@ -1,5 +1,7 @@
-//! Rendering tests on the Table I model. Set `TILTNOISE_PLOT_PREVIEW=<dir>` to also keep the
-//! rendered figures in `<dir>` for visual inspection.
+//! Rendering tests on the Table I model: the bytes [`render`] returns. Writing them to a file
+//! (atomically, errors naming the file) is the caller's job and is tested with the command
+//! line's output dispatch (`tests/it/figures.rs`). Set `TILTNOISE_PLOT_PREVIEW=<dir>` to also
+//! keep the rendered figures in `<dir>` for visual inspection.
 
 use super::chart::{Band, Dash, LegendPlacement, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
 use super::*;
@@ -27,42 +29,36 @@ fn table_i_matrix(n: usize, lo: f64, hi: f64) -> TransferMatrix {
     evaluate(&*tf, &freqs).unwrap()
 }
 
-fn preview_dir() -> Option<std::path::PathBuf> {
-    let dir = std::path::PathBuf::from(std::env::var_os("TILTNOISE_PLOT_PREVIEW")?);
-    std::fs::create_dir_all(&dir).ok()?;
-    Some(dir)
+/// Writes `bytes` as `<TILTNOISE_PLOT_PREVIEW>/<name>` when that variable is set.
+fn preview(name: &str, bytes: &[u8]) {
+    let Some(dir) = std::env::var_os("TILTNOISE_PLOT_PREVIEW") else {
+        return;
+    };
+    let dir = std::path::PathBuf::from(dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join(name), bytes).unwrap();
 }
 
-fn leftovers(dir: &Path) -> Vec<String> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.starts_with(".tiltnoise-plot-"))
-        .collect()
-}
+const PNG_SIGNATURE: &[u8] = b"\x89PNG\r\n\x1a\n";
 
 #[test]
 fn tf_figure_png_and_svg() {
     let tf = table_i_matrix(800, 1e-4, 30.0);
-    let dir = tempfile::tempdir().unwrap();
-    let png = dir.path().join("fig5.png");
-    let svg = dir.path().join("fig5.svg");
     let options = TfFigureOptions {
         note: Some("undamped, Table I parameters".to_string()),
         ..TfFigureOptions::default()
     };
-    tf_figure_with(&tf, &png, &options).unwrap();
-    tf_figure_with(&tf, &svg, &options).unwrap();
+    let bytes = tf_figure_with(&tf, ImageFormat::Png, &options).unwrap();
+    let svg = tf_figure_with(&tf, ImageFormat::Svg, &options).unwrap();
 
-    let bytes = std::fs::read(&png).unwrap();
     assert!(bytes.len() > 20_000, "PNG only {} bytes", bytes.len());
-    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    assert_eq!(&bytes[..8], PNG_SIGNATURE);
     // IHDR: width and height.
     let w = u32::from_be_bytes(bytes[16..20].try_into().unwrap());
     let h = u32::from_be_bytes(bytes[20..24].try_into().unwrap());
     assert_eq!((w, h), (1200, 1000));
 
-    let text = std::fs::read_to_string(&svg).unwrap();
+    let text = String::from_utf8(svg).unwrap();
     assert!(text.len() > 20_000, "SVG only {} bytes", text.len());
     assert!(text.starts_with("<svg"), "{}", &text[..40]);
     assert!(text.contains("frequency (Hz)"));
@@ -71,49 +67,30 @@ fn tf_figure_png_and_svg() {
     assert!(text.contains("θₜ: identically 0"));
     assert!(text.contains("10⁻⁴"));
     assert!(text.trim_end().ends_with("</svg>"));
-    assert!(leftovers(dir.path()).is_empty());
 
-    if let Some(out) = preview_dir() {
-        tf_figure_with(&tf, &out.join("tf_figure5.png"), &options).unwrap();
-        tf_figure_with(&tf, &out.join("tf_figure5.svg"), &options).unwrap();
-    }
+    preview("tf_figure5.png", &bytes);
+    preview("tf_figure5.svg", text.as_bytes());
 }
 
 #[test]
-fn default_tf_figure_writes_png() {
+fn default_tf_figure_renders_png() {
     let tf = table_i_matrix(60, 1e-4, 30.0);
-    let dir = tempfile::tempdir().unwrap();
-    let png = dir.path().join("F.PNG");
-    tf_figure(&tf, &png).unwrap();
-    assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
-}
-
-#[test]
-fn missing_directory_is_an_error_and_leaves_nothing() {
-    let tf = table_i_matrix(20, 1e-3, 10.0);
-    let dir = tempfile::tempdir().unwrap();
-    for name in ["fig.png", "fig.svg"] {
-        let path = dir.path().join("no-such-dir").join(name);
-        let err = tf_figure(&tf, &path).unwrap_err();
-        match &err {
-            OutputError::Write { path: p, .. } => assert_eq!(p, &path),
-            other => panic!("unexpected error {other:?}"),
-        }
-        assert!(err.to_string().contains("no-such-dir"), "{err}");
-        assert!(!path.exists());
-    }
-    assert!(!dir.path().join("no-such-dir").exists());
+    let png = tf_figure(&tf, ImageFormat::Png).unwrap();
+    assert_eq!(&png[..8], PNG_SIGNATURE);
+    assert!(png.len() > 10_000);
 }
 
 #[test]
 fn unknown_extension_is_rejected() {
-    let tf = table_i_matrix(20, 1e-3, 10.0);
-    let dir = tempfile::tempdir().unwrap();
     for name in ["fig.pdf", "fig"] {
-        let path = dir.path().join(name);
-        let err = tf_figure(&tf, &path).unwrap_err();
-        assert!(matches!(err, OutputError::UnknownFormat { .. }), "{err:?}");
-        assert!(!path.exists());
+        let err = ImageFormat::from_path(Path::new(name)).unwrap_err();
+        match &err {
+            OutputError::UnknownFormat { path, allowed } => {
+                assert_eq!(path, Path::new(name));
+                assert_eq!(*allowed, ImageFormat::ALLOWED);
+            }
+            other => panic!("unexpected error {other:?}"),
+        }
     }
     assert_eq!(
         ImageFormat::from_path(Path::new("a.Svg")).unwrap(),
@@ -122,7 +99,7 @@ fn unknown_extension_is_rejected() {
 }
 
 #[test]
-fn drawing_error_leaves_existing_target_untouched() {
+fn drawing_error_is_returned_in_every_format() {
     struct Failing;
     impl Figure for Failing {
         fn size(&self) -> (u32, u32) {
@@ -132,26 +109,10 @@ fn drawing_error_leaves_existing_target_untouched() {
             Err(DrawError("deliberate".to_string()))
         }
     }
-    let dir = tempfile::tempdir().unwrap();
-    for name in ["old.png", "old.svg"] {
-        let path = dir.path().join(name);
-        std::fs::write(&path, b"previous").unwrap();
-        let err = save_figure(&path, &Failing).unwrap_err();
+    for format in [ImageFormat::Png, ImageFormat::Svg] {
+        let err = render(format, &Failing).unwrap_err();
         assert!(err.to_string().contains("deliberate"), "{err}");
-        assert_eq!(std::fs::read(&path).unwrap(), b"previous");
     }
-    assert!(leftovers(dir.path()).is_empty());
-}
-
-#[test]
-fn overwrite_replaces_target() {
-    let tf = table_i_matrix(20, 1e-3, 10.0);
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("fig.svg");
-    std::fs::write(&path, b"previous").unwrap();
-    tf_figure(&tf, &path).unwrap();
-    assert!(std::fs::read_to_string(&path).unwrap().starts_with("<svg"));
-    assert!(leftovers(dir.path()).is_empty());
 }
 
 /// The chart helper with a noise-budget-like content: a band, a thick total, zeros and NaNs.
@@ -193,14 +154,10 @@ fn budget_like_chart_with_band() {
         columns: 1,
         caption: vec!["A caption strip under a single panel.".to_string()],
     };
-    let dir = tempfile::tempdir().unwrap();
-    for name in ["budget.png", "budget.svg"] {
-        let path = dir.path().join(name);
-        save_figure(&path, &fig).unwrap();
-        assert!(std::fs::metadata(&path).unwrap().len() > 10_000);
-        if let Some(out) = preview_dir() {
-            save_figure(&out.join(name), &fig).unwrap();
-        }
+    for format in [ImageFormat::Png, ImageFormat::Svg] {
+        let bytes = render(format, &fig).unwrap();
+        assert!(bytes.len() > 10_000);
+        preview(&format!("budget.{}", format.extension()), &bytes);
     }
 }
 
@@ -233,12 +190,7 @@ fn crowded_panel_legend() {
         columns: 1,
         caption: Vec::new(),
     };
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("crowded.svg");
-    save_figure(&path, &fig).unwrap();
-    let svg = std::fs::read_to_string(&path).unwrap();
+    let svg = String::from_utf8(render(ImageFormat::Svg, &fig).unwrap()).unwrap();
     assert!(svg.contains("term 6: slope -0.5"));
-    if let Some(out) = preview_dir() {
-        save_figure(&out.join("crowded.png"), &fig).unwrap();
-    }
+    preview("crowded.png", &render(ImageFormat::Png, &fig).unwrap());
 }

@@ -3,7 +3,7 @@
 //! One generalization of the Appendix: it assumes I^b_22 = I^b_11, while Table I gives
 //! 2.77e-4 and 2.76e-4 kg m^2. Here I^b_22 is used wherever the test mass rotates about its
 //! y axis (the eta rows), which is what the Lagrangian of section II gives; with
-//! I^b_22 = I^b_11 the matrices are exactly the Appendix's. `tests/energy_crosscheck.rs`
+//! I^b_22 = I^b_11 the matrices are exactly the Appendix's. `tests/it/energy_crosscheck.rs`
 //! rebuilds every matrix from the energies of section II and checks this entry by entry.
 
 use super::{Coord, Derived, ForceMatrix, Mat8, ObservationMatrix};

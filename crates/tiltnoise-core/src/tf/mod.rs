@@ -19,12 +19,12 @@
 //! | [`Method::Direct`] | 8x8 LU per frequency | 1e-6: phi/eta_t, phi_a/eta_t grow as f^-2 below the torsion modes, eta/phi_t as f^2 above the swing modes |
 //! | [`Method::Block`] | 4x4 LU per needed block | as direct (the same operations) |
 //! | [`Method::Split`] | static part + translation forcing, absolute test-mass angles | 4e-13 outside 1 % of each entry's poles and zeros |
-//! | [`Method::PoleZero`] | per entry `g s^p prod(z_j - s) / prod(lambda_k - s)`, built once in double-double | 3e-14 outside 1 % of each entry's poles and zeros (`tests/polezero.rs`) |
+//! | [`Method::PoleZero`] | per entry `g s^p prod(z_j - s) / prod(lambda_k - s)`, built once in double-double | 3e-14 outside 1 % of each entry's poles and zeros (`tests/it/polezero.rs`) |
 //! | [`Method::Modal`] | modal superposition | 1e-9 where modal terms do not cancel (the eigenvalues' error, 1 % from nu_1); none on phi/eta_t, phi_a/eta_t at low frequency (1e2 at 1e-5 Hz); damping approximate |
 //! | [`Method::StateSpace`] | `[C, 0] (i w I - A)^-1 B + D`, 16x16 LU per frequency, as python-control and scipy.signal | 2.4e-5 on forces (phi/F_b.x at 100 Hz); none on phi/eta_t, phi_a/eta_t at low frequency (6e2 at 1e-5 Hz) |
 //! | [`Method::Torsion2`] | the 2-DoF torsional model of section IV.C | a reduced model: 1e-5..1e-3 from the 8-DoF one at 0.5..5 mHz |
 //!
-//! `tests/methods.rs` checks every method against the reference with a tolerance derived from
+//! `tests/it/methods.rs` checks every method against the reference with a tolerance derived from
 //! its rounding model and prints these numbers.
 
 mod block;

@@ -27,7 +27,7 @@
 //!   0: the torsion modes' tiny swing components times the large gravity forcing), so
 //!   their relative error grows as f^-4 (about 1e2 at 1e-5 Hz for Table I). With loss angles
 //!   the neglected damping coupling is worse still: phi_a/eta_t comes out as 5e-4 at f = 0 with
-//!   loss angles of 1e-3. Measured in `tests/methods.rs`.
+//!   loss angles of 1e-3. Measured in `tests/it/methods.rs`.
 //!
 //! Per frequency: a singularity check on the modal dynamic stiffness (equilibrated like the
 //! direct method's, `d_k = (lambda_k (1 + i phi_k) - w^2) / (|lambda_k (1 + i phi_k)| + w^2)`)

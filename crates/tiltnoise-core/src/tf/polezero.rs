@@ -29,8 +29,8 @@
 //! `1 - s / z`). Every factor is relatively accurate: the relative error of an entry is a few
 //! `eps (1 + sum |z| / |z - s| + sum |lambda| / |lambda - s|)`, about `1e2 eps` at 1 % from a
 //! pole or zero and `~eps` elsewhere, with no cancellation at low or high frequency
-//! (`tests/polezero.rs` measures 3e-14 at most outside the 1 % zones against the reference;
-//! `tests/polezero_batch.rs` checks the f64 evaluation against the same product form in
+//! (`tests/it/polezero.rs` measures 3e-14 at most outside the 1 % zones against the reference;
+//! `tests/it/polezero_batch.rs` checks the f64 evaluation against the same product form in
 //! double-double within this bound, from 0 Hz to 1e5 Hz). Entries whose observation row or
 //! forcing column misses a block get nothing from it; entries no block reaches are exactly 0.0.
 //!

@@ -25,7 +25,7 @@
 //! `c1 = m_b (Z + Z_b) + m_a (Z + Z_a)`, i.e. `R = (h / g) K_gravity S`. It is built here in
 //! closed form, so its phi and delta rows are exactly zero, whereas `G2 + M S` evaluated from
 //! the library matrices leaves rounding there in general (Table I's numbers happen to round to
-//! an exact 0; with m_a = 1.3 kg the phi_a row is -3.5e-18; `tests/methods.rs` checks that the
+//! an exact 0; with m_a = 1.3 kg the phi_a row is -3.5e-18; `tests/it/methods.rs` checks that the
 //! two agree to rounding). With exact zeros in `R` and no coupling of phi to eta in `K_c`, the
 //! f^4 of phi/eta_t comes out of the solve with relative accuracy: its phi components are
 //! driven only through the O(w^2) mass coupling. Above the block's modes the mass-line split

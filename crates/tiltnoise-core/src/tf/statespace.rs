@@ -22,7 +22,7 @@
 //! `K_c` (exact, as in the direct method); viscous damping is refused (its tilt forcing has a
 //! `w C M^-1 G2` term that this form does not carry).
 //!
-//! What the form costs (measured against the double-double reference in `tests/methods.rs`
+//! What the form costs (measured against the double-double reference in `tests/it/methods.rs`
 //! and by `tiltnoise methods`):
 //!
 //! * `B0 = G0 + K_c M^-1 G2` and `H = [C, 0] X + D` are sums of large terms of opposite signs.

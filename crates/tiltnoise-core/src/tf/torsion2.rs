@@ -26,7 +26,7 @@
 //! (away from 1 % of the torsion modes and of the entries' zeros) it is at most
 //! 1.8 (f / f_swing)^2 for the torques M_a.z, M_b.z (that is 2e-5 at nu_1 and 5e-5 at nu_2;
 //! measured 7e-5 at 5 mHz), 3.9 (f / f_swing)^2 for phi_t, and 38 (f / f_swing)^2 for the
-//! forces F_a.x, F_b.x, whose swing response X also reads directly (measured 9e-4 at 5 mHz). `tests/methods.rs` derives
+//! forces F_a.x, F_b.x, whose swing response X also reads directly (measured 9e-4 at 5 mHz). `tests/it/methods.rs` derives
 //! the first-order coupling error and checks the difference against it.
 
 use super::direct::{omega_sq, EquilibratedLu};

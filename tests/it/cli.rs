@@ -1,0 +1,216 @@
+//! The command line as a user meets it: exit codes, one-line errors naming the problem, no
+//! partial output files, and machine-readable output.
+
+use crate::common;
+
+use common::{assert_fails, stderr, tiltnoise};
+use std::path::Path;
+
+fn dir_is_empty(dir: &Path) -> bool {
+    std::fs::read_dir(dir).unwrap().next().is_none()
+}
+
+#[test]
+fn params_prints_toml_that_reads_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = tiltnoise(&["--set", "length.h_m=1.5", "params"]);
+    assert!(out.status.success());
+    let path = dir.path().join("p.toml");
+    std::fs::write(&path, &out.stdout).unwrap();
+    let back = tiltnoise_core::params::Params::from_file(&path).unwrap();
+    assert_eq!(back.length.h_m, 1.5);
+    assert_eq!(
+        back.with_override("length.h_m=2.0").unwrap(),
+        tiltnoise_core::params::Params::table_i()
+    );
+}
+
+#[test]
+fn bad_parameter_input_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "[mass\nm_a_kg = 1").unwrap();
+    let bad = bad.to_str().unwrap();
+    assert_fails(&["--params", bad, "modes"], &["bad.toml"]);
+    assert_fails(
+        &["--params", "/nonexistent/p.toml", "modes"],
+        &["/nonexistent/p.toml"],
+    );
+    // The operating system's reason, once (it is in the message, not also a chained source).
+    for (args, what) in [
+        (
+            &["--params", "/nonexistent/p.toml", "modes"][..],
+            "parameter file",
+        ),
+        (&["budget", "--tilt", "/nonexistent/t.h5"][..], "input file"),
+        (
+            &["budget", "--tilt", "/nonexistent/t.csv"][..],
+            "input file",
+        ),
+    ] {
+        let err = stderr(&tiltnoise(args));
+        assert!(
+            err.contains(&format!("cannot read {what} /nonexistent/")),
+            "{err}"
+        );
+        assert_eq!(err.matches("os error").count(), 1, "{err}");
+    }
+    assert_fails(
+        &["--set", "inertia.a11_kg_m2=-0.1", "modes"],
+        &["inertia.a11_kg_m2", "-0.1", "kg m^2", "> 0"],
+    );
+    assert_fails(
+        &["--set", "length.hh=1", "modes"],
+        &["unknown key", "length.hh"],
+    );
+    assert_fails(
+        &["--set", "mass.m_b_kg=nan", "modes"],
+        &["mass.m_b_kg", "NaN"],
+    );
+}
+
+#[test]
+fn bad_frequency_input_is_refused_without_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let out_csv = dir.path().join("out.csv");
+    let out = out_csv.to_str().unwrap();
+    let cases: [(&str, &[&str]); 4] = [
+        ("", &["no frequencies"]),
+        ("0.1\nabc\n", &["line 2", "abc"]),
+        ("0.1\n-2\n", &["-2", "line 2", ">= 0"]),
+        ("NaN\n", &["NaN"]),
+    ];
+    for (i, (text, needles)) in cases.iter().enumerate() {
+        let f = dir.path().join(format!("f{i}.txt"));
+        std::fs::write(&f, text).unwrap();
+        let f = f.to_str().unwrap();
+        assert_fails(&["tf", "--freq-file", f, "--save", out], needles);
+        assert!(!out_csv.exists());
+    }
+    assert_fails(&["tf", "--freq=-1:10:1", "--save", out], &["FLO"]);
+    assert!(!out_csv.exists());
+}
+
+#[test]
+fn unwritable_or_unknown_outputs_leave_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("no/such/dir/tf.h5");
+    assert_fails(
+        &[
+            "tf",
+            "--freq",
+            "1e-3:5:1",
+            "--save",
+            missing.to_str().unwrap(),
+        ],
+        &["no/such/dir/tf.h5"],
+    );
+    let unknown = dir.path().join("tf.xyz");
+    assert_fails(
+        &[
+            "tf",
+            "--freq",
+            "1e-3:5:1",
+            "--save",
+            unknown.to_str().unwrap(),
+        ],
+        &["tf.xyz", ".h5"],
+    );
+    assert!(dir_is_empty(dir.path()));
+}
+
+#[test]
+fn exact_resonance_in_a_frequency_file_is_an_error_not_garbage() {
+    // The Rayleigh-refined nu_8 of the undamped model, written with full precision.
+    let model =
+        tiltnoise_core::model::Model::new(&tiltnoise_core::params::Params::table_i()).unwrap();
+    let mode = tiltnoise_core::modes::NormalModes::new(&model).modes[7].clone();
+    let lambda = tiltnoise_core::modes::refined_omega_sq(&model, &mode);
+    let f = lambda.sqrt() / std::f64::consts::TAU;
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("f.txt");
+    std::fs::write(&file, format!("1.0\n{f:e}\n")).unwrap();
+    let out = dir.path().join("tf.csv");
+    assert_fails(
+        &[
+            "tf",
+            "--freq-file",
+            file.to_str().unwrap(),
+            "--save",
+            out.to_str().unwrap(),
+        ],
+        &["singular", "resonance"],
+    );
+    assert!(!out.exists());
+}
+
+#[test]
+fn modes_json_is_machine_readable() {
+    let out = tiltnoise(&["modes", "--format", "json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let modes = v["modes"].as_array().unwrap();
+    assert_eq!(modes.len(), 8);
+    let lib = tiltnoise_core::modes::NormalModes::new(
+        &tiltnoise_core::model::Model::new(&tiltnoise_core::params::Params::table_i()).unwrap(),
+    );
+    for (j, m) in modes.iter().zip(&lib.modes) {
+        assert_eq!(j["index"].as_u64().unwrap() as usize, m.index);
+        // serde_json prints f64 with round-trip precision.
+        assert_eq!(j["frequency_hz"].as_f64().unwrap(), m.frequency_hz);
+    }
+    let seen: Vec<&str> = modes[5]["seen_by"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s.as_str().unwrap())
+        .collect();
+    assert!(seen.contains(&"X"), "{seen:?}");
+}
+
+#[test]
+fn tf_writes_every_requested_format() {
+    let dir = tempfile::tempdir().unwrap();
+    let paths: Vec<String> = ["tf.h5", "tf.csv", "tf.png", "tf.svg"]
+        .iter()
+        .map(|n| dir.path().join(n).to_str().unwrap().to_string())
+        .collect();
+    let mut args = vec!["tf", "--freq", "1e-4:50:10"];
+    for p in &paths {
+        args.push("--save");
+        args.push(p);
+    }
+    let out = tiltnoise(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    for p in &paths {
+        assert!(std::fs::metadata(p).unwrap().len() > 1000, "{p}");
+    }
+    let csv = std::fs::read_to_string(&paths[1]).unwrap();
+    assert_eq!(csv.lines().count(), 51);
+    assert!(csv.starts_with("freq_hz,X.theta_t.re,X.theta_t.im,X.eta_t.re"));
+}
+
+#[test]
+fn mc_json_reports_every_mode_and_refuses_zero_samples() {
+    let out = tiltnoise(&["mc", "--samples", "2000", "--seed", "7", "--format", "json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let modes = v["modes"].as_array().unwrap();
+    assert_eq!(modes.len(), 8);
+    assert_eq!(v["samples"].as_u64(), Some(2000));
+    // The statistics are tested in crates/tiltnoise-core/tests/it/mc.rs; here the command must
+    // reproduce the library's result for the same seed exactly (JSON floats round-trip).
+    let params = tiltnoise_core::params::Params::table_i();
+    let cfg = tiltnoise_core::mc::McConfig {
+        samples: 2000,
+        seed: 7,
+        ..tiltnoise_core::mc::McConfig::default_for(&params)
+    };
+    let lib = tiltnoise_core::mc::run(&params, &cfg, &|_| {}).unwrap();
+    for (k, m) in modes.iter().enumerate() {
+        assert_eq!(m["index"].as_u64(), Some(k as u64 + 1));
+        assert_eq!(m["mean_hz"].as_f64().unwrap(), lib.mean_hz[k], "{m}");
+        assert_eq!(m["std_hz"].as_f64().unwrap(), lib.std_hz[k], "{m}");
+    }
+    assert_fails(&["mc", "--samples", "0"], &["samples = 0"]);
+}

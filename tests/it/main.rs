@@ -1,0 +1,30 @@
+//! Integration tests of the `tiltnoise` command line and of the files and figures it writes, one
+//! binary (linking dominates a test suite's build). The numerical core's tests are in
+//! `crates/tiltnoise-core/tests/it`, whose helpers and named tolerances this binary shares.
+
+/// The repository root: fixtures, reference data, examples and committed tilt data.
+const REPO_ROOT: &str = env!("CARGO_MANIFEST_DIR");
+
+mod common;
+/// Saving by extension (`src/cli/output.rs`): the command line has no library, so the tests of
+/// its output dispatch compile that module in here.
+#[path = "../../src/cli/output.rs"]
+mod output;
+#[path = "../../crates/tiltnoise-core/tests/it/tolerances.rs"]
+mod tolerances;
+
+mod budget_outputs;
+mod cli;
+mod cli_budget;
+mod damping;
+mod figures;
+mod fit;
+mod force_tf;
+mod input_readers;
+mod io_roundtrip;
+mod mc_outputs;
+mod noise_models;
+mod romy_budget;
+mod simulate_cli;
+mod simulate_roundtrip;
+mod thermal;
