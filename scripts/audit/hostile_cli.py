@@ -2081,18 +2081,27 @@ def keep_crasher(rec, case, args, binary, cdir: Path, crash_dir: Path, label: st
     dst = crash_dir / label / f"{n:04d}-{slug}"
     dst.mkdir(parents=True, exist_ok=True)
     files = []
+    local_args = list(args)
     for a in list(case.artifacts) + [a for a in args if a and len(a) < 4096]:
         p = Path(a) if os.path.isabs(a) else cdir / a
         try:
             if p.is_file() and not p.is_symlink() and p.stat().st_size <= ARTIFACT_CAP:
                 shutil.copyfile(p, dst / p.name)
                 files.append(p.name)
+                # The generated inputs are deleted after the audit: name the kept copy.
+                if os.path.isabs(a) and not a.startswith(str(REPO)):
+                    local_args = [p.name if x == a else x for x in local_args]
         except OSError:
             pass
+        if os.path.isabs(a) and os.path.islink(a) and os.readlink(a).startswith("/dev/"):
+            local_args = [os.readlink(a) + "  # via a symlink named " + os.path.basename(a)
+                          if x == a else x for x in local_args]
+    shown_cmd = (shlex.join([binary] + local_args) if all(len(a) < 4096 for a in local_args)
+                 else rec["command"])
     (dst / "command.txt").write_text(
         f"# {rec['classification']}: {case.cat} / {case.name}\n"
-        f"# run in a directory holding: {', '.join(files) or '(no input files)'}\n"
-        f"{shlex.join([binary] + args) if all(len(a) < 4096 for a in args) else rec['command']}\n"
+        f"# run in this directory (it holds: {', '.join(files) or 'no input files'})\n"
+        f"{shown_cmd}\n"
         f"# exit {rec['exit_code']} signal {rec['signal']} timed_out {rec['timed_out']}\n")
     (dst / "stderr.txt").write_text(rec.get("stderr_head") or "")
     rec["crasher_dir"] = str(dst)
