@@ -22,8 +22,8 @@ How a case runs
   machine), no core dumps, its own session, `RUST_BACKTRACE=0` (panic messages are short and
   alike for every binary) and `LC_ALL=C`. stdin is /dev/null unless the case says otherwise.
 * A case is killed (SIGKILL to its process group) after its timeout: 20 s by default (`--timeout`),
-  10 s for fuzz cases, 5 s for inputs that must be refused quickly (/dev/zero, /dev/urandom,
-  a 1 GB sparse file, 100 MB of spaces).
+  10 s for fuzz cases and 1 GB sparse files, 4 s for inputs that must be handled quickly
+  (/dev/zero, /dev/urandom, 100 MB of spaces, a 5 MB CSV with 100 000 columns).
 * stdout is streamed and scanned as it arrives (only its first 64 kB is kept), stderr is kept up
   to 1 MB.
 * Cases run on up to `--jobs` workers (default 2); the cases that send signals run one at a
@@ -123,7 +123,7 @@ DAMPED = str(REPO / "examples" / "damped.toml")
 MEM_LIMIT = 4 << 30
 DEFAULT_TIMEOUT = 20.0
 SHORT_TIMEOUT = 10.0
-QUICK_TIMEOUT = 5.0  # inputs that must be refused quickly (endless devices, huge files)
+QUICK_TIMEOUT = 4.0  # inputs that must be handled quickly (endless devices, 100 MB of spaces)
 STDOUT_HEAD = 64 << 10
 STDERR_CAP = 1 << 20
 TEXT_SCAN_CAP = 256 << 20
@@ -570,7 +570,7 @@ def cases_parameters(inputs: Path, keys: list[str], params_text: str) -> list[Ca
     with open(sparse, "wb") as fh:
         fh.truncate(1 << 30)
     for name, path, to in [("100 MB of spaces", spaces, QUICK_TIMEOUT),
-                           ("1 GB sparse file (NUL bytes)", sparse, QUICK_TIMEOUT),
+                           ("1 GB sparse file (NUL bytes)", sparse, SHORT_TIMEOUT),
                            ("/dev/zero", "/dev/zero", QUICK_TIMEOUT),
                            ("/dev/urandom", "/dev/urandom", QUICK_TIMEOUT),
                            ("/dev/null", "/dev/null", None),
@@ -705,7 +705,8 @@ def cases_tilt(inputs: Path) -> list[Case]:
     wide = write(d / "series_100k_columns.csv", joined(
         ["time_s,theta_t,eta_t," + ",".join(f"c{i}" for i in range(100_000))]
         + [ln + "," * 100_000 for ln in base[1:50]]))
-    budget("csv series: 100 000 columns", wide, must_fail=False)
+    budget("csv series: 100 000 columns (5 MB, must take well under a second)", wide,
+           must_fail=False, timeout=QUICK_TIMEOUT)
     # gaps and quantity
     p = write(d / "series_gap_interior.csv", joined(row_edit(100, 1, "nan")))
     budget("csv series: interior NaN with --gaps interpolate", p, ["--gaps", "interpolate"],
@@ -1230,11 +1231,13 @@ def cases_frequency(inputs: Path) -> list[Case]:
     sparse = d / "sparse_1GB.txt"
     with open(sparse, "wb") as fh:
         fh.truncate(1 << 30)
-    for name, path in [("1 GB sparse file", sparse), ("/dev/urandom", "/dev/urandom"),
-                       ("/dev/zero", "/dev/zero"), ("a directory", d),
-                       ("a missing file", d / "missing.txt"), ("/dev/null", "/dev/null")]:
+    for name, path, to in [("1 GB sparse file", sparse, SHORT_TIMEOUT),
+                           ("/dev/urandom", "/dev/urandom", QUICK_TIMEOUT),
+                           ("/dev/zero", "/dev/zero", QUICK_TIMEOUT), ("a directory", d, None),
+                           ("a missing file", d / "missing.txt", None),
+                           ("/dev/null", "/dev/null", None)]:
         cases.append(C(cat, f"tf --freq-file {name}", ["tf", "--freq-file", path] + small,
-                       must_fail=True, timeout=QUICK_TIMEOUT))
+                       must_fail=True, timeout=to))
     cases.append(C(cat, "tf --freq and --freq-file together",
                    ["tf", "--freq", "1e-3:10:1", "--freq-file", d / "single.txt"]))
     for i in range(8):
@@ -2081,6 +2084,7 @@ def keep_crasher(rec, case, args, binary, cdir: Path, crash_dir: Path, label: st
     dst = crash_dir / label / f"{n:04d}-{slug}"
     dst.mkdir(parents=True, exist_ok=True)
     files = []
+    prelude: list[str] = []
     local_args = list(args)
     for a in list(case.artifacts) + [a for a in args if a and len(a) < 4096]:
         p = Path(a) if os.path.isabs(a) else cdir / a
@@ -2094,14 +2098,15 @@ def keep_crasher(rec, case, args, binary, cdir: Path, crash_dir: Path, label: st
         except OSError:
             pass
         if os.path.isabs(a) and os.path.islink(a) and os.readlink(a).startswith("/dev/"):
-            local_args = [os.readlink(a) + "  # via a symlink named " + os.path.basename(a)
-                          if x == a else x for x in local_args]
+            prelude.append(shlex.join(["ln", "-sf", os.readlink(a), os.path.basename(a)]))
+            local_args = [os.path.basename(a) if x == a else x for x in local_args]
     shown_cmd = (shlex.join([binary] + local_args) if all(len(a) < 4096 for a in local_args)
                  else rec["command"])
     (dst / "command.txt").write_text(
         f"# {rec['classification']}: {case.cat} / {case.name}\n"
         f"# run in this directory (it holds: {', '.join(files) or 'no input files'})\n"
-        f"{shown_cmd}\n"
+        + "".join(line + "\n" for line in prelude)
+        + f"{shown_cmd}\n"
         f"# exit {rec['exit_code']} signal {rec['signal']} timed_out {rec['timed_out']}\n")
     (dst / "stderr.txt").write_text(rec.get("stderr_head") or "")
     rec["crasher_dir"] = str(dst)
