@@ -1975,7 +1975,7 @@ def execute(case: Case, binary: str, workroot: Path, keep_scratch: bool,
                     if set(os.listdir(cdir)) - initial_names:
                         time.sleep(0.3)
                         fire = True
-                    elif now - t0 > 15:
+                    elif now - t0 > timeout - 5:  # never appeared: signal before the end
                         fire = True
                 elif now - t0 >= float(case.sig_when):
                     fire = True
