@@ -164,6 +164,13 @@ fn initial_state(model: &Model, args: &SimulateArgs) -> Result<(InitialState, St
                  x for these parameters, so the kick is undefined"
             );
         }
+        if let Err(e) = tiltnoise_core::simulate::check_initial_state(&init) {
+            bail!(
+                "--kick-x {} m: the static deflection it starts from is outside the linear \
+                 model ({e})",
+                tiltnoise_core::error::Num(x)
+            );
+        }
         return Ok((
             init,
             format!("kick: static X displacement of {x:e} m released from rest"),

@@ -17,6 +17,14 @@ use crate::csv_text::{line_text, CsvRecords};
 /// The measured column of Table II of the paper, in the format above.
 pub const TABLE_II_MEASURED_CSV: &str = include_str!("table2_measured.csv");
 
+/// The highest measured mode frequency accepted (Hz): far above every mode of a torsion
+/// pendulum (PETER's highest is 11 Hz); larger values are not measurements of one.
+pub const MAX_MEASURED_HZ: f64 = 1e6;
+
+/// The smallest error bar accepted, relative to its frequency: a few units of f64's resolution
+/// (2^-50); a smaller one cannot be resolved by any fitted frequency and turns chi^2 infinite.
+pub const MIN_SIGMA_REL: f64 = 8.881784197001252e-16;
+
 /// Where a default sigma came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SigmaSource {
@@ -114,15 +122,18 @@ impl Measured {
                     format!("mode {mode} is listed twice; give each mode once"),
                 ));
             }
-            let frequency_hz = parse_positive(cells[1]).ok_or_else(|| {
-                fail(
-                    n,
-                    format!(
-                        "frequency_hz `{}` of mode {mode} is not allowed: must be finite and > 0",
-                        cells[1]
-                    ),
-                )
-            })?;
+            let frequency_hz = parse_positive(cells[1])
+                .filter(|f| *f <= MAX_MEASURED_HZ)
+                .ok_or_else(|| {
+                    fail(
+                        n,
+                        format!(
+                            "frequency_hz `{}` of mode {mode} is not allowed: must be finite, > 0 \
+                             and <= {MAX_MEASURED_HZ:e} Hz",
+                            cells[1]
+                        ),
+                    )
+                })?;
             let (sigma_hz, sigma_source) = match with_sigma && !cells[2].is_empty() {
                 true => (
                     parse_positive(cells[2]).ok_or_else(|| {
@@ -132,6 +143,16 @@ impl Measured {
                 ),
                 false => (half_last_digit(cells[1]), SigmaSource::Digits),
             };
+            if sigma_hz < MIN_SIGMA_REL * frequency_hz {
+                return Err(fail(
+                    n,
+                    format!(
+                        "sigma_hz {sigma_hz:e} of mode {mode} is not allowed: must be at least \
+                         {MIN_SIGMA_REL:e} times the frequency ({:e} Hz), the resolution of f64",
+                        MIN_SIGMA_REL * frequency_hz
+                    ),
+                ));
+            }
             modes.push(MeasuredMode {
                 mode,
                 frequency_hz,

@@ -36,7 +36,7 @@
 //!
 //! Pure numerics: depends on `model`, `modes` and (for [`resonance`]) `spectral` only.
 
-use crate::model::{Model, Observable, Vec8};
+use crate::model::{Coord, Model, Observable, Vec8};
 use crate::modes::NormalModes;
 use crate::rng::Rng;
 
@@ -137,6 +137,25 @@ impl Simulation {
 /// Why a simulation was refused. Every variant names the value and what is allowed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SimError {
+    /// An initial coordinate or rate outside the linear model's range, or not finite.
+    #[error(
+        "initial {what} of {coordinate} = {} {unit} is not allowed: must be finite and at most \
+         {} {unit} in magnitude (the model is linearized about the equilibrium)",
+        crate::error::Num(*.value),
+        crate::error::Num(*.max)
+    )]
+    InitialOutOfRange {
+        /// The coordinate.
+        coordinate: &'static str,
+        /// `value` or `rate`.
+        what: &'static str,
+        /// The value given.
+        value: f64,
+        /// Its unit.
+        unit: &'static str,
+        /// The largest magnitude allowed.
+        max: f64,
+    },
     /// The model has non-zero loss angles.
     #[error(
         "the model is damped (non-zero loss angles in [loss]): exact free-motion propagation \
@@ -416,6 +435,7 @@ pub fn simulate_with_progress(
             });
         }
     }
+    check_initial_state(init)?;
     let n = n_samples as usize;
     let mut prop = ModalPropagator::new(model, init, dt_s)?;
 
@@ -464,6 +484,42 @@ pub fn simulate_with_progress(
         q,
         observables: Observable::ALL.into_iter().zip(obs).collect(),
     })
+}
+
+/// The largest initial coordinate: 1 rad for an angle, 1 m for an elongation. The model is
+/// linearized about the equilibrium (small angles); far larger amplitudes are outside it and,
+/// squared in the spectra, would overflow `f64`.
+pub const MAX_INITIAL_COORDINATE: f64 = 1.0;
+
+/// The largest initial rate: an amplitude of [`MAX_INITIAL_COORDINATE`] at 100 Hz, far above
+/// every mode (rad/s or m/s).
+pub const MAX_INITIAL_RATE: f64 = MAX_INITIAL_COORDINATE * std::f64::consts::TAU * 100.0;
+
+/// Refuses an initial state outside the linear model's range (see
+/// [`MAX_INITIAL_COORDINATE`], [`MAX_INITIAL_RATE`]) or not finite, naming the coordinate.
+pub fn check_initial_state(init: &InitialState) -> Result<(), SimError> {
+    for c in Coord::ALL {
+        let (q, v) = (init.q[c.index()], init.qdot[c.index()]);
+        if !(q.is_finite() && q.abs() <= MAX_INITIAL_COORDINATE) {
+            return Err(SimError::InitialOutOfRange {
+                coordinate: c.name(),
+                what: "value",
+                value: q,
+                unit: c.unit(),
+                max: MAX_INITIAL_COORDINATE,
+            });
+        }
+        if !(v.is_finite() && v.abs() <= MAX_INITIAL_RATE) {
+            return Err(SimError::InitialOutOfRange {
+                coordinate: c.name(),
+                what: "rate",
+                value: v,
+                unit: if c.unit() == "m" { "m/s" } else { "rad/s" },
+                max: MAX_INITIAL_RATE,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// A static displacement along X released from rest: the static deflection `K q = B[:, F_b.x] F`
