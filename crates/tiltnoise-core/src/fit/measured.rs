@@ -269,7 +269,18 @@ mod tests {
             ("mode,frequency_hz\n1,1.0\n1,2.0\n", "listed twice"),
             ("mode,frequency_hz\n1,-1.0\n", "frequency_hz `-1.0`"),
             ("mode,frequency_hz\n1,nan\n", "frequency_hz `nan`"),
-            ("mode,frequency_hz\n1,inf\n", "must be finite and > 0"),
+            (
+                "mode,frequency_hz\n1,inf\n",
+                "must be finite, > 0 and <= 1e6 Hz",
+            ),
+            (
+                "mode,frequency_hz\n1,1e300\n",
+                "must be finite, > 0 and <= 1e6 Hz",
+            ),
+            (
+                "mode,frequency_hz,sigma_hz\n1,1.0,1e-300\n",
+                "at least 8.881784197001252e-16 times the frequency",
+            ),
             ("mode,frequency_hz,sigma_hz\n1,1.0,0\n", "sigma_hz `0`"),
             ("mode,freq\n1,1.0\n", "header"),
             ("mode,frequency_hz\n1\n", "has 1 fields"),
