@@ -81,6 +81,17 @@ impl RunMeta {
     }
 }
 
+/// The first line of a library's message: HDF5 errors can span several lines (the library's
+/// error stack), and every error tiltnoise prints is one line.
+pub(crate) fn first_line(message: &str) -> String {
+    message
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .trim_end()
+        .to_string()
+}
+
 /// Version of the HDF5 library linked into this build (`major.minor.release`): the one
 /// bundled with `hdf5-metno`, built from source and linked statically.
 pub fn hdf5_version() -> String {
