@@ -12,6 +12,7 @@ use tiltnoise_core::budget::{
     add_measured, budget_from_series, budget_from_spectra, loglog_at, series_psds, BudgetOptions,
     MeasuredPsds,
 };
+use tiltnoise_core::error::Shown;
 use tiltnoise_core::freq;
 use tiltnoise_core::model::Model;
 use tiltnoise_core::modes::NormalModes;
@@ -88,8 +89,12 @@ fn parse_readout(items: &[String]) -> Result<Readout> {
 }
 
 fn parse_percentiles(text: &str) -> Result<(f64, f64)> {
-    let err =
-        || anyhow!("--percentiles {text}: expected LOWER,UPPER with 0 <= LOWER < UPPER <= 100");
+    let err = || {
+        anyhow!(
+            "--percentiles {}: expected LOWER,UPPER with 0 <= LOWER < UPPER <= 100",
+            Shown(text)
+        )
+    };
     let (a, b) = text.split_once(',').ok_or_else(err)?;
     let (a, b): (f64, f64) = (
         a.trim().parse().map_err(|_| err())?,

@@ -9,6 +9,7 @@ use clap::Args;
 use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::PathBuf;
+use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::{Coord, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
@@ -109,16 +110,17 @@ fn parse_coords(option: &str, items: &[String], out: &mut [f64; 8]) -> Result<()
     let mut given = [false; 8];
     for item in items {
         for entry in item.split(',').map(str::trim).filter(|e| !e.is_empty()) {
+            let shown = Shown(entry);
             let (name, value) = entry.split_once('=').ok_or_else(|| {
-                anyhow!("{option} {entry}: expected COORD=VALUE, e.g. phi_b=0.01")
+                anyhow!("{option} {shown}: expected COORD=VALUE, e.g. phi_b=0.01")
             })?;
             let c = Coord::ALL
                 .into_iter()
                 .find(|c| c.name() == name.trim())
                 .ok_or_else(|| {
                     anyhow!(
-                        "{option} {entry}: unknown coordinate `{}`; allowed: {}",
-                        name.trim(),
+                        "{option} {shown}: unknown coordinate `{}`; allowed: {}",
+                        Shown(name.trim()),
                         names.join(", ")
                     )
                 })?;
@@ -127,15 +129,17 @@ fn parse_coords(option: &str, items: &[String], out: &mut [f64; 8]) -> Result<()
             } else {
                 format!("{}/s", c.unit())
             };
-            let v: f64 = value
-                .trim()
-                .parse()
-                .map_err(|_| anyhow!("{option} {entry}: `{}` is not a number", value.trim()))?;
+            let v: f64 = value.trim().parse().map_err(|_| {
+                anyhow!(
+                    "{option} {shown}: `{}` is not a number",
+                    Shown(value.trim())
+                )
+            })?;
             if !v.is_finite() {
-                bail!("{option} {entry}: {v} {unit} is not allowed: must be finite");
+                bail!("{option} {shown}: {v} {unit} is not allowed: must be finite");
             }
             if given[c.index()] {
-                bail!("{option} {entry}: coordinate `{}` is given twice", c.name());
+                bail!("{option} {shown}: coordinate `{}` is given twice", c.name());
             }
             given[c.index()] = true;
             out[c.index()] = v;

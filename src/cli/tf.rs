@@ -13,6 +13,7 @@ use super::output::save_tf;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::PathBuf;
+use tiltnoise_core::error::Shown;
 use tiltnoise_core::freq;
 use tiltnoise_core::model::{ForceInput, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
@@ -71,7 +72,10 @@ fn split_names<'a>(option: &str, specs: &'a [String]) -> Result<Vec<&'a str>> {
     for spec in specs {
         for name in spec.split(',').map(str::trim) {
             if name.is_empty() {
-                bail!("{option} {spec:?}: empty name in the list (names are separated by single commas)");
+                bail!(
+                    "{option} \"{}\": empty name in the list (names are separated by single commas)",
+                    Shown(spec)
+                );
             }
             names.push(name);
         }
@@ -92,7 +96,8 @@ pub fn parse_inputs(specs: &[String]) -> Result<Vec<Input>> {
             _ => match Input::from_name(name) {
                 Some(i) => vec![i],
                 None => bail!(
-                    "--input: unknown input {name:?}; allowed: {}",
+                    "--input: unknown input \"{}\"; allowed: {}",
+                    Shown(name),
                     input_names()
                 ),
             },
@@ -117,7 +122,8 @@ pub fn parse_outputs(specs: &[String]) -> Result<Vec<Observable>> {
         let Some(o) = Observable::from_name(name) else {
             let allowed: Vec<&str> = Observable::ALL.iter().map(|o| o.name()).collect();
             bail!(
-                "--output: unknown observable {name:?}; allowed: {}",
+                "--output: unknown observable \"{}\"; allowed: {}",
+                Shown(name),
                 allowed.join(", ")
             );
         };
