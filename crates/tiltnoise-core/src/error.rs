@@ -249,6 +249,15 @@ pub enum OutputError {
         /// The supported extensions.
         allowed: &'static str,
     },
+    /// An output path that breaks a rule of the run, found before anything is computed: no
+    /// such directory, not writable, a directory, given twice, or an input of the run.
+    #[error("cannot save {path}: {rule}")]
+    Refused {
+        /// The path asked for.
+        path: PathBuf,
+        /// The rule it breaks.
+        rule: String,
+    },
     /// Any I/O failure (directory missing, permission denied, disk full).
     #[error("cannot write {path}: {message}")]
     Write {

@@ -157,6 +157,17 @@ pub fn write_atomic(
     }
 }
 
+/// Creates and removes a temporary file in `dir`: whether the run can create its outputs there.
+pub(crate) fn probe_directory(dir: &Path) -> io::Result<()> {
+    let temp = tempfile::Builder::new()
+        .prefix(".tiltnoise-probe.")
+        .rand_bytes(RANDOM_LEN)
+        .make_in(dir, create_new)?;
+    // Registered while it exists, so that an interrupt removes it too.
+    drop(Registered::new(temp.into_temp_path()));
+    Ok(())
+}
+
 /// Random characters in a temporary file's name.
 const RANDOM_LEN: usize = 6;
 
