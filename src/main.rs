@@ -4,6 +4,10 @@ mod cli;
 
 use clap::{CommandFactory, FromArgMatches};
 use std::process::ExitCode;
+use tiltnoise_core::error::shown_within;
+
+/// The longest error line printed (characters); values inside it are already cut to 200.
+const MAX_ERROR_CHARS: usize = 2000;
 
 fn main() -> ExitCode {
     // `--version` names the HDF5 library linked in (bundled, static).
@@ -19,9 +23,18 @@ fn main() -> ExitCode {
     };
     match cli::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("tiltnoise: error: {e:#}");
-            ExitCode::from(2)
-        }
+        // The reader of standard output has gone (`tiltnoise tf | head -1`): nothing to say.
+        Err(e) if cli::is_closed_pipe(&e) => ExitCode::SUCCESS,
+        Err(e) => fail(&format!("{e:#}")),
     }
+}
+
+/// Prints `tiltnoise: error: MESSAGE` on one line, control characters escaped and the length
+/// bounded whatever the message holds, and returns exit code 2.
+fn fail(message: &str) -> ExitCode {
+    cli::note(&format!(
+        "tiltnoise: error: {}",
+        shown_within(message, MAX_ERROR_CHARS)
+    ));
+    ExitCode::from(2)
 }

@@ -3,11 +3,12 @@
 
 use super::args::{parse_readout_item, AverageArg};
 use super::output::save_budget;
+use super::Run;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use std::fmt::Write as _;
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use tiltnoise_core::budget::{
     add_measured, budget_from_series, budget_from_spectra, loglog_at, series_psds, BudgetOptions,
     MeasuredPsds,
@@ -198,11 +199,15 @@ fn refuse_spectra_options(args: &BudgetArgs, path: &std::path::Path) -> Result<(
 }
 
 /// Runs `tiltnoise budget`.
-pub(crate) fn run_budget(params: &Params, args: BudgetArgs) -> Result<()> {
-    let model = Model::new(params)?;
+pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Result<()> {
     for path in &args.save {
         OutputKind::from_path(path)?;
     }
+    let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
+    let mut inputs = vec![("--tilt", args.tilt.as_path())];
+    inputs.extend(args.measured.as_deref().map(|p| ("--measured", p)));
+    run.check_outputs(&saves, &inputs)?;
+    let model = Model::new(params)?;
     if args.percentiles.is_some() && args.segment_duration.is_none() {
         bail!(
             "--percentiles applies to the per-segment band and needs --segment-duration \
@@ -282,16 +287,17 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs) -> Result<()> {
         add_measured_file(&mut report, measured)?;
     }
     for note in &provenance.notes {
-        println!("input: {note}");
+        writeln!(run.out, "input: {note}")?;
     }
-    print!("{}", summary(&report));
+    write!(run.out, "{}", summary(&report))?;
     let meta = RunMeta::of_this_run(params, Some(&NormalModes::new(&model)));
     let input = InputMeta::from(&provenance);
-    for out in &args.save {
-        save_budget(out, &report, &meta, &input)?;
-        println!("wrote {}", out.display());
-    }
-    Ok(())
+    run.write_outputs(false, || {
+        for out in &args.save {
+            save_budget(out, &report, &meta, &input)?;
+        }
+        Ok(())
+    })
 }
 
 /// Adds the `measured` and `residual` terms from `--measured FILE`: a CSV of ASDs is

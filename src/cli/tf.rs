@@ -10,15 +10,16 @@
 
 use super::args::MethodArg;
 use super::output::save_tf;
+use super::Run;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::freq;
 use tiltnoise_core::model::{ForceInput, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
-use tiltnoise_core::tf::planner::{Scene, DEFAULT_REL_TOL};
+use tiltnoise_core::tf::planner::{choose, NoChoice, Scene, DEFAULT_REL_TOL};
 use tiltnoise_core::tf::{self, Input, Request};
 use tiltnoise_io::{read_freq_file, RunMeta};
 
@@ -54,7 +55,8 @@ pub struct TfArgs {
     /// measured error against the double-double reference on the grid's band is at most this.
     #[arg(long, value_name = "REL", default_value_t = DEFAULT_REL_TOL)]
     rel_tol: f64,
-    /// Say which method `auto` picked and why (every candidate's measured error).
+    /// Say which method `auto` picked and why, or why none qualifies (every candidate's
+    /// measured error, on standard error).
     #[arg(long)]
     explain: bool,
 }
@@ -136,7 +138,7 @@ pub fn parse_outputs(specs: &[String]) -> Result<Vec<Observable>> {
 }
 
 /// Runs `tiltnoise tf`.
-pub fn run_tf(params: &Params, args: TfArgs) -> Result<()> {
+pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()> {
     let request = Request {
         outputs: parse_outputs(&args.outputs)?,
         inputs: parse_inputs(&args.inputs)?,
@@ -147,16 +149,23 @@ pub fn run_tf(params: &Params, args: TfArgs) -> Result<()> {
             args.rel_tol
         );
     }
+    // Check every output before computing, so a typo costs nothing.
+    for path in &args.save {
+        tiltnoise_io::OutputKind::from_path(path)?;
+    }
+    let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
+    let inputs: Vec<(&str, &Path)> = args
+        .freq_file
+        .iter()
+        .map(|p| ("--freq-file", p.as_path()))
+        .collect();
+    run.check_outputs(&saves, &inputs)?;
     let model = Model::new(params)?;
     let freqs = match (&args.freq, &args.freq_file) {
         (Some(spec), _) => freq::parse_spec(spec)?,
         (None, Some(path)) => read_freq_file(path)?,
         (None, None) => freq::default_grid(&model),
     };
-    // Check every output's format before computing, so a typo costs nothing.
-    for path in &args.save {
-        tiltnoise_io::OutputKind::from_path(path)?;
-    }
     let method = match args.method.fixed() {
         Some(m) => m,
         None => {
@@ -173,32 +182,43 @@ pub fn run_tf(params: &Params, args: TfArgs) -> Result<()> {
                 band_hz: band,
                 rel_tol: args.rel_tol,
             };
-            let choice =
-                tiltnoise_core::tf::planner::choose(&model, &scene).map_err(anyhow::Error::msg)?;
+            let choice = match choose(&model, &scene) {
+                Ok(choice) => choice,
+                Err(refusal) if args.explain => {
+                    super::note(&refusal.explain());
+                    return Err(refusal.into());
+                }
+                Err(refusal @ NoChoice::Tolerance { .. }) => {
+                    bail!("{refusal}; run with --explain for every candidate")
+                }
+                Err(refusal) => return Err(refusal.into()),
+            };
             if args.explain {
-                eprintln!("{}", choice.explain());
+                super::note(&choice.explain());
             }
             choice.method
         }
     };
     let plan = tf::plan(&model, &request, method)?;
     let tf = tf::evaluate(plan.as_ref(), &freqs).context("evaluating the transfer functions")?;
+    let out = &mut run.out;
     if args.save.is_empty() {
-        print!("{}", tiltnoise_io::tf_csv_string(&tf));
+        write!(out, "{}", tiltnoise_io::tf_csv_string(&tf))?;
         return Ok(());
     }
     let modes = NormalModes::new(&model);
     let meta = RunMeta::of_this_run(params, Some(&modes));
-    print!("{}", super::report::modes_table(&modes));
+    write!(out, "{}", super::report::modes_table(&modes))?;
     if request.inputs.iter().any(|i| matches!(i, Input::Tilt(_))) {
-        println!();
-        print!("{}", super::report::static_limits(&model));
+        writeln!(out)?;
+        write!(out, "{}", super::report::static_limits(&model))?;
     }
-    for path in &args.save {
-        save_tf(path, &tf, &meta)?;
-        println!("wrote {}", path.display());
-    }
-    Ok(())
+    run.write_outputs(false, || {
+        for path in &args.save {
+            save_tf(path, &tf, &meta)?;
+        }
+        Ok(())
+    })
 }
 
 #[cfg(test)]
