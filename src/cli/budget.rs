@@ -30,7 +30,7 @@ pub struct BudgetArgs {
     #[arg(long, value_name = "FILE")]
     pub tilt: PathBuf,
     /// Axis map, e.g. `theta_t=-E,eta_t=-N` (default: from the file, else theta_t=-E, eta_t=-N).
-    #[arg(long, value_name = "MAP")]
+    #[arg(long, value_name = "MAP", allow_hyphen_values = true)]
     pub axes: Option<String>,
     /// Quantity of the channels: angle (rad) or rate (rad/s); default from the file, else angle.
     #[arg(long, value_name = "angle|rate")]
@@ -40,7 +40,7 @@ pub struct BudgetArgs {
     #[arg(long, value_name = "reject|interpolate")]
     pub gaps: Option<String>,
     /// Welch segment length in samples (default 2^14, or the largest power of two <= N/4).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
     pub nperseg: Option<usize>,
     /// Welch overlap as a fraction of the segment (default 0.5).
     #[arg(long, value_name = "FRACTION", allow_negative_numbers = true)]
@@ -53,15 +53,15 @@ pub struct BudgetArgs {
     pub segment_duration: Option<f64>,
     /// Percentiles of the band across segments, LOWER,UPPER (default 10,90; with
     /// --segment-duration).
-    #[arg(long, value_name = "LO,HI")]
+    #[arg(long, value_name = "LO,HI", allow_hyphen_values = true)]
     pub percentiles: Option<String>,
     /// White readout noise OBS=ASD in the observable's unit/sqrt(Hz) (repeatable; default
     /// X=9e-9 m/sqrt(Hz) from the paper; OBS=0 removes it).
-    #[arg(long, value_name = "OBS=ASD")]
+    #[arg(long, value_name = "OBS=ASD", allow_hyphen_values = true)]
     pub readout: Vec<String>,
     /// Model grid for spectra input, FLO:N:FHI (default 1e-4:2000:30 plus resonance points);
     /// restricted to the band the data cover.
-    #[arg(long, value_name = "FLO:N:FHI")]
+    #[arg(long, value_name = "FLO:N:FHI", allow_hyphen_values = true)]
     pub freq: Option<String>,
     /// Measured record of the observables for comparison: CSV `freq_hz,X[,phi,phi_a]` of
     /// one-sided ASDs (m/sqrt(Hz), rad/sqrt(Hz)), or a time series (HDF5 as written by

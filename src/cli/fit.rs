@@ -25,7 +25,12 @@ pub(crate) struct FitArgs {
     #[arg(long, value_name = "KEY,KEY,...", value_delimiter = ',')]
     free: Option<Vec<String>>,
     /// Box half-width in error bars: |p - p0| <= N sigma_p.
-    #[arg(long, value_name = "N", default_value_t = 1.0)]
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 1.0,
+        allow_negative_numbers = true
+    )]
     bound_sigmas: f64,
     /// Add the Gaussian prior sum ((p - p0) / sigma_p)^2 to chi^2 (the box still applies).
     #[arg(long)]

@@ -16,7 +16,12 @@ use tiltnoise_core::params::Params;
 #[derive(Debug, Args)]
 pub struct MethodsArgs {
     /// Log grid FLO:N:FHI (Hz:count:Hz).
-    #[arg(long, value_name = "FLO:N:FHI", default_value = "1e-5:400:100")]
+    #[arg(
+        long,
+        value_name = "FLO:N:FHI",
+        default_value = "1e-5:400:100",
+        allow_hyphen_values = true
+    )]
     freq: String,
     /// Output format on the terminal.
     #[arg(long, value_enum, default_value_t = Format::Table)]

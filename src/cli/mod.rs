@@ -44,7 +44,12 @@ struct ParamArgs {
     #[arg(long, global = true, value_name = "FILE")]
     params: Option<PathBuf>,
     /// Override one parameter, e.g. `--set length.h_m=1.5` (repeatable; SI units as in the key).
-    #[arg(long = "set", global = true, value_name = "KEY=VALUE")]
+    #[arg(
+        long = "set",
+        global = true,
+        value_name = "KEY=VALUE",
+        allow_hyphen_values = true
+    )]
     set: Vec<String>,
 }
 
@@ -74,13 +79,13 @@ enum Command {
     /// 2.5 % on masses, lengths, inertias; 10 % on torsion and bouncing constants; g, h exact).
     Mc {
         /// Number of draws.
-        #[arg(long, default_value_t = 10_000)]
+        #[arg(long, default_value_t = 10_000, allow_negative_numbers = true)]
         samples: usize,
         /// Seed of the random streams (results do not depend on the thread count).
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
         seed: u64,
         /// Worker threads (0: all cores).
-        #[arg(long, default_value_t = 0)]
+        #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
         threads: usize,
         /// Output format on the terminal.
         #[arg(long, value_enum, default_value_t = Format::Table)]

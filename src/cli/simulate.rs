@@ -76,11 +76,11 @@ pub(crate) struct SimulateArgs {
     #[arg(long, value_name = "OBS=ASD", allow_hyphen_values = true)]
     readout: Vec<String>,
     /// Seed of the readout-noise generator.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
     seed: u64,
     /// Welch segment length in samples for the ASDs (default: the largest power of two that
     /// fits three times into the record, 2^17 for 12 h at 0.1 s; 50 % overlap, mean).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
     nperseg: Option<usize>,
     /// Output (repeatable): .h5/.hdf5 time series + ASDs + run (the budget's --measured reads
     /// it), .csv ASDs (freq_hz,X,...), .png/.svg Figure 3 (ASDs).

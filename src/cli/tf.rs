@@ -28,7 +28,12 @@ use tiltnoise_io::{read_freq_file, RunMeta};
 pub struct TfArgs {
     /// Log-spaced grid FLO:N:FHI (Hz:count:Hz), e.g. 1e-4:2000:30. Default: 0.1 mHz to 30 Hz,
     /// 2000 points, plus points around every resonance.
-    #[arg(long, value_name = "FLO:N:FHI", conflicts_with = "freq_file")]
+    #[arg(
+        long,
+        value_name = "FLO:N:FHI",
+        conflicts_with = "freq_file",
+        allow_hyphen_values = true
+    )]
     freq: Option<String>,
     /// File with one frequency in Hz per line (# comments allowed).
     #[arg(long, value_name = "FILE")]
@@ -53,7 +58,12 @@ pub struct TfArgs {
     method: MethodArg,
     /// Relative tolerance for `--method auto`: the smallest model and cheapest method whose
     /// measured error against the double-double reference on the grid's band is at most this.
-    #[arg(long, value_name = "REL", default_value_t = DEFAULT_REL_TOL)]
+    #[arg(
+        long,
+        value_name = "REL",
+        default_value_t = DEFAULT_REL_TOL,
+        allow_negative_numbers = true
+    )]
     rel_tol: f64,
     /// Say which method `auto` picked and why, or why none qualifies (every candidate's
     /// measured error, on standard error).
