@@ -2,6 +2,7 @@
 
 mod cli;
 
+use clap::error::ErrorKind;
 use clap::{CommandFactory, FromArgMatches};
 use std::process::ExitCode;
 use tiltnoise_core::error::shown_within;
@@ -16,10 +17,13 @@ fn main() -> ExitCode {
         env!("CARGO_PKG_VERSION"),
         tiltnoise_io::hdf5_version()
     );
-    let matches = cli::Cli::command().version(version).get_matches();
-    let cli = match cli::Cli::from_arg_matches(&matches) {
+    let parsed = cli::Cli::command()
+        .version(version)
+        .try_get_matches()
+        .and_then(|m| cli::Cli::from_arg_matches(&m));
+    let cli = match parsed {
         Ok(cli) => cli,
-        Err(e) => e.exit(),
+        Err(e) => return clap_exit(&e),
     };
     match cli::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
@@ -37,4 +41,32 @@ fn fail(message: &str) -> ExitCode {
         shown_within(message, MAX_ERROR_CHARS)
     ));
     ExitCode::from(2)
+}
+
+/// `--help` and `--version` print as usual (exit code 0); a command-line error is one line,
+/// clap's first, without the usage and the tips that follow it (exit code 2).
+fn clap_exit(e: &clap::Error) -> ExitCode {
+    match e.kind() {
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+            // A closed standard output loses the text; nothing else to do.
+            let _ = e.print();
+            ExitCode::SUCCESS
+        }
+        ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand | ErrorKind::MissingSubcommand => {
+            let names: Vec<String> = cli::Cli::command()
+                .get_subcommands()
+                .map(|c| c.get_name().to_string())
+                .filter(|n| n != "help")
+                .collect();
+            fail(&format!(
+                "no command given; allowed: {} (tiltnoise --help describes them)",
+                names.join(", ")
+            ))
+        }
+        _ => {
+            let text = e.render().to_string();
+            let first = text.lines().next().unwrap_or_default();
+            fail(first.strip_prefix("error: ").unwrap_or(first))
+        }
+    }
 }
