@@ -11,6 +11,9 @@ use tiltnoise_core::error::shown_within;
 const MAX_ERROR_CHARS: usize = 2000;
 
 fn main() -> ExitCode {
+    // First, before any thread exists: SIGINT and SIGTERM remove the temporary files of the
+    // outputs being written, print one line and end the process with exit code 2.
+    tiltnoise_io::remove_temporaries_on_interrupt();
     // `--version` names the HDF5 library linked in (bundled, static).
     let version = format!(
         "{} (HDF5 {}, static)",
