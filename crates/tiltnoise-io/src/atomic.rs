@@ -19,7 +19,7 @@ use tempfile::TempPath;
 use tiltnoise_core::error::OutputError;
 
 /// The longest file name most file systems accept (bytes).
-const NAME_MAX: usize = 255;
+pub(crate) const NAME_MAX: usize = 255;
 
 /// Temporary files that exist right now, for the interrupt handler.
 static LIVE_TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());

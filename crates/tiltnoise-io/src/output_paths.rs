@@ -2,7 +2,7 @@
 //! not write its results fails in a moment instead of after the computation, and never
 //! replaces one of its own inputs.
 
-use crate::atomic::probe_directory;
+use crate::atomic::{probe_directory, NAME_MAX};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::OutputError;
 
@@ -10,7 +10,8 @@ use tiltnoise_core::error::OutputError;
 /// reads (`inputs`: the option that names each, such as `--tilt`, and its path); the
 /// extension, which depends on the command, is the caller's to check.
 ///
-/// * The path names a file and is not an existing directory.
+/// * The path names a file of at most 255 bytes (which most file systems accept, so that the
+///   final rename cannot fail on it) and is not an existing directory.
 /// * Its directory exists, is a directory, and a file can be created in it (a temporary file
 ///   is created there and removed at once).
 /// * No two outputs are the same file, and no output is an input of the run. Files are
@@ -33,8 +34,17 @@ pub fn check_outputs(outputs: &[&Path], inputs: &[(&str, &Path)]) -> Result<(), 
     let mut checked: Vec<(&Path, Identity)> = Vec::with_capacity(outputs.len());
     let mut probed: Vec<PathBuf> = Vec::new();
     for &path in outputs {
-        if path.file_name().is_none() {
+        let Some(name) = path.file_name() else {
             return Err(refuse(path, "the path does not name a file".to_string()));
+        };
+        if name.len() > NAME_MAX {
+            return Err(refuse(
+                path,
+                format!(
+                    "the file name is {} bytes long; at most {NAME_MAX} are allowed",
+                    name.len()
+                ),
+            ));
         }
         if path.is_dir() {
             return Err(refuse(
@@ -170,6 +180,8 @@ mod tests {
         assert!(e.contains("it is a directory"), "{e}");
         let e = refusal(&[Path::new("..")], &[]);
         assert!(e.contains("does not name a file"), "{e}");
+        let e = refusal(&[&d.join(format!("{}.h5", "n".repeat(253)))], &[]);
+        assert!(e.contains("256 bytes long; at most 255"), "{e}");
 
         let e = refusal(&[&a, &b, &a], &[]);
         assert!(e.contains("given twice"), "{e}");
