@@ -282,6 +282,7 @@ mod unix {
     use super::LIVE_TEMPORARIES;
 
     pub(super) fn install() {
+        use std::io::Write as _;
         // SAFETY: `set` is initialised by sigemptyset before use; pthread_sigmask and sigwait
         // only read it. Blocking SIGINT and SIGTERM here makes every thread started later
         // inherit the mask, so the signals are delivered only to `sigwait` below.
@@ -316,7 +317,10 @@ mod unix {
                 } else {
                     "SIGTERM"
                 };
-                eprintln!(
+                // Not eprintln!: a panic on a closed standard error would end this thread
+                // before the process, leaving both signals blocked for good.
+                let _ = writeln!(
+                    std::io::stderr(),
                     "tiltnoise: error: interrupted by {name}; {removed} temporary file(s) \
                      removed, no output written"
                 );
