@@ -47,7 +47,7 @@ fn fail(message: &str) -> ExitCode {
 }
 
 /// `--help` and `--version` print as usual (exit code 0); a command-line error is one line,
-/// clap's first, without the usage and the tips that follow it (exit code 2).
+/// clap's message without the usage block (exit code 2).
 fn clap_exit(e: &clap::Error) -> ExitCode {
     match e.kind() {
         ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
@@ -66,10 +66,23 @@ fn clap_exit(e: &clap::Error) -> ExitCode {
                 names.join(", ")
             ))
         }
-        _ => {
-            let text = e.render().to_string();
-            let first = text.lines().next().unwrap_or_default();
-            fail(first.strip_prefix("error: ").unwrap_or(first))
-        }
+        _ => fail(&clap_message(&e.render().to_string())),
     }
+}
+
+/// clap's message on one line: its lines up to the usage block, joined (a list of missing
+/// arguments, the possible values and tips follow the first line).
+fn clap_message(text: &str) -> String {
+    let mut lines = text
+        .lines()
+        .map(str::trim)
+        .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+        .filter(|l| !l.is_empty());
+    let first = lines.next().unwrap_or_default();
+    let mut message = first.strip_prefix("error: ").unwrap_or(first).to_string();
+    for line in lines {
+        message.push_str(if message.ends_with(':') { " " } else { "; " });
+        message.push_str(line);
+    }
+    message
 }

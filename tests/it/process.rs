@@ -214,7 +214,14 @@ fn command_line_errors_are_one_line_and_help_is_not_an_error() {
             &["tf", "--bogus"][..],
             "unexpected argument '--bogus' found",
         ),
-        (&["modes", "--format", "xml"], "invalid value 'xml'"),
+        (
+            &["modes", "--format", "xml"],
+            "invalid value 'xml' for '--format <FORMAT>'; [possible values: table, json]",
+        ),
+        (
+            &["budget"],
+            "the following required arguments were not provided: --tilt <FILE>",
+        ),
         (
             &["mc", "--samples", "-5"],
             "invalid value '-5' for '--samples",
