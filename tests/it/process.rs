@@ -7,7 +7,7 @@
 use crate::common;
 
 use common::{assert_fails, assert_fails_without_output, listing, stderr, tiltnoise};
-use std::io::Read;
+use std::io::{Read, Write};
 use std::path::Path;
 use std::process::{Child, Command, ExitStatus, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -41,6 +41,14 @@ fn wait_bounded(child: &mut Child, limit: Duration) -> ExitStatus {
         }
         std::thread::sleep(Duration::from_millis(5));
     }
+}
+
+/// Says on standard error, past the test harness's capture, that `test` was skipped and why.
+fn skipped(test: &str, why: &str) {
+    let line = format!("skipped {test}: {why}\n");
+    std::io::stderr()
+        .write_all(line.as_bytes())
+        .expect("standard error is writable");
 }
 
 /// Standard error of a finished child.
@@ -100,7 +108,10 @@ fn a_reader_that_goes_away_ends_the_run_quietly() {
 #[test]
 fn a_full_standard_output_is_one_error_line() {
     let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
-        eprintln!("skipped a_full_standard_output_is_one_error_line: no /dev/full here");
+        skipped(
+            "a_full_standard_output_is_one_error_line",
+            "no /dev/full here",
+        );
         return;
     };
     let dir = tempfile::tempdir().unwrap();
@@ -381,23 +392,43 @@ fn output_paths_are_checked_before_anything_is_computed() {
 #[test]
 fn an_unwritable_directory_is_refused_before_computing() {
     use std::os::unix::fs::PermissionsExt;
+    use std::os::unix::process::CommandExt;
     let dir = tempfile::tempdir().unwrap();
     let ro = dir.path().join("ro");
     std::fs::create_dir(&ro).unwrap();
     std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o555)).unwrap();
-    if std::fs::write(ro.join("probe"), "x").is_ok() {
-        eprintln!(
-            "skipped an_unwritable_directory_is_refused_before_computing: this user (root?) \
-             can write into a read-only directory"
-        );
-        return;
-    }
     let out = ro.join("a.h5");
-    assert_fails_without_output(
+    let mut child = command(
         &["mc", "--samples", "10", "--save", out.to_str().unwrap()],
-        &ro,
-        &["ro/a.h5", "is not writable", "Permission denied"],
+        dir.path(),
     );
+    // Root writes into a read-only directory: run the child as the unprivileged user
+    // `nobody` (65534) instead, in a directory it may enter.
+    // SAFETY: geteuid only reads the process's credentials.
+    if unsafe { libc::geteuid() } == 0 {
+        std::fs::set_permissions(dir.path(), std::fs::Permissions::from_mode(0o755)).unwrap();
+        child.uid(65534).gid(65534);
+    }
+    let result = match child.output() {
+        Ok(result) => result,
+        Err(e) => {
+            skipped(
+                "an_unwritable_directory_is_refused_before_computing",
+                &format!("cannot run the binary as an unprivileged user: {e}"),
+            );
+            return;
+        }
+    };
+    let err = stderr(&result);
+    assert_eq!(result.status.code(), Some(2), "{err}");
+    assert_one_line("read-only directory", &err);
+    assert!(
+        err.contains("ro/a.h5")
+            && err.contains("is not writable")
+            && err.contains("Permission denied"),
+        "{err}"
+    );
+    assert!(listing(&ro).is_empty());
 }
 
 #[test]
