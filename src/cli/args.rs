@@ -3,6 +3,7 @@
 
 use anyhow::{anyhow, bail, Result};
 use clap::ValueEnum;
+use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::Observable;
 use tiltnoise_core::tf::Method;
 
@@ -62,21 +63,23 @@ impl MethodArg {
 /// One `--readout OBS=ASD` item (also used by `simulate`): the observable and its white
 /// readout noise, one-sided ASD in the observable's unit/sqrt(Hz), finite and >= 0.
 pub fn parse_readout_item(item: &str) -> Result<(Observable, f64)> {
+    let shown = Shown(item);
     let (name, value) = item
         .split_once('=')
-        .ok_or_else(|| anyhow!("--readout {item}: expected OBS=ASD, e.g. X=9e-9"))?;
+        .ok_or_else(|| anyhow!("--readout {shown}: expected OBS=ASD, e.g. X=9e-9"))?;
     let o = Observable::from_name(name.trim()).ok_or_else(|| {
-            anyhow!(
-                "--readout {item}: unknown observable `{name}`; allowed: X, Y, Z, theta, eta, phi, phi_a"
-            )
-        })?;
+        anyhow!(
+            "--readout {shown}: unknown observable `{}`; allowed: X, Y, Z, theta, eta, phi, phi_a",
+            Shown(name)
+        )
+    })?;
     let asd: f64 = value
         .trim()
         .parse()
-        .map_err(|_| anyhow!("--readout {item}: `{value}` is not a number"))?;
+        .map_err(|_| anyhow!("--readout {shown}: `{}` is not a number", Shown(value)))?;
     if !(asd.is_finite() && asd >= 0.0) {
         bail!(
-            "--readout {item}: ASD {asd} {}/sqrt(Hz) is not allowed: must be finite and >= 0",
+            "--readout {shown}: ASD {asd} {}/sqrt(Hz) is not allowed: must be finite and >= 0",
             o.unit()
         );
     }

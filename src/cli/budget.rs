@@ -3,15 +3,17 @@
 
 use super::args::{parse_readout_item, AverageArg};
 use super::output::save_budget;
+use super::Run;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use std::fmt::Write as _;
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use tiltnoise_core::budget::{
     add_measured, budget_from_series, budget_from_spectra, loglog_at, series_psds, BudgetOptions,
     MeasuredPsds,
 };
+use tiltnoise_core::error::Shown;
 use tiltnoise_core::freq;
 use tiltnoise_core::model::Model;
 use tiltnoise_core::modes::NormalModes;
@@ -28,7 +30,7 @@ pub struct BudgetArgs {
     #[arg(long, value_name = "FILE")]
     pub tilt: PathBuf,
     /// Axis map, e.g. `theta_t=-E,eta_t=-N` (default: from the file, else theta_t=-E, eta_t=-N).
-    #[arg(long, value_name = "MAP")]
+    #[arg(long, value_name = "MAP", allow_hyphen_values = true)]
     pub axes: Option<String>,
     /// Quantity of the channels: angle (rad) or rate (rad/s); default from the file, else angle.
     #[arg(long, value_name = "angle|rate")]
@@ -38,7 +40,7 @@ pub struct BudgetArgs {
     #[arg(long, value_name = "reject|interpolate")]
     pub gaps: Option<String>,
     /// Welch segment length in samples (default 2^14, or the largest power of two <= N/4).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
     pub nperseg: Option<usize>,
     /// Welch overlap as a fraction of the segment (default 0.5).
     #[arg(long, value_name = "FRACTION", allow_negative_numbers = true)]
@@ -51,15 +53,15 @@ pub struct BudgetArgs {
     pub segment_duration: Option<f64>,
     /// Percentiles of the band across segments, LOWER,UPPER (default 10,90; with
     /// --segment-duration).
-    #[arg(long, value_name = "LO,HI")]
+    #[arg(long, value_name = "LO,HI", allow_hyphen_values = true)]
     pub percentiles: Option<String>,
     /// White readout noise OBS=ASD in the observable's unit/sqrt(Hz) (repeatable; default
     /// X=9e-9 m/sqrt(Hz) from the paper; OBS=0 removes it).
-    #[arg(long, value_name = "OBS=ASD")]
+    #[arg(long, value_name = "OBS=ASD", allow_hyphen_values = true)]
     pub readout: Vec<String>,
     /// Model grid for spectra input, FLO:N:FHI (default 1e-4:2000:30 plus resonance points);
     /// restricted to the band the data cover.
-    #[arg(long, value_name = "FLO:N:FHI")]
+    #[arg(long, value_name = "FLO:N:FHI", allow_hyphen_values = true)]
     pub freq: Option<String>,
     /// Measured record of the observables for comparison: CSV `freq_hz,X[,phi,phi_a]` of
     /// one-sided ASDs (m/sqrt(Hz), rad/sqrt(Hz)), or a time series (HDF5 as written by
@@ -88,8 +90,12 @@ fn parse_readout(items: &[String]) -> Result<Readout> {
 }
 
 fn parse_percentiles(text: &str) -> Result<(f64, f64)> {
-    let err =
-        || anyhow!("--percentiles {text}: expected LOWER,UPPER with 0 <= LOWER < UPPER <= 100");
+    let err = || {
+        anyhow!(
+            "--percentiles {}: expected LOWER,UPPER with 0 <= LOWER < UPPER <= 100",
+            Shown(text)
+        )
+    };
     let (a, b) = text.split_once(',').ok_or_else(err)?;
     let (a, b): (f64, f64) = (
         a.trim().parse().map_err(|_| err())?,
@@ -193,11 +199,15 @@ fn refuse_spectra_options(args: &BudgetArgs, path: &std::path::Path) -> Result<(
 }
 
 /// Runs `tiltnoise budget`.
-pub(crate) fn run_budget(params: &Params, args: BudgetArgs) -> Result<()> {
-    let model = Model::new(params)?;
+pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Result<()> {
     for path in &args.save {
         OutputKind::from_path(path)?;
     }
+    let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
+    let mut inputs = vec![("--tilt", args.tilt.as_path())];
+    inputs.extend(args.measured.as_deref().map(|p| ("--measured", p)));
+    run.check_outputs(&saves, &inputs)?;
+    let model = Model::new(params)?;
     if args.percentiles.is_some() && args.segment_duration.is_none() {
         bail!(
             "--percentiles applies to the per-segment band and needs --segment-duration \
@@ -277,16 +287,17 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs) -> Result<()> {
         add_measured_file(&mut report, measured)?;
     }
     for note in &provenance.notes {
-        println!("input: {note}");
+        writeln!(run.out, "input: {note}")?;
     }
-    print!("{}", summary(&report));
+    write!(run.out, "{}", summary(&report))?;
     let meta = RunMeta::of_this_run(params, Some(&NormalModes::new(&model)));
     let input = InputMeta::from(&provenance);
-    for out in &args.save {
-        save_budget(out, &report, &meta, &input)?;
-        println!("wrote {}", out.display());
-    }
-    Ok(())
+    run.write_outputs(false, || {
+        for out in &args.save {
+            save_budget(out, &report, &meta, &input)?;
+        }
+        Ok(())
+    })
 }
 
 /// Adds the `measured` and `residual` terms from `--measured FILE`: a CSV of ASDs is

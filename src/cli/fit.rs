@@ -2,6 +2,7 @@
 //! measured mode frequencies ([`tiltnoise_core::fit`]): argument parsing, the table and JSON reports and
 //! the `--save` writers (.json, .h5; written atomically, checked before the fit runs).
 
+use super::Run;
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use serde::Serialize;
@@ -24,7 +25,12 @@ pub(crate) struct FitArgs {
     #[arg(long, value_name = "KEY,KEY,...", value_delimiter = ',')]
     free: Option<Vec<String>>,
     /// Box half-width in error bars: |p - p0| <= N sigma_p.
-    #[arg(long, value_name = "N", default_value_t = 1.0)]
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 1.0,
+        allow_negative_numbers = true
+    )]
     bound_sigmas: f64,
     /// Add the Gaussian prior sum ((p - p0) / sigma_p)^2 to chi^2 (the box still applies).
     #[arg(long)]
@@ -44,10 +50,17 @@ enum FitFormat {
 }
 
 /// Runs `tiltnoise fit`.
-pub(crate) fn run_fit(params: &Params, args: FitArgs) -> Result<()> {
+pub(crate) fn run_fit(params: &Params, args: FitArgs, run: &mut Run) -> Result<()> {
     for path in &args.save {
         save_kind(path)?;
     }
+    let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
+    let inputs: Vec<(&str, &Path)> = args
+        .measured
+        .iter()
+        .map(|p| ("--measured", p.as_path()))
+        .collect();
+    run.check_outputs(&saves, &inputs)?;
     let measured = match &args.measured {
         Some(path) => read_measured_modes(path)?,
         None => Measured::table_ii(),
@@ -64,22 +77,24 @@ pub(crate) fn run_fit(params: &Params, args: FitArgs) -> Result<()> {
     let result = fit::fit(params, &measured, &config)?;
     let json = fit_json(&result, &measured.origin);
     match args.format {
-        FitFormat::Json => println!("{}", serde_json::to_string_pretty(&json)?),
-        FitFormat::Table => print!("{}", fit_table(&result, &measured.origin)),
+        FitFormat::Json => writeln!(run.out, "{}", serde_json::to_string_pretty(&json)?)?,
+        FitFormat::Table => write!(run.out, "{}", fit_table(&result, &measured.origin))?,
     }
-    for path in &args.save {
-        match save_kind(path)? {
-            SaveKind::Json => {
-                let text = serde_json::to_string_pretty(&json)? + "\n";
-                write_atomic(path, |tmp| {
-                    std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
-                })?
+    // JSON on standard output stays parseable: the `wrote` lines go to standard error.
+    run.write_outputs(args.format == FitFormat::Json, || {
+        for path in &args.save {
+            match save_kind(path)? {
+                SaveKind::Json => {
+                    let text = serde_json::to_string_pretty(&json)? + "\n";
+                    write_atomic(path, |tmp| {
+                        std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
+                    })?
+                }
+                SaveKind::Hdf5 => write_fit_hdf5(path, &result, &measured.origin)?,
             }
-            SaveKind::Hdf5 => write_fit_hdf5(path, &result, &measured.origin)?,
         }
-        println!("wrote {}", path.display());
-    }
-    Ok(())
+        Ok(())
+    })
 }
 
 enum SaveKind {

@@ -2,6 +2,7 @@
 //! the parameter file, see [`tiltnoise_core::params::uncertainty`]); a table or JSON on stdout, histograms
 //! (PNG/SVG) and HDF5 with `--save`.
 
+use super::Run;
 use anyhow::Result;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -51,14 +52,16 @@ fn output_kind(path: &Path) -> Result<McOutput, OutputError> {
     }
 }
 
-/// Runs `tiltnoise mc`. Every `--save` format is checked before computing.
-pub(crate) fn run_mc(params: &Params, opts: McOptions) -> Result<()> {
+/// Runs `tiltnoise mc`. Every `--save` path is checked before computing.
+pub(crate) fn run_mc(params: &Params, opts: McOptions, run: &mut Run) -> Result<()> {
     use std::io::IsTerminal;
     let kinds = opts
         .save
         .iter()
         .map(|p| output_kind(p))
         .collect::<Result<Vec<_>, _>>()?;
+    let saves: Vec<&Path> = opts.save.iter().map(PathBuf::as_path).collect();
+    run.check_outputs(&saves, &[])?;
     let cfg = McConfig {
         samples: opts.samples,
         seed: opts.seed,
@@ -80,30 +83,27 @@ pub(crate) fn run_mc(params: &Params, opts: McOptions) -> Result<()> {
         .try_into()
         .map_err(|v: Vec<f64>| anyhow::anyhow!("expected 8 modes, got {}", v.len()))?;
     if opts.json {
-        println!("{}", json(&result, &nominal, opts.seed)?);
+        writeln!(run.out, "{}", json(&result, &nominal, opts.seed)?)?;
     } else {
-        print!("{}", table(&result, &nominal, opts.seed));
+        write!(run.out, "{}", table(&result, &nominal, opts.seed))?;
     }
     if opts.save.is_empty() {
         return Ok(());
     }
     let meta = RunMeta::of_this_run(params, None);
     let caption = caption(&result, &cfg);
-    for (path, kind) in opts.save.iter().zip(kinds) {
-        match kind {
-            McOutput::Hdf5 => write_mc_hdf5(path, &result, &cfg, &nominal, &meta)?,
-            McOutput::Figure => super::output::save_image(path, |format| {
-                tiltnoise_plot::mc_figure::mc_figure(&result, &nominal, &caption, format)
-            })?,
+    // JSON on standard output stays parseable: the `wrote` lines go to standard error.
+    run.write_outputs(opts.json, || {
+        for (path, kind) in opts.save.iter().zip(kinds) {
+            match kind {
+                McOutput::Hdf5 => write_mc_hdf5(path, &result, &cfg, &nominal, &meta)?,
+                McOutput::Figure => super::output::save_image(path, |format| {
+                    tiltnoise_plot::mc_figure::mc_figure(&result, &nominal, &caption, format)
+                })?,
+            }
         }
-        // The table goes to stdout; keep JSON on stdout parseable.
-        if opts.json {
-            eprintln!("wrote {}", path.display());
-        } else {
-            println!("wrote {}", path.display());
-        }
-    }
-    Ok(())
+        Ok(())
+    })
 }
 
 /// The figure's caption: what is marked, counts, seed and the error model, grouped by error.

@@ -3,10 +3,11 @@
 
 use super::args::Format;
 use super::output::save_image;
+use super::Run;
 use anyhow::Result;
 use clap::Args;
 use serde::Serialize;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use tiltnoise_core::freq;
 use tiltnoise_core::model::{Model, Request};
 use tiltnoise_core::params::Params;
@@ -15,7 +16,12 @@ use tiltnoise_core::params::Params;
 #[derive(Debug, Args)]
 pub struct MethodsArgs {
     /// Log grid FLO:N:FHI (Hz:count:Hz).
-    #[arg(long, value_name = "FLO:N:FHI", default_value = "1e-5:400:100")]
+    #[arg(
+        long,
+        value_name = "FLO:N:FHI",
+        default_value = "1e-5:400:100",
+        allow_hyphen_values = true
+    )]
     freq: String,
     /// Output format on the terminal.
     #[arg(long, value_enum, default_value_t = Format::Table)]
@@ -47,7 +53,7 @@ struct MethodsJson<'a> {
 }
 
 /// Runs `tiltnoise methods`.
-pub fn run_methods(params: &Params, args: MethodsArgs) -> Result<()> {
+pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> Result<()> {
     let MethodsArgs {
         freq: spec,
         format,
@@ -59,6 +65,9 @@ pub fn run_methods(params: &Params, args: MethodsArgs) -> Result<()> {
     for path in save {
         tiltnoise_plot::ImageFormat::from_path(path)?;
     }
+    let saves: Vec<&Path> = save.iter().map(PathBuf::as_path).collect();
+    run.check_outputs(&saves, &[])?;
+    let out = &mut run.out;
     let model = Model::new(params)?;
     let grid = freq::parse_spec(spec)?;
     let request = Request::all_tilt();
@@ -72,7 +81,7 @@ pub fn run_methods(params: &Params, args: MethodsArgs) -> Result<()> {
         },
     )
     .map(|c| c.method.name().to_string())
-    .unwrap_or_else(|why| format!("none ({why})"));
+    .unwrap_or_else(|refusal| format!("none ({refusal})"));
     let rows = methods_table(&model, &request, &grid);
     match format {
         Format::Json => {
@@ -94,20 +103,23 @@ pub fn run_methods(params: &Params, args: MethodsArgs) -> Result<()> {
                 grid: spec,
                 methods,
             };
-            println!("{}", serde_json::to_string_pretty(&json)?);
+            writeln!(out, "{}", serde_json::to_string_pretty(&json)?)?;
         }
         Format::Table => {
-            println!(
+            writeln!(
+                out,
                 "7x3 tilt matrix on {spec} Hz ({} points; accuracy checked > 1 % from every mode)",
                 grid.len()
-            );
-            println!(
+            )?;
+            writeln!(
+                out,
                 "{:<9} {:>13} {:>14} {:>12} {:>12}  exact zeros",
                 "method", "max rel err", "worst entry", "at (Hz)", "ns/point"
-            );
+            )?;
             for r in &rows {
                 match (&r.worst, r.ns_per_point) {
-                    (Some((e, entry, f)), Some(ns)) => println!(
+                    (Some((e, entry, f)), Some(ns)) => writeln!(
+                        out,
                         "{:<9} {:>13.2e} {:>14} {:>12.4e} {:>12.0}  {}",
                         r.method.name(),
                         e,
@@ -119,15 +131,19 @@ pub fn run_methods(params: &Params, args: MethodsArgs) -> Result<()> {
                         } else {
                             "no"
                         }
-                    ),
-                    _ => println!(
+                    )?,
+                    _ => writeln!(
+                        out,
                         "{:<9} not usable: {}",
                         r.method.name(),
                         r.unusable.as_deref().unwrap_or("")
-                    ),
+                    )?,
                 }
             }
-            println!("auto picks: {auto} (target: relative error <= {DEFAULT_REL_TOL:e})");
+            writeln!(
+                out,
+                "auto picks: {auto} (target: relative error <= {DEFAULT_REL_TOL:e})"
+            )?;
         }
     }
     let points: Vec<tiltnoise_plot::methods_figure::MethodPoint> = rows
@@ -140,16 +156,18 @@ pub fn run_methods(params: &Params, args: MethodsArgs) -> Result<()> {
             ))
         })
         .collect();
-    for path in save {
-        save_image(path, |format| {
-            tiltnoise_plot::methods_figure::methods_figure(
-                &points,
-                DEFAULT_REL_TOL,
-                &format!("Speed against accuracy, 7x3 tilt matrix, {spec} Hz"),
-                format,
-            )
-        })?;
-        println!("wrote {}", path.display());
-    }
-    Ok(())
+    // JSON on standard output stays parseable: the `wrote` lines go to standard error.
+    run.write_outputs(format == Format::Json, || {
+        for path in save {
+            save_image(path, |format| {
+                tiltnoise_plot::methods_figure::methods_figure(
+                    &points,
+                    DEFAULT_REL_TOL,
+                    &format!("Speed against accuracy, 7x3 tilt matrix, {spec} Hz"),
+                    format,
+                )
+            })?;
+        }
+        Ok(())
+    })
 }

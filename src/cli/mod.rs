@@ -1,6 +1,8 @@
 //! Command-line interface: clap derive for the raw arguments, then conversion to validated
 //! library inputs and the run of each subcommand. `main.rs` only maps the result to an exit code.
-//! Everything printed goes to stdout; errors are returned to `main`.
+//! Results are printed on standard output through [`Out`]; errors are returned to `main`.
+//! Every command that saves files checks all their paths before it computes anything
+//! ([`Run::check_outputs`]) and writes them all or none ([`Run::write_outputs`]).
 
 mod args;
 mod budget;
@@ -10,15 +12,19 @@ mod methods;
 mod output;
 mod report;
 mod simulate;
+mod stdout;
 mod tf;
+
+pub use stdout::{is_closed_pipe, note, Out};
 
 use anyhow::Result;
 use args::Format;
 use clap::{Args, Parser, Subcommand};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use tiltnoise_core::model::Model;
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
+use tiltnoise_io::Staging;
 
 /// Tilt-noise budgets for double torsion pendulums (the 8-DoF PETER model of
 /// De Marchi et al., Phys. Rev. D 87, 122006, 2013).
@@ -38,7 +44,12 @@ struct ParamArgs {
     #[arg(long, global = true, value_name = "FILE")]
     params: Option<PathBuf>,
     /// Override one parameter, e.g. `--set length.h_m=1.5` (repeatable; SI units as in the key).
-    #[arg(long = "set", global = true, value_name = "KEY=VALUE")]
+    #[arg(
+        long = "set",
+        global = true,
+        value_name = "KEY=VALUE",
+        allow_hyphen_values = true
+    )]
     set: Vec<String>,
 }
 
@@ -68,13 +79,13 @@ enum Command {
     /// 2.5 % on masses, lengths, inertias; 10 % on torsion and bouncing constants; g, h exact).
     Mc {
         /// Number of draws.
-        #[arg(long, default_value_t = 10_000)]
+        #[arg(long, default_value_t = 10_000, allow_negative_numbers = true)]
         samples: usize,
         /// Seed of the random streams (results do not depend on the thread count).
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
         seed: u64,
         /// Worker threads (0: all cores).
-        #[arg(long, default_value_t = 0)]
+        #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
         threads: usize,
         /// Output format on the terminal.
         #[arg(long, value_enum, default_value_t = Format::Table)]
@@ -101,28 +112,83 @@ impl ParamArgs {
     }
 }
 
-/// Runs the parsed command line.
+/// What every command shares besides its parameters: standard output, and the parameter file,
+/// which no output of the run may replace.
+pub(crate) struct Run {
+    /// Standard output.
+    pub(crate) out: Out,
+    params_file: Option<PathBuf>,
+}
+
+impl Run {
+    /// Checks every output path of the command before anything is computed (the rules of
+    /// [`tiltnoise_io::check_outputs`]); `inputs` are the files the command reads besides the
+    /// parameter file, with the options that name them.
+    pub(crate) fn check_outputs(&self, outputs: &[&Path], inputs: &[(&str, &Path)]) -> Result<()> {
+        let mut all = inputs.to_vec();
+        if let Some(p) = &self.params_file {
+            all.push(("--params", p));
+        }
+        Ok(tiltnoise_io::check_outputs(outputs, &all)?)
+    }
+
+    /// Writes every output of the run all or none: `write` saves them (each through
+    /// `tiltnoise_io::write_atomic`), and they appear only once all are written and standard
+    /// output has taken everything printed before (so a run whose standard output fails
+    /// leaves none). Then one `wrote PATH` line per output, on standard error when
+    /// `report_on_stderr` (standard output carries JSON).
+    pub(crate) fn write_outputs(
+        &mut self,
+        report_on_stderr: bool,
+        write: impl FnOnce() -> Result<()>,
+    ) -> Result<()> {
+        let stage = Staging::begin();
+        write()?;
+        self.out.flush()?;
+        for path in stage.commit()? {
+            match report_on_stderr {
+                true => note(&format!("wrote {}", path.display())),
+                false => writeln!(self.out, "wrote {}", path.display())?,
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Runs the parsed command line. Everything printed is flushed before it returns; when the
+/// command fails, what it printed before is still flushed (its failure is not reported).
 pub fn run(cli: Cli) -> Result<()> {
+    let mut run = Run {
+        out: Out::stdout(),
+        params_file: cli.params.params.clone(),
+    };
+    let result = run_command(cli, &mut run);
+    let flushed = run.out.flush();
+    result?;
+    Ok(flushed?)
+}
+
+fn run_command(cli: Cli, run: &mut Run) -> Result<()> {
     let params = cli.params.resolve()?;
     match cli.command {
         Command::Params => {
-            print!("{}", params.to_toml());
+            write!(run.out, "{}", params.to_toml())?;
             Ok(())
         }
         Command::Modes { format } => {
             let model = Model::new(&params)?;
             let modes = NormalModes::new(&model);
             match format {
-                Format::Table => print!("{}", report::modes_table(&modes)),
-                Format::Json => println!("{}", report::modes_json(&modes)),
+                Format::Table => write!(run.out, "{}", report::modes_table(&modes))?,
+                Format::Json => writeln!(run.out, "{}", report::modes_json(&modes))?,
             }
             Ok(())
         }
-        Command::Tf(args) => tf::run_tf(&params, args),
-        Command::Budget(args) => budget::run_budget(&params, args),
-        Command::Simulate(args) => simulate::run_simulate(&params, args),
-        Command::Fit(args) => fit::run_fit(&params, args),
-        Command::Methods(args) => methods::run_methods(&params, args),
+        Command::Tf(args) => tf::run_tf(&params, args, run),
+        Command::Budget(args) => budget::run_budget(&params, args, run),
+        Command::Simulate(args) => simulate::run_simulate(&params, args, run),
+        Command::Fit(args) => fit::run_fit(&params, args, run),
+        Command::Methods(args) => methods::run_methods(&params, args, run),
         Command::Mc {
             samples,
             seed,
@@ -138,6 +204,7 @@ pub fn run(cli: Cli) -> Result<()> {
                 json: format == Format::Json,
                 save,
             },
+            run,
         ),
     }
 }

@@ -4,11 +4,13 @@
 //! bar (only when stderr is a terminal and the run is long). Documented in `docs/simulate.md`.
 
 use super::output::save_image;
+use super::Run;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use std::fmt::Write as _;
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::{Coord, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
@@ -74,11 +76,11 @@ pub(crate) struct SimulateArgs {
     #[arg(long, value_name = "OBS=ASD", allow_hyphen_values = true)]
     readout: Vec<String>,
     /// Seed of the readout-noise generator.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
     seed: u64,
     /// Welch segment length in samples for the ASDs (default: the largest power of two that
     /// fits three times into the record, 2^17 for 12 h at 0.1 s; 50 % overlap, mean).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
     nperseg: Option<usize>,
     /// Output (repeatable): .h5/.hdf5 time series + ASDs + run (the budget's --measured reads
     /// it), .csv ASDs (freq_hz,X,...), .png/.svg Figure 3 (ASDs).
@@ -109,16 +111,17 @@ fn parse_coords(option: &str, items: &[String], out: &mut [f64; 8]) -> Result<()
     let mut given = [false; 8];
     for item in items {
         for entry in item.split(',').map(str::trim).filter(|e| !e.is_empty()) {
+            let shown = Shown(entry);
             let (name, value) = entry.split_once('=').ok_or_else(|| {
-                anyhow!("{option} {entry}: expected COORD=VALUE, e.g. phi_b=0.01")
+                anyhow!("{option} {shown}: expected COORD=VALUE, e.g. phi_b=0.01")
             })?;
             let c = Coord::ALL
                 .into_iter()
                 .find(|c| c.name() == name.trim())
                 .ok_or_else(|| {
                     anyhow!(
-                        "{option} {entry}: unknown coordinate `{}`; allowed: {}",
-                        name.trim(),
+                        "{option} {shown}: unknown coordinate `{}`; allowed: {}",
+                        Shown(name.trim()),
                         names.join(", ")
                     )
                 })?;
@@ -127,15 +130,17 @@ fn parse_coords(option: &str, items: &[String], out: &mut [f64; 8]) -> Result<()
             } else {
                 format!("{}/s", c.unit())
             };
-            let v: f64 = value
-                .trim()
-                .parse()
-                .map_err(|_| anyhow!("{option} {entry}: `{}` is not a number", value.trim()))?;
+            let v: f64 = value.trim().parse().map_err(|_| {
+                anyhow!(
+                    "{option} {shown}: `{}` is not a number",
+                    Shown(value.trim())
+                )
+            })?;
             if !v.is_finite() {
-                bail!("{option} {entry}: {v} {unit} is not allowed: must be finite");
+                bail!("{option} {shown}: {v} {unit} is not allowed: must be finite");
             }
             if given[c.index()] {
-                bail!("{option} {entry}: coordinate `{}` is given twice", c.name());
+                bail!("{option} {shown}: coordinate `{}` is given twice", c.name());
             }
             given[c.index()] = true;
             out[c.index()] = v;
@@ -212,7 +217,7 @@ fn initial_state(model: &Model, args: &SimulateArgs) -> Result<(InitialState, St
 }
 
 /// Runs `tiltnoise simulate`.
-pub(crate) fn run_simulate(params: &Params, args: SimulateArgs) -> Result<()> {
+pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -> Result<()> {
     let model = Model::new(params)?;
     if !model.is_undamped() {
         bail!(
@@ -269,6 +274,13 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs) -> Result<()> {
     for path in &args.save_time {
         tiltnoise_plot::ImageFormat::from_path(path)?;
     }
+    let saves: Vec<&Path> = args
+        .save
+        .iter()
+        .chain(&args.save_time)
+        .map(PathBuf::as_path)
+        .collect();
+    run.check_outputs(&saves, &[])?;
     let readout = parse_readout(&args.readout)?;
     let (init, init_source) = initial_state(&model, &args)?;
     let cfg = SimConfig {
@@ -309,7 +321,8 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs) -> Result<()> {
     let amplitude: [f64; 8] = std::array::from_fn(|k| u0[k].hypot(v0[k]));
     let check = check_resonances(&modes, &amplitude, &psds, fs, nperseg, &readout);
 
-    print!(
+    write!(
+        run.out,
         "{}",
         summary(
             &sim,
@@ -320,8 +333,8 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs) -> Result<()> {
             &wcfg,
             psds[0].1.n_segments
         )
-    );
-    print!("{}", check.table());
+    )?;
+    write!(run.out, "{}", check.table())?;
 
     let freqs_hz = psds[0].1.freqs_hz.clone();
     let asd: Vec<(Observable, Vec<f64>)> = psds.iter().map(|(o, p)| (*o, p.asd())).collect();
@@ -344,64 +357,64 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs) -> Result<()> {
             fs / 2.0
         ),
     ];
-    for path in &args.save {
-        match OutputKind::from_path(path)? {
-            OutputKind::Hdf5 => {
-                let series_asd = SeriesAsd {
-                    freqs_hz: freqs_hz.clone(),
-                    asd: asd.clone(),
-                    segment_len: nperseg,
-                    overlap: wcfg.overlap,
-                    averaging: "mean".to_string(),
-                    n_segments: psds[0].1.n_segments,
-                };
-                let smeta = SimulationMeta {
-                    run: meta.clone(),
-                    description: format!(
-                        "SIMULATED free motion of the double torsion pendulum model (not a \
+    run.write_outputs(false, || {
+        for path in &args.save {
+            match OutputKind::from_path(path)? {
+                OutputKind::Hdf5 => {
+                    let series_asd = SeriesAsd {
+                        freqs_hz: freqs_hz.clone(),
+                        asd: asd.clone(),
+                        segment_len: nperseg,
+                        overlap: wcfg.overlap,
+                        averaging: "mean".to_string(),
+                        n_segments: psds[0].1.n_segments,
+                    };
+                    let smeta = SimulationMeta {
+                        run: meta.clone(),
+                        description: format!(
+                            "SIMULATED free motion of the double torsion pendulum model (not a \
                          measurement). {}",
-                        caption[0]
-                    ),
-                    start_time: None,
-                    seed: args.seed,
-                    init,
-                    init_source: init_source.clone(),
-                    readout_asd: readout.clone(),
-                    duration_s: args.duration,
-                };
-                write_observable_series_hdf5(path, &sim, &series_asd, &smeta)?;
-            }
-            OutputKind::Csv => tiltnoise_io::write_asd_csv(path, &freqs_hz, &asd)
-                .with_context(|| format!("writing {}", path.display()))?,
-            OutputKind::Png | OutputKind::Svg => {
-                let data = SimAsdData {
-                    freqs_hz: freqs_hz.clone(),
-                    asd: asd.clone(),
-                    readout_asd: readout.clone(),
-                    modes: modes
-                        .modes
-                        .iter()
-                        .enumerate()
-                        .map(|(k, m)| ModeMark {
-                            index: m.index,
-                            frequency_hz: m.frequency_hz,
-                            apparent_frequency_hz: aliased_frequency_hz(m.frequency_hz, fs),
-                            seen_by: modes.observables_seeing(k),
-                        })
-                        .collect(),
-                    caption: caption.clone(),
-                };
-                save_image(path, |format| asd_figure(&data, format))?;
+                            caption[0]
+                        ),
+                        start_time: None,
+                        seed: args.seed,
+                        init,
+                        init_source: init_source.clone(),
+                        readout_asd: readout.clone(),
+                        duration_s: args.duration,
+                    };
+                    write_observable_series_hdf5(path, &sim, &series_asd, &smeta)?;
+                }
+                OutputKind::Csv => tiltnoise_io::write_asd_csv(path, &freqs_hz, &asd)
+                    .with_context(|| format!("writing {}", path.display()))?,
+                OutputKind::Png | OutputKind::Svg => {
+                    let data = SimAsdData {
+                        freqs_hz: freqs_hz.clone(),
+                        asd: asd.clone(),
+                        readout_asd: readout.clone(),
+                        modes: modes
+                            .modes
+                            .iter()
+                            .enumerate()
+                            .map(|(k, m)| ModeMark {
+                                index: m.index,
+                                frequency_hz: m.frequency_hz,
+                                apparent_frequency_hz: aliased_frequency_hz(m.frequency_hz, fs),
+                                seen_by: modes.observables_seeing(k),
+                            })
+                            .collect(),
+                        caption: caption.clone(),
+                    };
+                    save_image(path, |format| asd_figure(&data, format))?;
+                }
             }
         }
-        println!("wrote {}", path.display());
-    }
-    for path in &args.save_time {
-        let data = time_series_data(&sim, &modes, &init_source);
-        save_image(path, |format| time_series_figure(&data, format))?;
-        println!("wrote {}", path.display());
-    }
-    Ok(())
+        for path in &args.save_time {
+            let data = time_series_data(&sim, &modes, &init_source);
+            save_image(path, |format| time_series_figure(&data, format))?;
+        }
+        Ok(())
+    })
 }
 
 fn readout_text(readout: &[(Observable, f64)]) -> String {

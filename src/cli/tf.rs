@@ -10,14 +10,16 @@
 
 use super::args::MethodArg;
 use super::output::save_tf;
+use super::Run;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use tiltnoise_core::error::Shown;
 use tiltnoise_core::freq;
 use tiltnoise_core::model::{ForceInput, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
-use tiltnoise_core::tf::planner::{Scene, DEFAULT_REL_TOL};
+use tiltnoise_core::tf::planner::{choose, NoChoice, Scene, DEFAULT_REL_TOL};
 use tiltnoise_core::tf::{self, Input, Request};
 use tiltnoise_io::{read_freq_file, RunMeta};
 
@@ -26,7 +28,12 @@ use tiltnoise_io::{read_freq_file, RunMeta};
 pub struct TfArgs {
     /// Log-spaced grid FLO:N:FHI (Hz:count:Hz), e.g. 1e-4:2000:30. Default: 0.1 mHz to 30 Hz,
     /// 2000 points, plus points around every resonance.
-    #[arg(long, value_name = "FLO:N:FHI", conflicts_with = "freq_file")]
+    #[arg(
+        long,
+        value_name = "FLO:N:FHI",
+        conflicts_with = "freq_file",
+        allow_hyphen_values = true
+    )]
     freq: Option<String>,
     /// File with one frequency in Hz per line (# comments allowed).
     #[arg(long, value_name = "FILE")]
@@ -51,9 +58,15 @@ pub struct TfArgs {
     method: MethodArg,
     /// Relative tolerance for `--method auto`: the smallest model and cheapest method whose
     /// measured error against the double-double reference on the grid's band is at most this.
-    #[arg(long, value_name = "REL", default_value_t = DEFAULT_REL_TOL)]
+    #[arg(
+        long,
+        value_name = "REL",
+        default_value_t = DEFAULT_REL_TOL,
+        allow_negative_numbers = true
+    )]
     rel_tol: f64,
-    /// Say which method `auto` picked and why (every candidate's measured error).
+    /// Say which method `auto` picked and why, or why none qualifies (every candidate's
+    /// measured error, on standard error).
     #[arg(long)]
     explain: bool,
 }
@@ -71,7 +84,10 @@ fn split_names<'a>(option: &str, specs: &'a [String]) -> Result<Vec<&'a str>> {
     for spec in specs {
         for name in spec.split(',').map(str::trim) {
             if name.is_empty() {
-                bail!("{option} {spec:?}: empty name in the list (names are separated by single commas)");
+                bail!(
+                    "{option} \"{}\": empty name in the list (names are separated by single commas)",
+                    Shown(spec)
+                );
             }
             names.push(name);
         }
@@ -92,7 +108,8 @@ pub fn parse_inputs(specs: &[String]) -> Result<Vec<Input>> {
             _ => match Input::from_name(name) {
                 Some(i) => vec![i],
                 None => bail!(
-                    "--input: unknown input {name:?}; allowed: {}",
+                    "--input: unknown input \"{}\"; allowed: {}",
+                    Shown(name),
                     input_names()
                 ),
             },
@@ -117,7 +134,8 @@ pub fn parse_outputs(specs: &[String]) -> Result<Vec<Observable>> {
         let Some(o) = Observable::from_name(name) else {
             let allowed: Vec<&str> = Observable::ALL.iter().map(|o| o.name()).collect();
             bail!(
-                "--output: unknown observable {name:?}; allowed: {}",
+                "--output: unknown observable \"{}\"; allowed: {}",
+                Shown(name),
                 allowed.join(", ")
             );
         };
@@ -130,7 +148,7 @@ pub fn parse_outputs(specs: &[String]) -> Result<Vec<Observable>> {
 }
 
 /// Runs `tiltnoise tf`.
-pub fn run_tf(params: &Params, args: TfArgs) -> Result<()> {
+pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()> {
     let request = Request {
         outputs: parse_outputs(&args.outputs)?,
         inputs: parse_inputs(&args.inputs)?,
@@ -141,16 +159,23 @@ pub fn run_tf(params: &Params, args: TfArgs) -> Result<()> {
             args.rel_tol
         );
     }
+    // Check every output before computing, so a typo costs nothing.
+    for path in &args.save {
+        tiltnoise_io::OutputKind::from_path(path)?;
+    }
+    let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
+    let inputs: Vec<(&str, &Path)> = args
+        .freq_file
+        .iter()
+        .map(|p| ("--freq-file", p.as_path()))
+        .collect();
+    run.check_outputs(&saves, &inputs)?;
     let model = Model::new(params)?;
     let freqs = match (&args.freq, &args.freq_file) {
         (Some(spec), _) => freq::parse_spec(spec)?,
         (None, Some(path)) => read_freq_file(path)?,
         (None, None) => freq::default_grid(&model),
     };
-    // Check every output's format before computing, so a typo costs nothing.
-    for path in &args.save {
-        tiltnoise_io::OutputKind::from_path(path)?;
-    }
     let method = match args.method.fixed() {
         Some(m) => m,
         None => {
@@ -167,32 +192,43 @@ pub fn run_tf(params: &Params, args: TfArgs) -> Result<()> {
                 band_hz: band,
                 rel_tol: args.rel_tol,
             };
-            let choice =
-                tiltnoise_core::tf::planner::choose(&model, &scene).map_err(anyhow::Error::msg)?;
+            let choice = match choose(&model, &scene) {
+                Ok(choice) => choice,
+                Err(refusal) if args.explain => {
+                    super::note(&refusal.explain());
+                    return Err(refusal.into());
+                }
+                Err(refusal @ NoChoice::Tolerance { .. }) => {
+                    bail!("{refusal}; run with --explain for every candidate")
+                }
+                Err(refusal) => return Err(refusal.into()),
+            };
             if args.explain {
-                eprintln!("{}", choice.explain());
+                super::note(&choice.explain());
             }
             choice.method
         }
     };
     let plan = tf::plan(&model, &request, method)?;
     let tf = tf::evaluate(plan.as_ref(), &freqs).context("evaluating the transfer functions")?;
+    let out = &mut run.out;
     if args.save.is_empty() {
-        print!("{}", tiltnoise_io::tf_csv_string(&tf));
+        write!(out, "{}", tiltnoise_io::tf_csv_string(&tf))?;
         return Ok(());
     }
     let modes = NormalModes::new(&model);
     let meta = RunMeta::of_this_run(params, Some(&modes));
-    print!("{}", super::report::modes_table(&modes));
+    write!(out, "{}", super::report::modes_table(&modes))?;
     if request.inputs.iter().any(|i| matches!(i, Input::Tilt(_))) {
-        println!();
-        print!("{}", super::report::static_limits(&model));
+        writeln!(out)?;
+        write!(out, "{}", super::report::static_limits(&model))?;
     }
-    for path in &args.save {
-        save_tf(path, &tf, &meta)?;
-        println!("wrote {}", path.display());
-    }
-    Ok(())
+    run.write_outputs(false, || {
+        for path in &args.save {
+            save_tf(path, &tf, &meta)?;
+        }
+        Ok(())
+    })
 }
 
 #[cfg(test)]

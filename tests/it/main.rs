@@ -24,6 +24,7 @@ mod input_readers;
 mod io_roundtrip;
 mod mc_outputs;
 mod noise_models;
+mod process;
 mod romy_budget;
 mod simulate_cli;
 mod simulate_roundtrip;

@@ -2,8 +2,93 @@
 //! the key or file, the offending value, the unit and what is allowed. The binary adds context
 //! with `anyhow` and maps every error to exit code 2.
 
-use std::fmt;
+use std::fmt::{self, Write as _};
 use std::path::PathBuf;
+
+/// Characters of a value from the user or a file that a message shows ([`Shown`]).
+pub const SHOWN_MAX_CHARS: usize = 200;
+
+/// A value from the command line or from a file as a one-line message shows it: control
+/// characters and invisible line and direction marks escaped (`\n`, `\t`, `\x1b`, `\u{2028}`),
+/// so that the message stays on one line and cannot drive the terminal, and at most
+/// [`SHOWN_MAX_CHARS`] characters, the rest replaced by `... (N bytes)` with the length of the
+/// whole value.
+///
+/// ```
+/// use tiltnoise_core::error::Shown;
+/// assert_eq!(Shown("a\tb\n").to_string(), "a\\tb\\n");
+/// let long = "x".repeat(100_000);
+/// assert_eq!(Shown(&long).to_string(), format!("{}... (100000 bytes)", "x".repeat(200)));
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shown<'a>(pub &'a str);
+
+impl fmt::Display for Shown<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&shown_within(self.0, SHOWN_MAX_CHARS))
+    }
+}
+
+/// `text` with control characters and invisible line and direction marks escaped, at most
+/// `max_chars` characters of it (counted after escaping), followed by `... (N bytes)` when it
+/// was cut. [`Shown`] is this with [`SHOWN_MAX_CHARS`].
+pub fn shown_within(text: &str, max_chars: usize) -> String {
+    let mut out = String::with_capacity(text.len().min(max_chars) + 24);
+    let mut chars = 0;
+    let mut escaped = String::new();
+    for c in text.chars() {
+        escaped.clear();
+        escape_char(c, &mut escaped);
+        let n = escaped.chars().count();
+        if chars + n > max_chars {
+            let _ = write!(out, "... ({} bytes)", text.len());
+            return out;
+        }
+        chars += n;
+        out.push_str(&escaped);
+    }
+    out
+}
+
+/// Names from the command line or a file joined with `, ` as messages show them: each one
+/// [`Shown`], the list cut once it is longer than [`SHOWN_MAX_CHARS`] characters, with
+/// `... (N more)` for the names left out.
+pub fn shown_list<S: AsRef<str>>(names: &[S]) -> String {
+    let mut out = String::new();
+    for (i, name) in names.iter().enumerate() {
+        if i > 0 && out.chars().count() > SHOWN_MAX_CHARS {
+            let _ = write!(out, ", ... ({} more)", names.len() - i);
+            break;
+        }
+        if i > 0 {
+            out.push_str(", ");
+        }
+        let _ = write!(out, "{}", Shown(name.as_ref()));
+    }
+    out
+}
+
+fn escape_char(c: char, out: &mut String) {
+    match c {
+        '\n' => out.push_str("\\n"),
+        '\r' => out.push_str("\\r"),
+        '\t' => out.push_str("\\t"),
+        c if c.is_ascii_control() => {
+            let _ = write!(out, "\\x{:02x}", u32::from(c));
+        }
+        // C1 controls; line and paragraph separators, direction marks and overrides, which
+        // break a line or reorder it on a terminal; the byte-order mark.
+        '\u{80}'..='\u{9f}'
+        | '\u{200e}'
+        | '\u{200f}'
+        | '\u{2028}'..='\u{202e}'
+        | '\u{2066}'..='\u{2069}'
+        | '\u{feff}' => {
+            let _ = write!(out, "\\u{{{:x}}}", u32::from(c));
+        }
+        c => out.push(c),
+    }
+}
 
 /// A number as messages show it: the shortest decimal that reads back to the same `f64`, in
 /// exponent form when it would be long (`|x| >= 1e7` or `|x| < 1e-5`), so that a value such as
@@ -84,7 +169,7 @@ pub enum ParamError {
         detail: String,
     },
     /// `--set KEY=VALUE` with a malformed assignment or a key that does not exist.
-    #[error("--set {assignment}: {message}")]
+    #[error("--set {}: {message}", Shown(.assignment))]
     Override {
         /// The assignment as given.
         assignment: String,
@@ -164,6 +249,15 @@ pub enum OutputError {
         /// The supported extensions.
         allowed: &'static str,
     },
+    /// An output path that breaks a rule of the run, found before anything is computed: no
+    /// such directory, not writable, a directory, given twice, or an input of the run.
+    #[error("cannot save {path}: {rule}")]
+    Refused {
+        /// The path asked for.
+        path: PathBuf,
+        /// The rule it breaks.
+        rule: String,
+    },
     /// Any I/O failure (directory missing, permission denied, disk full).
     #[error("cannot write {path}: {message}")]
     Write {
@@ -172,4 +266,45 @@ pub enum OutputError {
         /// What went wrong.
         message: String,
     },
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shown_values_are_one_line_and_short() {
+        assert_eq!(Shown("length.h_m").to_string(), "length.h_m");
+        assert_eq!(
+            Shown("a\nb\r\t\u{1b}[31m\u{7f}\u{85}\u{2028}\u{202e}").to_string(),
+            "a\\nb\\r\\t\\x1b[31m\\x7f\\u{85}\\u{2028}\\u{202e}"
+        );
+        // Non-ASCII text that is not a control stays as it is.
+        assert_eq!(Shown("φ_a µrad").to_string(), "φ_a µrad");
+        let long = "é".repeat(300);
+        let shown = Shown(&long).to_string();
+        assert_eq!(shown, format!("{}... (600 bytes)", "é".repeat(200)));
+        // The limit counts the escaped text.
+        let controls = "\u{1b}".repeat(100);
+        let shown = Shown(&controls).to_string();
+        assert!(shown.chars().count() <= SHOWN_MAX_CHARS + 20, "{shown}");
+        assert!(shown.ends_with("... (100 bytes)"), "{shown}");
+        assert_eq!(shown_within("abcdef", 3), "abc... (6 bytes)");
+        assert_eq!(shown_within("abc", 3), "abc");
+    }
+
+    #[test]
+    fn shown_lists_are_cut_with_a_count() {
+        assert_eq!(shown_list(&["E", "N\n"]), "E, N\\n");
+        assert_eq!(shown_list::<&str>(&[]), "");
+        let names: Vec<String> = (0..100_000).map(|i| format!("c{i}")).collect();
+        let shown = shown_list(&names);
+        assert!(shown.len() < 2 * SHOWN_MAX_CHARS, "{shown}");
+        assert!(shown.starts_with("c0, c1, c2"), "{shown}");
+        assert!(shown.ends_with("more)"), "{shown}");
+        let huge = vec!["x".repeat(10_000); 3];
+        let shown = shown_list(&huge);
+        assert!(shown.len() < 3 * SHOWN_MAX_CHARS, "{shown}");
+        assert!(shown.ends_with("(2 more)"), "{shown}");
+    }
 }

@@ -4,7 +4,7 @@
 //!
 //! All frequencies are in Hz. Depends on `modes` (for resonance placement) and `error` only.
 
-use crate::error::FreqError;
+use crate::error::{FreqError, Shown};
 use crate::model::Model;
 use crate::modes::NormalModes;
 
@@ -52,7 +52,7 @@ pub fn log_grid(lo: f64, hi: f64, n: usize) -> Result<Vec<f64>, FreqError> {
 /// Parses `FLO:N:FHI` (Hz, count, Hz), e.g. `1e-4:2000:30`.
 pub fn parse_spec(spec: &str) -> Result<Vec<f64>, FreqError> {
     let err = |message: &str| FreqError::Spec {
-        origin: format!("--freq {spec}"),
+        origin: format!("--freq {}", Shown(spec)),
         message: message.into(),
     };
     let parts: Vec<&str> = spec.split(':').map(str::trim).collect();

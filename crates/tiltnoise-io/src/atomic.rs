@@ -19,7 +19,7 @@ use tempfile::TempPath;
 use tiltnoise_core::error::OutputError;
 
 /// The longest file name most file systems accept (bytes).
-const NAME_MAX: usize = 255;
+pub(crate) const NAME_MAX: usize = 255;
 
 /// Temporary files that exist right now, for the interrupt handler.
 static LIVE_TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
@@ -39,11 +39,16 @@ struct Staged {
 struct Registered(Option<TempPath>);
 
 impl Registered {
-    fn new(temp: TempPath) -> Registered {
-        if let Ok(mut live) = LIVE_TEMPORARIES.lock() {
-            live.push(temp.to_path_buf());
-        }
-        Registered(Some(temp))
+    /// Creates the temporary file with `create` and registers it, holding the registry's lock
+    /// throughout: an interrupt handled in between waits for the lock and then finds the file,
+    /// so there is no moment when the file exists unregistered.
+    fn create(create: impl FnOnce() -> io::Result<TempPath>) -> io::Result<Registered> {
+        let mut live = LIVE_TEMPORARIES
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let temp = create()?;
+        live.push(temp.to_path_buf());
+        Ok(Registered(Some(temp)))
     }
 
     fn path(&self) -> &Path {
@@ -123,14 +128,16 @@ pub fn write_atomic(
 
     // `make_in` (unlike `tempfile_in`) returns the operating system's error unchanged, and lets
     // the file be created with the ordinary umask-controlled mode instead of 0o600.
-    let temp = tempfile::Builder::new()
-        .prefix(&prefix)
-        .suffix(&suffix)
-        .rand_bytes(RANDOM_LEN)
-        .make_in(&dir, create_new)
-        .map_err(|e| fail(e.to_string()))?;
     // Close our handle; keep the path, which deletes the file when dropped.
-    let temp = Registered::new(temp.into_temp_path());
+    let temp = Registered::create(|| {
+        tempfile::Builder::new()
+            .prefix(&prefix)
+            .suffix(&suffix)
+            .rand_bytes(RANDOM_LEN)
+            .make_in(&dir, create_new)
+            .map(|t| t.into_temp_path())
+    })
+    .map_err(|e| fail(e.to_string()))?;
 
     write(temp.path()).map_err(fail)?;
     OpenOptions::new()
@@ -155,6 +162,19 @@ pub fn write_atomic(
         Some(temp) => temp.persist(path).map_err(|e| fail(e.to_string())),
         None => Ok(()),
     }
+}
+
+/// Creates and removes a temporary file in `dir`: whether the run can create its outputs there.
+pub(crate) fn probe_directory(dir: &Path) -> io::Result<()> {
+    // Registered while it exists, so that an interrupt removes it too.
+    drop(Registered::create(|| {
+        tempfile::Builder::new()
+            .prefix(".tiltnoise-probe.")
+            .rand_bytes(RANDOM_LEN)
+            .make_in(dir, create_new)
+            .map(|t| t.into_temp_path())
+    })?);
+    Ok(())
 }
 
 /// Random characters in a temporary file's name.
@@ -271,6 +291,7 @@ mod unix {
     use super::LIVE_TEMPORARIES;
 
     pub(super) fn install() {
+        use std::io::Write as _;
         // SAFETY: `set` is initialised by sigemptyset before use; pthread_sigmask and sigwait
         // only read it. Blocking SIGINT and SIGTERM here makes every thread started later
         // inherit the mask, so the signals are delivered only to `sigwait` below.
@@ -291,21 +312,22 @@ mod unix {
                     return;
                 }
                 // Waits for a writer that holds the lock for a moment; nothing else does.
-                let removed = match LIVE_TEMPORARIES.lock() {
-                    Ok(live) => {
-                        for p in live.iter() {
-                            let _ = std::fs::remove_file(p);
-                        }
-                        live.len()
-                    }
-                    Err(_) => 0,
-                };
+                let live = LIVE_TEMPORARIES
+                    .lock()
+                    .unwrap_or_else(std::sync::PoisonError::into_inner);
+                for p in live.iter() {
+                    let _ = std::fs::remove_file(p);
+                }
+                let removed = live.len();
                 let name = if sig == libc::SIGINT {
                     "SIGINT"
                 } else {
                     "SIGTERM"
                 };
-                eprintln!(
+                // Not eprintln!: a panic on a closed standard error would end this thread
+                // before the process, leaving both signals blocked for good.
+                let _ = writeln!(
+                    std::io::stderr(),
                     "tiltnoise: error: interrupted by {name}; {removed} temporary file(s) \
                      removed, no output written"
                 );

@@ -42,7 +42,8 @@ pub fn write_budget_hdf5(
 ) -> Result<(), OutputError> {
     write_atomic(path, |temp| {
         report.check()?;
-        write_file(temp, report, meta, input).map_err(|e| format!("HDF5: {e}"))
+        write_file(temp, report, meta, input)
+            .map_err(|e| format!("HDF5: {}", crate::first_line(&e.to_string())))
     })
 }
 

@@ -14,7 +14,7 @@ use tiltnoise_core::fit::{Bound, FitResult};
 /// [`OutputError::Write`] naming `path`; nothing is left there.
 pub fn write_fit_hdf5(path: &Path, r: &FitResult, origin: &str) -> Result<(), OutputError> {
     crate::write_atomic(path, |tmp| {
-        write_h5(tmp, r, origin).map_err(|e| e.to_string())
+        write_h5(tmp, r, origin).map_err(|e| crate::first_line(&e.to_string()))
     })
 }
 

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 use tiltnoise_core::csv_text::{line_text, CsvRecords};
-use tiltnoise_core::error::FreqError;
+use tiltnoise_core::error::{FreqError, Shown};
 
 /// Reads a frequency file. Every value must be finite and >= 0; at least one is required.
 ///
@@ -46,7 +46,7 @@ fn parse_freq_text(text: &str, origin: &str) -> Result<Vec<f64>, FreqError> {
                 origin: at(line),
                 message: format!(
                     "`{}` is not a number (one frequency in Hz per line)",
-                    line_text(text, line)
+                    Shown(line_text(text, line))
                 ),
             });
         };

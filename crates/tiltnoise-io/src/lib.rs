@@ -6,6 +6,7 @@
 //!   (frequency grids).
 //! * Writers: transfer functions, noise budgets, Monte Carlo, fit and simulation results as
 //!   HDF5 or CSV (schemas in `docs/schemas.md`).
+//! * [`check_outputs`]: the output paths of a run, checked before it computes anything.
 //! * [`write_atomic`]: every writer is atomic: a failed write leaves nothing at the target
 //!   path and never clobbers an existing file. Figures (`tiltnoise-plot`) are written through
 //!   it by the caller.
@@ -23,6 +24,7 @@ mod h5util;
 pub mod input;
 mod mc_hdf5;
 mod measured_modes;
+mod output_paths;
 mod series_hdf5;
 mod tf_csv;
 mod tf_hdf5;
@@ -37,6 +39,7 @@ pub use fit_hdf5::write_fit_hdf5;
 pub use freq_file::read_freq_file;
 pub use mc_hdf5::{write_mc_hdf5, REJECTED_DRAWS, SCHEMA_MC, SCHEMA_VERSION_MC};
 pub use measured_modes::read_measured_modes;
+pub use output_paths::check_outputs;
 pub use series_hdf5::{
     write_observable_series_hdf5, SeriesAsd, SimulationMeta, SCHEMA_OBSERVABLE_SERIES,
     SCHEMA_VERSION_OBSERVABLE_SERIES,
@@ -79,6 +82,17 @@ impl RunMeta {
                 .unwrap_or_default(),
         }
     }
+}
+
+/// The first line of a library's message: HDF5 errors can span several lines (the library's
+/// error stack), and every error tiltnoise prints is one line.
+pub(crate) fn first_line(message: &str) -> String {
+    message
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .trim_end()
+        .to_string()
 }
 
 /// Version of the HDF5 library linked into this build (`major.minor.release`): the one

@@ -36,7 +36,8 @@ pub fn write_mc_hdf5(
     meta: &RunMeta,
 ) -> Result<(), OutputError> {
     write_atomic(path, |temp| {
-        write_file(temp, result, cfg, nominal_hz, meta).map_err(|e| format!("HDF5: {e}"))
+        write_file(temp, result, cfg, nominal_hz, meta)
+            .map_err(|e| format!("HDF5: {}", crate::first_line(&e.to_string())))
     })
 }
 

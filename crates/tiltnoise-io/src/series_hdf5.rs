@@ -82,7 +82,8 @@ pub fn write_observable_series_hdf5(
                 asd.freqs_hz.len()
             ));
         }
-        write_file(temp, sim, asd, meta).map_err(|e| format!("HDF5: {e}"))
+        write_file(temp, sim, asd, meta)
+            .map_err(|e| format!("HDF5: {}", crate::first_line(&e.to_string())))
     })
 }
 

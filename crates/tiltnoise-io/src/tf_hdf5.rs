@@ -36,7 +36,8 @@ pub const TIME_DEPENDENCE: &str = "exp(+i w t)";
 /// [`OutputError::Write`] naming `path` on any I/O or HDF5 failure; nothing is left at `path`.
 pub fn write_tf_hdf5(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> Result<(), OutputError> {
     write_atomic(path, |temp| {
-        write_file(temp, tf, meta).map_err(|e| format!("HDF5: {e}"))
+        write_file(temp, tf, meta)
+            .map_err(|e| format!("HDF5: {}", crate::first_line(&e.to_string())))
     })
 }
 

@@ -13,6 +13,7 @@
 
 use super::FitError;
 use crate::csv_text::{line_text, CsvRecords};
+use crate::error::Shown;
 
 /// The measured column of Table II of the paper, in the format above.
 pub const TABLE_II_MEASURED_CSV: &str = include_str!("table2_measured.csv");
@@ -86,7 +87,7 @@ impl Measured {
                     hline,
                     format!(
                         "header `{}`; allowed: `mode,frequency_hz` or `mode,frequency_hz,sigma_hz`",
-                        line_text(text, hline)
+                        Shown(line_text(text, hline))
                     ),
                 ))
             }
@@ -98,7 +99,7 @@ impl Measured {
                     n,
                     format!(
                         "`{}` has {} fields, the header has {n_columns}",
-                        line_text(text, n),
+                        Shown(line_text(text, n)),
                         cells.len(),
                     ),
                 ));
@@ -112,7 +113,7 @@ impl Measured {
                         n,
                         format!(
                             "mode `{}` is not allowed: must be an integer 1..8",
-                            cells[0]
+                            Shown(cells[0])
                         ),
                     )
                 })?;
@@ -130,14 +131,14 @@ impl Measured {
                         format!(
                             "frequency_hz `{}` of mode {mode} is not allowed: must be finite, > 0 \
                              and <= {MAX_MEASURED_HZ:e} Hz",
-                            cells[1]
+                            Shown(cells[1])
                         ),
                     )
                 })?;
             let (sigma_hz, sigma_source) = match with_sigma && !cells[2].is_empty() {
                 true => (
                     parse_positive(cells[2]).ok_or_else(|| {
-                        fail(n, format!("sigma_hz `{}` of mode {mode} is not allowed: must be finite and > 0 (or empty: half the last digit)", cells[2]))
+                        fail(n, format!("sigma_hz `{}` of mode {mode} is not allowed: must be finite and > 0 (or empty: half the last digit)", Shown(cells[2])))
                     })?,
                     SigmaSource::File,
                 ),

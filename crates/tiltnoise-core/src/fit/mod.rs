@@ -33,7 +33,7 @@ pub mod measured;
 
 pub use measured::{Measured, MeasuredMode, SigmaSource};
 
-use crate::error::ParamError;
+use crate::error::{ParamError, Shown};
 use crate::params::Params;
 use nalgebra::{DMatrix, DVector};
 
@@ -221,7 +221,10 @@ pub enum FitError {
         measured: usize,
     },
     /// A free key that is not a parameter.
-    #[error("fit: unknown parameter key `{key}` in --free; allowed keys: {allowed}")]
+    #[error(
+        "fit: unknown parameter key `{}` in --free; allowed keys: {allowed}",
+        Shown(.key)
+    )]
     UnknownKey {
         /// The key given.
         key: String,
@@ -240,7 +243,10 @@ pub enum FitError {
         allowed: String,
     },
     /// The same key twice.
-    #[error("fit: parameter `{key}` is listed twice in --free; give each key once")]
+    #[error(
+        "fit: parameter `{}` is listed twice in --free; give each key once",
+        Shown(.key)
+    )]
     DuplicateKey {
         /// The key.
         key: String,

@@ -2,6 +2,7 @@
 //! sign; and the default mapping used when no map is given.
 
 use super::error::InputError;
+use crate::error::{shown_list, Shown};
 use crate::model::TiltAxis;
 use std::fmt;
 use std::path::Path;
@@ -107,7 +108,10 @@ impl AxisMap {
                 .ok_or_else(|| {
                     err(
                         entry,
-                        format!("unknown target `{target}`, allowed: theta_t, eta_t, phi_t"),
+                        format!(
+                            "unknown target `{}`, allowed: theta_t, eta_t, phi_t",
+                            Shown(target)
+                        ),
                     )
                 })?;
             let source = source.trim();
@@ -124,13 +128,17 @@ impl AxisMap {
             if name.starts_with(['+', '-']) {
                 return Err(err(
                     entry,
-                    format!("source `{name}` has more than one sign"),
+                    format!("source `{}` has more than one sign", Shown(name)),
                 ));
             }
             if let Some(c) = name.chars().find(|c| c.is_whitespace() || *c == '=') {
                 return Err(err(
                     entry,
-                    format!("source `{name}` contains `{c}`, not allowed in a channel name"),
+                    format!(
+                        "source `{}` contains `{}`, not allowed in a channel name",
+                        Shown(name),
+                        Shown(c.encode_utf8(&mut [0; 4]))
+                    ),
                 ));
             }
             if let Some(prev) = entries.iter().find(|e| e.target == target) {
@@ -140,7 +148,7 @@ impl AxisMap {
                         "target {} is assigned twice (already {}{})",
                         target.name(),
                         prev.sign.prefix(),
-                        prev.source
+                        Shown(&prev.source)
                     ),
                 ));
             }
@@ -148,7 +156,8 @@ impl AxisMap {
                 return Err(err(
                     entry,
                     format!(
-                        "source `{name}` is used twice (already for {})",
+                        "source `{}` is used twice (already for {})",
+                        Shown(name),
                         prev.target.name()
                     ),
                 ));
@@ -264,8 +273,14 @@ pub fn resolve(
     match origin {
         MapOrigin::Options(map) | MapOrigin::File(map, _) => {
             match origin {
-                MapOrigin::File(_, from) => notes.push(format!("axis map: {map} (from {from})")),
-                _ => notes.push(format!("axis map: {map} (given explicitly)")),
+                MapOrigin::File(_, from) => notes.push(format!(
+                    "axis map: {} (from {from})",
+                    Shown(&map.to_string())
+                )),
+                _ => notes.push(format!(
+                    "axis map: {} (given explicitly)",
+                    Shown(&map.to_string())
+                )),
             }
             for e in map.entries() {
                 let index = available
@@ -276,7 +291,7 @@ pub fn resolve(
                         target: e.target.name(),
                         kind,
                         source_name: e.source.clone(),
-                        available: available.join(", "),
+                        available: shown_list(available),
                     })?;
                 channels.push(Mapped {
                     axis: e.target,
@@ -312,7 +327,7 @@ pub fn resolve(
                             path: path.to_path_buf(),
                             kind,
                             axis: axis.name(),
-                            candidates: names.join(", "),
+                            candidates: shown_list(&names),
                             first: names[0].to_string(),
                         });
                     }
@@ -325,7 +340,7 @@ pub fn resolve(
                     found: if available.is_empty() {
                         "(none)".to_string()
                     } else {
-                        available.join(", ")
+                        shown_list(available)
                     },
                 });
             }
@@ -339,7 +354,7 @@ pub fn resolve(
         .map(|(_, n)| n.as_str())
         .collect();
     if !ignored.is_empty() {
-        notes.push(format!("ignored {kind}s: {}", ignored.join(", ")));
+        notes.push(format!("ignored {kind}s: {}", shown_list(&ignored)));
     }
     let map = AxisMap::from_entries(
         channels

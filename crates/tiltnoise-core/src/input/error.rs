@@ -5,6 +5,7 @@
 //! index, the unit where there is one, and what is allowed. Sample indices are 0-based (the
 //! sample index in the series); CSV line numbers are 1-based (as shown by an editor).
 
+use crate::error::Shown;
 use std::path::{Path, PathBuf};
 
 /// Formats an optional CSV line number as ` (line N)`.
@@ -29,8 +30,9 @@ pub enum InputError {
 
     /// The extension names no supported format.
     #[error(
-        "input file {path}: extension `{extension}` is not supported; allowed: .h5 or .hdf5 \
-         (HDF5), .csv (comma-separated text)"
+        "input file {path}: extension `{}` is not supported; allowed: .h5 or .hdf5 \
+         (HDF5), .csv (comma-separated text)",
+        Shown(.extension)
     )]
     Extension {
         /// The file.
@@ -40,7 +42,7 @@ pub enum InputError {
     },
 
     /// The HDF5 library failed (not an HDF5 file, corrupt file, unreadable object).
-    #[error("input file {path}: HDF5 error reading {object}: {message}")]
+    #[error("input file {path}: HDF5 error reading {}: {message}", Shown(.object))]
     Hdf5 {
         /// The file.
         path: PathBuf,
@@ -51,7 +53,7 @@ pub enum InputError {
     },
 
     /// A string stored in the file (an attribute's text) is not valid UTF-8.
-    #[error("input file {path}: {object} is not valid text: {detail}")]
+    #[error("input file {path}: {} is not valid text: {detail}", Shown(.object))]
     InvalidText {
         /// The file.
         path: PathBuf,
@@ -99,7 +101,11 @@ pub enum InputError {
     },
 
     /// An HDF5 attribute (or CSV metadata key) with a value or type that is not allowed.
-    #[error("input file {path}: attribute `{attribute}` of {object} = {value} is not allowed: must be {allowed}")]
+    #[error(
+        "input file {path}: attribute `{attribute}` of {} = {} is not allowed: must be {allowed}",
+        Shown(.object),
+        Shown(.value)
+    )]
     BadAttribute {
         /// The file.
         path: PathBuf,
@@ -125,7 +131,11 @@ pub enum InputError {
     },
 
     /// An HDF5 dataset of the wrong type or shape.
-    #[error("input file {path}: dataset `{dataset}` has {found}; allowed: {allowed}")]
+    #[error(
+        "input file {path}: dataset `{}` has {}; allowed: {allowed}",
+        Shown(.dataset),
+        Shown(.found)
+    )]
     BadDataset {
         /// The file.
         path: PathBuf,
@@ -139,8 +149,9 @@ pub enum InputError {
 
     /// A NaN or infinite sample while gaps are rejected.
     #[error(
-        "input file {path}: channel `{channel}` sample index {index}{} is {value:?} {unit}; \
+        "input file {path}: channel `{}` sample index {index}{} is {value:?} {unit}; \
          allowed: finite values (or select gap interpolation to bridge interior gaps linearly)",
+        Shown(.channel),
         at_line(.line)
     )]
     NonFinite {
@@ -161,9 +172,10 @@ pub enum InputError {
     /// A run of non-finite samples touching the start or the end of a channel, which linear
     /// interpolation cannot bridge.
     #[error(
-        "input file {path}: channel `{channel}` has a {edge} gap of non-finite samples at \
+        "input file {path}: channel `{}` has a {edge} gap of non-finite samples at \
          indices {first}..={last} (of {len} samples, unit {unit}); gap interpolation needs a \
-         finite sample on both sides: trim the series"
+         finite sample on both sides: trim the series",
+        Shown(.channel)
     )]
     EdgeGap {
         /// The file.
@@ -184,8 +196,10 @@ pub enum InputError {
 
     /// Two channels of different lengths.
     #[error(
-        "input file {path}: channel `{channel_a}` has {len_a} samples but `{channel_b}` has \
-         {len_b}; all channels must have the same length"
+        "input file {path}: channel `{}` has {len_a} samples but `{}` has {len_b}; all \
+         channels must have the same length",
+        Shown(.channel_a),
+        Shown(.channel_b)
     )]
     LengthMismatch {
         /// The file.
@@ -201,7 +215,7 @@ pub enum InputError {
     },
 
     /// Too few samples or frequencies.
-    #[error("input file {path}: {what} has {len} {unit}; at least {min} required")]
+    #[error("input file {path}: {} has {len} {unit}; at least {min} required", Shown(.what))]
     TooShort {
         /// The file.
         path: PathBuf,
@@ -217,9 +231,11 @@ pub enum InputError {
 
     /// A malformed axis-map specification.
     #[error(
-        "{origin}: axis map `{spec}`, entry `{entry}`: {message}; syntax: \
+        "{origin}: axis map `{}`, entry `{}`: {message}; syntax: \
          TARGET=[+|-]SOURCE[,TARGET=[+|-]SOURCE...] with TARGET one of theta_t, eta_t, phi_t, \
-         e.g. theta_t=-E,eta_t=-N"
+         e.g. theta_t=-E,eta_t=-N",
+        Shown(.spec),
+        Shown(.entry)
     )]
     AxisMapSyntax {
         /// Where the specification came from: `axis map`, or `<file>, attribute axis_map`.
@@ -234,8 +250,9 @@ pub enum InputError {
 
     /// The axis map names a channel that the file does not have.
     #[error(
-        "input file {path}: the axis map assigns {target} to {kind} `{source_name}`, which the \
-         file does not have; available {kind}s: {available}"
+        "input file {path}: the axis map assigns {target} to {kind} `{}`, which the file does \
+         not have; available {kind}s: {available}",
+        Shown(.source_name)
     )]
     AxisMapSource {
         /// The file.
@@ -269,7 +286,8 @@ pub enum InputError {
     /// Several channels qualify for the same axis under the default mapping.
     #[error(
         "input file {path}: {kind}s {candidates} all qualify for {axis} under the default \
-         mapping; allowed: exactly one, so give an explicit axis map (e.g. {axis}=-{first})"
+         mapping; allowed: exactly one, so give an explicit axis map (e.g. {axis}=-{})",
+        Shown(.first)
     )]
     AmbiguousAxis {
         /// The file.
@@ -285,7 +303,10 @@ pub enum InputError {
     },
 
     /// A unit string that is not understood.
-    #[error("input file {path}: {location} has units `{value}`; allowed: {allowed}")]
+    #[error(
+        "input file {path}: {location} has units `{}`; allowed: {allowed}",
+        Shown(.value)
+    )]
     Units {
         /// The file.
         path: PathBuf,
@@ -299,9 +320,10 @@ pub enum InputError {
 
     /// Channels with different quantities (angle and rate) in one file.
     #[error(
-        "input file {path}: channel `{channel_a}` is in {unit_a} but `{channel_b}` is in \
-         {unit_b}; allowed: all channels in rad (angle) or all in rad/s (rate), or an \
-         explicit quantity override"
+        "input file {path}: channel `{}` is in {unit_a} but `{}` is in {unit_b}; allowed: all \
+         channels in rad (angle) or all in rad/s (rate), or an explicit quantity override",
+        Shown(.channel_a),
+        Shown(.channel_b)
     )]
     MixedQuantity {
         /// The file.
@@ -330,8 +352,10 @@ pub enum InputError {
 
     /// A CSV field that is not a number.
     #[error(
-        "input file {path}, line {line}: column `{column}` = `{text}` is not a number \
-         ({unit}); allowed: a decimal floating-point number{}",
+        "input file {path}, line {line}: column `{}` = `{}` is not a number ({unit}); \
+         allowed: a decimal floating-point number{}",
+        Shown(.column),
+        Shown(.text),
         if *.empty_allowed { " (an empty field is a gap)" } else { "" }
     )]
     CsvNumber {
@@ -412,7 +436,11 @@ pub enum InputError {
     },
 
     /// A negative or non-finite amplitude spectral density.
-    #[error("input file {path}: {location}, column `{column}`: ASD {value:?} {unit} is not allowed: must be finite and >= 0")]
+    #[error(
+        "input file {path}: {location}, column `{}`: ASD {value:?} {unit} is not allowed: must \
+         be finite and >= 0",
+        Shown(.column)
+    )]
     Asd {
         /// The file.
         path: PathBuf,

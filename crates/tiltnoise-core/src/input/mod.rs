@@ -64,6 +64,7 @@ pub use series::{gap_note, process_channel, ChannelCtx, Gap, GapScanner, Integra
 pub use source::SeriesSource;
 pub use spectra::{assemble, TiltSpectra, CSD_RTOL};
 
+use crate::error::Shown;
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
@@ -138,7 +139,8 @@ impl FromStr for Quantity {
             "angle" => Ok(Quantity::Angle),
             "rate" => Ok(Quantity::Rate),
             _ => Err(format!(
-                "quantity `{s}` is not allowed: must be angle (rad) or rate (rad/s)"
+                "quantity `{}` is not allowed: must be angle (rad) or rate (rad/s)",
+                Shown(s)
             )),
         }
     }
@@ -173,7 +175,8 @@ impl FromStr for GapPolicy {
             "reject" => Ok(GapPolicy::Reject),
             "interpolate" => Ok(GapPolicy::Interpolate),
             _ => Err(format!(
-                "gap policy `{s}` is not allowed: must be reject or interpolate"
+                "gap policy `{}` is not allowed: must be reject or interpolate",
+                Shown(s)
             )),
         }
     }

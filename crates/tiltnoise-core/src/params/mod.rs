@@ -6,7 +6,7 @@
 //! assumptions the paper does not state (`length.h_m`, `environment.g_m_per_s2`) and loss angles of 0.
 //! This module depends on nothing else in the crate but the error types.
 
-use crate::error::ParamError;
+use crate::error::{shown_within, ParamError, Shown, SHOWN_MAX_CHARS};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -282,7 +282,7 @@ impl Params {
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Params, ParamError> {
         let params: Params = toml::from_str(text).map_err(|e| ParamError::Syntax {
             origin: origin.to_string(),
-            message: e.to_string().trim_end().replace('\n', " "),
+            message: toml_error_line(&e, text),
         })?;
         params.validate()?;
         Ok(params)
@@ -322,13 +322,17 @@ impl Params {
         let keys: Vec<&str> = self.fields().iter().map(|f| f.key).collect();
         if !keys.contains(&key) {
             return Err(err(format!(
-                "unknown key `{key}`; allowed keys: {}",
+                "unknown key `{}`; allowed keys: {}",
+                Shown(key),
                 keys.join(", ")
             )));
         }
-        let number: f64 = value
-            .parse()
-            .map_err(|_| err(format!("value `{value}` of `{key}` is not a number")))?;
+        let number: f64 = value.parse().map_err(|_| {
+            err(format!(
+                "value `{}` of `{key}` is not a number",
+                Shown(value)
+            ))
+        })?;
         let mut table = toml::Table::try_from(self).expect("parameters convert to a TOML table");
         let (section, name) = key.split_once('.').expect("keys are section.name");
         table
@@ -336,9 +340,9 @@ impl Params {
             .and_then(|s| s.as_table_mut())
             .expect("every key's section exists")
             .insert(name.to_string(), toml::Value::Float(number));
-        let params: Params = table
-            .try_into()
-            .map_err(|e: toml::de::Error| err(e.to_string().trim_end().replace('\n', " ")))?;
+        let params: Params = table.try_into().map_err(|e: toml::de::Error| {
+            err(shown_within(e.message().trim(), 2 * SHOWN_MAX_CHARS))
+        })?;
         params.validate()?;
         Ok(params)
     }
@@ -597,6 +601,18 @@ impl Params {
     }
 }
 
+/// A TOML error as one line: the line and column in `text` where the parser stopped, and its
+/// message (which may quote the file, so it is [`shown_within`] a bound).
+fn toml_error_line(e: &toml::de::Error, text: &str) -> String {
+    let message = shown_within(e.message().trim(), 2 * SHOWN_MAX_CHARS);
+    let Some(before) = e.span().and_then(|span| text.get(..span.start)) else {
+        return message;
+    };
+    let line = before.matches('\n').count() + 1;
+    let column = before.chars().rev().take_while(|&c| c != '\n').count() + 1;
+    format!("line {line}, column {column}: {message}")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -637,6 +653,39 @@ mod tests {
         assert!(e.contains("not a number"), "{e}");
         let e = p.with_override("length.h_m").unwrap_err().to_string();
         assert!(e.contains("KEY=VALUE"), "{e}");
+    }
+
+    #[test]
+    fn override_and_file_errors_are_one_short_line() {
+        let p = Params::table_i();
+        let long = format!("length.h_m={}", "x".repeat(100_000));
+        let e = p.with_override(&long).unwrap_err().to_string();
+        assert!(e.len() < 1000 && e.contains("(100011 bytes)"), "{e}");
+        let e = p
+            .with_override("length.h\n_m\u{1b}=1")
+            .unwrap_err()
+            .to_string();
+        assert!(!e.contains(['\n', '\u{1b}']), "{e}");
+        assert!(e.contains("`length.h\\n_m\\x1b`"), "{e}");
+        let text = TABLE_I_TOML.replace("m_b_kg = 0.11", "m_b_kg = \"0.11\"");
+        let e = Params::from_toml_str(&text, "t.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(!e.contains('\n'), "{e}");
+        let line = TABLE_I_TOML
+            .lines()
+            .position(|l| l.starts_with("m_b_kg"))
+            .unwrap()
+            + 1;
+        assert!(
+            e.contains(&format!("t.toml: line {line}, column 10: invalid type")),
+            "{e}"
+        );
+        let text = format!("{}\n{} = 1\n", TABLE_I_TOML, "q".repeat(100_000));
+        let e = Params::from_toml_str(&text, "t.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.len() < 1000 && !e.contains('\n'), "{e}");
     }
 
     #[test]

@@ -23,6 +23,7 @@
 //! fit use it, never the other way round.
 
 use super::Params;
+use crate::error::Shown;
 use serde::de::Error as _;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::sync::OnceLock;
@@ -106,7 +107,10 @@ pub struct Uncertainty {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum UncertaintyError {
     /// A key that is not a parameter.
-    #[error("[uncertainty]: unknown parameter key `{key}`; allowed keys: {allowed}")]
+    #[error(
+        "[uncertainty]: unknown parameter key `{}`; allowed keys: {allowed}",
+        Shown(.key)
+    )]
     UnknownKey {
         /// The key given.
         key: String,
@@ -114,7 +118,10 @@ pub enum UncertaintyError {
         allowed: String,
     },
     /// The same key listed twice.
-    #[error("[uncertainty]: parameter `{key}` has more than one uncertainty; give each key once")]
+    #[error(
+        "[uncertainty]: parameter `{}` has more than one uncertainty; give each key once",
+        Shown(.key)
+    )]
     DuplicateKey {
         /// The repeated key.
         key: String,
@@ -149,7 +156,8 @@ pub enum UncertaintyError {
     },
     /// A distribution name that is not known.
     #[error(
-        "[uncertainty]: distribution of `{key}` = \"{name}\" is not known; allowed: {allowed}",
+        "[uncertainty]: distribution of `{key}` = \"{}\" is not known; allowed: {allowed}",
+        Shown(.name),
         allowed = ALLOWED_DISTRIBUTIONS
     )]
     UnknownDistribution {
@@ -161,7 +169,8 @@ pub enum UncertaintyError {
     /// An entry that is not `{ rel_sigma = ..., distribution = ... }`.
     #[error(
         "[uncertainty]: entry `{key}`: {message}; expected e.g. \
-         `\"{key}\" = {{ rel_sigma = 0.03, distribution = \"gaussian\" }}`"
+         `\"{key}\" = {{ rel_sigma = 0.03, distribution = \"gaussian\" }}`",
+        key = Shown(.key)
     )]
     Malformed {
         /// The key of the entry.

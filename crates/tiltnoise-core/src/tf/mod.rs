@@ -51,7 +51,9 @@ pub(crate) use grid::check_grid_len;
 pub use grid::{eval_grid_threads, evaluate, evaluate_into};
 pub use matrix::{Layout, TransferMatrix};
 pub use modal::Modal;
-pub use planner::{choose, plan_auto, Choice, Scene, Verdict, DEFAULT_REL_TOL, POLE_EXCLUSION};
+pub use planner::{
+    choose, plan_auto, Choice, NoChoice, Scene, Verdict, DEFAULT_REL_TOL, POLE_EXCLUSION,
+};
 pub use polezero::{EntryFactors, PoleZero};
 pub use split::Split;
 pub use statespace::StateSpace;

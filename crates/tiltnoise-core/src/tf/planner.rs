@@ -9,7 +9,8 @@
 //! against the ~30-digit reference ([`crate::reference`]) on a verification grid of the band.
 //! Points within 1 % of a normal mode are left out of the verification (the issue's accuracy
 //! target excludes the poles), and a structurally zero entry must come out exactly zero. The
-//! [`Choice`] keeps every candidate's verdict, so `--explain` can say what was picked and why.
+//! [`Choice`] keeps every candidate's verdict, so `--explain` can say what was picked and why;
+//! so does [`NoChoice`] when nothing meets the tolerance, whose message names only the best.
 
 use crate::error::TfError;
 use crate::model::{Input, Request};
@@ -77,6 +78,73 @@ pub struct Choice {
     pub scene: Scene,
 }
 
+/// Why [`choose`] picked no method. Its message is one line; [`NoChoice::explain`] lists
+/// every candidate's verdict.
+#[derive(Debug, Clone, PartialEq)]
+pub enum NoChoice {
+    /// The band cannot be verified: empty, not positive, not finite, or within
+    /// [`POLE_EXCLUSION`] of a mode everywhere.
+    Band(String),
+    /// Every candidate was tried and none meets the tolerance.
+    Tolerance {
+        /// The scene.
+        scene: Scene,
+        /// Every candidate's outcome, in order.
+        verdicts: Vec<Verdict>,
+    },
+}
+
+impl std::fmt::Display for NoChoice {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (scene, verdicts) = match self {
+            NoChoice::Band(why) => return f.write_str(why),
+            NoChoice::Tolerance { scene, verdicts } => (scene, verdicts),
+        };
+        let (lo, hi) = scene.band_hz;
+        write!(
+            f,
+            "no method meets the relative tolerance {:e} on {lo} .. {hi} Hz",
+            scene.rel_tol
+        )?;
+        let best = verdicts
+            .iter()
+            .filter_map(|v| v.outcome.as_ref().ok().map(|e| (v, *e)))
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        match (best, verdicts.first()) {
+            (Some((v, e)), _) => write!(
+                f,
+                "; the most accurate, `{}` ({} DoF), reaches {e:.1e}",
+                v.method.name(),
+                v.dofs
+            ),
+            (None, Some(v)) => write!(
+                f,
+                "; no candidate is usable (`{}`: {})",
+                v.method.name(),
+                v.outcome.as_ref().err().map_or("", String::as_str)
+            ),
+            (None, None) => Ok(()),
+        }
+    }
+}
+
+impl std::error::Error for NoChoice {}
+
+impl NoChoice {
+    /// A human explanation over several lines: the scene and every candidate's verdict (for a
+    /// refused band, the message).
+    pub fn explain(&self) -> String {
+        match self {
+            NoChoice::Band(why) => why.clone(),
+            NoChoice::Tolerance { scene, verdicts } => format!(
+                "{}\n{}\nnone meets the tolerance",
+                explain_scene(scene),
+                explain_verdicts(verdicts)
+            ),
+        }
+    }
+}
+
 /// Candidates in order of model size, then cost per point (pole-zero ~30-90 ns, block and
 /// split ~1 us, modal ~0.3 us on the full model, direct ~3 us). The state-space method is not
 /// one: slower than direct (~6 us) and never more accurate, it is there for comparison.
@@ -127,18 +195,23 @@ pub fn measured_error(
 }
 
 /// Picks the smallest model and cheapest method meeting the scene's tolerance.
-pub fn choose(model: &Model, scene: &Scene) -> Result<Choice, String> {
+///
+/// # Errors
+///
+/// [`NoChoice::Band`] for a band that cannot be verified, [`NoChoice::Tolerance`] when no
+/// candidate meets the tolerance.
+pub fn choose(model: &Model, scene: &Scene) -> Result<Choice, NoChoice> {
     let (lo, hi) = scene.band_hz;
     if !(lo > 0.0 && hi >= lo && hi.is_finite()) {
-        return Err(format!(
+        return Err(NoChoice::Band(format!(
             "scene band {lo} .. {hi} Hz is not allowed: need 0 < lo <= hi, finite"
-        ));
+        )));
     }
     let grid = verification_grid(model, scene.band_hz);
     if grid.is_empty() {
-        return Err(format!(
+        return Err(NoChoice::Band(format!(
             "scene band {lo} .. {hi} Hz lies within {POLE_EXCLUSION} of a mode: nothing to verify"
-        ));
+        )));
     }
     let reference = ReferenceModel::new(model.params());
     let mut verdicts = Vec::new();
@@ -158,11 +231,10 @@ pub fn choose(model: &Model, scene: &Scene) -> Result<Choice, String> {
             });
         }
     }
-    Err(format!(
-        "no method meets the relative tolerance {:e} on {lo} .. {hi} Hz:\n{}",
-        scene.rel_tol,
-        explain_verdicts(&verdicts)
-    ))
+    Err(NoChoice::Tolerance {
+        scene: scene.clone(),
+        verdicts,
+    })
 }
 
 fn explain_verdicts(verdicts: &[Verdict]) -> String {
@@ -187,34 +259,28 @@ fn explain_verdicts(verdicts: &[Verdict]) -> String {
 impl Choice {
     /// A human explanation: the scene, every candidate's verdict, and the pick.
     pub fn explain(&self) -> String {
-        let s = &self.scene;
-        let names = |v: &[String]| v.join(", ");
         format!(
-            "scene: inputs {}; outputs {}; band {:e} .. {:e} Hz; tolerance {:e} (relative, vs the \
-             double-double reference on {} points, skipping 1 % around each mode)\n{}\npicked \
-             `{}`: the smallest model and cheapest method that meets the tolerance",
-            names(
-                &s.request
-                    .inputs
-                    .iter()
-                    .map(|i| i.name().to_string())
-                    .collect::<Vec<_>>()
-            ),
-            names(
-                &s.request
-                    .outputs
-                    .iter()
-                    .map(|o| o.name().to_string())
-                    .collect::<Vec<_>>()
-            ),
-            s.band_hz.0,
-            s.band_hz.1,
-            s.rel_tol,
-            VERIFY_POINTS,
+            "{}\n{}\npicked `{}`: the smallest model and cheapest method that meets the tolerance",
+            explain_scene(&self.scene),
             explain_verdicts(&self.verdicts),
             self.method.name()
         )
     }
+}
+
+fn explain_scene(s: &Scene) -> String {
+    let inputs: Vec<&str> = s.request.inputs.iter().map(|i| i.name()).collect();
+    let outputs: Vec<&str> = s.request.outputs.iter().map(|o| o.name()).collect();
+    format!(
+        "scene: inputs {}; outputs {}; band {:e} .. {:e} Hz; tolerance {:e} (relative, vs the \
+         double-double reference on {} points, skipping 1 % around each mode)",
+        inputs.join(", "),
+        outputs.join(", "),
+        s.band_hz.0,
+        s.band_hz.1,
+        s.rel_tol,
+        VERIFY_POINTS,
+    )
 }
 
 /// Convenience: a scene for `inputs` -> `outputs` over a band at the default tolerance.
@@ -232,13 +298,15 @@ pub fn scene(inputs: Vec<Input>, outputs: Vec<Observable>, band_hz: (f64, f64)) 
 ///
 /// # Errors
 ///
-/// [`TfError::NoMethod`] when no candidate meets the tolerance (its message lists every
-/// candidate's verdict) or the band is not allowed.
+/// [`TfError::NoMethod`] when no candidate meets the tolerance (its message names the most
+/// accurate) or the band is not allowed.
 pub fn plan_auto(
     model: &Model,
     scene: &Scene,
 ) -> Result<(Box<dyn TransferFunction>, Choice), TfError> {
-    let choice = choose(model, scene).map_err(|message| TfError::NoMethod { message })?;
+    let choice = choose(model, scene).map_err(|e| TfError::NoMethod {
+        message: e.to_string(),
+    })?;
     let tf = plan(model, &scene.request, choice.method).map_err(|e| TfError::NoMethod {
         message: e.to_string(),
     })?;

@@ -116,8 +116,29 @@ fn impossible_scenes_are_refused_with_reasons() {
     let model = table_i();
     let mut s = scene(Input::all_tilts(), Observable::ALL.to_vec(), (1e-5, 100.0));
     s.rel_tol = 1e-20;
-    let e = choose(&model, &s).unwrap_err();
-    assert!(e.contains("no method meets") && e.contains("split"), "{e}");
+    let refusal = choose(&model, &s).unwrap_err();
+    // One line naming the tolerance and the most accurate candidate; every verdict on its own
+    // line only in the explanation.
+    let e = refusal.to_string();
+    assert!(
+        e.contains("no method meets the relative tolerance 1e-20") && e.contains("reaches"),
+        "{e}"
+    );
+    assert!(!e.contains('\n'), "{e}");
+    let explained = refusal.explain();
+    assert!(
+        explained.ends_with("none meets the tolerance"),
+        "{explained}"
+    );
+    for name in ["torsion2", "polezero", "block", "split", "modal", "direct"] {
+        assert!(
+            explained.contains(&format!("  {name}")),
+            "{name}: {explained}"
+        );
+    }
     let bad = scene(Input::all_tilts(), vec![Observable::X], (0.0, 1.0));
-    assert!(choose(&model, &bad).unwrap_err().contains("band"));
+    assert!(choose(&model, &bad)
+        .unwrap_err()
+        .to_string()
+        .contains("band"));
 }

@@ -12,6 +12,7 @@ use std::fs::File;
 use std::io::{BufRead, BufReader, Chain, Cursor, Read};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::csv_text::{CsvRecords, RecordError};
+use tiltnoise_core::error::{shown_list, Shown};
 
 /// Metadata keys recognised in `# key: value` lines before the header.
 pub(crate) const META_KEYS: [&str; 4] = ["units", "axes", "start_time", "description"];
@@ -190,8 +191,8 @@ impl CsvFile {
             }
             if let Some(j) = header[..i].iter().position(|n| n == name) {
                 return Err(header_err(format!(
-                    "header column `{name}` appears twice (columns {} and {}); allowed: unique \
-                     names",
+                    "header column `{}` appears twice (columns {} and {}); allowed: unique names",
+                    Shown(name),
                     j + 1,
                     i + 1
                 )));
@@ -274,7 +275,7 @@ fn declared_units(
     let bad_unit = |column: Option<&str>, value: &str| InputError::Units {
         path: path.to_path_buf(),
         location: match column {
-            Some(c) => format!("line {} (# units:), column `{c}`", m.line),
+            Some(c) => format!("line {} (# units:), column `{}`", m.line, Shown(c)),
             None => format!("line {} (# units:)", m.line),
         },
         value: value.to_string(),
@@ -291,7 +292,7 @@ fn declared_units(
                     message: format!(
                         "`# units:` entry `{}` has no `=`; allowed: one unit for all columns \
                          (e.g. `# units: rad/s`) or COLUMN=UNIT entries separated by commas",
-                        item.trim()
+                        Shown(item.trim())
                     ),
                 });
             };
@@ -301,14 +302,15 @@ fn declared_units(
                     path: path.to_path_buf(),
                     line: m.line,
                     message: format!(
-                        "`# units:` names column `{name}`, which is {}; allowed: each data \
-                         column of the header ({}) at most once",
+                        "`# units:` names column `{}`, which is {}; allowed: each data column \
+                         of the header ({}) at most once",
+                        Shown(name),
                         if seen.contains(&name) {
                             "repeated"
                         } else {
                             "not a data column"
                         },
-                        prelude.header[1..].join(", ")
+                        shown_list(&prelude.header[1..])
                     ),
                 });
             }
@@ -396,7 +398,7 @@ pub(crate) fn interpret(
     let quantity = decide_quantity(path, opts.quantity, &declared, &undeclared, &mut notes)?;
     let start_time = start_time(path, prelude)?;
     if let Some(d) = prelude.meta("description") {
-        notes.push(format!("description: {}", d.value));
+        notes.push(format!("description: {}", Shown(&d.value)));
     }
     Ok(Interpreted {
         resolved,

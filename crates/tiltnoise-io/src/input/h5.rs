@@ -10,6 +10,7 @@ use super::{
 use hdf5::types::{FixedAscii, FixedUnicode, TypeDescriptor, VarLenAscii, VarLenUnicode};
 use hdf5::{Attribute, Location, LocationType};
 use std::path::Path;
+use tiltnoise_core::error::shown_list;
 
 /// Maps an HDF5 error to [`InputError::Hdf5`] naming `object`.
 pub(crate) fn h5err(
@@ -21,7 +22,7 @@ pub(crate) fn h5err(
     move |e| InputError::Hdf5 {
         path,
         object,
-        message: e.to_string(),
+        message: crate::first_line(&e.to_string()),
     }
 }
 
@@ -266,7 +267,7 @@ pub(crate) fn detect_kind(
                             if found.is_empty() {
                                 "(none)".to_string()
                             } else {
-                                found.join(", ")
+                                shown_list(&found)
                             }
                         ),
                         accepted: ACCEPTED_LAYOUTS,

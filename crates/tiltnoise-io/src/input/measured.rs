@@ -20,6 +20,7 @@ use super::h5::{self, h5err, AttrValue};
 use super::InputError;
 use super::InputFormat;
 use std::path::Path;
+use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::Observable;
 
 /// Schema name of an HDF5 time series of the observables (root attribute `schema`, optional);
@@ -182,8 +183,9 @@ fn read_series_csv(
             csv_err(
                 header_line,
                 format!(
-                    "measured series: unknown column `{name}`; allowed: X, Y, Z, theta, eta, \
-                     phi, phi_a (in m or rad)"
+                    "measured series: unknown column `{}`; allowed: X, Y, Z, theta, eta, \
+                     phi, phi_a (in m or rad)",
+                    Shown(name)
                 ),
             )
         })?;
@@ -198,7 +200,11 @@ fn read_series_csv(
             Ok(Some(v)) => Ok(v),
             _ => Err(csv_err(
                 line,
-                format!("column `{}` = `{}` is not a number", header[i], fields[i]),
+                format!(
+                    "column `{}` = `{}` is not a number",
+                    Shown(&header[i]),
+                    Shown(fields[i])
+                ),
             )),
         };
         let t = number(0)?;
@@ -290,8 +296,9 @@ fn read_spectra_csv(
             csv_err(
                 prelude.header_line,
                 format!(
-                    "measured spectrum: unknown column `{name}`; allowed: X, Y, Z, theta, \
-                         eta, phi, phi_a"
+                    "measured spectrum: unknown column `{}`; allowed: X, Y, Z, theta, \
+                         eta, phi, phi_a",
+                    Shown(name)
                 ),
             )
         })?;
@@ -306,7 +313,8 @@ fn read_spectra_csv(
                 line,
                 format!(
                     "column `{}` = `{}` is not a number",
-                    prelude.header[i], fields[i]
+                    Shown(&prelude.header[i]),
+                    Shown(fields[i])
                 ),
             )),
         };

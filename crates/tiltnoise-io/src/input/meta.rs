@@ -3,6 +3,7 @@
 use super::InputError;
 use super::Quantity;
 use std::path::Path;
+use tiltnoise_core::error::{shown_list, Shown};
 
 /// Accepted unit strings of time-series channels, for messages.
 pub(crate) const SERIES_UNITS: &str = "rad (angle) or rad/s (rate)";
@@ -95,8 +96,8 @@ pub(crate) fn decide_quantity(
                 notes.push(format!(
                     "the explicit quantity {} overrides the file's units `{}` of channel `{}`",
                     q.name(),
-                    d.unit,
-                    d.channel
+                    Shown(&d.unit),
+                    Shown(&d.channel)
                 ));
             }
             if q == Quantity::Rate {
@@ -114,7 +115,7 @@ pub(crate) fn decide_quantity(
                 notes.push(format!(
                     "channels without units, assumed {}: {}",
                     d.quantity.name(),
-                    undeclared.join(", ")
+                    shown_list(undeclared)
                 ));
             }
             if d.quantity == Quantity::Rate {

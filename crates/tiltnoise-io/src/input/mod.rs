@@ -31,6 +31,7 @@ pub use source::TiltSeriesSource;
 pub use tiltnoise_core::input::*;
 
 use std::path::Path;
+use tiltnoise_core::error::Shown;
 
 /// Reads a tilt input of either kind: the format from the extension (`.h5`/`.hdf5`, `.csv`),
 /// the kind from the content (HDF5: `schema` attribute if present, else root attribute
@@ -126,7 +127,7 @@ fn csv_kind(path: &Path, prelude: &csv::Prelude) -> Result<InputKind, InputError
             found: format!(
                 "the header (line {}) starts with column `{}`, not time_s or freq_hz",
                 prelude.header_line,
-                other.unwrap_or("")
+                Shown(other.unwrap_or(""))
             ),
             accepted: ACCEPTED_LAYOUTS,
         }),
