@@ -571,7 +571,18 @@ fn invalid_settings_are_refused_with_the_value() {
     let mut bad = init;
     bad.qdot[5] = f64::NAN;
     let e = simulate(&model, &bad, &base).unwrap_err();
-    assert!(e.to_string().contains("qdot[5]"), "{e}");
+    assert!(
+        matches!(e, SimError::InitialOutOfRange { .. })
+            && e.to_string().contains("initial rate of eta_b = NaN"),
+        "{e}"
+    );
+    let mut far = init;
+    far.q[2] = 1e300;
+    let e = simulate(&model, &far, &base).unwrap_err();
+    assert!(
+        e.to_string().contains("initial value of phi_a = 1e300 rad"),
+        "{e}"
+    );
     let mut p = Params::table_i();
     p.loss.torsion_b_rad = 1e-3;
     let damped = Model::new(&p).unwrap();
