@@ -20,6 +20,7 @@ mod damping;
 mod figures;
 mod fit;
 mod force_tf;
+mod fuzz;
 mod input_readers;
 mod io_roundtrip;
 mod mc_outputs;

@@ -231,3 +231,19 @@ fn measured_csv_series_and_too_short_records() {
         &["--measured", "x.csv", "2048 samples", "16384"],
     );
 }
+
+#[test]
+fn measured_csv_series_needs_finite_times() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("t.csv");
+    for first in ["nan", "-inf"] {
+        std::fs::write(&csv, format!("time_s,X\n{first},1e-9\n1,2e-9\n2,3e-9\n")).unwrap();
+        let e = tiltnoise_io::input::read_measured_input(&csv)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("time_s = `{first}`")) && e.contains("must be finite"),
+            "{e}"
+        );
+    }
+}

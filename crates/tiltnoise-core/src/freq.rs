@@ -22,13 +22,24 @@ const UNDAMPED_OFFSETS: [f64; 11] = [
 /// Points across a damped resonance, in units of its half-width at half power `phi_k / 2`.
 const DAMPED_WIDTHS: [f64; 9] = [0.0, 0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 5.0, 10.0];
 
-/// `n` log-spaced frequencies from `lo` to `hi` inclusive (`n = 1` gives `[lo]`).
+/// Most points of a log grid (80 MB of frequencies): far more than any figure or fit needs, and
+/// a bound that turns a mistyped `N` into an error instead of an allocation that aborts.
+pub const MAX_GRID_POINTS: usize = 10_000_000;
+
+/// `n` log-spaced frequencies from `lo` to `hi` inclusive (`n = 1` gives `[lo]`), `n` at most
+/// [`MAX_GRID_POINTS`].
 pub fn log_grid(lo: f64, hi: f64, n: usize) -> Result<Vec<f64>, FreqError> {
     let spec = || format!("log grid {lo}:{n}:{hi}");
     if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi >= lo && n >= 1) {
         return Err(FreqError::Spec {
             origin: spec(),
             message: "need 0 < FLO <= FHI, both finite, and N >= 1".into(),
+        });
+    }
+    if n > MAX_GRID_POINTS {
+        return Err(FreqError::Spec {
+            origin: spec(),
+            message: format!("N = {n} points is too many: at most {MAX_GRID_POINTS} allowed"),
         });
     }
     if n == 1 {
@@ -162,6 +173,10 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("FLO <= FHI"));
+        assert!(parse_spec("1e-4:4294967296:30")
+            .unwrap_err()
+            .to_string()
+            .contains("at most 10000000 allowed"));
     }
 
     /// A single loss angle leaves the modes that touch its element only weakly with modal loss

@@ -280,6 +280,16 @@ impl Params {
 
     /// Parses and validates a TOML parameter set. `origin` names the source in error messages.
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Params, ParamError> {
+        let depth = max_nesting(text);
+        if depth > MAX_NESTING {
+            return Err(ParamError::Syntax {
+                origin: origin.to_string(),
+                message: format!(
+                    "brackets `[ ]` and `{{ }}` nested {depth} levels deep; allowed: at most \
+                     {MAX_NESTING} (a parameter file needs 1)"
+                ),
+            });
+        }
         let params: Params = toml::from_str(text).map_err(|e| ParamError::Syntax {
             origin: origin.to_string(),
             message: toml_error_line(&e, text),
@@ -613,6 +623,54 @@ fn toml_error_line(e: &toml::de::Error, text: &str) -> String {
     format!("line {line}, column {column}: {message}")
 }
 
+/// Deepest nesting of brackets a parameter file may have. The TOML parser's own limit does
+/// not hold for every malformed input (an array opened and closed inside an unclosed inline
+/// table, `a={[b]` repeated, recurses once per repetition until the stack overflows), so the
+/// depth is checked before parsing.
+const MAX_NESTING: usize = 16;
+
+/// The deepest nesting of `[` and `{` in a TOML text, outside strings and comments (unclosed
+/// brackets count to the end; a table header `[a]` is one level).
+fn max_nesting(text: &str) -> usize {
+    let b = text.as_bytes();
+    let (mut depth, mut deepest, mut i) = (0usize, 0usize, 0usize);
+    while i < b.len() {
+        match b[i] {
+            b'#' => {
+                while i < b.len() && b[i] != b'\n' {
+                    i += 1;
+                }
+            }
+            q @ (b'"' | b'\'') => {
+                let multiline = b[i..].starts_with(&[q, q, q]);
+                i += if multiline { 3 } else { 1 };
+                while i < b.len() {
+                    if q == b'"' && b[i] == b'\\' {
+                        i += 2;
+                        continue;
+                    }
+                    if multiline && b[i..].starts_with(&[q, q, q]) {
+                        i += 2;
+                        break;
+                    }
+                    if !multiline && (b[i] == q || b[i] == b'\n') {
+                        break;
+                    }
+                    i += 1;
+                }
+            }
+            b'[' | b'{' => {
+                depth += 1;
+                deepest = deepest.max(depth);
+            }
+            b']' | b'}' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+        i += 1;
+    }
+    deepest
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -622,6 +680,18 @@ mod tests {
         let p = Params::table_i();
         let back = Params::from_toml_str(&p.to_toml(), "round trip").unwrap();
         assert_eq!(p, back);
+    }
+
+    #[test]
+    fn nesting_is_bounded_before_parsing() {
+        assert_eq!(
+            max_nesting("a = \"{[\\\"{\" # [[\n[b]\nc = { d = ['['] }\ne = \"\"\"\n[[\"\"\"\n"),
+            2
+        );
+        // Without the check, the parser recurses once per repetition: a stack overflow.
+        let e = Params::from_toml_str(&"a={[b]\n".repeat(20_000), "deep.toml").unwrap_err();
+        let e = e.to_string();
+        assert!(e.contains("deep.toml") && e.contains("at most 16"), "{e}");
     }
 
     #[test]

@@ -208,8 +208,17 @@ fn read_series_csv(
             )),
         };
         let t = number(0)?;
+        if !t.is_finite() {
+            return Err(csv_err(
+                line,
+                format!(
+                    "time_s = `{}` is not allowed: must be finite (s)",
+                    fields[0]
+                ),
+            ));
+        }
         if let Some(&previous) = times.last() {
-            if t.is_nan() || t <= previous {
+            if t <= previous {
                 return Err(InputError::TimeNotIncreasing {
                     path: path.to_path_buf(),
                     line,

@@ -146,7 +146,8 @@ pub(crate) fn is_iso8601(s: &str) -> bool {
             .flatten()
     }
     let b = s.as_bytes();
-    if b.len() < 10 || b[4] != b'-' || b[7] != b'-' {
+    // ASCII only: the fields below are sliced at fixed byte offsets.
+    if !s.is_ascii() || b.len() < 10 || b[4] != b'-' || b[7] != b'-' {
         return false;
     }
     let (Some(y), Some(mo), Some(d)) = (num(&s[0..4], 4), num(&s[5..7], 2), num(&s[8..10], 2))
@@ -256,6 +257,9 @@ mod tests {
             "2018-01-23T09",
             "2018-01-23T09:31+1",
             "2018-01-23X09:31",
+            "2018-01-2\u{feff}3T09:31",
+            "2018-01-23T09:31+0\u{e9}0",
+            "2018-01-23T09:31-1\u{20ac}",
         ] {
             assert!(!is_iso8601(bad), "{bad}");
         }

@@ -1,0 +1,404 @@
+//! The fuzz targets: one function per reader, taking the path of an input file. Each runs its
+//! readers under every option set that selects different code, formats every error (a
+//! `Display` impl can panic too) and checks what a successful read promises. A reader's error
+//! is a correct answer; a panic is the finding.
+//!
+//! Always checked: frequency grids and files finite, parameters that read back unchanged.
+//! Checked with `TILTNOISE_FUZZ_STRICT` set (promises that finite but extreme inputs still
+//! break, see `docs/robustness.md`): tilt and measured values finite after conversion,
+//! sample rates finite and > 0, sigmas of measured modes > 0, streamed chunks bit-identical
+//! to the in-memory read.
+//!
+//! Self-contained (std, `tiltnoise-core`, `tiltnoise-io`), so that libFuzzer targets for
+//! nightly can compile this file as it is (`docs/robustness.md`).
+
+use std::path::Path;
+use tiltnoise_core::freq::parse_spec;
+use tiltnoise_core::params::Params;
+use tiltnoise_io::input::{
+    read_measured, read_measured_input, read_tilt, read_tilt_series, read_tilt_spectra, AxisMap,
+    GapPolicy, MeasuredInput, Quantity, ReadOptions, TiltInput, TiltSeries, TiltSeriesSource,
+    TiltSpectra,
+};
+use tiltnoise_io::{read_freq_file, read_measured_modes};
+
+/// A reader under fuzzing: its name (also the corpus directory under `tests/fuzz_corpus/`),
+/// the extension its input files need, and the function that reads one.
+#[derive(Clone, Copy)]
+pub struct Target {
+    /// Name of the target and of its corpus directory.
+    pub name: &'static str,
+    /// Extension of the input file (the tilt readers dispatch on it).
+    pub ext: &'static str,
+    /// Runs the readers on the file; panics on a finding.
+    pub read: fn(&Path),
+}
+
+/// CSV tilt series and spectra: [`read_tilt`] and the kind-specific readers.
+pub const TILT_CSV: Target = Target {
+    name: "tilt_csv",
+    ext: "csv",
+    read: read_tilt_any,
+};
+/// HDF5 tilt series and spectra, from mutated bytes of valid files.
+pub const TILT_H5_BYTES: Target = Target {
+    name: "tilt_h5_bytes",
+    ext: "h5",
+    read: read_hdf5_any,
+};
+/// HDF5 inputs written with unexpected types, shapes, encodings and links.
+pub const H5_STRUCTURED: Target = Target {
+    name: "h5_structured",
+    ext: "h5",
+    read: read_hdf5_any,
+};
+/// HDF5 time series of the observables (`read_measured_input`), from mutated bytes.
+pub const MEASURED_H5_BYTES: Target = Target {
+    name: "measured_h5_bytes",
+    ext: "h5",
+    read: read_hdf5_any,
+};
+/// Measured spectra and series of the observables, CSV.
+pub const MEASURED_CSV: Target = Target {
+    name: "measured_csv",
+    ext: "csv",
+    read: read_measured_csv,
+};
+/// Measured mode frequencies for the fit.
+pub const MEASURED_MODES: Target = Target {
+    name: "measured_modes",
+    ext: "csv",
+    read: read_modes,
+};
+/// Frequency files of `tf --freq-file`.
+pub const FREQ_FILE: Target = Target {
+    name: "freq_file",
+    ext: "txt",
+    read: read_freqs,
+};
+/// `FLO:N:FHI` specifications of `tf --freq`, one per line.
+pub const FREQ_SPEC: Target = Target {
+    name: "freq_spec",
+    ext: "txt",
+    read: parse_specs,
+};
+/// Parameter files (TOML).
+pub const PARAMS_TOML: Target = Target {
+    name: "params_toml",
+    ext: "toml",
+    read: read_params,
+};
+/// `--set KEY=VALUE` overrides of Table I, one per line, applied in turn.
+pub const PARAMS_OVERRIDE: Target = Target {
+    name: "params_override",
+    ext: "txt",
+    read: apply_overrides,
+};
+
+/// Every target.
+pub const ALL: [Target; 10] = [
+    TILT_CSV,
+    TILT_H5_BYTES,
+    H5_STRUCTURED,
+    MEASURED_H5_BYTES,
+    MEASURED_CSV,
+    MEASURED_MODES,
+    FREQ_FILE,
+    FREQ_SPEC,
+    PARAMS_TOML,
+    PARAMS_OVERRIDE,
+];
+
+/// Whether the promise checks with open findings run (`TILTNOISE_FUZZ_STRICT` set).
+fn strict() -> bool {
+    static STRICT: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *STRICT.get_or_init(|| std::env::var_os("TILTNOISE_FUZZ_STRICT").is_some())
+}
+
+/// Reader options that take different paths: the defaults; rate integration with gap
+/// bridging; an explicit axis map with signs.
+fn option_sets() -> [ReadOptions; 3] {
+    [
+        ReadOptions::default(),
+        ReadOptions {
+            quantity: Some(Quantity::Rate),
+            gaps: GapPolicy::Interpolate,
+            ..ReadOptions::default()
+        },
+        ReadOptions {
+            axis_map: Some(
+                AxisMap::parse("theta_t=-E,eta_t=+N,phi_t=-LJZ").expect("a valid axis map"),
+            ),
+            quantity: Some(Quantity::Angle),
+            ..ReadOptions::default()
+        },
+    ]
+}
+
+/// The text of an error, formatted as the command line would print it.
+fn shown<T, E: std::fmt::Display>(r: Result<T, E>) -> Option<T> {
+    match r {
+        Ok(v) => Some(v),
+        Err(e) => {
+            std::hint::black_box(e.to_string());
+            None
+        }
+    }
+}
+
+fn assert_finite(what: &str, values: impl IntoIterator<Item = f64>) {
+    if let Some((i, v)) = values.into_iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        panic!("a successful read returned {what}[{i}] = {v}");
+    }
+}
+
+fn assert_increasing(what: &str, freqs: &[f64]) {
+    assert!(
+        freqs.len() >= 2,
+        "{what}: {} values, at least 2 promised",
+        freqs.len()
+    );
+    assert!(freqs[0] > 0.0, "{what}[0] = {} is not > 0", freqs[0]);
+    if let Some(k) = (1..freqs.len()).find(|&k| freqs[k] <= freqs[k - 1]) {
+        panic!(
+            "{what} not strictly increasing at {k}: {:?}",
+            &freqs[k - 1..=k]
+        );
+    }
+}
+
+fn check_series(s: &TiltSeries) {
+    if !strict() {
+        return;
+    }
+    assert!(
+        s.sample_rate_hz.is_finite() && s.sample_rate_hz > 0.0,
+        "sample rate {}",
+        s.sample_rate_hz
+    );
+    assert_eq!(s.data.len(), s.axes.len(), "one channel per axis");
+    for (axis, ch) in s.axes.iter().zip(&s.data) {
+        assert!(
+            ch.len() >= 2 && ch.len() == s.data[0].len(),
+            "channel lengths"
+        );
+        assert_finite(&format!("series {axis:?}"), ch.iter().copied());
+    }
+}
+
+fn check_spectra(s: &TiltSpectra) {
+    if !strict() {
+        return;
+    }
+    assert_increasing("frequency", &s.freqs_hz);
+    let n = s.axes.len();
+    assert_eq!(s.csd.len(), s.freqs_hz.len() * n * n, "CSD size");
+    assert_finite("CSD", s.csd.iter().flat_map(|c| [c.re, c.im]));
+}
+
+fn check_tilt(input: &TiltInput) {
+    match input {
+        TiltInput::Series(s) => check_series(s),
+        TiltInput::Spectra(s) => check_spectra(s),
+    }
+}
+
+fn check_measured(m: &MeasuredInput) {
+    if !strict() {
+        return;
+    }
+    match m {
+        MeasuredInput::Spectra(s) => {
+            assert_increasing("measured frequency", &s.freqs_hz);
+            for (o, asd) in &s.asd {
+                assert_eq!(asd.len(), s.freqs_hz.len(), "{o:?}: one ASD per frequency");
+                assert_finite(&format!("measured ASD {o:?}"), asd.iter().copied());
+            }
+        }
+        MeasuredInput::Series(s) => {
+            assert!(s.sample_rate_hz.is_finite() && s.sample_rate_hz > 0.0);
+            for (o, x) in &s.channels {
+                assert!(
+                    x.len() >= 2 && x.len() == s.channels[0].1.len(),
+                    "{o:?}: lengths"
+                );
+                assert_finite(&format!("measured series {o:?}"), x.iter().copied());
+            }
+        }
+    }
+}
+
+/// The tilt readers on a file of any format; the kind-specific readers with the defaults.
+fn read_tilt_any(path: &Path) {
+    for opts in option_sets() {
+        if let Some(input) = shown(read_tilt(path, &opts)) {
+            check_tilt(&input);
+        }
+    }
+    let opts = ReadOptions::default();
+    if let Some(s) = shown(read_tilt_series(path, &opts)) {
+        check_series(&s);
+    }
+    if let Some(s) = shown(read_tilt_spectra(path, &opts)) {
+        check_spectra(&s);
+    }
+}
+
+/// Every HDF5 reader: the tilt readers, streaming against in-memory, the measured series.
+fn read_hdf5_any(path: &Path) {
+    let bytes = std::fs::read(path).expect("the input file was just written");
+    if global_heap_hangs_hdf5(&bytes) {
+        return;
+    }
+    read_tilt_any(path);
+    if strict() {
+        for opts in option_sets() {
+            streamed_equals_in_memory(path, &opts);
+        }
+    }
+    if let Some(m) = shown(read_measured_input(path)) {
+        check_measured(&m);
+    }
+}
+
+/// When the in-memory read succeeds, the streaming source opens and every chunk, read forward
+/// in small pieces and once more backward from the middle, is bit-identical to it.
+fn streamed_equals_in_memory(path: &Path, opts: &ReadOptions) {
+    let Some(whole) = shown(read_tilt_series(path, opts)) else {
+        return;
+    };
+    let mut src = TiltSeriesSource::open(path, opts)
+        .unwrap_or_else(|e| panic!("read_tilt_series succeeded, TiltSeriesSource::open: {e}"));
+    let n = src.len();
+    assert_eq!(n, whole.len(), "streamed length");
+    let step = 5;
+    let forward = (0..n).step_by(step).map(|s| (s, step.min(n - s)));
+    let backward = [(n / 2, n - n / 2), (0, n / 2)];
+    for (start, len) in forward.chain(backward) {
+        let chunk = src
+            .read_chunk(start, len)
+            .unwrap_or_else(|e| panic!("read_all succeeded, read_chunk({start}, {len}): {e}"));
+        for (a, (c, w)) in chunk.iter().zip(&whole.data).enumerate() {
+            let same = c.len() == len
+                && c.iter()
+                    .zip(&w[start..start + len])
+                    .all(|(x, y)| x.to_bits() == y.to_bits());
+            assert!(
+                same,
+                "axis {a}, chunk ({start}, {len}) differs from read_all"
+            );
+        }
+    }
+}
+
+fn read_measured_csv(path: &Path) {
+    if let Some(m) = shown(read_measured_input(path)) {
+        check_measured(&m);
+    }
+    if let Some(s) = shown(read_measured(path)) {
+        check_measured(&MeasuredInput::Spectra(s));
+    }
+}
+
+fn read_modes(path: &Path) {
+    if let Some(m) = shown(read_measured_modes(path)) {
+        assert!(!m.modes.is_empty(), "no modes");
+        for mode in &m.modes {
+            assert!((1..=8).contains(&mode.mode), "mode {}", mode.mode);
+            assert!(mode.frequency_hz.is_finite() && mode.frequency_hz > 0.0);
+            assert!(
+                !strict() || (mode.sigma_hz.is_finite() && mode.sigma_hz > 0.0),
+                "mode {}: sigma {} Hz",
+                mode.mode,
+                mode.sigma_hz
+            );
+        }
+    }
+}
+
+fn read_freqs(path: &Path) {
+    if let Some(f) = shown(read_freq_file(path)) {
+        assert!(!f.is_empty());
+        assert!(f.iter().all(|v| v.is_finite() && *v >= 0.0), "{f:?}");
+    }
+}
+
+/// The lines of a text input (bytes that are not UTF-8 replaced: command-line arguments are
+/// text by the time they reach the library).
+fn lines(path: &Path) -> Vec<String> {
+    let bytes = std::fs::read(path).expect("the input file was just written");
+    String::from_utf8_lossy(&bytes)
+        .lines()
+        .map(str::to_string)
+        .collect()
+}
+
+fn parse_specs(path: &Path) {
+    for spec in lines(path) {
+        if let Some(grid) = shown(parse_spec(&spec)) {
+            assert!(!grid.is_empty(), "{spec}: empty grid");
+            assert_finite(&format!("grid of {spec}"), grid.iter().copied());
+            assert!(grid[0] > 0.0, "{spec}: grid starts at {}", grid[0]);
+        }
+    }
+}
+
+/// A parameter set written by `to_toml` reads back unchanged.
+fn check_round_trip(p: &Params) {
+    let text = p.to_toml();
+    let back = Params::from_toml_str(&text, "to_toml output")
+        .unwrap_or_else(|e| panic!("to_toml output does not read back: {e}\n{text}"));
+    assert!(back == *p, "to_toml output reads back different:\n{text}");
+}
+
+fn read_params(path: &Path) {
+    if let Some(p) = shown(Params::from_file(path)) {
+        check_round_trip(&p);
+    }
+}
+
+fn apply_overrides(path: &Path) {
+    let mut p = Params::table_i();
+    for assignment in lines(path) {
+        if let Some(q) = shown(p.with_override(&assignment)) {
+            p = q;
+        }
+    }
+    check_round_trip(&p);
+}
+
+/// Whether `bytes` hold a global heap collection (signature `GCOL`: where variable-length
+/// strings live) that HDF5 2.0.0 decodes forever. Its decoder (`H5HG__cache_heap_deserialize`)
+/// advances by the size of each object, and the free-space object (index 0) has no header of
+/// its own: one of size 0 never advances. That is a bug of the C library (reported upstream,
+/// see `docs/robustness.md`) which no reader can stop, so such inputs are skipped; every
+/// collection of the file is walked as HDF5 walks it (8-byte lengths).
+pub fn global_heap_hangs_hdf5(bytes: &[u8]) -> bool {
+    const OBJECT_HEADER: usize = 16;
+    let word = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().expect("8 bytes"));
+    let mut from = 0;
+    while let Some(at) = bytes[from..].windows(4).position(|w| w == b"GCOL") {
+        let base = from + at;
+        from = base + 1;
+        if base + 16 > bytes.len() {
+            break;
+        }
+        let size = usize::try_from(word(base + 8)).unwrap_or(usize::MAX);
+        let end = base.saturating_add(size).min(bytes.len());
+        let mut p = base + 16;
+        while p + OBJECT_HEADER <= end {
+            let index = u16::from_le_bytes([bytes[p], bytes[p + 1]]);
+            let len = word(p + 8);
+            let need = match index {
+                0 if len == 0 => return true,
+                0 => len,
+                _ => len.div_ceil(8).saturating_mul(8).saturating_add(16),
+            };
+            match usize::try_from(need).ok().and_then(|n| p.checked_add(n)) {
+                Some(next) => p = next,
+                None => break,
+            }
+        }
+    }
+    false
+}
