@@ -2,6 +2,7 @@
 //! the key or file, the offending value, the unit and what is allowed. The binary adds context
 //! with `anyhow` and maps every error to exit code 2.
 
+use crate::limits::LimitError;
 use std::fmt;
 use std::path::PathBuf;
 
@@ -112,6 +113,10 @@ pub enum FreqError {
         /// What is wrong and what is allowed.
         message: String,
     },
+    /// A grid or frequency file over its size limit ([`crate::limits::MAX_GRID_POINTS`],
+    /// [`crate::limits::MAX_FREQ_FILE_BYTES`]).
+    #[error(transparent)]
+    TooLarge(#[from] LimitError),
 }
 
 /// An evaluation of a transfer function that has no meaningful result.

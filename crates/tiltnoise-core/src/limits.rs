@@ -91,7 +91,7 @@ pub const MAX_LINE_BYTES: u64 = 64 << 10;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum LimitError {
     /// A count (points, draws, samples) over its fixed limit.
-    #[error("{what}: {} {unit} is over the limit: at most {limit} are allowed (see {DOCS})", Num(*.value))]
+    #[error("{what}: {} {unit}, more than the {limit} allowed (see {DOCS})", Num(*.value))]
     TooMany {
         /// The option with its value, or the file, e.g. `--samples 1000000000000`.
         what: String,
@@ -391,8 +391,7 @@ mod tests {
             .to_string();
         assert_eq!(
             e,
-            "--freq 1:11:2: 11 frequency points is over the limit: at most 10 are allowed (see \
-             docs/limits.md)"
+            "--freq 1:11:2: 11 frequency points, more than the 10 allowed (see docs/limits.md)"
         );
         assert!(check_count(|| "x".into(), f64::NAN, "samples", 10).is_err());
         let e = check_count(|| "x".into(), 1.8446744073709552e19, "draws", 10).unwrap_err();
