@@ -92,6 +92,10 @@ pub enum ParamError {
         /// What is wrong and what is allowed.
         message: String,
     },
+    /// A parameter file, or one of its lines, over its size limit
+    /// ([`crate::limits::MAX_SETTINGS_FILE_BYTES`], [`crate::limits::MAX_LINE_BYTES`]).
+    #[error(transparent)]
+    TooLarge(#[from] LimitError),
 }
 
 /// A frequency request that cannot be evaluated.
