@@ -366,8 +366,15 @@ impl TiltSeriesSource {
     ///
     /// # Errors
     ///
-    /// As [`TiltSeriesSource::read_chunk`].
+    /// [`InputError::TooLarge`] for more than
+    /// [`tiltnoise_core::limits::MAX_SERIES_SAMPLES`] samples or more than the memory
+    /// available; otherwise as [`TiltSeriesSource::read_chunk`].
     pub fn read_all(&mut self) -> Result<TiltSeries, InputError> {
+        let first = self
+            .channels
+            .first()
+            .map_or(String::new(), |m| format!("/{}", m.source));
+        h5::check_whole_read(&self.path, &first, self.len, self.channels.len(), "samples")?;
         let data = self.read_chunk(0, self.len)?;
         Ok(TiltSeries {
             sample_rate_hz: self.sample_rate_hz,
