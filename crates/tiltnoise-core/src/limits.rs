@@ -47,6 +47,10 @@ pub const MAX_MC_DRAWS: usize = 10_000_000;
 /// Bytes planned per Monte Carlo draw (150 measured, with the HDF5 and figure outputs 158).
 pub const MC_BYTES_PER_DRAW: u64 = 160;
 
+/// Most worker threads (`mc --threads`): more threads than cores only add overhead, and each
+/// reserves a stack; 1024 is beyond any workstation's core count.
+pub const MAX_THREADS: usize = 1024;
+
 /// Most samples of a simulation (`simulate --duration / --step`). A sample costs 64 bytes of
 /// coordinates and 56 of observables; with the spectra and the outputs (HDF5, figures) 175
 /// bytes were measured, so 2^24 samples take 3 GB: 19 days at the paper's 0.1 s, 39 times its
@@ -91,7 +95,7 @@ pub const MAX_LINE_BYTES: u64 = 64 << 10;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum LimitError {
     /// A count (points, draws, samples) over its fixed limit.
-    #[error("{what}: {} {unit}, more than the {limit} allowed (see {DOCS})", Num(*.value))]
+    #[error("{what}: {} {unit}, more than the {limit} allowed (see {DOCS})", Count(*.value))]
     TooMany {
         /// The option with its value, or the file, e.g. `--samples 1000000000000`.
         what: String,
@@ -126,6 +130,22 @@ pub enum LimitError {
         /// `MemAvailable` at the time of the check.
         available: u64,
     },
+}
+
+/// A count as messages show it: every digit of a whole number below 10^15 (exact in `f64`),
+/// else as [`Num`] (`1.8446744073709552e19`, `inf`).
+#[derive(Debug, Clone, Copy)]
+struct Count(f64);
+
+impl fmt::Display for Count {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let x = self.0;
+        if x.fract() == 0.0 && x.abs() < 1e15 {
+            write!(f, "{x:.0}")
+        } else {
+            write!(f, "{}", Num(x))
+        }
+    }
 }
 
 /// Bytes as messages show them: `1 MiB`, `64 KiB`, `3.2 GiB`.
@@ -439,6 +459,15 @@ mod tests {
         if cfg!(target_os = "linux") {
             assert!(available_memory_bytes().is_some_and(|b| b > 0));
         }
+    }
+
+    #[test]
+    fn counts_read_like_counts() {
+        assert_eq!(Count(1e12).to_string(), "1000000000000");
+        assert_eq!(Count(10000001.0).to_string(), "10000001");
+        assert_eq!(Count(u64::MAX as f64).to_string(), "1.8446744073709552e19");
+        assert_eq!(Count(1.5e9).to_string(), "1500000000");
+        assert_eq!(Count(f64::INFINITY).to_string(), "inf");
     }
 
     #[test]
