@@ -59,6 +59,7 @@ pub(crate) fn run_mc(params: &Params, opts: McOptions) -> Result<()> {
         .iter()
         .map(|p| output_kind(p))
         .collect::<Result<Vec<_>, _>>()?;
+    tiltnoise_core::mc::check_size(opts.samples, opts.threads, ("--samples", "--threads"))?;
     let cfg = McConfig {
         samples: opts.samples,
         seed: opts.seed,
