@@ -9,13 +9,14 @@ use clap::Args;
 use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::PathBuf;
+use tiltnoise_core::error::Num;
 use tiltnoise_core::model::{Coord, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::simulate::resonance::check_resonances;
 use tiltnoise_core::simulate::{
-    aliased_frequency_hz, equal_energy_init, kick_x, simulate_with_progress, InitialState,
-    ModalPropagator, SimConfig, Simulation, DEFAULT_MODE_ENERGY_J, MAX_SAMPLES,
+    aliased_frequency_hz, check_samples, equal_energy_init, kick_x, simulate_with_progress,
+    InitialState, ModalPropagator, SimConfig, Simulation, DEFAULT_MODE_ENERGY_J,
 };
 use tiltnoise_core::spectral::{welch, WelchConfig};
 use tiltnoise_io::{write_observable_series_hdf5, OutputKind, RunMeta, SeriesAsd, SimulationMeta};
@@ -234,14 +235,16 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs) -> Result<()> {
             args.step
         );
     }
-    if n_f > MAX_SAMPLES as f64 {
-        bail!(
-            "--duration {} s at --step {} s gives {n_f:e} samples: at most {MAX_SAMPLES} are \
-             allowed (increase --step or shorten --duration)",
-            args.duration,
-            args.step
-        );
-    }
+    check_samples(
+        || {
+            format!(
+                "--duration {} s at --step {} s",
+                Num(args.duration),
+                Num(args.step)
+            )
+        },
+        n_f,
+    )?;
     let n = n_f as usize;
     let nperseg = args.nperseg.unwrap_or_else(|| default_nperseg(n));
     if nperseg < 16 {
