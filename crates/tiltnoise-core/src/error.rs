@@ -153,6 +153,9 @@ pub enum TfError {
         /// The first frequency (in grid order) with a non-finite value.
         freq_hz: f64,
     },
+    /// A grid whose result does not fit into the memory available ([`crate::tf::evaluate`]).
+    #[error(transparent)]
+    TooLarge(#[from] LimitError),
     /// The planner found no method that meets the requested tolerance, or cannot plan the
     /// request ([`crate::tf::plan_auto`]).
     #[error("{message}")]
