@@ -8,8 +8,10 @@
 //! few GiB, into a lab workstation of 16 GiB, while the runs the tool is made for (a 12 h
 //! simulation, a day of tilt data, 10 000 Monte Carlo draws, the 2000-point default grid)
 //! stay far below it and within the 256 MB the long runs target. Where the honest bound is the
-//! machine rather than a fixed number, [`check_memory`] compares the planned allocation with
-//! `MemAvailable` of `/proc/meminfo` (Linux; elsewhere only the fixed limits apply).
+//! machine rather than a fixed number, [`check_memory`] refuses a planned allocation of more
+//! than half of `MemAvailable` in `/proc/meminfo` (Linux; elsewhere only the fixed limits
+//! apply): the other half is for the rest of the machine and for the copies the per-item
+//! estimates leave out.
 //!
 //! Text inputs are read through [`BoundedReader`], which stops at the file's byte limit plus
 //! one and at [`MAX_LINE_BYTES`] within a line, so a device (`/dev/zero`, `/dev/urandom`), a
@@ -118,7 +120,8 @@ pub enum LimitError {
     },
     /// An allocation that does not fit into the memory available.
     #[error(
-        "{what}: needs about {} of memory, and {} is available; ask for less (see {DOCS})",
+        "{what}: needs about {} of memory, more than half of the {} available; ask for less \
+         (see {DOCS})",
         Bytes(*.needed),
         Bytes(*.available)
     )]
@@ -127,7 +130,7 @@ pub enum LimitError {
         what: String,
         /// Bytes the run would allocate (`u64::MAX` when the product overflows).
         needed: u64,
-        /// `MemAvailable` at the time of the check.
+        /// `MemAvailable` at the time of the check (at most half of it may be planned).
         available: u64,
     },
 }
@@ -196,7 +199,7 @@ pub fn planned_bytes(count: usize, bytes_each: u64) -> u64 {
     (count as u64).checked_mul(bytes_each).unwrap_or(u64::MAX)
 }
 
-/// Refuses an allocation of `needed` bytes larger than the memory available now
+/// Refuses an allocation of `needed` bytes larger than half of the memory available now
 /// ([`available_memory_bytes`]); without that information (not Linux) it accepts.
 pub fn check_memory(what: impl FnOnce() -> String, needed: u64) -> Result<(), LimitError> {
     check_memory_against(what, needed, available_memory_bytes())
@@ -209,7 +212,7 @@ pub fn check_memory_against(
     available: Option<u64>,
 ) -> Result<(), LimitError> {
     match available {
-        Some(available) if needed > available => Err(LimitError::Memory {
+        Some(available) if needed > available / 2 => Err(LimitError::Memory {
             what: what(),
             needed,
             available,
@@ -435,14 +438,15 @@ mod tests {
     #[test]
     fn memory_check_against_what_is_available() {
         assert!(check_memory_against(|| "x".into(), 10, None).is_ok());
-        assert!(check_memory_against(|| "x".into(), 10, Some(10)).is_ok());
-        let e = check_memory_against(|| "--samples 5".into(), 3 << 30, Some(1 << 30))
+        assert!(check_memory_against(|| "x".into(), 10, Some(20)).is_ok());
+        assert!(check_memory_against(|| "x".into(), 11, Some(20)).is_err());
+        let e = check_memory_against(|| "--samples 5".into(), 3 << 30, Some(4 << 30))
             .unwrap_err()
             .to_string();
         assert_eq!(
             e,
-            "--samples 5: needs about 3 GiB of memory, and 1 GiB is available; ask for less \
-             (see docs/limits.md)"
+            "--samples 5: needs about 3 GiB of memory, more than half of the 4 GiB available; \
+             ask for less (see docs/limits.md)"
         );
         // The machine running the tests has some memory, and not 16 EiB.
         assert!(check_memory(|| "x".into(), 1).is_ok());
