@@ -295,11 +295,7 @@ fn check_kept_memory(
     n_outputs: usize,
 ) -> Result<(), BudgetError> {
     let n_freqs = cfg.n_freqs() as u64;
-    let mut bytes = 0u64;
-    if cfg.averaging == Averaging::Median {
-        let per_segment = n_freqs.saturating_mul(16 * n_ax as u64);
-        bytes = planned_bytes(cfg.n_segments(n), per_segment);
-    }
+    let mut bytes = cfg.kept_bytes(n, n_ax);
     if let Some(seg) = segment_samples {
         let per_segment = n_freqs.saturating_mul(4 * n_outputs as u64);
         bytes = bytes.saturating_add(planned_bytes(n / seg.max(1), per_segment));
