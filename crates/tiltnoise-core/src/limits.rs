@@ -69,6 +69,12 @@ pub const SIM_BYTES_PER_SAMPLE: u64 = 192;
 /// read back. HDF5 tilt series streamed by the budget are not held whole and not limited by it.
 pub const MAX_SERIES_SAMPLES: usize = 1 << 25;
 
+/// Most samples per channel of an HDF5 tilt series the budget streams (in chunks, in bounded
+/// memory, so the bound is time): at about 10^7 samples per second (measured), 2^32 samples
+/// take several minutes to half an hour. They are 13 years at 10 Hz; the limit stops a file of
+/// a few KiB whose metadata claims 10^12 samples.
+pub const MAX_STREAMED_SAMPLES: usize = 1 << 32;
+
 /// Bytes planned per sample and channel of an input held in memory: the 8-byte value and its
 /// copy while it is processed.
 pub const SERIES_BYTES_PER_SAMPLE: u64 = 16;
@@ -431,6 +437,7 @@ mod tests {
         assert!(planned_bytes(MAX_SIM_SAMPLES, SIM_BYTES_PER_SAMPLE) <= 4 * GIB);
         assert!(planned_bytes(MAX_SERIES_SAMPLES, 4 * SERIES_BYTES_PER_SAMPLE) <= 4 * GIB);
         assert!(MAX_SIM_SAMPLES <= MAX_SERIES_SAMPLES);
+        assert!(MAX_SERIES_SAMPLES <= MAX_STREAMED_SAMPLES);
         assert!(MAX_GRID_POINTS as u64 * 64 <= MAX_FREQ_FILE_BYTES);
         assert_eq!(planned_bytes(usize::MAX, 16), u64::MAX);
     }
