@@ -98,6 +98,14 @@ pub const MAX_DATA_FILE_BYTES: u64 = 1 << 30;
 /// many channels, a description). Bounds the memory of a line that never ends (`/dev/zero`).
 pub const MAX_LINE_BYTES: u64 = 64 << 10;
 
+// Every simulation can be read back, in memory and streamed; a frequency file holds every
+// grid at 64 characters a line.
+const _: () = {
+    assert!(MAX_SIM_SAMPLES <= MAX_SERIES_SAMPLES);
+    assert!(MAX_SERIES_SAMPLES <= MAX_STREAMED_SAMPLES);
+    assert!(MAX_GRID_POINTS as u64 * 64 <= MAX_FREQ_FILE_BYTES);
+};
+
 /// A size over its limit. The message names the option or file (`what`), the value and the
 /// limit, and where the limits are documented.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -187,8 +195,7 @@ pub fn check_count(
     unit: &'static str,
     limit: usize,
 ) -> Result<(), LimitError> {
-    // `!(<=)` so that a NaN is refused too.
-    if !(value <= limit as f64) {
+    if value.is_nan() || value > limit as f64 {
         return Err(LimitError::TooMany {
             what: what(),
             value,
@@ -202,7 +209,7 @@ pub fn check_count(
 /// `count` items of `bytes_each` bytes, or `u64::MAX` when the product overflows (which no
 /// machine has: [`check_memory`] refuses it).
 pub fn planned_bytes(count: usize, bytes_each: u64) -> u64 {
-    (count as u64).checked_mul(bytes_each).unwrap_or(u64::MAX)
+    (count as u64).saturating_mul(bytes_each)
 }
 
 /// Refuses an allocation of `needed` bytes larger than half of the memory available now
@@ -436,9 +443,6 @@ mod tests {
         assert!(planned_bytes(MAX_MC_DRAWS, MC_BYTES_PER_DRAW) <= 4 * GIB);
         assert!(planned_bytes(MAX_SIM_SAMPLES, SIM_BYTES_PER_SAMPLE) <= 4 * GIB);
         assert!(planned_bytes(MAX_SERIES_SAMPLES, 4 * SERIES_BYTES_PER_SAMPLE) <= 4 * GIB);
-        assert!(MAX_SIM_SAMPLES <= MAX_SERIES_SAMPLES);
-        assert!(MAX_SERIES_SAMPLES <= MAX_STREAMED_SAMPLES);
-        assert!(MAX_GRID_POINTS as u64 * 64 <= MAX_FREQ_FILE_BYTES);
         assert_eq!(planned_bytes(usize::MAX, 16), u64::MAX);
     }
 
