@@ -240,6 +240,16 @@ impl CsvFile {
     pub fn for_each_record(
         &mut self,
         n_fields: usize,
+        f: impl FnMut(usize, &[&str]) -> Result<(), InputError>,
+    ) -> Result<(), InputError> {
+        self.for_each_record_up_to(MAX_SERIES_SAMPLES, n_fields, f)
+    }
+
+    /// [`CsvFile::for_each_record`] with at most `max_records` records.
+    fn for_each_record_up_to(
+        &mut self,
+        max_records: usize,
+        n_fields: usize,
         mut f: impl FnMut(usize, &[&str]) -> Result<(), InputError>,
     ) -> Result<(), InputError> {
         let mut count = 0usize;
@@ -253,7 +263,7 @@ impl CsvFile {
                 || format!("input file {}, line {line}", self.path.display()),
                 count as f64,
                 "data rows",
-                MAX_SERIES_SAMPLES,
+                max_records,
             )?;
             if fields.len() != n_fields {
                 return Err(InputError::Csv {
@@ -462,6 +472,31 @@ fn start_time(path: &Path, prelude: &Prelude) -> Result<Option<String>, InputErr
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn records_beyond_the_limit_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.csv");
+        std::fs::write(&path, "# units: rad\ntime_s,E\n0,1\n1,2\n\n2,3\n3,4\n").unwrap();
+        let (mut file, _) = CsvFile::open(&path).unwrap();
+        let mut rows = 0;
+        let e = file
+            .for_each_record_up_to(3, 2, |_, _| {
+                rows += 1;
+                Ok(())
+            })
+            .unwrap_err()
+            .to_string();
+        assert_eq!(rows, 3);
+        assert_eq!(
+            e,
+            format!(
+                "input file {}, line 7: 4 data rows, more than the 3 allowed (see \
+                 docs/limits.md)",
+                path.display()
+            )
+        );
+    }
 
     #[test]
     fn resolution() {
