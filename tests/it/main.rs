@@ -22,6 +22,7 @@ mod fit;
 mod force_tf;
 mod input_readers;
 mod io_roundtrip;
+mod limits;
 mod mc_outputs;
 mod noise_models;
 mod romy_budget;
