@@ -254,9 +254,9 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs) -> Result<()> {
         bail!(
             "--duration {} s at --step {} s gives {n} samples, shorter than one Welch segment \
              (--nperseg {nperseg} = {} s): lengthen --duration or lower --nperseg",
-            args.duration,
-            args.step,
-            nperseg as f64 * args.step
+            Num(args.duration),
+            Num(args.step),
+            Num(nperseg as f64 * args.step)
         );
     }
     for path in &args.save {

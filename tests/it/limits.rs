@@ -203,6 +203,43 @@ fn simulations_over_the_sample_limit() {
     );
 }
 
+/// A Welch segment is limited by the record it cuts.
+#[test]
+fn welch_segments_longer_than_the_record() {
+    let tilt = repo("tilt_data/lab_tilt_24h.h5");
+    let huge = "18446744073709551615";
+    for (args, needles) in [
+        (
+            vec![
+                "budget",
+                "--tilt",
+                tilt.to_str().unwrap(),
+                "--nperseg",
+                huge,
+            ],
+            [
+                "series of 86400 samples",
+                "shorter than one Welch segment of 18446744073709551615 samples",
+            ],
+        ),
+        (
+            vec!["simulate", "--nperseg", huge],
+            [
+                "gives 432000 samples",
+                "(--nperseg 18446744073709551615 = 1.8446744073709553e18 s)",
+            ],
+        ),
+    ] {
+        let out = run(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        for n in needles {
+            assert!(err.contains(n), "{args:?}: `{n}` missing from: {err}");
+        }
+    }
+}
+
 #[test]
 fn text_files_over_their_length() {
     let dir = tempfile::tempdir().unwrap();
