@@ -60,6 +60,7 @@ pub(crate) fn run_mc(params: &Params, opts: McOptions, run: &mut Run) -> Result<
         .iter()
         .map(|p| output_kind(p))
         .collect::<Result<Vec<_>, _>>()?;
+    tiltnoise_core::mc::check_size(opts.samples, opts.threads, ("--samples", "--threads"))?;
     let saves: Vec<&Path> = opts.save.iter().map(PathBuf::as_path).collect();
     run.check_outputs(&saves, &[])?;
     let cfg = McConfig {

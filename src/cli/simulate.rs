@@ -10,14 +10,14 @@ use clap::Args;
 use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use tiltnoise_core::error::Shown;
+use tiltnoise_core::error::{Num, Shown};
 use tiltnoise_core::model::{Coord, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::simulate::resonance::check_resonances;
 use tiltnoise_core::simulate::{
-    aliased_frequency_hz, equal_energy_init, kick_x, simulate_with_progress, InitialState,
-    ModalPropagator, SimConfig, Simulation, DEFAULT_MODE_ENERGY_J, MAX_SAMPLES,
+    aliased_frequency_hz, check_samples, equal_energy_init, kick_x, simulate_with_progress,
+    InitialState, ModalPropagator, SimConfig, Simulation, DEFAULT_MODE_ENERGY_J,
 };
 use tiltnoise_core::spectral::{welch, WelchConfig};
 use tiltnoise_io::{write_observable_series_hdf5, OutputKind, RunMeta, SeriesAsd, SimulationMeta};
@@ -246,14 +246,16 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
             args.step
         );
     }
-    if n_f > MAX_SAMPLES as f64 {
-        bail!(
-            "--duration {} s at --step {} s gives {n_f:e} samples: at most {MAX_SAMPLES} are \
-             allowed (increase --step or shorten --duration)",
-            args.duration,
-            args.step
-        );
-    }
+    check_samples(
+        || {
+            format!(
+                "--duration {} s at --step {} s",
+                Num(args.duration),
+                Num(args.step)
+            )
+        },
+        n_f,
+    )?;
     let n = n_f as usize;
     let nperseg = args.nperseg.unwrap_or_else(|| default_nperseg(n));
     if nperseg < 16 {
@@ -263,9 +265,9 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
         bail!(
             "--duration {} s at --step {} s gives {n} samples, shorter than one Welch segment \
              (--nperseg {nperseg} = {} s): lengthen --duration or lower --nperseg",
-            args.duration,
-            args.step,
-            nperseg as f64 * args.step
+            Num(args.duration),
+            Num(args.step),
+            Num(nperseg as f64 * args.step)
         );
     }
     for path in &args.save {

@@ -23,6 +23,7 @@ mod force_tf;
 mod fuzz;
 mod input_readers;
 mod io_roundtrip;
+mod limits;
 mod mc_outputs;
 mod noise_models;
 mod process;

@@ -2,6 +2,7 @@
 //! the key or file, the offending value, the unit and what is allowed. The binary adds context
 //! with `anyhow` and maps every error to exit code 2.
 
+use crate::limits::LimitError;
 use std::fmt::{self, Write as _};
 use std::path::PathBuf;
 
@@ -176,6 +177,10 @@ pub enum ParamError {
         /// What is wrong and what is allowed.
         message: String,
     },
+    /// A parameter file, or one of its lines, over its size limit
+    /// ([`crate::limits::MAX_SETTINGS_FILE_BYTES`], [`crate::limits::MAX_LINE_BYTES`]).
+    #[error(transparent)]
+    TooLarge(#[from] LimitError),
 }
 
 /// A frequency request that cannot be evaluated.
@@ -197,6 +202,10 @@ pub enum FreqError {
         /// What is wrong and what is allowed.
         message: String,
     },
+    /// A grid or frequency file over its size limit ([`crate::limits::MAX_GRID_POINTS`],
+    /// [`crate::limits::MAX_FREQ_FILE_BYTES`]).
+    #[error(transparent)]
+    TooLarge(#[from] LimitError),
 }
 
 /// An evaluation of a transfer function that has no meaningful result.
@@ -229,6 +238,9 @@ pub enum TfError {
         /// The first frequency (in grid order) with a non-finite value.
         freq_hz: f64,
     },
+    /// A grid whose result does not fit into the memory available ([`crate::tf::evaluate`]).
+    #[error(transparent)]
+    TooLarge(#[from] LimitError),
     /// The planner found no method that meets the requested tolerance, or cannot plan the
     /// request ([`crate::tf::plan_auto`]).
     #[error("{message}")]

@@ -2,9 +2,11 @@
 //! around every resonance so that no peak is missed. Frequency files are read by
 //! `tiltnoise_io::read_freq_file`.
 //!
-//! All frequencies are in Hz. Depends on `modes` (for resonance placement) and `error` only.
+//! All frequencies are in Hz. A grid has at most [`MAX_GRID_POINTS`] points. Depends on
+//! `modes` (for resonance placement), `error` and `limits` only.
 
 use crate::error::{FreqError, Shown};
+use crate::limits::{check_count, MAX_GRID_POINTS};
 use crate::model::Model;
 use crate::modes::NormalModes;
 
@@ -22,14 +24,20 @@ const UNDAMPED_OFFSETS: [f64; 11] = [
 /// Points across a damped resonance, in units of its half-width at half power `phi_k / 2`.
 const DAMPED_WIDTHS: [f64; 9] = [0.0, 0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 5.0, 10.0];
 
-/// Most points of a log grid (80 MB of frequencies): far more than any figure or fit needs, and
-/// a bound that turns a mistyped `N` into an error instead of an allocation that aborts.
-pub const MAX_GRID_POINTS: usize = 10_000_000;
+/// Most points [`refine_around_modes`] adds per mode (both sides of every offset and width).
+const REFINEMENT_POINTS_PER_MODE: usize = 2 * (UNDAMPED_OFFSETS.len() + DAMPED_WIDTHS.len());
 
-/// `n` log-spaced frequencies from `lo` to `hi` inclusive (`n = 1` gives `[lo]`), `n` at most
+// The refined default grid (eight modes) stays within the grid limit.
+const _: () = assert!(DEFAULT_POINTS + 8 * REFINEMENT_POINTS_PER_MODE <= MAX_GRID_POINTS);
+
+/// What a grid's size is counted in, for messages.
+const POINTS: &str = "frequency points";
+
+/// `n` log-spaced frequencies from `lo` to `hi` inclusive (`n = 1` gives `[lo]`), at most
 /// [`MAX_GRID_POINTS`].
 pub fn log_grid(lo: f64, hi: f64, n: usize) -> Result<Vec<f64>, FreqError> {
     let spec = || format!("log grid {lo}:{n}:{hi}");
+    check_count(spec, n as f64, POINTS, MAX_GRID_POINTS)?;
     if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi >= lo && n >= 1) {
         return Err(FreqError::Spec {
             origin: spec(),
@@ -60,21 +68,27 @@ pub fn log_grid(lo: f64, hi: f64, n: usize) -> Result<Vec<f64>, FreqError> {
         .collect())
 }
 
-/// Parses `FLO:N:FHI` (Hz, count, Hz), e.g. `1e-4:2000:30`.
+/// Parses `FLO:N:FHI` (Hz, count, Hz), e.g. `1e-4:2000:30`; N is at most
+/// [`MAX_GRID_POINTS`].
 pub fn parse_spec(spec: &str) -> Result<Vec<f64>, FreqError> {
+    let origin = || format!("--freq {}", Shown(spec));
     let err = |message: &str| FreqError::Spec {
-        origin: format!("--freq {}", Shown(spec)),
+        origin: origin(),
         message: message.into(),
     };
     let parts: Vec<&str> = spec.split(':').map(str::trim).collect();
-    let [lo, n, hi] = parts[..] else {
+    let [lo, n_text, hi] = parts[..] else {
         return Err(err("expected FLO:N:FHI, e.g. 1e-4:2000:30 (Hz:count:Hz)"));
     };
     let lo: f64 = lo.parse().map_err(|_| err("FLO is not a number"))?;
     let hi: f64 = hi.parse().map_err(|_| err("FHI is not a number"))?;
-    let n: usize = n
-        .parse()
-        .map_err(|_| err("N is not a positive whole number"))?;
+    let n: usize = match n_text.parse() {
+        Ok(n) => n,
+        // More digits than a usize holds: a count over the limit all the same.
+        Err(e) if *e.kind() == std::num::IntErrorKind::PosOverflow => usize::MAX,
+        Err(_) => return Err(err("N is not a positive whole number")),
+    };
+    check_count(origin, n as f64, POINTS, MAX_GRID_POINTS)?;
     log_grid(lo, hi, n).map_err(|e| match e {
         FreqError::Spec { message, .. } => err(&message),
         other => other,
@@ -129,7 +143,7 @@ pub fn refine_around_modes(grid: &[f64], model: &Model) -> Vec<f64> {
 }
 
 /// The default grid: [`DEFAULT_POINTS`] log-spaced points from 0.1 mHz to 30 Hz, refined
-/// around every resonance.
+/// around every resonance (at most 40 points more per mode: far within [`MAX_GRID_POINTS`]).
 pub fn default_grid(model: &Model) -> Vec<f64> {
     let base = log_grid(DEFAULT_F_LO_HZ, DEFAULT_F_HI_HZ, DEFAULT_POINTS)
         .expect("default grid bounds are valid");
@@ -149,6 +163,32 @@ mod tests {
         for w in g.windows(2) {
             assert!((w[1] / w[0] - 10.0).abs() < 1e-13 * 10.0, "{w:?}");
         }
+    }
+
+    #[test]
+    fn grids_over_the_limit_are_refused_before_allocating() {
+        assert_eq!(
+            log_grid(1.0, 2.0, MAX_GRID_POINTS).unwrap().len(),
+            MAX_GRID_POINTS
+        );
+        for spec in [
+            "1e-3:18446744073709551615:1",
+            "1e-4:1000000000:30",
+            "1e-4:99999999999999999999999:30",
+            "1e-4:1000001:30",
+        ] {
+            let e = parse_spec(spec).unwrap_err();
+            assert!(matches!(e, FreqError::TooLarge(_)), "{spec}: {e}");
+            let e = e.to_string();
+            assert!(
+                e.starts_with(&format!("--freq {spec}: "))
+                    && e.contains("frequency points")
+                    && e.contains("more than the 1000000 allowed"),
+                "{e}"
+            );
+        }
+        let e = log_grid(1.0, 2.0, usize::MAX).unwrap_err().to_string();
+        assert!(e.contains("more than the 1000000 allowed"), "{e}");
     }
 
     #[test]

@@ -51,6 +51,7 @@ pub mod error;
 pub mod fit;
 pub mod freq;
 pub mod input;
+pub mod limits;
 pub mod mc;
 pub mod methods;
 pub mod model;

@@ -15,6 +15,8 @@
 //! * Only parameters that enter the undamped modes are drawn (masses, inertias, torsion and
 //!   bouncing constants, lengths, g); an error on any other (loss angles, damping, temperature)
 //!   is accepted and has no effect.
+//! * At most [`MAX_MC_DRAWS`] draws on at most [`MAX_THREADS`] threads, and no more draws than
+//!   fit into the memory available ([`check_size`]).
 //! * Reproducible: sample `i` has its own random stream derived from `(seed, i)`, so the result
 //!   is bit-identical for a given seed whatever the number of threads.
 //! * Per draw only the eigenvalues are computed, per decoupled 4x4 block (Cholesky reduction and
@@ -24,6 +26,10 @@
 //! Pure numerics: depends on `params` and `model` only; no I/O.
 
 use crate::error::ParamError;
+use crate::limits::{
+    check_count, check_memory, planned_bytes, LimitError, MAX_MC_DRAWS, MAX_THREADS,
+    MC_BYTES_PER_DRAW,
+};
 use crate::model::{Block, Model};
 use crate::params::uncertainty::{check, UncertaintyError};
 use crate::params::Params;
@@ -98,6 +104,9 @@ pub enum McError {
     /// The nominal parameter set does not build a model.
     #[error("Monte Carlo: nominal parameters: {0}")]
     Nominal(#[from] ParamError),
+    /// More draws or threads than allowed, or than fit into memory.
+    #[error("Monte Carlo: {0}")]
+    TooLarge(#[from] LimitError),
     /// Every draw was rejected.
     #[error(
         "Monte Carlo: all {samples} draws were rejected as non-physical; reduce the error bars"
@@ -133,6 +142,18 @@ pub fn mode_frequencies_hz(model: &Model) -> Option<[f64; 8]> {
     }
     out.sort_by(f64::total_cmp);
     Some(out)
+}
+
+/// Refuses more than [`MAX_MC_DRAWS`] draws, more than fit into the memory available
+/// ([`MC_BYTES_PER_DRAW`] each), or more than [`MAX_THREADS`] threads, before anything is
+/// allocated. `names` are what the messages call the two counts, e.g. the options
+/// `("--samples", "--threads")`.
+pub fn check_size(samples: usize, threads: usize, names: (&str, &str)) -> Result<(), LimitError> {
+    let what = || format!("{} {samples}", names.0);
+    check_count(what, samples as f64, "Monte Carlo draws", MAX_MC_DRAWS)?;
+    check_memory(what, planned_bytes(samples, MC_BYTES_PER_DRAW))?;
+    let what = || format!("{} {threads}", names.1);
+    check_count(what, threads as f64, "threads", MAX_THREADS)
 }
 
 /// Runs the Monte Carlo. `progress` is called from the worker threads with the number of draws
@@ -227,6 +248,7 @@ impl Plan {
         if cfg.samples == 0 {
             return Err(McError::NoSamples);
         }
+        check_size(cfg.samples, cfg.threads, ("samples", "threads"))?;
         Model::new(params)?;
         let keys: Vec<&str> = params.fields().iter().map(|f| f.key).collect();
         check(&cfg.uncertainties, &keys)?;
@@ -329,6 +351,26 @@ mod tests {
             assert!(modal_field(&u.key).is_some(), "{}", u.key);
         }
         assert_eq!(drawn, 20);
+    }
+
+    #[test]
+    fn sizes_over_the_limits_are_refused_before_drawing() {
+        let p = Params::table_i();
+        for (samples, threads, needle) in [
+            (usize::MAX, 1, "samples 18446744073709551615: "),
+            (MAX_MC_DRAWS + 1, 1, "10000001 Monte Carlo draws"),
+            (10, MAX_THREADS + 1, "threads 1025: 1025 threads"),
+        ] {
+            let cfg = McConfig {
+                samples,
+                threads,
+                ..McConfig::default_for(&p)
+            };
+            let e = run(&p, &cfg, &|_| {}).unwrap_err();
+            assert!(matches!(e, McError::TooLarge(_)), "{e}");
+            assert!(e.to_string().contains(needle), "{e}");
+        }
+        assert!(check_size(MAX_MC_DRAWS, MAX_THREADS, ("a", "b")).is_ok());
     }
 
     #[test]

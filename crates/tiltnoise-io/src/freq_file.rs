@@ -1,23 +1,35 @@
 //! Frequency files (`tiltnoise tf --freq-file`): one frequency in Hz per line; blank lines and
 //! `#` comment lines are ignored; CSV text as [`tiltnoise_core::csv_text`] reads it, with a
-//! single column.
+//! single column. At most [`MAX_FREQ_FILE_BYTES`] and [`MAX_GRID_POINTS`] frequencies.
 
 use std::path::Path;
 use tiltnoise_core::csv_text::{line_text, CsvRecords};
 use tiltnoise_core::error::{FreqError, Shown};
+use tiltnoise_core::limits::{
+    check_count, read_text_file, TextFileError, MAX_FREQ_FILE_BYTES, MAX_GRID_POINTS,
+};
 
 /// Reads a frequency file. Every value must be finite and >= 0; at least one is required.
 ///
 /// # Errors
 ///
 /// [`FreqError::Spec`] naming the file (and line) when it cannot be read, a line is not one
-/// number or there is none; [`FreqError::Invalid`] for a negative or non-finite frequency.
+/// number or there is none; [`FreqError::Invalid`] for a negative or non-finite frequency;
+/// [`FreqError::TooLarge`] for a file over [`MAX_FREQ_FILE_BYTES`] (a device or pipe is read
+/// no further), a line over [`tiltnoise_core::limits::MAX_LINE_BYTES`] or more than
+/// [`MAX_GRID_POINTS`] frequencies.
 pub fn read_freq_file(path: &Path) -> Result<Vec<f64>, FreqError> {
     let origin = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| FreqError::Spec {
-        origin: origin.clone(),
-        message: format!("cannot read: {e}"),
-    })?;
+    let name = format!("frequency file {origin}");
+    let text = read_text_file(path, MAX_FREQ_FILE_BYTES, &name, "a frequency file").map_err(
+        |e| match e {
+            TextFileError::Io(e) => FreqError::Spec {
+                origin: origin.clone(),
+                message: format!("cannot read: {e}"),
+            },
+            TextFileError::TooLarge(e) => FreqError::TooLarge(e),
+        },
+    )?;
     parse_freq_text(&text, &origin)
 }
 
@@ -55,6 +67,19 @@ fn parse_freq_text(text: &str, origin: &str) -> Result<Vec<f64>, FreqError> {
                 value,
                 origin: at(line),
             });
+        }
+        if freqs.len() == MAX_GRID_POINTS {
+            // Count the rest only for the message (the text is in memory, within its limit).
+            let mut count = MAX_GRID_POINTS + 1;
+            while let Ok(Some(_)) = records.next_record() {
+                count += 1;
+            }
+            check_count(
+                || format!("frequency file {origin}"),
+                count as f64,
+                "frequency points",
+                MAX_GRID_POINTS,
+            )?;
         }
         freqs.push(value);
     }
@@ -94,5 +119,21 @@ mod tests {
             let e = parse_freq_text(text, "f.txt").unwrap_err().to_string();
             assert!(needles.iter().all(|n| e.contains(n)), "{text:?}: {e}");
         }
+    }
+
+    #[test]
+    fn at_most_the_grid_limit_of_frequencies() {
+        let full = "1\n".repeat(MAX_GRID_POINTS);
+        assert_eq!(
+            parse_freq_text(&full, "f.txt").unwrap().len(),
+            MAX_GRID_POINTS
+        );
+        let over = full + "# comment\n2\n3\n";
+        let e = parse_freq_text(&over, "f.txt").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "frequency file f.txt: 1000002 frequency points, more than the 1000000 allowed (see \
+             docs/limits.md)"
+        );
     }
 }

@@ -3,17 +3,30 @@
 
 use std::path::Path;
 use tiltnoise_core::fit::{FitError, Measured};
+use tiltnoise_core::limits::{read_text_file, TextFileError, MAX_SETTINGS_FILE_BYTES};
 
 /// Reads and validates a measured-frequency file; its path names it in messages.
 ///
 /// # Errors
 ///
-/// [`FitError::Measured`] naming the file (and line) when it cannot be read or is malformed.
+/// [`FitError::Measured`] naming the file (and line) when it cannot be read or is malformed;
+/// [`FitError::TooLarge`] for a file over [`MAX_SETTINGS_FILE_BYTES`] (a device or pipe is
+/// read no further) or a line over [`tiltnoise_core::limits::MAX_LINE_BYTES`].
 pub fn read_measured_modes(path: &Path) -> Result<Measured, FitError> {
     let origin = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| FitError::Measured {
-        origin: origin.clone(),
-        message: e.to_string(),
+    let name = format!("measured frequencies {origin}");
+    let text = read_text_file(
+        path,
+        MAX_SETTINGS_FILE_BYTES,
+        &name,
+        "a measured-frequency file",
+    )
+    .map_err(|e| match e {
+        TextFileError::Io(e) => FitError::Measured {
+            origin: origin.clone(),
+            message: e.to_string(),
+        },
+        TextFileError::TooLarge(e) => FitError::TooLarge(e),
     })?;
     Measured::parse(&text, &origin)
 }

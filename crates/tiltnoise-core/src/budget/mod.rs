@@ -14,6 +14,7 @@ pub use measured::{add_measured, series_psds, MeasuredPsds};
 
 use crate::error::TfError;
 use crate::input::{InputError, SeriesSource, TiltSpectra};
+use crate::limits::{check_memory, planned_bytes, LimitError};
 use crate::model::{Model, Observable, TiltAxis};
 use crate::noise::{
     add_equivalent_response, add_thermal, tilt_budget, Budget, BudgetReport, Readout, SegmentBand,
@@ -42,6 +43,9 @@ pub enum BudgetError {
     /// A transfer function could not be evaluated on the grid.
     #[error(transparent)]
     Tf(#[from] TfError),
+    /// More spectra to keep than fit into the memory available.
+    #[error(transparent)]
+    TooLarge(#[from] LimitError),
     /// Options that contradict each other or the input.
     #[error("{0}")]
     Config(String),
@@ -156,15 +160,17 @@ pub fn budget_from_series(
             let s = (d * fs).round();
             if !(d.is_finite() && s >= seg_len as f64) {
                 return Err(BudgetError::Config(format!(
-                    "segment duration {d} s is not allowed: must hold at least one Welch segment \
+                    "segment duration {} s is not allowed: must hold at least one Welch segment \
                      ({seg_len} samples = {} s at {fs} Hz)",
+                    crate::error::Num(d),
                     seg_len as f64 / fs
                 )));
             }
             if s > n as f64 {
                 return Err(BudgetError::Config(format!(
-                    "segment duration {d} s is not allowed: it is longer than the record \
+                    "segment duration {} s is not allowed: it is longer than the record \
                      ({n} samples = {} s at {fs} Hz), which then has no segment to compare",
+                    crate::error::Num(d),
                     crate::error::Num(n as f64 / fs)
                 )));
             }
@@ -172,6 +178,7 @@ pub fn budget_from_series(
         }
     };
     let n_ax = axes.len();
+    check_kept_memory(&cfg, n, n_ax, segment_samples, opts.outputs.len())?;
     let mut whole = WelchAccumulator::new(n_ax, fs, &cfg)?;
     let mut current: Option<WelchAccumulator> = None;
     let mut in_segment = 0usize;
@@ -274,6 +281,37 @@ pub fn budget_from_series(
         readout: opts.readout.clone(),
         notes,
     })
+}
+
+/// Refuses a run whose memory grows with the record beyond the memory available: a median
+/// keeps every Welch segment's spectrum (16 bytes per channel and frequency), and budget
+/// segments keep their tilt PSDs (4 bytes per output and frequency). A mean over the whole
+/// record keeps neither.
+fn check_kept_memory(
+    cfg: &WelchConfig,
+    n: usize,
+    n_ax: usize,
+    segment_samples: Option<usize>,
+    n_outputs: usize,
+) -> Result<(), BudgetError> {
+    let n_freqs = cfg.n_freqs() as u64;
+    let mut bytes = cfg.kept_bytes(n, n_ax);
+    if let Some(seg) = segment_samples {
+        let per_segment = n_freqs.saturating_mul(4 * n_outputs as u64);
+        bytes = bytes.saturating_add(planned_bytes(n / seg.max(1), per_segment));
+    }
+    check_memory(
+        || {
+            format!(
+                "{} Welch segments of {} samples (overlap {}) over {n} samples",
+                cfg.n_segments(n),
+                cfg.segment_len,
+                cfg.overlap
+            )
+        },
+        bytes,
+    )?;
+    Ok(())
 }
 
 fn band_per_observable(

@@ -206,6 +206,10 @@ pub enum FitError {
         /// What is wrong and what is allowed.
         message: String,
     },
+    /// A measured-frequency file, or one of its lines, over its size limit
+    /// ([`crate::limits::MAX_SETTINGS_FILE_BYTES`], [`crate::limits::MAX_LINE_BYTES`]).
+    #[error(transparent)]
+    TooLarge(#[from] crate::limits::LimitError),
     /// No free parameter.
     #[error("fit: no free parameter; give at least one with --free KEY,...")]
     NoFree,

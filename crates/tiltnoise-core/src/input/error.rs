@@ -28,6 +28,10 @@ pub enum InputError {
         reason: std::io::Error,
     },
 
+    /// A file, line, dataset or record count over its size limit ([`crate::limits`]).
+    #[error(transparent)]
+    TooLarge(#[from] crate::limits::LimitError),
+
     /// The extension names no supported format.
     #[error(
         "input file {path}: extension `{}` is not supported; allowed: .h5 or .hdf5 \

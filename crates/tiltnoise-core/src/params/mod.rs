@@ -298,12 +298,21 @@ impl Params {
         Ok(params)
     }
 
-    /// Reads, parses and validates a TOML parameter file.
+    /// Reads, parses and validates a TOML parameter file of at most
+    /// [`MAX_SETTINGS_FILE_BYTES`](crate::limits::MAX_SETTINGS_FILE_BYTES) (a device or pipe
+    /// is read no further) and lines of at most
+    /// [`MAX_LINE_BYTES`](crate::limits::MAX_LINE_BYTES).
     pub fn from_file(path: &Path) -> Result<Params, ParamError> {
-        let text = std::fs::read_to_string(path).map_err(|reason| ParamError::Read {
-            path: path.to_path_buf(),
-            reason,
-        })?;
+        use crate::limits::{read_text_file, TextFileError, MAX_SETTINGS_FILE_BYTES};
+        let name = format!("parameter file {}", path.display());
+        let text = read_text_file(path, MAX_SETTINGS_FILE_BYTES, &name, "a parameter file")
+            .map_err(|e| match e {
+                TextFileError::Io(reason) => ParamError::Read {
+                    path: path.to_path_buf(),
+                    reason,
+                },
+                TextFileError::TooLarge(e) => ParamError::TooLarge(e),
+            })?;
         Params::from_toml_str(&text, &path.display().to_string())
     }
 

@@ -36,14 +36,26 @@
 //!
 //! Pure numerics: depends on `model`, `modes` and (for [`resonance`]) `spectral` only.
 
+use crate::error::Num;
+use crate::limits::{
+    check_count, check_memory, planned_bytes, LimitError, MAX_SIM_SAMPLES, SIM_BYTES_PER_SAMPLE,
+};
 use crate::model::{Coord, Model, Observable, Vec8};
 use crate::modes::NormalModes;
 use crate::rng::Rng;
 
 pub mod resonance;
 
-/// Largest number of samples [`simulate`] accepts (8 GB of coordinates alone at 1e9).
-pub const MAX_SAMPLES: usize = 1_000_000_000;
+/// Refuses a simulation of `n_samples` (a float: `floor(duration / dt)` may be beyond any
+/// integer) over [`MAX_SIM_SAMPLES`] or over the memory available ([`SIM_BYTES_PER_SAMPLE`]
+/// each, outputs included), before anything is allocated. `what` names the request in the
+/// message, e.g. `--duration 9e7 s at --step 0.1 s`.
+pub fn check_samples(what: impl Fn() -> String, n_samples: f64) -> Result<(), LimitError> {
+    check_count(&what, n_samples, "samples", MAX_SIM_SAMPLES)?;
+    // Within the limit, so a whole number of samples that fits a usize.
+    let n = n_samples as usize;
+    check_memory(&what, planned_bytes(n, SIM_BYTES_PER_SAMPLE))
+}
 
 /// Initial conditions in crate coordinate order ([`crate::model::Coord::ALL`]), SI units
 /// (rad, m; rad/s, m/s).
@@ -187,21 +199,10 @@ pub enum SimError {
         /// floor(duration / dt).
         n_samples: f64,
     },
-    /// duration / dt is above [`MAX_SAMPLES`].
-    #[error(
-        "duration {duration_s} s at dt = {dt_s} s gives {n_samples:e} samples: at most {max} \
-         are allowed (increase dt or shorten the duration)"
-    )]
-    TooManySamples {
-        /// The duration given (s).
-        duration_s: f64,
-        /// The step given (s).
-        dt_s: f64,
-        /// floor(duration / dt).
-        n_samples: f64,
-        /// [`MAX_SAMPLES`].
-        max: usize,
-    },
+    /// duration / dt is above [`MAX_SIM_SAMPLES`] or the memory available
+    /// ([`check_samples`]).
+    #[error(transparent)]
+    TooLarge(#[from] LimitError),
     /// A non-finite initial coordinate or velocity.
     #[error("initial {what}[{index}] = {value} is not allowed: must be finite")]
     InvalidInitial {
@@ -419,14 +420,10 @@ pub fn simulate_with_progress(
             n_samples,
         });
     }
-    if n_samples > MAX_SAMPLES as f64 {
-        return Err(SimError::TooManySamples {
-            duration_s,
-            dt_s,
-            n_samples,
-            max: MAX_SAMPLES,
-        });
-    }
+    check_samples(
+        || format!("duration {} s at dt = {} s", Num(duration_s), Num(dt_s)),
+        n_samples,
+    )?;
     for &(o, asd) in &cfg.readout_asd {
         if !(asd.is_finite() && asd >= 0.0) {
             return Err(SimError::InvalidReadout {

@@ -101,6 +101,19 @@ impl WelchConfig {
         self.segment_len.saturating_sub(self.overlap)
     }
 
+    /// Bytes a [`Averaging::Median`] keeps for a series of `n_samples` on `n_channels`
+    /// channels: every segment's spectrum, 16 bytes per channel and frequency (saturating at
+    /// `u64::MAX`); 0 for a mean, whose memory does not grow with the series.
+    pub fn kept_bytes(&self, n_samples: usize, n_channels: usize) -> u64 {
+        match self.averaging {
+            Averaging::Mean => 0,
+            Averaging::Median => crate::limits::planned_bytes(
+                self.n_segments(n_samples),
+                (self.n_freqs() as u64).saturating_mul(16 * n_channels as u64),
+            ),
+        }
+    }
+
     /// Number of one-sided frequency bins, `segment_len / 2 + 1`.
     pub fn n_freqs(&self) -> usize {
         self.segment_len / 2 + 1
@@ -132,6 +145,17 @@ impl WelchConfig {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_median_keeps_every_segment_a_mean_nothing() {
+        // Segments of 8 samples, step 4: 24 segments of 5 frequencies in 100 samples.
+        let mean = WelchConfig::new(8);
+        assert_eq!(mean.kept_bytes(100, 2), 0);
+        let median = mean.with_averaging(Averaging::Median);
+        assert_eq!(median.kept_bytes(100, 2), 24 * 5 * 2 * 16);
+        let huge = WelchConfig::new(usize::MAX / 2).with_averaging(Averaging::Median);
+        assert_eq!(huge.kept_bytes(usize::MAX, 3), u64::MAX);
+    }
 
     #[test]
     fn defaults_are_scipy_defaults() {

@@ -110,6 +110,9 @@ pub enum SpectralError {
         /// Number of channels given.
         got: usize,
     },
+    /// A median whose segment spectra do not fit into the memory available.
+    #[error(transparent)]
+    TooLarge(#[from] crate::limits::LimitError),
     /// No channel at all was given.
     #[error("at least one channel is needed for a spectral estimate")]
     NoChannels,

@@ -8,6 +8,7 @@ use realfft::{RealFftPlanner, RealToComplex};
 use super::stats::{median_bias, median_in_place, pairwise_sum};
 use super::window::hann_periodic;
 use super::{Averaging, Detrend, SpectralError, WelchConfig};
+use crate::limits::check_memory;
 
 /// One-sided power spectral density of one series.
 #[derive(Debug, Clone, PartialEq)]
@@ -422,7 +423,17 @@ pub fn csd_matrix(
         return Err(SpectralError::NoChannels);
     }
     check_equal_lengths(channels)?;
-    let n_segments = cfg.check_series_len(channels[0].len())?;
+    let n = channels[0].len();
+    let n_segments = cfg.check_series_len(n)?;
+    check_memory(
+        || {
+            format!(
+                "median of {n_segments} Welch segments of {} samples (overlap {})",
+                cfg.segment_len, cfg.overlap
+            )
+        },
+        cfg.kept_bytes(n, channels.len()),
+    )?;
     let mut acc = WelchAccumulator::new(channels.len(), fs_hz, cfg)?;
     acc.reserve_segments(n_segments);
     acc.push(channels)?;
@@ -455,6 +466,27 @@ pub fn csd(x: &[f64], y: &[f64], fs_hz: f64, cfg: &WelchConfig) -> Result<Csd, S
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Linux only: elsewhere the memory available is unknown and the run would start.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_median_beyond_any_memory_is_refused_before_allocating() {
+        // 5e5 segments of 2.5e5 frequencies: 2 TB of spectra to keep.
+        let x = vec![0.0; 1_000_000];
+        let cfg = WelchConfig::new(500_000)
+            .with_overlap(499_999)
+            .with_averaging(Averaging::Median);
+        match welch(&x, 1.0, &cfg) {
+            Err(SpectralError::TooLarge(e)) => {
+                let e = e.to_string();
+                assert!(
+                    e.starts_with("median of 500001 Welch segments of 500000"),
+                    "{e}"
+                );
+            }
+            other => panic!("{:?}", other.map(|p| p.n_segments)),
+        }
+    }
 
     fn series(n: usize, seed: u64) -> Vec<f64> {
         // Deterministic, non-trivial test signal (a cheap LCG plus a tone).

@@ -5,6 +5,7 @@
 use super::buffer::zeroed_f64;
 use super::{Request, TransferFunction, TransferMatrix};
 use crate::error::TfError;
+use crate::limits::{check_memory, planned_bytes, GRID_BYTES_PER_ENTRY};
 use num_complex::Complex64;
 
 /// Values per frequency of `request`; panics unless `out` holds that many per frequency of
@@ -88,10 +89,22 @@ pub fn eval_grid_threads(
 
 /// Evaluates a plan on every frequency of a grid, on one thread, into a new matrix in the
 /// plan's [`Layout`](super::Layout) ([`TransferFunction::layout`]). Stops at the first singular frequency.
+///
+/// # Errors
+///
+/// [`TfError::TooLarge`] before allocating when the result and an output written from it
+/// ([`GRID_BYTES_PER_ENTRY`] per entry and frequency) do not fit into the memory available;
+/// [`TfError::Singular`], [`TfError::NotFinite`] at the first frequency that has no value.
 pub fn evaluate(tf: &dyn TransferFunction, freqs_hz: &[f64]) -> Result<TransferMatrix, TfError> {
     let layout = tf.layout();
-    let data = zeroed_f64(layout.n_planes() * freqs_hz.len());
     let r = tf.request();
+    let (n_out, n_in, n) = (r.outputs.len(), r.inputs.len(), freqs_hz.len());
+    let entries = (n_out * n_in) as u64;
+    check_memory(
+        || format!("transfer functions of {n_out} outputs x {n_in} inputs at {n} frequencies"),
+        planned_bytes(n, entries.saturating_mul(GRID_BYTES_PER_ENTRY)),
+    )?;
+    let data = zeroed_f64(layout.n_planes() * n);
     let mut m = TransferMatrix::from_parts(
         Vec::new(),
         r.outputs.clone(),

@@ -557,7 +557,10 @@ fn invalid_settings_are_refused_with_the_value() {
         ..base.clone()
     });
     assert!(
-        matches!(e, SimError::TooManySamples { .. }) && e.to_string().contains("1000000000"),
+        matches!(e, SimError::TooLarge(_))
+            && e.to_string().contains("dt = 1e-6 s: ")
+            && e.to_string()
+                .contains("samples, more than the 16777216 allowed"),
         "{e}"
     );
     let e = run(SimConfig {

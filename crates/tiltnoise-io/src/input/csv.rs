@@ -4,6 +4,10 @@
 //! (they carry the metadata); the header and the records are tokenized by
 //! [`tiltnoise_core::csv_text`], whose rules (blank and comment lines skipped, fields trimmed,
 //! double quotes) hold for every CSV file tiltnoise reads.
+//!
+//! A file is read through [`BoundedReader`]: at most [`MAX_DATA_FILE_BYTES`] (a larger regular
+//! file is refused before reading), lines of at most [`MAX_LINE_BYTES`], and at most
+//! [`MAX_SERIES_SAMPLES`] records.
 
 use super::meta::decide_quantity;
 use super::InputError;
@@ -13,6 +17,16 @@ use std::io::{BufRead, BufReader, Chain, Cursor, Read};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::csv_text::{CsvRecords, RecordError};
 use tiltnoise_core::error::{shown_list, Shown};
+use tiltnoise_core::limits::{
+    check_count, check_file_len, BoundedReader, Overrun, MAX_DATA_FILE_BYTES, MAX_LINE_BYTES,
+    MAX_SERIES_SAMPLES,
+};
+
+/// What [`MAX_DATA_FILE_BYTES`] limits, for messages.
+const DATA_FILE: &str = "a CSV input";
+
+/// The file as read: bounded in bytes and line length.
+type Source = BufReader<BoundedReader<File>>;
 
 /// Metadata keys recognised in `# key: value` lines before the header.
 pub(crate) const META_KEYS: [&str; 4] = ["units", "axes", "start_time", "description"];
@@ -48,13 +62,13 @@ impl Prelude {
 pub(crate) struct CsvFile {
     pub path: PathBuf,
     /// The header line, then the rest of the file.
-    records: CsvRecords<Chain<Cursor<String>, BufReader<File>>>,
+    records: CsvRecords<Chain<Cursor<String>, Source>>,
 }
 
 /// The lines before the header, one at a time.
 struct Lines<'a> {
     path: &'a Path,
-    reader: BufReader<File>,
+    reader: Source,
     line_no: usize,
     /// The last line read, with its line ending.
     buf: String,
@@ -76,10 +90,7 @@ impl Lines<'_> {
             if e.kind() == std::io::ErrorKind::InvalidData {
                 self.err(self.line_no + 1, NOT_UTF8.to_string())
             } else {
-                InputError::Io {
-                    path: self.path.to_path_buf(),
-                    reason: e,
-                }
+                io_error(self.path, e)
             }
         })?;
         if n == 0 {
@@ -93,13 +104,23 @@ impl Lines<'_> {
     }
 }
 
-/// The error of a record that could not be read.
-fn record_error(path: &Path, e: RecordError) -> InputError {
-    match e {
-        RecordError::Io(reason) => InputError::Io {
+/// The error of a failed read: a limit of the [`BoundedReader`] or the operating system's.
+fn io_error(path: &Path, reason: std::io::Error) -> InputError {
+    match Overrun::of(&reason) {
+        Some(o) => o
+            .to_limit_error(&format!("input file {}", path.display()), DATA_FILE)
+            .into(),
+        None => InputError::Io {
             path: path.to_path_buf(),
             reason,
         },
+    }
+}
+
+/// The error of a record that could not be read.
+fn record_error(path: &Path, e: RecordError) -> InputError {
+    match e {
+        RecordError::Io(reason) => io_error(path, reason),
         RecordError::NotUtf8 { line } => InputError::Csv {
             path: path.to_path_buf(),
             line,
@@ -116,13 +137,20 @@ fn record_error(path: &Path, e: RecordError) -> InputError {
 impl CsvFile {
     /// Opens `path` and reads its comment and metadata lines and its header.
     pub fn open(path: &Path) -> Result<(CsvFile, Prelude), InputError> {
-        let file = File::open(path).map_err(|reason| InputError::Io {
+        let io = |reason| InputError::Io {
             path: path.to_path_buf(),
             reason,
-        })?;
+        };
+        let file = File::open(path).map_err(io)?;
+        let meta = file.metadata().map_err(io)?;
+        if meta.is_file() {
+            let what = || format!("input file {}", path.display());
+            check_file_len(what, meta.len(), MAX_DATA_FILE_BYTES, DATA_FILE)?;
+        }
+        let bounded = BoundedReader::new(file, MAX_DATA_FILE_BYTES, MAX_LINE_BYTES);
         let mut lines = Lines {
             path,
-            reader: BufReader::with_capacity(1 << 16, file),
+            reader: BufReader::with_capacity(1 << 16, bounded),
             line_no: 0,
             buf: String::new(),
         };
@@ -208,18 +236,36 @@ impl CsvFile {
         ))
     }
 
-    /// Calls `f(line_number, fields)` for every record after the header. Every record must have
-    /// `n_fields` fields.
+    /// Calls `f(line_number, fields)` for every record after the header, at most
+    /// [`MAX_SERIES_SAMPLES`]. Every record must have `n_fields` fields.
     pub fn for_each_record(
         &mut self,
         n_fields: usize,
+        f: impl FnMut(usize, &[&str]) -> Result<(), InputError>,
+    ) -> Result<(), InputError> {
+        self.for_each_record_up_to(MAX_SERIES_SAMPLES, n_fields, f)
+    }
+
+    /// [`CsvFile::for_each_record`] with at most `max_records` records.
+    fn for_each_record_up_to(
+        &mut self,
+        max_records: usize,
+        n_fields: usize,
         mut f: impl FnMut(usize, &[&str]) -> Result<(), InputError>,
     ) -> Result<(), InputError> {
+        let mut count = 0usize;
         while let Some((line, fields)) = self
             .records
             .next_record()
             .map_err(|e| record_error(&self.path, e))?
         {
+            count += 1;
+            check_count(
+                || format!("input file {}, line {line}", self.path.display()),
+                count as f64,
+                "data rows",
+                max_records,
+            )?;
             if fields.len() != n_fields {
                 return Err(InputError::Csv {
                     path: self.path.clone(),
@@ -428,6 +474,31 @@ fn start_time(path: &Path, prelude: &Prelude) -> Result<Option<String>, InputErr
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn records_beyond_the_limit_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.csv");
+        std::fs::write(&path, "# units: rad\ntime_s,E\n0,1\n1,2\n\n2,3\n3,4\n").unwrap();
+        let (mut file, _) = CsvFile::open(&path).unwrap();
+        let mut rows = 0;
+        let e = file
+            .for_each_record_up_to(3, 2, |_, _| {
+                rows += 1;
+                Ok(())
+            })
+            .unwrap_err()
+            .to_string();
+        assert_eq!(rows, 3);
+        assert_eq!(
+            e,
+            format!(
+                "input file {}, line 7: 4 data rows, more than the 3 allowed (see \
+                 docs/limits.md)",
+                path.display()
+            )
+        );
+    }
 
     #[test]
     fn resolution() {

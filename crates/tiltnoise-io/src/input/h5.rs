@@ -11,6 +11,9 @@ use hdf5::types::{FixedAscii, FixedUnicode, TypeDescriptor, VarLenAscii, VarLenU
 use hdf5::{Attribute, Location, LocationType};
 use std::path::Path;
 use tiltnoise_core::error::shown_list;
+use tiltnoise_core::limits::{
+    check_count, check_memory, planned_bytes, MAX_SERIES_SAMPLES, SERIES_BYTES_PER_SAMPLE,
+};
 
 /// Maps an HDF5 error to [`InputError::Hdf5`] naming `object`.
 pub(crate) fn h5err(
@@ -35,6 +38,23 @@ pub(crate) fn open(path: &Path) -> Result<hdf5::File, InputError> {
         });
     }
     hdf5::File::open(path).map_err(h5err(path, "file (is it an HDF5 file?)"))
+}
+
+/// Refuses to read `channels` datasets of `len` samples (or frequencies) each into memory when
+/// `len` is over [`MAX_SERIES_SAMPLES`] or they do not fit into the memory available: the
+/// length comes from the file's metadata, which a file of a few KiB can set to 10^12.
+pub(crate) fn check_whole_read(
+    path: &Path,
+    dataset: &str,
+    len: usize,
+    channels: usize,
+    unit: &'static str,
+) -> Result<(), InputError> {
+    let what = || format!("input file {}, dataset {dataset}", path.display());
+    check_count(what, len as f64, unit, MAX_SERIES_SAMPLES)?;
+    let per_sample = SERIES_BYTES_PER_SAMPLE.saturating_mul(channels as u64);
+    check_memory(what, planned_bytes(len, per_sample))?;
+    Ok(())
 }
 
 /// A decoded attribute value.

@@ -85,7 +85,12 @@ fn read_series_hdf5(path: &Path) -> Result<MeasuredSeries, InputError> {
     }
     let sample_rate_hz = h5::sample_rate_hz(path, &file)?;
     let mut channels: Vec<(Observable, Vec<f64>)> = Vec::new();
-    for name in h5::root_datasets(path, &file)? {
+    let names = h5::root_datasets(path, &file)?;
+    let n_observables = names
+        .iter()
+        .filter(|n| Observable::from_name(n).is_some())
+        .count();
+    for name in names {
         let Some(o) = Observable::from_name(&name) else {
             continue;
         };
@@ -113,6 +118,13 @@ fn read_series_hdf5(path: &Path) -> Result<MeasuredSeries, InputError> {
                 })
             }
         }
+        h5::check_whole_read(
+            path,
+            &format!("/{name}"),
+            shape[0],
+            n_observables,
+            "samples",
+        )?;
         let data: Vec<f64> = ds.read_raw::<f64>().map_err(h5err(path, object.clone()))?;
         channels.push((o, data));
     }

@@ -8,6 +8,7 @@ use super::{gap_note, ChannelCtx, Gap, GapScanner, Integrator, TiltSeries};
 use super::{require_two, InputError};
 use super::{GapPolicy, InputFormat, InputKind, Provenance, Quantity, ReadOptions, SeriesSource};
 use std::path::{Path, PathBuf};
+use tiltnoise_core::limits::{check_count, MAX_STREAMED_SAMPLES};
 use tiltnoise_core::model::TiltAxis;
 
 /// Samples per channel read at a time by the scanning pass at open (2 MiB of `f64`).
@@ -24,7 +25,7 @@ const CHECKPOINT_SPACING: usize = 1 << 16;
 ///
 /// # Cost and memory
 ///
-/// Opening reads only metadata, except when the quantity is a rate or gaps are interpolated:
+/// At most [`MAX_STREAMED_SAMPLES`] per channel. Opening reads only metadata, except when the quantity is a rate or gaps are interpolated:
 /// then one streaming pass over every mapped channel (in blocks of 2^18 samples) computes the
 /// mean of the rate and records the interior gaps (32 bytes per gap). A chunk costs
 /// `n_axes * len * 8` bytes. For a rate, the running integral is carried from one chunk to the
@@ -162,6 +163,12 @@ impl TiltSeriesSource {
         let quantity = decide_quantity(path, opts.quantity, &declared, &undeclared, &mut notes)?;
         let (first_name, len) = first_len.unwrap_or_default();
         require_two(path, &format!("dataset /{first_name}"), len, "samples")?;
+        check_count(
+            || format!("input file {}, dataset /{first_name}", path.display()),
+            len as f64,
+            "samples",
+            MAX_STREAMED_SAMPLES,
+        )?;
         notes.push(format!(
             "sample rate {sample_rate_hz} Hz from root attribute sample_rate_hz"
         ));
@@ -366,8 +373,15 @@ impl TiltSeriesSource {
     ///
     /// # Errors
     ///
-    /// As [`TiltSeriesSource::read_chunk`].
+    /// [`InputError::TooLarge`] for more than
+    /// [`tiltnoise_core::limits::MAX_SERIES_SAMPLES`] samples or more than the memory
+    /// available; otherwise as [`TiltSeriesSource::read_chunk`].
     pub fn read_all(&mut self) -> Result<TiltSeries, InputError> {
+        let first = self
+            .channels
+            .first()
+            .map_or(String::new(), |m| format!("/{}", m.source));
+        h5::check_whole_read(&self.path, &first, self.len, self.channels.len(), "samples")?;
         let data = self.read_chunk(0, self.len)?;
         Ok(TiltSeries {
             sample_rate_hz: self.sample_rate_hz,

@@ -43,6 +43,8 @@ pub(crate) fn read(
             allowed: "a 1-D float64 dataset (Hz)".to_string(),
         });
     }
+    // The values: one CSD matrix of up to 3 x 3 complex (2 x 9 `f64`) per frequency.
+    h5::check_whole_read(path, "/frequency_hz", fds.size(), 19, "frequencies")?;
     let freqs: Vec<f64> = fds
         .read_raw::<f64>()
         .map_err(h5err(path, "dataset /frequency_hz"))?;
