@@ -216,7 +216,7 @@ mod tests {
         assert!(parse_spec("1e-4:4294967296:30")
             .unwrap_err()
             .to_string()
-            .contains("at most 10000000 allowed"));
+            .contains("more than the 1000000 allowed"));
     }
 
     /// A single loss angle leaves the modes that touch its element only weakly with modal loss
