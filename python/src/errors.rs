@@ -5,7 +5,8 @@
 //! * A file that was read but is not valid (layout, attributes, values, a parameter file's
 //!   TOML): [`InputFileError`], a subclass of `OSError`.
 //! * Everything else the caller can fix (a parameter out of range, an unknown name, an option
-//!   that does not fit the data, a frequency on an undamped resonance): `ValueError`.
+//!   that does not fit the data, a file extension that names no format, a frequency on an
+//!   undamped resonance): `ValueError`.
 
 use pyo3::exceptions::{
     PyFileNotFoundError, PyIsADirectoryError, PyOSError, PyPermissionError, PyValueError,
@@ -57,6 +58,9 @@ impl IntoPyErr for InputError {
         let message = self.to_string();
         match self {
             InputError::Io { reason, .. } => os_error(reason.kind(), message),
+            // A path whose extension names no supported format: the argument is wrong, not
+            // the file (which is not opened).
+            InputError::Extension { .. } => PyValueError::new_err(message),
             _ => InputFileError::new_err(message),
         }
     }
