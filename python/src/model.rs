@@ -354,7 +354,11 @@ impl PyModel {
     /// Returns a complex128 array ``H[n_freq, n_outputs, n_inputs]`` in the order asked: the
     /// complex amplitude of each observable per unit input for ``exp(+i w t)`` time
     /// dependence, in the observable's unit per the input's unit (m/rad, rad/rad, m/N,
-    /// rad/(N m), ...). Raises ``ValueError`` for an unknown name, a frequency that is
+    /// rad/(N m), ...). ``auto`` measures the candidates against the double-double reference
+    /// on the grid's band (about 0.1 s) once per request, band and tolerance, and remembers the
+    /// pick: the result never depends on earlier calls. For many grids on different bands,
+    /// name the method (``method="polezero"`` is what it picks for the tilt matrix of Table I).
+    /// Raises ``ValueError`` for an unknown name, a frequency that is
     /// negative or not finite, or one on an undamped resonance.
     #[pyo3(signature = (freq_hz, inputs=None, outputs=None, method="auto", rel_tol=tf::DEFAULT_REL_TOL, threads=None, out=None))]
     #[allow(clippy::too_many_arguments)]
