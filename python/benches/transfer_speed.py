@@ -98,6 +98,10 @@ def main():
         "tiltnoise_1thread_out": lambda: model.transfer(f, threads=1, out=out),
         "numpy_stack": stack,
         "numpy_solve": lambda: solve(d, g),
+        # The memory floor of the result: writing its 336 bytes per point, into a new array
+        # and into a reused one, with nothing computed.
+        "floor_new_array": lambda: np.ones(h.shape, h.dtype),
+        "floor_fill_out": lambda: out.fill(1.0),
     }
     names = list(runs)
     for fn in runs.values():
