@@ -4,7 +4,7 @@
 //!
 //! A thin layer: every number comes from the library crates. It converts arguments (names as
 //! on the command line, NumPy arrays), the library's typed errors into Python exceptions with
-//! the command line's messages ([`errors`]), and releases the GIL around every computation.
+//! the command line's messages (module `errors`), and releases the GIL around every computation.
 
 mod budget;
 mod errors;
