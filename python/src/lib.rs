@@ -8,6 +8,7 @@
 
 mod budget;
 mod errors;
+mod fit;
 mod model;
 mod params;
 mod spectral;
@@ -27,6 +28,7 @@ fn tiltnoise_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<model::PyModel>()?;
     m.add_class::<model::Mode>()?;
     m.add_class::<model::MonteCarlo>()?;
+    m.add_class::<fit::Fit>()?;
     m.add_class::<budget::Budget>()?;
     m.add_function(wrap_pyfunction!(spectral::welch, m)?)?;
     m.add_function(wrap_pyfunction!(spectral::csd, m)?)?;

@@ -520,6 +520,23 @@ impl PyModel {
         })
     }
 
+    /// Constrained least-squares fit of the parameters ``free`` (dotted keys; default the
+    /// command line's eight) to measured mode frequencies, each within ``bound_sigmas`` of its
+    /// error bar, optionally with the Gaussian prior (the command line's ``tiltnoise fit``;
+    /// ``docs/fit.md``). ``measured``: a CSV file ``mode,frequency_hz[,sigma_hz]`` (any subset
+    /// of the modes); default Table II's measured column. Returns a :class:`Fit`.
+    #[pyo3(signature = (free=None, measured=None, bound_sigmas=1.0, prior=false))]
+    fn fit(
+        &self,
+        py: Python<'_>,
+        free: Option<Vec<String>>,
+        measured: Option<std::path::PathBuf>,
+        bound_sigmas: f64,
+        prior: bool,
+    ) -> PyResult<crate::fit::Fit> {
+        crate::fit::run(py, self.model.params(), free, measured, bound_sigmas, prior)
+    }
+
     fn __repr__(&self) -> String {
         format!("Model({})", self.params().describe())
     }

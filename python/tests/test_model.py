@@ -162,3 +162,24 @@ def test_bad_frequencies_and_resonances_raise_value_error(model):
 def test_explain_names_the_pick(model):
     text = model.explain(np.logspace(-5, 2, 100))
     assert "picked `polezero`" in text
+
+
+def test_fit_equals_the_command_lines(model, cli):
+    expected = json.loads(cli("fit", "--format", "json"))
+    got = model.fit()
+    for name in ("chi2", "chi2_nominal", "dof", "iterations", "evaluations", "stop",
+                 "prior_term", "projected_gradient", "singular_values"):
+        assert getattr(got, name) == expected[name], name
+    assert got.measured_origin == expected["measured_origin"]
+    assert got.parameters == expected["parameters"]
+    assert got.modes == expected["modes"]
+    assert got.params.to_toml() == expected["fitted_params_toml"]
+
+
+def test_fit_errors(model, tmp_path):
+    with pytest.raises(ValueError, match="unknown parameter key `length.hh`"):
+        model.fit(free=["length.hh"])
+    bad = tmp_path / "modes.csv"
+    bad.write_text("mode,frequency_hz\n9,1.0\n")
+    with pytest.raises(tiltnoise.InputFileError, match="modes.csv"):
+        model.fit(measured=bad)

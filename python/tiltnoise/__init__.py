@@ -24,6 +24,7 @@ files that are read but not valid.
 
 from ._tiltnoise import (
     Budget,
+    Fit,
     InputFileError,
     Mode,
     Model,
@@ -39,6 +40,7 @@ from ._tiltnoise import (
 
 __all__ = [
     "Budget",
+    "Fit",
     "InputFileError",
     "Mode",
     "Model",

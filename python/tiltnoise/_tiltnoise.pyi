@@ -51,6 +51,25 @@ class MonteCarlo:
     mean_hz: list[float]
     std_hz: list[float]
 
+class Fit:
+    @property
+    def params(self) -> Params: ...
+    @property
+    def parameters(self) -> list[dict[str, Any]]: ...
+    @property
+    def modes(self) -> list[dict[str, Any]]: ...
+    chi2: float
+    chi2_nominal: float
+    prior_term: float
+    dof: int
+    singular_values: list[float]
+    weak_directions: list[Tuple[float, list[Tuple[str, float]]]]
+    iterations: int
+    evaluations: int
+    stop: str
+    projected_gradient: float
+    measured_origin: str
+
 class Model:
     def __init__(self, params: Optional[Params] = None) -> None: ...
     @property
@@ -77,6 +96,13 @@ class Model:
     ) -> str: ...
     def matrices(self) -> dict[str, Any]: ...
     def monte_carlo(self, samples: int = 10000, seed: int = 1, threads: int = 0) -> MonteCarlo: ...
+    def fit(
+        self,
+        free: Optional[Sequence[str]] = None,
+        measured: Optional[_Path] = None,
+        bound_sigmas: float = 1.0,
+        prior: bool = False,
+    ) -> Fit: ...
 
 class Budget:
     @property
