@@ -180,3 +180,20 @@ def test_to_gwpy(lab_budget):
     np.testing.assert_allclose(x.frequencies.value, lab_budget.freq_hz, rtol=1e-12)
     assert str(x.unit) in ("m / Hz(1/2)", "m / Hz1/2")
     assert set(series["phi"]) == {"tilt", "tilt.theta_t", "tilt.eta_t", "total"}
+
+
+def test_saved_hdf5_equals_the_command_lines(lab_budget, cli, tmp_path):
+    h5py = pytest.importorskip("h5py")
+    theirs, mine = tmp_path / "cli.h5", tmp_path / "mine.h5"
+    cli("budget", "--tilt", LAB_TILT, "--nperseg", 4096, "--segment-duration", 14400,
+        "--save", theirs)
+    lab_budget.save(mine)
+    with h5py.File(theirs, "r") as a, h5py.File(mine, "r") as b:
+        assert b.attrs["schema"] == "tiltnoise.budget"
+        for key in ("parameters_toml", "input_path", "input_axis_map", "source", "n_samples"):
+            assert a.attrs[key] == b.attrs[key], key
+        assert list(a.attrs["notes"]) == list(b.attrs["notes"])
+        names = []
+        a.visititems(lambda name, obj: names.append(name) if isinstance(obj, h5py.Dataset) else None)
+        for name in names:
+            np.testing.assert_array_equal(a[name][()], b[name][()], err_msg=name)
