@@ -5,7 +5,8 @@
 #   python/run_tests.sh [VENV_DIR]        (default: a new temporary directory)
 #
 # The tests that compare with the command line need its binary: `cargo build --release`
-# first (CI's `cargo test --release` builds it), or set TILTNOISE_BIN. CARGO_TARGET_DIR is
+# first (CI's `cargo test --release` builds it); with TILTNOISE_BIN=/abs/path/tiltnoise they
+# fail instead of being skipped when it is missing. CARGO_TARGET_DIR is
 # honoured, so a previous build of the crates is reused. Exits non-zero when pytest fails or
 # collects no test (pytest's exit code 5).
 set -euo pipefail

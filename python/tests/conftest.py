@@ -12,9 +12,15 @@ LAB_TILT = REPO / "tilt_data" / "lab_tilt_24h.h5"
 
 
 def _cli():
-    """The `tiltnoise` binary: $TILTNOISE_BIN, else target/release of this checkout (or of
+    """The `tiltnoise` binary: $TILTNOISE_BIN (which must then exist: CI sets it so that the
+    comparisons cannot be skipped), else target/release of this checkout (or of
     $CARGO_TARGET_DIR), else one on PATH."""
-    candidates = [os.environ.get("TILTNOISE_BIN")]
+    given = os.environ.get("TILTNOISE_BIN")
+    if given:
+        if not (Path(given).is_file() and os.access(given, os.X_OK)):
+            raise pytest.UsageError(f"TILTNOISE_BIN={given} is not an executable file")
+        return given
+    candidates = []
     for target in (os.environ.get("CARGO_TARGET_DIR"), REPO / "target"):
         if target:
             candidates.append(Path(target) / "release" / "tiltnoise")
