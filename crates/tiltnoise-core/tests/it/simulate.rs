@@ -571,7 +571,11 @@ fn invalid_settings_are_refused_with_the_value() {
     let mut bad = init;
     bad.qdot[5] = f64::NAN;
     let e = simulate(&model, &bad, &base).unwrap_err();
-    assert!(e.to_string().contains("qdot[5]"), "{e}");
+    // qdot[5] is the rate of eta_b (Coord::ALL order), named as such.
+    assert!(
+        e.to_string().contains("rate of eta_b") && e.to_string().contains("NaN"),
+        "{e}"
+    );
     let mut p = Params::table_i();
     p.loss.torsion_b_rad = 1e-3;
     let damped = Model::new(&p).unwrap();
