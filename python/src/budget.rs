@@ -49,7 +49,15 @@ impl SeriesSource for ArraySeries {
     }
 
     fn read_chunk(&mut self, start: usize, len: usize) -> Result<Vec<Vec<f64>>, InputError> {
-        // The budget job reads in order within `len()`: a slice out of range is a bug there.
+        let available = SeriesSource::len(self);
+        if start.checked_add(len).is_none_or(|end| end > available) {
+            return Err(InputError::ChunkOutOfRange {
+                path: PathBuf::from("(arrays)"),
+                start,
+                len,
+                available,
+            });
+        }
         Ok(self
             .data
             .iter()
