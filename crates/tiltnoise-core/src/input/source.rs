@@ -1,9 +1,10 @@
 //! [`SeriesSource`]: what the budget job needs of a tilt time series, so that it can stream a
 //! long record from a file (`tiltnoise-io`'s HDF5 reader) or run on one held in memory
-//! ([`TiltSeries`]) without knowing which.
+//! ([`TiltSeries`], or arrays handed over by the Python package) without knowing which. Only
+//! samples: where they came from ([`super::Provenance`]) is the caller's to record.
 
 use super::error::InputError;
-use super::{Provenance, TiltSeries};
+use super::TiltSeries;
 use crate::model::TiltAxis;
 
 /// A tilt time series read in sequential chunks: tilt angle `t` (rad) in the convention of
@@ -22,9 +23,6 @@ pub trait SeriesSource {
 
     /// The axes, in canonical order; [`SeriesSource::read_chunk`] returns one vector per entry.
     fn axes(&self) -> &[TiltAxis];
-
-    /// Where the series came from (for the output files).
-    fn provenance(&self) -> &Provenance;
 
     /// Samples `start .. start + len` of every axis, tilt angle (rad). Callers read in order
     /// (a rate source carries its integral from one chunk to the next).
@@ -47,10 +45,6 @@ impl SeriesSource for TiltSeries {
 
     fn axes(&self) -> &[TiltAxis] {
         &self.axes
-    }
-
-    fn provenance(&self) -> &Provenance {
-        &self.provenance
     }
 
     fn read_chunk(&mut self, start: usize, len: usize) -> Result<Vec<Vec<f64>>, InputError> {

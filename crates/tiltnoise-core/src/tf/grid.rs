@@ -179,6 +179,7 @@ const CHECK_BLOCK: usize = 2048;
 
 /// Whether every value is finite: `v - v` is 0 for a finite value and NaN for inf or NaN, and
 /// sums of those, kept in independent lanes, vectorize with plain SSE2.
+#[allow(clippy::eq_op, reason = "`v - v` is the finiteness test")]
 fn all_finite(values: &[f64]) -> bool {
     let mut lanes = [0.0f64; 8];
     let mut chunks = values.chunks_exact(8);

@@ -405,10 +405,6 @@ impl SeriesSource for TiltSeriesSource {
         TiltSeriesSource::axes(self)
     }
 
-    fn provenance(&self) -> &Provenance {
-        TiltSeriesSource::provenance(self)
-    }
-
     fn read_chunk(&mut self, start: usize, len: usize) -> Result<Vec<Vec<f64>>, InputError> {
         TiltSeriesSource::read_chunk(self, start, len)
     }

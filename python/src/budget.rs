@@ -1,0 +1,897 @@
+//! `tiltnoise.budget` (arrays) and `tiltnoise.budget_from_file` (the command line's `budget
+//! --tilt FILE`), and the `Budget` they return.
+
+use crate::errors::{value_error, IntoPyErr, PyResultExt};
+use crate::model::PyModel;
+use crate::params::PyParams;
+use crate::spectral::{averaging, series};
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use tiltnoise_core::budget::{
+    add_measured, budget_from_series, budget_from_spectra, series_psds, BudgetError, BudgetOptions,
+    MeasuredPsds,
+};
+use tiltnoise_core::freq;
+use tiltnoise_core::input::{
+    process_channel, ChannelCtx, GapPolicy, InputError, InputMeta, Quantity, SeriesSource,
+};
+use tiltnoise_core::model::{Model, Observable, TiltAxis};
+use tiltnoise_core::noise::equivalent::referred_terms;
+use tiltnoise_core::noise::{BudgetReport, Readout, SpectralSource};
+use tiltnoise_core::params::Params;
+use tiltnoise_io::input::{
+    read_measured_input, read_tilt, AxisMap, InputFormat, MeasuredInput, ReadOptions, TiltInput,
+    TiltSeriesSource,
+};
+use tiltnoise_io::RunMeta;
+
+/// A tilt time series handed over as arrays: angle (rad) per axis in canonical order.
+struct ArraySeries {
+    sample_rate_hz: f64,
+    axes: Vec<TiltAxis>,
+    data: Vec<Vec<f64>>,
+}
+
+impl SeriesSource for ArraySeries {
+    fn sample_rate_hz(&self) -> f64 {
+        self.sample_rate_hz
+    }
+
+    fn len(&self) -> usize {
+        self.data.first().map_or(0, Vec::len)
+    }
+
+    fn axes(&self) -> &[TiltAxis] {
+        &self.axes
+    }
+
+    fn read_chunk(&mut self, start: usize, len: usize) -> Result<Vec<Vec<f64>>, InputError> {
+        let available = SeriesSource::len(self);
+        if start.checked_add(len).is_none_or(|end| end > available) {
+            return Err(InputError::ChunkOutOfRange {
+                path: PathBuf::from("(arrays)"),
+                start,
+                len,
+                available,
+            });
+        }
+        Ok(self
+            .data
+            .iter()
+            .map(|c| c[start..start + len].to_vec())
+            .collect())
+    }
+}
+
+/// The model of `params`: a `Model` (reused as it is), a `Params`, or Table I for `None`.
+fn model_of(params: Option<&Bound<'_, PyAny>>) -> PyResult<(Arc<Model>, Params)> {
+    let Some(p) = params else {
+        let params = Params::table_i();
+        return Ok((Arc::new(Model::new(&params).py()?), params));
+    };
+    if let Ok(m) = p.cast::<PyModel>() {
+        let model = Arc::clone(&m.get().model);
+        let params = model.params().clone();
+        return Ok((model, params));
+    }
+    let params = p
+        .cast::<PyParams>()
+        .map_err(|_| value_error("params: expected a tiltnoise.Params or a tiltnoise.Model"))?
+        .get()
+        .inner
+        .clone();
+    Ok((Arc::new(Model::new(&params).py()?), params))
+}
+
+/// The readout of `readout` (`{observable: ASD}`), over the default 9e-9 m/sqrt(Hz) on X as
+/// the command line's `--readout OBS=ASD`: a value replaces the observable's readout, 0
+/// removes it.
+fn readout(arg: Option<&Bound<'_, PyDict>>, budgeted: &[Observable]) -> PyResult<Readout> {
+    let mut readout = Readout::default();
+    let Some(d) = arg else {
+        return Ok(readout);
+    };
+    for (name, value) in d.iter() {
+        let name: String = name.extract()?;
+        let names: Vec<&str> = budgeted.iter().map(|o| o.name()).collect();
+        let o = Observable::from_name(&name)
+            .filter(|o| budgeted.contains(o))
+            .ok_or_else(|| {
+                value_error(format!(
+                    "readout {name:?}: not a budgeted observable; allowed: {}",
+                    names.join(", ")
+                ))
+            })?;
+        let asd: f64 = value
+            .extract()
+            .map_err(|_| value_error(format!("readout {name}: the ASD must be a number")))?;
+        if !(asd.is_finite() && asd >= 0.0) {
+            return Err(value_error(format!(
+                "readout {name}={asd}: ASD {asd} {}/sqrt(Hz) is not allowed: must be finite and >= 0",
+                o.unit()
+            )));
+        }
+        readout.asd.retain(|(x, _)| *x != o);
+        if asd > 0.0 {
+            readout.asd.push((o, asd));
+        }
+    }
+    Ok(readout)
+}
+
+/// The Welch and segment options common to both entry points, as on the command line.
+struct SeriesOptions {
+    nperseg: Option<usize>,
+    overlap: Option<f64>,
+    average: Option<String>,
+    segment_duration: Option<f64>,
+    percentiles: Option<(f64, f64)>,
+}
+
+impl SeriesOptions {
+    /// The first option given, by name, for refusing them with spectra input.
+    fn first_given(&self) -> Option<&'static str> {
+        [
+            ("nperseg", self.nperseg.is_some()),
+            ("overlap", self.overlap.is_some()),
+            ("average", self.average.is_some()),
+            ("segment_duration", self.segment_duration.is_some()),
+        ]
+        .into_iter()
+        .find(|(_, given)| *given)
+        .map(|(name, _)| name)
+    }
+
+    fn apply(&self, opts: &mut BudgetOptions) -> PyResult<()> {
+        opts.welch_segment_len = self.nperseg;
+        if let Some(o) = self.overlap {
+            opts.welch_overlap_fraction = o;
+        }
+        if let Some(a) = &self.average {
+            opts.averaging = averaging(a)?;
+        }
+        opts.segment_duration_s = self.segment_duration;
+        if let Some((lo, hi)) = self.percentiles {
+            if self.segment_duration.is_none() {
+                return Err(value_error(
+                    "percentiles apply to the per-segment band and need segment_duration \
+                     (e.g. segment_duration=3600)",
+                ));
+            }
+            if !(0.0 <= lo && lo < hi && hi <= 100.0) {
+                return Err(value_error(format!(
+                    "percentiles ({lo}, {hi}): expected (LOWER, UPPER) with 0 <= LOWER < UPPER <= 100"
+                )));
+            }
+            opts.percentiles = (lo, hi);
+        }
+        Ok(())
+    }
+}
+
+/// Adds the `measured` and `residual` terms from a measured record of the observables (the
+/// command line's `--measured FILE`).
+fn add_measured_file(report: &mut BudgetReport, path: &Path) -> Result<(), BudgetError> {
+    let (freqs_hz, psds, description) = match read_measured_input(path)? {
+        MeasuredInput::Spectra(m) => {
+            let psds = m
+                .asd
+                .iter()
+                .map(|(o, asd)| (*o, asd.iter().map(|a| a * a).collect()))
+                .collect();
+            (m.freqs_hz, psds, "measured spectrum".to_string())
+        }
+        MeasuredInput::Series(s) => {
+            let m = series_psds(&s.channels, s.sample_rate_hz, &report.source)?;
+            (m.freqs_hz, m.psds, m.description)
+        }
+    };
+    let measured = MeasuredPsds {
+        freqs_hz,
+        psds,
+        description,
+    };
+    add_measured(report, &measured, &path.display().to_string());
+    Ok(())
+}
+
+/// The tilt axis of a name, or a `ValueError` naming what is allowed.
+fn tilt_axis(name: &str) -> PyResult<TiltAxis> {
+    TiltAxis::ALL
+        .into_iter()
+        .find(|a| a.name() == name)
+        .ok_or_else(|| {
+            value_error(format!(
+                "tilt axis {name:?} is not allowed: must be theta_t, eta_t or phi_t (rad, the \
+                 rotation taking the floor frame to the inertial frame)"
+            ))
+        })
+}
+
+/// A gap or non-finite sample of an array, named by the axis instead of a file.
+fn array_error(e: InputError) -> PyErr {
+    match e {
+        InputError::NonFinite {
+            channel,
+            index,
+            value,
+            unit,
+            ..
+        } => value_error(format!(
+            "tilt[{channel:?}][{index}] is {value:?} {unit}; allowed: finite values (or \
+             gaps=\"interpolate\" to bridge interior gaps linearly)"
+        )),
+        InputError::EdgeGap {
+            channel,
+            edge,
+            first,
+            last,
+            len,
+            ..
+        } => value_error(format!(
+            "tilt[{channel:?}] has a {edge} gap of non-finite samples at indices \
+             {first}..={last} (of {len}); gap interpolation needs a finite sample on both \
+             sides: trim the series"
+        )),
+        other => value_error(other.to_string()),
+    }
+}
+
+/// `(axis, samples)` from a dict `{axis: array}` or a 2-D array with `axes`.
+fn tilt_channels(
+    tilt: &Bound<'_, PyAny>,
+    axes: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Vec<(TiltAxis, Vec<f64>)>> {
+    if let Ok(d) = tilt.cast::<PyDict>() {
+        if axes.is_some() {
+            return Err(value_error(
+                "axes: give the axes either as the keys of the tilt dict or with a 2-D array, \
+                 not both",
+            ));
+        }
+        return d
+            .iter()
+            .map(|(k, v)| {
+                let name: String = k.extract()?;
+                let axis = tilt_axis(&name)?;
+                Ok((axis, series(&format!("tilt[{name:?}]"), &v)?))
+            })
+            .collect();
+    }
+    let Some(axes) = axes else {
+        return Err(value_error(
+            "tilt: a 2-D array needs axes, e.g. axes=(\"theta_t\", \"eta_t\") for its rows; or \
+             give a dict {\"theta_t\": ..., \"eta_t\": ...}",
+        ));
+    };
+    let names: Vec<String> = match axes.cast::<PyString>() {
+        Ok(s) => s
+            .to_cow()?
+            .split(',')
+            .map(|n| n.trim().to_string())
+            .collect(),
+        Err(_) => axes.extract()?,
+    };
+    let np = tilt.py().import("numpy")?;
+    let array = np
+        .call_method1("asarray", (tilt, "float64"))
+        .map_err(|e| value_error(format!("tilt: not an array of numbers ({e})")))?
+        .cast_into::<PyArrayDyn<f64>>()?;
+    let shape = array.shape().to_vec();
+    if shape.len() != 2 || shape[0] != names.len() {
+        return Err(value_error(format!(
+            "tilt: expected a 2-D array of shape (len(axes), n_samples) = ({}, n), got shape {shape:?}",
+            names.len()
+        )));
+    }
+    let view = array.readonly();
+    let view = view.as_array();
+    names
+        .iter()
+        .zip(view.outer_iter())
+        .map(|(name, row)| Ok((tilt_axis(name)?, row.iter().copied().collect())))
+        .collect()
+}
+
+/// Noise budget of X, phi and phi_a from a tilt time series given as arrays.
+///
+/// ``tilt``: a dict ``{"theta_t": x, "eta_t": y}`` of 1-D arrays, or a 2-D array whose rows
+/// are the axes named by ``axes``. The axes are the crate's tilt angles ``theta_t``,
+/// ``eta_t``, ``phi_t`` (rad; the rotation taking the floor frame to the inertial frame, so
+/// a floor rotation ``E`` about East gives ``theta_t = -E``); ``quantity="rate"`` for rad/s,
+/// integrated as the file readers do. ``fs``: sample rate (Hz). ``gaps``: ``"reject"``
+/// (default) or ``"interpolate"`` non-finite samples.
+///
+/// The other options are the command line's ``budget`` options: ``nperseg`` (Welch segment,
+/// default 2**14 or the largest power of two <= n/4), ``overlap`` (fraction, default 0.5),
+/// ``average`` (``"mean"``/``"median"``), ``segment_duration`` (s) and ``percentiles``
+/// (default (10, 90)) for the per-segment band, ``readout`` (``{observable: ASD}`` over the
+/// default ``{"X": 9e-9}`` m/sqrt(Hz); 0 removes one), ``measured`` (a file of measured ASDs
+/// or series of the observables: adds the terms ``measured`` and ``residual``).
+/// ``params``: a :class:`Params` or a :class:`Model` (default Table I).
+///
+/// Returns a :class:`Budget`. Raises ``ValueError`` for options or data that do not fit.
+#[pyfunction]
+#[pyo3(signature = (tilt, fs, *, axes=None, quantity="angle", gaps="reject", params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, readout=None, measured=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn budget(
+    py: Python<'_>,
+    tilt: &Bound<'_, PyAny>,
+    fs: f64,
+    axes: Option<&Bound<'_, PyAny>>,
+    quantity: &str,
+    gaps: &str,
+    params: Option<&Bound<'_, PyAny>>,
+    nperseg: Option<usize>,
+    overlap: Option<f64>,
+    average: Option<String>,
+    segment_duration: Option<f64>,
+    percentiles: Option<(f64, f64)>,
+    readout: Option<&Bound<'_, PyDict>>,
+    measured: Option<PathBuf>,
+) -> PyResult<Budget> {
+    let (model, params) = model_of(params)?;
+    let quantity: Quantity = quantity.parse().map_err(value_error)?;
+    let gaps: GapPolicy = gaps.parse().map_err(value_error)?;
+    if !(fs.is_finite() && fs > 0.0) {
+        return Err(value_error(format!(
+            "fs {fs} Hz is not allowed: the sample rate must be finite and > 0"
+        )));
+    }
+    let mut channels = tilt_channels(tilt, axes)?;
+    channels.sort_by_key(|(a, _)| a.index());
+    if channels.is_empty() {
+        return Err(value_error(
+            "tilt: no axis given; give at least one of theta_t, eta_t, phi_t",
+        ));
+    }
+    for w in channels.windows(2) {
+        if w[0].0 == w[1].0 {
+            return Err(value_error(format!(
+                "tilt: axis {} is given twice",
+                w[0].0.name()
+            )));
+        }
+        if w[0].1.len() != w[1].1.len() {
+            return Err(value_error(format!(
+                "tilt: {} has {} samples but {} has {}: the axes must have equal length",
+                w[0].0.name(),
+                w[0].1.len(),
+                w[1].0.name(),
+                w[1].1.len()
+            )));
+        }
+    }
+    let mut opts = BudgetOptions {
+        readout: self::readout(readout, &BudgetOptions::default().outputs)?,
+        ..BudgetOptions::default()
+    };
+    SeriesOptions {
+        nperseg,
+        overlap,
+        average,
+        segment_duration,
+        percentiles,
+    }
+    .apply(&mut opts)?;
+    let mut notes = Vec::new();
+    let report = py.detach(|| -> PyResult<BudgetReport> {
+        for (axis, data) in channels.iter_mut() {
+            let ctx = ChannelCtx {
+                path: Path::new("tilt"),
+                channel: axis.name(),
+                unit: quantity.unit(),
+            };
+            let bridged = process_channel(data, gaps, quantity, fs, &ctx).map_err(array_error)?;
+            if bridged > 0 {
+                notes.push(tiltnoise_core::input::gap_note(axis.name(), bridged));
+            }
+        }
+        let mut source = ArraySeries {
+            sample_rate_hz: fs,
+            axes: channels.iter().map(|(a, _)| *a).collect(),
+            data: channels.into_iter().map(|(_, d)| d).collect(),
+        };
+        let mut report = budget_from_series(&model, &mut source, &opts, &mut |_, _| {}).py()?;
+        if let Some(path) = &measured {
+            add_measured_file(&mut report, path).py()?;
+        }
+        Ok(report)
+    })?;
+    let axis_map = report
+        .axes
+        .iter()
+        .map(|a| format!("{0}={0}", a.name()))
+        .collect::<Vec<_>>()
+        .join(",");
+    Ok(Budget::new(
+        &model,
+        report,
+        params,
+        InputMeta {
+            path: "(arrays)".into(),
+            format: "numpy".into(),
+            kind: "series".into(),
+            quantity: quantity.name().into(),
+            axis_map,
+            start_time: None,
+            notes,
+        },
+    ))
+}
+
+/// Noise budget of X, phi and phi_a from a tilt file (the command line's ``tiltnoise budget
+/// --tilt FILE``): HDF5 or CSV time series (angle or rate) or spectra, as described in
+/// ``docs/input_formats.md``; an HDF5 series is streamed from disk in bounded memory.
+///
+/// ``axes`` is the axis map (``"theta_t=-E,eta_t=-N"``; default from the file, else that),
+/// ``quantity`` ``"angle"``/``"rate"`` (default from the file, else angle), ``gaps``
+/// ``"reject"``/``"interpolate"``; ``freq`` is the model grid of spectra input (``"FLO:N:FHI"``
+/// or an array of Hz; default 1e-4..30 Hz plus points around every resonance). The Welch,
+/// segment, readout and measured options are those of :func:`budget`; series options are
+/// refused for spectra and ``freq`` for a series, as on the command line.
+///
+/// Raises ``FileNotFoundError``/``OSError`` if the file cannot be read, :class:`InputFileError`
+/// (an ``OSError``) if it is not a valid tilt input (the message names the file, the dataset
+/// or column and what is allowed), ``ValueError`` for options that do not fit.
+#[pyfunction]
+#[pyo3(signature = (path, *, axes=None, quantity=None, gaps=None, params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, readout=None, freq=None, measured=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn budget_from_file(
+    py: Python<'_>,
+    path: PathBuf,
+    axes: Option<&str>,
+    quantity: Option<&str>,
+    gaps: Option<&str>,
+    params: Option<&Bound<'_, PyAny>>,
+    nperseg: Option<usize>,
+    overlap: Option<f64>,
+    average: Option<String>,
+    segment_duration: Option<f64>,
+    percentiles: Option<(f64, f64)>,
+    readout: Option<&Bound<'_, PyDict>>,
+    freq: Option<&Bound<'_, PyAny>>,
+    measured: Option<PathBuf>,
+) -> PyResult<Budget> {
+    let (model, params) = model_of(params)?;
+    let ropts = ReadOptions {
+        axis_map: axes
+            .map(AxisMap::parse)
+            .transpose()
+            .map_err(|e| value_error(e.to_string()))?,
+        quantity: quantity.map(str::parse).transpose().map_err(value_error)?,
+        gaps: gaps.unwrap_or("reject").parse().map_err(value_error)?,
+    };
+    let series_opts = SeriesOptions {
+        nperseg,
+        overlap,
+        average,
+        segment_duration,
+        percentiles,
+    };
+    let mut opts = BudgetOptions {
+        readout: self::readout(readout, &BudgetOptions::default().outputs)?,
+        ..BudgetOptions::default()
+    };
+    series_opts.apply(&mut opts)?;
+    let grid = match freq {
+        None => None,
+        Some(f) => Some(match f.cast::<PyString>() {
+            Ok(spec) => freq::parse_spec(&spec.to_cow()?).py()?,
+            Err(_) => crate::model::frequencies(f)?,
+        }),
+    };
+    let refuse_series_options = || match series_opts.first_given().or(gaps.map(|_| "gaps")) {
+        Some(name) => Err(value_error(format!(
+            "{name} applies to time-series input, and {} holds spectra; leave it out (the \
+             model grid of spectra input is set with freq)",
+            path.display()
+        ))),
+        None => Ok(()),
+    };
+    let refuse_spectra_options = || match grid.is_some() {
+        true => Err(value_error(format!(
+            "freq applies to spectra input, and {} holds a time series, whose budget is on the \
+             Welch grid (set its resolution with nperseg)",
+            path.display()
+        ))),
+        false => Ok(()),
+    };
+    let (report, provenance) = py.detach(|| -> PyResult<_> {
+        let streamed = match InputFormat::from_path(&path).py()? {
+            InputFormat::Hdf5 => TiltSeriesSource::open(&path, &ropts).ok(),
+            InputFormat::Csv => None,
+        };
+        let (report, provenance) = match streamed {
+            Some(mut source) => {
+                refuse_spectra_options()?;
+                let provenance = source.provenance().clone();
+                (
+                    budget_from_series(&model, &mut source, &opts, &mut |_, _| {}),
+                    provenance,
+                )
+            }
+            None => match read_tilt(&path, &ropts).py()? {
+                TiltInput::Series(mut series) => {
+                    refuse_spectra_options()?;
+                    let provenance = series.provenance.clone();
+                    (
+                        budget_from_series(&model, &mut series, &opts, &mut |_, _| {}),
+                        provenance,
+                    )
+                }
+                TiltInput::Spectra(spectra) => {
+                    refuse_series_options()?;
+                    let provenance = spectra.provenance.clone();
+                    opts.spectra_grid_hz =
+                        grid.clone().unwrap_or_else(|| freq::default_grid(&model));
+                    (budget_from_spectra(&model, &spectra, &opts), provenance)
+                }
+            },
+        };
+        let mut report = report.map_err(|e| match e {
+            BudgetError::Input(e) => e.into_py_err(),
+            other => value_error(format!("budget of {}: {other}", path.display())),
+        })?;
+        if let Some(m) = &measured {
+            add_measured_file(&mut report, m).py()?;
+        }
+        Ok((report, provenance))
+    })?;
+    Ok(Budget::new(
+        &model,
+        report,
+        params,
+        InputMeta::from(&provenance),
+    ))
+}
+
+/// A noise budget: one-sided spectra of each observable's terms on one frequency grid.
+///
+/// ``freq_hz`` (Hz); ``terms[observable][term]`` and ``total[observable]`` are ASDs in
+/// ``units[observable]`` (``m/sqrt(Hz)`` for X, ``rad/sqrt(Hz)`` for phi and phi_a); the
+/// names are those of the budget files (``tilt``, ``tilt.eta_t``, ``readout``, ``thermal``,
+/// ``thermal.torsion_b``, ``measured``, ``residual``; ``total`` is the sum in power of
+/// ``tilt``, ``thermal`` and ``readout``). :meth:`psd` gives the PSDs; ``equivalent`` the
+/// terms referred to the test mass's acceleration (X) or torque (phi, phi_a) for a damped
+/// model; ``segment_bands`` the per-segment percentile band of the ``tilt`` term.
+#[pyclass(module = "tiltnoise", frozen)]
+pub struct Budget {
+    report: BudgetReport,
+    params: Params,
+    modes: Vec<(usize, f64)>,
+    input: InputMeta,
+}
+
+impl Budget {
+    fn new(model: &Model, report: BudgetReport, params: Params, input: InputMeta) -> Budget {
+        let modes = tiltnoise_core::modes::NormalModes::new(model)
+            .modes
+            .iter()
+            .map(|m| (m.index, m.frequency_hz))
+            .collect();
+        Budget {
+            report,
+            params,
+            modes,
+            input,
+        }
+    }
+
+    fn observable(&self, name: &str) -> PyResult<&tiltnoise_core::noise::ObservableBudget> {
+        let observables: Vec<&str> = self
+            .report
+            .budget
+            .observables
+            .iter()
+            .map(|o| o.observable.name())
+            .collect();
+        Observable::from_name(name)
+            .and_then(|o| self.report.budget.observable(o))
+            .ok_or_else(|| {
+                pyo3::exceptions::PyKeyError::new_err(format!(
+                    "observable {name:?} is not in the budget; it has {}",
+                    observables.join(", ")
+                ))
+            })
+    }
+
+    fn psd_of(&self, observable: &str, term: &str) -> PyResult<Vec<f64>> {
+        let ob = self.observable(observable)?;
+        if term == tiltnoise_core::noise::TOTAL_NAME {
+            return Ok(ob.total());
+        }
+        ob.term_named(term).map(|t| t.psd.clone()).ok_or_else(|| {
+            let names: Vec<String> = ob.components().iter().map(|(c, _)| c.name()).collect();
+            pyo3::exceptions::PyKeyError::new_err(format!(
+                "term {term:?} is not in the budget of {observable}; it has {}",
+                names.join(", ")
+            ))
+        })
+    }
+}
+
+fn asd<'py>(py: Python<'py>, psd: &[f64]) -> Bound<'py, PyArray1<f64>> {
+    PyArray1::from_iter(py, psd.iter().map(|p| p.sqrt()))
+}
+
+#[pymethods]
+impl Budget {
+    /// Frequencies (Hz), increasing, all > 0.
+    #[getter]
+    fn freq_hz<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.report.budget.freqs_hz)
+    }
+
+    /// The observables, in report order (``X``, ``phi``, ``phi_a``).
+    #[getter]
+    fn observables(&self) -> Vec<&'static str> {
+        self.report
+            .budget
+            .observables
+            .iter()
+            .map(|o| o.observable.name())
+            .collect()
+    }
+
+    /// ``{observable: {term: ASD}}``, every term in report order (not the total).
+    #[getter]
+    fn terms<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for ob in &self.report.budget.observables {
+            let t = PyDict::new(py);
+            for term in &ob.terms {
+                t.set_item(term.name(), asd(py, &term.psd))?;
+            }
+            d.set_item(ob.observable.name(), t)?;
+        }
+        Ok(d)
+    }
+
+    /// ``{observable: ASD}`` of the total: the sum in power of tilt, thermal and readout.
+    #[getter]
+    fn total<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for ob in &self.report.budget.observables {
+            d.set_item(ob.observable.name(), asd(py, &ob.total()))?;
+        }
+        Ok(d)
+    }
+
+    /// ``{observable: unit of its ASDs}``: ``m/sqrt(Hz)`` or ``rad/sqrt(Hz)``.
+    #[getter]
+    fn units<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for ob in &self.report.budget.observables {
+            d.set_item(
+                ob.observable.name(),
+                format!("{}/sqrt(Hz)", ob.observable.unit()),
+            )?;
+        }
+        Ok(d)
+    }
+
+    /// One-sided PSD of a term (or ``"total"``) of an observable, (unit)**2/Hz.
+    #[pyo3(signature = (observable, term="total"))]
+    fn psd<'py>(
+        &self,
+        py: Python<'py>,
+        observable: &str,
+        term: &str,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(PyArray1::from_vec(py, self.psd_of(observable, term)?))
+    }
+
+    /// ASD of a term (or ``"total"``) of an observable, unit/sqrt(Hz).
+    #[pyo3(signature = (observable, term="total"))]
+    fn asd<'py>(
+        &self,
+        py: Python<'py>,
+        observable: &str,
+        term: &str,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(asd(py, &self.psd_of(observable, term)?))
+    }
+
+    /// For a damped model, ``{observable: {"input", "unit", "quantity", "response_abs",
+    /// "terms": {term: ASD}}}``: every model term (and ``total``) referred to the test mass's
+    /// acceleration along x (X; ``m s^-2/sqrt(Hz)``) or torque about z (phi, phi_a;
+    /// ``N m/sqrt(Hz)``). Empty for an undamped model.
+    #[getter]
+    fn equivalent<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for ob in &self.report.budget.observables {
+            let Some(r) = referred_terms(ob) else {
+                continue;
+            };
+            let e = PyDict::new(py);
+            e.set_item("input", r.input)?;
+            e.set_item("unit", format!("{}/sqrt(Hz)", r.unit))?;
+            e.set_item("quantity", r.quantity)?;
+            e.set_item("response_abs", asd(py, r.response_psd))?;
+            let t = PyDict::new(py);
+            for (c, psd) in &r.terms {
+                t.set_item(c.name(), asd(py, psd))?;
+            }
+            e.set_item("terms", t)?;
+            d.set_item(ob.observable.name(), e)?;
+        }
+        Ok(d)
+    }
+
+    /// With ``segment_duration``: ``{observable: {"median", "lower", "upper" (ASDs of the
+    /// tilt term across segments), "lower_pct", "upper_pct", "n_segments"}}``; else empty.
+    #[getter]
+    fn segment_bands<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (o, band) in &self.report.segment_bands {
+            let b = PyDict::new(py);
+            b.set_item("median", asd(py, &band.median))?;
+            b.set_item("lower", asd(py, &band.lower))?;
+            b.set_item("upper", asd(py, &band.upper))?;
+            b.set_item("lower_pct", band.lower_pct)?;
+            b.set_item("upper_pct", band.upper_pct)?;
+            b.set_item("n_segments", band.n_segments)?;
+            d.set_item(o.name(), b)?;
+        }
+        Ok(d)
+    }
+
+    /// Segment length (s) of ``segment_bands``, or ``None``.
+    #[getter]
+    fn segment_duration_s(&self) -> Option<f64> {
+        self.report.segment_duration_s
+    }
+
+    /// How the tilt spectra were obtained: ``{"source": "welch", "sample_rate_hz",
+    /// "segment_len", "overlap", "averaging", "n_welch_segments", "n_samples"}`` or
+    /// ``{"source": "spectra", "data_band_hz"}`` (the attributes of the budget's HDF5 file).
+    #[getter]
+    fn source<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        match &self.report.source {
+            SpectralSource::Welch {
+                sample_rate_hz,
+                segment_len,
+                overlap,
+                averaging,
+                n_welch_segments,
+                n_samples,
+            } => {
+                d.set_item("source", "welch")?;
+                d.set_item("sample_rate_hz", sample_rate_hz)?;
+                d.set_item("segment_len", segment_len)?;
+                d.set_item("overlap", overlap)?;
+                d.set_item("averaging", averaging)?;
+                d.set_item("n_welch_segments", n_welch_segments)?;
+                d.set_item("n_samples", n_samples)?;
+            }
+            SpectralSource::Spectra { data_band_hz } => {
+                d.set_item("source", "spectra")?;
+                d.set_item("data_band_hz", data_band_hz)?;
+            }
+        }
+        Ok(d)
+    }
+
+    /// The tilt axes that entered the budget.
+    #[getter]
+    fn axes(&self) -> Vec<&'static str> {
+        self.report.axes.iter().map(|a| a.name()).collect()
+    }
+
+    /// ``{observable: white readout ASD}`` used (unit/sqrt(Hz)).
+    #[getter]
+    fn readout<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (o, a) in &self.report.readout.asd {
+            d.set_item(o.name(), a)?;
+        }
+        Ok(d)
+    }
+
+    /// The input reader's notes, then the budget's (band restrictions, samples left out of the
+    /// segments, gaps bridged).
+    #[getter]
+    fn notes(&self) -> Vec<String> {
+        self.input
+            .notes
+            .iter()
+            .chain(&self.report.notes)
+            .cloned()
+            .collect()
+    }
+
+    /// Where the tilt came from: ``path``, ``format``, ``kind``, ``quantity``, ``axis_map``,
+    /// ``start_time`` (the ``input_*`` attributes of the budget's HDF5 file).
+    #[getter]
+    fn input<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let i = &self.input;
+        let d = PyDict::new(py);
+        d.set_item("path", &i.path)?;
+        d.set_item("format", &i.format)?;
+        d.set_item("kind", &i.kind)?;
+        d.set_item("quantity", &i.quantity)?;
+        d.set_item("axis_map", &i.axis_map)?;
+        d.set_item("start_time", &i.start_time)?;
+        Ok(d)
+    }
+
+    /// The parameters of the model the budget was computed with.
+    #[getter]
+    fn params(&self) -> PyParams {
+        PyParams {
+            inner: self.params.clone(),
+        }
+    }
+
+    /// The budget as the command line's CSV (ASD columns ``OBS.TERM``; ``docs/schemas.md``).
+    fn to_csv(&self) -> PyResult<String> {
+        tiltnoise_io::budget_csv_string(&self.report).map_err(value_error)
+    }
+
+    /// Writes the budget as the command line's ``--save`` does: ``.h5``/``.hdf5`` (schema
+    /// ``tiltnoise.budget``, with the parameters and the input's provenance) or ``.csv``;
+    /// atomically (nothing is left at ``path`` on failure). Raises ``OSError`` if it cannot
+    /// be written, ``ValueError`` for another extension.
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        use tiltnoise_io::OutputKind;
+        let kind = OutputKind::from_path(&path).py()?;
+        let meta = RunMeta {
+            modes: self.modes.clone(),
+            ..RunMeta::of_this_run(&self.params, None)
+        };
+        py.detach(|| match kind {
+            OutputKind::Hdf5 => {
+                tiltnoise_io::write_budget_hdf5(&path, &self.report, &meta, &self.input)
+            }
+            OutputKind::Csv => tiltnoise_io::write_budget_csv(&path, &self.report),
+            OutputKind::Png | OutputKind::Svg => Err(tiltnoise_io::OutputError::UnknownFormat {
+                path: path.clone(),
+                allowed: ".h5, .hdf5, .csv (figures: see examples/budget_matplotlib.py)",
+            }),
+        })
+        .py()
+    }
+
+    /// ``{observable: {term: gwpy.frequencyseries.FrequencySeries}}`` of the ASDs, ``total``
+    /// included, with their units. Needs gwpy (``pip install gwpy``); raises ``ImportError``
+    /// saying so without it.
+    fn to_gwpy<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        slf.py()
+            .import("tiltnoise._gwpy")?
+            .call_method1("to_gwpy", (slf,))
+    }
+
+    fn __repr__(&self) -> String {
+        let b = &self.report.budget;
+        let (lo, hi) = (
+            b.freqs_hz.first().copied().unwrap_or(f64::NAN),
+            b.freqs_hz.last().copied().unwrap_or(f64::NAN),
+        );
+        let obs: Vec<String> = b
+            .observables
+            .iter()
+            .map(|o| {
+                format!(
+                    "{} [{}]",
+                    o.observable.name(),
+                    o.terms
+                        .iter()
+                        .map(|t| t.name())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            })
+            .collect();
+        format!(
+            "Budget({} frequencies {lo:.4e}..{hi:.4e} Hz from {}; {})",
+            b.freqs_hz.len(),
+            self.input.path,
+            obs.join("; ")
+        )
+    }
+}

@@ -1,0 +1,622 @@
+//! `tiltnoise.Model`: normal modes, transfer functions (the command line's `modes` and `tf`),
+//! the model's matrices and the Monte Carlo of the modes (`mc`).
+
+use crate::errors::{value_error, PyResultExt};
+use crate::params::PyParams;
+use numpy::{Complex64, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyString};
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
+use tiltnoise_core::freq::DEFAULT_F_LO_HZ;
+use tiltnoise_core::mc::{self, McConfig};
+use tiltnoise_core::model::{Coord, ForceInput, Input, Model, Observable, Request};
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::tf::{self, eval_grid_threads, Method, Scene, TransferFunction};
+
+/// Share of a mode's kinetic energy above which a coordinate is listed as dominant (the
+/// command line's `modes` table and JSON).
+const DOMINANT_SHARE: f64 = 0.05;
+
+/// Grids at least this long are evaluated on every core: below it, starting a thread costs
+/// more than the points it takes over (about 10 ns each).
+const THREADED_GRID: usize = 8192;
+
+/// Plans built so far, per request and method: a plan does its per-model work (pole-zero
+/// factors in double-double, factorized forcing) once, so later calls cost only their points.
+type PlanCache = HashMap<(Vec<Input>, Vec<Observable>, Method), Arc<dyn TransferFunction>>;
+
+/// The planner's choices so far, per request, band and tolerance (the `f64` bits).
+type ChoiceCache = HashMap<(Vec<Input>, Vec<Observable>, [u64; 3]), Method>;
+
+/// The linear 8-DoF model of the double torsion pendulum built from one parameter set.
+///
+/// ``Model(params=None)`` builds it from ``params`` (a :class:`Params`; default Table I) and
+/// raises ``ValueError`` if the parameters do not describe a stable pendulum (the message
+/// names the unstable mode or the offending keys).
+///
+/// Conventions (as the command line's): SI units; complex amplitudes for ``exp(+i w t)`` time
+/// dependence; the tilt ``(theta_t, eta_t, phi_t)`` is the rotation taking the floor frame to
+/// the inertial frame, so that ``X -> -eta_t (Z + Z_b + h_c)`` as ``f -> 0``.
+#[pyclass(name = "Model", module = "tiltnoise", frozen)]
+pub struct PyModel {
+    pub model: Arc<Model>,
+    modes: OnceLock<NormalModes>,
+    plans: Mutex<PlanCache>,
+    choices: Mutex<ChoiceCache>,
+}
+
+impl PyModel {
+    /// The model of `params` (Table I when `None`).
+    pub fn build(params: Option<&PyParams>) -> PyResult<PyModel> {
+        let model = Model::new(&PyParams::or_table_i(params)).py()?;
+        Ok(PyModel {
+            model: Arc::new(model),
+            modes: OnceLock::new(),
+            plans: Mutex::new(HashMap::new()),
+            choices: Mutex::new(HashMap::new()),
+        })
+    }
+
+    pub fn normal_modes(&self) -> &NormalModes {
+        self.modes.get_or_init(|| NormalModes::new(&self.model))
+    }
+
+    /// The method `auto` takes for `request` on `freqs` (the command line's `--method auto`:
+    /// the band of the positive frequencies), remembered per request, band and tolerance.
+    fn auto_method(
+        &self,
+        py: Python<'_>,
+        request: &Request,
+        freqs: &[f64],
+        rel_tol: f64,
+    ) -> PyResult<Method> {
+        let positive = freqs.iter().copied().filter(|&f| f > 0.0 && f.is_finite());
+        let lo = positive.clone().fold(f64::INFINITY, f64::min);
+        let hi = positive.fold(0.0, f64::max);
+        let band = if hi > 0.0 {
+            (lo, hi)
+        } else {
+            (DEFAULT_F_LO_HZ, DEFAULT_F_LO_HZ)
+        };
+        let key = (
+            request.inputs.clone(),
+            request.outputs.clone(),
+            [band.0.to_bits(), band.1.to_bits(), rel_tol.to_bits()],
+        );
+        if let Some(&m) = lock(&self.choices).get(&key) {
+            return Ok(m);
+        }
+        let scene = Scene {
+            request: request.clone(),
+            band_hz: band,
+            rel_tol,
+        };
+        let model = &self.model;
+        let choice = py
+            .detach(|| tf::choose(model, &scene))
+            .map_err(value_error)?;
+        lock(&self.choices).insert(key, choice.method);
+        Ok(choice.method)
+    }
+
+    /// The plan of `request` with `method`, built once per model.
+    fn plan(
+        &self,
+        py: Python<'_>,
+        request: &Request,
+        method: Method,
+    ) -> PyResult<Arc<dyn TransferFunction>> {
+        let key = (request.inputs.clone(), request.outputs.clone(), method);
+        if let Some(p) = lock(&self.plans).get(&key) {
+            return Ok(Arc::clone(p));
+        }
+        let model = &self.model;
+        let plan: Arc<dyn TransferFunction> = py
+            .detach(|| tf::plan(model, request, method))
+            .map_err(|e| value_error(e.to_string()))?
+            .into();
+        lock(&self.plans).insert(key, Arc::clone(&plan));
+        Ok(plan)
+    }
+}
+
+/// A mutex's data; a panic while it was held cannot leave a cache inconsistent (entries are
+/// inserted whole), so a poisoned lock is used as it is.
+fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Every name `inputs` accepts, for error messages.
+fn input_names() -> String {
+    let mut names: Vec<&str> = Input::all_tilts().into_iter().map(Input::name).collect();
+    names.extend(ForceInput::ALL.iter().map(|f| f.name()));
+    format!("{}, or the groups `tilt` and `forces`", names.join(", "))
+}
+
+/// Names from a `str` (comma-separated) or a sequence of `str`.
+fn names(what: &str, arg: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
+    let items: Vec<String> = if let Ok(s) = arg.cast::<PyString>() {
+        s.to_cow()?
+            .split(',')
+            .map(|n| n.trim().to_string())
+            .collect()
+    } else {
+        arg.extract::<Vec<String>>()
+            .map_err(|_| value_error(format!("{what}: expected a str or a sequence of str")))?
+    };
+    if items.is_empty() || items.iter().any(String::is_empty) {
+        return Err(value_error(format!(
+            "{what}: empty name (give one or more names, e.g. {})",
+            if what == "inputs" {
+                "\"eta_t\" or [\"F_b.x\", \"M_b.z\"]"
+            } else {
+                "\"X\" or [\"phi\", \"phi_a\"]"
+            }
+        )));
+    }
+    Ok(items)
+}
+
+/// `inputs` of [`PyModel::transfer`]: names as on the command line's `--input`.
+fn parse_inputs(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Input>> {
+    let Some(arg) = arg else {
+        return Ok(Input::all_tilts());
+    };
+    let mut inputs: Vec<Input> = Vec::new();
+    for name in names("inputs", arg)? {
+        let group: Vec<Input> = match name.as_str() {
+            "tilt" => Input::all_tilts(),
+            "forces" => ForceInput::ALL.into_iter().map(Input::Force).collect(),
+            _ => match Input::from_name(&name) {
+                Some(i) => vec![i],
+                None => {
+                    return Err(value_error(format!(
+                        "inputs: unknown input {name:?}; allowed: {}",
+                        input_names()
+                    )))
+                }
+            },
+        };
+        for i in group {
+            if inputs.contains(&i) {
+                return Err(value_error(format!(
+                    "inputs: {} is given twice; name each input once",
+                    i.name()
+                )));
+            }
+            inputs.push(i);
+        }
+    }
+    Ok(inputs)
+}
+
+/// `outputs` of [`PyModel::transfer`]: names as on the command line's `--output`.
+fn parse_outputs(
+    what: &str,
+    arg: Option<&Bound<'_, PyAny>>,
+    default: &[Observable],
+) -> PyResult<Vec<Observable>> {
+    let Some(arg) = arg else {
+        return Ok(default.to_vec());
+    };
+    let mut outputs = Vec::new();
+    for name in names(what, arg)? {
+        let Some(o) = Observable::from_name(&name) else {
+            let allowed: Vec<&str> = Observable::ALL.iter().map(|o| o.name()).collect();
+            return Err(value_error(format!(
+                "{what}: unknown observable {name:?}; allowed: {}",
+                allowed.join(", ")
+            )));
+        };
+        if outputs.contains(&o) {
+            return Err(value_error(format!(
+                "{what}: {name} is given twice; name each observable once"
+            )));
+        }
+        outputs.push(o);
+    }
+    Ok(outputs)
+}
+
+/// `method` of [`PyModel::transfer`]: `auto` (`None`) or a method's command-line name.
+fn parse_method(name: &str) -> PyResult<Option<Method>> {
+    if name == "auto" {
+        return Ok(None);
+    }
+    Method::ALL
+        .into_iter()
+        .find(|m| m.name() == name)
+        .map(Some)
+        .ok_or_else(|| {
+            let allowed: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+            value_error(format!(
+                "method: unknown method {name:?}; allowed: auto, {}",
+                allowed.join(", ")
+            ))
+        })
+}
+
+/// Frequencies (Hz) from a number or a 1-D array-like, as `f64`.
+pub fn frequencies(arg: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    if let Ok(f) = arg.extract::<f64>() {
+        return Ok(vec![f]);
+    }
+    let np = arg.py().import("numpy")?;
+    let array = np
+        .call_method1("asarray", (arg, "float64"))
+        .map_err(|e| value_error(format!("freq_hz: not an array of numbers ({e})")))?;
+    let array = array.cast_into::<numpy::PyArrayDyn<f64>>()?;
+    if array.ndim() != 1 {
+        return Err(value_error(format!(
+            "freq_hz: expected a number or a 1-D array of frequencies in Hz, got {} dimensions",
+            array.ndim()
+        )));
+    }
+    Ok(array.readonly().as_array().iter().copied().collect())
+}
+
+/// `rel_tol` of [`PyModel::transfer`], as the command line's `--rel-tol`.
+fn check_rel_tol(rel_tol: f64) -> PyResult<()> {
+    if rel_tol.is_finite() && rel_tol > 0.0 && rel_tol < 1.0 {
+        return Ok(());
+    }
+    Err(value_error(format!(
+        "rel_tol {rel_tol}: the tolerance must be a finite relative error in (0, 1)"
+    )))
+}
+
+/// An 8x8 (or other) nalgebra matrix as a row-major NumPy array.
+fn matrix<'py, R: nalgebra::Dim, C: nalgebra::Dim, S: nalgebra::RawStorage<f64, R, C>>(
+    py: Python<'py>,
+    m: &nalgebra::Matrix<f64, R, C, S>,
+) -> Bound<'py, PyArray2<f64>> {
+    let rows: Vec<Vec<f64>> = (0..m.nrows())
+        .map(|r| (0..m.ncols()).map(|c| m[(r, c)]).collect())
+        .collect();
+    PyArray2::from_vec2(py, &rows).expect("rows of equal length")
+}
+
+#[pymethods]
+impl PyModel {
+    #[new]
+    #[pyo3(signature = (params=None))]
+    fn new(params: Option<PyRef<'_, PyParams>>) -> PyResult<Self> {
+        PyModel::build(params.as_deref())
+    }
+
+    /// The parameters the model was built from.
+    #[getter]
+    fn params(&self) -> PyParams {
+        PyParams {
+            inner: self.model.params().clone(),
+        }
+    }
+
+    /// The normal modes (the command line's ``tiltnoise modes``), nu_1 first.
+    ///
+    /// Each :class:`Mode` has ``index`` (1-based), ``frequency_hz``, ``quality_factor`` (also
+    /// ``q``; ``inf`` for an undamped model), ``loss_angle_rad``, ``block``,
+    /// ``dominant_coordinates`` (``(coordinate, energy share)`` for every coordinate holding at
+    /// least 5 % of the modal kinetic energy, largest first), ``energy_share``, ``seen_by``
+    /// (the observables that see the mode), ``observable_amplitude`` and ``shape``.
+    fn modes(&self, py: Python<'_>) -> Vec<Mode> {
+        let modes = py.detach(|| self.normal_modes());
+        modes
+            .modes
+            .iter()
+            .enumerate()
+            .map(|(k, m)| Mode {
+                index: m.index,
+                frequency_hz: m.frequency_hz,
+                omega_sq_rad2_per_s2: m.omega_sq,
+                quality_factor: m.quality_factor,
+                loss_angle_rad: m.loss_angle,
+                block: m.block.name(),
+                dominant_coordinates: m
+                    .dominant_coords(DOMINANT_SHARE)
+                    .into_iter()
+                    .map(|(c, s)| (c.name(), s))
+                    .collect(),
+                energy_share: Coord::ALL
+                    .iter()
+                    .map(|c| (c.name(), m.energy_share[c.index()]))
+                    .collect(),
+                seen_by: modes
+                    .observables_seeing(k)
+                    .iter()
+                    .map(|o| o.name())
+                    .collect(),
+                observable_amplitude: Observable::ALL
+                    .iter()
+                    .map(|o| (o.name(), m.observable_amplitude[o.index()]))
+                    .collect(),
+                shape: m.shape.iter().copied().collect(),
+            })
+            .collect()
+    }
+
+    /// Transfer functions from inputs to observables (the command line's ``tiltnoise tf``).
+    ///
+    /// ``freq_hz``: a number or a 1-D array of frequencies in Hz, finite and >= 0.
+    /// ``inputs``: names as ``--input``, a comma-separated ``str`` or a sequence: the tilt
+    /// angles ``theta_t``, ``eta_t``, ``phi_t`` (rad), the force components ``F_a.x`` ..
+    /// ``F_b.z`` (N) and torque components ``M_a.x`` .. ``M_b.z`` (N m) on the crossbar (a)
+    /// and the test mass (b), and the groups ``tilt`` and ``forces``; default the three tilt
+    /// angles. ``outputs``: ``X``, ``Y``, ``Z`` (m), ``theta``, ``eta``, ``phi``, ``phi_a``
+    /// (rad); default all seven. ``method``: ``auto`` (the cheapest method whose error against
+    /// the double-double reference on the grid's band is at most ``rel_tol``), ``direct``,
+    /// ``block``, ``split``, ``polezero``, ``modal``, ``statespace`` or ``torsion2``.
+    /// ``threads``: evaluation threads (default: every core for grids of 8192 points or more).
+    /// ``out``: a C-contiguous complex128 array of the result's shape to write into (as
+    /// NumPy's ``out=``; saves allocating and first touching a new array on repeated calls).
+    ///
+    /// Returns a complex128 array ``H[n_freq, n_outputs, n_inputs]`` in the order asked: the
+    /// complex amplitude of each observable per unit input for ``exp(+i w t)`` time
+    /// dependence, in the observable's unit per the input's unit (m/rad, rad/rad, m/N,
+    /// rad/(N m), ...). ``auto`` measures the candidates against the double-double reference
+    /// on the grid's band (about 0.1 s) once per request, band and tolerance, and remembers the
+    /// pick: the result never depends on earlier calls. For many grids on different bands,
+    /// name the method (``method="polezero"`` is what it picks for the tilt matrix of Table I).
+    /// Raises ``ValueError`` for an unknown name, a frequency that is
+    /// negative or not finite, or one on an undamped resonance.
+    #[pyo3(signature = (freq_hz, inputs=None, outputs=None, method="auto", rel_tol=tf::DEFAULT_REL_TOL, threads=None, out=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn transfer<'py>(
+        &self,
+        py: Python<'py>,
+        freq_hz: &Bound<'py, PyAny>,
+        inputs: Option<&Bound<'py, PyAny>>,
+        outputs: Option<&Bound<'py, PyAny>>,
+        method: &str,
+        rel_tol: f64,
+        threads: Option<usize>,
+        out: Option<Bound<'py, PyArray3<Complex64>>>,
+    ) -> PyResult<Bound<'py, PyArray3<Complex64>>> {
+        let request = Request {
+            inputs: parse_inputs(inputs)?,
+            outputs: parse_outputs("outputs", outputs, &Observable::ALL)?,
+        };
+        let method = parse_method(method)?;
+        check_rel_tol(rel_tol)?;
+        let freqs = frequencies(freq_hz)?;
+        let method = match method {
+            Some(m) => m,
+            None => self.auto_method(py, &request, &freqs, rel_tol)?,
+        };
+        let plan = self.plan(py, &request, method)?;
+        let threads = threads.unwrap_or(match freqs.len() >= THREADED_GRID {
+            true => std::thread::available_parallelism().map_or(1, |n| n.get()),
+            false => 1,
+        });
+        let dims = [freqs.len(), request.outputs.len(), request.inputs.len()];
+        let h = match out {
+            Some(h) => {
+                if h.shape() != dims {
+                    return Err(value_error(format!(
+                        "out: shape {:?} does not fit the result's (n_freq, n_outputs, n_inputs) = {dims:?}",
+                        h.shape()
+                    )));
+                }
+                h
+            }
+            // SAFETY: every element is written by `eval_grid_threads` before the array is
+            // returned (on error it is dropped unread), and nothing else holds the new array.
+            None => unsafe { PyArray3::<Complex64>::new(py, dims, false) },
+        };
+        {
+            let mut rw = h
+                .try_readwrite()
+                .map_err(|e| value_error(format!("out: not writeable ({e})")))?;
+            let buffer = rw
+                .as_slice_mut()
+                .map_err(|_| value_error("out: must be C-contiguous"))?;
+            py.detach(|| eval_grid_threads(plan.as_ref(), &freqs, buffer, threads))
+                .py()?;
+        }
+        Ok(h)
+    }
+
+    /// Which method ``method="auto"`` picks for this request and grid, and why: every
+    /// candidate's measured error against the double-double reference (the command line's
+    /// ``tf --explain``).
+    #[pyo3(signature = (freq_hz, inputs=None, outputs=None, rel_tol=tf::DEFAULT_REL_TOL))]
+    fn explain(
+        &self,
+        py: Python<'_>,
+        freq_hz: &Bound<'_, PyAny>,
+        inputs: Option<&Bound<'_, PyAny>>,
+        outputs: Option<&Bound<'_, PyAny>>,
+        rel_tol: f64,
+    ) -> PyResult<String> {
+        let request = Request {
+            inputs: parse_inputs(inputs)?,
+            outputs: parse_outputs("outputs", outputs, &Observable::ALL)?,
+        };
+        check_rel_tol(rel_tol)?;
+        let scene = Scene {
+            rel_tol,
+            ..Scene::over_grid(request, &frequencies(freq_hz)?)
+        };
+        let model = &self.model;
+        let choice = py
+            .detach(|| tf::choose(model, &scene))
+            .map_err(value_error)?;
+        Ok(choice.explain())
+    }
+
+    /// The model's matrices as NumPy arrays, for work outside tiltnoise:
+    /// ``H(w) = C (K + i K_imag + i w D - w^2 M)^-1 G(w)`` with ``G = G0 + w^2 G2`` (tilt)
+    /// or ``F`` (forces and torques).
+    ///
+    /// Keys: ``M`` (8x8 mass matrix), ``K`` (8x8 undamped stiffness), ``K_imag`` (8x8
+    /// structural damping, ``Im K_c``), ``D`` (8x8 viscous damping), ``G0``, ``G2`` (8x3 tilt
+    /// forcing), ``F`` (8x12 force/torque forcing), ``C`` (7x8 observation matrix), and the
+    /// labels ``coordinates``, ``observables``, ``tilt_inputs``, ``force_inputs``.
+    fn matrices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let m = &self.model;
+        let d = PyDict::new(py);
+        d.set_item("M", matrix(py, m.mass()))?;
+        d.set_item("K", matrix(py, &m.stiffness()))?;
+        d.set_item("K_imag", matrix(py, m.stiffness_imag()))?;
+        d.set_item("D", matrix(py, m.damping()))?;
+        d.set_item("G0", matrix(py, &m.tilt_forcing().g0))?;
+        d.set_item("G2", matrix(py, &m.tilt_forcing().g2))?;
+        d.set_item("F", matrix(py, m.force_matrix()))?;
+        d.set_item("C", matrix(py, m.observation()))?;
+        let names = |v: Vec<&'static str>| PyList::new(py, v);
+        d.set_item(
+            "coordinates",
+            names(Coord::ALL.iter().map(|c| c.name()).collect())?,
+        )?;
+        d.set_item(
+            "observables",
+            names(Observable::ALL.iter().map(|o| o.name()).collect())?,
+        )?;
+        d.set_item(
+            "tilt_inputs",
+            names(Input::all_tilts().into_iter().map(Input::name).collect())?,
+        )?;
+        d.set_item(
+            "force_inputs",
+            names(ForceInput::ALL.iter().map(|f| f.name()).collect())?,
+        )?;
+        Ok(d)
+    }
+
+    /// Monte Carlo of the normal modes over the parameter errors (the command line's
+    /// ``tiltnoise mc``): Gaussian draws with the default error model (2.5 % on masses,
+    /// lengths and inertias, 10 % on torsion and bouncing constants, g and h exact) or the
+    /// parameter file's ``[uncertainty]`` table. The result depends on ``seed`` only, not on
+    /// ``threads`` (0: every core).
+    #[pyo3(signature = (samples=10_000, seed=1, threads=0))]
+    fn monte_carlo(
+        &self,
+        py: Python<'_>,
+        samples: usize,
+        seed: u64,
+        threads: usize,
+    ) -> PyResult<MonteCarlo> {
+        let params = self.model.params();
+        let cfg = McConfig {
+            samples,
+            seed,
+            threads,
+            ..McConfig::default_for(params)
+        };
+        let r = py.detach(|| mc::run(params, &cfg, &|_| {})).py()?;
+        Ok(MonteCarlo {
+            samples: r.samples,
+            rejected: r.rejected,
+            freqs_hz: PyArray2::from_vec2(
+                py,
+                &r.freqs_hz.iter().map(|f| f.to_vec()).collect::<Vec<_>>(),
+            )
+            .map_err(|e| value_error(e.to_string()))?
+            .unbind(),
+            sample_index: PyArray1::from_vec(py, r.sample_index).unbind(),
+            mean_hz: r.mean_hz.to_vec(),
+            std_hz: r.std_hz.to_vec(),
+        })
+    }
+
+    /// Constrained least-squares fit of the parameters ``free`` (dotted keys; default the
+    /// command line's eight) to measured mode frequencies, each within ``bound_sigmas`` of its
+    /// error bar, optionally with the Gaussian prior (the command line's ``tiltnoise fit``;
+    /// ``docs/fit.md``). ``measured``: a CSV file ``mode,frequency_hz[,sigma_hz]`` (any subset
+    /// of the modes); default Table II's measured column. Returns a :class:`Fit`.
+    #[pyo3(signature = (free=None, measured=None, bound_sigmas=1.0, prior=false))]
+    fn fit(
+        &self,
+        py: Python<'_>,
+        free: Option<Vec<String>>,
+        measured: Option<std::path::PathBuf>,
+        bound_sigmas: f64,
+        prior: bool,
+    ) -> PyResult<crate::fit::Fit> {
+        crate::fit::run(py, self.model.params(), free, measured, bound_sigmas, prior)
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Model({})", self.params().describe())
+    }
+}
+
+/// One normal mode (see :meth:`Model.modes`).
+#[pyclass(module = "tiltnoise", frozen, get_all)]
+pub struct Mode {
+    /// 1-based, in order of increasing frequency (the paper's nu_1 ... nu_8).
+    index: usize,
+    /// Frequency (Hz), refined to the last bit in double-double.
+    frequency_hz: f64,
+    /// Eigenvalue w^2 (rad^2/s^2).
+    omega_sq_rad2_per_s2: f64,
+    /// Quality factor; ``inf`` when the model is undamped.
+    quality_factor: f64,
+    /// Modal loss angle 1/Q (rad).
+    loss_angle_rad: f64,
+    /// The decoupled block of the model the mode lives in.
+    block: &'static str,
+    /// ``(coordinate, share)`` of the coordinates with at least 5 % of the kinetic energy.
+    dominant_coordinates: Vec<(&'static str, f64)>,
+    /// Share of the modal kinetic energy per coordinate (sums to 1).
+    energy_share: HashMap<&'static str, f64>,
+    /// Observables that see the mode.
+    seen_by: Vec<&'static str>,
+    /// Observable amplitudes of the mass-normalized shape.
+    observable_amplitude: HashMap<&'static str, f64>,
+    /// Mass-normalized shape, coordinates in ``Model.matrices()["coordinates"]`` order.
+    shape: Vec<f64>,
+}
+
+#[pymethods]
+impl Mode {
+    /// The quality factor (``inf`` when undamped).
+    #[getter]
+    fn q(&self) -> f64 {
+        self.quality_factor
+    }
+
+    fn __repr__(&self) -> String {
+        let dominant: Vec<String> = self
+            .dominant_coordinates
+            .iter()
+            .map(|(c, s)| format!("{c} {s:.2}"))
+            .collect();
+        format!(
+            "Mode(nu_{}: {:.6e} Hz, Q {}, {}; seen by {})",
+            self.index,
+            self.frequency_hz,
+            self.quality_factor,
+            dominant.join(", "),
+            self.seen_by.join(" ")
+        )
+    }
+}
+
+/// The result of :meth:`Model.monte_carlo`.
+#[pyclass(module = "tiltnoise", frozen, get_all)]
+pub struct MonteCarlo {
+    /// Draws made (accepted + rejected).
+    samples: usize,
+    /// Draws rejected as non-physical.
+    rejected: usize,
+    /// Mode frequencies (Hz) of every accepted draw, ``[n_accepted, 8]``, each row ascending.
+    freqs_hz: Py<PyArray2<f64>>,
+    /// 0-based draw number of each row of ``freqs_hz``.
+    sample_index: Py<PyArray1<usize>>,
+    /// Mean frequency per mode (Hz).
+    mean_hz: Vec<f64>,
+    /// Standard deviation (n - 1) per mode (Hz).
+    std_hz: Vec<f64>,
+}
+
+#[pymethods]
+impl MonteCarlo {
+    fn __repr__(&self) -> String {
+        format!(
+            "MonteCarlo({} draws, {} rejected; mean_hz={:?}, std_hz={:?})",
+            self.samples, self.rejected, self.mean_hz, self.std_hz
+        )
+    }
+}

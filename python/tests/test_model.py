@@ -1,0 +1,185 @@
+"""tiltnoise.Model: modes and transfer functions equal to the command line's, physics limits,
+the matrices, the Monte Carlo, and errors."""
+
+import json
+
+import numpy as np
+import pytest
+
+import tiltnoise
+
+TILT = ["theta_t", "eta_t", "phi_t"]
+OBSERVABLES = ["X", "Y", "Z", "theta", "eta", "phi", "phi_a"]
+
+
+@pytest.fixture(scope="module")
+def model():
+    return tiltnoise.Model()
+
+
+def read_tf_csv(path):
+    """`tiltnoise tf --save tf.csv` as (freq, H[n_freq, n_entries], entry names)."""
+    with open(path) as fh:
+        header = fh.readline().rstrip("\n").split(",")
+    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    return data[:, 0], data[:, 1::2] + 1j * data[:, 2::2], [n[: -len(".re")] for n in header[1::2]]
+
+
+def test_low_frequency_limit_of_x_per_eta_t(model):
+    """X -> -eta_t (Z + Z_b + h_c) as f -> 0 (section IV.B): -1.664 m/rad for Table I."""
+    h = model.transfer(1e-5, inputs="eta_t", outputs="X")
+    p = model.params
+    lever = p.get("length.z_m") + p.get("length.z_b_m") + p.get("length.h_c_m")
+    assert h.shape == (1, 1, 1) and h.dtype == np.complex128
+    assert abs(h[0, 0, 0].real + 1.664) < 1e-6
+    assert abs(h[0, 0, 0] + lever) < 1e-8 * lever
+    # Y -> +theta_t (Z + Z_b + h_c), and X does not see theta_t at all.
+    h = model.transfer([1e-5], inputs=["theta_t"], outputs=["Y", "X"])
+    assert abs(h[0, 0, 0] - lever) < 1e-8 * lever and h[0, 1, 0] == 0
+
+
+def test_modes_equal_the_command_lines(model, cli):
+    expected = json.loads(cli("modes", "--format", "json"))["modes"]
+    got = model.modes()
+    assert len(got) == len(expected) == 8
+    for m, e in zip(got, expected):
+        assert m.index == e["index"] and m.block == e["block"]
+        assert m.frequency_hz == e["frequency_hz"]
+        assert m.omega_sq_rad2_per_s2 == e["omega_sq_rad2_per_s2"]
+        assert m.q == float("inf") and e["quality_factor"] == "inf"
+        assert m.seen_by == e["seen_by"]
+        assert m.dominant_coordinates == [
+            (d["coordinate"], d["energy_share"]) for d in e["dominant_coordinates"]
+        ]
+        assert m.observable_amplitude == e["observable_amplitude"]
+        assert abs(sum(m.energy_share.values()) - 1) < 1e-12
+
+
+def test_damped_modes_have_the_command_lines_q(cli):
+    params = tiltnoise.Params().set("loss.torsion_b_rad", 1e-3)
+    expected = json.loads(cli("--set", "loss.torsion_b_rad=1e-3", "modes", "--format", "json"))
+    q = [m.q for m in tiltnoise.Model(params).modes()]
+    assert q == [e["quality_factor"] if e["quality_factor"] != "inf" else float("inf")
+                 for e in expected["modes"]]
+    assert q[1] == pytest.approx(1e3, rel=1e-2)
+
+
+@pytest.mark.parametrize(
+    "inputs, method",
+    [("tilt", "auto"), ("F_b.x,M_b.z,F_a.y", "auto"), ("tilt", "split"), ("M_b.z", "direct")],
+)
+def test_transfer_equals_the_command_lines_file(model, cli, tmp_path, inputs, method):
+    f = np.concatenate([[0.0], np.logspace(-5, 2, 301)])
+    grid = tmp_path / "grid.txt"
+    grid.write_text("".join(f"{float(x)!r}\n" for x in f))
+    out = tmp_path / "tf.csv"
+    cli("tf", "--freq-file", grid, "--input", inputs, "--method", method, "--save", out)
+    freq, h_cli, names = read_tf_csv(out)
+    h = model.transfer(f, inputs=inputs, method=method)
+    assert np.array_equal(freq, f)
+    ins = [n for n in inputs.split(",")] if inputs != "tilt" else TILT
+    assert names == [f"{o}.{i}" for o in OBSERVABLES for i in ins]
+    assert h.shape == (len(f), 7, len(ins))
+    np.testing.assert_array_equal(h.reshape(len(f), -1), h_cli)
+
+
+def test_transfer_order_threads_and_out(model):
+    f = np.logspace(-4, 1.5, 20_000)
+    h = model.transfer(f)
+    swapped = model.transfer(f, inputs=["phi_t", "theta_t"], outputs=("phi_a", "X"))
+    np.testing.assert_array_equal(swapped[:, 0, 0], h[:, 6, 2])
+    np.testing.assert_array_equal(swapped[:, 1, 1], h[:, 0, 0])
+    one = model.transfer(f, threads=1)
+    np.testing.assert_array_equal(one, h)
+    out = np.empty_like(h)
+    assert model.transfer(f, out=out) is out
+    np.testing.assert_array_equal(out, h)
+    with pytest.raises(ValueError, match="out: shape"):
+        model.transfer(f[:10], out=out)
+
+
+def test_matrices_rebuild_the_transfer_functions(model):
+    """H = C (K - w^2 M)^-1 (G0 + w^2 G2) in NumPy, away from the resonances, where the direct
+    solve in f64 is accurate."""
+    m = model.matrices()
+    assert m["M"].shape == (8, 8) and m["G0"].shape == (8, 3) and m["C"].shape == (7, 8)
+    assert m["observables"] == OBSERVABLES and m["tilt_inputs"] == TILT
+    f = np.array([3e-3, 0.05, 0.3, 2.0, 30.0])
+    w2 = (2 * np.pi * f) ** 2
+    d = m["K"] + 1j * m["K_imag"] - w2[:, None, None] * m["M"]
+    g = m["G0"] + w2[:, None, None] * m["G2"]
+    h_np = m["C"] @ np.linalg.solve(d, g.astype(complex))
+    h = model.transfer(f)
+    scale = np.abs(h).max(axis=0, keepdims=True)
+    np.testing.assert_allclose(h_np, h, rtol=0, atol=1e-9 * scale.max())
+    forces = model.transfer(f, inputs="forces")
+    h_np = m["C"] @ np.linalg.solve(d, np.broadcast_to(m["F"], (len(f), 8, 12)).astype(complex))
+    np.testing.assert_allclose(h_np, forces, rtol=1e-8, atol=1e-12 * np.abs(forces).max())
+
+
+def test_monte_carlo_equals_the_command_lines(model, cli):
+    expected = json.loads(cli("mc", "--samples", 300, "--seed", 7, "--format", "json"))
+    got = model.monte_carlo(samples=300, seed=7, threads=1)
+    assert (got.samples, got.rejected) == (expected["samples"], expected["rejected"])
+    assert got.mean_hz == [m["mean_hz"] for m in expected["modes"]]
+    assert got.std_hz == [m["std_hz"] for m in expected["modes"]]
+    assert got.freqs_hz.shape == (300 - got.rejected, 8)
+    again = model.monte_carlo(samples=300, seed=7, threads=2)
+    np.testing.assert_array_equal(again.freqs_hz, got.freqs_hz)
+
+
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        ({"inputs": "F_c.x"}, ["unknown input", "F_c.x", "M_b.z", "theta_t"]),
+        ({"inputs": "tilt,eta_t"}, ["eta_t is given twice"]),
+        ({"inputs": ""}, ["inputs: empty name"]),
+        ({"outputs": "x"}, ["unknown observable", "phi_a"]),
+        ({"method": "fast"}, ["unknown method", "polezero"]),
+        ({"rel_tol": 0.0}, ["rel_tol", "(0, 1)"]),
+        ({"method": "torsion2"}, ["torsion2", "theta_t"]),
+    ],
+)
+def test_bad_requests_raise_value_error_naming_the_item(model, kwargs, words):
+    with pytest.raises(ValueError) as e:
+        model.transfer([1e-3, 1e-2], **kwargs)
+    for w in words:
+        assert w in str(e.value)
+
+
+def test_bad_frequencies_and_resonances_raise_value_error(model):
+    with pytest.raises(ValueError, match=r"frequency -1 Hz .* must be finite and >= 0"):
+        model.transfer([1e-3, -1.0])
+    with pytest.raises(ValueError, match="finite"):
+        model.transfer(np.nan)
+    with pytest.raises(ValueError, match="1-D"):
+        model.transfer(np.ones((2, 2)))
+    nu_1 = model.modes()[0].frequency_hz
+    with pytest.raises(ValueError, match="singular"):
+        model.transfer([1e-3, nu_1], method="direct")
+
+
+def test_explain_names_the_pick(model):
+    text = model.explain(np.logspace(-5, 2, 100))
+    assert "picked `polezero`" in text
+
+
+def test_fit_equals_the_command_lines(model, cli):
+    expected = json.loads(cli("fit", "--format", "json"))
+    got = model.fit()
+    for name in ("chi2", "chi2_nominal", "dof", "iterations", "evaluations", "stop",
+                 "prior_term", "projected_gradient", "singular_values"):
+        assert getattr(got, name) == expected[name], name
+    assert got.measured_origin == expected["measured_origin"]
+    assert got.parameters == expected["parameters"]
+    assert got.modes == expected["modes"]
+    assert got.params.to_toml() == expected["fitted_params_toml"]
+
+
+def test_fit_errors(model, tmp_path):
+    with pytest.raises(ValueError, match="unknown parameter key `length.hh`"):
+        model.fit(free=["length.hh"])
+    bad = tmp_path / "modes.csv"
+    bad.write_text("mode,frequency_hz\n9,1.0\n")
+    with pytest.raises(tiltnoise.InputFileError, match="modes.csv"):
+        model.fit(measured=bad)

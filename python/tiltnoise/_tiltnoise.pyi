@@ -1,0 +1,192 @@
+"""Type stubs of the extension module tiltnoise._tiltnoise (see the docstrings at run time)."""
+
+import os
+from typing import Any, Literal, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+hdf5_version: str
+
+_Names = Union[str, Sequence[str]]
+_Path = Union[str, os.PathLike[str]]
+_Freqs = Union[float, npt.ArrayLike]
+
+class InputFileError(OSError):
+    """A file that was read but is not valid (layout, attribute or value)."""
+
+class Params:
+    def __init__(self) -> None: ...
+    @staticmethod
+    def from_toml(source: Union[str, os.PathLike[str]]) -> Params: ...
+    def to_toml(self) -> str: ...
+    def set(self, key: str, value: float) -> Params: ...
+    def update(self, values: Mapping[str, float]) -> Params: ...
+    def get(self, key: str) -> float: ...
+    def keys(self) -> list[Tuple[str, float, str, str]]: ...
+    def to_dict(self) -> dict[str, float]: ...
+    def __eq__(self, other: object) -> bool: ...
+
+class Mode:
+    index: int
+    frequency_hz: float
+    omega_sq_rad2_per_s2: float
+    quality_factor: float
+    loss_angle_rad: float
+    block: str
+    dominant_coordinates: list[Tuple[str, float]]
+    energy_share: dict[str, float]
+    seen_by: list[str]
+    observable_amplitude: dict[str, float]
+    shape: list[float]
+    @property
+    def q(self) -> float: ...
+
+class MonteCarlo:
+    samples: int
+    rejected: int
+    freqs_hz: npt.NDArray[np.float64]
+    sample_index: npt.NDArray[np.uintp]
+    mean_hz: list[float]
+    std_hz: list[float]
+
+class Fit:
+    @property
+    def params(self) -> Params: ...
+    @property
+    def parameters(self) -> list[dict[str, Any]]: ...
+    @property
+    def modes(self) -> list[dict[str, Any]]: ...
+    chi2: float
+    chi2_nominal: float
+    prior_term: float
+    dof: int
+    singular_values: list[float]
+    weak_directions: list[Tuple[float, list[Tuple[str, float]]]]
+    iterations: int
+    evaluations: int
+    stop: str
+    projected_gradient: float
+    measured_origin: str
+
+class Model:
+    def __init__(self, params: Optional[Params] = None) -> None: ...
+    @property
+    def params(self) -> Params: ...
+    def modes(self) -> list[Mode]: ...
+    def transfer(
+        self,
+        freq_hz: _Freqs,
+        inputs: Optional[_Names] = None,
+        outputs: Optional[_Names] = None,
+        method: Literal[
+            "auto", "direct", "block", "split", "polezero", "modal", "statespace", "torsion2"
+        ] = "auto",
+        rel_tol: float = 1e-9,
+        threads: Optional[int] = None,
+        out: Optional[npt.NDArray[np.complex128]] = None,
+    ) -> npt.NDArray[np.complex128]: ...
+    def explain(
+        self,
+        freq_hz: _Freqs,
+        inputs: Optional[_Names] = None,
+        outputs: Optional[_Names] = None,
+        rel_tol: float = 1e-9,
+    ) -> str: ...
+    def matrices(self) -> dict[str, Any]: ...
+    def monte_carlo(self, samples: int = 10000, seed: int = 1, threads: int = 0) -> MonteCarlo: ...
+    def fit(
+        self,
+        free: Optional[Sequence[str]] = None,
+        measured: Optional[_Path] = None,
+        bound_sigmas: float = 1.0,
+        prior: bool = False,
+    ) -> Fit: ...
+
+class Budget:
+    @property
+    def freq_hz(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def observables(self) -> list[str]: ...
+    @property
+    def terms(self) -> dict[str, dict[str, npt.NDArray[np.float64]]]: ...
+    @property
+    def total(self) -> dict[str, npt.NDArray[np.float64]]: ...
+    @property
+    def units(self) -> dict[str, str]: ...
+    @property
+    def equivalent(self) -> dict[str, dict[str, Any]]: ...
+    @property
+    def segment_bands(self) -> dict[str, dict[str, Any]]: ...
+    @property
+    def segment_duration_s(self) -> Optional[float]: ...
+    @property
+    def source(self) -> dict[str, Any]: ...
+    @property
+    def axes(self) -> list[str]: ...
+    @property
+    def readout(self) -> dict[str, float]: ...
+    @property
+    def notes(self) -> list[str]: ...
+    @property
+    def input(self) -> dict[str, Optional[str]]: ...
+    @property
+    def params(self) -> Params: ...
+    def psd(self, observable: str, term: str = "total") -> npt.NDArray[np.float64]: ...
+    def asd(self, observable: str, term: str = "total") -> npt.NDArray[np.float64]: ...
+    def to_csv(self) -> str: ...
+    def save(self, path: _Path) -> None: ...
+    def to_gwpy(self) -> dict[str, dict[str, Any]]: ...
+
+def welch(
+    x: npt.ArrayLike,
+    fs: float = 1.0,
+    window: str = "hann",
+    nperseg: int = 256,
+    noverlap: Optional[int] = None,
+    detrend: Union[Literal["constant"], Literal[False], None] = None,
+    average: Literal["mean", "median"] = "mean",
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+def csd(
+    x: npt.ArrayLike,
+    y: npt.ArrayLike,
+    fs: float = 1.0,
+    window: str = "hann",
+    nperseg: int = 256,
+    noverlap: Optional[int] = None,
+    detrend: Union[Literal["constant"], Literal[False], None] = None,
+    average: Literal["mean", "median"] = "mean",
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.complex128]]: ...
+def budget(
+    tilt: Union[Mapping[str, npt.ArrayLike], npt.ArrayLike],
+    fs: float,
+    *,
+    axes: Optional[_Names] = None,
+    quantity: Literal["angle", "rate"] = "angle",
+    gaps: Literal["reject", "interpolate"] = "reject",
+    params: Union[Params, Model, None] = None,
+    nperseg: Optional[int] = None,
+    overlap: Optional[float] = None,
+    average: Optional[Literal["mean", "median"]] = None,
+    segment_duration: Optional[float] = None,
+    percentiles: Optional[Tuple[float, float]] = None,
+    readout: Optional[Mapping[str, float]] = None,
+    measured: Optional[_Path] = None,
+) -> Budget: ...
+def budget_from_file(
+    path: _Path,
+    *,
+    axes: Optional[str] = None,
+    quantity: Optional[Literal["angle", "rate"]] = None,
+    gaps: Optional[Literal["reject", "interpolate"]] = None,
+    params: Union[Params, Model, None] = None,
+    nperseg: Optional[int] = None,
+    overlap: Optional[float] = None,
+    average: Optional[Literal["mean", "median"]] = None,
+    segment_duration: Optional[float] = None,
+    percentiles: Optional[Tuple[float, float]] = None,
+    readout: Optional[Mapping[str, float]] = None,
+    freq: Union[str, npt.ArrayLike, None] = None,
+    measured: Optional[_Path] = None,
+) -> Budget: ...
