@@ -95,7 +95,7 @@ impl PyModel {
         let model = &self.model;
         let choice = py
             .detach(|| tf::choose(model, &scene))
-            .map_err(value_error)?;
+            .map_err(|e| value_error(e.to_string()))?;
         lock(&self.choices).insert(key, choice.method);
         Ok(choice.method)
     }
@@ -441,7 +441,7 @@ impl PyModel {
         let model = &self.model;
         let choice = py
             .detach(|| tf::choose(model, &scene))
-            .map_err(value_error)?;
+            .map_err(|e| value_error(e.to_string()))?;
         Ok(choice.explain())
     }
 
