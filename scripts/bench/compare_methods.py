@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Speed of each transfer-function method against numpy.linalg.solve, side by side (issue 4, item 4).
+"""Speed of each transfer-function method against numpy.linalg.solve, side by side.
 
     python3 scripts/bench/compare_methods.py [--points 100000] [--rounds 3] [--runs 5]
                                              [--dir /tmp/tiltnoise-bench] [--bench-exe PATH]
@@ -38,7 +38,7 @@ machine hit every side alike. Reported: the median over rounds of each figure, t
 medians (NumPy ns/point over Rust ns/point at the same thread count), and the per-round ratio's
 median and range.
 
-Target (issue 4): what `auto` does for the user (polezero_matrix: the pole-zero method, which
+Target: what `auto` does for the user (polezero_matrix: the pole-zero method, which
 meets the 1e-9 relative accuracy target of crates/tiltnoise-core/tests/it/polezero.rs and
 crates/tiltnoise-core/tests/it/methods.rs, evaluating the whole grid into its result) at least --target-ratio (100) times faster per point than
 NumPy into preallocated arrays, single thread. Exit code 0 if met, 1 if missed, 2 if a run

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""NumPy baseline of the transfer-function speed benchmark (issue 4, item 4).
+"""NumPy baseline of the transfer-function speed benchmark.
 
     python3 scripts/bench/methods_numpy.py [--threads 1] [--points 100000] [--runs 5]
 

@@ -2,7 +2,7 @@
 //!
 //! # What it is for
 //!
-//! The oracle of the accuracy tests and of the methods table of issue 4: it evaluates
+//! The oracle of the accuracy tests and of the methods table: it evaluates
 //! `H(w) = C (K_c - w^2 M)^-1 (G0 + w^2 G2)` (or a column of the force matrix instead of the
 //! tilt forcing) to about 30 significant digits, so that the error of every `f64` method
 //! ([`crate::tf::Method`]) can be measured rather than estimated. It costs about 8 us per
