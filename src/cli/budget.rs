@@ -252,12 +252,14 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     };
     let ropts = read_options(&args)?;
     let path = &args.tilt;
-    // HDF5 time series stream from disk; everything else is read at once.
-    let streamable = InputFormat::from_path(path)? == InputFormat::Hdf5
-        && TiltSeriesSource::open(path, &ropts).is_ok();
-    let (report, provenance) = if streamable {
+    // Opened once: an HDF5 series streams from the file; anything else is read whole below
+    // (which reports why an HDF5 file is not a series).
+    let streamed = match InputFormat::from_path(path)? {
+        InputFormat::Hdf5 => TiltSeriesSource::open(path, &ropts).ok(),
+        InputFormat::Csv => None,
+    };
+    let (report, provenance) = if let Some(mut source) = streamed {
         refuse_spectra_options(&args, path)?;
-        let mut source = TiltSeriesSource::open(path, &ropts)?;
         let provenance = source.provenance().clone();
         let bar = progress_bar(source.len() as u64);
         let report = budget_from_series(&model, &mut source, &opts, &mut |done, _| {
