@@ -642,7 +642,11 @@ const MAX_NESTING: usize = 16;
 /// brackets count to the end; a table header `[a]` is one level).
 fn max_nesting(text: &str) -> usize {
     let b = text.as_bytes();
-    let (mut depth, mut deepest, mut i) = (0usize, 0usize, 0usize);
+    // The open brackets, innermost last. A closer pops only the bracket it matches: the
+    // parser's error recovery keeps `{` open across a stray `]` (`a = { b]` repeated recurses
+    // once per line), so a mismatched closer must not lower the count.
+    let mut open: Vec<u8> = Vec::new();
+    let (mut deepest, mut i) = (0usize, 0usize);
     while i < b.len() {
         match b[i] {
             b'#' => {
@@ -668,11 +672,16 @@ fn max_nesting(text: &str) -> usize {
                     i += 1;
                 }
             }
-            b'[' | b'{' => {
-                depth += 1;
-                deepest = deepest.max(depth);
+            c @ (b'[' | b'{') => {
+                open.push(c);
+                deepest = deepest.max(open.len());
             }
-            b']' | b'}' => depth = depth.saturating_sub(1),
+            b']' if open.last() == Some(&b'[') => {
+                open.pop();
+            }
+            b'}' if open.last() == Some(&b'{') => {
+                open.pop();
+            }
             _ => {}
         }
         i += 1;
@@ -701,6 +710,11 @@ mod tests {
         let e = Params::from_toml_str(&"a={[b]\n".repeat(20_000), "deep.toml").unwrap_err();
         let e = e.to_string();
         assert!(e.contains("deep.toml") && e.contains("at most 16"), "{e}");
+        // A stray closer does not close a bracket of the other kind.
+        assert_eq!(max_nesting("a = { b]\nc = [ d}\n"), 2);
+        let stray = "[uncertainty]\n\"length.h_m\" = { rel_sigma]\n".repeat(20_000);
+        let e = Params::from_toml_str(&stray, "stray.toml").unwrap_err().to_string();
+        assert!(e.contains("stray.toml") && e.contains("at most 16"), "{e}");
     }
 
     #[test]
