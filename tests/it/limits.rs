@@ -113,6 +113,20 @@ fn frequency_grids_over_the_limit() {
             "more than the 1000000 allowed",
         ],
     );
+    // Frequencies above the highest one allowed, in a grid and in a frequency file.
+    refused(
+        &["methods", "--freq", "1e300:2:1e301"],
+        &["frequency 1e301 Hz (FHI of log grid 1e300:2:1e301) is not allowed"],
+    );
+    let high = arg(dir.path(), "high.txt");
+    std::fs::write(&high, "1e-3\n2e6\n").unwrap();
+    refused(
+        &["tf", "--freq-file", &high],
+        &[&format!(
+            "frequency 2000000 Hz ({high}, line 2) is not allowed"
+        )],
+    );
+    std::fs::remove_file(&high).unwrap();
     let spectra = repo("tilt_data/peterson_tilt_asd.csv");
     refused(
         &[
@@ -505,6 +519,28 @@ mod devices {
         );
         let _ = writer.kill();
         writer.wait().unwrap();
+    }
+
+    /// An HDF5 input that is a named pipe: HDF5 reads at random offsets and would wait for
+    /// a writer for ever, so the file is refused before the library sees it.
+    #[test]
+    fn an_hdf5_input_through_a_fifo() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("tilt.h5");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        let out = super::run(&["budget", "--tilt", fifo.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        let expected = format!(
+            "tiltnoise: error: cannot read input file {}: it is a FIFO, not a regular file",
+            fifo.display()
+        );
+        assert!(err.starts_with(&expected), "{err}");
     }
 }
 

@@ -561,6 +561,12 @@ fn an_interrupt_during_a_write_leaves_no_file() {
         libc::SIGTERM,
         "SIGTERM",
     );
+    interrupt_during_write(
+        &["tf", "--freq", "1e-4:200000:30", "--save", "big.csv"],
+        "big.csv",
+        libc::SIGHUP,
+        "SIGHUP",
+    );
 }
 
 /// Standard output of a successful run.

@@ -186,8 +186,14 @@ pub enum ParamError {
 /// A frequency request that cannot be evaluated.
 #[derive(Debug, thiserror::Error)]
 pub enum FreqError {
-    /// A frequency that is negative, NaN or infinite.
-    #[error("frequency {} Hz ({origin}) is not allowed: must be finite and >= 0", Num(*.value))]
+    /// A frequency that is negative, NaN, infinite or above
+    /// [`MAX_FREQUENCY_HZ`](crate::limits::MAX_FREQUENCY_HZ).
+    #[error(
+        "frequency {} Hz ({origin}) is not allowed: must be finite, >= 0 and <= {:e} Hz \
+         (see docs/limits.md)",
+        Num(*.value),
+        crate::limits::MAX_FREQUENCY_HZ
+    )]
     Invalid {
         /// The value.
         value: f64,

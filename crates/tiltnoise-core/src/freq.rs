@@ -5,8 +5,8 @@
 //! All frequencies are in Hz. A grid has at most [`MAX_GRID_POINTS`] points. Depends on
 //! `modes` (for resonance placement), `error` and `limits` only.
 
-use crate::error::{FreqError, Shown};
-use crate::limits::{check_count, MAX_GRID_POINTS};
+use crate::error::{FreqError, Num, Shown};
+use crate::limits::{check_count, MAX_FREQUENCY_HZ, MAX_GRID_POINTS};
 use crate::model::Model;
 use crate::modes::NormalModes;
 
@@ -36,12 +36,18 @@ const POINTS: &str = "frequency points";
 /// `n` log-spaced frequencies from `lo` to `hi` inclusive (`n = 1` gives `[lo]`), at most
 /// [`MAX_GRID_POINTS`].
 pub fn log_grid(lo: f64, hi: f64, n: usize) -> Result<Vec<f64>, FreqError> {
-    let spec = || format!("log grid {lo}:{n}:{hi}");
+    let spec = || format!("log grid {}:{n}:{}", Num(lo), Num(hi));
     check_count(spec, n as f64, POINTS, MAX_GRID_POINTS)?;
     if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi >= lo && n >= 1) {
         return Err(FreqError::Spec {
             origin: spec(),
             message: "need 0 < FLO <= FHI, both finite, and N >= 1".into(),
+        });
+    }
+    if hi > MAX_FREQUENCY_HZ {
+        return Err(FreqError::Invalid {
+            value: hi,
+            origin: format!("FHI of {}", spec()),
         });
     }
     if n > MAX_GRID_POINTS {
@@ -66,6 +72,22 @@ pub fn log_grid(lo: f64, hi: f64, n: usize) -> Result<Vec<f64>, FreqError> {
             }
         })
         .collect())
+}
+
+/// Checks frequencies given by a caller (an array from Python, say): each finite, >= 0 and at
+/// most [`MAX_FREQUENCY_HZ`]. `origin` names them in the message, with the index of the first
+/// offending value.
+pub fn check_frequencies(freqs_hz: &[f64], origin: &str) -> Result<(), FreqError> {
+    match freqs_hz
+        .iter()
+        .position(|f| !(f.is_finite() && (0.0..=MAX_FREQUENCY_HZ).contains(f)))
+    {
+        None => Ok(()),
+        Some(i) => Err(FreqError::Invalid {
+            value: freqs_hz[i],
+            origin: format!("{origin}, index {i}"),
+        }),
+    }
 }
 
 /// Parses `FLO:N:FHI` (Hz, count, Hz), e.g. `1e-4:2000:30`; N is at most
@@ -153,6 +175,25 @@ pub fn default_grid(model: &Model) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn frequencies_above_the_limit_are_refused() {
+        assert!(check_frequencies(&[0.0, 1e-3, MAX_FREQUENCY_HZ], "f").is_ok());
+        for bad in [-1e-3, f64::NAN, f64::INFINITY, 1.000001e6] {
+            let e = check_frequencies(&[1.0, bad], "freq_hz")
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("freq_hz, index 1") && e.contains("<= 1e6 Hz"),
+                "{e}"
+            );
+        }
+        let e = log_grid(1e300, 1e301, 2).unwrap_err().to_string();
+        assert!(
+            e.contains("1e301 Hz (FHI of log grid 1e300:2:1e301)"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn log_grid_endpoints_and_ratio() {

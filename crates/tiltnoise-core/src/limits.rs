@@ -79,6 +79,11 @@ pub const MAX_STREAMED_SAMPLES: usize = 1 << 32;
 /// copy while it is processed.
 pub const SERIES_BYTES_PER_SAMPLE: u64 = 16;
 
+/// Highest frequency (Hz) of any grid (`--freq`, a frequency file, an array from Python): a
+/// million times the highest mode of the pendulum (about 10 Hz). Far above it the dynamic
+/// stiffness is `-w^2 M` to the last bit and every method is singular or meaningless.
+pub const MAX_FREQUENCY_HZ: f64 = 1e6;
+
 /// Largest parameter file (`--params`) or measured mode-frequency file (`fit --measured`):
 /// hand-written files of a few KiB (the full parameter set is 3 KiB), parsed into trees
 /// several times their size. 1 MiB is 300 times that.

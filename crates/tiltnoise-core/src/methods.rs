@@ -8,6 +8,7 @@
 //! [`crate::tf::evaluate`] stores it), repeated until at least [`MIN_TIMING_S`] has passed,
 //! divided by the points evaluated; single thread.
 
+use crate::error::Num;
 use crate::model::Model;
 use crate::modes::NormalModes;
 use crate::reference::{relative_errors, ReferenceModel};
@@ -75,8 +76,8 @@ pub fn methods_table(model: &Model, request: &Request, grid: &[f64]) -> Vec<Meth
             for (&f, want) in checked.iter().zip(&wants) {
                 let (got, want) = match (tf.eval(f), want) {
                     (Ok(g), Ok(w)) => (g, w),
-                    (Err(e), _) => return unusable(format!("at {f} Hz: {e}")),
-                    (_, Err(e)) => return unusable(format!("reference at {f} Hz: {e}")),
+                    (Err(e), _) => return unusable(format!("at {} Hz: {e}", Num(f))),
+                    (_, Err(e)) => return unusable(format!("reference at {} Hz: {e}", Num(f))),
                 };
                 for (idx, err) in relative_errors(&got, want).into_iter().enumerate() {
                     if want[idx].to_c64() == Complex64::new(0.0, 0.0)

@@ -6,7 +6,7 @@
 //!   [`write_atomic`] leaves each finished temporary file in place, and [`Staging::commit`]
 //!   renames them all at the end; if the run fails before, dropping the `Staging` removes them,
 //!   so either every output of the run appears or none does.
-//! * [`remove_temporaries_on_interrupt`]: SIGINT and SIGTERM remove the temporary files that
+//! * [`remove_temporaries_on_interrupt`]: SIGINT, SIGTERM and SIGHUP remove the temporary files that
 //!   exist at that moment before the process ends.
 
 use std::cell::RefCell;
@@ -276,9 +276,9 @@ impl Drop for Staging {
     }
 }
 
-/// Removes the temporary files of [`write_atomic`] that exist when the process receives SIGINT
-/// or SIGTERM, prints one line naming the signal, and ends the process with exit code 2. Call
-/// it once, early in `main`, before any thread is started: it blocks both signals in the
+/// Removes the temporary files of [`write_atomic`] that exist when the process receives SIGINT,
+/// SIGTERM or SIGHUP (unless SIGHUP is ignored, as under `nohup`), prints one line naming the signal, and ends the process with exit code 2. Call
+/// it once, early in `main`, before any thread is started: it blocks these signals in the
 /// calling thread (so in every thread started later) and waits for them in a thread of its
 /// own. Does nothing on platforms without POSIX signals.
 pub fn remove_temporaries_on_interrupt() {
@@ -293,13 +293,21 @@ mod unix {
     pub(super) fn install() {
         use std::io::Write as _;
         // SAFETY: `set` is initialised by sigemptyset before use; pthread_sigmask and sigwait
-        // only read it. Blocking SIGINT and SIGTERM here makes every thread started later
+        // only read it. Blocking the signals here makes every thread started later
         // inherit the mask, so the signals are delivered only to `sigwait` below.
         unsafe {
             let mut set: libc::sigset_t = std::mem::zeroed();
             libc::sigemptyset(&mut set);
             libc::sigaddset(&mut set, libc::SIGINT);
             libc::sigaddset(&mut set, libc::SIGTERM);
+            // A hangup (the terminal closed) ends the run as well, unless it is ignored, as
+            // under `nohup`: then the run goes on.
+            let mut hup: libc::sigaction = std::mem::zeroed();
+            if libc::sigaction(libc::SIGHUP, std::ptr::null(), &mut hup) == 0
+                && hup.sa_sigaction != libc::SIG_IGN
+            {
+                libc::sigaddset(&mut set, libc::SIGHUP);
+            }
             if libc::pthread_sigmask(libc::SIG_BLOCK, &set, std::ptr::null_mut()) != 0 {
                 return;
             }
@@ -319,10 +327,10 @@ mod unix {
                     let _ = std::fs::remove_file(p);
                 }
                 let removed = live.len();
-                let name = if sig == libc::SIGINT {
-                    "SIGINT"
-                } else {
-                    "SIGTERM"
+                let name = match sig {
+                    libc::SIGINT => "SIGINT",
+                    libc::SIGHUP => "SIGHUP",
+                    _ => "SIGTERM",
                 };
                 // Not eprintln!: a panic on a closed standard error would end this thread
                 // before the process, leaving both signals blocked for good.

@@ -6,10 +6,12 @@ use std::path::Path;
 use tiltnoise_core::csv_text::{line_text, CsvRecords};
 use tiltnoise_core::error::{FreqError, Shown};
 use tiltnoise_core::limits::{
-    check_count, read_text_file, TextFileError, MAX_FREQ_FILE_BYTES, MAX_GRID_POINTS,
+    check_count, read_text_file, TextFileError, MAX_FREQUENCY_HZ, MAX_FREQ_FILE_BYTES,
+    MAX_GRID_POINTS,
 };
 
-/// Reads a frequency file. Every value must be finite and >= 0; at least one is required.
+/// Reads a frequency file. Every value must be finite, >= 0 and at most
+/// [`MAX_FREQUENCY_HZ`]; at least one is required.
 ///
 /// # Errors
 ///
@@ -62,7 +64,7 @@ fn parse_freq_text(text: &str, origin: &str) -> Result<Vec<f64>, FreqError> {
                 ),
             });
         };
-        if !(value.is_finite() && value >= 0.0) {
+        if !(value.is_finite() && (0.0..=MAX_FREQUENCY_HZ).contains(&value)) {
             return Err(FreqError::Invalid {
                 value,
                 origin: at(line),

@@ -713,7 +713,9 @@ mod tests {
         // A stray closer does not close a bracket of the other kind.
         assert_eq!(max_nesting("a = { b]\nc = [ d}\n"), 2);
         let stray = "[uncertainty]\n\"length.h_m\" = { rel_sigma]\n".repeat(20_000);
-        let e = Params::from_toml_str(&stray, "stray.toml").unwrap_err().to_string();
+        let e = Params::from_toml_str(&stray, "stray.toml")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("stray.toml") && e.contains("at most 16"), "{e}");
     }
 

@@ -12,7 +12,7 @@
 //! [`Choice`] keeps every candidate's verdict, so `--explain` can say what was picked and why;
 //! so does [`NoChoice`] when nothing meets the tolerance, whose message names only the best.
 
-use crate::error::TfError;
+use crate::error::{Num, TfError};
 use crate::model::{Input, Request};
 use crate::model::{Model, Observable};
 use crate::modes::NormalModes;
@@ -103,8 +103,10 @@ impl std::fmt::Display for NoChoice {
         let (lo, hi) = scene.band_hz;
         write!(
             f,
-            "no method meets the relative tolerance {:e} on {lo} .. {hi} Hz",
-            scene.rel_tol
+            "no method meets the relative tolerance {:e} on {} .. {} Hz",
+            scene.rel_tol,
+            Num(lo),
+            Num(hi)
         )?;
         let best = verdicts
             .iter()
@@ -204,13 +206,17 @@ pub fn choose(model: &Model, scene: &Scene) -> Result<Choice, NoChoice> {
     let (lo, hi) = scene.band_hz;
     if !(lo > 0.0 && hi >= lo && hi.is_finite()) {
         return Err(NoChoice::Band(format!(
-            "scene band {lo} .. {hi} Hz is not allowed: need 0 < lo <= hi, finite"
+            "scene band {} .. {} Hz is not allowed: need 0 < lo <= hi, finite",
+            Num(lo),
+            Num(hi)
         )));
     }
     let grid = verification_grid(model, scene.band_hz);
     if grid.is_empty() {
         return Err(NoChoice::Band(format!(
-            "scene band {lo} .. {hi} Hz lies within {POLE_EXCLUSION} of a mode: nothing to verify"
+            "scene band {} .. {} Hz lies within {POLE_EXCLUSION} of a mode: nothing to verify",
+            Num(lo),
+            Num(hi)
         )));
     }
     let reference = ReferenceModel::new(model.params());

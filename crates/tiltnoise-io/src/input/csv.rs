@@ -99,6 +99,16 @@ impl Lines<'_> {
         self.line_no += 1;
         if self.line_no == 1 && self.buf.starts_with('\u{feff}') {
             self.buf.drain(..3);
+            // A second mark is text, not encoding (the CSV parser would drop it silently):
+            // the file was concatenated or converted twice.
+            if self.buf.starts_with('\u{feff}') {
+                return Err(self.err(
+                    1,
+                    "starts with two byte-order marks (U+FEFF); allowed: at most one, at the \
+                     start of the file"
+                        .to_string(),
+                ));
+            }
         }
         Ok(true)
     }
@@ -474,6 +484,20 @@ fn start_time(path: &Path, prelude: &Prelude) -> Result<Option<String>, InputErr
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn one_byte_order_mark_is_read_two_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.csv");
+        std::fs::write(&path, "\u{feff}time_s,E\n0,1\n1,2\n").unwrap();
+        assert!(CsvFile::open(&path).is_ok());
+        std::fs::write(&path, "\u{feff}\u{feff}time_s,E\n0,1\n1,2\n").unwrap();
+        let e = CsvFile::open(&path).err().unwrap().to_string();
+        assert!(
+            e.contains("line 1") && e.contains("two byte-order marks"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn records_beyond_the_limit_are_refused() {

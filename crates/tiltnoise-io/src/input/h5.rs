@@ -29,13 +29,23 @@ pub(crate) fn h5err(
     }
 }
 
-/// Opens `path` read-only.
+/// Opens `path` read-only. Only a regular file is handed to HDF5, which reads at random
+/// offsets: a FIFO or a character device would block it forever or feed it endless bytes.
 pub(crate) fn open(path: &Path) -> Result<hdf5::File, InputError> {
-    if let Err(reason) = std::fs::metadata(path) {
-        return Err(InputError::Io {
-            path: path.to_path_buf(),
-            reason,
-        });
+    let io_error = |reason| InputError::Io {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let kind = std::fs::metadata(path).map_err(io_error)?.file_type();
+    if !kind.is_file() {
+        return Err(io_error(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!(
+                "it is {}, not a regular file; an HDF5 file is read at random offsets, so \
+                 copy it to a regular file first",
+                crate::file_kind(&kind)
+            ),
+        )));
     }
     hdf5::File::open(path).map_err(h5err(path, "file (is it an HDF5 file?)"))
 }
