@@ -22,6 +22,11 @@ pub const TABLE_II_MEASURED_CSV: &str = include_str!("table2_measured.csv");
 /// pendulum (PETER's highest is 11 Hz); larger values are not measurements of one.
 pub const MAX_MEASURED_HZ: f64 = 1e6;
 
+/// The lowest measured mode frequency accepted (Hz): a period of 30 years, far below every mode
+/// of a torsion pendulum; smaller values (down to subnormal numbers, whose error bars underflow
+/// to 0) are not measurements of one.
+pub const MIN_MEASURED_HZ: f64 = 1e-9;
+
 /// The smallest error bar accepted, relative to its frequency: a few units of f64's resolution
 /// (2^-50); a smaller one cannot be resolved by any fitted frequency and turns chi^2 infinite.
 pub const MIN_SIGMA_REL: f64 = 8.881784197001252e-16;
@@ -124,13 +129,13 @@ impl Measured {
                 ));
             }
             let frequency_hz = parse_positive(cells[1])
-                .filter(|f| *f <= MAX_MEASURED_HZ)
+                .filter(|f| (MIN_MEASURED_HZ..=MAX_MEASURED_HZ).contains(f))
                 .ok_or_else(|| {
                     fail(
                         n,
                         format!(
-                            "frequency_hz `{}` of mode {mode} is not allowed: must be finite, > 0 \
-                             and <= {MAX_MEASURED_HZ:e} Hz",
+                            "frequency_hz `{}` of mode {mode} is not allowed: must be finite, \
+                             >= {MIN_MEASURED_HZ:e} Hz and <= {MAX_MEASURED_HZ:e} Hz",
                             Shown(cells[1])
                         ),
                     )
@@ -144,7 +149,7 @@ impl Measured {
                 ),
                 false => (half_last_digit(cells[1]), SigmaSource::Digits),
             };
-            if sigma_hz < MIN_SIGMA_REL * frequency_hz {
+            if !(sigma_hz >= MIN_SIGMA_REL * frequency_hz && sigma_hz > 0.0) {
                 return Err(fail(
                     n,
                     format!(
@@ -272,11 +277,15 @@ mod tests {
             ("mode,frequency_hz\n1,nan\n", "frequency_hz `nan`"),
             (
                 "mode,frequency_hz\n1,inf\n",
-                "must be finite, > 0 and <= 1e6 Hz",
+                "must be finite, >= 1e-9 Hz and <= 1e6 Hz",
+            ),
+            (
+                "mode,frequency_hz\n5,4.9e-324\n",
+                "must be finite, >= 1e-9 Hz and <= 1e6 Hz",
             ),
             (
                 "mode,frequency_hz\n1,1e300\n",
-                "must be finite, > 0 and <= 1e6 Hz",
+                "must be finite, >= 1e-9 Hz and <= 1e6 Hz",
             ),
             (
                 "mode,frequency_hz,sigma_hz\n1,1.0,1e-300\n",
