@@ -1499,3 +1499,38 @@ fn interpolation_zeros_coherence_and_band_restriction() {
     let (none, empty) = s.interpolate_loglog(&[10.0, 20.0]);
     assert!(none.is_empty() && empty.is_empty());
 }
+
+/// Finite values whose spectrum overflows: an ASD whose square is infinite (CSV) and an HDF5
+/// ASD of `f64::MAX` are refused by the readers, naming the entry and frequency.
+#[test]
+fn spectra_that_overflow_on_squaring_are_refused() {
+    let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_corpus");
+    for file in [
+        "tilt_csv/regressions/asd_whose_square_overflows.csv",
+        "h5_structured/regressions/asd_of_f64_max.h5",
+    ] {
+        let path = corpus.join(file);
+        err_msg(
+            spectra_err(&path, &ReadOptions::default()),
+            &path,
+            &["tilt cross-spectral density S(", "overflows f64"],
+        );
+    }
+}
+
+/// A contiguous dataset whose storage is shorter than its extent (a damaged file): HDF5 would
+/// hand back made-up values for the missing entries, so the reader refuses it.
+#[test]
+fn truncated_contiguous_storage_is_refused() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(
+        "tests/fuzz_corpus/tilt_h5_bytes/regressions/contiguous_storage_smaller_than_extent.h5",
+    );
+    err_msg(
+        series_err(&path, &ReadOptions::default()),
+        &path,
+        &[
+            "dataset `/Z`",
+            "45 bytes of storage for 12 entries of 4 bytes",
+        ],
+    );
+}

@@ -439,6 +439,25 @@ pub enum InputError {
         allowed: String,
     },
 
+    /// Finite values whose spectrum overflows f64 (an ASD above about 1.3e154 squares to
+    /// infinity; a rate spectrum is divided by `(2 pi f)^2`).
+    #[error(
+        "input file {path}: the tilt cross-spectral density {entry} at {} Hz overflows f64 \
+         ({value:?} rad^2/Hz): the values are far too large for tilt (check the file's units \
+         and the quantity)",
+        crate::error::Num(*.freq_hz)
+    )]
+    SpectrumOverflow {
+        /// The file.
+        path: PathBuf,
+        /// The entry, e.g. `S(theta_t, eta_t)`.
+        entry: String,
+        /// Its frequency (Hz).
+        freq_hz: f64,
+        /// The value (real or imaginary part) that is not finite.
+        value: f64,
+    },
+
     /// A negative or non-finite amplitude spectral density.
     #[error(
         "input file {path}: {location}, column `{}`: ASD {value:?} {unit} is not allowed: must \

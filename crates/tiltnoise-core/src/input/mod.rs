@@ -62,7 +62,7 @@ pub use axis_map::{resolve, AxisMap, AxisMapEntry, MapOrigin, Mapped, Resolved, 
 pub use error::{require_two, InputError};
 pub use series::{gap_note, process_channel, ChannelCtx, Gap, GapScanner, Integrator, TiltSeries};
 pub use source::SeriesSource;
-pub use spectra::{assemble, TiltSpectra, CSD_RTOL};
+pub use spectra::{assemble, check_csd_finite, TiltSpectra, CSD_RTOL};
 
 use crate::error::Shown;
 use std::fmt;

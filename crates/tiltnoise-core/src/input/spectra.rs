@@ -155,6 +155,31 @@ impl TiltSpectra {
     }
 }
 
+/// Refuses a CSD matrix (`[f][i][j]`, as in [`TiltSpectra::csd`]) with a non-finite entry:
+/// finite inputs can still overflow on squaring or on the division of a rate spectrum.
+pub fn check_csd_finite(
+    path: &std::path::Path,
+    freqs_hz: &[f64],
+    axes: &[TiltAxis],
+    csd: &[Complex64],
+) -> Result<(), super::InputError> {
+    let n = axes.len();
+    let Some(at) = csd
+        .iter()
+        .position(|z| !(z.re.is_finite() && z.im.is_finite()))
+    else {
+        return Ok(());
+    };
+    let (k, i, j) = (at / (n * n), at / n % n, at % n);
+    let z = csd[at];
+    Err(super::InputError::SpectrumOverflow {
+        path: path.to_path_buf(),
+        entry: format!("S({}, {})", axes[i].name(), axes[j].name()),
+        freq_hz: freqs_hz[k],
+        value: if z.re.is_finite() { z.im } else { z.re },
+    })
+}
+
 /// Builds the output CSD in canonical axis order from a source CSD `src(k, a, b)` indexed by
 /// source channel: `S_ij = s_i s_j src(k, a_i, a_j)`, divided by `(2 pi f)^2` for a rate.
 pub fn assemble(

@@ -50,6 +50,36 @@ pub(crate) fn open(path: &Path) -> Result<hdf5::File, InputError> {
     hdf5::File::open(path).map_err(h5err(path, "file (is it an HDF5 file?)"))
 }
 
+/// Refuses a contiguous dataset whose storage is smaller than its extent: HDF5 then returns
+/// fill values (or, for a partial read, other bytes) for the entries past the end, so the
+/// numbers read would be made up. A dataset that was never written has no storage at all.
+pub(crate) fn check_storage(
+    path: &Path,
+    ds: &hdf5::Dataset,
+    dataset: &str,
+) -> Result<(), InputError> {
+    if ds.layout() != hdf5::dataset::Layout::Contiguous {
+        return Ok(());
+    }
+    let entry_bytes = ds.dtype().map(|t| t.size() as u64).unwrap_or(0);
+    let need = (ds.size() as u64).saturating_mul(entry_bytes);
+    let have = ds.storage_size();
+    if have >= need {
+        return Ok(());
+    }
+    Err(InputError::BadDataset {
+        path: path.to_path_buf(),
+        dataset: dataset.to_string(),
+        found: format!(
+            "{have} bytes of storage for {} entries of {entry_bytes} bytes ({need} bytes)",
+            ds.size()
+        ),
+        allowed: "storage for every entry (this dataset is truncated, damaged or was never \
+                  written)"
+            .to_string(),
+    })
+}
+
 /// Refuses to read `channels` datasets of `len` samples (or frequencies) each into memory when
 /// `len` is over [`MAX_SERIES_SAMPLES`] or they do not fit into the memory available: the
 /// length comes from the file's metadata, which a file of a few KiB can set to 10^12.

@@ -106,6 +106,7 @@ fn read_series_hdf5(path: &Path) -> Result<MeasuredSeries, InputError> {
                 allowed: "a 1-D float64 (or float32) dataset, one sample per entry".to_string(),
             });
         }
+        h5::check_storage(path, &ds, &format!("/{name}"))?;
         match h5::attr(path, &ds, &object, "units")? {
             None => {}
             Some(AttrValue::Str(u)) if u.trim() == o.unit() => {}

@@ -118,6 +118,7 @@ impl TiltSeriesSource {
                     allowed: "a 1-D float64 (or float32) dataset, one sample per entry".to_string(),
                 });
             }
+            h5::check_storage(path, &ds, &name)?;
             match &first_len {
                 None => first_len = Some((m.source.clone(), shape[0])),
                 Some((a, n)) if *n != shape[0] => {

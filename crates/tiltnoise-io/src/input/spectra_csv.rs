@@ -3,7 +3,7 @@
 
 use super::csv::{self, parse_field, CsvFile, Prelude};
 use super::meta::{asd_quantity, ASD_UNITS};
-use super::{assemble, TiltSpectra};
+use super::{assemble, check_csd_finite, TiltSpectra};
 use super::{require_two, InputError};
 use super::{InputFormat, InputKind, Provenance, ReadOptions};
 use num_complex::Complex64;
@@ -99,9 +99,11 @@ pub(crate) fn read(
             Complex64::new(0.0, 0.0)
         }
     });
+    let axes: Vec<_> = resolved.channels.iter().map(|c| c.axis).collect();
+    check_csd_finite(&path, &freqs, &axes, &csd)?;
     Ok(TiltSpectra {
         freqs_hz: freqs,
-        axes: resolved.channels.iter().map(|m| m.axis).collect(),
+        axes,
         csd,
         provenance: Provenance {
             path,

@@ -3,7 +3,7 @@
 
 use super::h5::{self, h5err, AttrValue};
 use super::meta::{asd_quantity, csd_quantity, decide_quantity, Declared, ASD_UNITS, CSD_UNITS};
-use super::{assemble, TiltSpectra, CSD_RTOL};
+use super::{assemble, check_csd_finite, TiltSpectra, CSD_RTOL};
 use super::{require_two, InputError};
 use super::{InputFormat, InputKind, Provenance, Quantity, ReadOptions, ACCEPTED_LAYOUTS};
 use num_complex::Complex64;
@@ -43,6 +43,7 @@ pub(crate) fn read(
             allowed: "a 1-D float64 dataset (Hz)".to_string(),
         });
     }
+    h5::check_storage(path, &fds, "/frequency_hz")?;
     // The values: one CSD matrix of up to 3 x 3 complex (2 x 9 `f64`) per frequency.
     h5::check_whole_read(path, "/frequency_hz", fds.size(), 19, "frequencies")?;
     let freqs: Vec<f64> = fds
@@ -159,9 +160,11 @@ pub(crate) fn read(
     let csd = assemble(&freqs, &resolved.channels, quantity, |k, a, b| {
         src[(k * m + a) * m + b]
     });
+    let axes: Vec<_> = resolved.channels.iter().map(|c| c.axis).collect();
+    check_csd_finite(path, &freqs, &axes, &csd)?;
     Ok(TiltSpectra {
         freqs_hz: freqs,
-        axes: resolved.channels.iter().map(|c| c.axis).collect(),
+        axes,
         csd,
         provenance: Provenance {
             path: path.to_path_buf(),
@@ -252,6 +255,7 @@ fn open_values(
             allowed,
         });
     }
+    h5::check_storage(path, &ds, &format!("/{}", kind.name))?;
     let declared = units(path, &ds, kind.name, kind.classify, kind.units_allowed)?;
     Ok((ds, declared))
 }
