@@ -148,7 +148,7 @@ HUGE_ZERO_RE = re.compile(r"(?<![0-9.])[-+]?0\.000e[-+]?0(?![0-9])")
 # Allowed by design: Q = inf of an undamped mode.
 ALLOWED_STDOUT = [
     re.compile(r"(?m)^(\s*nu_\d+\s+\S+\s+\S+\s+)inf\b"),
-    re.compile(r"\"quality_factor\"\s*:\s*\"inf\""),
+    re.compile(r"\"quality_factor\"\s*:\s*\"inf\""),  # before JSON numbers became null
     re.compile(r"\(NaN outside\)"),
 ]
 ALLOWED_NONFINITE_NAMES = re.compile(r"measured|residual|fitted_sigma")

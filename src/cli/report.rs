@@ -92,15 +92,13 @@ pub fn modes_json(modes: &NormalModes) -> String {
                 .map(|o| (o.name(), m.observable_amplitude[o.index()]))
                 .collect(),
             omega_sq_rad2_per_s2: m.omega_sq,
-            quality_factor: match m.quality_factor.is_finite() {
-                true => QualityFactor::Finite(m.quality_factor),
-                false => QualityFactor::Undamped("inf"),
-            },
+            quality_factor: m.quality_factor.is_finite().then_some(m.quality_factor),
             seen_by: modes
                 .observables_seeing(k)
                 .iter()
                 .map(|o| o.name())
                 .collect(),
+            undamped: !m.quality_factor.is_finite(),
         })
         .collect();
     serde_json::to_string_pretty(&ModesJson { modes: list }).expect("JSON of plain data")
@@ -123,22 +121,17 @@ struct ModeJson {
     loss_angle_rad: f64,
     observable_amplitude: BTreeMap<&'static str, f64>,
     omega_sq_rad2_per_s2: f64,
-    quality_factor: QualityFactor,
+    /// `null` when undamped (JSON has no infinity; numbers are never strings).
+    quality_factor: Option<f64>,
     seen_by: Vec<&'static str>,
+    /// No loss reaches the mode: Q is infinite, `quality_factor` is null.
+    undamped: bool,
 }
 
 #[derive(Serialize)]
 struct CoordinateShare {
     coordinate: &'static str,
     energy_share: f64,
-}
-
-/// JSON has no infinity: `"inf"` (a string) when undamped, as in the table.
-#[derive(Serialize)]
-#[serde(untagged)]
-enum QualityFactor {
-    Finite(f64),
-    Undamped(&'static str),
 }
 
 /// The quasi-static (f = 0) tilt response next to the paper's stated limits.
@@ -187,6 +180,7 @@ mod tests {
     fn modes_json_lists_keys_alphabetically() {
         let modes = NormalModes::new(&Model::new(&Params::table_i()).unwrap());
         let value = assert_keys_sorted(&modes_json(&modes));
-        assert_eq!(value["modes"][0]["quality_factor"], "inf");
+        assert!(value["modes"][0]["quality_factor"].is_null());
+        assert_eq!(value["modes"][0]["undamped"], true);
     }
 }
