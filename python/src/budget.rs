@@ -28,9 +28,11 @@ use tiltnoise_io::input::{
 };
 use tiltnoise_io::RunMeta;
 
-/// A tilt time series handed over as arrays: angle (rad) per axis in canonical order.
+/// A tilt time series handed over as arrays: angle (rad) or rate (rad/s) per axis in canonical
+/// order.
 struct ArraySeries {
     sample_rate_hz: f64,
+    quantity: Quantity,
     axes: Vec<TiltAxis>,
     data: Vec<Vec<f64>>,
 }
@@ -38,6 +40,10 @@ struct ArraySeries {
 impl SeriesSource for ArraySeries {
     fn sample_rate_hz(&self) -> f64 {
         self.sample_rate_hz
+    }
+
+    fn quantity(&self) -> Quantity {
+        self.quantity
     }
 
     fn len(&self) -> usize {
@@ -302,7 +308,8 @@ fn tilt_channels(
 /// are the axes named by ``axes``. The axes are the crate's tilt angles ``theta_t``,
 /// ``eta_t``, ``phi_t`` (rad; the rotation taking the floor frame to the inertial frame, so
 /// a floor rotation ``E`` about East gives ``theta_t = -E``); ``quantity="rate"`` for rad/s,
-/// integrated as the file readers do. ``fs``: sample rate (Hz). ``gaps``: ``"reject"``
+/// whose cross-spectra are divided by ``(2 pi f)**2`` (exact up to Nyquist, DC excluded), as
+/// for the files. ``fs``: sample rate (Hz). ``gaps``: ``"reject"``
 /// (default) or ``"interpolate"`` non-finite samples.
 ///
 /// The other options are the command line's ``budget`` options: ``nperseg`` (Welch segment,
@@ -385,13 +392,14 @@ pub fn budget(
                 channel: axis.name(),
                 unit: quantity.unit(),
             };
-            let bridged = process_channel(data, gaps, quantity, fs, &ctx).map_err(array_error)?;
+            let bridged = process_channel(data, gaps, &ctx).map_err(array_error)?;
             if bridged > 0 {
                 notes.push(tiltnoise_core::input::gap_note(axis.name(), bridged));
             }
         }
         let mut source = ArraySeries {
             sample_rate_hz: fs,
+            quantity,
             axes: channels.iter().map(|(a, _)| *a).collect(),
             data: channels.into_iter().map(|(_, d)| d).collect(),
         };

@@ -16,6 +16,7 @@ mod methods;
 mod modes;
 mod polezero;
 mod polezero_batch;
+mod rate_spectra;
 mod reference_precision;
 mod scenes;
 mod simulate;
