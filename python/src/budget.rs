@@ -181,24 +181,25 @@ impl SeriesOptions {
 /// Adds the `measured` and `residual` terms from a measured record of the observables (the
 /// command line's `--measured FILE`).
 fn add_measured_file(report: &mut BudgetReport, path: &Path) -> Result<(), BudgetError> {
-    let (freqs_hz, psds, description) = match read_measured_input(path)? {
+    let (freqs_hz, psds, description, welch) = match read_measured_input(path)? {
         MeasuredInput::Spectra(m) => {
             let psds = m
                 .asd
                 .iter()
                 .map(|(o, asd)| (*o, asd.iter().map(|a| a * a).collect()))
                 .collect();
-            (m.freqs_hz, psds, "measured spectrum".to_string())
+            (m.freqs_hz, psds, "measured spectrum".to_string(), None)
         }
         MeasuredInput::Series(s) => {
             let m = series_psds(&s.channels, s.sample_rate_hz, &report.source)?;
-            (m.freqs_hz, m.psds, m.description)
+            (m.freqs_hz, m.psds, m.description, m.welch)
         }
     };
     let measured = MeasuredPsds {
         freqs_hz,
         psds,
         description,
+        welch,
     };
     add_measured(report, &measured, &path.display().to_string());
     Ok(())

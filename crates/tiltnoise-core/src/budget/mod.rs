@@ -9,8 +9,10 @@
 //! Conventions: one-sided spectra, PSD in unit^2/Hz (see [`crate::noise`]).
 
 mod measured;
+mod summary;
 
 pub use measured::{add_measured, series_psds, MeasuredPsds};
+pub use summary::{SummaryRequest, DEFAULT_BAND_FRACTION, DEFAULT_SUMMARY_FREQS_HZ};
 
 use crate::error::TfError;
 use crate::input::rate::angle_csd_above_dc;
@@ -74,6 +76,8 @@ pub struct BudgetOptions {
     pub readout: Readout,
     /// Model grid for spectra input (Hz); time series use the Welch grid.
     pub spectra_grid_hz: Vec<f64>,
+    /// Frequencies to read the budget at ([`crate::noise::SummaryAt`]).
+    pub summary: SummaryRequest,
 }
 
 impl Default for BudgetOptions {
@@ -87,6 +91,7 @@ impl Default for BudgetOptions {
             percentiles: (10.0, 90.0),
             readout: Readout::default(),
             spectra_grid_hz: Vec::new(),
+            summary: SummaryRequest::default(),
         }
     }
 }
@@ -138,6 +143,7 @@ pub fn budget_from_series(
     opts: &BudgetOptions,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<BudgetReport, BudgetError> {
+    opts.summary.validate()?;
     let fs = series.sample_rate_hz();
     let n = series.len();
     let axes = series.axes().to_vec();
@@ -262,7 +268,7 @@ pub fn budget_from_series(
     let segment_bands = band_per_observable(&opts.outputs, &segment_tilt, opts.percentiles);
     add_damping_terms(model, &mut budget)?;
     check_budget_finite(&budget)?;
-    Ok(BudgetReport {
+    let report = BudgetReport {
         budget,
         segment_duration_s: segment_samples
             .map(|s| s as f64 / fs)
@@ -282,7 +288,28 @@ pub fn budget_from_series(
         axes,
         readout: opts.readout.clone(),
         notes,
-    })
+        summary: Vec::new(),
+    };
+    let tilt = summary::TiltData::Welch {
+        freqs_hz: &grid,
+        csd: &csd,
+        cfg,
+        n_segments: spectra.n_segments,
+    };
+    with_summary(model, report, &tilt, &opts.summary)
+}
+
+/// `report` with its summary ([`summary::summarize`]), and a note for every frequency left out.
+fn with_summary(
+    model: &Model,
+    mut report: BudgetReport,
+    tilt: &summary::TiltData<'_>,
+    req: &SummaryRequest,
+) -> Result<BudgetReport, BudgetError> {
+    let (summary, notes) = summary::summarize(model, &report, tilt, req)?;
+    report.summary = summary;
+    report.notes.extend(notes);
+    Ok(report)
 }
 
 /// Refuses a run whose memory grows with the record beyond the memory available: a median
@@ -366,7 +393,7 @@ pub fn budget_from_spectra(
     );
     add_damping_terms(model, &mut budget)?;
     check_budget_finite(&budget)?;
-    Ok(BudgetReport {
+    let report = BudgetReport {
         budget,
         segment_bands: Vec::new(),
         segment_duration_s: None,
@@ -376,7 +403,14 @@ pub fn budget_from_spectra(
         axes: on_grid.axes.clone(),
         readout: opts.readout.clone(),
         notes,
-    })
+        summary: Vec::new(),
+    };
+    with_summary(
+        model,
+        report,
+        &summary::TiltData::Spectra(spectra),
+        &opts.summary,
+    )
 }
 
 /// Refuses tilt cross-spectra that overflowed `f64` (samples far beyond any tilt angle or rate,

@@ -145,3 +145,9 @@ pub const FFT_STAGE_REL: f64 = 4.0 * EPS;
 /// roundings (absolute error `<= 2 * 4 pi u`, passed on with slope `<= 1`), `cos` is faithful
 /// (1 ulp) and the product with `A` rounds once: `8 pi u + 3 u < 29 u`, rounded up to `32 u`.
 pub const TONE_SAMPLE_ABS: f64 = 32.0 * U;
+
+/// Relative error of `spectral::band_dof` for segments of up to 2^16 samples and bands of up to
+/// 1000 bins: each `|rho|^2` comes from an FFT (`2 log2 n FFT_STAGE_REL` = 32 x 4 eps, relative
+/// to the largest term, which dominates the sum) and the weighted sum has up to 6000 rounded
+/// terms (6000 u): 1.4e-12, rounded up to 2e-12.
+pub const DOF_REL: f64 = 2e-12;
