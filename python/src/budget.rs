@@ -28,9 +28,11 @@ use tiltnoise_io::input::{
 };
 use tiltnoise_io::RunMeta;
 
-/// A tilt time series handed over as arrays: angle (rad) per axis in canonical order.
+/// A tilt time series handed over as arrays: angle (rad) or rate (rad/s) per axis in canonical
+/// order.
 struct ArraySeries {
     sample_rate_hz: f64,
+    quantity: Quantity,
     axes: Vec<TiltAxis>,
     data: Vec<Vec<f64>>,
 }
@@ -38,6 +40,10 @@ struct ArraySeries {
 impl SeriesSource for ArraySeries {
     fn sample_rate_hz(&self) -> f64 {
         self.sample_rate_hz
+    }
+
+    fn quantity(&self) -> Quantity {
+        self.quantity
     }
 
     fn len(&self) -> usize {
@@ -175,24 +181,25 @@ impl SeriesOptions {
 /// Adds the `measured` and `residual` terms from a measured record of the observables (the
 /// command line's `--measured FILE`).
 fn add_measured_file(report: &mut BudgetReport, path: &Path) -> Result<(), BudgetError> {
-    let (freqs_hz, psds, description) = match read_measured_input(path)? {
+    let (freqs_hz, psds, description, welch) = match read_measured_input(path)? {
         MeasuredInput::Spectra(m) => {
             let psds = m
                 .asd
                 .iter()
                 .map(|(o, asd)| (*o, asd.iter().map(|a| a * a).collect()))
                 .collect();
-            (m.freqs_hz, psds, "measured spectrum".to_string())
+            (m.freqs_hz, psds, "measured spectrum".to_string(), None)
         }
         MeasuredInput::Series(s) => {
             let m = series_psds(&s.channels, s.sample_rate_hz, &report.source)?;
-            (m.freqs_hz, m.psds, m.description)
+            (m.freqs_hz, m.psds, m.description, m.welch)
         }
     };
     let measured = MeasuredPsds {
         freqs_hz,
         psds,
         description,
+        welch,
     };
     add_measured(report, &measured, &path.display().to_string());
     Ok(())
@@ -302,7 +309,8 @@ fn tilt_channels(
 /// are the axes named by ``axes``. The axes are the crate's tilt angles ``theta_t``,
 /// ``eta_t``, ``phi_t`` (rad; the rotation taking the floor frame to the inertial frame, so
 /// a floor rotation ``E`` about East gives ``theta_t = -E``); ``quantity="rate"`` for rad/s,
-/// integrated as the file readers do. ``fs``: sample rate (Hz). ``gaps``: ``"reject"``
+/// whose cross-spectra are divided by ``(2 pi f)**2`` (exact up to Nyquist, DC excluded), as
+/// for the files. ``fs``: sample rate (Hz). ``gaps``: ``"reject"``
 /// (default) or ``"interpolate"`` non-finite samples.
 ///
 /// The other options are the command line's ``budget`` options: ``nperseg`` (Welch segment,
@@ -385,13 +393,14 @@ pub fn budget(
                 channel: axis.name(),
                 unit: quantity.unit(),
             };
-            let bridged = process_channel(data, gaps, quantity, fs, &ctx).map_err(array_error)?;
+            let bridged = process_channel(data, gaps, &ctx).map_err(array_error)?;
             if bridged > 0 {
                 notes.push(tiltnoise_core::input::gap_note(axis.name(), bridged));
             }
         }
         let mut source = ArraySeries {
             sample_rate_hz: fs,
+            quantity,
             axes: channels.iter().map(|(a, _)| *a).collect(),
             data: channels.into_iter().map(|(_, d)| d).collect(),
         };

@@ -84,10 +84,11 @@ def test_array_budget_equals_the_file_budget_of_the_same_samples(tmp_path):
     c = tiltnoise.budget(rows, fs, axes=("theta_t", "eta_t"), **opts)
     assert c.to_csv() == a.to_csv()
     assert a.input["format"] == "numpy"
-    # A rate is integrated as the readers do: its budget is the one of the integrated angle.
+    # A rate is not integrated in time: its cross-spectra are divided by (2 pi f)^2, DC excluded.
     rate = {k: np.gradient(v) * fs for k, v in tilt.items()}
     r = tiltnoise.budget(rate, fs, quantity="rate", nperseg=1024)
     assert r.source["n_samples"] == n
+    assert any("divided by (2 pi f)^2" in note for note in r.notes)
 
 
 def test_gaps_in_arrays():

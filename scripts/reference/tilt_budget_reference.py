@@ -5,7 +5,7 @@ Run from anywhere:  python3 scripts/reference/tilt_budget_reference.py
 
 Nothing here comes from the Rust code. The model is rebuilt from the paper (De Marchi et al.,
 Phys. Rev. D 87, 122006 (2013), Appendix A and section IV.B) and the parameters of
-src/params/table1.toml, in mpmath with 40 significant digits; the spectral part is
+crates/tiltnoise-core/src/params/table1.toml, in mpmath with 40 significant digits; the spectral part is
 scipy.signal.csd on the real ROMY record in ../shared/tilt_data/ (read, never copied).
 
 Writes romy_budget_reference.json next to this script (floats with repr: full double
@@ -27,7 +27,7 @@ from scipy import signal
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
-PARAMS_TOML = os.path.join(REPO, "src", "params", "table1.toml")
+PARAMS_TOML = os.path.join(REPO, "crates", "tiltnoise-core", "src", "params", "table1.toml")
 ROMY_REL = "../shared/tilt_data/romy_6c_teleseism_20180123/ROMY_gulf_of_alaska_teleseism.csv"
 ROMY_CSV = os.path.normpath(os.path.join(REPO, ROMY_REL))
 OUT_JSON = os.path.join(HERE, "romy_budget_reference.json")
@@ -207,7 +207,8 @@ def sanity_checks(model, tp):
     """Physics identities the model and transfer functions must satisfy; returns a dict for the JSON."""
     M, Kg = model["M"], model["Kg"]
     assert all(M[r, c] == M[c, r] and Kg[r, c] == Kg[c, r] for r in range(8) for c in range(8))
-    assert all(float(v) == 0.0 for v in tp["loss"].values()), "the fixture assumes zero loss angles"
+    assert all(float(v) == 0.0 for k, v in tp["loss"].items() if k.endswith("_rad")), "the fixture assumes zero loss angles"
+    assert all(float(v) == 0.0 for v in tp.get("viscous", {}).values()), "the fixture assumes no viscous damping"
     tiny = mp.mpf(10) ** -30
     # Tilt = rigid rotation of the frame + translation of the suspension point by h t'':
     # G2 + M S_rot = -B [F_trans] with F_i = -m_i (w' x (0,0,h)), where S_rot puts theta_t, eta_t,
@@ -270,16 +271,6 @@ def read_romy(path=ROMY_CSV):
     dt = {t[k + 1] - t[k] for k in range(len(t) - 1)}
     assert dt == {1.0}, dt
     return cols
-
-
-def integrate_rate(rate, fs):
-    """Remove the mean (correctly rounded sum / n), then trapezoid from theta[0] = 0."""
-    mean = math.fsum(rate) / len(rate)
-    r = [x - mean for x in rate]
-    theta = [0.0] * len(r)
-    for n in range(1, len(r)):
-        theta[n] = theta[n - 1] + (r[n - 1] + r[n]) / 2.0 / fs
-    return np.array(theta)
 
 
 def csd_matrix(x, fs):
@@ -391,11 +382,13 @@ def main():
 
     cols = read_romy()
     fs = 1.0
-    # lab x = East, y = North; t is minus the floor rotation
-    theta_t = integrate_rate([-v for v in cols["LJE"]], fs)
-    eta_t = integrate_rate([-v for v in cols["LJN"]], fs)
-    freqs, S = csd_matrix([theta_t, eta_t], fs)
+    # lab x = East, y = North; t is minus the floor rotation. The rates stay rates: their CSD
+    # divided by (2 pi f)^2 is the angle's (exp(+i w t): T = R / (i w)); k = 0 has no angle.
+    theta_t_rate = np.array([-v for v in cols["LJE"]])
+    eta_t_rate = np.array([-v for v in cols["LJN"]])
+    freqs, S_rate = csd_matrix([theta_t_rate, eta_t_rate], fs)
     assert np.all(freqs == np.arange(1, len(freqs) + 1) / WELCH["nperseg"])
+    S = S_rate / ((2 * np.pi * freqs) ** 2)[:, None, None]
 
     H_list = [transfer(model, mp.mpf(int(k)) / WELCH["nperseg"]) for k in range(1, len(freqs) + 1)]
     tilt, per_axis = budget(H_list, S)
@@ -431,20 +424,18 @@ def main():
             "file_relative_to": "repository root",
             "sha256": sha256(ROMY_CSV),
             "sample_rate_hz": fs,
-            "n_samples": len(theta_t),
+            "n_samples": len(theta_t_rate),
             "mapping": "lab x = East, y = North; theta_t rate = -LJE, eta_t rate = -LJN (rad/s); "
             "t is minus the floor rotation (tiltnoise sign convention)",
-            "integration": "per channel: subtract the mean of the rate (math.fsum / n), then "
-            "theta[0] = 0, theta[n] = theta[n-1] + (r[n-1] + r[n]) / 2 / fs",
-            "theta_t_first": theta_t[:6].tolist(),
-            "eta_t_first": eta_t[:6].tolist(),
-            "theta_t_last": float(theta_t[-1]),
-            "eta_t_last": float(eta_t[-1]),
+            "rate_to_angle": "no time integration: csd of the rates (rad^2/s^2/Hz) divided by "
+            "(2 pi f)^2 at every bin k >= 1; k = 0 carries no angle information",
+            "theta_t_rate_first": theta_t_rate[:6].tolist(),
+            "eta_t_rate_first": eta_t_rate[:6].tolist(),
             "welch": dict(WELCH, return_onesided=True, window_note="periodic Hann (scipy get_window)"),
             "dropped": "k = 0 (DC)",
         },
         "parameters": {
-            "source": "src/params/table1.toml",
+            "source": "crates/tiltnoise-core/src/params/table1.toml",
             "values": tp,
             "derived": {"y_a_m": float(model["y_a"]), "Z_plus_Zb_plus_hc_m": -checks["minus_Z_plus_Zb_plus_hc_m"]},
             "generalization": "I^b_22 in the eta rows (I_b2, I_b4, I_b5), I^b_11 in the theta rows",

@@ -1,23 +1,22 @@
 //! The `budget` subcommand: validated options -> the budget job -> files and a terminal summary.
 //! Owns the progress bar (only when stderr is a terminal).
 
-use super::args::{parse_readout_item, AverageArg};
+use super::args::{parse_readout_item, AverageArg, Format};
 use super::output::save_budget;
 use super::Run;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
-use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::budget::{
-    add_measured, budget_from_series, budget_from_spectra, loglog_at, series_psds, BudgetOptions,
-    MeasuredPsds,
+    add_measured, budget_from_series, budget_from_spectra, series_psds, BudgetOptions,
+    MeasuredPsds, SummaryRequest, DEFAULT_BAND_FRACTION,
 };
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::freq;
 use tiltnoise_core::model::Model;
 use tiltnoise_core::modes::NormalModes;
-use tiltnoise_core::noise::{BudgetReport, Readout, TermKind};
+use tiltnoise_core::noise::{BudgetReport, Readout};
 use tiltnoise_core::params::Params;
 use tiltnoise_core::spectral::Averaging;
 use tiltnoise_io::input::{read_tilt, InputFormat, ReadOptions, TiltInput, TiltSeriesSource};
@@ -69,13 +68,58 @@ pub struct BudgetArgs {
     /// budget's Welch settings; adds the terms `measured` and `residual`.
     #[arg(long, value_name = "FILE")]
     pub measured: Option<PathBuf>,
+    /// Frequencies (Hz) to read the budget at, e.g. 1e-3,2e-3,5e-3 (the default): model terms
+    /// exact there, Welch estimates as band means with their statistical error; each must lie
+    /// in the budget's band.
+    #[arg(long, value_name = "F1,F2,...", allow_hyphen_values = true)]
+    pub at: Option<String>,
+    /// Half-width of the band of the Welch band means, relative to the frequency: the bins in
+    /// f (1 - B) .. f (1 + B) are averaged (default 0.1).
+    #[arg(long, value_name = "B", allow_negative_numbers = true)]
+    pub at_band: Option<f64>,
+    /// Output format on the terminal: table (default) or json (the --at summary and the notes).
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    pub format: Format,
     /// Output file (.h5, .csv, .png, .svg), repeatable.
     #[arg(long, value_name = "PATH")]
     pub save: Vec<PathBuf>,
 }
 
-/// Frequencies (Hz) at which the terminal summary reads the budget.
-const SUMMARY_FREQS_HZ: [f64; 3] = [1e-3, 2e-3, 5e-3];
+/// The `--at` and `--at-band` request: explicit frequencies are refused when the budget cannot
+/// be read there; the default ones are left out with a note.
+fn summary_request(args: &BudgetArgs) -> Result<SummaryRequest> {
+    let mut req = SummaryRequest {
+        band_fraction: args.at_band.unwrap_or(DEFAULT_BAND_FRACTION),
+        ..SummaryRequest::default()
+    };
+    if let Some(text) = &args.at {
+        req.strict = true;
+        req.freqs_hz = text
+            .split(',')
+            .map(|item| {
+                item.trim().parse::<f64>().map_err(|_| {
+                    anyhow!(
+                        "--at {}: `{}` is not a frequency in Hz; expected F1,F2,... e.g. \
+                         1e-3,2e-3,5e-3",
+                        Shown(text),
+                        Shown(item)
+                    )
+                })
+            })
+            .collect::<Result<_>>()?;
+    }
+    req.validate().map_err(|e| {
+        anyhow!(
+            "{}: {e}",
+            if args.at_band.is_some() {
+                "--at-band"
+            } else {
+                "--at"
+            }
+        )
+    })?;
+    Ok(req)
+}
 
 fn parse_readout(items: &[String]) -> Result<Readout> {
     let mut readout = Readout::default();
@@ -127,44 +171,6 @@ fn read_options(args: &BudgetArgs) -> Result<ReadOptions> {
             .parse()
             .map_err(|e: String| anyhow!("--gaps: {e}"))?,
     })
-}
-
-fn summary(report: &BudgetReport) -> String {
-    let mut s = String::from("noise budget (one-sided ASD):\n");
-    let b = &report.budget;
-    let damped = b
-        .observables
-        .iter()
-        .any(|ob| ob.term(&TermKind::Thermal).is_some());
-    for ob in &b.observables {
-        let unit = format!("{}/sqrt(Hz)", ob.observable.unit());
-        let total = ob.total();
-        for f in SUMMARY_FREQS_HZ {
-            let asd_at = |psd: &[f64]| loglog_at(&b.freqs_hz, psd, f).map(f64::sqrt);
-            let at = |kind: TermKind| ob.term(&kind).and_then(|t| asd_at(&t.psd));
-            if let (Some(t), Some(tot)) = (at(TermKind::Tilt), asd_at(&total)) {
-                let thermal = at(TermKind::Thermal)
-                    .map(|th| format!("thermal {th:.3e}  "))
-                    .unwrap_or_default();
-                let _ = writeln!(
-                    s,
-                    "  {:<6} at {:>4} mHz: tilt {t:.3e}  {thermal}total {tot:.3e} {unit}",
-                    ob.observable.name(),
-                    f * 1e3,
-                );
-            }
-        }
-    }
-    if !damped {
-        s.push_str(
-            "thermal: none (undamped model: every loss angle and viscous coefficient is 0; \
-             see docs/damping.md)\n",
-        );
-    }
-    for note in &report.notes {
-        let _ = writeln!(s, "note: {note}");
-    }
-    s
 }
 
 /// Options of a time series, refused for spectra input rather than ignored.
@@ -248,6 +254,7 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
             Some(spec) => freq::parse_spec(spec)?,
             None => freq::default_grid(&model),
         },
+        summary: summary_request(&args)?,
         ..BudgetOptions::default()
     };
     let ropts = read_options(&args)?;
@@ -288,13 +295,22 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     if let Some(measured) = &args.measured {
         add_measured_file(&mut report, measured)?;
     }
-    for note in &provenance.notes {
-        writeln!(run.out, "input: {note}")?;
+    let json = args.format == Format::Json;
+    if json {
+        writeln!(
+            run.out,
+            "{}",
+            super::budget_summary::json(&report, &provenance.notes)?
+        )?;
+    } else {
+        for note in &provenance.notes {
+            writeln!(run.out, "input: {note}")?;
+        }
+        write!(run.out, "{}", super::budget_summary::table(&report))?;
     }
-    write!(run.out, "{}", summary(&report))?;
     let meta = RunMeta::of_this_run(params, Some(&NormalModes::new(&model)));
     let input = InputMeta::from(&provenance);
-    run.write_outputs(false, || {
+    run.write_outputs(json, || {
         for out in &args.save {
             save_budget(out, &report, &meta, &input)?;
         }
@@ -308,25 +324,26 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
 /// one-sided PSDs by [`series_psds`].
 fn add_measured_file(report: &mut BudgetReport, path: &std::path::Path) -> Result<()> {
     use tiltnoise_io::input::MeasuredInput;
-    let (freqs_hz, psds, what) = match tiltnoise_io::input::read_measured_input(path)? {
+    let (freqs_hz, psds, what, welch) = match tiltnoise_io::input::read_measured_input(path)? {
         MeasuredInput::Spectra(m) => {
             let psds = m
                 .asd
                 .iter()
                 .map(|(o, asd)| (*o, asd.iter().map(|a| a * a).collect()))
                 .collect();
-            (m.freqs_hz, psds, "measured spectrum".to_string())
+            (m.freqs_hz, psds, "measured spectrum".to_string(), None)
         }
         MeasuredInput::Series(series) => {
             let m = series_psds(&series.channels, series.sample_rate_hz, &report.source)
                 .with_context(|| format!("--measured {}", path.display()))?;
-            (m.freqs_hz, m.psds, m.description)
+            (m.freqs_hz, m.psds, m.description, m.welch)
         }
     };
     let measured = MeasuredPsds {
         freqs_hz,
         psds,
         description: what,
+        welch,
     };
     add_measured(report, &measured, &path.display().to_string());
     Ok(())

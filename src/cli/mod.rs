@@ -6,6 +6,7 @@
 
 mod args;
 mod budget;
+mod budget_summary;
 mod fit;
 mod mc;
 mod methods;

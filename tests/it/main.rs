@@ -13,6 +13,7 @@ mod output;
 #[path = "../../crates/tiltnoise-core/tests/it/tolerances.rs"]
 mod tolerances;
 
+mod budget_at;
 mod budget_outputs;
 mod cli;
 mod cli_budget;

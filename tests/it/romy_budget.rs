@@ -1,5 +1,6 @@
 //! Real data through the whole time-series path: the two-axis ROMY tilt-rate record (LJN, LJE)
-//! -> tilt angle -> Welch ASD and CSD -> transfer functions -> budget of X, phi, phi_a, checked
+//! -> Welch CSD of the rates / (2 pi f)^2 (the angle's) -> transfer functions -> budget of X,
+//! phi, phi_a, checked
 //! against the independent reference of `scripts/reference/tilt_budget_reference.py` (SciPy for
 //! the spectra, mpmath at 40 digits for the model, built from the paper, not from this crate).
 

@@ -6,7 +6,7 @@ use crate::atomic::write_atomic;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
 use tiltnoise_core::noise::equivalent::referred_terms;
-use tiltnoise_core::noise::{BudgetReport, SpectralSource};
+use tiltnoise_core::noise::{BudgetReport, Evaluation, SpectralSource, SummaryAt};
 
 /// Value of the root attribute `schema`.
 pub const SCHEMA_BUDGET: &str = "tiltnoise.budget";
@@ -26,7 +26,7 @@ pub const SPECTRAL_CONVENTION: &str =
 /// obtained); `/frequency_hz`; one group per observable (`/X`, `/phi`, `/phi_a`) holding one
 /// group per term (`/X/tilt`, `/X/tilt.eta_t`, `/X/readout`, `/X/total`, ...) with datasets
 /// `psd` and `asd`; `/segments` with the percentile band of the `tilt` term when the report
-/// has one. A damped budget adds `thermal`, `thermal.<element>` term groups and, per observable,
+/// has one; `/summary` with the budget read at chosen frequencies. A damped budget adds `thermal`, `thermal.<element>` term groups and, per observable,
 /// an `equivalent` group with every term referred to the test mass's acceleration (X) or
 /// torque (phi, phi_a). Every item is described in `docs/schemas.md`.
 ///
@@ -174,7 +174,61 @@ fn write_file(
         }
     }
 
+    if !report.summary.is_empty() {
+        write_summary(&file, &report.summary)?;
+    }
+
     file.close()
+}
+
+/// `/summary`: one group per frequency (`/summary/0`, `/summary/1`, ... in request order), one
+/// group per observable in it and one per term (and `total`), with scalar attributes: `psd`,
+/// `asd`, `evaluation` (`exact` or `band_mean`); a band mean adds `n_bins`, `first_bin_hz`,
+/// `last_bin_hz` and, when known, `dof` and `asd_rel_std` (`psd_std / (2 psd)`).
+fn write_summary(file: &hdf5::File, summary: &[SummaryAt]) -> hdf5::Result<()> {
+    let root = file.create_group("summary")?;
+    let freqs: Vec<f64> = summary.iter().map(|a| a.freq_hz).collect();
+    root.new_attr_builder()
+        .with_data(freqs.as_slice())
+        .create("frequency_hz")?;
+    let rel = |psd: f64, std: f64| if psd > 0.0 { std / (2.0 * psd) } else { 0.0 };
+    for (i, at) in summary.iter().enumerate() {
+        let g = root.create_group(&i.to_string())?;
+        scalar_attr(&g, "freq_hz", at.freq_hz)?;
+        scalar_attr(&g, "band_lo_hz", at.band_hz.0)?;
+        scalar_attr(&g, "band_hi_hz", at.band_hz.1)?;
+        for ob in &at.observables {
+            let og = g.create_group(ob.observable.name())?;
+            str_attr(&og, "asd_units", &asd_unit(ob.observable.unit()))?;
+            let mut names: Vec<String> = ob.terms.iter().map(|t| t.kind.name()).collect();
+            names.push(tiltnoise_core::noise::TOTAL_NAME.to_string());
+            let names: Vec<&str> = names.iter().map(String::as_str).collect();
+            strs_attr(&og, "terms", &names)?;
+            for t in &ob.terms {
+                let tg = og.create_group(&t.kind.name())?;
+                scalar_attr(&tg, "psd", t.psd)?;
+                scalar_attr(&tg, "asd", t.psd.sqrt())?;
+                str_attr(&tg, "evaluation", t.evaluation.name())?;
+                if let Evaluation::BandMean(b) = &t.evaluation {
+                    scalar_attr(&tg, "n_bins", int(b.n_bins)?)?;
+                    scalar_attr(&tg, "first_bin_hz", b.first_bin_hz)?;
+                    scalar_attr(&tg, "last_bin_hz", b.last_bin_hz)?;
+                    if let (Some(dof), Some(std)) = (b.dof, t.psd_std()) {
+                        scalar_attr(&tg, "dof", dof)?;
+                        scalar_attr(&tg, "asd_rel_std", rel(t.psd, std))?;
+                    }
+                }
+            }
+            let total = og.create_group(tiltnoise_core::noise::TOTAL_NAME)?;
+            let psd = ob.total_psd();
+            scalar_attr(&total, "psd", psd)?;
+            scalar_attr(&total, "asd", psd.sqrt())?;
+            if let Some(std) = ob.total_psd_std() {
+                scalar_attr(&total, "asd_rel_std", rel(psd, std))?;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// `/<obs>/equivalent`: every noise term referred to the equivalent input (see

@@ -1,10 +1,11 @@
 //! A measured record of the observables beside the model's budget: its one-sided PSDs on its
-//! own grid, put onto the budget's grid as the terms `measured` and `residual`.
+//! own grid, put onto the budget's grid as the terms `measured` and `residual`, and into the
+//! summary as band means over its own points.
 
 use super::BudgetError;
 use crate::model::Observable;
-use crate::noise::{BudgetReport, SpectralSource};
-use crate::spectral::{welch, Averaging, WelchConfig};
+use crate::noise::{BandMean, BudgetReport, Evaluation, SpectralSource, TermAt, TermKind};
+use crate::spectral::{band_dof, welch, Averaging, WelchConfig};
 
 /// A measured record on its own grid: frequencies (Hz), one-sided PSD per observable
 /// (unit^2/Hz), and a description for the budget's notes.
@@ -16,12 +17,17 @@ pub struct MeasuredPsds {
     pub psds: Vec<(Observable, Vec<f64>)>,
     /// What the record is (spectrum, or series and its Welch settings).
     pub description: String,
+    /// The Welch settings and the number of segments averaged, for a series (the statistical
+    /// error of a band mean); `None` for a given spectrum, whose averaging is not known.
+    pub welch: Option<(WelchConfig, usize)>,
 }
 
 /// Adds the terms `measured` and `residual` of every budgeted observable of `measured` to
 /// `report`: on the budget's own grid when the budget's bins are bins 1.. of the measured
 /// grid, otherwise interpolated log-log onto it (NaN where the record does not reach), with a
-/// note naming `origin` (the file) and the band covered.
+/// note naming `origin` (the file) and the band covered. In the summary the term `measured` is
+/// the mean of the record's own points in each frequency's band, with its degrees of freedom
+/// for a series; a frequency whose band holds no point of the record gets a note instead.
 pub fn add_measured(report: &mut BudgetReport, measured: &MeasuredPsds, origin: &str) {
     let (freqs_hz, psds, what) = (&measured.freqs_hz, &measured.psds, &measured.description);
     let grid = report.budget.freqs_hz.clone();
@@ -47,6 +53,7 @@ pub fn add_measured(report: &mut BudgetReport, measured: &MeasuredPsds, origin: 
         crate::noise::add_measured(&mut report.budget, *o, on_grid);
         used.push(o.name());
     }
+    add_measured_summary(report, measured, origin);
     let (lo, hi) = (freqs_hz[0], freqs_hz[freqs_hz.len() - 1]);
     report.notes.push(format!(
         "{what} {} ({}) covers {lo:e} .. {hi:e} Hz (NaN outside); {}",
@@ -62,6 +69,45 @@ pub fn add_measured(report: &mut BudgetReport, measured: &MeasuredPsds, origin: 
             "interpolated log-log onto the budget grid"
         }
     ));
+}
+
+/// The `measured` term of every summary frequency: the mean of the record's points in the band.
+fn add_measured_summary(report: &mut BudgetReport, measured: &MeasuredPsds, origin: &str) {
+    let f = &measured.freqs_hz;
+    let mut notes = Vec::new();
+    for at in report.summary.iter_mut() {
+        let (lo, hi) = at.band_hz;
+        let points: Vec<usize> = (0..f.len()).filter(|&k| f[k] >= lo && f[k] <= hi).collect();
+        let (Some(&first), Some(&last)) = (points.first(), points.last()) else {
+            notes.push(format!(
+                "summary at {} Hz: the measured record {origin} has no point in {lo:.4e} .. \
+                 {hi:.4e} Hz, so no measured value there",
+                crate::error::Num(at.freq_hz)
+            ));
+            continue;
+        };
+        let mean = BandMean {
+            first_bin_hz: f[first],
+            last_bin_hz: f[last],
+            n_bins: points.len(),
+            dof: measured
+                .welch
+                .as_ref()
+                .and_then(|(cfg, n_seg)| band_dof(cfg, *n_seg, points.len())),
+        };
+        for ob in at.observables.iter_mut() {
+            let Some((_, psd)) = measured.psds.iter().find(|(o, _)| *o == ob.observable) else {
+                continue;
+            };
+            let sum: f64 = points.iter().map(|&k| psd[k]).sum();
+            ob.terms.push(TermAt {
+                kind: TermKind::Measured,
+                psd: sum / points.len() as f64,
+                evaluation: Evaluation::BandMean(mean.clone()),
+            });
+        }
+    }
+    report.notes.extend(notes);
 }
 
 /// One-sided PSDs (unit^2/Hz) of a measured time series with the budget's own Welch settings:
@@ -126,5 +172,6 @@ pub fn series_psds(
         freqs_hz: freqs,
         psds,
         description: what,
+        welch: Some((cfg, n_segments)),
     })
 }

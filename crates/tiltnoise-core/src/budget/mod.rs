@@ -9,11 +9,14 @@
 //! Conventions: one-sided spectra, PSD in unit^2/Hz (see [`crate::noise`]).
 
 mod measured;
+mod summary;
 
 pub use measured::{add_measured, series_psds, MeasuredPsds};
+pub use summary::{SummaryRequest, DEFAULT_BAND_FRACTION, DEFAULT_SUMMARY_FREQS_HZ};
 
 use crate::error::TfError;
-use crate::input::{InputError, SeriesSource, TiltSpectra};
+use crate::input::rate::angle_csd_above_dc;
+use crate::input::{InputError, Quantity, SeriesSource, TiltSpectra};
 use crate::limits::{check_memory, planned_bytes, LimitError};
 use crate::model::{Model, Observable, TiltAxis};
 use crate::noise::{
@@ -73,6 +76,8 @@ pub struct BudgetOptions {
     pub readout: Readout,
     /// Model grid for spectra input (Hz); time series use the Welch grid.
     pub spectra_grid_hz: Vec<f64>,
+    /// Frequencies to read the budget at ([`crate::noise::SummaryAt`]).
+    pub summary: SummaryRequest,
 }
 
 impl Default for BudgetOptions {
@@ -86,6 +91,7 @@ impl Default for BudgetOptions {
             percentiles: (10.0, 90.0),
             readout: Readout::default(),
             spectra_grid_hz: Vec::new(),
+            summary: SummaryRequest::default(),
         }
     }
 }
@@ -123,22 +129,25 @@ pub fn add_damping_terms(model: &Model, budget: &mut Budget) -> Result<(), TfErr
     add_equivalent_response(budget, model)
 }
 
-/// Drops the DC bin (index 0) of a Welch CSD: the budget is shown on log axes, and detrending
-/// removed the mean anyway.
-fn without_dc(csd: &[num_complex::Complex64], n: usize) -> &[num_complex::Complex64] {
-    &csd[n * n..]
-}
+/// The note of a budget from a tilt-rate series.
+pub const RATE_BUDGET_NOTE: &str = "tilt rate: the Welch cross-spectra of the rate \
+     (rad^2/s^2/Hz) divided by (2 pi f)^2 at every bin f > 0, exact up to Nyquist (no time \
+     integration); the DC bin carries no angle information and is excluded";
 
-/// Budget from a time series. `progress(done, total)` is called with samples processed.
+/// Budget from a time series of tilt angle or rate ([`SeriesSource::quantity`]; a rate's
+/// spectra become the angle's by [`crate::input::rate`], the DC bin is dropped for both).
+/// `progress(done, total)` is called with samples processed.
 pub fn budget_from_series(
     model: &Model,
     series: &mut dyn SeriesSource,
     opts: &BudgetOptions,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<BudgetReport, BudgetError> {
+    opts.summary.validate()?;
     let fs = series.sample_rate_hz();
     let n = series.len();
     let axes = series.axes().to_vec();
+    let quantity = series.quantity();
     let seg_len = opts
         .welch_segment_len
         .unwrap_or_else(|| default_segment_len(n));
@@ -206,13 +215,9 @@ pub fn budget_from_series(
                 if in_segment == seg {
                     let spectra = current.take().expect("segment in progress").finish()?;
                     in_segment = 0;
+                    let (grid, csd) = angle_csd_above_dc(&spectra, quantity);
                     if tf_cache.is_none() {
-                        tf_cache = Some(tilt_tf(
-                            model,
-                            &opts.outputs,
-                            &axes,
-                            &spectra.freqs_hz[1..],
-                        )?);
+                        tf_cache = Some(tilt_tf(model, &opts.outputs, &axes, &grid)?);
                     }
                     let tf = tf_cache.as_ref().expect("computed above");
                     // Reduce each finished segment to its tilt PSDs at once (bounded memory).
@@ -220,7 +225,7 @@ pub fn budget_from_series(
                         tf,
                         &TiltCsd {
                             axes: &axes,
-                            csd: without_dc(&spectra.data, n_ax),
+                            csd: &csd,
                         },
                         &Readout { asd: vec![] },
                     );
@@ -235,21 +240,24 @@ pub fn budget_from_series(
         progress(start as u64, n as u64);
     }
     let spectra = whole.finish()?;
-    let grid = &spectra.freqs_hz[1..];
+    let (grid, csd) = angle_csd_above_dc(&spectra, quantity);
     let tf = match tf_cache {
         Some(tf) => tf,
-        None => tilt_tf(model, &opts.outputs, &axes, grid)?,
+        None => tilt_tf(model, &opts.outputs, &axes, &grid)?,
     };
-    check_csd_finite(&spectra.data, &axes)?;
+    check_csd_finite(&csd, &axes, quantity)?;
     let mut budget = tilt_budget(
         &tf,
         &TiltCsd {
             axes: &axes,
-            csd: without_dc(&spectra.data, n_ax),
+            csd: &csd,
         },
         &opts.readout,
     );
     let mut notes = Vec::new();
+    if quantity == Quantity::Rate {
+        notes.push(RATE_BUDGET_NOTE.to_string());
+    }
     if in_segment > 0 {
         notes.push(format!(
             "the last {in_segment} samples ({:.0} s) do not fill a segment and are left out of \
@@ -260,7 +268,7 @@ pub fn budget_from_series(
     let segment_bands = band_per_observable(&opts.outputs, &segment_tilt, opts.percentiles);
     add_damping_terms(model, &mut budget)?;
     check_budget_finite(&budget)?;
-    Ok(BudgetReport {
+    let report = BudgetReport {
         budget,
         segment_duration_s: segment_samples
             .map(|s| s as f64 / fs)
@@ -280,7 +288,28 @@ pub fn budget_from_series(
         axes,
         readout: opts.readout.clone(),
         notes,
-    })
+        summary: Vec::new(),
+    };
+    let tilt = summary::TiltData::Welch {
+        freqs_hz: &grid,
+        csd: &csd,
+        cfg,
+        n_segments: spectra.n_segments,
+    };
+    with_summary(model, report, &tilt, &opts.summary)
+}
+
+/// `report` with its summary ([`summary::summarize`]), and a note for every frequency left out.
+fn with_summary(
+    model: &Model,
+    mut report: BudgetReport,
+    tilt: &summary::TiltData<'_>,
+    req: &SummaryRequest,
+) -> Result<BudgetReport, BudgetError> {
+    let (summary, notes) = summary::summarize(model, &report, tilt, req)?;
+    report.summary = summary;
+    report.notes.extend(notes);
+    Ok(report)
 }
 
 /// Refuses a run whose memory grows with the record beyond the memory available: a median
@@ -364,7 +393,7 @@ pub fn budget_from_spectra(
     );
     add_damping_terms(model, &mut budget)?;
     check_budget_finite(&budget)?;
-    Ok(BudgetReport {
+    let report = BudgetReport {
         budget,
         segment_bands: Vec::new(),
         segment_duration_s: None,
@@ -374,12 +403,23 @@ pub fn budget_from_spectra(
         axes: on_grid.axes.clone(),
         readout: opts.readout.clone(),
         notes,
-    })
+        summary: Vec::new(),
+    };
+    with_summary(
+        model,
+        report,
+        &summary::TiltData::Spectra(spectra),
+        &opts.summary,
+    )
 }
 
-/// Refuses tilt cross-spectra that overflowed `f64` (samples far beyond any tilt angle, e.g.
-/// 1e200 rad, square to infinity), naming the axis.
-fn check_csd_finite(csd: &[num_complex::Complex64], axes: &[TiltAxis]) -> Result<(), BudgetError> {
+/// Refuses tilt cross-spectra that overflowed `f64` (samples far beyond any tilt angle or rate,
+/// e.g. 1e200 rad, square to infinity), naming the axis.
+fn check_csd_finite(
+    csd: &[num_complex::Complex64],
+    axes: &[TiltAxis],
+    quantity: Quantity,
+) -> Result<(), BudgetError> {
     let n = axes.len();
     if let Some(j) = csd
         .iter()
@@ -388,8 +428,10 @@ fn check_csd_finite(csd: &[num_complex::Complex64], axes: &[TiltAxis]) -> Result
         let axis = axes[(j % (n * n)) / n];
         return Err(BudgetError::NotFinite(format!(
             "the tilt power spectrum of {} overflows f64: its samples are far too large to be \
-             tilt angles in rad (check the file's units and --quantity)",
-            axis.name()
+             tilt {}s in {} (check the file's units and --quantity)",
+            axis.name(),
+            quantity.name(),
+            quantity.unit()
         )));
     }
     Ok(())

@@ -1,5 +1,5 @@
 //! Floor-tilt inputs as data: tilt **time series** and tilt **spectra**, their conventions, the
-//! channel-to-axis map, rate integration, gaps, provenance and the typed [`InputError`]. The
+//! channel-to-axis map, rate to angle, gaps, provenance and the typed [`InputError`]. The
 //! readers that fill them from HDF5 or CSV files are in `tiltnoise-io` (`tiltnoise_io::input`);
 //! this module reads no file. The exact file layouts are documented in `docs/input_formats.md`.
 //!
@@ -9,7 +9,8 @@
 //! right-handed rotation taking the **floor** frame to the **inertial** frame: the floor itself
 //! rotates by `-t` (see [`crate::model::tilt`]). Lab axes: `x`, `y` horizontal (`x` along the
 //! crossbar arm, `y` along the other), `z` up. Every value returned by this module is `t` in
-//! this convention, in rad (angle), one-sided PSD/CSD in rad²/Hz for spectra.
+//! this convention: a series in rad (angle) or rad/s (its rate), spectra as one-sided PSD/CSD
+//! of the angle in rad²/Hz.
 //!
 //! **Instrument axes and the default mapping.** Seismological rotation channels give the
 //! right-handed rotation (or rotation rate) *of the ground* about North, East (and Up). Unless
@@ -34,15 +35,16 @@
 //! quantity comes from [`ReadOptions::quantity`] if given (it overrides the file, with a note),
 //! else from the file's metadata (HDF5 attribute `units` on each channel dataset: `rad` or
 //! `rad/s`; CSV: a `# units:` line), else it **defaults to angle** and the provenance says so.
-//! A rate is converted to angle by removing its mean and integrating with the trapezoidal rule,
-//! `theta[0] = 0`, `theta[k] = theta[k-1] + (r[k-1] + r[k]) * (dt/2)` with `r = rate - mean`
-//! (the mean is a compensated sum over the whole channel divided by its length). Spectra of a
-//! rate are divided by `(2 pi f)²`.
+//! A rate is **kept as a rate** in a time series ([`TiltSeries::quantity`],
+//! [`SeriesSource::quantity`]) and converted to angle where spectra are formed: its one-sided
+//! CSD divided by `(2 pi f)²` at every `f > 0`, exactly up to Nyquist; the DC bin carries no
+//! angle information and is excluded ([`rate`]). Spectra of a rate are divided by `(2 pi f)²`
+//! as they are read.
 //!
 //! **Gaps.** NaN or infinite samples are refused ([`InputError::NonFinite`], naming channel
 //! and sample index) unless [`GapPolicy::Interpolate`] is selected: then each interior run of
 //! non-finite samples is replaced by the straight line between its finite neighbours, in the
-//! signed channel, before any integration; a run touching either end is an error
+//! signed channel; a run touching either end is an error
 //! ([`InputError::EdgeGap`]). In CSV an empty field is a non-finite sample.
 //!
 //! # What the readers return
@@ -54,13 +56,14 @@
 
 mod axis_map;
 mod error;
+pub mod rate;
 mod series;
 mod source;
 mod spectra;
 
 pub use axis_map::{resolve, AxisMap, AxisMapEntry, MapOrigin, Mapped, Resolved, Sign};
 pub use error::{require_two, InputError};
-pub use series::{gap_note, process_channel, ChannelCtx, Gap, GapScanner, Integrator, TiltSeries};
+pub use series::{gap_note, process_channel, ChannelCtx, Gap, GapScanner, TiltSeries};
 pub use source::SeriesSource;
 pub use spectra::{assemble, check_csd_finite, TiltSpectra, CSD_RTOL};
 
@@ -87,7 +90,8 @@ pub const ACCEPTED_LAYOUTS: &str = "HDF5 time series (root attribute sample_rate
 pub enum Quantity {
     /// Tilt angle, rad (spectra: rad/sqrt(Hz) or rad²/Hz).
     Angle,
-    /// Tilt rate, rad/s (spectra: rad/s/sqrt(Hz) or rad²/s²/Hz); converted to angle.
+    /// Tilt rate, rad/s (spectra: rad/s/sqrt(Hz) or rad²/s²/Hz); converted to angle in the
+    /// frequency domain ([`rate`]).
     Rate,
 }
 
@@ -273,7 +277,8 @@ pub struct Provenance {
     pub format: InputFormat,
     /// Series or spectra.
     pub kind: InputKind,
-    /// The quantity of the file's channels (before conversion to angle).
+    /// The quantity of the file's channels: the unit of a series' samples; spectra are
+    /// converted to angle as they are read.
     pub quantity: Quantity,
     /// The effective axis map in [`AxisMap`] syntax, e.g. `theta_t=-LJE,eta_t=-LJN`.
     pub axis_map: String,
@@ -287,7 +292,7 @@ pub struct Provenance {
 /// The content of a tilt input file.
 #[derive(Debug, Clone, PartialEq)]
 pub enum TiltInput {
-    /// A time series (angle, rad).
+    /// A time series (angle in rad or rate in rad/s, [`TiltSeries::quantity`]).
     Series(TiltSeries),
     /// Spectra (one-sided CSD, rad²/Hz).
     Spectra(TiltSpectra),

@@ -1,22 +1,23 @@
 //! [`TiltSeries`] and the sample-level processing shared by the in-memory and the streaming
-//! readers: gap detection and linear bridging, the compensated mean, and the trapezoidal
-//! integrator. Both readers push the same values through the same code in the same order, so
-//! their results are bit-identical whatever the chunking.
+//! readers: gap detection and linear bridging. Both readers push the same values through the
+//! same code in the same order, so their results are bit-identical whatever the chunking. A
+//! rate stays a rate here: spectra convert it to angle ([`super::rate`]).
 
 use super::error::InputError;
 use super::{GapPolicy, Provenance, Quantity};
 use crate::model::TiltAxis;
 use std::path::Path;
 
-/// A uniformly sampled tilt time series, converted to angle (rad) in the crate's sign
-/// convention.
+/// A uniformly sampled tilt time series in the crate's sign convention: tilt angle `t` (rad) or
+/// its rate `dt/dt` (rad/s), as [`TiltSeries::quantity`] says.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TiltSeries {
     /// Sample rate (Hz), finite and > 0.
     pub sample_rate_hz: f64,
     /// The axes present, in canonical order (theta_t, eta_t, phi_t), at least one.
     pub axes: Vec<TiltAxis>,
-    /// One channel per entry of `axes`, all of length [`TiltSeries::len`]; tilt angle `t` (rad).
+    /// One channel per entry of `axes`, all of length [`TiltSeries::len`]; tilt angle `t` (rad)
+    /// or tilt rate (rad/s), see [`TiltSeries::quantity`].
     pub data: Vec<Vec<f64>>,
     /// Where it came from.
     pub provenance: Provenance,
@@ -33,7 +34,12 @@ impl TiltSeries {
         self.len() == 0
     }
 
-    /// The channel of `axis` (rad), if present.
+    /// Angle (rad) or rate (rad/s) samples: the quantity of the file's channels, kept as read.
+    pub fn quantity(&self) -> Quantity {
+        self.provenance.quantity
+    }
+
+    /// The channel of `axis` (rad or rad/s, [`TiltSeries::quantity`]), if present.
     pub fn channel(&self, axis: TiltAxis) -> Option<&[f64]> {
         self.axes
             .iter()
@@ -71,69 +77,6 @@ impl Gap {
     }
 }
 
-/// Neumaier-compensated running sum, for the mean of a rate channel.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct MeanAcc {
-    sum: f64,
-    comp: f64,
-    n: usize,
-}
-
-impl MeanAcc {
-    pub fn add(&mut self, x: f64) {
-        let t = self.sum + x;
-        if self.sum.abs() >= x.abs() {
-            self.comp += (self.sum - t) + x;
-        } else {
-            self.comp += (x - t) + self.sum;
-        }
-        self.sum = t;
-        self.n += 1;
-    }
-
-    pub fn mean(&self) -> f64 {
-        (self.sum + self.comp) / self.n as f64
-    }
-}
-
-/// Trapezoidal integrator of `rate - mean`, `theta[0] = 0`. `Copy` so that its state can be
-/// checkpointed.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Integrator {
-    mean: f64,
-    half_dt: f64,
-    prev: f64,
-    theta: f64,
-    started: bool,
-}
-
-impl Integrator {
-    pub fn new(mean: f64, sample_rate_hz: f64) -> Self {
-        Integrator {
-            mean,
-            half_dt: 0.5 / sample_rate_hz,
-            prev: 0.0,
-            theta: 0.0,
-            started: false,
-        }
-    }
-
-    /// Integrates the next rate sample in place (it becomes the angle).
-    pub fn step_in_place(&mut self, values: &mut [f64]) {
-        for v in values {
-            let r = *v - self.mean;
-            if self.started {
-                self.theta += (self.prev + r) * self.half_dt;
-            } else {
-                self.theta = 0.0;
-                self.started = true;
-            }
-            self.prev = r;
-            *v = self.theta;
-        }
-    }
-}
-
 /// Context for error messages about one channel.
 #[derive(Debug, Clone, Copy)]
 pub struct ChannelCtx<'a> {
@@ -168,8 +111,7 @@ impl ChannelCtx<'_> {
 }
 
 /// Streams over one (signed) channel in order, in blocks of any size: validates finiteness
-/// under [`GapPolicy::Reject`], records interior gaps under [`GapPolicy::Interpolate`], and
-/// accumulates the mean of the gap-bridged values.
+/// under [`GapPolicy::Reject`] and records interior gaps under [`GapPolicy::Interpolate`].
 #[derive(Debug)]
 pub struct GapScanner {
     policy: GapPolicy,
@@ -178,7 +120,6 @@ pub struct GapScanner {
     last_finite: Option<(usize, f64)>,
     gap_start: Option<usize>,
     gaps: Vec<Gap>,
-    mean: MeanAcc,
 }
 
 impl GapScanner {
@@ -191,7 +132,6 @@ impl GapScanner {
             last_finite: None,
             gap_start: None,
             gaps: Vec::new(),
-            mean: MeanAcc::default(),
         }
     }
 
@@ -204,18 +144,13 @@ impl GapScanner {
                     let Some((before, a)) = self.last_finite else {
                         return Err(ctx.edge_gap("leading", start, k - 1, self.len));
                     };
-                    let gap = Gap {
+                    self.gaps.push(Gap {
                         before,
                         after: k,
                         a,
                         b: v,
-                    };
-                    for j in before + 1..k {
-                        self.mean.add(gap.value(j));
-                    }
-                    self.gaps.push(gap);
+                    });
                 }
-                self.mean.add(v);
                 self.last_finite = Some((k, v));
             } else {
                 match self.policy {
@@ -231,15 +166,15 @@ impl GapScanner {
         Ok(())
     }
 
-    /// Ends the scan: `(gaps, mean)`.
-    pub fn finish(self, ctx: &ChannelCtx<'_>) -> Result<(Vec<Gap>, f64), InputError> {
+    /// Ends the scan: the interior gaps, in order.
+    pub fn finish(self, ctx: &ChannelCtx<'_>) -> Result<Vec<Gap>, InputError> {
         if let Some(start) = self.gap_start {
             return Err(match self.last_finite {
                 Some(_) => ctx.edge_gap("trailing", start, self.pos - 1, self.len),
                 None => ctx.edge_gap("leading", start, self.pos - 1, self.len),
             });
         }
-        Ok((self.gaps, self.mean.mean()))
+        Ok(self.gaps)
     }
 }
 
@@ -262,22 +197,17 @@ pub fn fill_gaps(
     Ok(())
 }
 
-/// In-memory processing of a whole signed channel: gaps (policy), then integration when the
-/// quantity is a rate. Returns the number of bridged samples.
+/// In-memory processing of a whole signed channel (angle or rate alike): non-finite samples
+/// refused or bridged, as `policy` says. Returns the number of bridged samples.
 pub fn process_channel(
     data: &mut [f64],
     policy: GapPolicy,
-    quantity: Quantity,
-    sample_rate_hz: f64,
     ctx: &ChannelCtx<'_>,
 ) -> Result<usize, InputError> {
     let mut scan = GapScanner::new(policy, data.len());
     scan.push(data, ctx)?;
-    let (gaps, mean) = scan.finish(ctx)?;
+    let gaps = scan.finish(ctx)?;
     fill_gaps(data, 0, &gaps, ctx)?;
-    if quantity == Quantity::Rate {
-        Integrator::new(mean, sample_rate_hz).step_in_place(data);
-    }
     Ok(gaps.iter().map(|g| g.after - g.before - 1).sum())
 }
 
@@ -298,38 +228,15 @@ mod tests {
             unit: "rad",
         };
         let mut d = vec![0.0, f64::NAN, f64::NAN, 3.0, 4.0, f64::INFINITY, 6.0];
-        let n =
-            process_channel(&mut d, GapPolicy::Interpolate, Quantity::Angle, 1.0, &ctx).unwrap();
+        let n = process_channel(&mut d, GapPolicy::Interpolate, &ctx).unwrap();
         assert_eq!(n, 3);
         assert_eq!(d, vec![0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
         let mut lead = vec![f64::NAN, 1.0, 2.0];
-        let e = process_channel(
-            &mut lead,
-            GapPolicy::Interpolate,
-            Quantity::Angle,
-            1.0,
-            &ctx,
-        )
-        .unwrap_err();
+        let e = process_channel(&mut lead, GapPolicy::Interpolate, &ctx).unwrap_err();
         assert!(e.to_string().contains("leading"), "{e}");
         let mut trail = vec![1.0, 2.0, f64::NAN];
-        let e = process_channel(
-            &mut trail,
-            GapPolicy::Interpolate,
-            Quantity::Angle,
-            1.0,
-            &ctx,
-        )
-        .unwrap_err();
+        let e = process_channel(&mut trail, GapPolicy::Interpolate, &ctx).unwrap_err();
         assert!(e.to_string().contains("trailing"), "{e}");
         assert!(e.to_string().contains("2..=2"), "{e}");
-    }
-
-    #[test]
-    fn integrator_trapezoid() {
-        let mut v = vec![1.0, 3.0, 5.0];
-        Integrator::new(3.0, 2.0).step_in_place(&mut v);
-        // r = -2, 0, 2; dt/2 = 0.25
-        assert_eq!(v, vec![0.0, -0.5, 0.0]);
     }
 }

@@ -4,14 +4,18 @@
 //! samples: where they came from ([`super::Provenance`]) is the caller's to record.
 
 use super::error::InputError;
-use super::TiltSeries;
+use super::{Quantity, TiltSeries};
 use crate::model::TiltAxis;
 
-/// A tilt time series read in sequential chunks: tilt angle `t` (rad) in the convention of
-/// [`crate::model::tilt`], one channel per axis, uniformly sampled.
+/// A tilt time series read in sequential chunks: tilt angle `t` (rad) or its rate (rad/s) in the
+/// convention of [`crate::model::tilt`], one channel per axis, uniformly sampled. A consumer
+/// that needs the angle converts the rate's spectra ([`super::rate`]).
 pub trait SeriesSource {
     /// Sample rate (Hz).
     fn sample_rate_hz(&self) -> f64;
+
+    /// Whether the samples are angles (rad) or rates (rad/s).
+    fn quantity(&self) -> Quantity;
 
     /// Number of samples per channel.
     fn len(&self) -> usize;
@@ -24,8 +28,8 @@ pub trait SeriesSource {
     /// The axes, in canonical order; [`SeriesSource::read_chunk`] returns one vector per entry.
     fn axes(&self) -> &[TiltAxis];
 
-    /// Samples `start .. start + len` of every axis, tilt angle (rad). Callers read in order
-    /// (a rate source carries its integral from one chunk to the next).
+    /// Samples `start .. start + len` of every axis, in rad or rad/s
+    /// ([`SeriesSource::quantity`]).
     ///
     /// # Errors
     ///
@@ -37,6 +41,10 @@ pub trait SeriesSource {
 impl SeriesSource for TiltSeries {
     fn sample_rate_hz(&self) -> f64 {
         self.sample_rate_hz
+    }
+
+    fn quantity(&self) -> Quantity {
+        TiltSeries::quantity(self)
     }
 
     fn len(&self) -> usize {

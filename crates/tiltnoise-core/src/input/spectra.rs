@@ -181,7 +181,12 @@ pub fn check_csd_finite(
 }
 
 /// Builds the output CSD in canonical axis order from a source CSD `src(k, a, b)` indexed by
-/// source channel: `S_ij = s_i s_j src(k, a_i, a_j)`, divided by `(2 pi f)^2` for a rate.
+/// source channel: `S_ij = s_i s_j src(k, a_i, a_j)`, divided by `(2 pi f)^2` for a rate
+/// ([`super::rate`]).
+///
+/// # Panics
+///
+/// For a rate at a frequency `<= 0` (the readers refuse such frequencies before calling).
 pub fn assemble(
     freqs_hz: &[f64],
     channels: &[super::axis_map::Mapped],
@@ -191,10 +196,8 @@ pub fn assemble(
     let n = channels.len();
     let mut csd = Vec::with_capacity(freqs_hz.len() * n * n);
     for (k, &f) in freqs_hz.iter().enumerate() {
-        let w2 = match quantity {
-            super::Quantity::Angle => 1.0,
-            super::Quantity::Rate => crate::units::angular(f).powi(2),
-        };
+        let w2 = super::rate::angle_psd_divisor(quantity, f)
+            .expect("the readers refuse frequencies <= 0 before assembling");
         for a in channels {
             for b in channels {
                 let s = a.sign.factor() * b.sign.factor();

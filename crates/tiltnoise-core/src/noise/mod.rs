@@ -16,15 +16,18 @@
 //! never stored: [`ObservableBudget::total`] computes it, the sum in power of the terms whose
 //! kind adds to it ([`TermKind::in_total`]). A damped budget also carries a [`Calibration`] per
 //! observable that has an equivalent input: the squared response that refers every term to
-//! the test mass's acceleration or torque ([`equivalent`]). Pure numerics: depends on `model`,
-//! `tf` and `thermal` only.
+//! the test mass's acceleration or torque ([`equivalent`]). A report also reads the budget at
+//! chosen frequencies ([`SummaryAt`]: exact for model terms, band means with their statistical
+//! error for Welch estimates). Pure numerics: depends on `model`, `tf` and `thermal` only.
 
 pub mod equivalent;
 mod segments;
+mod summary;
 mod term;
 
 pub use equivalent::{add_equivalent_response, equivalent_input, Calibration};
 pub use segments::{percentile, SegmentBand};
+pub use summary::{BandMean, Evaluation, ObservableAt, SummaryAt, TermAt};
 pub use term::{Component, TermGroup, TermKind};
 
 use crate::model::{Observable, TiltAxis};
@@ -152,6 +155,16 @@ impl Readout {
     pub fn of(&self, o: Observable) -> Option<f64> {
         self.asd.iter().find(|(x, _)| *x == o).map(|&(_, a)| a)
     }
+
+    /// The readout term of `o` on `freqs_hz` (PSD = ASD^2 at every frequency), if `o` has a
+    /// readout: the same values on a budget's grid and at a summary's frequency.
+    pub fn term(&self, o: Observable, freqs_hz: &[f64]) -> Option<NoiseTerm> {
+        let asd = self.of(o)?;
+        Some(NoiseTerm {
+            kind: TermKind::Readout,
+            psd: vec![asd * asd; freqs_hz.len()],
+        })
+    }
 }
 
 /// Tilt cross-spectral matrices on a frequency grid: `csd[(k * n + i) * n + j] = S_ij(f_k)`,
@@ -234,12 +247,7 @@ pub fn tilt_budget(tf: &TransferMatrix, tilt: &TiltCsd, readout: &Readout) -> Bu
                     psd,
                 });
             }
-            if let Some(asd) = readout.of(observable) {
-                terms.push(NoiseTerm {
-                    kind: TermKind::Readout,
-                    psd: vec![asd * asd; n_f],
-                });
-            }
+            terms.extend(readout.term(observable, &tf.freqs_hz));
             ObservableBudget::new(observable, terms)
         })
         .collect();
@@ -426,6 +434,8 @@ pub struct BudgetReport {
     pub readout: Readout,
     /// Human-readable notes for the user and the files (band restrictions, assumptions).
     pub notes: Vec<String>,
+    /// The budget read at chosen frequencies ([`SummaryAt`]), in increasing order of request.
+    pub summary: Vec<SummaryAt>,
 }
 
 impl BudgetReport {
@@ -463,6 +473,21 @@ impl BudgetReport {
                         "calibration of {o} has {} values, expected {n_f}",
                         c.response_psd.len()
                     ));
+                }
+            }
+        }
+        for at in &report.summary {
+            for ob in &at.observables {
+                for t in &ob.terms {
+                    if !(t.psd.is_finite() && t.psd >= 0.0) {
+                        return Err(format!(
+                            "summary term {}.{} at {} Hz is {}: must be finite and >= 0",
+                            ob.observable.name(),
+                            t.kind,
+                            at.freq_hz,
+                            t.psd
+                        ));
+                    }
                 }
             }
         }

@@ -39,6 +39,12 @@
 //! * The number of segments is `(n - overlap) / step` (integer division), as in scipy; the
 //!   trailing `(n - overlap) % step` samples that do not complete a segment are ignored.
 //!
+//! # Statistical error
+//!
+//! [`band_dof`] gives the equivalent chi-squared degrees of freedom of a mean Welch PSD
+//! averaged over adjacent bins (overlap and window correlations included), hence the relative
+//! standard deviation `sqrt(2 / nu)` of a band average.
+//!
 //! # Memory and streaming
 //!
 //! [`WelchAccumulator`] is fed chunks of samples of any size and finalised with
@@ -53,11 +59,13 @@
 //! does, the affected median NaN.
 
 mod config;
+mod dof;
 mod stats;
 mod welch;
 mod window;
 
 pub use config::{Averaging, Detrend, WelchConfig};
+pub use dof::band_dof;
 pub use welch::{csd, csd_matrix, welch, CrossSpectra, Csd, Psd, WelchAccumulator};
 pub use window::hann_periodic;
 

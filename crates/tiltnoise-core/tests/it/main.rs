@@ -9,6 +9,7 @@ const REPO_ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
 mod common;
 mod tolerances;
 
+mod budget_summary;
 mod energy_crosscheck;
 mod freq_grid;
 mod mc;
@@ -16,6 +17,7 @@ mod methods;
 mod modes;
 mod polezero;
 mod polezero_batch;
+mod rate_spectra;
 mod reference_precision;
 mod scenes;
 mod simulate;

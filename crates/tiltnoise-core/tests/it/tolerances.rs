@@ -127,6 +127,27 @@ pub const WELCH_FLOOR_FRAC: f64 = 1e-3;
 pub const PIPELINE_REL: f64 = 1e-8;
 
 /// Floor of the pipeline comparison for bins far below a spectrum's peak, as a fraction of the
-/// peak: the integrated tilt angle carries the rounding of 8192 trapezoid steps, `n eps ~ 2e-12`
-/// of its amplitude, so a PSD bin can be off by about that fraction of the peak PSD.
+/// peak: FFT rounding is normwise (`log2 n FFT_STAGE_REL ~ 5e-15` of a segment's norm), so a PSD
+/// bin is off by up to `2 * 5e-15 * ||X|| / |X_peak| <= 1e-14 sqrt(n_bins) ~ 3e-13` of the peak
+/// (1025 bins), and the rate-to-angle division by `(2 pi f)^2` only lowers the bins above the
+/// (red) peak; 1e-11 is a wide margin.
 pub const PEAK_FLOOR: f64 = 1e-11;
+
+/// Normwise relative error of an f64 FFT per stage (`log2 n` stages): Higham, *Accuracy and
+/// Stability of Numerical Algorithms* (2002), Thm 24.2, for radix-2 Cooley-Tukey with twiddle
+/// factors correct to `u`: `||dy|| / ||y|| <= log2(n) eta`, `eta = u + gamma_4 (sqrt 2 + u)`
+/// `~ 6.7 u = 3.4 eps`, rounded up to 4 eps (rustfft's mixed-radix butterflies have the same
+/// per-stage structure).
+pub const FFT_STAGE_REL: f64 = 4.0 * EPS;
+
+/// Absolute error of one sampled sinusoid `A cos(2 pi j / N + phase)` (or `sin`), per unit of
+/// `A`, with `j = m n mod N` exact: the argument, at most `4 pi` in magnitude, is formed with two
+/// roundings (absolute error `<= 2 * 4 pi u`, passed on with slope `<= 1`), `cos` is faithful
+/// (1 ulp) and the product with `A` rounds once: `8 pi u + 3 u < 29 u`, rounded up to `32 u`.
+pub const TONE_SAMPLE_ABS: f64 = 32.0 * U;
+
+/// Relative error of `spectral::band_dof` for segments of up to 2^16 samples and bands of up to
+/// 1000 bins: each `|rho|^2` comes from an FFT (`2 log2 n FFT_STAGE_REL` = 32 x 4 eps, relative
+/// to the largest term, which dominates the sum) and the weighted sum has up to 6000 rounded
+/// terms (6000 u): 1.4e-12, rounded up to 2e-12.
+pub const DOF_REL: f64 = 2e-12;

@@ -132,8 +132,10 @@ pub(crate) fn decide_quantity(
     }
 }
 
-const RATE_NOTE: &str = "rate converted to angle: mean removed, trapezoidal integration, \
-     theta[0] = 0 (spectra: divided by (2 pi f)^2)";
+/// How a rate is turned into angle (`tiltnoise_core::input::rate`), for the provenance.
+const RATE_NOTE: &str = "rate to angle: spectra divided by (2 pi f)^2 at every f > 0, exact \
+     up to Nyquist (a series' samples stay in rad/s, nothing is integrated in time); f = 0 \
+     carries no angle information and is excluded";
 
 /// Whether `s` is an ISO 8601 date or date-time: `YYYY-MM-DD`, optionally followed by `T` (or
 /// a space) and `hh:mm`, `hh:mm:ss` or `hh:mm:ss.fff...`, optionally followed by `Z` or a UTC

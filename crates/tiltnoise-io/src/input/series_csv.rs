@@ -103,7 +103,7 @@ pub(crate) fn read(
             channel: &m.source,
             unit,
         };
-        let bridged = process_channel(ch, opts.gaps, quantity, sample_rate_hz, &ctx)?;
+        let bridged = process_channel(ch, opts.gaps, &ctx)?;
         if bridged > 0 {
             notes.push(gap_note(&m.source, bridged));
         }

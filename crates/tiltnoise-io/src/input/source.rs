@@ -4,7 +4,7 @@
 use super::h5::{self, h5err, AttrValue};
 use super::meta::{decide_quantity, series_quantity, Declared, SERIES_UNITS};
 use super::Mapped;
-use super::{gap_note, ChannelCtx, Gap, GapScanner, Integrator, TiltSeries};
+use super::{gap_note, ChannelCtx, Gap, GapScanner, TiltSeries};
 use super::{require_two, InputError};
 use super::{GapPolicy, InputFormat, InputKind, Provenance, Quantity, ReadOptions, SeriesSource};
 use std::path::{Path, PathBuf};
@@ -13,25 +13,22 @@ use tiltnoise_core::model::TiltAxis;
 
 /// Samples per channel read at a time by the scanning pass at open (2 MiB of `f64`).
 const SCAN_BLOCK: usize = 1 << 18;
-/// Minimum distance between two integration checkpoints (samples).
-const CHECKPOINT_SPACING: usize = 1 << 16;
 
 /// An open HDF5 tilt time series read in chunks.
 ///
 /// [`TiltSeriesSource::read_chunk`] returns samples `start .. start + len` of every axis as
-/// tilt angle (rad) in the crate's sign convention: the axis map and sign applied, finiteness
-/// validated (errors name the absolute sample index) or gaps bridged, rates integrated. The
-/// values are **bit-identical** to those of [`super::read_tilt_series`] for any chunking.
+/// tilt angle (rad) or rate (rad/s, [`TiltSeriesSource::quantity`]; a rate is not integrated:
+/// its spectra are converted, see [`tiltnoise_core::input::rate`]) in the crate's sign
+/// convention: the axis map and sign applied, finiteness validated (errors name the absolute
+/// sample index) or gaps bridged. The values are **bit-identical** to those of
+/// [`super::read_tilt_series`] for any chunking, and chunks may be read in any order.
 ///
 /// # Cost and memory
 ///
-/// At most [`MAX_STREAMED_SAMPLES`] per channel. Opening reads only metadata, except when the quantity is a rate or gaps are interpolated:
-/// then one streaming pass over every mapped channel (in blocks of 2^18 samples) computes the
-/// mean of the rate and records the interior gaps (32 bytes per gap). A chunk costs
-/// `n_axes * len * 8` bytes. For a rate, the running integral is carried from one chunk to the
-/// next; reading chunks in increasing order is the fast path. Any other order is allowed:
-/// the integral is resumed from the nearest checkpoint (kept every >= 2^16 samples of read
-/// positions) before `start`, re-reading at most the samples in between.
+/// At most [`MAX_STREAMED_SAMPLES`] per channel. Opening reads only metadata, except when gaps
+/// are interpolated: then one streaming pass over every mapped channel (in blocks of 2^18
+/// samples) records the interior gaps (32 bytes per gap). A chunk costs `n_axes * len * 8`
+/// bytes.
 #[derive(Debug)]
 pub struct TiltSeriesSource {
     path: PathBuf,
@@ -44,8 +41,6 @@ pub struct TiltSeriesSource {
     quantity: Quantity,
     policy: GapPolicy,
     gaps: Vec<Vec<Gap>>,
-    cursor: Option<(usize, Vec<Integrator>)>,
-    checkpoints: Vec<(usize, Vec<Integrator>)>,
     provenance: Provenance,
 }
 
@@ -57,8 +52,8 @@ impl TiltSeriesSource {
     /// [`InputError::Extension`] unless the extension is `.h5`/`.hdf5`;
     /// [`InputError::WrongKind`] for spectra; [`InputError::MissingAttribute`] without a root
     /// attribute `sample_rate_hz`; any validation error of the layout (see
-    /// `docs/input_formats.md`); with a rate or gap interpolation, also the errors of the
-    /// scanning pass (non-finite samples, edge gaps).
+    /// `docs/input_formats.md`); with gap interpolation, also the errors of the scanning pass
+    /// (edge gaps).
     pub fn open(path: &Path, opts: &ReadOptions) -> Result<Self, InputError> {
         if super::InputFormat::from_path(path)? != InputFormat::Hdf5 {
             return Err(InputError::UnknownLayout {
@@ -185,8 +180,6 @@ impl TiltSeriesSource {
             quantity,
             policy: opts.gaps,
             gaps: vec![Vec::new(); resolved.channels.len()],
-            cursor: None,
-            checkpoints: Vec::new(),
             provenance: Provenance {
                 path: path.to_path_buf(),
                 format: InputFormat::Hdf5,
@@ -197,15 +190,14 @@ impl TiltSeriesSource {
                 notes,
             },
         };
-        if quantity == Quantity::Rate || opts.gaps == GapPolicy::Interpolate {
+        if opts.gaps == GapPolicy::Interpolate {
             src.scan()?;
         }
         Ok(src)
     }
 
-    /// The scanning pass: gaps and means; initialises the integrators for a rate.
+    /// The scanning pass: the interior gaps of every channel.
     fn scan(&mut self) -> Result<(), InputError> {
-        let mut integrators = Vec::new();
         for ch in 0..self.channels.len() {
             let source = self.channels[ch].source.clone();
             let ctx = ChannelCtx {
@@ -225,16 +217,12 @@ impl TiltSeriesSource {
                 scanner.push(&block, &ctx)?;
                 pos += n;
             }
-            let (gaps, mean) = scanner.finish(&ctx)?;
+            let gaps = scanner.finish(&ctx)?;
             let bridged: usize = gaps.iter().map(|g| g.after - g.before - 1).sum();
             if bridged > 0 {
                 self.provenance.notes.push(gap_note(&source, bridged));
             }
             self.gaps[ch] = gaps;
-            integrators.push(Integrator::new(mean, self.sample_rate_hz));
-        }
-        if self.quantity == Quantity::Rate {
-            self.checkpoints = vec![(0, integrators)];
         }
         Ok(())
     }
@@ -256,7 +244,7 @@ impl TiltSeriesSource {
         Ok(v)
     }
 
-    /// Signed, validated or gap-bridged samples of channel `ch` (before integration).
+    /// Signed, validated or gap-bridged samples of channel `ch`.
     fn load(&self, ch: usize, start: usize, len: usize) -> Result<Vec<f64>, InputError> {
         let mut v = self.read_raw(ch, start, len)?;
         let s = self.channels[ch].sign.factor();
@@ -301,7 +289,7 @@ impl TiltSeriesSource {
         &self.axes
     }
 
-    /// The quantity stored in the file (the output is always angle).
+    /// The quantity of the samples: angle (rad) or rate (rad/s), as stored in the file.
     pub fn quantity(&self) -> Quantity {
         self.quantity
     }
@@ -311,7 +299,7 @@ impl TiltSeriesSource {
         &self.provenance
     }
 
-    /// Samples `start .. start + len` of every axis, tilt angle (rad).
+    /// Samples `start .. start + len` of every axis, tilt angle (rad) or rate (rad/s).
     ///
     /// # Errors
     ///
@@ -319,55 +307,20 @@ impl TiltSeriesSource {
     /// [`InputError::NonFinite`] naming the absolute sample index (gaps rejected);
     /// [`InputError::Hdf5`] on a read failure.
     pub fn read_chunk(&mut self, start: usize, len: usize) -> Result<Vec<Vec<f64>>, InputError> {
-        let end = start
-            .checked_add(len)
-            .filter(|&e| e <= self.len)
-            .ok_or_else(|| InputError::ChunkOutOfRange {
+        if start.checked_add(len).is_none_or(|end| end > self.len) {
+            return Err(InputError::ChunkOutOfRange {
                 path: self.path.clone(),
                 start,
                 len,
                 available: self.len,
-            })?;
-        let n = self.channels.len();
+            });
+        }
         if len == 0 {
-            return Ok(vec![Vec::new(); n]);
+            return Ok(vec![Vec::new(); self.channels.len()]);
         }
-        if self.quantity != Quantity::Rate {
-            return (0..n).map(|ch| self.load(ch, start, len)).collect();
-        }
-        // Resume the integral from the latest saved state at or before `start`.
-        let i = self.checkpoints.partition_point(|(p, _)| *p <= start) - 1;
-        let (mut pos, mut state) = self.checkpoints[i].clone();
-        if let Some((p, s)) = &self.cursor {
-            if *p <= start && *p > pos {
-                (pos, state) = (*p, s.clone());
-            }
-        }
-        while pos < start {
-            let b = SCAN_BLOCK.min(start - pos);
-            for (ch, integ) in state.iter_mut().enumerate() {
-                let mut v = self.load(ch, pos, b)?;
-                integ.step_in_place(&mut v);
-            }
-            pos += b;
-        }
-        let mut out = Vec::with_capacity(n);
-        for (ch, integ) in state.iter_mut().enumerate() {
-            let mut v = self.load(ch, start, len)?;
-            integ.step_in_place(&mut v);
-            out.push(v);
-        }
-        let j = self.checkpoints.partition_point(|(p, _)| *p <= end);
-        if end - self.checkpoints[j - 1].0 >= CHECKPOINT_SPACING
-            && self
-                .checkpoints
-                .get(j)
-                .is_none_or(|(p, _)| p - end >= CHECKPOINT_SPACING)
-        {
-            self.checkpoints.insert(j, (end, state.clone()));
-        }
-        self.cursor = Some((end, state));
-        Ok(out)
+        (0..self.channels.len())
+            .map(|ch| self.load(ch, start, len))
+            .collect()
     }
 
     /// Reads the whole series into memory.
@@ -396,6 +349,10 @@ impl TiltSeriesSource {
 impl SeriesSource for TiltSeriesSource {
     fn sample_rate_hz(&self) -> f64 {
         TiltSeriesSource::sample_rate_hz(self)
+    }
+
+    fn quantity(&self) -> Quantity {
+        TiltSeriesSource::quantity(self)
     }
 
     fn len(&self) -> usize {

@@ -1,0 +1,83 @@
+//! Tilt rate to tilt angle, in the frequency domain and exactly.
+//!
+//! With time dependence `exp(+i w t)`, `w = 2 pi f`, a rate `r = dt/dt` has the Fourier
+//! amplitude `R(f) = i w T(f)`, so `T = R / (i w)` at every `f > 0`, and the one-sided
+//! cross-spectra of the angles are those of the rates divided by `w^2`:
+//! `S^T_ij = conj(R_i / (i w)) R_j / (i w) = S^R_ij / w^2` (the phase factors cancel because all
+//! channels of an input have the same quantity). This holds bin by bin up to Nyquist, with no
+//! integrator in the time domain (the trapezoid rule's response falls as `x cot x`,
+//! `x = pi f / f_s`: 59 % low at 0.4 `f_s`).
+//!
+//! A Welch estimate of the rate, divided by `w^2`, equals the Welch estimate of the angle the
+//! rate came from wherever the angle spectrum is flat across the window's main lobe (two bins
+//! either side for the Hann window), for example at a spectral line on a bin. Next to a line at
+//! `f_l` the window's leakage is in the rate's units, so it arrives divided by `(2 pi f)^2`
+//! instead of `(2 pi f_l)^2`: `(f_l / f)^2` times the angle estimate's leakage. The per-segment
+//! constant detrend removes the rate's mean, which for the angle is a linear trend, so a
+//! drifting angle leaks less into the lowest bins than the angle series itself would.
+//!
+//! **DC.** At `f = 0` a rate carries no information about the angle (the angle's constant is
+//! lost and the rate's mean is the angle's trend), so the DC bin is **excluded** from every
+//! angle spectrum derived from a rate; it is never returned as infinite or NaN. The budget drops
+//! the DC bin of angles too (its grid is logarithmic).
+
+use super::Quantity;
+use crate::spectral::CrossSpectra;
+use num_complex::Complex64;
+
+/// The divisor that turns a one-sided PSD or CSD of `quantity` at `f_hz` into that of the
+/// angle: 1 for an angle, `(2 pi f)^2` for a rate at `f > 0`. `None` for a rate at `f = 0`,
+/// which carries no angle information (see the module docs).
+pub fn angle_psd_divisor(quantity: Quantity, f_hz: f64) -> Option<f64> {
+    match quantity {
+        Quantity::Angle => Some(1.0),
+        Quantity::Rate if f_hz > 0.0 => Some(crate::units::angular(f_hz).powi(2)),
+        Quantity::Rate => None,
+    }
+}
+
+/// The angle cross-spectra of Welch cross-spectra `spectra` of a series in `quantity`, on the
+/// bins `f > 0`: `(freqs_hz, csd)` with `csd[((k - 1) * n + i) * n + j] = S_ij(f_k)` in rad²/Hz
+/// for `k = 1 ..`, `n = spectra.n_channels`. The DC bin is dropped for both quantities (for a
+/// rate it has no angle information); a rate's matrices are divided by `(2 pi f_k)^2`.
+pub fn angle_csd_above_dc(
+    spectra: &CrossSpectra,
+    quantity: Quantity,
+) -> (Vec<f64>, Vec<Complex64>) {
+    let nn = spectra.n_channels * spectra.n_channels;
+    let freqs_hz = spectra.freqs_hz[1..].to_vec();
+    let mut csd = spectra.data[nn..].to_vec();
+    if quantity == Quantity::Rate {
+        for (block, &f) in csd.chunks_exact_mut(nn).zip(&freqs_hz) {
+            let w2 = angle_psd_divisor(quantity, f).expect("Welch bins above DC have f > 0");
+            for s in block {
+                *s /= w2;
+            }
+        }
+    }
+    (freqs_hz, csd)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dc_of_a_rate_is_excluded_not_infinite() {
+        assert_eq!(angle_psd_divisor(Quantity::Rate, 0.0), None);
+        assert_eq!(angle_psd_divisor(Quantity::Angle, 0.0), Some(1.0));
+        let one = Complex64::new(1.0, 0.0);
+        let spectra = CrossSpectra {
+            freqs_hz: vec![0.0, 0.5, 1.0],
+            n_channels: 1,
+            data: vec![one; 3],
+            n_segments: 1,
+        };
+        let (f, csd) = angle_csd_above_dc(&spectra, Quantity::Rate);
+        assert_eq!(f, vec![0.5, 1.0]);
+        let w2 = |f: f64| (std::f64::consts::TAU * f).powi(2);
+        assert_eq!(csd, vec![one / w2(0.5), one / w2(1.0)]);
+        let (_, csd) = angle_csd_above_dc(&spectra, Quantity::Angle);
+        assert_eq!(csd, vec![one, one]);
+    }
+}
