@@ -1506,3 +1506,18 @@ fn truncated_contiguous_storage_is_refused() {
         ],
     );
 }
+
+/// An ASD whose square would overflow (or nearly, once summed over a band) is refused by every
+/// spectra reader, naming file, line and column: the measured spectrum of a budget too.
+#[test]
+fn absurdly_large_asds_are_refused() {
+    let dir = tmp();
+    let measured = dir.path().join("measured.csv");
+    std::fs::write(&measured, "freq_hz,X\n1e-3,1e-8\n2e-3,1e200\n").unwrap();
+    let e = tiltnoise_io::input::read_measured(&measured).unwrap_err();
+    err_msg(e, &measured, &["line 3", "column `X`", "1e200", "<= 1e150"]);
+    let tilt = dir.path().join("tilt.csv");
+    std::fs::write(&tilt, "freq_hz,theta_t\n1e-3,1e-8\n2e-3,2e150\n").unwrap();
+    let e = spectra_err(&tilt, &ReadOptions::default());
+    err_msg(e, &tilt, &["column `theta_t`", "2e150", "<= 1e150"]);
+}

@@ -79,6 +79,11 @@ pub const MAX_STREAMED_SAMPLES: usize = 1 << 32;
 /// copy while it is processed.
 pub const SERIES_BYTES_PER_SAMPLE: u64 = 16;
 
+/// Largest amplitude spectral density read from a file (in its unit per sqrt(Hz)): its square,
+/// the PSD, and sums of up to 10^8 such PSDs (band means, totals) stay finite in f64. No
+/// physical tilt, displacement or angle comes anywhere near it.
+pub const MAX_ASD: f64 = 1e150;
+
 /// Highest frequency (Hz) of any grid (`--freq`, a frequency file, an array from Python): a
 /// million times the highest mode of the pendulum (about 10 Hz). Far above it the dynamic
 /// stiffness is `-w^2 M` to the last bit and every method is singular or meaningless.

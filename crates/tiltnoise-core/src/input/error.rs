@@ -458,11 +458,13 @@ pub enum InputError {
         value: f64,
     },
 
-    /// A negative or non-finite amplitude spectral density.
+    /// A negative, non-finite or absurdly large amplitude spectral density (above
+    /// [`MAX_ASD`](crate::limits::MAX_ASD)).
     #[error(
         "input file {path}: {location}, column `{}`: ASD {value:?} {unit} is not allowed: must \
-         be finite and >= 0",
-        Shown(.column)
+         be finite, >= 0 and <= {:e}",
+        Shown(.column),
+        crate::limits::MAX_ASD
     )]
     Asd {
         /// The file.

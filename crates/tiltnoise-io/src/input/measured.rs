@@ -3,7 +3,8 @@
 //!
 //! * **Spectrum, CSV**: header `freq_hz` then any of `X`, `Y`, `Z`, `theta`, `eta`, `phi`,
 //!   `phi_a`; values are one-sided ASDs (m/sqrt(Hz) for X, Y, Z; rad/sqrt(Hz) for the angles).
-//!   Frequencies strictly increasing and > 0; ASDs finite and >= 0 ([`read_measured`]).
+//!   Frequencies strictly increasing and > 0; ASDs finite, >= 0 and at most
+//!   [`MAX_ASD`](tiltnoise_core::limits::MAX_ASD) ([`read_measured`]).
 //! * **Time series, HDF5** (`.h5`, `.hdf5`): the layout `tiltnoise simulate` writes, root
 //!   attribute `schema = tiltnoise.observable_series` (optional), root attribute
 //!   `sample_rate_hz`, one 1-D float dataset per observable named as above, optional `units`
@@ -353,7 +354,7 @@ fn read_spectra_csv(
         freqs.push(f);
         for (c, (o, column)) in observables.iter().zip(asd.iter_mut()).enumerate() {
             let v = number(c + 1)?;
-            if !(v.is_finite() && v >= 0.0) {
+            if !(v.is_finite() && (0.0..=tiltnoise_core::limits::MAX_ASD).contains(&v)) {
                 return Err(InputError::Asd {
                     path: path.to_path_buf(),
                     location: format!("line {line}"),

@@ -78,7 +78,7 @@ pub(crate) fn read(
                     })
                 }
             };
-            if !(v.is_finite() && v >= 0.0) {
+            if !(v.is_finite() && (0.0..=tiltnoise_core::limits::MAX_ASD).contains(&v)) {
                 return Err(InputError::Asd {
                     path: path.clone(),
                     location: format!("line {line} (row {row})"),

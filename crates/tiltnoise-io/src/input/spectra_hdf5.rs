@@ -285,7 +285,7 @@ fn read_asd(
     for k in 0..nf {
         for a in 0..m {
             let v = asd[k * m + a];
-            if !(v.is_finite() && v >= 0.0) {
+            if !(v.is_finite() && (0.0..=tiltnoise_core::limits::MAX_ASD).contains(&v)) {
                 return Err(InputError::Asd {
                     path: path.to_path_buf(),
                     location: format!("/asd[{k}, {a}] at {} Hz", freqs[k]),
