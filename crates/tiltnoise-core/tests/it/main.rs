@@ -9,6 +9,7 @@ const REPO_ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
 mod common;
 mod tolerances;
 
+mod coherence;
 mod energy_crosscheck;
 mod freq_grid;
 mod mc;
