@@ -21,7 +21,9 @@
 
 pub mod budget_figure;
 pub mod chart;
+pub mod coherence_figure;
 mod labels;
+mod linear_axis;
 pub mod mc_figure;
 pub mod methods_figure;
 pub mod simulate_figure;
@@ -29,7 +31,10 @@ mod text;
 pub mod tf_figure;
 
 pub use budget_figure::{budget_figure, budget_figure_with, BudgetFigureOptions};
-pub use chart::{Band, Dash, LegendPlacement, LogLogFigure, Panel, TextSizes, Trace, TraceStyle};
+pub use chart::{
+    Band, Dash, LegendPlacement, LogLogFigure, Panel, TextSizes, Trace, TraceStyle, YScale,
+};
+pub use coherence_figure::{coherence_figure, CoherenceFigureOptions};
 pub use text::GlyphPlacement;
 pub use tf_figure::{tf_figure, tf_figure_with, TfFigureOptions};
 

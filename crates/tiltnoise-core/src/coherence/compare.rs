@@ -52,6 +52,18 @@ impl Agreement {
     }
 }
 
+/// `value` and its standard error `error` as text, the error to two significant digits and the
+/// value to the same decimal place: `(1.10012, 0.00013)` gives `("1.10012", "0.00013")`. Plain
+/// `{:e}`-free decimals for errors down to 1e-12, scientific notation below or for a non-finite
+/// error.
+pub fn with_error(value: f64, error: f64) -> (String, String) {
+    if !(error.is_finite() && error > 1e-12) || !value.is_finite() {
+        return (format!("{value:.3e}"), format!("{error:.1e}"));
+    }
+    let decimals = (1 - error.log10().floor() as i64).max(0) as usize;
+    (format!("{value:.decimals$}"), format!("{error:.decimals$}"))
+}
+
 /// Fits `tf = g model` over the bins where `usable` holds and the model, the estimate and its
 /// error are finite with `sigma > 0`, `model != 0` (module docs). `correlation` is `c_0, c_1,
 /// c_2` of adjacent-bin estimation errors. `None` when no bin qualifies.
@@ -115,6 +127,17 @@ pub fn fit_agreement(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn values_are_shown_to_the_precision_of_their_error() {
+        assert_eq!(
+            with_error(1.100_123, 0.000_134),
+            ("1.10012".into(), "0.00013".into())
+        );
+        assert_eq!(with_error(27.85, 9.78), ("27.9".into(), "9.8".into()));
+        assert_eq!(with_error(1234.5, 250.0), ("1234".into(), "250".into()));
+        assert_eq!(with_error(1.0, f64::NAN).1, "NaN");
+    }
 
     #[test]
     fn exact_scaled_model_gives_its_factor_and_no_misfit() {

@@ -31,8 +31,10 @@
 //! [`CoherenceReport::estimable`] false), with a note.
 
 mod compare;
+mod resolution;
 
-pub use compare::{fit_agreement, Agreement};
+pub use compare::{fit_agreement, with_error, Agreement};
+pub use resolution::{kernel, smoothed, KERNEL_OFFSETS, RESOLUTION_FRACTION};
 
 use crate::align::{align, AlignError, Alignment, RecordClock};
 use crate::budget::default_segment_len;
@@ -137,6 +139,9 @@ pub struct AxisEstimate {
     pub tf_sigma: Vec<f64>,
     /// The model's transfer function on the same bins.
     pub model: Vec<Complex64>,
+    /// Whether the Welch resolution resolves the model at each bin ([`resolution`]): only
+    /// those bins enter [`AxisEstimate::agreement`].
+    pub model_resolved: Vec<bool>,
     /// Measured/model fit; `None` when no bin qualifies or the model entry is zero.
     pub agreement: Option<Agreement>,
 }
@@ -318,9 +323,11 @@ pub fn coherence_from_series(
     let r = alignment.residual_offset_s;
     let unshift =
         |k: usize| Complex64::from_polar(1.0, -2.0 * std::f64::consts::PI * freqs_hz[k] * r);
-    let model_tf = model_tf(model, &measured.channels, &axes, &freqs_hz)?;
+    let (model_tf, model_smoothed) =
+        model_tf(model, &measured.channels, &axes, &freqs_hz, cfg.segment_len)?;
     let correlation = bin_correlation(cfg.segment_len);
     let mc_threshold = coherence_threshold(n_d, q, alpha);
+    let mut notes = alignment.notes.clone();
     let mut observables = Vec::new();
     for (o, (obs, _)) in measured.channels.iter().enumerate() {
         let y = q + o;
@@ -347,10 +354,29 @@ pub fn coherence_from_series(
                 .map(|k| tf_sigma(residual_psd[k], mimo.inverse_diagonal_at(at(k), i), n_d, q))
                 .collect();
             let model_entry: Vec<Complex64> = (0..nf).map(|k| model_tf.get(k, o, i)).collect();
+            let smoothed = &model_smoothed[o * q + i];
+            let model_resolved: Vec<bool> = (0..nf)
+                .map(|k| (smoothed[k] - model_entry[k]).norm() <= RESOLUTION_FRACTION * sigma[k])
+                .collect();
+            let unresolved = (0..nf)
+                .filter(|&k| estimable[k] && !model_resolved[k])
+                .count();
+            if unresolved > 0 {
+                notes.push(format!(
+                    "{}/{}: {unresolved} of {nf} bins are left out of the measured/model fit: \
+                     the model varies across the Welch resolution there by more than {} of the \
+                     bin's standard error (resonances, the lowest bins)",
+                    obs.name(),
+                    axis.name(),
+                    RESOLUTION_FRACTION
+                ));
+            }
+            // Every estimable bin of the band, whatever its coherence: selecting bins by their
+            // estimated coherence would select underestimated residuals, and so errors.
             let usable: Vec<bool> = (0..nf)
                 .map(|k| {
                     estimable[k]
-                        && mc[k] >= mc_threshold
+                        && model_resolved[k]
                         && opts
                             .fit_band_hz
                             .is_none_or(|(lo, hi)| (lo..=hi).contains(&freqs_hz[k]))
@@ -367,6 +393,7 @@ pub fn coherence_from_series(
                 tf_radius: radius,
                 tf_sigma: sigma,
                 model: model_entry,
+                model_resolved,
                 agreement,
             });
         }
@@ -380,7 +407,6 @@ pub fn coherence_from_series(
             axes: per_axis,
         });
     }
-    let mut notes = alignment.notes.clone();
     let missing = estimable.iter().filter(|&&e| !e).count();
     if missing > 0 {
         let first = estimable.iter().position(|&e| !e).unwrap_or(0);
@@ -474,17 +500,41 @@ fn intervals(gamma2: &[f64], n_d: f64, q: usize, level: f64) -> (Vec<f64>, Vec<f
 }
 
 /// The model's tilt transfer functions to the measured observables on the bins (through the
-/// planner, as the budget and `tf` evaluate them).
+/// planner, as the budget and `tf` evaluate them), and per entry (`[output * n_axes + axis]`)
+/// the model smoothed by the Welch kernel of `segment_len` samples ([`resolution`]).
 fn model_tf(
     model: &Model,
     measured: &[(Observable, &[f64])],
     axes: &[TiltAxis],
     freqs_hz: &[f64],
-) -> Result<tf::TransferMatrix, TfError> {
+    segment_len: usize,
+) -> Result<(tf::TransferMatrix, Vec<Vec<Complex64>>), TfError> {
     let request = Request {
         outputs: measured.iter().map(|(o, _)| *o).collect(),
         inputs: axes.iter().map(|&a| Input::Tilt(a)).collect(),
     };
-    let (plan, _) = tf::plan_auto(model, &Scene::over_grid(request, freqs_hz))?;
-    tf::evaluate(plan.as_ref(), freqs_hz)
+    let df = freqs_hz[0];
+    let kernel = kernel(segment_len);
+    let mut fine = Vec::with_capacity(freqs_hz.len() * kernel.len());
+    let mut usable = Vec::with_capacity(fine.capacity());
+    for &f in freqs_hz {
+        for &(nu, _) in &kernel {
+            let g = f + nu * df;
+            usable.push(g > 0.0);
+            fine.push(if g > 0.0 { g } else { f });
+        }
+    }
+    let (plan, _) = tf::plan_auto(model, &Scene::over_grid(request, &fine))?;
+    let at_bins = tf::evaluate(plan.as_ref(), freqs_hz)?;
+    let at_fine = tf::evaluate(plan.as_ref(), &fine)?;
+    let (no, ni) = (at_bins.outputs.len(), at_bins.inputs.len());
+    let smoothed_entries = (0..no * ni)
+        .map(|e| {
+            let samples: Vec<Complex64> = (0..fine.len())
+                .map(|k| at_fine.get(k, e / ni, e % ni))
+                .collect();
+            smoothed(&samples, &usable, &kernel)
+        })
+        .collect();
+    Ok((at_bins, smoothed_entries))
 }
