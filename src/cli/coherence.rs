@@ -6,7 +6,7 @@ use super::args::tilt_read_options;
 use super::output::save_coherence;
 use super::tf::parse_outputs;
 use super::Run;
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, bail, Result};
 use clap::Args;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -141,8 +141,7 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
         args.quantity.as_deref(),
         args.gaps.as_deref(),
     )?;
-    let tilt = read_tilt_series(&args.tilt, &ropts)
-        .with_context(|| format!("--tilt {}", args.tilt.display()))?;
+    let tilt = read_tilt_series(&args.tilt, &ropts)?;
     let measured = match read_measured_input(&args.measured)? {
         MeasuredInput::Series(s) => s,
         MeasuredInput::Spectra(_) => bail!(
@@ -171,8 +170,7 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
         start_time: measured_start.as_deref(),
         channels: select_outputs(&args, &measured.channels)?,
     };
-    let report = coherence_from_series(&model, &tilt_record, &measured_record, &opts)
-        .context("coherence")?;
+    let report = coherence_from_series(&model, &tilt_record, &measured_record, &opts)?;
     for note in &tilt.provenance.notes {
         writeln!(run.out, "input: {note}")?;
     }

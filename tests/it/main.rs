@@ -16,6 +16,7 @@ mod tolerances;
 mod budget_outputs;
 mod cli;
 mod cli_budget;
+mod coherence_cli;
 mod damping;
 mod figures;
 mod fit;

@@ -11,17 +11,16 @@
 //! * through the whole job: a record made from tilt through the model's own transfer functions
 //!   gives back the model (factor 1), a gain error, and a sub-sample offset of the grids.
 
-use crate::common::{json, repo};
+use crate::common::{coloured, json, repo, through_model};
 use crate::tolerances::{
     BIN_FREQ_REL, COHERENCE_ABS, MIMO_REL_PER_COND, NORMAL_QUANTILE_REL, QUANTILE_REL,
     WINDOW_SUM_REL,
 };
 use num_complex::Complex64;
-use realfft::RealFftPlanner;
 use serde_json::Value;
 use std::f64::consts::PI;
 use tiltnoise_core::coherence::{coherence_from_series, CoherenceOptions, Record};
-use tiltnoise_core::model::{Input, Model, Observable, Request, TiltAxis};
+use tiltnoise_core::model::{Model, Observable, TiltAxis};
 use tiltnoise_core::params::Params;
 use tiltnoise_core::rng::Rng;
 use tiltnoise_core::spectral::confidence::{
@@ -29,7 +28,6 @@ use tiltnoise_core::spectral::confidence::{
     f2_upper_quantile, normal_quantile, tf_radius,
 };
 use tiltnoise_core::spectral::{coherence, csd_matrix, multiple_input, WelchConfig};
-use tiltnoise_core::tf;
 
 const FIXTURES: &str = "tests/fixtures/coherence";
 
@@ -218,19 +216,6 @@ fn equivalent_averages_and_quantiles_equal_the_independent_computation() {
     }
 }
 
-/// Coloured Gaussian noise: white noise through `y[n] = a y[n-1] + x[n]`, after a burn-in.
-fn coloured(rng: &mut Rng, n: usize, a: f64) -> Vec<f64> {
-    let mut y = 0.0;
-    let burn = 200;
-    (0..n + burn)
-        .map(|_| {
-            y = a * y + rng.gaussian();
-            y
-        })
-        .skip(burn)
-        .collect()
-}
-
 /// Share of `hits` out of `n` checks of `level`-confidence statements, asserted to lie within
 /// 5 standard deviations of `level` for `n / inflation` independent checks (neighbouring Welch
 /// bins are correlated; `inflation` counts that). A fixed seed makes the outcome deterministic;
@@ -387,82 +372,18 @@ fn coherence_intervals_and_thresholds_have_their_coverage() {
     );
 }
 
-/// `x` filtered through `h(f)` on the circular grid of the whole record (exact for a periodic
-/// record): `IFFT(h(f_k) FFT(x))`, with `h` of the `exp(+i w t)` convention, DC set to 0.
-fn filter_circular(x: &[f64], fs: f64, h: impl Fn(f64) -> Complex64) -> Vec<f64> {
-    let n = x.len();
-    let mut planner = RealFftPlanner::<f64>::new();
-    let mut input = x.to_vec();
-    let mut spectrum = planner.plan_fft_forward(n).make_output_vec();
-    planner
-        .plan_fft_forward(n)
-        .process(&mut input, &mut spectrum)
-        .unwrap();
-    for (k, z) in spectrum.iter_mut().enumerate() {
-        let f = k as f64 * fs / n as f64;
-        *z = if k == 0 {
-            Complex64::new(0.0, 0.0)
-        } else {
-            *z * h(f) / n as f64
-        };
-    }
-    if n % 2 == 0 {
-        let last = spectrum.len() - 1;
-        spectrum[last].im = 0.0;
-    }
-    let mut out = vec![0.0; n];
-    planner
-        .plan_fft_inverse(n)
-        .process(&mut spectrum, &mut out)
-        .unwrap();
-    out
-}
-
-/// Two-axis synthetic tilt (rad) at 1 Hz, theta_t and eta_t correlated, and the model's X and
-/// phi from it with `gain` on the model and a sub-sample advance `advance_s` of the samples
-/// (`y(t_k + advance_s)`), plus white readout noise.
+/// Synthetic tilt and the model's X and phi from it: [`through_model`] with readouts 1e-9
+/// m/sqrt(Hz) and 1e-13 rad/sqrt(Hz) (phi/eta_t is small: a quiet phi readout makes it
+/// measurable).
 struct Synthetic {
     tilt: Vec<Vec<f64>>,
     measured: Vec<Vec<f64>>,
 }
 
 fn synthetic(model: &Model, n: usize, gain: f64, advance_s: f64) -> Synthetic {
-    let fs = 1.0;
-    let mut rng = Rng::stream(3, 0);
-    let common = coloured(&mut rng, n, 0.95);
-    let eta: Vec<f64> = common.iter().map(|v| 1e-8 * v).collect();
-    let own = coloured(&mut rng, n, 0.95);
-    let theta: Vec<f64> = common
-        .iter()
-        .zip(&own)
-        .map(|(c, o)| 1e-8 * (0.4 * c + o))
-        .collect();
     let outputs = [Observable::X, Observable::Phi];
-    let grid: Vec<f64> = (1..=n / 2).map(|k| k as f64 * fs / n as f64).collect();
-    let request = Request {
-        outputs: outputs.to_vec(),
-        inputs: vec![Input::Tilt(TiltAxis::ThetaT), Input::Tilt(TiltAxis::EtaT)],
-    };
-    let plan = tf::plan(model, &request, tf::Method::PoleZero).unwrap();
-    let h = tf::evaluate(plan.as_ref(), &grid).unwrap();
-    let readout = [1e-9, 1e-13];
-    let measured = (0..2)
-        .map(|o| {
-            let at = |f: f64, i: usize| {
-                let k = (f * n as f64 / fs).round() as usize;
-                gain * h.get(k - 1, o, i) * Complex64::from_polar(1.0, 2.0 * PI * f * advance_s)
-            };
-            let from_theta = filter_circular(&theta, fs, |f| at(f, 0));
-            let from_eta = filter_circular(&eta, fs, |f| at(f, 1));
-            (0..n)
-                .map(|k| from_theta[k] + from_eta[k] + readout[o] * rng.gaussian())
-                .collect()
-        })
-        .collect();
-    Synthetic {
-        tilt: vec![theta, eta],
-        measured,
-    }
+    let (tilt, measured) = through_model(model, n, &outputs, &[1e-9, 1e-13], gain, advance_s, 3);
+    Synthetic { tilt, measured }
 }
 
 fn records<'a>(
