@@ -362,3 +362,80 @@ fn outputs_are_checked_before_anything_is_read() {
         &["c.pdf", ".png"],
     );
 }
+
+#[test]
+fn saved_files_hold_the_report_exactly() {
+    use tiltnoise_core::coherence::{coherence_from_series, CoherenceOptions, Record};
+    use tiltnoise_core::model::TiltAxis;
+    use tiltnoise_io::{CoherenceInputs, InputMeta, RunMeta};
+    let model = Model::new(&Params::table_i()).unwrap();
+    let outputs = [Observable::X];
+    let (tilt, measured) = through_model(&model, 4096, &outputs, &[9e-10], 1.0, 0.0, 9);
+    let tilt_record = Record {
+        name: "--tilt t",
+        sample_rate_hz: 1.0,
+        start_time: None,
+        channels: vec![
+            (TiltAxis::ThetaT, &tilt[0][..]),
+            (TiltAxis::EtaT, &tilt[1][..]),
+        ],
+    };
+    let measured_record = Record {
+        name: "--measured m",
+        sample_rate_hz: 1.0,
+        start_time: None,
+        channels: vec![(Observable::X, &measured[0][..])],
+    };
+    let opts = CoherenceOptions {
+        welch_segment_len: Some(256),
+        ..CoherenceOptions::default()
+    };
+    let report = coherence_from_series(&model, &tilt_record, &measured_record, &opts).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let (h5, csv) = (dir.path().join("r.h5"), dir.path().join("r.csv"));
+    let inputs = CoherenceInputs {
+        tilt: InputMeta {
+            path: "t".into(),
+            ..InputMeta::default()
+        },
+        measured_path: "m".into(),
+        measured_start_time: None,
+    };
+    let names = ("t".to_string(), "m".to_string());
+    for path in [&h5, &csv] {
+        crate::output::save_coherence(path, &report, &RunMeta::default(), &inputs, &names).unwrap();
+    }
+    let file = hdf5::File::open(&h5).unwrap();
+    assert_eq!(str_attr(&file, "alignment"), "assumed_simultaneous");
+    let read = |name: &str| file.dataset(name).unwrap().read_raw::<f64>().unwrap();
+    assert_eq!(read("frequency_hz"), report.freqs_hz);
+    let x = &report.observables[0];
+    assert_eq!(
+        read("observables/X/multiple_coherence"),
+        x.multiple_coherence
+    );
+    let tf = file
+        .dataset("observables/X/eta_t/tf")
+        .unwrap()
+        .read_raw::<num_complex::Complex64>()
+        .unwrap();
+    assert_eq!(tf, x.axes[1].tf);
+    // CSV: every value parses back to the same f64.
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = header
+        .iter()
+        .position(|h| *h == "X.eta_t.tf_im[m/rad]")
+        .unwrap();
+    let back: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(col).unwrap().parse().unwrap())
+        .collect();
+    let want: Vec<f64> = x.axes[1].tf.iter().map(|z| z.im).collect();
+    assert_eq!(back, want);
+    // A figure drawn from the same report.
+    let png = dir.path().join("r.png");
+    crate::output::save_coherence(&png, &report, &RunMeta::default(), &inputs, &names).unwrap();
+    assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
+}

@@ -324,7 +324,8 @@ pub fn align(a: &RecordClock<'_>, b: &RecordClock<'_>) -> Result<Alignment, Alig
     let first = shift.max(0.0);
     let end = na.min(nb + shift);
     let len = end - first;
-    if !(len >= 2.0) {
+    // `len` is finite: sample counts and a rounded, finite shift.
+    if len < 2.0 {
         let shown = |r: &RecordClock<'_>| r.start_time.unwrap_or("an unstated start").to_string();
         return Err(AlignError::NoOverlap {
             name_a: a.name.to_string(),
@@ -336,7 +337,7 @@ pub fn align(a: &RecordClock<'_>, b: &RecordClock<'_>) -> Result<Alignment, Alig
         });
     }
     let drift = (1.0 / a.sample_rate_hz - 1.0 / b.sample_rate_hz).abs() * fs * len;
-    if !(drift <= MAX_DRIFT_SAMPLES) {
+    if drift.is_nan() || drift > MAX_DRIFT_SAMPLES {
         return Err(AlignError::SampleRates {
             name_a: a.name.to_string(),
             rate_a: a.sample_rate_hz,

@@ -1,5 +1,6 @@
-//! Reusable log-log line charts: panels of traces with legend, decade ticks and grid, arranged in
-//! a grid with an optional title and caption.
+//! Reusable line charts on a logarithmic frequency axis: panels of traces with legend, ticks and
+//! grid, arranged in a grid with an optional title and caption. The y axis is logarithmic
+//! (decade ticks) or, with [`YScale::Linear`], linear (phase, coherence).
 //!
 //! The data model is plain: a [`Trace`] is a label, `(x, y)` points and a [`TraceStyle`]; a
 //! [`Band`] is a shaded area between two curves (e.g. a percentile band of a noise budget); a

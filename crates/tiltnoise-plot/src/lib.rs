@@ -11,7 +11,9 @@
 //! ([`chart::LogLogFigure`] of [`chart::Panel`]s of [`chart::Trace`]s and an optional
 //! [`chart::Band`]), [`tf_figure()`] builds the paper's Figure 5 from a
 //! [`TransferMatrix`](tiltnoise_core::tf::TransferMatrix), [`budget_figure()`] a noise budget from a
-//! [`BudgetReport`](tiltnoise_core::noise::BudgetReport).
+//! [`BudgetReport`](tiltnoise_core::noise::BudgetReport), [`coherence_figure()`] measured against
+//! model transfer functions from a
+//! [`CoherenceReport`](tiltnoise_core::coherence::CoherenceReport).
 //!
 //! Text is rendered with DejaVu Sans (`assets/DejaVuSans.ttf`, licence in
 //! `assets/DejaVuSans-LICENSE.txt`), embedded in the binary and registered with plotters once

@@ -57,7 +57,7 @@ impl Agreement {
 /// `{:e}`-free decimals for errors down to 1e-12, scientific notation below or for a non-finite
 /// error.
 pub fn with_error(value: f64, error: f64) -> (String, String) {
-    if !(error.is_finite() && error > 1e-12) || !value.is_finite() {
+    if !(error.is_finite() && error > 1e-12 && value.is_finite()) {
         return (format!("{value:.3e}"), format!("{error:.1e}"));
     }
     let decimals = (1 - error.log10().floor() as i64).max(0) as usize;

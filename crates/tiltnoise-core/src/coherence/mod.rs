@@ -31,10 +31,9 @@
 //! [`CoherenceReport::estimable`] false), with a note.
 
 mod compare;
-mod resolution;
+pub mod resolution;
 
 pub use compare::{fit_agreement, with_error, Agreement};
-pub use resolution::{kernel, smoothed, KERNEL_OFFSETS, RESOLUTION_FRACTION};
 
 use crate::align::{align, AlignError, Alignment, RecordClock};
 use crate::budget::default_segment_len;
@@ -47,6 +46,7 @@ use crate::spectral::confidence::{
 use crate::spectral::{coherence, csd_matrix, multiple_input, SpectralError, WelchConfig};
 use crate::tf::{self, Scene};
 use num_complex::Complex64;
+use resolution::{kernel, smoothed, RESOLUTION_FRACTION};
 
 /// A uniformly sampled record handed to the job: its name for messages (the option and the
 /// file), sample rate, start time and channels (all of equal length, finite samples).

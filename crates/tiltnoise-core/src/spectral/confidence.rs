@@ -1,6 +1,6 @@
 //! Statistics of Welch estimates: the equivalent number of independent averages of an
 //! overlapped Welch mean, and the sampling distributions behind the confidence intervals of
-//! coherence and transfer-function estimates ([`super::cross`]).
+//! coherence and transfer-function estimates ([`super::coherence`], [`super::multiple_input`]).
 //!
 //! # The number of averages
 //!

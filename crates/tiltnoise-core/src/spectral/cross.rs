@@ -274,8 +274,8 @@ mod tests {
         let m = spectra(&[block], 3);
         let est = multiple_input(&m, &[0, 1], &[2]).unwrap();
         assert!(est.estimable[0]);
-        for i in 0..2 {
-            assert!((est.tf_at(0, 0, i) - h[i]).norm() < 1e-14, "{i}");
+        for (i, hi) in h.iter().enumerate() {
+            assert!((est.tf_at(0, 0, i) - hi).norm() < 1e-14, "{i}");
         }
         assert!((est.multiple_coherence_at(0, 0) - 1.0).abs() < 1e-14);
         assert!(est.residual_psd_at(0, 0) < 1e-13 * s_yy);
