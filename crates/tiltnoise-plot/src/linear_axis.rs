@@ -6,15 +6,15 @@
 
 use super::chart::{Band, Panel, Trace, YScale};
 
-/// A nice tick step for `[lo, hi]`: 1, 2 or 5 times a power of ten, giving 4 to 10 ticks.
+/// A nice tick step for `[lo, hi]`: the smallest of 1, 2 or 5 times a power of ten that
+/// divides the span into at most 8 intervals.
 pub(crate) fn nice_step(lo: f64, hi: f64) -> f64 {
     let span = (hi - lo).abs().max(f64::MIN_POSITIVE);
-    let raw = span / 6.0;
-    let p = 10f64.powf(raw.log10().floor());
+    let p = 10f64.powf((span / 8.0).log10().floor());
     [1.0, 2.0, 5.0, 10.0]
         .iter()
         .map(|m| m * p)
-        .find(|s| span / s <= 10.0)
+        .find(|s| span / s <= 8.0)
         .unwrap_or(10.0 * p)
 }
 

@@ -220,7 +220,8 @@ pub enum CoherenceError {
 ///
 /// # Errors
 ///
-/// [`CoherenceError`]: options out of range; records that do not overlap, have different
+/// [`CoherenceError`]: options out of range; a record without channels, with channels of
+/// unequal length or a non-finite sample; records that do not overlap, have different
 /// sample rates or a common stretch shorter than one Welch segment or too short for the number
 /// of tilt axes; a channel without power or whose spectrum overflows; tilt axes dependent at
 /// every frequency; a model transfer function that cannot be evaluated.
@@ -231,16 +232,8 @@ pub fn coherence_from_series(
     opts: &CoherenceOptions,
 ) -> Result<CoherenceReport, CoherenceError> {
     check_options(opts)?;
-    for (name, n) in [
-        (tilt.name, tilt.channels.len()),
-        (measured.name, measured.channels.len()),
-    ] {
-        if n == 0 {
-            return Err(CoherenceError::Config(format!(
-                "{name}: no channel to analyse"
-            )));
-        }
-    }
+    check_record(tilt)?;
+    check_record(measured)?;
     let alignment = align(&tilt.clock(), &measured.clock())?;
     let n = alignment.len;
     let fs = alignment.sample_rate_hz;
@@ -440,6 +433,54 @@ pub fn coherence_from_series(
         fit_band_hz: opts.fit_band_hz,
         notes,
     })
+}
+
+/// At least one channel, all of the same length, every sample finite.
+fn check_record<C: Label>(record: &Record<'_, C>) -> Result<(), CoherenceError> {
+    let name = record.name;
+    let Some((first, x0)) = record.channels.first() else {
+        return Err(CoherenceError::Config(format!(
+            "{name}: no channel to analyse"
+        )));
+    };
+    for (c, x) in &record.channels {
+        if x.len() != x0.len() {
+            return Err(CoherenceError::Config(format!(
+                "{name}: channel {} has {} samples but channel {} has {}: channels must have \
+                 equal length",
+                c.label(),
+                x.len(),
+                first.label(),
+                x0.len()
+            )));
+        }
+        if let Some(k) = x.iter().position(|v| !v.is_finite()) {
+            return Err(CoherenceError::Config(format!(
+                "{name}: channel {} has the non-finite sample {} at index {k}: every sample must \
+                 be finite",
+                c.label(),
+                x[k]
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// A channel's name in messages.
+trait Label {
+    fn label(&self) -> &'static str;
+}
+
+impl Label for TiltAxis {
+    fn label(&self) -> &'static str {
+        self.name()
+    }
+}
+
+impl Label for Observable {
+    fn label(&self) -> &'static str {
+        self.name()
+    }
 }
 
 fn check_options(opts: &CoherenceOptions) -> Result<(), CoherenceError> {

@@ -540,6 +540,22 @@ fn records_that_cannot_be_analysed_are_refused_with_their_names() {
     dead.channels[1].1 = &flat;
     let e = run(&dead, &measured);
     assert!(e.contains("eta_t of --tilt synthetic has no power"), "{e}");
+    let mut nan = s.measured[0].clone();
+    nan[99] = f64::NAN;
+    let mut bad = measured.clone();
+    bad.channels[0].1 = &nan;
+    let e = run(&tilt, &bad);
+    assert!(
+        e.contains("--measured synthetic: channel X has the non-finite sample NaN at index 99"),
+        "{e}"
+    );
+    let mut ragged = measured.clone();
+    ragged.channels[1].1 = &s.measured[1][..100];
+    let e = run(&tilt, &ragged);
+    assert!(
+        e.contains("channel phi has 100 samples but channel X has 4096"),
+        "{e}"
+    );
     let doubled: Vec<f64> = s.tilt[0].iter().map(|v| 2.0 * v).collect();
     let mut dependent = tilt.clone();
     dependent.channels[1].1 = &doubled;
