@@ -6,6 +6,7 @@ use clap::ValueEnum;
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::Observable;
 use tiltnoise_core::tf::Method;
+use tiltnoise_io::input::{AxisMap, ReadOptions};
 
 /// Welch averaging.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -84,4 +85,24 @@ pub fn parse_readout_item(item: &str) -> Result<(Observable, f64)> {
         );
     }
     Ok((o, asd))
+}
+
+/// How to read a tilt file from the `--axes MAP`, `--quantity angle|rate` and
+/// `--gaps reject|interpolate` options (each optional; gaps default to reject).
+pub fn tilt_read_options(
+    axes: Option<&str>,
+    quantity: Option<&str>,
+    gaps: Option<&str>,
+) -> Result<ReadOptions> {
+    Ok(ReadOptions {
+        axis_map: axes.map(AxisMap::parse).transpose()?,
+        quantity: quantity
+            .map(str::parse)
+            .transpose()
+            .map_err(|e: String| anyhow!("--quantity: {e}"))?,
+        gaps: gaps
+            .unwrap_or("reject")
+            .parse()
+            .map_err(|e: String| anyhow!("--gaps: {e}"))?,
+    })
 }

@@ -7,6 +7,7 @@
 mod args;
 mod budget;
 mod budget_summary;
+mod coherence;
 mod fit;
 mod mc;
 mod methods;
@@ -69,6 +70,9 @@ enum Command {
     Tf(tf::TfArgs),
     /// Noise budget of X, phi, phi_a from measured floor tilt (time series or spectra).
     Budget(budget::BudgetArgs),
+    /// Coherence of measured observables with the tilt axes, and their measured transfer
+    /// functions (multiple-input estimate with confidence intervals) against the model's.
+    Coherence(coherence::CoherenceArgs),
     /// Free motion of the undamped model (exact modal propagation, 12 h at 0.1 s by default)
     /// with readout noise: ASDs as in Figure 3, the resonance check against the mode
     /// observability table, the X kick of Figures 4 and 5, HDF5 series the budget reads.
@@ -187,6 +191,7 @@ fn run_command(cli: Cli, run: &mut Run) -> Result<()> {
         }
         Command::Tf(args) => tf::run_tf(&params, args, run),
         Command::Budget(args) => budget::run_budget(&params, args, run),
+        Command::Coherence(args) => coherence::run_coherence(&params, args, run),
         Command::Simulate(args) => simulate::run_simulate(&params, args, run),
         Command::Fit(args) => fit::run_fit(&params, args, run),
         Command::Methods(args) => methods::run_methods(&params, args, run),

@@ -17,6 +17,7 @@ mod budget_at;
 mod budget_outputs;
 mod cli;
 mod cli_budget;
+mod coherence_cli;
 mod damping;
 mod figures;
 mod fit;

@@ -44,7 +44,9 @@
 //! assert!((h.get(0, x, eta).re + 1.664).abs() < 1e-3);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+pub mod align;
 pub mod budget;
+pub mod coherence;
 pub mod csv_text;
 pub mod dd;
 pub mod error;

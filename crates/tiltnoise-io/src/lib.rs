@@ -4,7 +4,7 @@
 //!   layouts in `docs/input_formats.md`.
 //! * [`read_measured_modes`] (measured mode frequencies for the fit) and [`read_freq_file`]
 //!   (frequency grids).
-//! * Writers: transfer functions, noise budgets, Monte Carlo, fit and simulation results as
+//! * Writers: transfer functions, noise budgets, coherence, Monte Carlo, fit and simulation results as
 //!   HDF5 or CSV (schemas in `docs/schemas.md`).
 //! * [`check_outputs`]: the output paths of a run, checked before it computes anything.
 //! * [`write_atomic`]: every writer is atomic: a failed write leaves nothing at the target
@@ -18,6 +18,8 @@ mod asd_csv;
 mod atomic;
 mod budget_csv;
 mod budget_hdf5;
+mod coherence_csv;
+mod coherence_hdf5;
 mod fit_hdf5;
 mod freq_file;
 mod h5util;
@@ -34,6 +36,10 @@ pub use atomic::{remove_temporaries_on_interrupt, write_atomic, Staging};
 pub use budget_csv::{budget_csv_string, write_budget_csv};
 pub use budget_hdf5::{
     write_budget_hdf5, SCHEMA_BUDGET, SCHEMA_VERSION_BUDGET, SPECTRAL_CONVENTION,
+};
+pub use coherence_csv::{coherence_csv_string, write_coherence_csv};
+pub use coherence_hdf5::{
+    write_coherence_hdf5, CoherenceInputs, SCHEMA_COHERENCE, SCHEMA_VERSION_COHERENCE,
 };
 pub use fit_hdf5::write_fit_hdf5;
 pub use freq_file::read_freq_file;

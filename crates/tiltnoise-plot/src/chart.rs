@@ -1,5 +1,6 @@
-//! Reusable log-log line charts: panels of traces with legend, decade ticks and grid, arranged in
-//! a grid with an optional title and caption.
+//! Reusable line charts on a logarithmic frequency axis: panels of traces with legend, ticks and
+//! grid, arranged in a grid with an optional title and caption. The y axis is logarithmic
+//! (decade ticks) or, with [`YScale::Linear`], linear (phase, coherence).
 //!
 //! The data model is plain: a [`Trace`] is a label, `(x, y)` points and a [`TraceStyle`]; a
 //! [`Band`] is a shaded area between two curves (e.g. a percentile band of a noise budget); a
@@ -120,7 +121,22 @@ impl Band {
     }
 }
 
-/// One log-log chart.
+/// Scale of a panel's y axis; the x axis is always logarithmic.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum YScale {
+    /// Logarithmic, decade ticks (the default).
+    #[default]
+    Log,
+    /// Linear (phase, coherence): ticks every `tick_step` (`None`: 1, 2 or 5 times a power of
+    /// ten); the automatic range is the data extended to whole steps. Values need not be
+    /// positive.
+    Linear {
+        /// Distance between ticks, in y units.
+        tick_step: Option<f64>,
+    },
+}
+
+/// One chart: logarithmic frequency axis, logarithmic or linear y axis.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Panel {
     /// Title above the frame.
@@ -148,6 +164,8 @@ pub struct Panel {
     pub max_decades: Option<f64>,
     /// Where the legend goes.
     pub legend: LegendPlacement,
+    /// Logarithmic (default) or linear y axis.
+    pub y_scale: YScale,
 }
 
 impl Panel {
@@ -170,6 +188,7 @@ impl Panel {
             y_range: None,
             max_decades: Some(12.0),
             legend: LegendPlacement::Auto,
+            y_scale: YScale::Log,
         }
     }
 
@@ -189,6 +208,17 @@ impl Panel {
     /// The y range that will be drawn: [`Panel::y_range`] or the finite positive y values
     /// (within the x range) padded to whole decades and limited by [`Panel::max_decades`].
     pub fn resolved_y_range(&self) -> (f64, f64) {
+        if let YScale::Linear { tick_step } = self.y_scale {
+            if let Some((a, b)) = self.y_range.filter(|(a, b)| a.is_finite() && b > a) {
+                return (a, b);
+            }
+            let (x0, x1) = self.resolved_x_range();
+            let ys = self
+                .all_points()
+                .filter(|p| p.0 >= x0 && p.0 <= x1)
+                .map(|p| p.1);
+            return super::linear_axis::auto_range(ys, tick_step);
+        }
         if let Some(r) = self.y_range.filter(|r| valid_range(*r)) {
             return r;
         }
@@ -351,6 +381,24 @@ pub fn draw_panel<DB: DrawingBackend>(
     panel: &Panel,
     ts: &TextSizes,
 ) -> Result<(), DrawError> {
+    match panel.y_scale {
+        YScale::Log => draw_log_panel(area, panel, ts, None),
+        YScale::Linear { tick_step } => {
+            let (log, ticks) =
+                super::linear_axis::as_log(panel, panel.resolved_y_range(), tick_step);
+            draw_log_panel(area, &log, ts, Some(ticks))
+        }
+    }
+}
+
+/// [`draw_panel`] of a log-y panel; `linear_ticks` (positions on the log axis and their labels)
+/// replace the decade ticks of a panel mapped from a linear one.
+fn draw_log_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    panel: &Panel,
+    ts: &TextSizes,
+    linear_ticks: Option<Vec<(f64, String)>>,
+) -> Result<(), DrawError> {
     let xr = panel.resolved_x_range();
     let yr = panel.resolved_y_range();
     let body = if panel.title.is_empty() {
@@ -374,7 +422,15 @@ pub fn draw_panel<DB: DrawingBackend>(
     let m_right = (1.4 * tick_h).ceil();
     let plot_h = (h - m_top - m_bottom - x_label_area).max(10.0);
 
-    let y_ticks = decade_ticks(yr.0, yr.1, plot_h, 2.5 * tick_h);
+    let y_ticks = match linear_ticks {
+        Some(labelled) => Ticks {
+            major: labelled.iter().map(|t| t.0).collect(),
+            minor: Vec::new(),
+            step: 1,
+            labels: labelled,
+        },
+        None => decade_ticks(yr.0, yr.1, plot_h, 2.5 * tick_h),
+    };
     let mut y_label_w: f64 = 0.0;
     for v in &y_ticks.major {
         y_label_w =
@@ -585,10 +641,20 @@ struct Ticks {
     minor: Vec<f64>,
     /// Label every `step`-th decade (exponents divisible by `step`).
     step: i32,
+    /// Explicit labels of a linear axis mapped onto a log one: `(position, text)`.
+    labels: Vec<(f64, String)>,
 }
 
 impl Ticks {
     fn label(&self, v: f64) -> String {
+        if !self.labels.is_empty() {
+            return self
+                .labels
+                .iter()
+                .find(|(p, _)| (p - v).abs() <= 1e-9 * p.abs())
+                .map(|(_, text)| text.clone())
+                .unwrap_or_default();
+        }
         let e = v.log10().round() as i32;
         if e.rem_euclid(self.step) == 0 {
             pow10_label(e)
@@ -619,7 +685,12 @@ fn decade_ticks(lo: f64, hi: f64, pixels: f64, min_spacing: f64) -> Ticks {
             }
         }
     }
-    Ticks { major, minor, step }
+    Ticks {
+        major,
+        minor,
+        step,
+        labels: Vec::new(),
+    }
 }
 
 /// `10ⁿ` with a Unicode superscript exponent (`10⁻⁴`, `10⁰`, `10¹`).

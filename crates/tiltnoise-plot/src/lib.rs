@@ -11,7 +11,9 @@
 //! ([`chart::LogLogFigure`] of [`chart::Panel`]s of [`chart::Trace`]s and an optional
 //! [`chart::Band`]), [`tf_figure()`] builds the paper's Figure 5 from a
 //! [`TransferMatrix`](tiltnoise_core::tf::TransferMatrix), [`budget_figure()`] a noise budget from a
-//! [`BudgetReport`](tiltnoise_core::noise::BudgetReport).
+//! [`BudgetReport`](tiltnoise_core::noise::BudgetReport), [`coherence_figure()`] measured against
+//! model transfer functions from a
+//! [`CoherenceReport`](tiltnoise_core::coherence::CoherenceReport).
 //!
 //! Text is rendered with DejaVu Sans (`assets/DejaVuSans.ttf`, licence in
 //! `assets/DejaVuSans-LICENSE.txt`), embedded in the binary and registered with plotters once
@@ -21,7 +23,9 @@
 
 pub mod budget_figure;
 pub mod chart;
+pub mod coherence_figure;
 mod labels;
+mod linear_axis;
 pub mod mc_figure;
 pub mod methods_figure;
 pub mod simulate_figure;
@@ -29,7 +33,10 @@ mod text;
 pub mod tf_figure;
 
 pub use budget_figure::{budget_figure, budget_figure_with, BudgetFigureOptions};
-pub use chart::{Band, Dash, LegendPlacement, LogLogFigure, Panel, TextSizes, Trace, TraceStyle};
+pub use chart::{
+    Band, Dash, LegendPlacement, LogLogFigure, Panel, TextSizes, Trace, TraceStyle, YScale,
+};
+pub use coherence_figure::{coherence_figure, CoherenceFigureOptions};
 pub use text::GlyphPlacement;
 pub use tf_figure::{tf_figure, tf_figure_with, TfFigureOptions};
 

@@ -55,17 +55,26 @@
 //! segment's spectrum (`n_segments × n_channels × n_freqs` complex values, 16 bytes each) until
 //! `finish`; memory then grows linearly with the series length.
 //!
+//! # Coherence and transfer functions
+//!
+//! [`coherence`] and [`multiple_input`] turn a [`CrossSpectra`] into ordinary and multiple
+//! coherence, multiple-input transfer functions and residual PSDs (channels chosen as inputs and
+//! outputs by the caller); [`confidence`] holds the statistics of their confidence intervals.
+//!
 //! Non-finite input samples propagate: a NaN makes the affected mean NaN and, as `np.median`
 //! does, the affected median NaN.
 
+pub mod confidence;
 mod config;
 mod dof;
+mod cross;
 mod stats;
 mod welch;
 mod window;
 
 pub use config::{Averaging, Detrend, WelchConfig};
 pub use dof::band_dof;
+pub use cross::{coherence, multiple_input, MultipleInput, INPUT_RCOND_MIN};
 pub use welch::{csd, csd_matrix, welch, CrossSpectra, Csd, Psd, WelchAccumulator};
 pub use window::hann_periodic;
 

@@ -10,6 +10,7 @@ mod common;
 mod tolerances;
 
 mod budget_summary;
+mod coherence;
 mod energy_crosscheck;
 mod freq_grid;
 mod mc;

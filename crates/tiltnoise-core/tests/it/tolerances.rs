@@ -151,3 +151,34 @@ pub const TONE_SAMPLE_ABS: f64 = 32.0 * U;
 /// to the largest term, which dominates the sum) and the weighted sum has up to 6000 rounded
 /// terms (6000 u): 1.4e-12, rounded up to 2e-12.
 pub const DOF_REL: f64 = 2e-12;
+/// Agreement of coherence with `scipy.signal.coherence`, absolute on its `[0, 1]` scale: the
+/// ratio `|S_xy|^2 / S_xx / S_yy` of Welch values that are each within [`WELCH_REL`] of scipy's
+/// is within `4 WELCH_REL` relative, and coherence is at most 1.
+pub const COHERENCE_ABS: f64 = 4.0 * WELCH_REL;
+
+/// Agreement of multiple-input estimates (transfer functions, multiple coherence, residual PSD)
+/// with `numpy.linalg.solve` on scipy's CSD matrix, per unit condition number of the normalized
+/// input matrix: the data of the two solves differ by [`WELCH_REL`] (this crate's Welch values
+/// against scipy's), which a solve amplifies by at most the condition number, once through the
+/// matrix and once through the right-hand side.
+pub const MIMO_REL_PER_COND: f64 = 2.0 * WELCH_REL;
+
+/// Relative rounding of a sum of at most 128 products of window values (a lag product of a
+/// Welch segment of up to 128 samples, or its energy): `gamma_n = n eps` with one rounding per
+/// product and per addition, `n = 2 x 128`.
+pub const WINDOW_SUM_REL: f64 = 256.0 * EPS;
+
+/// The published bound of Acklam's rational approximation of the normal quantile, relative:
+/// the approximation error itself, far above the rounding of its evaluation.
+pub const NORMAL_QUANTILE_REL: f64 = 1.15e-9;
+
+/// Agreement of the F(2, m) and Beta(q, n - q) quantiles with scipy.stats, relative: a closed
+/// form or a tail sum of at most 3 terms, each a few roundings (`~8 eps`), is inverted through
+/// `x f(x) / S(x)` (density over tail), which stays below `n` = 500 for the test cases, and
+/// `1 - alpha^(1/(n-1))` cancels by up to the same factor: `500 x 8 eps ~ 1e-12`, times 10
+/// for scipy's own error.
+pub const QUANTILE_REL: f64 = 1e-11;
+
+/// Welch bin frequencies computed as `k fs / L` here and `k / (L / fs)` by scipy: each side
+/// rounds twice, so they agree to `2 eps` relative.
+pub const BIN_FREQ_REL: f64 = 2.0 * EPS;

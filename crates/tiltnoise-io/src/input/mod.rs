@@ -13,6 +13,7 @@
 //!   results bit-identical to [`read_tilt_series`]; it is a
 //!   [`tiltnoise_core::input::SeriesSource`] for the budget job.
 //! * [`read_measured`], [`read_measured_input`]: measured ASDs or series of the observables.
+//! * [`read_start_time`]: the start time a series file of either kind states.
 
 mod csv;
 mod h5;
@@ -22,12 +23,14 @@ mod series_csv;
 mod source;
 mod spectra_csv;
 mod spectra_hdf5;
+mod start_time;
 
 pub use measured::{
     read_measured, read_measured_input, MeasuredInput, MeasuredSeries, MeasuredSpectra,
     SCHEMA_OBSERVABLE_SERIES,
 };
 pub use source::TiltSeriesSource;
+pub use start_time::read_start_time;
 pub use tiltnoise_core::input::*;
 
 use std::path::Path;

@@ -1,0 +1,297 @@
+//! `tiltnoise coherence`: a tilt time series and a measured time series of the observables ->
+//! coherence, measured transfer functions with confidence intervals, the model's beside them ->
+//! files and a terminal summary.
+
+use super::args::tilt_read_options;
+use super::output::save_coherence;
+use super::tf::parse_outputs;
+use super::Run;
+use anyhow::{anyhow, bail, Result};
+use clap::Args;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use tiltnoise_core::coherence::{
+    coherence_from_series, with_error, CoherenceOptions, CoherenceReport, ObservableEstimate,
+    Record,
+};
+use tiltnoise_core::error::Shown;
+use tiltnoise_core::model::{Model, Observable, TiltAxis};
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::params::Params;
+use tiltnoise_io::input::{read_measured_input, read_start_time, read_tilt_series, MeasuredInput};
+use tiltnoise_io::{CoherenceInputs, InputMeta, OutputKind, RunMeta};
+
+/// Arguments of `tiltnoise coherence`.
+#[derive(Debug, Args)]
+pub struct CoherenceArgs {
+    /// Tilt time series (HDF5 or CSV, angle or rate); see docs/input_formats.md.
+    #[arg(long, value_name = "FILE")]
+    pub tilt: PathBuf,
+    /// Measured time series of the observables: HDF5 as `tiltnoise simulate` writes it, or CSV
+    /// `time_s,X,...` (m, rad). Records are aligned by their start times (`start_time`
+    /// attribute, `# start_time:` line); without them both start together.
+    #[arg(long, value_name = "FILE")]
+    pub measured: PathBuf,
+    /// Axis map of the tilt file, e.g. `theta_t=-E,eta_t=-N` (default: from the file, else
+    /// theta_t=-E, eta_t=-N).
+    #[arg(long, value_name = "MAP", allow_hyphen_values = true)]
+    pub axes: Option<String>,
+    /// Quantity of the tilt channels: angle (rad) or rate (rad/s); default from the file, else
+    /// angle.
+    #[arg(long, value_name = "angle|rate")]
+    pub quantity: Option<String>,
+    /// Non-finite tilt samples: reject (default) or interpolate linearly across interior gaps.
+    #[arg(long, value_name = "reject|interpolate")]
+    pub gaps: Option<String>,
+    /// Observables to analyse, comma-separated (default: every observable in the measured file).
+    #[arg(long = "output", value_name = "NAME[,NAME...]")]
+    pub outputs: Vec<String>,
+    /// Welch segment length in samples (default 2^14, or the largest power of two <= N/4 of the
+    /// common stretch).
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    pub nperseg: Option<usize>,
+    /// Welch overlap as a fraction of the segment (default 0.5).
+    #[arg(long, value_name = "FRACTION", allow_negative_numbers = true)]
+    pub overlap: Option<f64>,
+    /// Confidence level of every interval and threshold (default 0.95).
+    #[arg(long, value_name = "LEVEL", allow_negative_numbers = true)]
+    pub confidence: Option<f64>,
+    /// Band of the measured/model fit, FLO:FHI in Hz (default: every bin).
+    #[arg(long, value_name = "FLO:FHI", allow_hyphen_values = true)]
+    pub fit_band: Option<String>,
+    /// Output file (.h5, .csv, .png, .svg), repeatable.
+    #[arg(long, value_name = "PATH")]
+    pub save: Vec<PathBuf>,
+}
+
+fn parse_fit_band(text: &str) -> Result<(f64, f64)> {
+    let shown = Shown(text);
+    let (lo, hi) = text
+        .split_once(':')
+        .ok_or_else(|| anyhow!("--fit-band {shown}: expected FLO:FHI in Hz, e.g. 1e-3:0.1"))?;
+    let number = |s: &str| -> Result<f64> {
+        s.trim()
+            .parse::<f64>()
+            .map_err(|_| anyhow!("--fit-band {shown}: `{}` is not a number", Shown(s)))
+    };
+    let (lo, hi) = (number(lo)?, number(hi)?);
+    if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && lo < hi) {
+        bail!("--fit-band {shown}: must be finite with 0 <= FLO < FHI (Hz)");
+    }
+    Ok((lo, hi))
+}
+
+/// The measured observables to analyse: `--output` (each must be in the file) or all of them.
+fn select_outputs<'a>(
+    args: &CoherenceArgs,
+    channels: &'a [(Observable, Vec<f64>)],
+) -> Result<Vec<(Observable, &'a [f64])>> {
+    let present = || {
+        channels
+            .iter()
+            .map(|(o, _)| o.name())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    if args.outputs.is_empty() {
+        return Ok(channels.iter().map(|(o, x)| (*o, x.as_slice())).collect());
+    }
+    parse_outputs(&args.outputs)?
+        .into_iter()
+        .map(|o| {
+            channels
+                .iter()
+                .find(|(c, _)| *c == o)
+                .map(|(c, x)| (*c, x.as_slice()))
+                .ok_or_else(|| {
+                    anyhow!(
+                        "--output {}: the measured file {} has no channel {}; it has {}",
+                        o.name(),
+                        args.measured.display(),
+                        o.name(),
+                        present()
+                    )
+                })
+        })
+        .collect()
+}
+
+/// Runs `tiltnoise coherence`.
+pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run) -> Result<()> {
+    for path in &args.save {
+        OutputKind::from_path(path)?;
+    }
+    let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
+    run.check_outputs(
+        &saves,
+        &[
+            ("--tilt", args.tilt.as_path()),
+            ("--measured", args.measured.as_path()),
+        ],
+    )?;
+    let opts = CoherenceOptions {
+        welch_segment_len: args.nperseg,
+        welch_overlap_fraction: args.overlap.unwrap_or(0.5),
+        confidence: args.confidence.unwrap_or(0.95),
+        fit_band_hz: args.fit_band.as_deref().map(parse_fit_band).transpose()?,
+    };
+    let model = Model::new(params)?;
+    let ropts = tilt_read_options(
+        args.axes.as_deref(),
+        args.quantity.as_deref(),
+        args.gaps.as_deref(),
+    )?;
+    let tilt = read_tilt_series(&args.tilt, &ropts)?;
+    let measured = match read_measured_input(&args.measured)? {
+        MeasuredInput::Series(s) => s,
+        MeasuredInput::Spectra(_) => bail!(
+            "--measured {}: the file holds spectra (header freq_hz); coherence needs a time \
+             series of the observables (header time_s, or HDF5)",
+            args.measured.display()
+        ),
+    };
+    let measured_start = read_start_time(&args.measured)?;
+    let tilt_name = format!("--tilt {}", args.tilt.display());
+    let measured_name = format!("--measured {}", args.measured.display());
+    let tilt_record = Record {
+        name: &tilt_name,
+        sample_rate_hz: tilt.sample_rate_hz,
+        start_time: tilt.provenance.start_time.as_deref(),
+        channels: tilt
+            .axes
+            .iter()
+            .zip(&tilt.data)
+            .map(|(a, x)| (*a, x.as_slice()))
+            .collect::<Vec<(TiltAxis, &[f64])>>(),
+    };
+    let measured_record = Record {
+        name: &measured_name,
+        sample_rate_hz: measured.sample_rate_hz,
+        start_time: measured_start.as_deref(),
+        channels: select_outputs(&args, &measured.channels)?,
+    };
+    let report = coherence_from_series(&model, &tilt_record, &measured_record, &opts)?;
+    for note in &tilt.provenance.notes {
+        writeln!(run.out, "input: {note}")?;
+    }
+    write!(run.out, "{}", summary(&report))?;
+    let meta = RunMeta::of_this_run(params, Some(&NormalModes::new(&model)));
+    let inputs = CoherenceInputs {
+        tilt: InputMeta::from(&tilt.provenance),
+        measured_path: args.measured.display().to_string(),
+        measured_start_time: measured_start.clone(),
+    };
+    let names = (
+        args.tilt.display().to_string(),
+        args.measured.display().to_string(),
+    );
+    run.write_outputs(false, || {
+        for out in &args.save {
+            save_coherence(out, &report, &meta, &inputs, &names)?;
+        }
+        Ok(())
+    })
+}
+
+/// A band of bins as text: `N bins in FLO..FHI Hz`.
+fn bins_text(freqs: &[f64], selected: &[usize]) -> String {
+    match (selected.first(), selected.last()) {
+        (Some(&a), Some(&b)) => format!(
+            "{} of {} bins, {:.3e}..{:.3e} Hz",
+            selected.len(),
+            freqs.len(),
+            freqs[a],
+            freqs[b]
+        ),
+        _ => format!("none of {} bins", freqs.len()),
+    }
+}
+
+fn summary(report: &CoherenceReport) -> String {
+    let mut s = String::new();
+    let w = &report.welch;
+    let pct = 100.0 * report.confidence;
+    let _ = writeln!(
+        s,
+        "coherence: {} common samples at {} Hz ({:.4} h); Welch {} samples (overlap {}), {} \
+         segments, {:.1} independent averages",
+        w.n_samples,
+        w.sample_rate_hz,
+        w.n_samples as f64 / w.sample_rate_hz / 3600.0,
+        w.segment_len,
+        w.overlap,
+        w.n_segments,
+        w.n_equivalent
+    );
+    let _ = writeln!(
+        s,
+        "  noise thresholds at {pct:.0} %: ordinary coherence {:.3}, multiple coherence with {} \
+         axes {:.3}",
+        report.coherence_threshold,
+        report.axes.len(),
+        report.multiple_coherence_threshold
+    );
+    for ob in &report.observables {
+        observable_summary(&mut s, report, ob);
+    }
+    for note in &report.notes {
+        let _ = writeln!(s, "note: {note}");
+    }
+    s
+}
+
+fn observable_summary(s: &mut String, report: &CoherenceReport, ob: &ObservableEstimate) {
+    let f = &report.freqs_hz;
+    let unit = ob.observable.unit();
+    let significant: Vec<usize> = (0..f.len())
+        .filter(|&k| ob.multiple_coherence[k] >= report.multiple_coherence_threshold)
+        .collect();
+    let _ = writeln!(
+        s,
+        "  {}: multiple coherence significant in {} (about {:.0} expected from noise alone)",
+        ob.observable.name(),
+        bins_text(f, &significant),
+        (1.0 - report.confidence) * f.len() as f64
+    );
+    for a in &ob.axes {
+        let best = (0..f.len())
+            .filter(|&k| a.coherence[k].is_finite())
+            .max_by(|&i, &j| a.coherence[i].total_cmp(&a.coherence[j]));
+        let peak = best
+            .map(|k| format!("max coherence {:.3} at {:.3e} Hz", a.coherence[k], f[k]))
+            .unwrap_or_else(|| "no finite coherence".into());
+        let model_zero = a.model.iter().all(|z| z.norm() == 0.0);
+        let fit = match (&a.agreement, model_zero) {
+            (_, true) => "model identically 0".to_string(),
+            (Some(g), false) => {
+                let (gain, gain_sigma) = with_error(g.gain(), g.sigma);
+                let (phase, phase_sigma) = with_error(g.phase_deg(), g.phase_sigma_deg());
+                format!(
+                    "measured/model = {gain} +/- {gain_sigma} at {phase} +/- {phase_sigma} deg \
+                     ({} bins, {:.3e}..{:.3e} Hz, chi2/nu {:.2})",
+                    g.n_bins, g.band_hz.0, g.band_hz.1, g.chi2_per_dof
+                )
+            }
+            (None, false) => "no bin to compare with the model".to_string(),
+        };
+        let _ = writeln!(
+            s,
+            "    {:<7} {peak}; {fit} [H in {unit}/rad]",
+            a.axis.name()
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fit_band_parses_and_refuses() {
+        assert_eq!(parse_fit_band("1e-3:0.1").unwrap(), (1e-3, 0.1));
+        for bad in ["1e-3", "0.1:1e-3", "a:1", "-1:1", "0:inf"] {
+            let e = parse_fit_band(bad).unwrap_err().to_string();
+            assert!(e.starts_with("--fit-band"), "{bad}: {e}");
+        }
+    }
+}
