@@ -7,6 +7,7 @@
 mod args;
 mod budget;
 mod budget_summary;
+mod budget_terms;
 mod fit;
 mod mc;
 mod methods;
@@ -67,7 +68,7 @@ enum Command {
     /// Transfer functions from floor tilt (theta_t, eta_t, phi_t) and/or forces and torques
     /// (F_a.x .. M_b.z) to the observables.
     Tf(tf::TfArgs),
-    /// Noise budget of X, phi, phi_a from measured floor tilt (time series or spectra).
+    /// Noise budget of X, phi, phi_a (or any observables: --observables) from measured floor tilt (time series or spectra), with readout, thermal and user-named terms.
     Budget(budget::BudgetArgs),
     /// Free motion of the undamped model (exact modal propagation, 12 h at 0.1 s by default)
     /// with readout noise: ASDs as in Figure 3, the resonance check against the mode

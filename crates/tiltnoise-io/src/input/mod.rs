@@ -13,7 +13,9 @@
 //!   results bit-identical to [`read_tilt_series`]; it is a
 //!   [`tiltnoise_core::input::SeriesSource`] for the budget job.
 //! * [`read_measured`], [`read_measured_input`]: measured ASDs or series of the observables.
+//! * [`read_asd_column`]: the ASD of one quantity (a coloured readout, a user-named term).
 
+mod asd_file;
 mod csv;
 mod h5;
 mod measured;
@@ -23,6 +25,7 @@ mod source;
 mod spectra_csv;
 mod spectra_hdf5;
 
+pub use asd_file::{read_asd_column, AsdColumn, GENERIC_ASD_COLUMN};
 pub use measured::{
     read_measured, read_measured_input, MeasuredInput, MeasuredSeries, MeasuredSpectra,
     SCHEMA_OBSERVABLE_SERIES,
