@@ -1,7 +1,8 @@
 //! The `budget` subcommand: validated options -> the budget job -> files and a terminal summary.
 //! Owns the progress bar (only when stderr is a terminal).
 
-use super::args::{parse_readout_item, AverageArg, Format};
+use super::args::{AverageArg, Format};
+use super::budget_terms::{parse_observables, parse_readout, parse_terms};
 use super::output::save_budget;
 use super::Run;
 use anyhow::{anyhow, bail, Context, Result};
@@ -16,7 +17,7 @@ use tiltnoise_core::error::Shown;
 use tiltnoise_core::freq;
 use tiltnoise_core::model::Model;
 use tiltnoise_core::modes::NormalModes;
-use tiltnoise_core::noise::{BudgetReport, Readout};
+use tiltnoise_core::noise::BudgetReport;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::spectral::Averaging;
 use tiltnoise_io::input::{read_tilt, InputFormat, ReadOptions, TiltInput, TiltSeriesSource};
@@ -54,10 +55,21 @@ pub struct BudgetArgs {
     /// --segment-duration).
     #[arg(long, value_name = "LO,HI", allow_hyphen_values = true)]
     pub percentiles: Option<String>,
-    /// White readout noise OBS=ASD in the observable's unit/sqrt(Hz) (repeatable; default
-    /// X=9e-9 m/sqrt(Hz) from the paper; OBS=0 removes it).
-    #[arg(long, value_name = "OBS=ASD", allow_hyphen_values = true)]
+    /// Observables to budget, e.g. X,Y,Z,theta,eta,phi,phi_a (default X,phi,phi_a).
+    #[arg(long, value_name = "OBS,...")]
+    pub observables: Option<String>,
+    /// Readout noise of an observable (repeatable): OBS=ASD white, in the observable's
+    /// unit/sqrt(Hz) (default X=9e-9 m/sqrt(Hz) from the paper; OBS=0 removes it), or OBS=FILE
+    /// coloured, a CSV (freq_hz,OBS or freq_hz,asd) or HDF5 (/frequency_hz, /OBS or /asd) ASD
+    /// file that covers the budget's band.
+    #[arg(long, value_name = "OBS=ASD|FILE", allow_hyphen_values = true)]
     pub readout: Vec<String>,
+    /// A user-named noise term NAME=SOURCE:FILE (repeatable): SOURCE an observable (the file is
+    /// its ASD) or an input of the model, theta_t..phi_t, F_a.x..F_b.z, M_a.x..M_b.z (the file
+    /// is the input's ASD, propagated through the transfer functions); FILE as for --readout.
+    /// Added in quadrature to the total as `user.NAME`.
+    #[arg(long, value_name = "NAME=SOURCE:FILE", allow_hyphen_values = true)]
+    pub term: Vec<String>,
     /// Model grid for spectra input, FLO:N:FHI (default 1e-4:2000:30 plus resonance points);
     /// restricted to the band the data cover.
     #[arg(long, value_name = "FLO:N:FHI", allow_hyphen_values = true)]
@@ -119,18 +131,6 @@ fn summary_request(args: &BudgetArgs) -> Result<SummaryRequest> {
         )
     })?;
     Ok(req)
-}
-
-fn parse_readout(items: &[String]) -> Result<Readout> {
-    let mut readout = Readout::default();
-    for item in items {
-        let (o, asd) = parse_readout_item(item)?;
-        readout.asd.retain(|(x, _)| *x != o);
-        if asd > 0.0 {
-            readout.asd.push((o, asd));
-        }
-    }
-    Ok(readout)
 }
 
 fn parse_percentiles(text: &str) -> Result<(f64, f64)> {
@@ -209,9 +209,18 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     for path in &args.save {
         OutputKind::from_path(path)?;
     }
+    let defaults = BudgetOptions::default();
+    let outputs = match &args.observables {
+        Some(text) => parse_observables(text)?,
+        None => defaults.outputs.clone(),
+    };
+    let (readout, readout_files) = parse_readout(&args.readout, &outputs)?;
+    let (user_terms, term_files) = parse_terms(&args.term, &outputs)?;
     let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
     let mut inputs = vec![("--tilt", args.tilt.as_path())];
     inputs.extend(args.measured.as_deref().map(|p| ("--measured", p)));
+    inputs.extend(readout_files.iter().map(|p| ("--readout", p.as_path())));
+    inputs.extend(term_files.iter().map(|p| ("--term", p.as_path())));
     run.check_outputs(&saves, &inputs)?;
     let model = Model::new(params)?;
     if args.percentiles.is_some() && args.segment_duration.is_none() {
@@ -219,23 +228,6 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
             "--percentiles applies to the per-segment band and needs --segment-duration \
              (e.g. --segment-duration 3600)"
         );
-    }
-    let defaults = BudgetOptions::default();
-    let readout = parse_readout(&args.readout)?;
-    for (o, _) in &readout.asd {
-        if !defaults.outputs.contains(o) {
-            bail!(
-                "--readout {}=...: {} is not budgeted; allowed: {}",
-                o.name(),
-                o.name(),
-                defaults
-                    .outputs
-                    .iter()
-                    .map(|o| o.name())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            );
-        }
     }
     let opts = BudgetOptions {
         welch_segment_len: args.nperseg,
@@ -249,13 +241,14 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
             Some(text) => parse_percentiles(text)?,
             None => defaults.percentiles,
         },
+        outputs,
         readout,
+        user_terms,
         spectra_grid_hz: match &args.freq {
             Some(spec) => freq::parse_spec(spec)?,
             None => freq::default_grid(&model),
         },
         summary: summary_request(&args)?,
-        ..BudgetOptions::default()
     };
     let ropts = read_options(&args)?;
     let path = &args.tilt;

@@ -52,9 +52,10 @@ fn error_text(t: &TermAt) -> String {
     }
 }
 
-/// The terms printed: every term that adds to the total, and the measured one.
+/// The terms printed: every term that adds to the total, each user-named one, and the
+/// measured one.
 fn printed(t: &TermAt) -> bool {
-    t.kind.in_total() || t.kind == TermKind::Measured
+    t.kind.in_total() || matches!(t.kind, TermKind::Measured | TermKind::UserNamed(_))
 }
 
 /// The table of the summary, then the notes.
@@ -165,6 +166,7 @@ struct TermJson {
     asd_rel_std: Option<f64>,
     band: Option<BandJson>,
     evaluation: &'static str,
+    group: &'static str,
     psd: f64,
     term: String,
 }
@@ -238,6 +240,7 @@ fn term_json(t: &TermAt) -> TermJson {
         },
         band,
         evaluation: t.evaluation.name(),
+        group: t.kind.group().name(),
         psd: t.psd,
         term: t.kind.name(),
     }

@@ -8,6 +8,7 @@ mod args;
 mod budget;
 mod budget_summary;
 mod coherence;
+mod budget_terms;
 mod fit;
 mod mc;
 mod methods;
@@ -68,7 +69,7 @@ enum Command {
     /// Transfer functions from floor tilt (theta_t, eta_t, phi_t) and/or forces and torques
     /// (F_a.x .. M_b.z) to the observables.
     Tf(tf::TfArgs),
-    /// Noise budget of X, phi, phi_a from measured floor tilt (time series or spectra).
+    /// Noise budget of X, phi, phi_a (or any observables: --observables) from measured floor tilt (time series or spectra), with readout, thermal and user-named terms.
     Budget(budget::BudgetArgs),
     /// Coherence of measured observables with the tilt axes, and their measured transfer
     /// functions (multiple-input estimate with confidence intervals) against the model's.

@@ -81,6 +81,7 @@ fn synthetic_report() -> BudgetReport {
         },
         axes: vec![TiltAxis::ThetaT, TiltAxis::EtaT],
         readout: Readout::default(),
+        user_terms: Vec::new(),
         notes: vec!["the last 12 samples do not fill a segment".to_string()],
         summary: Vec::new(),
     }
@@ -551,6 +552,7 @@ fn realistic_report() -> BudgetReport {
         },
         axes: axes.to_vec(),
         readout: Readout::default(),
+        user_terms: Vec::new(),
         notes: vec![],
         summary: Vec::new(),
     }

@@ -14,6 +14,7 @@ mod output;
 mod tolerances;
 
 mod budget_at;
+mod budget_open;
 mod budget_outputs;
 mod cli;
 mod cli_budget;

@@ -56,7 +56,7 @@ fn check_model(rows: &[(f64, f64)], expected_key: &str) {
     let model = Model::new(&Params::table_i()).unwrap();
     let opts = BudgetOptions {
         spectra_grid_hz: freqs.clone(),
-        readout: Readout { asd: vec![] },
+        readout: Readout::none(),
         ..BudgetOptions::default()
     };
     let report = budget_from_spectra(&model, &spectra, &opts).unwrap();

@@ -6,7 +6,9 @@ use crate::atomic::write_atomic;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
 use tiltnoise_core::noise::equivalent::referred_terms;
-use tiltnoise_core::noise::{BudgetReport, Evaluation, SpectralSource, SummaryAt};
+use tiltnoise_core::noise::{
+    BudgetReport, Component, Evaluation, SpectralSource, SummaryAt, TermKind, TOTAL_NAME,
+};
 
 /// Value of the root attribute `schema`.
 pub const SCHEMA_BUDGET: &str = "tiltnoise.budget";
@@ -122,20 +124,32 @@ fn write_file(
         let unit = o.unit();
         let group = file.create_group(o.name())?;
         str_attr(&group, "unit", unit)?;
-        let named: Vec<(String, Vec<f64>)> = ob
-            .components()
-            .into_iter()
-            .map(|(c, psd)| (c.name(), psd))
-            .collect();
-        let terms: Vec<&str> = named.iter().map(|(n, _)| n.as_str()).collect();
+        let components = ob.components();
+        let names: Vec<String> = components.iter().map(|(c, _)| c.name()).collect();
+        let terms: Vec<&str> = names.iter().map(String::as_str).collect();
         strs_attr(&group, "terms", &terms)?;
         if let Some(asd) = report.readout.of(o) {
             scalar_attr(&group, "readout_asd", asd)?;
             str_attr(&group, "readout_asd_units", &asd_unit(unit))?;
         }
-        for (name, psd) in &named {
-            let g = group.create_group(name)?;
+        if let Some(given) = report.readout.given_of(o) {
+            str_attr(&group, "readout_given", given.origin())?;
+        }
+        for (component, psd) in &components {
+            let g = group.create_group(&component.name())?;
             write_psd_asd(&g, "psd", "asd", psd, unit)?;
+            let Component::Term(kind) = component else {
+                str_attr(&g, "group", TOTAL_NAME)?;
+                continue;
+            };
+            str_attr(&g, "group", kind.group().name())?;
+            if let TermKind::UserNamed(name) = kind {
+                if let Some(t) = report.user_terms.iter().find(|t| &t.name == name) {
+                    str_attr(&g, "source", t.source.name())?;
+                    str_attr(&g, "source_asd_units", &t.source.asd_unit())?;
+                    str_attr(&g, "given", t.asd.origin())?;
+                }
+            }
         }
         if let Some(referred) = referred_terms(ob) {
             write_equivalent(&group, &referred, unit)?;

@@ -2,7 +2,7 @@
 //! panel of amplitude spectral densities per observable, one curve per noise term, the total
 //! thick and black, the spread of the tilt noise across segments as a shaded band.
 
-use super::chart::{Band, Dash, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
+use super::chart::{Band, Dash, LegendPlacement, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
 use super::labels::{observable_symbol, observable_title, tilt_symbol};
 use super::{render, DrawError, ImageFormat};
 use plotters::style::RGBColor;
@@ -11,7 +11,7 @@ use tiltnoise_core::input::InputMeta;
 use tiltnoise_core::model::{Observable, TiltAxis};
 use tiltnoise_core::noise::equivalent::referred_terms;
 use tiltnoise_core::noise::{
-    BudgetReport, Component, Readout, SegmentBand, SpectralSource, TermKind,
+    BudgetReport, Component, Readout, SegmentBand, SpectralSource, TermKind, UserSource,
 };
 
 /// Options of [`budget_figure_with`].
@@ -41,10 +41,13 @@ impl Default for BudgetFigureOptions {
 
 /// Draws the noise budget of `report` as a PNG or SVG file's bytes: one panel per observable
 /// (in the report's order, e.g. X, φ, φₐ), ASD versus frequency, log-log. Terms: `total` thick
-/// black, `tilt` solid, `tilt.<axis>` (each axis alone) thin dashed, `readout` grey, `measured`
-/// black thin, `residual` dotted, and the segment band of the tilt ASD (lower to upper
-/// percentile, with its median as a thin line) shaded. Terms that are exactly zero at every
-/// frequency are listed in the legend as identically 0 instead of drawn.
+/// black, `tilt` solid, `tilt.<axis>` (each axis alone) thin dashed, `readout` grey, `user`
+/// solid and each `user.<name>` dashed, `measured` black thin, `residual` dotted, and the
+/// segment band of the tilt ASD (lower to upper percentile, with its median as a thin line)
+/// shaded. Terms that are exactly zero at every frequency are listed in the legend as
+/// identically 0 instead of drawn (thermal elements and user terms of the other block of the
+/// model are left out). More than four panels: three columns, legends inside, no per-axis or
+/// per-element curves, a one-paragraph caption.
 ///
 /// # Errors
 ///
@@ -82,8 +85,19 @@ const THERMAL_ELEMENTS: [&str; 6] = [
     "swing_b",
 ];
 
+/// Colour of the `user` term (the user-named terms together).
+const USER_COLOR: RGBColor = RGBColor(120, 60, 160);
+
+/// How the readout of a panel is labelled: its white value, or as a given spectrum (whose file
+/// the caption names).
+#[derive(Clone, Copy)]
+enum ReadoutLabel {
+    White(f64, Observable),
+    Given,
+}
+
 /// Legend label and style of a budget component: the kind decides, not its name.
-fn term_style(component: &Component, readout: Option<(f64, Observable)>) -> (String, TraceStyle) {
+fn term_style(component: &Component, readout: Option<ReadoutLabel>) -> (String, TraceStyle) {
     let style = |c, d, w| TraceStyle::new(c, d, w);
     let kind = match component {
         Component::Total => return ("total".to_string(), style(BLACK, Dash::Solid, 4)),
@@ -93,10 +107,20 @@ fn term_style(component: &Component, readout: Option<(f64, Observable)>) -> (Str
         TermKind::Tilt => ("tilt".to_string(), style(TILT_COLOR, Dash::Solid, 2)),
         TermKind::Readout => {
             let label = match readout {
-                Some((asd, o)) => format!("readout, {}", si_asd(asd, o.unit())),
+                Some(ReadoutLabel::White(asd, o)) => format!("readout, {}", si_asd(asd, o.unit())),
+                Some(ReadoutLabel::Given) => "readout (given spectrum)".to_string(),
                 None => "readout".to_string(),
             };
             (label, style(READOUT_COLOR, Dash::Solid, 2))
+        }
+        TermKind::User => ("user terms".to_string(), style(USER_COLOR, Dash::Solid, 2)),
+        TermKind::UserNamed(name) => {
+            // A stable colour per name.
+            let k = name.bytes().map(usize::from).sum::<usize>() % OTHER_COLORS.len();
+            (
+                format!("user, {}", name.replace('_', " ")),
+                style(OTHER_COLORS[k], Dash::Dashed, 2),
+            )
         }
         TermKind::Measured => ("measured".to_string(), style(BLACK, Dash::Solid, 1)),
         TermKind::Residual => ("residual".to_string(), style(PALETTE[3], Dash::Dotted, 2)),
@@ -146,6 +170,8 @@ fn draw_rank(component: &Component) -> u8 {
             TermKind::Readout => 5,
             TermKind::Thermal => 6,
             TermKind::ThermalElement(_) => 7,
+            TermKind::User => 8,
+            TermKind::UserNamed(_) => 9,
         },
     }
 }
@@ -165,6 +191,9 @@ pub fn build_budget_figure(
     if report.budget.observables.is_empty() {
         return Err("the budget has no observable to draw".to_string());
     }
+    // More than the four cells of the usual 2 x 2 grid: small panels, so the diagnostic
+    // breakdowns (one tilt axis, one thermal element) stay in the files only.
+    let compact = report.budget.observables.len() + usize::from(equivalent_x(report)) > 4;
     let mut panels = Vec::new();
     for ob in &report.budget.observables {
         let o = ob.observable;
@@ -178,14 +207,35 @@ pub fn build_budget_figure(
             ),
         );
         panel.max_decades = Some(options.max_decades);
+        if compact {
+            // A legend beside a third of the width would leave the curves no room.
+            panel.legend = LegendPlacement::Inside;
+        }
         let mut components = ob.components();
         components.sort_by_key(|(c, _)| draw_rank(c));
         for (component, psd) in components {
-            let readout = report.readout.of(o).map(|a| (a, o));
+            let breakdown = matches!(
+                component,
+                Component::Term(TermKind::TiltAxis(_) | TermKind::ThermalElement(_))
+            );
+            if compact && breakdown {
+                continue;
+            }
+            let readout = match (report.readout.of(o), report.readout.given_of(o)) {
+                (Some(a), _) => Some(ReadoutLabel::White(a, o)),
+                (None, Some(_)) => Some(ReadoutLabel::Given),
+                (None, None) => None,
+            };
             let (label, style) = term_style(&component, readout);
             if psd.iter().all(|&p| p == 0.0) {
-                // An element of the other block: exactly 0 by the model's structure, not news.
-                if matches!(component, Component::Term(TermKind::ThermalElement(_))) {
+                // An element, or an input, of the other block: exactly 0 by the model's
+                // structure, not news (the files keep the zeros).
+                if matches!(
+                    component,
+                    Component::Term(
+                        TermKind::ThermalElement(_) | TermKind::User | TermKind::UserNamed(_)
+                    )
+                ) {
                     continue;
                 }
                 let short = label.strip_prefix("tilt, ").unwrap_or(&label);
@@ -206,29 +256,47 @@ pub fn build_budget_figure(
         }
         panels.push(panel);
     }
-    if let Some(panel) = equivalent_panel(report, options) {
+    if let Some(mut panel) = equivalent_panel(report, options) {
+        if compact {
+            panel.legend = LegendPlacement::Inside;
+        }
         panels.push(panel);
     }
-    let damped = report
-        .budget
-        .observables
-        .iter()
-        .any(|b| b.term(&TermKind::Thermal).is_some());
-    let mut title = if damped {
-        "Noise budget (tilt, thermal, readout): one-sided amplitude spectral densities"
+    let has = |kind: TermKind| {
+        report
+            .budget
+            .observables
+            .iter()
+            .any(|b| b.term(&kind).is_some())
+    };
+    let (damped, user) = (has(TermKind::Thermal), has(TermKind::User));
+    let mut title = if damped || user {
+        let mut groups = vec!["tilt"];
+        if damped {
+            groups.push("thermal");
+        }
+        groups.push("readout");
+        if user {
+            groups.push("user terms");
+        }
+        format!(
+            "Noise budget ({}): one-sided amplitude spectral densities",
+            groups.join(", ")
+        )
     } else {
-        "Tilt noise budget: one-sided amplitude spectral densities"
-    }
-    .to_string();
+        "Tilt noise budget: one-sided amplitude spectral densities".to_string()
+    };
     if let Some(note) = &options.note {
         title.push_str(&format!(" ({note})"));
     }
+    let caption = caption(report, options.input.as_ref(), compact);
     Ok(LogLogFigure {
         size: options.size,
         title: Some(title),
         panels,
-        columns: 2,
-        caption: caption(report, options.input.as_ref()),
+        // Three columns for more than four panels: the caption then takes a free cell.
+        columns: if compact { 3 } else { 2 },
+        caption,
     })
 }
 
@@ -236,6 +304,14 @@ pub fn build_budget_figure(
 /// mass's acceleration, `S_X / |m_b H_X,F_b.x|^2` (m s^-2/sqrt(Hz)): the free-fall figure of
 /// merit, in the fourth slot of the 2x2 grid. Terms as in the X panel, without the measured
 /// ones and the per-axis or per-element breakdown.
+/// Whether the figure gets the X acceleration panel: a budget of X with its calibration.
+fn equivalent_x(report: &BudgetReport) -> bool {
+    report
+        .budget
+        .observable(Observable::X)
+        .is_some_and(|ob| referred_terms(ob).is_some())
+}
+
 fn equivalent_panel(report: &BudgetReport, options: &BudgetFigureOptions) -> Option<Panel> {
     let ob = report
         .budget
@@ -420,18 +496,19 @@ pub fn si_asd(value: f64, unit: &str) -> String {
 }
 
 /// Caption paragraphs: input, spectral estimate, segments, readout, conventions, notes.
-fn caption(report: &BudgetReport, input: Option<&InputMeta>) -> Vec<String> {
+/// With `many_panels` (more than four) the conventions are said in one short paragraph.
+fn caption(report: &BudgetReport, input: Option<&InputMeta>, many_panels: bool) -> Vec<String> {
     let mut out = Vec::new();
     if let Some(i) = input {
         let name = Path::new(&i.path)
             .file_name()
             .map_or_else(|| i.path.clone(), |n| n.to_string_lossy().into_owned());
         let mut s = format!("Input: {name} ({} {}, {}", i.format, i.kind, i.quantity);
-        if !i.axis_map.is_empty() {
+        if !i.axis_map.is_empty() && !many_panels {
             s.push_str(&format!("; {}", i.axis_map));
         }
         s.push(')');
-        if let Some(t) = &i.start_time {
+        if let Some(t) = i.start_time.as_ref().filter(|_| !many_panels) {
             s.push_str(&format!(", start {t}"));
         }
         s.push('.');
@@ -449,14 +526,22 @@ fn caption(report: &BudgetReport, input: Option<&InputMeta>) -> Vec<String> {
             n_samples,
         } => {
             let fs = *sample_rate_hz;
-            format!(
-                "Tilt ({axes}): Welch estimate at {} Hz, {} segments of {segment_len} samples \
+            if many_panels {
+                format!(
+                    "Tilt ({axes}): Welch, {n_welch_segments} segments of {segment_len} samples \
+                     at {} Hz, {averaging}.",
+                    compact(fs)
+                )
+            } else {
+                format!(
+                    "Tilt ({axes}): Welch estimate at {} Hz, {} segments of {segment_len} samples \
                  ({}), overlap {overlap}, {averaging} averaging; {n_samples} samples ({}).",
-                compact(fs),
-                n_welch_segments,
-                duration(*segment_len as f64 / fs),
-                duration(*n_samples as f64 / fs),
-            )
+                    compact(fs),
+                    n_welch_segments,
+                    duration(*segment_len as f64 / fs),
+                    duration(*n_samples as f64 / fs),
+                )
+            }
         }
         SpectralSource::Spectra { data_band_hz } => format!(
             "Tilt ({axes}): spectra given from {} to {} Hz, interpolated log-log onto the model \
@@ -477,24 +562,54 @@ fn caption(report: &BudgetReport, input: Option<&InputMeta>) -> Vec<String> {
         ));
     }
     out.push(readout_sentence(&report.readout, report));
-    out.push(
-        if report
-            .budget
-            .observables
+    if !report.user_terms.is_empty() {
+        let terms: Vec<String> = report
+            .user_terms
             .iter()
-            .any(|b| b.term(&TermKind::Thermal).is_some())
-        {
+            .map(|t| {
+                let file = short_origin(t.asd.origin());
+                match t.source {
+                    UserSource::Observable(o) => {
+                        format!("{} ({} ASD, {file})", t.name, observable_symbol(o))
+                    }
+                    UserSource::Input(i) => {
+                        format!("{} ({} ASD via the model, {file})", t.name, i.name())
+                    }
+                }
+            })
+            .collect();
+        out.push(format!(
+            "User terms (independent, summed in power): {}.",
+            terms.join("; ")
+        ));
+    }
+    let damped = report
+        .budget
+        .observables
+        .iter()
+        .any(|b| b.term(&TermKind::Thermal).is_some());
+    let conventions = match (damped, !report.user_terms.is_empty()) {
+        (_, true) => {
+            "All curves are one-sided ASDs (√PSD). tilt: all axes with their cross-spectra; \
+             “alone”: one axis, for diagnosis; thermal: fluctuation-dissipation theorem, sum over \
+             the dissipative elements (dotted: each element alone); user terms: their sum \
+             (dashed: each alone); total: quadrature sum of tilt, thermal, readout and user terms."
+        }
+        (true, false) => {
             "All curves are one-sided ASDs (√PSD). tilt: all axes with their cross-spectra; \
              “alone”: one axis, for diagnosis; thermal: fluctuation-dissipation theorem, sum over \
              the dissipative elements (dotted: each element alone); total: quadrature sum of \
              tilt, thermal and readout."
-                .to_string()
-        } else {
+        }
+        (false, false) => {
             "All curves are one-sided ASDs (√PSD). tilt: all axes with their cross-spectra; \
              “alone”: one axis, for diagnosis; total: quadrature sum of tilt and readout."
-                .to_string()
-        },
-    );
+        }
+    };
+    // With many panels the title says what the curves are; the rest is in the files.
+    if !many_panels {
+        out.push(conventions.to_string());
+    }
     out.extend(report.notes.iter().map(|n| {
         let n = n.trim();
         let end = if n.ends_with(['.', '!', '?']) {
@@ -504,7 +619,21 @@ fn caption(report: &BudgetReport, input: Option<&InputMeta>) -> Vec<String> {
         };
         format!("Note: {n}{end}")
     }));
+    if many_panels {
+        // One paragraph: the caption shares a cell with the panels.
+        out = vec![out.join(" ")];
+    }
     out
+}
+
+/// The file named in a given spectrum's origin (`--term a=F_b.x:dir/f.csv (column F_b.x)` ->
+/// `f.csv`), for the caption.
+fn short_origin(origin: &str) -> String {
+    let head = origin.rfind(" (column ").map_or(origin, |i| &origin[..i]);
+    let file = head.rsplit(['=', ':']).next().unwrap_or(head);
+    Path::new(file)
+        .file_name()
+        .map_or_else(|| file.to_string(), |n| n.to_string_lossy().into_owned())
 }
 
 fn readout_sentence(readout: &Readout, report: &BudgetReport) -> String {
@@ -512,12 +641,22 @@ fn readout_sentence(readout: &Readout, report: &BudgetReport) -> String {
     let mut without = Vec::new();
     for ob in &report.budget.observables {
         let o = ob.observable;
-        match readout.of(o) {
-            Some(a) => with.push(format!("{} {}", observable_symbol(o), si_asd(a, o.unit()))),
-            None => without.push(observable_symbol(o)),
+        match (readout.of(o), readout.given_of(o)) {
+            (Some(a), _) => with.push(format!("{} {}", observable_symbol(o), si_asd(a, o.unit()))),
+            (None, Some(g)) => with.push(format!(
+                "{} coloured, given by {}",
+                observable_symbol(o),
+                short_origin(g.origin())
+            )),
+            (None, None) => without.push(observable_symbol(o)),
         }
     }
-    let mut s = String::from("Readout noise (white, assumed): ");
+    let white_only = readout.given.is_empty();
+    let mut s = String::from(if white_only {
+        "Readout noise (white, assumed): "
+    } else {
+        "Readout noise: "
+    });
     if with.is_empty() {
         s.push_str("none");
     } else {

@@ -16,9 +16,9 @@ use std::path::Path;
 use tiltnoise_core::freq::parse_spec;
 use tiltnoise_core::params::Params;
 use tiltnoise_io::input::{
-    read_measured, read_measured_input, read_tilt, read_tilt_series, read_tilt_spectra, AxisMap,
-    GapPolicy, MeasuredInput, Quantity, ReadOptions, TiltInput, TiltSeries, TiltSeriesSource,
-    TiltSpectra,
+    read_asd_column, read_measured, read_measured_input, read_tilt, read_tilt_series,
+    read_tilt_spectra, AxisMap, GapPolicy, MeasuredInput, Quantity, ReadOptions, TiltInput,
+    TiltSeries, TiltSeriesSource, TiltSpectra,
 };
 use tiltnoise_io::{read_freq_file, read_measured_modes};
 
@@ -115,7 +115,7 @@ fn strict() -> bool {
     *STRICT.get_or_init(|| std::env::var_os("TILTNOISE_FUZZ_STRICT").is_some())
 }
 
-/// Reader options that take different paths: the defaults; rate integration with gap
+/// Reader options that take different paths: the defaults; a rate with gap
 /// bridging; an explicit axis map with signs.
 fn option_sets() -> [ReadOptions; 3] {
     [
@@ -297,6 +297,22 @@ fn read_measured_csv(path: &Path) {
     }
     if let Some(s) = shown(read_measured(path)) {
         check_measured(&MeasuredInput::Spectra(s));
+    }
+    // The ASD reader of --readout OBS=FILE and --term reads the same layout, one column.
+    for quantity in ["X", "phi", "F_b.x"] {
+        if let Some(c) = shown(read_asd_column(path, quantity, "m/sqrt(Hz)")) {
+            assert!(c.freqs_hz.len() >= 2 && c.freqs_hz.len() == c.asd.len());
+            assert!(c.freqs_hz[0] > 0.0);
+            assert!(c
+                .freqs_hz
+                .windows(2)
+                .all(|w| w[1] > w[0] && w[1].is_finite()));
+            assert!(
+                c.asd.iter().all(|a| a.is_finite() && *a >= 0.0),
+                "{:?}",
+                c.asd
+            );
+        }
     }
 }
 

@@ -1,6 +1,6 @@
 //! The budget job: a tilt input (time series or spectra) -> tilt cross-spectra -> transfer
-//! functions on the same grid -> the noise budget of X, phi and phi_a, whole record and per
-//! segment.
+//! functions on the same grid -> the noise budget of the chosen observables (tilt, readout,
+//! thermal, user-named terms), whole record and per segment, and read at chosen frequencies.
 //!
 //! Time series are streamed in chunks through Welch accumulators, so a month of 10 Hz data is
 //! processed in bounded memory: one whole-record accumulator, one for the current segment, and
@@ -11,6 +11,7 @@
 mod measured;
 mod summary;
 
+pub use crate::noise::loglog_at;
 pub use measured::{add_measured, series_psds, MeasuredPsds};
 pub use summary::{SummaryRequest, DEFAULT_BAND_FRACTION, DEFAULT_SUMMARY_FREQS_HZ};
 
@@ -20,8 +21,8 @@ use crate::input::{InputError, Quantity, SeriesSource, TiltSpectra};
 use crate::limits::{check_memory, planned_bytes, LimitError};
 use crate::model::{Model, Observable, TiltAxis};
 use crate::noise::{
-    add_equivalent_response, add_thermal, tilt_budget, Budget, BudgetReport, Readout, SegmentBand,
-    SpectralSource, TermKind, TiltCsd,
+    add_equivalent_response, add_thermal, add_user_terms, check_user_terms, tilt_budget, Budget,
+    BudgetReport, Readout, SegmentBand, SpectralSource, TermKind, TiltCsd, UserTerm, UserTermError,
 };
 use crate::spectral::{Averaging, SpectralError, WelchAccumulator, WelchConfig};
 use crate::tf::{self, Input, Request, TransferMatrix};
@@ -49,6 +50,9 @@ pub enum BudgetError {
     /// More spectra to keep than fit into the memory available.
     #[error(transparent)]
     TooLarge(#[from] LimitError),
+    /// A user term or a coloured readout that does not fit the budget.
+    #[error(transparent)]
+    User(#[from] UserTermError),
     /// Options that contradict each other or the input.
     #[error("{0}")]
     Config(String),
@@ -72,8 +76,10 @@ pub struct BudgetOptions {
     pub segment_duration_s: Option<f64>,
     /// Percentiles of the band, e.g. (10, 90).
     pub percentiles: (f64, f64),
-    /// Readout noise per observable.
+    /// Readout noise per observable, white or coloured.
     pub readout: Readout,
+    /// User-named terms (ASDs of observables, or input noises through the model).
+    pub user_terms: Vec<UserTerm>,
     /// Model grid for spectra input (Hz); time series use the Welch grid.
     pub spectra_grid_hz: Vec<f64>,
     /// Frequencies to read the budget at ([`crate::noise::SummaryAt`]).
@@ -90,6 +96,7 @@ impl Default for BudgetOptions {
             segment_duration_s: None,
             percentiles: (10.0, 90.0),
             readout: Readout::default(),
+            user_terms: Vec::new(),
             spectra_grid_hz: Vec::new(),
             summary: SummaryRequest::default(),
         }
@@ -163,6 +170,13 @@ pub fn budget_from_series(
         .with_averaging(opts.averaging);
     cfg.validate()?;
     cfg.check_series_len(n)?;
+    // The Welch grid's band, known before the record is read: refuse given spectra that do not
+    // cover it now rather than after a long pass.
+    check_given_spectra(
+        opts,
+        fs / seg_len as f64,
+        (seg_len / 2) as f64 * fs / seg_len as f64,
+    )?;
     let segment_samples = match opts.segment_duration_s {
         None => None,
         Some(d) => {
@@ -227,7 +241,7 @@ pub fn budget_from_series(
                             axes: &axes,
                             csd: &csd,
                         },
-                        &Readout { asd: vec![] },
+                        &Readout::none(),
                     );
                     for (o, ob) in b.observables.iter().enumerate() {
                         let psd = &ob.term(&TermKind::Tilt).expect("tilt term").psd;
@@ -267,6 +281,7 @@ pub fn budget_from_series(
     }
     let segment_bands = band_per_observable(&opts.outputs, &segment_tilt, opts.percentiles);
     add_damping_terms(model, &mut budget)?;
+    add_user_terms(&mut budget, model, &opts.user_terms)?;
     check_budget_finite(&budget)?;
     let report = BudgetReport {
         budget,
@@ -287,6 +302,7 @@ pub fn budget_from_series(
         },
         axes,
         readout: opts.readout.clone(),
+        user_terms: opts.user_terms.clone(),
         notes,
         summary: Vec::new(),
     };
@@ -296,7 +312,7 @@ pub fn budget_from_series(
         cfg,
         n_segments: spectra.n_segments,
     };
-    with_summary(model, report, &tilt, &opts.summary)
+    with_summary(model, report, &tilt, &opts.summary, &opts.user_terms)
 }
 
 /// `report` with its summary ([`summary::summarize`]), and a note for every frequency left out.
@@ -305,11 +321,22 @@ fn with_summary(
     mut report: BudgetReport,
     tilt: &summary::TiltData<'_>,
     req: &SummaryRequest,
+    user_terms: &[UserTerm],
 ) -> Result<BudgetReport, BudgetError> {
-    let (summary, notes) = summary::summarize(model, &report, tilt, req)?;
+    let (summary, notes) = summary::summarize(model, &report, tilt, req, user_terms)?;
     report.summary = summary;
     report.notes.extend(notes);
     Ok(report)
+}
+
+/// Refuses a coloured readout or a user term whose spectrum does not cover the budget's band
+/// `[lo, hi]` (Hz), or that is an ASD of an observable not budgeted.
+fn check_given_spectra(opts: &BudgetOptions, lo: f64, hi: f64) -> Result<(), BudgetError> {
+    opts.readout
+        .check_covers(lo, hi)
+        .map_err(|e| BudgetError::User(UserTermError::Coverage(e)))?;
+    check_user_terms(&opts.user_terms, &opts.outputs, lo, hi)?;
+    Ok(())
 }
 
 /// Refuses a run whose memory grows with the record beyond the memory available: a median
@@ -382,6 +409,7 @@ pub fn budget_from_spectra(
             ));
         }
     }
+    check_given_spectra(opts, grid[0], grid[grid.len() - 1])?;
     let tf = tilt_tf(model, &opts.outputs, &on_grid.axes, &grid)?;
     let mut budget: Budget = tilt_budget(
         &tf,
@@ -392,6 +420,7 @@ pub fn budget_from_spectra(
         &opts.readout,
     );
     add_damping_terms(model, &mut budget)?;
+    add_user_terms(&mut budget, model, &opts.user_terms)?;
     check_budget_finite(&budget)?;
     let report = BudgetReport {
         budget,
@@ -402,6 +431,7 @@ pub fn budget_from_spectra(
         },
         axes: on_grid.axes.clone(),
         readout: opts.readout.clone(),
+        user_terms: opts.user_terms.clone(),
         notes,
         summary: Vec::new(),
     };
@@ -410,6 +440,7 @@ pub fn budget_from_spectra(
         report,
         &summary::TiltData::Spectra(spectra),
         &opts.summary,
+        &opts.user_terms,
     )
 }
 
@@ -454,22 +485,4 @@ fn check_budget_finite(budget: &Budget) -> Result<(), BudgetError> {
         }
     }
     Ok(())
-}
-
-/// Log-log interpolation of a positive spectrum `(freqs, values)` at `f` (for reading a budget
-/// at exactly 1, 2, 5 mHz). `None` outside the band.
-pub fn loglog_at(freqs: &[f64], values: &[f64], f: f64) -> Option<f64> {
-    let k = freqs.partition_point(|&x| x < f);
-    if k == freqs.len() || (k == 0 && freqs[0] != f) {
-        return None;
-    }
-    if freqs[k] == f {
-        return Some(values[k]);
-    }
-    let (f0, f1, v0, v1) = (freqs[k - 1], freqs[k], values[k - 1], values[k]);
-    if v0 <= 0.0 || v1 <= 0.0 {
-        return Some(v0 + (v1 - v0) * (f - f0) / (f1 - f0));
-    }
-    let t = (f / f0).ln() / (f1 / f0).ln();
-    Some((v0.ln() + t * (v1 / v0).ln()).exp())
 }

@@ -1,7 +1,8 @@
 //! Reading a budget at chosen frequencies ([`crate::noise::SummaryAt`]) by the code that fills
-//! its grid, at exactly each frequency: the transfer functions, the thermal formula and the
-//! readout at `f`. The tilt cross-spectra there are the given spectra taken at `f` (spectra
-//! input: the value is exact), or for a time series the mean of the Welch cross-spectral
+//! its grid, at exactly each frequency: the transfer functions, the thermal formula, the readout
+//! and the user terms at `f` (given spectra taken at `f`, log-log between their points). The
+//! tilt cross-spectra there are the given spectra taken at `f` (spectra input: the value is
+//! exact), or for a time series the mean of the Welch cross-spectral
 //! matrices of the bins in a band around `f`, with its chi-squared degrees of freedom: the
 //! floor's spectrum is averaged over the band, the pendulum's resonances are not (they are in
 //! the transfer functions, evaluated at `f`). Never an interpolation between bins: across a
@@ -11,8 +12,8 @@ use super::{tilt_tf, BudgetError};
 use crate::input::TiltSpectra;
 use crate::model::{Model, Observable};
 use crate::noise::{
-    add_thermal, tilt_budget, BandMean, BudgetReport, Evaluation, ObservableAt, SummaryAt, TermAt,
-    TermGroup, TiltCsd,
+    add_thermal, add_user_terms, tilt_budget, BandMean, BudgetReport, Evaluation, ObservableAt,
+    SummaryAt, TermAt, TermGroup, TiltCsd, UserTerm,
 };
 use crate::spectral::{band_dof, WelchConfig};
 use num_complex::Complex64;
@@ -154,6 +155,7 @@ pub(super) fn summarize(
     report: &BudgetReport,
     tilt: &TiltData<'_>,
     req: &SummaryRequest,
+    user_terms: &[UserTerm],
 ) -> Result<(Vec<SummaryAt>, Vec<String>), BudgetError> {
     req.validate()?;
     let outputs: Vec<Observable> = report
@@ -207,6 +209,7 @@ pub(super) fn summarize(
                 &crate::thermal::thermal_noise(model, &outputs, &at_f)?,
             );
         }
+        add_user_terms(&mut point, model, user_terms)?;
         let observables = report
             .budget
             .observables

@@ -21,14 +21,18 @@
 //! error for Welch estimates). Pure numerics: depends on `model`, `tf` and `thermal` only.
 
 pub mod equivalent;
+mod given;
 mod segments;
 mod summary;
 mod term;
+mod user;
 
 pub use equivalent::{add_equivalent_response, equivalent_input, Calibration};
+pub use given::{loglog_at, GivenAsd, GivenAsdError};
 pub use segments::{percentile, SegmentBand};
 pub use summary::{BandMean, Evaluation, ObservableAt, SummaryAt, TermAt};
-pub use term::{Component, TermGroup, TermKind};
+pub use term::{is_term_name, Component, TermGroup, TermKind};
+pub use user::{add_user_terms, check_user_terms, UserSource, UserTerm, UserTermError};
 
 use crate::model::{Observable, TiltAxis};
 use crate::tf::{Input, TransferMatrix};
@@ -134,11 +138,14 @@ impl Budget {
     }
 }
 
-/// White readout noise per observable: ASD in the observable's unit/sqrt(Hz).
+/// Readout noise per observable: white (an ASD in the observable's unit/sqrt(Hz)) or coloured
+/// (a [`GivenAsd`]). An observable is in at most one of the two lists.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Readout {
-    /// `(observable, ASD)`; observables not listed have no readout term.
+    /// White readout, `(observable, ASD)`.
     pub asd: Vec<(Observable, f64)>,
+    /// Coloured readout, `(observable, ASD given on its own points)`.
+    pub given: Vec<(Observable, GivenAsd)>,
 }
 
 impl Default for Readout {
@@ -146,23 +153,49 @@ impl Default for Readout {
     fn default() -> Readout {
         Readout {
             asd: vec![(Observable::X, PAPER_X_READOUT_ASD_M)],
+            given: Vec::new(),
         }
     }
 }
 
 impl Readout {
-    /// Readout ASD of an observable, if any.
+    /// No readout on any observable.
+    pub fn none() -> Readout {
+        Readout {
+            asd: Vec::new(),
+            given: Vec::new(),
+        }
+    }
+
+    /// White readout ASD of an observable, if it has one.
     pub fn of(&self, o: Observable) -> Option<f64> {
         self.asd.iter().find(|(x, _)| *x == o).map(|&(_, a)| a)
     }
 
-    /// The readout term of `o` on `freqs_hz` (PSD = ASD^2 at every frequency), if `o` has a
-    /// readout: the same values on a budget's grid and at a summary's frequency.
+    /// Coloured readout of an observable, if it has one.
+    pub fn given_of(&self, o: Observable) -> Option<&GivenAsd> {
+        self.given.iter().find(|(x, _)| *x == o).map(|(_, g)| g)
+    }
+
+    /// Refuses a coloured readout that does not cover the band `[lo, hi]` (Hz).
+    pub fn check_covers(&self, lo: f64, hi: f64) -> Result<(), GivenAsdError> {
+        self.given
+            .iter()
+            .try_for_each(|(_, g)| g.check_covers(lo, hi))
+    }
+
+    /// The readout term of `o` on `freqs_hz` (white: ASD^2 everywhere; coloured: the given
+    /// spectrum at each frequency, inside its band), if `o` has a readout: the same values on a
+    /// budget's grid and at a summary's frequency.
     pub fn term(&self, o: Observable, freqs_hz: &[f64]) -> Option<NoiseTerm> {
-        let asd = self.of(o)?;
+        let psd = match (self.of(o), self.given_of(o)) {
+            (Some(asd), _) => vec![asd * asd; freqs_hz.len()],
+            (None, Some(g)) => g.psd_on(freqs_hz),
+            (None, None) => return None,
+        };
         Some(NoiseTerm {
             kind: TermKind::Readout,
-            psd: vec![asd * asd; freqs_hz.len()],
+            psd,
         })
     }
 }
@@ -381,7 +414,7 @@ mod tests {
                 axes: &axes,
                 csd: &csd,
             },
-            &Readout { asd: vec![] },
+            &Readout::none(),
         );
         add_measured(&mut budget, Observable::X, vec![5.0]);
         let x = budget.observable(Observable::X).unwrap();
@@ -430,8 +463,10 @@ pub struct BudgetReport {
     pub source: SpectralSource,
     /// The tilt axes that entered the budget.
     pub axes: Vec<TiltAxis>,
-    /// Readout noise used (observable, ASD in unit/sqrt(Hz)).
+    /// Readout noise used, white or coloured.
     pub readout: Readout,
+    /// The user-named terms (their definitions, for provenance; their values are terms).
+    pub user_terms: Vec<UserTerm>,
     /// Human-readable notes for the user and the files (band restrictions, assumptions).
     pub notes: Vec<String>,
     /// The budget read at chosen frequencies ([`SummaryAt`]), in increasing order of request.

@@ -20,6 +20,11 @@ pub enum TermKind {
     /// Thermal noise of one dissipative element (`torsion_b`, `swing_a_viscous`, ...): a
     /// breakdown of [`TermKind::Thermal`], not part of the total.
     ThermalElement(String),
+    /// The user-named terms together (independent: their sum in power).
+    User,
+    /// One user-named term (an ASD of the observable, or an input noise through the model): a
+    /// breakdown of [`TermKind::User`], not part of the total.
+    UserNamed(String),
     /// A measured spectrum of the observable, for comparison: not part of the model's total.
     Measured,
     /// `measured - total` in power, clipped at 0: what the model does not explain.
@@ -35,13 +40,16 @@ pub enum TermGroup {
     Readout,
     /// [`TermKind::Thermal`] and its per-element breakdown.
     Thermal,
+    /// [`TermKind::User`] and the user-named terms.
+    User,
     /// [`TermKind::Measured`] and [`TermKind::Residual`]: data, not model.
     Measured,
 }
 
 impl TermKind {
     /// The key of the term in the budget files (`tilt`, `tilt.eta_t`, `readout`, `thermal`,
-    /// `thermal.torsion_b`, `measured`, `residual`); see `docs/schemas.md`.
+    /// `thermal.torsion_b`, `user`, `user.<name>`, `measured`, `residual`); see
+    /// `docs/schemas.md`.
     pub fn name(&self) -> String {
         match self {
             TermKind::Tilt => "tilt".into(),
@@ -49,6 +57,8 @@ impl TermKind {
             TermKind::Readout => "readout".into(),
             TermKind::Thermal => "thermal".into(),
             TermKind::ThermalElement(e) => format!("thermal.{e}"),
+            TermKind::User => "user".into(),
+            TermKind::UserNamed(n) => format!("user.{n}"),
             TermKind::Measured => "measured".into(),
             TermKind::Residual => "residual".into(),
         }
@@ -60,11 +70,17 @@ impl TermKind {
             "tilt" => TermKind::Tilt,
             "readout" => TermKind::Readout,
             "thermal" => TermKind::Thermal,
+            "user" => TermKind::User,
             "measured" => TermKind::Measured,
             "residual" => TermKind::Residual,
             _ => {
                 if let Some(axis) = name.strip_prefix("tilt.") {
                     TermKind::TiltAxis(TiltAxis::ALL.into_iter().find(|a| a.name() == axis)?)
+                } else if let Some(user) = name.strip_prefix("user.") {
+                    if !is_term_name(user) {
+                        return None;
+                    }
+                    TermKind::UserNamed(user.to_string())
                 } else {
                     let element = name.strip_prefix("thermal.")?;
                     if element.is_empty() {
@@ -79,7 +95,10 @@ impl TermKind {
     /// Whether the term is an independent noise of the model that adds in power to the total.
     /// Breakdowns (one tilt axis, one thermal element) and data (measured, residual) do not.
     pub fn in_total(&self) -> bool {
-        matches!(self, TermKind::Tilt | TermKind::Readout | TermKind::Thermal)
+        matches!(
+            self,
+            TermKind::Tilt | TermKind::Readout | TermKind::Thermal | TermKind::User
+        )
     }
 
     /// Whether the term is a noise the model predicts (everything but measured and residual):
@@ -94,6 +113,7 @@ impl TermKind {
             TermKind::Tilt | TermKind::TiltAxis(_) => TermGroup::Tilt,
             TermKind::Readout => TermGroup::Readout,
             TermKind::Thermal | TermKind::ThermalElement(_) => TermGroup::Thermal,
+            TermKind::User | TermKind::UserNamed(_) => TermGroup::User,
             TermKind::Measured | TermKind::Residual => TermGroup::Measured,
         }
     }
@@ -103,6 +123,28 @@ impl TermKind {
     pub fn asd_unit(&self, o: Observable) -> String {
         format!("{}/sqrt(Hz)", o.unit())
     }
+}
+
+impl TermGroup {
+    /// `tilt`, `readout`, `thermal`, `user` or `measured`: the attribute `group` of a term in
+    /// the budget files.
+    pub fn name(self) -> &'static str {
+        match self {
+            TermGroup::Tilt => "tilt",
+            TermGroup::Readout => "readout",
+            TermGroup::Thermal => "thermal",
+            TermGroup::User => "user",
+            TermGroup::Measured => "measured",
+        }
+    }
+}
+
+/// Whether `name` can name a user term: 1 to 64 ASCII letters, digits or `_`, starting with a
+/// letter (a file key: no `.`, `/`, `,` or spaces).
+pub fn is_term_name(name: &str) -> bool {
+    (1..=64).contains(&name.len())
+        && name.starts_with(|c: char| c.is_ascii_alphabetic())
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
 /// One curve of an observable's budget: a term, or the computed total.
@@ -142,6 +184,8 @@ mod tests {
             TermKind::Readout,
             TermKind::Thermal,
             TermKind::ThermalElement("swing_a_viscous".into()),
+            TermKind::User,
+            TermKind::UserNamed("magnetic_2".into()),
             TermKind::Measured,
             TermKind::Residual,
         ];
@@ -151,12 +195,15 @@ mod tests {
         assert_eq!(TermKind::from_name("total"), None);
         assert_eq!(TermKind::from_name("tilt.x"), None);
         assert_eq!(TermKind::from_name("thermal."), None);
+        assert_eq!(TermKind::from_name("user."), None);
+        assert_eq!(TermKind::from_name("user.a.b"), None);
     }
 
     #[test]
     fn only_independent_noises_add_to_the_total() {
         assert!(TermKind::Tilt.in_total() && TermKind::Readout.in_total());
-        assert!(TermKind::Thermal.in_total());
+        assert!(TermKind::Thermal.in_total() && TermKind::User.in_total());
+        assert!(!TermKind::UserNamed("actuation".into()).in_total());
         assert!(!TermKind::TiltAxis(TiltAxis::ThetaT).in_total());
         assert!(!TermKind::ThermalElement("torsion_b".into()).in_total());
         assert!(!TermKind::Measured.in_total() && !TermKind::Residual.in_total());

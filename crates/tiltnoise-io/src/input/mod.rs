@@ -14,7 +14,9 @@
 //!   [`tiltnoise_core::input::SeriesSource`] for the budget job.
 //! * [`read_measured`], [`read_measured_input`]: measured ASDs or series of the observables.
 //! * [`read_start_time`]: the start time a series file of either kind states.
+//! * [`read_asd_column`]: the ASD of one quantity (a coloured readout, a user-named term).
 
+mod asd_file;
 mod csv;
 mod h5;
 mod measured;
@@ -25,6 +27,7 @@ mod spectra_csv;
 mod spectra_hdf5;
 mod start_time;
 
+pub use asd_file::{read_asd_column, AsdColumn, GENERIC_ASD_COLUMN};
 pub use measured::{
     read_measured, read_measured_input, MeasuredInput, MeasuredSeries, MeasuredSpectra,
     SCHEMA_OBSERVABLE_SERIES,
