@@ -18,7 +18,9 @@ use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::{Model, Observable, TiltAxis};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
-use tiltnoise_io::input::{read_measured_input, read_start_time, read_tilt_series, MeasuredInput};
+use tiltnoise_io::input::{
+    read_measured_input, read_start_time, read_tilt_series, MeasuredInput, Quantity,
+};
 use tiltnoise_io::{CoherenceInputs, InputMeta, OutputKind, RunMeta};
 
 /// Arguments of `tiltnoise coherence`.
@@ -134,6 +136,7 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
         welch_overlap_fraction: args.overlap.unwrap_or(0.5),
         confidence: args.confidence.unwrap_or(0.95),
         fit_band_hz: args.fit_band.as_deref().map(parse_fit_band).transpose()?,
+        tilt_quantity: Quantity::Angle,
     };
     let model = Model::new(params)?;
     let ropts = tilt_read_options(
@@ -142,6 +145,10 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
         args.gaps.as_deref(),
     )?;
     let tilt = read_tilt_series(&args.tilt, &ropts)?;
+    let opts = CoherenceOptions {
+        tilt_quantity: tilt.quantity(),
+        ..opts
+    };
     let measured = match read_measured_input(&args.measured)? {
         MeasuredInput::Series(s) => s,
         MeasuredInput::Spectra(_) => bail!(

@@ -7,8 +7,8 @@
 mod args;
 mod budget;
 mod budget_summary;
-mod coherence;
 mod budget_terms;
+mod coherence;
 mod fit;
 mod mc;
 mod methods;

@@ -89,6 +89,10 @@ pub struct CoherenceOptions {
     pub confidence: f64,
     /// Band (Hz) of the measured/model fit ([`Agreement`]); `None`: every bin.
     pub fit_band_hz: Option<(f64, f64)>,
+    /// What the tilt record holds: angles (rad) or rates (rad/s). A rate's cross-spectra are
+    /// turned into the angle's bin by bin ([`crate::input::rate::rate_channels_to_angle`]), so
+    /// the measured transfer functions are from the angle, as the model's.
+    pub tilt_quantity: crate::input::Quantity,
 }
 
 impl Default for CoherenceOptions {
@@ -98,6 +102,7 @@ impl Default for CoherenceOptions {
             welch_overlap_fraction: 0.5,
             confidence: 0.95,
             fit_band_hz: None,
+            tilt_quantity: crate::input::Quantity::Angle,
         }
     }
 }
@@ -264,7 +269,11 @@ pub fn coherence_from_series(
             .iter()
             .map(|(_, x)| &x[alignment.start_b..alignment.start_b + n]),
     );
-    let spectra = csd_matrix(&channels, fs, &cfg)?;
+    let mut spectra = csd_matrix(&channels, fs, &cfg)?;
+    if opts.tilt_quantity == crate::input::Quantity::Rate {
+        let rates: Vec<usize> = (0..tilt.channels.len()).collect();
+        crate::input::rate::rate_channels_to_angle(&mut spectra, &rates);
+    }
     let names: Vec<String> = tilt
         .channels
         .iter()

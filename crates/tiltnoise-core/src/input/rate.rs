@@ -58,9 +58,64 @@ pub fn angle_csd_above_dc(
     (freqs_hz, csd)
 }
 
+/// Turns the Welch cross-spectral matrices of a mixed set of channels, of which those listed in
+/// `rate_channels` are tilt rates, into those of the angles, in place, on every bin `f > 0`:
+/// with `a_c = 1 / (i w)` for a rate channel and 1 otherwise, `S_ij -> conj(a_i) a_j S_ij`
+/// (`S_ij = conj(X_i) X_j`), so a rate-rate entry is divided by `w^2`, a rate-other entry
+/// multiplied by `i / w` (rate first) or `-i / w` (rate second). Exact bin by bin, as
+/// [`angle_csd_above_dc`]; ordinary and multiple coherences are unchanged by it, transfer
+/// functions become those from the angle. The DC bin is left as it is: it carries no angle
+/// information, and callers must drop it.
+pub fn rate_channels_to_angle(spectra: &mut CrossSpectra, rate_channels: &[usize]) {
+    let n = spectra.n_channels;
+    let is_rate: Vec<bool> = (0..n).map(|c| rate_channels.contains(&c)).collect();
+    for (k, &f) in spectra.freqs_hz.iter().enumerate() {
+        if f <= 0.0 {
+            continue;
+        }
+        let w = crate::units::angular(f);
+        let a = |c: usize| match is_rate[c] {
+            true => Complex64::new(0.0, -1.0 / w),
+            false => Complex64::new(1.0, 0.0),
+        };
+        for i in 0..n {
+            for j in 0..n {
+                if is_rate[i] || is_rate[j] {
+                    spectra.data[(k * n + i) * n + j] *= a(i).conj() * a(j);
+                }
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn mixed_channels_become_angles_with_the_right_phase() {
+        // Channel 0: the rate of an angle t = exp(i w t0) -> R = i w T; channel 1: y = 2 T.
+        let f = 0.25;
+        let w = crate::units::angular(f);
+        let t = Complex64::from_polar(1.0, 0.3);
+        let x = [Complex64::new(0.0, w) * t, 2.0 * t];
+        let mut spectra = CrossSpectra {
+            freqs_hz: vec![f],
+            n_channels: 2,
+            data: (0..4).map(|e| x[e / 2].conj() * x[e % 2]).collect(),
+            n_segments: 1,
+        };
+        rate_channels_to_angle(&mut spectra, &[0]);
+        let angle = [t, 2.0 * t];
+        for e in 0..4 {
+            let want = angle[e / 2].conj() * angle[e % 2];
+            let got = spectra.data[e];
+            assert!(
+                (got - want).norm() <= 4.0 * f64::EPSILON * want.norm(),
+                "{e}: {got} vs {want}"
+            );
+        }
+    }
 
     #[test]
     fn dc_of_a_rate_is_excluded_not_infinite() {

@@ -66,15 +66,15 @@
 
 pub mod confidence;
 mod config;
-mod dof;
 mod cross;
+mod dof;
 mod stats;
 mod welch;
 mod window;
 
 pub use config::{Averaging, Detrend, WelchConfig};
-pub use dof::band_dof;
 pub use cross::{coherence, multiple_input, MultipleInput, INPUT_RCOND_MIN};
+pub use dof::band_dof;
 pub use welch::{csd, csd_matrix, welch, CrossSpectra, Csd, Psd, WelchAccumulator};
 pub use window::hann_periodic;
 
