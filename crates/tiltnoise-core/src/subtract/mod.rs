@@ -471,8 +471,10 @@ pub fn subtract(
     for r in &residuals {
         if r.band.below_coherence_bound {
             notes.push(format!(
-                "{}: the cleaned residual in the report band is more than 3 sigma below what the \
-                 coherence allows: check for non-stationarity between the stretches",
+                "{}: the cleaned residual in the report band is more than 3 sigma below the \
+                 residual the measured coherence allows: the coherence estimate is limited there \
+                 (Welch resolution bias where the coupling or the delay varies within a bin, \
+                 with little noise), or the two stretches differ",
                 r.observable.name()
             ));
         }

@@ -455,7 +455,7 @@ pub(crate) fn interpret(
 }
 
 /// The `# start_time:` value, validated.
-fn start_time(path: &Path, prelude: &Prelude) -> Result<Option<String>, InputError> {
+pub(crate) fn start_time(path: &Path, prelude: &Prelude) -> Result<Option<String>, InputError> {
     let Some(m) = prelude.meta("start_time") else {
         return Ok(None);
     };
