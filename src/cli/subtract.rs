@@ -592,8 +592,8 @@ fn report_table(r: &SubtractResult) -> String {
     let _ = writeln!(s);
     let _ = writeln!(
         s,
-        "{:<28} {:>14} {:>34}  {}",
-        "parameter", "nominal", "estimate", "status"
+        "{:<28} {:>14} {:>34}  status",
+        "parameter", "nominal", "estimate"
     );
     for e in &f.estimates {
         let status = match e.status {

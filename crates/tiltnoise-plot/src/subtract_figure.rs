@@ -3,7 +3,7 @@
 //! residual, of the Wiener filter's residual and of the residual the coherence allows, with
 //! the readout level and the report band marked; the estimates in the caption.
 //!
-//! Plain data in ([`SubtractFigureData`]), a [`Figure`] out; written by [`render`].
+//! Plain data in ([`SubtractFigureData`]), a [`LogLogFigure`] out; drawn by [`subtract_figure`].
 
 use super::chart::{Dash, LegendPlacement, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
 use super::labels::{observable_symbol, observable_title};

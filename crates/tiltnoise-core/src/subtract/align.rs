@@ -62,7 +62,7 @@ pub fn align(
 ) -> Result<Alignment, SubtractError> {
     let longer = n_w.max(n_m) as f64;
     let drift = (fs_w - fs_m).abs() / fs_w * longer;
-    if !(drift <= MAX_RATE_DRIFT_SAMPLES) {
+    if drift.is_nan() || drift > MAX_RATE_DRIFT_SAMPLES {
         return Err(SubtractError::RateMismatch {
             witness_hz: fs_w,
             measured_hz: fs_m,
@@ -98,7 +98,7 @@ pub fn align(
     let k = shift.round();
     // Overlap of tilt samples 0..n_w with measured samples shifted by k.
     let (w_lo, w_hi) = (0.0f64.max(k), (n_w as f64).min(n_m as f64 + k));
-    if !(w_hi > w_lo) {
+    if w_hi <= w_lo {
         return Err(SubtractError::NoOverlap {
             witness_s: (0.0, n_w as f64 * dt),
             measured_s: (shift * dt, (shift + n_m as f64) * dt),

@@ -253,6 +253,24 @@ fn transfer(
 }
 
 impl Problem<'_> {
+    /// The gains (record's axis order) and the delay behind the aligned samples,
+    /// `tau - fraction_s` (s), at internal values `theta`.
+    fn coupling_at(&self, theta: &[f64]) -> (Vec<f64>, f64) {
+        let gains = self
+            .params
+            .iter()
+            .zip(theta)
+            .filter(|(p, _)| matches!(p.kind, Kind::Gain(_)))
+            .map(|(_, &v)| v.exp())
+            .collect();
+        let tau = self
+            .params
+            .iter()
+            .position(|p| matches!(p.kind, Kind::Delay))
+            .map_or(0.0, |i| theta[i]);
+        (gains, tau - self.fraction_s)
+    }
+
     /// The parameter set at internal values `theta` (keys only).
     fn params_at(&self, theta: &[f64]) -> Result<Params, SubtractError> {
         let mut p = self.base.clone();
@@ -296,18 +314,7 @@ impl Problem<'_> {
         let rows: usize = self.bins.iter().map(|(_, b)| b.len()).sum::<usize>() * 2 * self.n_in;
         let mut r = DVector::zeros(rows);
         let mut jac = DMatrix::zeros(rows, free.len());
-        let gains: Vec<f64> = self
-            .params
-            .iter()
-            .zip(theta)
-            .filter_map(|(p, &v)| matches!(p.kind, Kind::Gain(_)).then(|| v.exp()))
-            .collect();
-        let tau_index = self
-            .params
-            .iter()
-            .position(|p| matches!(p.kind, Kind::Delay));
-        let tau = tau_index.map_or(0.0, |i| theta[i]);
-        let tau_eff = tau - self.fraction_s;
+        let (gains, tau_eff) = self.coupling_at(theta);
         let x = tau_eff / self.segment_s;
         let rho = hann_delay_factor(x);
         let drho_dtau = hann_delay_factor_slope(x) / self.segment_s;
@@ -363,18 +370,7 @@ impl Problem<'_> {
         let params = self.params_at(theta)?;
         let h = transfer(&params, &self.request, &self.freqs)?;
         let block = self.request.outputs.len() * self.n_in;
-        let gains: Vec<f64> = self
-            .params
-            .iter()
-            .zip(theta)
-            .filter_map(|(p, &v)| matches!(p.kind, Kind::Gain(_)).then(|| v.exp()))
-            .collect();
-        let tau = self
-            .params
-            .iter()
-            .position(|p| matches!(p.kind, Kind::Delay))
-            .map_or(0.0, |i| theta[i]);
-        let tau_eff = tau - self.fraction_s;
+        let (gains, tau_eff) = self.coupling_at(theta);
         let rho = hann_delay_factor(tau_eff / self.segment_s);
         Ok(self
             .bins
@@ -673,7 +669,8 @@ pub fn fit(
         for (g, &k) in grid_bins.iter().enumerate() {
             let row = &h0[g * block + o * n_in..][..n_in];
             let row1 = &h1[g * block + o * n_in..][..n_in];
-            if !(super::predict::sensitivity(row, row1) < FIT_SENSITIVITY) {
+            let sensitivity = super::predict::sensitivity(row, row1);
+            if sensitivity.is_nan() || sensitivity >= FIT_SENSITIVITY {
                 sensitive += 1;
                 continue;
             }

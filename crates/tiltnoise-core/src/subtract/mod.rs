@@ -5,7 +5,7 @@
 //! axis) and a measured record of some observables (m, rad), each with its sample rate and,
 //! optionally, the ISO 8601 time of its first sample. The pipeline ([`subtract`]):
 //!
-//! 1. **Alignment** ([`align`]): by start times to the nearest sample (the fraction of a sample
+//! 1. **Alignment** ([`align()`]): by start times to the nearest sample (the fraction of a sample
 //!    left is a known part of the delay); without a start time in either file both records are
 //!    taken to start together (the provenance says so). Rates must agree; nothing is
 //!    resampled.
@@ -427,11 +427,10 @@ pub fn subtract(
     let wiener = residuals::Wiener::train(&training_spectra, tilt.axes.len(), outputs.len());
     let report_band = cfg.report_band_hz;
     let grid = &held_spectra.freqs_hz;
-    if !(report_band.0 < report_band.1)
-        || grid
-            .iter()
-            .skip(1)
-            .all(|&f| f < report_band.0 || f > report_band.1)
+    if grid
+        .iter()
+        .skip(1)
+        .all(|&f| f < report_band.0 || f > report_band.1)
     {
         return Err(SubtractError::Band {
             what: "report".into(),

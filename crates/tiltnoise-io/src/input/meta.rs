@@ -224,7 +224,7 @@ pub(crate) fn is_iso8601(s: &str) -> bool {
     }
 }
 
-/// Seconds since 1970-01-01T00:00:00Z of an ISO 8601 date-time accepted by [`is_iso8601`]:
+/// Seconds since 1970-01-01T00:00:00Z of an ISO 8601 date-time of the form the readers accept:
 /// `(whole seconds, fraction in [0, 1))`. Without a zone designator the time is taken as UTC
 /// (two records that both omit it are then compared in their common zone). A leap second
 /// `:60` counts as the next second, as POSIX time has no leap seconds.
