@@ -375,6 +375,33 @@ fn check_finite(r: &SubtractResult) -> Result<()> {
             );
         }
     }
+    if !(r.fit.chi2.is_finite() && r.fit.sigma_factor.is_finite()) {
+        bail!("the fit's chi^2 is {}: not finite", r.fit.chi2);
+    }
+    for res in &r.residuals {
+        let b = &res.band;
+        let values = [
+            ("measured", b.measured_asd),
+            ("predicted", b.predicted_asd),
+            ("cleaned", b.cleaned_asd),
+            ("Wiener residual", b.wiener_asd),
+            ("coherence limit", b.expected_asd),
+            ("cleaned / coherence limit", b.cleaned_to_expected.0),
+            ("its sigma", b.cleaned_to_expected.1),
+        ];
+        let readout = b.cleaned_to_readout.map_or([0.0; 2], |(x, s)| [x, s]);
+        if let Some((what, v)) = values
+            .into_iter()
+            .chain([("cleaned / readout", readout[0]), ("its sigma", readout[1])])
+            .find(|(_, v)| !v.is_finite())
+        {
+            bail!(
+                "the {what} ASD of {} in the report band is {v}: not finite (is the channel \
+                 constant or noiseless there? leave it out with --observables)",
+                res.observable.name()
+            );
+        }
+    }
     for (o, x) in r.cleaned.iter().chain(&r.prediction.series) {
         if let Some((i, v)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
             bail!(

@@ -398,11 +398,32 @@ fn bad_input_is_refused_without_output() {
     };
     bad.measured[0].1[5] = f64::NAN;
     write_measured(Path::new(&p("nan.h5")), &bad, 1.0, 0..n, t0);
+    write_measured(
+        Path::new(&p("badstart.h5")),
+        &rec,
+        1.0,
+        0..n,
+        Some("yesterday"),
+    );
+    // A CSV measured series states its start in a `# start_time:` line.
+    let mut csv = String::from("# start_time: 2024-03-05T00:00:00Z\ntime_s,X\n");
+    for (i, x) in rec.measured[0].1.iter().enumerate() {
+        csv.push_str(&format!("{i},{x:e}\n"));
+    }
+    std::fs::write(p("late.csv"), csv).unwrap();
     let save = out_dir.join("c.h5");
     let save = save.to_str().unwrap();
     let tilt = p("tilt.h5");
     let cases: Vec<(Vec<String>, Vec<&str>)> = vec![
         (vec![p("late.h5")], vec!["late.h5", "do not overlap"]),
+        (
+            vec![p("late.csv")],
+            vec!["late.csv", "do not overlap", "345600"],
+        ),
+        (
+            vec![p("badstart.h5")],
+            vec!["badstart.h5", "start_time", "yesterday"],
+        ),
         (
             vec![p("fast.h5")],
             vec!["fast.h5", "2 Hz", "does not resample"],
