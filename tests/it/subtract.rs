@@ -492,3 +492,91 @@ fn bad_input_is_refused_without_output() {
         &["c.txt", ".h5, .hdf5, .json, .png, .svg"],
     );
 }
+
+/// `simulate --tilt` makes the pendulum record from a tilt record (here the synthetic one,
+/// without its pendulum), through a tiltmeter with gains 0.95 and 1.04 and 1.5 s of delay;
+/// `subtract` finds them within 3 sigma. The driven run's own refusals name the option.
+#[test]
+fn simulate_tilt_then_subtract() {
+    let mut spec = Spec::verification();
+    spec.n = 1 << 13;
+    spec.oversample = 1;
+    spec.delay_steps = 0;
+    let rec = make(&spec);
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    write_tilt(
+        Path::new(&p("tilt.h5")),
+        &rec,
+        1.0,
+        0..spec.n,
+        Some("2024-03-01T00:00:00Z"),
+    );
+    let (tilt, pend) = (p("tilt.h5"), p("pend.h5"));
+    let out = tiltnoise(&[
+        "simulate",
+        "--tilt",
+        &tilt,
+        "--oversample",
+        "50",
+        "--drive-gain",
+        "theta_t=0.95,eta_t=1.04",
+        "--drive-delay",
+        "1.5",
+        "--readout",
+        "X=1e-9",
+        "--readout",
+        "Y=1e-9",
+        "--save",
+        &pend,
+    ]);
+    assert!(out.status.success(), "{}", common::stderr(&out));
+    let f = hdf5::File::open(&pend).unwrap();
+    assert_eq!(common::str_attr(&f, "start_time"), "2024-03-01T00:00:00Z");
+    let report = run_json(&[
+        "subtract",
+        "--tilt",
+        &tilt,
+        "--measured",
+        &pend,
+        "--observables",
+        "X,Y",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(report["alignment"]["samples"], spec.n);
+    for (name, truth) in [
+        ("gain.theta_t", 0.95),
+        ("gain.eta_t", 1.04),
+        ("delay_s", 1.5),
+    ] {
+        let e = estimate(&report, name);
+        let (value, sigma) = (e["value"].as_f64().unwrap(), e["sigma"].as_f64().unwrap());
+        eprintln!("{name}: true {truth}, estimated {value} +/- {sigma:.2e}");
+        assert!(
+            (value - truth).abs() < 3.0 * sigma,
+            "{name}: {value} +/- {sigma}"
+        );
+    }
+    let out_dir = dir.path().join("out");
+    std::fs::create_dir(&out_dir).unwrap();
+    let save = out_dir.join("s.h5");
+    let save = save.to_str().unwrap();
+    let base = ["simulate", "--tilt", &tilt, "--save", save];
+    for (extra, needles) in [
+        (
+            vec!["--drive-delay", "0.03"],
+            vec!["--drive-delay 0.03 s", "0.1 s"],
+        ),
+        (
+            vec!["--drive-gain", "phi_t=2"],
+            vec!["--drive-gain phi_t=2", "theta_t, eta_t"],
+        ),
+        (vec!["--oversample", "0"], vec!["oversampling factor 0"]),
+        (vec!["--duration", "100"], vec!["--duration", "--tilt"]),
+    ] {
+        let mut args = base.to_vec();
+        args.extend(extra);
+        assert_fails_without_output(&args, &out_dir, &needles);
+    }
+}
