@@ -63,7 +63,7 @@ pub(crate) struct SubtractArgs {
     #[arg(long, value_name = "FLO:FHI", default_value = "3e-3:3e-2")]
     report_band: String,
     /// Welch segment length in samples (default: the largest power of two fitting 8 times
-    /// into the training stretch, at most 2^16).
+    /// into the training stretch and twice into the held-out one, at most 2^16).
     #[arg(long, value_name = "N", allow_negative_numbers = true)]
     nperseg: Option<usize>,
     /// Fraction of the overlap held out at its end for validation, in (0, 0.5].
@@ -210,6 +210,15 @@ fn select_observables(
     names: &[String],
     channels: Vec<(Observable, Vec<f64>)>,
 ) -> Result<Vec<(Observable, Vec<f64>)>> {
+    for (i, (o, _)) in channels.iter().enumerate() {
+        if channels[..i].iter().any(|(x, _)| x == o) {
+            bail!(
+                "--measured {}: channel {} appears twice; give each observable once",
+                path.display(),
+                o.name()
+            );
+        }
+    }
     if names.is_empty() {
         return Ok(channels);
     }

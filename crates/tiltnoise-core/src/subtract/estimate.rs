@@ -51,7 +51,7 @@
 
 use super::stats::{hann_delay_factor, hann_delay_factor_slope};
 use super::SubtractError;
-use crate::fit::jacobian::{value_of, with_value};
+use crate::fit::jacobian::with_value;
 use crate::fit::lm::{self, LmOptions, Stop};
 use crate::model::{Input, Model, Observable, Request, TiltAxis};
 use crate::params::Params;
@@ -999,9 +999,4 @@ fn median(v: &mut [f64]) -> f64 {
     } else {
         0.5 * (v[n / 2 - 1] + v[n / 2])
     }
-}
-
-/// The keys' value in `params`, for reports.
-pub fn key_value(params: &Params, key: &str) -> Option<f64> {
-    value_of(params, key)
 }

@@ -52,7 +52,8 @@ pub const MAX_HOLDOUT_FRACTION: f64 = 0.5;
 /// swing modes.
 pub const DEFAULT_REPORT_BAND_HZ: (f64, f64) = (3e-3, 3e-2);
 /// The default segment is the largest power of two that fits this many times into the
-/// training stretch (15 half-overlapping segments).
+/// training stretch (15 half-overlapping segments) and [`MIN_HOLDOUT_SEGMENTS`] times into the
+/// held-out stretch.
 pub const DEFAULT_SEGMENTS_IN_TRAINING: usize = 8;
 /// Largest default segment (samples).
 pub const MAX_DEFAULT_SEGMENT: usize = 1 << 16;
@@ -300,7 +301,10 @@ pub fn subtract(
     let n_train = n - n_hold;
     let segment_len = match cfg.segment_len {
         Some(l) => l,
-        None => pow2_floor(n_train / DEFAULT_SEGMENTS_IN_TRAINING).min(MAX_DEFAULT_SEGMENT),
+        None => {
+            pow2_floor((n_train / DEFAULT_SEGMENTS_IN_TRAINING).min(n_hold / MIN_HOLDOUT_SEGMENTS))
+                .min(MAX_DEFAULT_SEGMENT)
+        }
     };
     let span = |m: usize| format!("{m} samples ({} s)", Num(m as f64 / fs));
     if segment_len < MIN_SEGMENT
