@@ -807,6 +807,17 @@ pub fn fit(
     let chi2 = r.norm_squared();
     let dof = r.len().saturating_sub(free.len()).max(1);
     let birge = (chi2 / dof as f64).max(1.0).sqrt();
+    // chi^2 / dof has a standard deviation of sqrt(2 / dof); beyond 5 of them the misfit is not
+    // noise, and the Birge scaling cannot stand for it.
+    if chi2 / dof as f64 > 1.0 + 5.0 * (2.0 / dof as f64).sqrt() {
+        notes.push(format!(
+            "chi^2/dof = {:.3} for {dof} dof: the model does not describe the data within their \
+             noise; the estimates may carry systematic errors that their uncertainties (scaled by \
+             {birge:.3}) do not include (a channel with almost no noise, a wrong fit band, a \
+             model parameter that should be fitted)",
+            chi2 / dof as f64
+        ));
+    }
     let sigma_factor = bin_variance_factor.sqrt() * birge;
     let (sig_u, correlation) = covariance(&jac);
     let (_, jac_all) = problem.residuals(&theta, &all)?;
