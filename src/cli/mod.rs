@@ -16,6 +16,7 @@ mod output;
 mod report;
 mod simulate;
 mod stdout;
+mod subtract;
 mod tf;
 
 pub use stdout::{is_closed_pipe, note, Out};
@@ -78,6 +79,10 @@ enum Command {
     /// with readout noise: ASDs as in Figure 3, the resonance check against the mode
     /// observability table, the X kick of Figures 4 and 5, HDF5 series the budget reads.
     Simulate(simulate::SimulateArgs),
+    /// Tilt subtraction: fit the coupling (a gain per tilt axis, a delay, chosen parameters) of
+    /// a tilt record to a measured record of the observables, predict the tilt part through
+    /// the model and remove it; held-out residuals against the coherence and a Wiener filter.
+    Subtract(subtract::SubtractArgs),
     /// Constrained least-squares fit of chosen parameters, within their error bars, to measured
     /// mode frequencies (default: Table II's measured column).
     Fit(fit::FitArgs),
@@ -195,6 +200,7 @@ fn run_command(cli: Cli, run: &mut Run) -> Result<()> {
         Command::Coherence(args) => coherence::run_coherence(&params, args, run),
         Command::Simulate(args) => simulate::run_simulate(&params, args, run),
         Command::Fit(args) => fit::run_fit(&params, args, run),
+        Command::Subtract(args) => subtract::run_subtract(&params, args, run),
         Command::Methods(args) => methods::run_methods(&params, args, run),
         Command::Mc {
             samples,

@@ -25,6 +25,8 @@ use tiltnoise_plot::simulate_figure::{
     asd_figure, time_series_figure, ModeMark, SimAsdData, TimePanel, TimeSeriesData,
 };
 
+mod driven;
+
 /// Default readout: the paper's 9 nm/sqrt(Hz) on X (the angles are noiseless unless given).
 const DEFAULT_X_READOUT_ASD_M: f64 = 9e-9;
 
@@ -90,6 +92,53 @@ pub(crate) struct SimulateArgs {
     /// quarter of the nu_1 period, as the paper's Figures 4 and 5 for --kick-x.
     #[arg(long = "save-time", value_name = "PATH")]
     save_time: Vec<PathBuf>,
+    /// Drive the pendulum with a tilt record instead of free motion (HDF5 or CSV time series
+    /// of angle or rate, as for `budget`): the response is interpolated band-limited and
+    /// propagated exactly, from the quasi-static state; the record's rate and length set the
+    /// output's.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["duration", "step", "init", "init_rate", "kick_x", "mode_energy", "save_time"])]
+    tilt: Option<PathBuf>,
+    /// Axis map of the tilt record (with --tilt), e.g. `theta_t=-E,eta_t=-N`.
+    #[arg(
+        long,
+        value_name = "MAP",
+        allow_hyphen_values = true,
+        requires = "tilt"
+    )]
+    axes: Option<String>,
+    /// Quantity of the tilt channels (with --tilt): angle or rate.
+    #[arg(long, value_name = "angle|rate", requires = "tilt")]
+    quantity: Option<String>,
+    /// Non-finite tilt samples (with --tilt): reject or interpolate.
+    #[arg(long, value_name = "reject|interpolate", requires = "tilt")]
+    gaps: Option<String>,
+    /// Fine steps per record sample of the driven propagation (with --tilt).
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 10,
+        allow_negative_numbers = true,
+        requires = "tilt"
+    )]
+    oversample: usize,
+    /// The pendulum sees GAIN times the record's tilt, AXIS=GAIN,... (with --tilt; default 1):
+    /// a tiltmeter calibration error.
+    #[arg(
+        long,
+        value_name = "AXIS=GAIN,...",
+        allow_hyphen_values = true,
+        requires = "tilt"
+    )]
+    drive_gain: Vec<String>,
+    /// The pendulum sees the record's tilt this many seconds late (with --tilt; a whole number
+    /// of fine steps): a clock offset.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        allow_negative_numbers = true,
+        requires = "tilt"
+    )]
+    drive_delay: Option<f64>,
 }
 
 fn parse_readout(items: &[String]) -> Result<Vec<(Observable, f64)>> {
@@ -225,6 +274,9 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
              free motion); the parameters have non-zero loss angles in [loss]: set every \
              loss.*_rad to 0, e.g. with --set"
         );
+    }
+    if let Some(path) = &args.tilt {
+        return driven::run(params, &model, &args, path, run);
     }
     if !(args.step.is_finite() && args.step > 0.0) {
         bail!(

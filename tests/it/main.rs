@@ -33,4 +33,5 @@ mod process;
 mod romy_budget;
 mod simulate_cli;
 mod simulate_roundtrip;
+mod subtract;
 mod thermal;

@@ -64,6 +64,7 @@ pub mod reference;
 pub mod rng;
 pub mod simulate;
 pub mod spectral;
+pub mod subtract;
 pub mod tf;
 pub mod thermal;
 pub mod units;

@@ -4,8 +4,9 @@
 //!   layouts in `docs/input_formats.md`.
 //! * [`read_measured_modes`] (measured mode frequencies for the fit) and [`read_freq_file`]
 //!   (frequency grids).
-//! * Writers: transfer functions, noise budgets, coherence, Monte Carlo, fit and simulation results as
-//!   HDF5 or CSV (schemas in `docs/schemas.md`).
+//! * Writers: transfer functions, noise budgets, coherence, Monte Carlo, fit and simulation
+//!   results as HDF5 or CSV (schemas in `docs/schemas.md`); the cleaned record of `subtract` in
+//!   the observable-series layout (`docs/subtract.md`).
 //! * [`check_outputs`]: the output paths of a run, checked before it computes anything.
 //! * [`write_atomic`]: every writer is atomic: a failed write leaves nothing at the target
 //!   path and never clobbers an existing file. Figures (`tiltnoise-plot`) are written through
@@ -28,6 +29,7 @@ mod mc_hdf5;
 mod measured_modes;
 mod output_paths;
 mod series_hdf5;
+mod subtract_hdf5;
 mod tf_csv;
 mod tf_hdf5;
 
@@ -50,6 +52,7 @@ pub use series_hdf5::{
     write_observable_series_hdf5, SeriesAsd, SimulationMeta, SCHEMA_OBSERVABLE_SERIES,
     SCHEMA_VERSION_OBSERVABLE_SERIES,
 };
+pub use subtract_hdf5::{write_subtract_hdf5, SubtractMeta};
 pub use tf_csv::{format_f64, tf_csv_string, write_tf_csv};
 pub use tf_hdf5::{write_tf_hdf5, SCHEMA_TF, SCHEMA_VERSION_TF, SIGN_CONVENTION, TIME_DEPENDENCE};
 

@@ -29,6 +29,7 @@ mod linear_axis;
 pub mod mc_figure;
 pub mod methods_figure;
 pub mod simulate_figure;
+pub mod subtract_figure;
 mod text;
 pub mod tf_figure;
 

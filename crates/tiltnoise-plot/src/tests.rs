@@ -194,3 +194,56 @@ fn crowded_panel_legend() {
     assert!(svg.contains("term 6: slope -0.5"));
     preview("crowded.png", &render(ImageFormat::Png, &fig).unwrap());
 }
+
+#[test]
+fn subtract_figure_png_and_svg() {
+    use crate::subtract_figure::{subtract_figure, ObservablePanel, SubtractFigureData};
+    use tiltnoise_core::model::Observable;
+    let freqs: Vec<f64> = (0..257).map(|k| k as f64 / 512.0).collect();
+    let curve = |a: f64, p: f64| -> Vec<f64> {
+        freqs
+            .iter()
+            .map(|&f| a * (f.max(1e-3) / 1e-2).powf(p) + 1e-9)
+            .collect()
+    };
+    let panel = |o| ObservablePanel {
+        observable: o,
+        freqs_hz: freqs.clone(),
+        measured: curve(1e-7, -1.0),
+        predicted: curve(1e-7, -1.0),
+        cleaned: curve(0.0, 0.0),
+        wiener: curve(1e-10, 0.0),
+        expected: curve(0.0, 0.0),
+        readout: Some(1e-9),
+    };
+    let data = SubtractFigureData {
+        panels: vec![
+            panel(Observable::X),
+            panel(Observable::Y),
+            panel(Observable::Phi),
+        ],
+        band_hz: (3e-3, 3e-2),
+        caption: vec!["Fit: gain.eta_t = 0.97 ± 1e-4.".into()],
+    };
+    let png = subtract_figure(&data, ImageFormat::Png).unwrap();
+    assert_eq!(&png[..8], PNG_SIGNATURE);
+    let (w, h) = (
+        u32::from_be_bytes(png[16..20].try_into().unwrap()),
+        u32::from_be_bytes(png[20..24].try_into().unwrap()),
+    );
+    assert_eq!((w, h), (1800, 120 + 620 * 2));
+    preview("subtract.png", &png);
+    let svg = String::from_utf8(subtract_figure(&data, ImageFormat::Svg).unwrap()).unwrap();
+    for text in [
+        "cleaned (model)",
+        "coherence limit",
+        "readout 1.0e-9",
+        "gain.eta_t",
+    ] {
+        assert!(svg.contains(text), "{text} missing from the SVG");
+    }
+    let mut bad = data.clone();
+    bad.panels[0].cleaned.pop();
+    let e = subtract_figure(&bad, ImageFormat::Png).unwrap_err();
+    assert!(e.0.contains("cleaned ASD of X has 256 values"), "{}", e.0);
+}

@@ -34,6 +34,8 @@
 //! [`resonance`] compares the peaks found in the ASD of each simulated channel with the modes
 //! the observability table ([`NormalModes::visible`]) says the channel sees.
 //!
+//! [`driven`] propagates the same modes driven by floor tilt.
+//!
 //! Pure numerics: depends on `model`, `modes` and (for [`resonance`]) `spectral` only.
 
 use crate::error::Num;
@@ -44,6 +46,7 @@ use crate::model::{Coord, Model, Observable, Vec8};
 use crate::modes::NormalModes;
 use crate::rng::Rng;
 
+pub mod driven;
 pub mod resonance;
 
 /// Refuses a simulation of `n_samples` (a float: `floor(duration / dt)` may be beyond any
@@ -220,6 +223,12 @@ pub enum SimError {
         observable: &'static str,
         /// The ASD given.
         asd: f64,
+    },
+    /// A tilt drive that cannot be propagated ([`driven`]): empty, ragged or non-finite.
+    #[error("tilt drive: {message}")]
+    InvalidDrive {
+        /// What is wrong and what is allowed.
+        message: String,
     },
     /// A mode with w^2 <= 0 (statically unstable or neutral pendulum): no oscillatory solution.
     #[error(

@@ -23,5 +23,7 @@ mod reference_precision;
 mod scenes;
 mod simulate;
 mod stability;
+mod subtract;
+mod synthetic;
 mod tilt_tf;
 mod welch_scipy;

@@ -8,10 +8,10 @@
 //! * **Time series, HDF5** (`.h5`, `.hdf5`): the layout `tiltnoise simulate` writes, root
 //!   attribute `schema = tiltnoise.observable_series` (optional), root attribute
 //!   `sample_rate_hz`, one 1-D float dataset per observable named as above, optional `units`
-//!   attribute that must then be the observable's unit (`m` or `rad`). Other root datasets and
-//!   all groups are ignored.
+//!   attribute that must then be the observable's unit (`m` or `rad`), optional root attribute
+//!   `start_time` (ISO 8601, time of sample 0). Other root datasets and all groups are ignored.
 //! * **Time series, CSV**: header `time_s` then observables, uniformly sampled, values in m or
-//!   rad.
+//!   rad; optional `# start_time:` line before the header.
 //!
 //! [`read_measured_input`] reads any of them; the budget turns a series into one-sided ASDs
 //! with its own Welch settings.
@@ -35,6 +35,8 @@ pub struct MeasuredSeries {
     pub sample_rate_hz: f64,
     /// `(observable, samples)`, all of equal length >= 2.
     pub channels: Vec<(Observable, Vec<f64>)>,
+    /// Time of the first sample (ISO 8601, validated), if the file states it.
+    pub start_time: Option<String>,
 }
 
 /// A measured record: spectra or a time series.
@@ -55,8 +57,10 @@ pub fn read_measured_input(path: &Path) -> Result<MeasuredInput, InputError> {
         InputFormat::Csv => {
             let (file, prelude) = CsvFile::open(path)?;
             if prelude.header.first().map(String::as_str) == Some("time_s") {
-                read_series_csv(path, file, &prelude.header, prelude.header_line)
-                    .map(MeasuredInput::Series)
+                let start_time = super::csv::start_time(path, &prelude)?;
+                let mut series = read_series_csv(path, file, &prelude.header, prelude.header_line)?;
+                series.start_time = start_time;
+                Ok(MeasuredInput::Series(series))
             } else {
                 read_spectra_csv(path, file, &prelude).map(MeasuredInput::Spectra)
             }
@@ -85,6 +89,18 @@ fn read_series_hdf5(path: &Path) -> Result<MeasuredSeries, InputError> {
         }
     }
     let sample_rate_hz = h5::sample_rate_hz(path, &file)?;
+    let start_time = h5::str_attr(path, &file, "/", "start_time", super::meta::ISO8601_ALLOWED)?;
+    if let Some(s) = &start_time {
+        if !super::meta::is_iso8601(s) {
+            return Err(InputError::BadAttribute {
+                path: path.to_path_buf(),
+                object: "/".to_string(),
+                attribute: "start_time",
+                value: format!("`{}`", Shown(s)),
+                allowed: super::meta::ISO8601_ALLOWED,
+            });
+        }
+    }
     let mut channels: Vec<(Observable, Vec<f64>)> = Vec::new();
     let names = h5::root_datasets(path, &file)?;
     let n_observables = names
@@ -130,7 +146,9 @@ fn read_series_hdf5(path: &Path) -> Result<MeasuredSeries, InputError> {
         let data: Vec<f64> = ds.read_raw::<f64>().map_err(h5err(path, object.clone()))?;
         channels.push((o, data));
     }
-    finish_series(path, sample_rate_hz, channels, None)
+    let mut series = finish_series(path, sample_rate_hz, channels, None)?;
+    series.start_time = start_time;
+    Ok(series)
 }
 
 /// Common checks: at least one channel, equal lengths >= 2, finite samples. `lines` maps a
@@ -177,6 +195,7 @@ fn finish_series(
     Ok(MeasuredSeries {
         sample_rate_hz,
         channels,
+        start_time: None,
     })
 }
 

@@ -226,6 +226,87 @@ pub(crate) fn is_iso8601(s: &str) -> bool {
     }
 }
 
+/// Seconds since 1970-01-01T00:00:00Z of an ISO 8601 date-time of the form the readers accept:
+/// `(whole seconds, fraction in [0, 1))`. Without a zone designator the time is taken as UTC
+/// (two records that both omit it are then compared in their common zone). A leap second
+/// `:60` counts as the next second, as POSIX time has no leap seconds.
+pub fn iso8601_to_unix(s: &str) -> Option<(i64, f64)> {
+    if !is_iso8601(s) {
+        return None;
+    }
+    let num = |a: usize, b: usize| s.get(a..b).and_then(|t| t.parse::<i64>().ok());
+    let (y, mo, d) = (num(0, 4)?, num(5, 7)?, num(8, 10)?);
+    // Days from the civil date (H. Hinnant's algorithm, proleptic Gregorian calendar).
+    let y_adj = if mo <= 2 { y - 1 } else { y };
+    let era = y_adj.div_euclid(400);
+    let yoe = y_adj - era * 400;
+    let mp = (mo + 9) % 12;
+    let doy = (153 * mp + 2) / 5 + d - 1;
+    let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+    let days = era * 146_097 + doe - 719_468;
+    let rest = &s[10..];
+    let (mut secs, mut frac) = (days * 86_400, 0.0);
+    if rest.is_empty() {
+        return Some((secs, frac));
+    }
+    let rest = &rest[1..];
+    let (time, zone) = match rest.find(['Z', '+', '-']) {
+        Some(i) => (&rest[..i], &rest[i..]),
+        None => (rest, ""),
+    };
+    let (hms, fraction) = match time.split_once(['.', ',']) {
+        Some((hms, f)) => (hms, Some(f)),
+        None => (time, None),
+    };
+    let parts: Vec<i64> = hms
+        .split(':')
+        .map(|p| p.parse().ok())
+        .collect::<Option<_>>()?;
+    secs += parts[0] * 3600 + parts[1] * 60 + parts.get(2).copied().unwrap_or(0);
+    if let Some(f) = fraction {
+        frac = format!("0.{f}").parse().ok()?;
+    }
+    if zone.len() > 1 {
+        let sign = if zone.starts_with('-') { -1 } else { 1 };
+        let digits: String = zone[1..].chars().filter(|c| c.is_ascii_digit()).collect();
+        let h: i64 = digits.get(0..2)?.parse().ok()?;
+        let m: i64 = digits.get(2..4).map_or(Some(0), |m| m.parse().ok())?;
+        // The local time is ahead of UTC by the offset.
+        secs -= sign * (h * 3600 + m * 60);
+    }
+    Some((secs, frac))
+}
+
+/// The ISO 8601 UTC date-time `YYYY-MM-DDThh:mm:ss[.ffffff]Z` of `unix_s + frac_s` seconds
+/// since 1970-01-01T00:00:00Z (`0 <= frac_s < 1`; microseconds, when not whole), the inverse
+/// of [`iso8601_to_unix`].
+pub fn unix_to_iso8601(unix_s: i64, frac_s: f64) -> String {
+    let mut micros = (frac_s * 1e6).round() as i64;
+    let mut secs = unix_s;
+    if micros >= 1_000_000 {
+        secs += 1;
+        micros -= 1_000_000;
+    }
+    let days = secs.div_euclid(86_400);
+    let sod = secs.rem_euclid(86_400);
+    // Civil date from days (H. Hinnant's algorithm).
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    let (h, mi, se) = (sod / 3600, sod % 3600 / 60, sod % 60);
+    if micros == 0 {
+        format!("{y:04}-{m:02}-{d:02}T{h:02}:{mi:02}:{se:02}Z")
+    } else {
+        format!("{y:04}-{m:02}-{d:02}T{h:02}:{mi:02}:{se:02}.{micros:06}Z")
+    }
+}
+
 /// What `start_time` must look like, for messages.
 pub(crate) const ISO8601_ALLOWED: &str = "an ISO 8601 date-time string, e.g. \
      2018-01-23T09:31:42Z or 2018-01-23T09:31:42.5+01:00";
@@ -264,6 +345,54 @@ mod tests {
             "2018-01-23T09:31-1\u{20ac}",
         ] {
             assert!(!is_iso8601(bad), "{bad}");
+        }
+    }
+
+    #[test]
+    fn iso8601_seconds() {
+        // Reference values: Python's datetime(...).timestamp() with tzinfo=UTC.
+        assert_eq!(iso8601_to_unix("1970-01-01"), Some((0, 0.0)));
+        assert_eq!(
+            iso8601_to_unix("2018-01-23T09:31:42Z"),
+            Some((1_516_699_902, 0.0))
+        );
+        assert_eq!(
+            iso8601_to_unix("2018-01-23T10:31:42.25+01:00"),
+            Some((1_516_699_902, 0.25))
+        );
+        assert_eq!(
+            iso8601_to_unix("2018-01-23T08:01:42-0130"),
+            Some((1_516_699_902, 0.0))
+        );
+        assert_eq!(
+            iso8601_to_unix("2000-02-29T00:00"),
+            Some((951_782_400, 0.0))
+        );
+        assert_eq!(iso8601_to_unix("1969-12-31T23:59:59Z"), Some((-1, 0.0)));
+        assert_eq!(
+            iso8601_to_unix("2018-01-23T09:31"),
+            Some((1_516_699_860, 0.0))
+        );
+        assert_eq!(iso8601_to_unix("not a date"), None);
+        assert_eq!(unix_to_iso8601(1_516_699_902, 0.0), "2018-01-23T09:31:42Z");
+        assert_eq!(
+            unix_to_iso8601(951_782_400, 0.25),
+            "2000-02-29T00:00:00.250000Z"
+        );
+        assert_eq!(unix_to_iso8601(-1, 0.0), "1969-12-31T23:59:59Z");
+        for s in [
+            -86_400_i64 * 700_000,
+            -3,
+            0,
+            59,
+            1_000_000_007,
+            4_102_444_800,
+        ] {
+            assert_eq!(
+                iso8601_to_unix(&unix_to_iso8601(s, 0.5)),
+                Some((s, 0.5)),
+                "{s}"
+            );
         }
     }
 

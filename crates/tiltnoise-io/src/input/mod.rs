@@ -32,6 +32,7 @@ pub use measured::{
     read_measured, read_measured_input, MeasuredInput, MeasuredSeries, MeasuredSpectra,
     SCHEMA_OBSERVABLE_SERIES,
 };
+pub use meta::{iso8601_to_unix, unix_to_iso8601};
 pub use source::TiltSeriesSource;
 pub use start_time::read_start_time;
 pub use tiltnoise_core::input::*;

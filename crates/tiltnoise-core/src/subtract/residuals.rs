@@ -1,0 +1,217 @@
+//! What is left after subtraction, judged on the held-out stretch: the measured PSD, the
+//! predicted tilt part, the model-cleaned residual, the residual of a multiple-input Wiener
+//! filter trained on the training stretch, and the residual the coherence allows.
+//!
+//! * **Wiener filter**: per bin `W = S^-1 s` from the training stretch's spectra (the
+//!   multiple-input optimum, Bendat and Piersol, *Random Data*, ch. 7); applied to the held-out
+//!   stretch segment by segment, its residual PSD is
+//!   `S_yy - 2 Re(sum_a W_a conj(s_a)) + W^H S W` with the held-out spectra: exactly the Welch
+//!   PSD of `y - W^T w` on the Welch grid.
+//! * **Expected residual**: `S_yy (1 - gamma^2)` with the multiple coherence
+//!   `gamma^2 = s^H S^-1 s / S_yy` of the held-out stretch itself, corrected for the
+//!   estimator's bias (`E[1 - gamma_hat^2] = (1 - gamma^2)(1 - A / K)` for `A` inputs and `K`
+//!   segments, Bendat and Piersol sec. 9.3): no linear filter of the tilt record, whatever
+//!   stretch it was trained on, can leave less on that stretch.
+//! * **Band summaries**: the mean PSD over the bins of a band, its relative statistical error
+//!   `sqrt(c / (n m))` (`m` bins, `n` effective averages, `c` the variance factor of adjacent
+//!   Hann bins), and the model-cleaned residual against the readout and against the expected
+//!   residual; a cleaned residual more than 3 sigma below the expected one is flagged (the
+//!   subtraction claims more than the coherence allows: overfitting or non-stationarity).
+
+use super::estimate::{coherence_residual, residual_psd};
+use crate::model::Observable;
+use crate::spectral::CrossSpectra;
+use nalgebra::{DMatrix, DVector};
+use num_complex::Complex64;
+
+/// Spectra of one observable on the held-out stretch (one-sided PSDs, unit^2/Hz, on the Welch
+/// grid with DC).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResidualSpectra {
+    /// The observable.
+    pub observable: Observable,
+    /// Welch frequencies (Hz), DC first.
+    pub freqs_hz: Vec<f64>,
+    /// Measured PSD.
+    pub measured_psd: Vec<f64>,
+    /// PSD of the predicted tilt part.
+    pub predicted_psd: Vec<f64>,
+    /// PSD of measured minus predicted.
+    pub cleaned_psd: Vec<f64>,
+    /// PSD of the Wiener filter's residual.
+    pub wiener_psd: Vec<f64>,
+    /// The residual the training stretch's coherence allows.
+    pub expected_psd: Vec<f64>,
+    /// White readout ASD (unit/sqrt(Hz)) if given.
+    pub readout_asd: Option<f64>,
+    /// Summary over the report band.
+    pub band: BandSummary,
+}
+
+/// Mean PSDs over the report band, as ASDs (unit/sqrt(Hz)).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BandSummary {
+    /// First and last bin frequency of the band (Hz).
+    pub band_hz: (f64, f64),
+    /// Bins averaged.
+    pub bins: usize,
+    /// Measured.
+    pub measured_asd: f64,
+    /// Predicted tilt part.
+    pub predicted_asd: f64,
+    /// Model-cleaned residual.
+    pub cleaned_asd: f64,
+    /// Wiener residual.
+    pub wiener_asd: f64,
+    /// Coherence-allowed residual.
+    pub expected_asd: f64,
+    /// Relative statistical error (1 sigma) of a band-mean PSD.
+    pub psd_rel_sigma: f64,
+    /// Cleaned / readout ASD and its 1-sigma error, when the readout is given.
+    pub cleaned_to_readout: Option<(f64, f64)>,
+    /// Cleaned / expected ASD and its 1-sigma error.
+    pub cleaned_to_expected: (f64, f64),
+    /// The cleaned residual is more than 3 sigma below the expected one.
+    pub below_coherence_bound: bool,
+}
+
+/// Wiener filters of every observable from the training spectra.
+pub struct Wiener {
+    n_in: usize,
+    /// `[observable][bin]`.
+    filters: Vec<Vec<Option<DVector<Complex64>>>>,
+}
+
+fn blocks(
+    spectra: &CrossSpectra,
+    k: usize,
+    n_in: usize,
+    y: usize,
+) -> (DMatrix<Complex64>, DVector<Complex64>, f64) {
+    let n = spectra.n_channels;
+    let m = spectra.matrix(k);
+    (
+        DMatrix::from_fn(n_in, n_in, |a, b| m[a * n + b]),
+        DVector::from_fn(n_in, |a, _| m[a * n + y]),
+        m[y * n + y].re,
+    )
+}
+
+impl Wiener {
+    /// Trains on `spectra` (tilt axes `0..n_in`, then `n_out` observables).
+    pub fn train(spectra: &CrossSpectra, n_in: usize, n_out: usize) -> Wiener {
+        let filters = (0..n_out)
+            .map(|o| {
+                (0..spectra.n_freqs())
+                    .map(|k| {
+                        let (sww, s, _) = blocks(spectra, k, n_in, n_in + o);
+                        sww.lu().solve(&s)
+                    })
+                    .collect()
+            })
+            .collect();
+        Wiener { n_in, filters }
+    }
+}
+
+/// Inputs of [`evaluate`]: the held-out spectra and series' PSDs.
+pub struct HeldOut<'a> {
+    /// Cross spectra of the tilt axes and the observables on the held-out stretch.
+    pub spectra: &'a CrossSpectra,
+    /// PSDs of the predicted tilt parts, per observable.
+    pub predicted_psd: &'a [Vec<f64>],
+    /// PSDs of the cleaned series, per observable.
+    pub cleaned_psd: &'a [Vec<f64>],
+    /// Effective averages of the held-out Welch estimate.
+    pub n_eff: f64,
+    /// Segments of the held-out Welch estimate.
+    pub n_segments: usize,
+    /// Variance factor of a mean over adjacent bins.
+    pub bin_variance_factor: f64,
+}
+
+/// Residual spectra and band summaries of every observable.
+pub fn evaluate(
+    wiener: &Wiener,
+    held: &HeldOut,
+    outputs: &[Observable],
+    readout: &[(Observable, f64)],
+    band_hz: (f64, f64),
+) -> Vec<ResidualSpectra> {
+    let n_in = wiener.n_in;
+    let freqs = &held.spectra.freqs_hz;
+    let lo = freqs.partition_point(|&f| f < band_hz.0).max(1);
+    let hi = freqs.partition_point(|&f| f <= band_hz.1);
+    let (k_seg, a) = (held.n_segments as f64, n_in as f64);
+    let bias = if k_seg > a {
+        k_seg / (k_seg - a)
+    } else {
+        f64::NAN
+    };
+    outputs
+        .iter()
+        .enumerate()
+        .map(|(o, &obs)| {
+            let mut measured = Vec::with_capacity(freqs.len());
+            let mut wien = Vec::with_capacity(freqs.len());
+            let mut expected = Vec::with_capacity(freqs.len());
+            for k in 0..freqs.len() {
+                let (sww, s, syy) = blocks(held.spectra, k, n_in, n_in + o);
+                measured.push(syy);
+                wien.push(match &wiener.filters[o][k] {
+                    Some(w) => residual_psd(syy, &s, &sww, w).max(0.0),
+                    None => syy,
+                });
+                expected.push(
+                    coherence_residual(syy, &s, &sww)
+                        .map_or(syy, |left| (left * bias).clamp(0.0, syy)),
+                );
+            }
+            let readout_asd = readout.iter().find(|(x, _)| *x == obs).map(|r| r.1);
+            let mean = |v: &[f64]| -> f64 {
+                if hi > lo {
+                    v[lo..hi].iter().sum::<f64>() / (hi - lo) as f64
+                } else {
+                    f64::NAN
+                }
+            };
+            let m = hi.saturating_sub(lo);
+            let rel = (held.bin_variance_factor / (held.n_eff * m as f64)).sqrt();
+            let (pm, pc, pe) = (mean(&measured), mean(&held.cleaned_psd[o]), mean(&expected));
+            // Ratio of ASDs: half the relative error of the PSD ratio; the cleaned and expected
+            // band means come from the same segments, so their errors are taken as independent
+            // (an upper bound on the ratio's error, their correlation being positive).
+            let to_expected = ((pc / pe).sqrt(), (pc / pe).sqrt() * rel * 2f64.sqrt() / 2.0);
+            let band = BandSummary {
+                band_hz: (
+                    freqs.get(lo).copied().unwrap_or(f64::NAN),
+                    freqs.get(hi.max(1) - 1).copied().unwrap_or(f64::NAN),
+                ),
+                bins: m,
+                measured_asd: pm.sqrt(),
+                predicted_asd: mean(&held.predicted_psd[o]).sqrt(),
+                cleaned_asd: pc.sqrt(),
+                wiener_asd: mean(&wien).sqrt(),
+                expected_asd: pe.sqrt(),
+                psd_rel_sigma: rel,
+                cleaned_to_readout: readout_asd.filter(|&r| r > 0.0).map(|r| {
+                    let ratio = pc.sqrt() / r;
+                    (ratio, ratio * rel / 2.0)
+                }),
+                cleaned_to_expected: to_expected,
+                below_coherence_bound: pc < pe * (1.0 - 3.0 * rel * 2f64.sqrt()),
+            };
+            ResidualSpectra {
+                observable: obs,
+                freqs_hz: freqs.clone(),
+                measured_psd: measured,
+                predicted_psd: held.predicted_psd[o].clone(),
+                cleaned_psd: held.cleaned_psd[o].clone(),
+                wiener_psd: wien,
+                expected_psd: expected,
+                readout_asd,
+                band,
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,789 @@
+//! The `subtract` subcommand: the tilt record and the measured record read and checked, the
+//! coupling fitted, the tilt part predicted and removed ([`tiltnoise_core::subtract`]), then
+//! the report (table or JSON) and the outputs: the cleaned record (.h5, the observable-series
+//! layout `budget --measured` reads), the report (.json), the figure (.png, .svg). Documented
+//! in `docs/subtract.md`.
+
+use super::args::{parse_readout_item, Format};
+use super::output::save_image;
+use super::Run;
+use anyhow::{anyhow, bail, Context, Result};
+use clap::Args;
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use tiltnoise_core::error::{Num, OutputError, Shown};
+use tiltnoise_core::model::{Observable, TiltAxis};
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::params::Params;
+use tiltnoise_core::subtract::{
+    subtract, MeasuredRecord, StartTime, Status, SubtractConfig, SubtractResult, TiltRecord,
+};
+use tiltnoise_io::input::{
+    iso8601_to_unix, read_measured_input, read_tilt, unix_to_iso8601, AxisMap, MeasuredInput,
+    ReadOptions, TiltInput,
+};
+use tiltnoise_io::{write_atomic, write_subtract_hdf5, InputMeta, RunMeta, SubtractMeta};
+use tiltnoise_plot::subtract_figure::{subtract_figure, ObservablePanel, SubtractFigureData};
+
+/// Arguments of `tiltnoise subtract`.
+#[derive(Debug, Args)]
+pub(crate) struct SubtractArgs {
+    /// Tilt record (the witness): HDF5 or CSV time series of tilt angle or rate, as for
+    /// `budget` (docs/input_formats.md).
+    #[arg(long, value_name = "FILE")]
+    tilt: PathBuf,
+    /// Measured record of the observables: HDF5 (as `simulate` writes) or CSV `time_s,X,...`
+    /// time series in m and rad, optional start time.
+    #[arg(long, value_name = "FILE")]
+    measured: PathBuf,
+    /// Observables of the measured record to use, comma-separated (default: every one in the
+    /// file).
+    #[arg(long, value_name = "OBS,...", value_delimiter = ',')]
+    observables: Vec<String>,
+    /// Axis map of the tilt record, e.g. `theta_t=-E,eta_t=-N` (default: from the file, else
+    /// that).
+    #[arg(long, value_name = "MAP", allow_hyphen_values = true)]
+    axes: Option<String>,
+    /// Quantity of the tilt channels: angle (rad) or rate (rad/s); default from the file.
+    #[arg(long, value_name = "angle|rate")]
+    quantity: Option<String>,
+    /// Non-finite samples of the tilt record: reject (default) or interpolate.
+    #[arg(long, value_name = "reject|interpolate")]
+    gaps: Option<String>,
+    /// Model parameters to fit besides a gain per tilt axis and the delay, comma-separated
+    /// parameter-file keys (e.g. `length.h_m`).
+    #[arg(long, value_name = "KEY,...", value_delimiter = ',')]
+    fit: Vec<String>,
+    /// Fit band FLO:FHI (Hz); default: from the third Welch bin to 0.8 of the Nyquist
+    /// frequency, resonances left out.
+    #[arg(long, value_name = "FLO:FHI")]
+    band: Option<String>,
+    /// Band of the residual summaries FLO:FHI (Hz).
+    #[arg(long, value_name = "FLO:FHI", default_value = "3e-3:3e-2")]
+    report_band: String,
+    /// Welch segment length in samples (default: the largest power of two fitting 8 times
+    /// into the training stretch and twice into the held-out one, at most 2^16).
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    nperseg: Option<usize>,
+    /// Fraction of the overlap held out at its end for validation, in (0, 0.5].
+    #[arg(
+        long,
+        value_name = "FRACTION",
+        default_value_t = 0.25,
+        allow_negative_numbers = true
+    )]
+    holdout: f64,
+    /// Largest delay between the records to search (s); default 5 % of a Welch segment.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    max_delay: Option<f64>,
+    /// White noise of the tilt record AXIS=ASD in rad/sqrt(Hz) (repeatable): removes the
+    /// bias its noise puts on the fitted gains (errors in variables).
+    #[arg(long, value_name = "AXIS=ASD", allow_hyphen_values = true)]
+    tilt_noise: Vec<String>,
+    /// White readout of a measured observable OBS=ASD in unit/sqrt(Hz) (repeatable): drawn,
+    /// and the cleaned residual is compared with it.
+    #[arg(long, value_name = "OBS=ASD", allow_hyphen_values = true)]
+    readout: Vec<String>,
+    /// Output format on the terminal.
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+    /// Output (repeatable): .h5/.hdf5 the cleaned record (what `budget --measured` reads) with
+    /// the predicted tilt parts, estimates and residual spectra; .json the report; .png/.svg
+    /// the figure.
+    #[arg(long, value_name = "PATH")]
+    save: Vec<PathBuf>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SaveKind {
+    Hdf5,
+    Json,
+    Image,
+}
+
+fn save_kind(path: &Path) -> Result<SaveKind, OutputError> {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("h5" | "hdf5") => Ok(SaveKind::Hdf5),
+        Some("json") => Ok(SaveKind::Json),
+        Some("png" | "svg") => Ok(SaveKind::Image),
+        _ => Err(OutputError::UnknownFormat {
+            path: path.to_path_buf(),
+            allowed: ".h5, .hdf5, .json, .png, .svg",
+        }),
+    }
+}
+
+fn parse_band(option: &str, text: &str) -> Result<(f64, f64)> {
+    let err = || {
+        anyhow!(
+            "{option} {}: expected FLO:FHI in Hz with 0 < FLO < FHI, e.g. 3e-3:3e-2",
+            Shown(text)
+        )
+    };
+    let (a, b) = text.split_once(':').ok_or_else(err)?;
+    let (a, b): (f64, f64) = (
+        a.trim().parse().map_err(|_| err())?,
+        b.trim().parse().map_err(|_| err())?,
+    );
+    if !(a.is_finite() && b.is_finite() && 0.0 < a && a < b) {
+        return Err(err());
+    }
+    Ok((a, b))
+}
+
+fn parse_tilt_noise(items: &[String]) -> Result<Vec<(TiltAxis, f64)>> {
+    let mut out: Vec<(TiltAxis, f64)> = Vec::new();
+    for item in items {
+        let shown = Shown(item);
+        let (name, value) = item
+            .split_once('=')
+            .ok_or_else(|| anyhow!("--tilt-noise {shown}: expected AXIS=ASD, e.g. eta_t=1e-9"))?;
+        let axis = TiltAxis::ALL
+            .into_iter()
+            .find(|a| a.name() == name.trim())
+            .ok_or_else(|| {
+                anyhow!(
+                    "--tilt-noise {shown}: unknown axis `{}`; allowed: theta_t, eta_t, phi_t",
+                    Shown(name)
+                )
+            })?;
+        let asd: f64 = value
+            .trim()
+            .parse()
+            .map_err(|_| anyhow!("--tilt-noise {shown}: `{}` is not a number", Shown(value)))?;
+        if !(asd.is_finite() && asd >= 0.0) {
+            bail!(
+                "--tilt-noise {shown}: ASD {asd} rad/sqrt(Hz) is not allowed: must be finite \
+                 and >= 0"
+            );
+        }
+        out.retain(|(a, _)| *a != axis);
+        out.push((axis, asd));
+    }
+    Ok(out)
+}
+
+fn read_options(args: &SubtractArgs) -> Result<ReadOptions> {
+    Ok(ReadOptions {
+        axis_map: args.axes.as_deref().map(AxisMap::parse).transpose()?,
+        quantity: args
+            .quantity
+            .as_deref()
+            .map(str::parse)
+            .transpose()
+            .map_err(|e: String| anyhow!("--quantity: {e}"))?,
+        gaps: args
+            .gaps
+            .as_deref()
+            .unwrap_or("reject")
+            .parse()
+            .map_err(|e: String| anyhow!("--gaps: {e}"))?,
+    })
+}
+
+fn start_of(path: &Path, what: &str, start: &Option<String>) -> Result<Option<StartTime>> {
+    start
+        .as_deref()
+        .map(|s| {
+            iso8601_to_unix(s)
+                .map(|(unix_s, frac_s)| StartTime { unix_s, frac_s })
+                .ok_or_else(|| {
+                    anyhow!(
+                        "{what} {}: start time `{}` is not an ISO 8601 date-time",
+                        path.display(),
+                        Shown(s)
+                    )
+                })
+        })
+        .transpose()
+}
+
+/// The channels of the measured record named by `--observables` (all when none is named).
+fn select_observables(
+    path: &Path,
+    names: &[String],
+    channels: Vec<(Observable, Vec<f64>)>,
+) -> Result<Vec<(Observable, Vec<f64>)>> {
+    for (i, (o, _)) in channels.iter().enumerate() {
+        if channels[..i].iter().any(|(x, _)| x == o) {
+            bail!(
+                "--measured {}: channel {} appears twice; give each observable once",
+                path.display(),
+                o.name()
+            );
+        }
+    }
+    if names.is_empty() {
+        return Ok(channels);
+    }
+    let available = || {
+        channels
+            .iter()
+            .map(|c| c.0.name())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut wanted: Vec<Observable> = Vec::new();
+    for name in names.iter().map(|n| n.trim()) {
+        let o = Observable::from_name(name).ok_or_else(|| {
+            anyhow!(
+                "--observables: unknown observable `{}`; allowed: X, Y, Z, theta, eta, phi, phi_a",
+                Shown(name)
+            )
+        })?;
+        if !channels.iter().any(|c| c.0 == o) {
+            bail!(
+                "--observables {name}: --measured {} has no channel {name}; it has {}",
+                path.display(),
+                available()
+            );
+        }
+        if !wanted.contains(&o) {
+            wanted.push(o);
+        }
+    }
+    Ok(channels
+        .into_iter()
+        .filter(|c| wanted.contains(&c.0))
+        .collect())
+}
+
+/// Runs `tiltnoise subtract`.
+pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -> Result<()> {
+    for path in &args.save {
+        save_kind(path)?;
+    }
+    let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
+    run.check_outputs(
+        &saves,
+        &[("--tilt", &args.tilt), ("--measured", &args.measured)],
+    )?;
+    let mut readout: Vec<(Observable, f64)> = Vec::new();
+    for item in &args.readout {
+        let (o, asd) = parse_readout_item(item)?;
+        readout.retain(|(x, _)| *x != o);
+        readout.push((o, asd));
+    }
+    let cfg = SubtractConfig {
+        segment_len: args.nperseg,
+        holdout_fraction: args.holdout,
+        keys: args.fit.iter().map(|k| k.trim().to_string()).collect(),
+        fit_band_hz: args
+            .band
+            .as_deref()
+            .map(|b| parse_band("--band", b))
+            .transpose()?,
+        max_delay_s: args.max_delay,
+        witness_noise_asd: parse_tilt_noise(&args.tilt_noise)?,
+        readout_asd: readout,
+        report_band_hz: parse_band("--report-band", &args.report_band)?,
+    };
+    let series = match read_tilt(&args.tilt, &read_options(&args)?)? {
+        TiltInput::Series(s) => s,
+        TiltInput::Spectra(_) => bail!(
+            "--tilt {}: holds spectra; subtract needs a time series of the tilt (angle or rate)",
+            args.tilt.display()
+        ),
+    };
+    let measured = match read_measured_input(&args.measured)? {
+        MeasuredInput::Series(m) => m,
+        MeasuredInput::Spectra(_) => bail!(
+            "--measured {}: holds spectra; subtract needs a time series of the observables \
+             (HDF5 as `tiltnoise simulate` writes, or CSV time_s,X,...)",
+            args.measured.display()
+        ),
+    };
+    let channels = select_observables(&args.measured, &args.observables, measured.channels)?;
+    let tilt_start = start_of(&args.tilt, "--tilt", &series.provenance.start_time)?;
+    let measured_start = start_of(&args.measured, "--measured", &measured.start_time)?;
+    let context = || {
+        format!(
+            "subtract --tilt {} --measured {}",
+            args.tilt.display(),
+            args.measured.display()
+        )
+    };
+    let result = subtract(
+        params,
+        &TiltRecord {
+            fs_hz: series.sample_rate_hz,
+            axes: &series.axes,
+            data: &series.data,
+            start: tilt_start,
+        },
+        &MeasuredRecord {
+            fs_hz: measured.sample_rate_hz,
+            channels: &channels,
+            start: measured_start,
+        },
+        &cfg,
+    )
+    .with_context(context)?;
+    check_finite(&result).with_context(context)?;
+    let overlap_start = measured_start.map(|s| {
+        let t = s.frac_s + result.alignment.measured_first as f64 / result.alignment.fs_hz;
+        let whole = t.floor();
+        unix_to_iso8601(s.unix_s + whole as i64, t - whole)
+    });
+    let input = InputMeta::from(&series.provenance);
+    for note in &series.provenance.notes {
+        match args.format {
+            Format::Json => super::note(&format!("input: {note}")),
+            Format::Table => writeln!(run.out, "input: {note}")?,
+        }
+    }
+    let json = report_json(&result, &args, &overlap_start);
+    match args.format {
+        Format::Json => writeln!(run.out, "{}", serde_json::to_string_pretty(&json)?)?,
+        Format::Table => write!(run.out, "{}", report_table(&result))?,
+    }
+    let model = tiltnoise_core::model::Model::new(params)?;
+    let meta = SubtractMeta {
+        run: RunMeta::of_this_run(params, Some(&NormalModes::new(&model))),
+        tilt: input,
+        measured_path: args.measured.display().to_string(),
+        start_time: overlap_start.clone(),
+    };
+    run.write_outputs(args.format == Format::Json, || {
+        for path in &args.save {
+            match save_kind(path)? {
+                SaveKind::Hdf5 => write_subtract_hdf5(path, &result, &meta)?,
+                SaveKind::Json => {
+                    let text = serde_json::to_string_pretty(&json)? + "\n";
+                    write_atomic(path, |tmp| {
+                        std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
+                    })?
+                }
+                SaveKind::Image => {
+                    let data = figure_data(&result);
+                    save_image(path, |format| subtract_figure(&data, format))?
+                }
+            }
+        }
+        Ok(())
+    })
+}
+
+/// Every number the run reports or writes must be finite, except the uncertainty of a
+/// parameter the data do not constrain at all (reported as not available).
+fn check_finite(r: &SubtractResult) -> Result<()> {
+    for e in &r.fit.estimates {
+        if !e.value.is_finite() || (e.status != Status::NotConstrained && !e.sigma.is_finite()) {
+            bail!(
+                "the fit of {} gave {} +/- {}: not finite (the data may be degenerate; fit \
+                 fewer parameters)",
+                e.name,
+                e.value,
+                e.sigma
+            );
+        }
+    }
+    if !(r.fit.chi2.is_finite() && r.fit.sigma_factor.is_finite()) {
+        bail!("the fit's chi^2 is {}: not finite", r.fit.chi2);
+    }
+    for res in &r.residuals {
+        let b = &res.band;
+        let values = [
+            ("measured", b.measured_asd),
+            ("predicted", b.predicted_asd),
+            ("cleaned", b.cleaned_asd),
+            ("Wiener residual", b.wiener_asd),
+            ("coherence limit", b.expected_asd),
+            ("cleaned / coherence limit", b.cleaned_to_expected.0),
+            ("its sigma", b.cleaned_to_expected.1),
+        ];
+        let readout = b.cleaned_to_readout.map_or([0.0; 2], |(x, s)| [x, s]);
+        if let Some((what, v)) = values
+            .into_iter()
+            .chain([("cleaned / readout", readout[0]), ("its sigma", readout[1])])
+            .find(|(_, v)| !v.is_finite())
+        {
+            bail!(
+                "the {what} ASD of {} in the report band is {v}: not finite (is the channel \
+                 constant or noiseless there? leave it out with --observables)",
+                res.observable.name()
+            );
+        }
+    }
+    for (o, x) in r.cleaned.iter().chain(&r.prediction.series) {
+        if let Some((i, v)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            bail!(
+                "the prediction of {} at sample {i} is {v}: not finite",
+                o.name()
+            );
+        }
+    }
+    Ok(())
+}
+
+fn finite(v: f64) -> Option<f64> {
+    v.is_finite().then_some(v)
+}
+
+// Keys in alphabetical order (fields declared in that order), as every JSON report of the tool.
+
+#[derive(Serialize)]
+struct ReportJson {
+    alignment: AlignmentJson,
+    estimates: Vec<EstimateJson>,
+    fit: FitJson,
+    measured: String,
+    notes: Vec<String>,
+    residuals: Vec<ResidualJson>,
+    tilt: String,
+}
+
+#[derive(Serialize)]
+struct AlignmentJson {
+    fraction_s: f64,
+    holdout_samples: usize,
+    measured_first_sample: usize,
+    note: String,
+    overlap_start_time: Option<String>,
+    sample_rate_hz: f64,
+    samples: usize,
+    segment_len: usize,
+    start_offset_s: Option<f64>,
+    tilt_first_sample: usize,
+    training_samples: usize,
+}
+
+#[derive(Serialize)]
+struct EstimateJson {
+    lower: f64,
+    name: String,
+    nominal: f64,
+    scale: f64,
+    sigma: Option<f64>,
+    status: &'static str,
+    unit: String,
+    upper: f64,
+    value: f64,
+}
+
+#[derive(Serialize)]
+struct FitJson {
+    band_hz: [f64; 2],
+    bins: std::collections::BTreeMap<&'static str, usize>,
+    chi2: f64,
+    dof: usize,
+    fitted: Vec<String>,
+    iterations: usize,
+    max_delay_s: f64,
+    sigma_factor: f64,
+    stop: &'static str,
+    witness_bias: std::collections::BTreeMap<&'static str, f64>,
+}
+
+#[derive(Serialize)]
+struct ResidualJson {
+    band_hz: [f64; 2],
+    bins: usize,
+    below_coherence_bound: bool,
+    cleaned_asd: f64,
+    cleaned_to_expected: [f64; 2],
+    cleaned_to_readout: Option<[f64; 2]>,
+    expected_asd: f64,
+    measured_asd: f64,
+    observable: &'static str,
+    predicted_asd: f64,
+    psd_rel_sigma: f64,
+    readout_asd: Option<f64>,
+    unit: String,
+    wiener_asd: f64,
+}
+
+fn report_json(r: &SubtractResult, args: &SubtractArgs, start: &Option<String>) -> ReportJson {
+    let a = &r.alignment;
+    ReportJson {
+        alignment: AlignmentJson {
+            fraction_s: a.fraction_s,
+            holdout_samples: r.n_holdout,
+            measured_first_sample: a.measured_first,
+            note: a.note.clone(),
+            overlap_start_time: start.clone(),
+            sample_rate_hz: a.fs_hz,
+            samples: a.len,
+            segment_len: r.segment_len,
+            start_offset_s: a.start_offset_s,
+            tilt_first_sample: a.witness_first,
+            training_samples: r.n_train,
+        },
+        estimates: r
+            .fit
+            .estimates
+            .iter()
+            .map(|e| EstimateJson {
+                lower: e.bounds.0,
+                name: e.name.clone(),
+                nominal: e.nominal,
+                scale: e.scale,
+                sigma: finite(e.sigma),
+                status: e.status.name(),
+                unit: e.unit.clone(),
+                upper: e.bounds.1,
+                value: e.value,
+            })
+            .collect(),
+        fit: FitJson {
+            band_hz: [r.fit.band_hz.0, r.fit.band_hz.1],
+            bins: r.fit.bins.iter().map(|(o, n)| (o.name(), *n)).collect(),
+            chi2: r.fit.chi2,
+            dof: r.fit.dof,
+            fitted: r.fit.fitted.clone(),
+            iterations: r.fit.iterations,
+            max_delay_s: r.max_delay_s,
+            sigma_factor: r.fit.sigma_factor,
+            stop: r.fit.stop.describe(),
+            witness_bias: r
+                .fit
+                .estimates
+                .iter()
+                .filter_map(|e| e.name.strip_prefix("gain."))
+                .zip(&r.fit.witness_bias)
+                .filter_map(|(axis, b)| {
+                    TiltAxis::ALL
+                        .into_iter()
+                        .find(|a| a.name() == axis)
+                        .map(|a| (a.name(), *b))
+                })
+                .collect(),
+        },
+        measured: args.measured.display().to_string(),
+        notes: r.notes.clone(),
+        residuals: r
+            .residuals
+            .iter()
+            .map(|s| {
+                let b = &s.band;
+                ResidualJson {
+                    band_hz: [b.band_hz.0, b.band_hz.1],
+                    bins: b.bins,
+                    below_coherence_bound: b.below_coherence_bound,
+                    cleaned_asd: b.cleaned_asd,
+                    cleaned_to_expected: [b.cleaned_to_expected.0, b.cleaned_to_expected.1],
+                    cleaned_to_readout: b.cleaned_to_readout.map(|(x, s)| [x, s]),
+                    expected_asd: b.expected_asd,
+                    measured_asd: b.measured_asd,
+                    observable: s.observable.name(),
+                    predicted_asd: b.predicted_asd,
+                    psd_rel_sigma: b.psd_rel_sigma,
+                    readout_asd: s.readout_asd,
+                    unit: format!("{}/sqrt(Hz)", s.observable.unit()),
+                    wiener_asd: b.wiener_asd,
+                }
+            })
+            .collect(),
+        tilt: args.tilt.display().to_string(),
+    }
+}
+
+/// A value with its uncertainty for the table: `0.97015 +/- 9.2e-05`.
+fn with_sigma(value: f64, sigma: f64) -> String {
+    if sigma.is_finite() && sigma > 0.0 {
+        let digits = (-(sigma.log10().floor()) + 1.0).clamp(0.0, 12.0) as usize;
+        format!("{value:.digits$} +/- {sigma:.2e}")
+    } else {
+        format!("{value} +/- (not constrained at all)")
+    }
+}
+
+fn report_table(r: &SubtractResult) -> String {
+    let mut s = String::new();
+    let a = &r.alignment;
+    let _ = writeln!(s, "alignment: {}", a.note);
+    let _ = writeln!(
+        s,
+        "overlap: {} samples at {} Hz ({} s); training {} samples, held out {} (the end); Welch \
+         segment {} samples",
+        a.len,
+        Num(a.fs_hz),
+        Num(a.len as f64 / a.fs_hz),
+        r.n_train,
+        r.n_holdout,
+        r.segment_len
+    );
+    let f = &r.fit;
+    let _ = writeln!(
+        s,
+        "fit band {} .. {} Hz, bins {}; chi^2 {:.1} for {} dof ({:.3}); uncertainties x {:.3}",
+        Num(f.band_hz.0),
+        Num(f.band_hz.1),
+        f.bins
+            .iter()
+            .map(|(o, n)| format!("{} {n}", o.name()))
+            .collect::<Vec<_>>()
+            .join(", "),
+        f.chi2,
+        f.dof,
+        f.chi2 / f.dof as f64,
+        f.sigma_factor
+    );
+    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
+        "{:<28} {:>14} {:>34}  status",
+        "parameter", "nominal", "estimate"
+    );
+    for e in &f.estimates {
+        let status = match e.status {
+            Status::Fitted => "fitted".to_string(),
+            Status::AtBound => format!("on the box [{}, {}]", Num(e.bounds.0), Num(e.bounds.1)),
+            Status::NotConstrained => format!(
+                "not constrained: held at nominal (the data would give +/- {}; scale {})",
+                if e.sigma.is_finite() {
+                    format!("{:.2e}", e.sigma)
+                } else {
+                    "infinity".to_string()
+                },
+                Num(e.scale)
+            ),
+        };
+        let est = match e.status {
+            Status::NotConstrained => format!("{}", e.value),
+            _ => with_sigma(e.value, e.sigma),
+        };
+        let _ = writeln!(
+            s,
+            "{:<28} {:>14} {:>34}  {status}",
+            format!("{} ({})", e.name, e.unit),
+            Num(e.nominal).to_string(),
+            est
+        );
+    }
+    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
+        "held-out residuals, band means as ASD (unit/sqrt(Hz)), +/- relative 1 sigma of a band \
+         PSD:"
+    );
+    for res in &r.residuals {
+        let b = &res.band;
+        let _ = writeln!(
+            s,
+            "  {:<6} {} .. {} Hz ({} bins, +/- {:.1} %): measured {:.3e}, predicted tilt {:.3e}, \
+             cleaned {:.3e}, Wiener {:.3e}, coherence limit {:.3e}",
+            res.observable.name(),
+            Num(b.band_hz.0),
+            Num(b.band_hz.1),
+            b.bins,
+            100.0 * b.psd_rel_sigma,
+            b.measured_asd,
+            b.predicted_asd,
+            b.cleaned_asd,
+            b.wiener_asd,
+            b.expected_asd
+        );
+        if let Some((ratio, sigma)) = b.cleaned_to_readout {
+            let _ = writeln!(
+                s,
+                "         cleaned / readout = {ratio:.4} +/- {sigma:.4}; cleaned / coherence \
+                 limit = {:.4} +/- {:.4}",
+                b.cleaned_to_expected.0, b.cleaned_to_expected.1
+            );
+        } else {
+            let _ = writeln!(
+                s,
+                "         cleaned / coherence limit = {:.4} +/- {:.4} (no --readout given)",
+                b.cleaned_to_expected.0, b.cleaned_to_expected.1
+            );
+        }
+    }
+    for note in &r.notes {
+        let _ = writeln!(s, "note: {note}");
+    }
+    s
+}
+
+/// `x` with three significant digits, without an exponent for 1e-4 <= |x| < 1e4.
+fn sig3(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || !(1e-4..1e4).contains(&x.abs()) {
+        return format!("{x:.2e}");
+    }
+    let decimals = (2 - x.abs().log10().floor() as i32).max(0) as usize;
+    format!("{x:.decimals$}")
+}
+
+fn figure_data(r: &SubtractResult) -> SubtractFigureData {
+    let asd = |p: &[f64]| p.iter().map(|v| v.max(0.0).sqrt()).collect::<Vec<f64>>();
+    let mut caption = Vec::new();
+    let est: Vec<String> = r
+        .fit
+        .estimates
+        .iter()
+        .map(|e| match e.status {
+            Status::NotConstrained => format!("{} not constrained (held at {})", e.name, e.nominal),
+            _ => format!(
+                "{} = {}",
+                e.name,
+                with_sigma(e.value, e.sigma).replace("+/-", "±")
+            ),
+        })
+        .collect();
+    caption.push(format!(
+        "Fit ({}–{} Hz, χ²/dof = {:.3}): {}.",
+        sig3(r.fit.band_hz.0),
+        sig3(r.fit.band_hz.1),
+        r.fit.chi2 / r.fit.dof as f64,
+        est.join(", ")
+    ));
+    let ratios: Vec<String> = r
+        .residuals
+        .iter()
+        .filter_map(|res| {
+            res.band
+                .cleaned_to_readout
+                .map(|(ratio, sigma)| format!("{} {ratio:.3} ± {sigma:.3}", res.observable.name()))
+        })
+        .collect();
+    if let Some(first) = r.residuals.first() {
+        caption.push(format!(
+            "Report band {}–{} Hz (dotted lines){}.",
+            sig3(first.band.band_hz.0),
+            sig3(first.band.band_hz.1),
+            if ratios.is_empty() {
+                String::new()
+            } else {
+                format!(": cleaned / readout ASD = {}", ratios.join(", "))
+            }
+        ));
+    }
+    caption.push(format!(
+        "Held-out stretch: the last {} of {} samples at {} Hz; Welch {} samples, Hann, 50 % \
+         overlap. Wiener residual: multiple-input filter trained on the first {} samples. \
+         Coherence limit: (1 − γ²) of the measured PSD, the least any linear filter of the tilt \
+         record can leave.",
+        r.n_holdout,
+        r.alignment.len,
+        Num(r.alignment.fs_hz),
+        r.segment_len,
+        r.n_train
+    ));
+    SubtractFigureData {
+        panels: r
+            .residuals
+            .iter()
+            .map(|s| ObservablePanel {
+                observable: s.observable,
+                freqs_hz: s.freqs_hz.clone(),
+                measured: asd(&s.measured_psd),
+                predicted: asd(&s.predicted_psd),
+                cleaned: asd(&s.cleaned_psd),
+                wiener: asd(&s.wiener_psd),
+                expected: asd(&s.expected_psd),
+                readout: s.readout_asd,
+            })
+            .collect(),
+        band_hz: r
+            .residuals
+            .first()
+            .map_or((f64::NAN, f64::NAN), |s| s.band.band_hz),
+        caption,
+    }
+}
