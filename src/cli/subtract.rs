@@ -285,7 +285,7 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
         report_band_hz: parse_band("--report-band", &args.report_band)?,
     };
     let series = match read_tilt(&args.tilt, &read_options(&args)?)? {
-        TiltInput::Series(s) => s,
+        TiltInput::Series(s) => s.into_angle(),
         TiltInput::Spectra(_) => bail!(
             "--tilt {}: holds spectra; subtract needs a time series of the tilt (angle or rate)",
             args.tilt.display()

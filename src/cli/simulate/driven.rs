@@ -83,7 +83,7 @@ pub(super) fn run(
             .map_err(|e: String| anyhow!("--gaps: {e}"))?,
     };
     let series = match read_tilt(path, &opts)? {
-        TiltInput::Series(s) => s,
+        TiltInput::Series(s) => s.into_angle(),
         TiltInput::Spectra(_) => bail!(
             "--tilt {}: holds spectra; a driven simulation needs a time series",
             path.display()

@@ -34,6 +34,25 @@ impl TiltSeries {
         self.len() == 0
     }
 
+    /// The series as tilt angles (rad): unchanged for an angle; a rate integrated in the
+    /// frequency domain ([`super::rate::integrate_rate_spectrally`]: exact up to Nyquist, zero
+    /// mean), with a provenance note. For the commands that need angles in the time domain.
+    pub fn into_angle(mut self) -> TiltSeries {
+        if self.quantity() == Quantity::Rate {
+            for channel in &mut self.data {
+                *channel = super::rate::integrate_rate_spectrally(channel, self.sample_rate_hz);
+            }
+            self.provenance.quantity = Quantity::Angle;
+            self.provenance.notes.push(
+                "rate integrated to angle in the frequency domain (R / (i 2 pi f) on every DFT \
+                 bin of the whole record, exact up to Nyquist; the angle's mean is unknown and set \
+                 to 0)"
+                    .to_string(),
+            );
+        }
+        self
+    }
+
     /// Angle (rad) or rate (rad/s) samples: the quantity of the file's channels, kept as read.
     pub fn quantity(&self) -> Quantity {
         self.provenance.quantity
