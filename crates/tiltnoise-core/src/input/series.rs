@@ -43,6 +43,10 @@ impl TiltSeries {
                 *channel = super::rate::integrate_rate_spectrally(channel, self.sample_rate_hz);
             }
             self.provenance.quantity = Quantity::Angle;
+            // The reader's note on rates (spectra divided by w^2) no longer applies.
+            self.provenance
+                .notes
+                .retain(|note| !note.starts_with("rate to angle"));
             self.provenance.notes.push(
                 "rate integrated to angle in the frequency domain (R / (i 2 pi f) on every DFT \
                  bin of the whole record, exact up to Nyquist; the angle's mean is unknown and set \
