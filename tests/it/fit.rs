@@ -434,7 +434,7 @@ fn cli_bad_input_exits_2_without_output() {
         (vec!["--free".into(), "environment.g_m_per_s2".into()], vec!["`environment.g_m_per_s2`", "exact"]),
         (vec!["--free".into(), "mass.m_a_kg,mass.m_a_kg".into()], vec!["`mass.m_a_kg`", "twice"]),
         (vec!["--bound-sigmas".into(), "0".into()], vec!["--bound-sigmas 0", "> 0"]),
-        (vec!["--measured".into(), file("neg.csv", "mode,frequency_hz\n1,-0.001\n")], vec!["neg.csv", "`-0.001`", "> 0"]),
+        (vec!["--measured".into(), file("neg.csv", "mode,frequency_hz\n1,-0.001\n")], vec!["neg.csv", "`-0.001`", ">= 1e-9 Hz"]),
         (vec!["--measured".into(), file("nan.csv", "mode,frequency_hz\n1,NaN\n")], vec!["nan.csv", "`NaN`", "finite"]),
         (vec!["--measured".into(), file("nine.csv", "mode,frequency_hz\n9,1.0\n")], vec!["nine.csv", "mode `9`", "1..8"]),
         (vec!["--measured".into(), file("dup.csv", "mode,frequency_hz\n2,1.0\n2,1.1\n")], vec!["dup.csv", "mode 2", "twice"]),

@@ -186,15 +186,22 @@ pub enum ParamError {
 /// A frequency request that cannot be evaluated.
 #[derive(Debug, thiserror::Error)]
 pub enum FreqError {
-    /// A frequency that is negative, NaN, infinite or above
-    /// [`MAX_FREQUENCY_HZ`](crate::limits::MAX_FREQUENCY_HZ).
+    /// A frequency that is negative, NaN or infinite.
+    #[error("frequency {} Hz ({origin}) is not allowed: must be finite and >= 0", Num(*.value))]
+    Invalid {
+        /// The value.
+        value: f64,
+        /// Where it came from, e.g. `line 3 of f.txt`.
+        origin: String,
+    },
+    /// A frequency above [`MAX_FREQUENCY_HZ`](crate::limits::MAX_FREQUENCY_HZ) in a grid the
+    /// user gives.
     #[error(
-        "frequency {} Hz ({origin}) is not allowed: must be finite, >= 0 and <= {:e} Hz \
-         (see docs/limits.md)",
+        "frequency {} Hz ({origin}) is not allowed: must be <= {:e} Hz (see docs/limits.md)",
         Num(*.value),
         crate::limits::MAX_FREQUENCY_HZ
     )]
-    Invalid {
+    TooHigh {
         /// The value.
         value: f64,
         /// Where it came from, e.g. `line 3 of f.txt`.

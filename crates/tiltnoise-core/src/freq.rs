@@ -45,7 +45,7 @@ pub fn log_grid(lo: f64, hi: f64, n: usize) -> Result<Vec<f64>, FreqError> {
         });
     }
     if hi > MAX_FREQUENCY_HZ {
-        return Err(FreqError::Invalid {
+        return Err(FreqError::TooHigh {
             value: hi,
             origin: format!("FHI of {}", spec()),
         });
@@ -83,10 +83,13 @@ pub fn check_frequencies(freqs_hz: &[f64], origin: &str) -> Result<(), FreqError
         .position(|f| !(f.is_finite() && (0.0..=MAX_FREQUENCY_HZ).contains(f)))
     {
         None => Ok(()),
-        Some(i) => Err(FreqError::Invalid {
-            value: freqs_hz[i],
-            origin: format!("{origin}, index {i}"),
-        }),
+        Some(i) => {
+            let (value, origin) = (freqs_hz[i], format!("{origin}, index {i}"));
+            Err(match value > MAX_FREQUENCY_HZ {
+                true => FreqError::TooHigh { value, origin },
+                false => FreqError::Invalid { value, origin },
+            })
+        }
     }
 }
 

@@ -16,7 +16,8 @@ use tiltnoise_core::limits::{
 /// # Errors
 ///
 /// [`FreqError::Spec`] naming the file (and line) when it cannot be read, a line is not one
-/// number or there is none; [`FreqError::Invalid`] for a negative or non-finite frequency;
+/// number or there is none; [`FreqError::Invalid`] for a negative or non-finite frequency,
+/// [`FreqError::TooHigh`] for one above [`MAX_FREQUENCY_HZ`];
 /// [`FreqError::TooLarge`] for a file over [`MAX_FREQ_FILE_BYTES`] (a device or pipe is read
 /// no further), a line over [`tiltnoise_core::limits::MAX_LINE_BYTES`] or more than
 /// [`MAX_GRID_POINTS`] frequencies.
@@ -64,8 +65,14 @@ fn parse_freq_text(text: &str, origin: &str) -> Result<Vec<f64>, FreqError> {
                 ),
             });
         };
-        if !(value.is_finite() && (0.0..=MAX_FREQUENCY_HZ).contains(&value)) {
+        if !(value.is_finite() && value >= 0.0) {
             return Err(FreqError::Invalid {
+                value,
+                origin: at(line),
+            });
+        }
+        if value > MAX_FREQUENCY_HZ {
+            return Err(FreqError::TooHigh {
                 value,
                 origin: at(line),
             });
