@@ -473,6 +473,7 @@ pub fn budget_from_file(
             .map_err(|e| value_error(e.to_string()))?,
         quantity: quantity.map(str::parse).transpose().map_err(value_error)?,
         gaps: gaps.unwrap_or("reject").parse().map_err(value_error)?,
+        scale: Vec::new(),
     };
     let series_opts = SeriesOptions {
         nperseg,
@@ -512,7 +513,7 @@ pub fn budget_from_file(
     let (report, provenance) = py.detach(|| -> PyResult<_> {
         let streamed = match InputFormat::from_path(&path).py()? {
             InputFormat::Hdf5 => TiltSeriesSource::open(&path, &ropts).ok(),
-            InputFormat::Csv => None,
+            InputFormat::Csv | InputFormat::Miniseed => None,
         };
         let (report, provenance) = match streamed {
             Some(mut source) => {

@@ -6,8 +6,9 @@
 //!
 //! # Entry points
 //!
-//! * [`read_tilt`]: decides by extension (`.h5`/`.hdf5` vs `.csv`) and content whether the
-//!   file holds a series or spectra, and returns a [`TiltInput`].
+//! * [`read_tilt`]: decides by extension (`.h5`/`.hdf5`, `.csv`, `.mseed`/`.miniseed`/`.ms`)
+//!   and content whether the file holds a series or spectra, and returns a [`TiltInput`]
+//!   (miniSEED always holds a series).
 //! * [`read_tilt_series`] / [`read_tilt_spectra`]: the same, insisting on one kind.
 //! * [`TiltSeriesSource`]: streaming access to an HDF5 series in chunks (bounded memory), with
 //!   results bit-identical to [`read_tilt_series`]; it is a
@@ -18,6 +19,7 @@ mod csv;
 mod h5;
 mod measured;
 mod meta;
+mod mseed;
 mod series_csv;
 mod source;
 mod spectra_csv;
@@ -33,7 +35,8 @@ pub use tiltnoise_core::input::*;
 use std::path::Path;
 use tiltnoise_core::error::Shown;
 
-/// Reads a tilt input of either kind: the format from the extension (`.h5`/`.hdf5`, `.csv`),
+/// Reads a tilt input of either kind: the format from the extension (`.h5`/`.hdf5`, `.csv`,
+/// `.mseed`/`.miniseed`/`.ms`),
 /// the kind from the content (HDF5: `schema` attribute if present, else root attribute
 /// `sample_rate_hz` -> series, dataset `/frequency_hz` -> spectra; CSV: first header column
 /// `time_s` -> series, `freq_hz` -> spectra).
@@ -63,6 +66,7 @@ pub fn read_tilt(path: &Path, opts: &ReadOptions) -> Result<TiltInput, InputErro
                 InputKind::Spectra => spectra_hdf5::read(path, &file, opts).map(TiltInput::Spectra),
             }
         }
+        InputFormat::Miniseed => mseed::read(path, opts).map(TiltInput::Series),
     }
 }
 
@@ -78,6 +82,7 @@ pub fn read_tilt_series(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, I
             let mut src = TiltSeriesSource::open(path, opts)?;
             src.read_all()
         }
+        InputFormat::Miniseed => mseed::read(path, opts),
         InputFormat::Csv => match read_tilt(path, opts)? {
             TiltInput::Series(s) => Ok(s),
             TiltInput::Spectra(_) => Err(wrong_kind(path, InputKind::Series, InputKind::Spectra)),
@@ -106,6 +111,7 @@ pub fn read_tilt_spectra(path: &Path, opts: &ReadOptions) -> Result<TiltSpectra,
                 InputKind::Series => Err(wrong_kind(path, InputKind::Spectra, InputKind::Series)),
             }
         }
+        InputFormat::Miniseed => Err(wrong_kind(path, InputKind::Spectra, InputKind::Series)),
     }
 }
 

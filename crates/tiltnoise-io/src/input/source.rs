@@ -55,12 +55,13 @@ impl TiltSeriesSource {
     /// `docs/input_formats.md`); with gap interpolation, also the errors of the scanning pass
     /// (edge gaps).
     pub fn open(path: &Path, opts: &ReadOptions) -> Result<Self, InputError> {
-        if super::InputFormat::from_path(path)? != InputFormat::Hdf5 {
+        let format = super::InputFormat::from_path(path)?;
+        if format != InputFormat::Hdf5 {
             return Err(InputError::UnknownLayout {
                 path: path.to_path_buf(),
-                format: "csv",
-                found: "a CSV file, which cannot be streamed".to_string(),
-                accepted: "HDF5 time series (use read_tilt_series for CSV)",
+                format: format.name(),
+                found: format!("a {} file, which cannot be streamed", format.name()),
+                accepted: "HDF5 time series (use read_tilt_series for CSV or miniSEED)",
             });
         }
         let file = h5::open(path)?;
