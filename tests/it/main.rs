@@ -26,6 +26,7 @@ mod input_readers;
 mod io_roundtrip;
 mod limits;
 mod mc_outputs;
+mod miniseed_input;
 mod noise_models;
 mod process;
 mod romy_budget;

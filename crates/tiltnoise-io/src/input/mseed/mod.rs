@@ -312,25 +312,6 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
 
     let mut data = Vec::new();
     for ((m, ch), &k) in resolved.channels.iter().zip(&chans).zip(&spans) {
-        if opts.gaps == GapPolicy::Reject {
-            if let Some(&(a, b)) = ch.gaps.iter().find(|&&(a, b)| b > k && a < k + len) {
-                return Err(fault(
-                    path,
-                    None,
-                    format!(
-                        "channel {}: no records for {} samples from {} to {} (sample indices \
-                         {}..={} of the series); allowed: no gaps, or gap interpolation to \
-                         bridge interior gaps linearly",
-                        ch.id,
-                        b - a,
-                        ch.time(a),
-                        ch.time(b - 1),
-                        a.max(k) - k,
-                        b.min(k + len) - 1 - k
-                    ),
-                ));
-            }
-        }
         let factor = match (scale_for(&scales, &ch.id), ch.counts) {
             (Some(f), _) => {
                 notes.push(scale_note(&ch.id, f, "given explicitly"));
@@ -357,6 +338,25 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
                 1.0
             }
         };
+        if opts.gaps == GapPolicy::Reject {
+            if let Some(&(a, b)) = ch.gaps.iter().find(|&&(a, b)| b > k && a < k + len) {
+                return Err(fault(
+                    path,
+                    None,
+                    format!(
+                        "channel {}: no records for {} samples from {} to {} (sample indices \
+                         {}..={} of the series); allowed: no gaps, or gap interpolation to \
+                         bridge interior gaps linearly",
+                        ch.id,
+                        b - a,
+                        ch.time(a),
+                        ch.time(b - 1),
+                        a.max(k) - k,
+                        b.min(k + len) - 1 - k
+                    ),
+                ));
+            }
+        }
         if !ch.gaps.is_empty() || ch.overlapping > 0 {
             notes.push(format!(
                 "channel {}: {} records, {} gaps ({} samples, filled with NaN before the gap \
