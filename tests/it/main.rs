@@ -23,6 +23,7 @@ mod fit;
 mod force_tf;
 mod fuzz;
 mod input_readers;
+mod input_units;
 mod io_roundtrip;
 mod limits;
 mod mc_outputs;

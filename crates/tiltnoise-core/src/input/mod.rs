@@ -225,14 +225,16 @@ impl InputFormat {
         }
     }
 
-    /// The format named by the extension of `path` (case-insensitive).
+    /// The format named by the extension of `path` (case-insensitive); an HDF5 address
+    /// `FILE.h5:/group/dataset` is HDF5 ([`split_hdf5_address`]).
     ///
     /// # Errors
     ///
     /// [`InputError::Extension`] for anything but `.h5`, `.hdf5`, `.csv`, `.mseed`,
     /// `.miniseed`, `.ms`.
     pub fn from_path(path: &Path) -> Result<InputFormat, InputError> {
-        let ext = path
+        let (file, _) = split_hdf5_address(path);
+        let ext = file
             .extension()
             .map(|e| e.to_string_lossy().to_ascii_lowercase())
             .unwrap_or_default();
@@ -351,5 +353,36 @@ impl From<&Provenance> for InputMeta {
             start_time: p.start_time.clone(),
             notes: p.notes.clone(),
         }
+    }
+}
+
+/// Splits an HDF5 address `FILE.h5:/group/dataset` (or `FILE.hdf5:/group`) into the file and
+/// the object path inside it. A path that exists as given, or has no `.h5:/` or `.hdf5:/`,
+/// is returned whole with no object.
+///
+/// ```
+/// use std::path::{Path, PathBuf};
+/// use tiltnoise_core::input::split_hdf5_address;
+/// let (file, object) = split_hdf5_address(Path::new("run/tilt.h5:/gwpy/theta"));
+/// assert_eq!((file, object.as_deref()), (PathBuf::from("run/tilt.h5"), Some("/gwpy/theta")));
+/// assert_eq!(split_hdf5_address(Path::new("tilt.h5")).1, None);
+/// ```
+pub fn split_hdf5_address(path: &Path) -> (PathBuf, Option<String>) {
+    let whole = (path.to_path_buf(), None);
+    if path.exists() {
+        return whole;
+    }
+    let text = path.to_string_lossy();
+    let lower = text.to_ascii_lowercase();
+    let found = [".h5:/", ".hdf5:/"]
+        .iter()
+        .filter_map(|m| lower.rfind(m).map(|i| (i + m.len() - 2, i + m.len() - 1)))
+        .max();
+    match found {
+        Some((colon, object)) => (
+            PathBuf::from(&text[..colon]),
+            Some(text[object..].to_string()),
+        ),
+        None => whole,
     }
 }

@@ -57,10 +57,14 @@ pub fn read_tilt(path: &Path, opts: &ReadOptions) -> Result<TiltInput, InputErro
             }
         }
         InputFormat::Hdf5 => {
+            if split_hdf5_address(path).1.is_some() {
+                let mut src = TiltSeriesSource::open(path, opts)?;
+                return src.read_all().map(TiltInput::Series);
+            }
             let file = h5::open(path)?;
             match h5::detect_kind(path, &file, None)? {
                 InputKind::Series => {
-                    let mut src = TiltSeriesSource::from_file(path, file, opts)?;
+                    let mut src = TiltSeriesSource::from_file(path, file, opts, None)?;
                     src.read_all().map(TiltInput::Series)
                 }
                 InputKind::Spectra => spectra_hdf5::read(path, &file, opts).map(TiltInput::Spectra),
@@ -136,6 +140,21 @@ fn csv_kind(path: &Path, prelude: &csv::Prelude) -> Result<InputKind, InputError
                 Shown(other.unwrap_or(""))
             ),
             accepted: ACCEPTED_LAYOUTS,
+        }),
+    }
+}
+
+/// Scale factors apply to the samples of a time series; spectra refuse them rather than
+/// ignore them.
+fn no_scale_for_spectra(path: &Path, opts: &ReadOptions) -> Result<(), InputError> {
+    match opts.scale.first() {
+        None => Ok(()),
+        Some(s) => Err(InputError::Scale {
+            path: path.to_path_buf(),
+            channel: s.channel.clone(),
+            message: "is given a scale, but the file holds spectra; allowed: scales for time \
+                      series only"
+                .to_string(),
         }),
     }
 }

@@ -290,7 +290,8 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
             Some((q, why)) => declared.push(Declared {
                 channel: ch.id.clone(),
                 unit: format!("{} ({why})", q.unit()),
-                quantity: q,
+                quantity: Some(q),
+                factor: 1.0,
             }),
             None if opts.quantity.is_none() => {
                 return Err(fault(
