@@ -178,3 +178,30 @@ fn gwpy_timeseries_at_the_root_is_detected() {
     assert_eq!((s.sample_rate_hz, s.quantity()), (2.0, Quantity::Angle));
     assert_eq!(s.data[0][6], 1e-6 * 3.0);
 }
+
+#[test]
+fn gwpy_frequencyseries_asds_are_tilt_spectra() {
+    // Written by gwpy 4.1: ASDs (k + 1) / 8 (E) and (k + 1) / 16 (N) rad/sqrt(Hz) at f = k / 4.
+    let address = format!("{}:/asd", gwpy("frequencyseries.h5").display());
+    let input = read_tilt(std::path::Path::new(&address), &ReadOptions::default()).unwrap();
+    let tiltnoise_io::input::TiltInput::Spectra(s) = input else {
+        panic!("spectra")
+    };
+    // The DC bin is dropped; 8 bins remain.
+    assert_eq!(s.freqs_hz, (1..9).map(|k| k as f64 / 4.0).collect::<Vec<_>>());
+    assert_eq!(s.axes.len(), 2);
+    for (i, f) in s.freqs_hz.iter().enumerate() {
+        let k = (f * 4.0) as usize;
+        let (e, n) = ((k + 1) as f64 / 8.0, (k + 1) as f64 / 16.0);
+        // Default map theta_t = -E, eta_t = -N: the signs cancel on the diagonal.
+        assert_eq!(s.csd[i * 4].re, e * e, "S(theta_t) at {f} Hz");
+        assert_eq!(s.csd[i * 4 + 3].re, n * n, "S(eta_t) at {f} Hz");
+        assert_eq!(s.csd[i * 4 + 1].norm(), 0.0, "uncorrelated");
+    }
+    let notes = s.provenance.notes.join("\n");
+    assert!(notes.contains("1 bins at f <= 0 Hz dropped"), "{notes}");
+    let e = tiltnoise_io::input::read_tilt_series(std::path::Path::new(&address), &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("xunit") && e.contains("FrequencySeries"), "{e}");
+}

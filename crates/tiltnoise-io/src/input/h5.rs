@@ -502,3 +502,60 @@ pub(crate) fn is_complex(ds: &hdf5::Dataset) -> hdf5::Result<(bool, String)> {
     };
     Ok((ok, d.to_string()))
 }
+
+/// The group an HDF5 address names, or the parent group of the one dataset it names.
+pub(crate) struct Located {
+    pub group: hdf5::Group,
+    /// The group's path without a trailing `/` (empty for the root), to prefix dataset names.
+    pub prefix: String,
+    /// The dataset, when the address names one.
+    pub only: Option<String>,
+}
+
+/// Finds `object` (`None`: the root) in `file`.
+pub(crate) fn locate(
+    path: &Path,
+    file: &hdf5::File,
+    object: Option<&str>,
+) -> Result<Located, InputError> {
+    let (group_name, only) = match object {
+        None => ("/".to_string(), None),
+        Some(o) => match file.loc_type_by_name(o) {
+            Ok(LocationType::Group) => (o.to_string(), None),
+            Ok(LocationType::Dataset) => {
+                let (parent, name) = o.rsplit_once('/').unwrap_or(("", o));
+                let parent = if parent.is_empty() { "/" } else { parent };
+                (parent.to_string(), Some(name.to_string()))
+            }
+            _ => {
+                return Err(InputError::MissingDataset {
+                    path: path.to_path_buf(),
+                    dataset: o.to_string(),
+                    expected: format!(
+                        "a group or a dataset of the file; datasets: {}",
+                        shown_list(&all_datasets(file))
+                    ),
+                })
+            }
+        },
+    };
+    let group = file
+        .group(&group_name)
+        .map_err(h5err(path, format!("group {group_name}")))?;
+    let prefix = group_name.trim_end_matches('/').to_string();
+    Ok(Located {
+        group,
+        prefix,
+        only,
+    })
+}
+
+/// The `xunit` attribute of dataset `name` of `group` (gwpy: `s` for a TimeSeries, `Hz` for a
+/// FrequencySeries), if it has a string one.
+pub(crate) fn xunit(path: &Path, group: &hdf5::Group, name: &str) -> Option<String> {
+    let ds = group.dataset(name).ok()?;
+    match attr(path, &ds, &format!("dataset {name}"), "xunit") {
+        Ok(Some(AttrValue::Str(u))) => Some(u.trim().to_string()),
+        _ => None,
+    }
+}

@@ -76,7 +76,7 @@ pub(crate) fn series_unit(unit: &str) -> Option<Unit> {
 pub(crate) fn asd_unit(unit: &str) -> Option<Unit> {
     match normalize(unit).as_str() {
         "rad/sqrt(hz)" => Some(Unit::si(Quantity::Angle)),
-        "rad/s/sqrt(hz)" => Some(Unit::si(Quantity::Rate)),
+        "rad/s/sqrt(hz)" | "rad/(sqrt(hz)s)" => Some(Unit::si(Quantity::Rate)),
         _ => None,
     }
 }
@@ -84,8 +84,8 @@ pub(crate) fn asd_unit(unit: &str) -> Option<Unit> {
 /// `rad^2/Hz` -> angle, `rad^2/s^2/Hz` -> rate.
 pub(crate) fn csd_unit(unit: &str) -> Option<Unit> {
     match normalize(unit).as_str() {
-        "rad^2/hz" => Some(Unit::si(Quantity::Angle)),
-        "rad^2/s^2/hz" => Some(Unit::si(Quantity::Rate)),
+        "rad^2/hz" | "rad2/hz" => Some(Unit::si(Quantity::Angle)),
+        "rad^2/s^2/hz" | "rad2/s2/hz" | "rad2/(hzs2)" => Some(Unit::si(Quantity::Rate)),
         _ => None,
     }
 }
@@ -373,10 +373,14 @@ mod tests {
         assert_eq!(q("krad"), None);
         assert_eq!(q("rad/s/s"), None);
         let a = |u: &str| asd_unit(u).and_then(|u| u.quantity);
+        let c = |u: &str| csd_unit(u).and_then(|u| u.quantity);
         assert_eq!(a("rad/√Hz"), Some(Quantity::Angle));
         assert_eq!(a("rad / Hz(1/2)"), Some(Quantity::Angle));
         assert_eq!(a("rad/s/sqrt(Hz)"), Some(Quantity::Rate));
-        let c = |u: &str| csd_unit(u).and_then(|u| u.quantity);
+        // astropy's text of the units gwpy writes
+        assert_eq!(a("rad / (Hz(1/2) s)"), Some(Quantity::Rate));
+        assert_eq!(c("rad2 / Hz"), Some(Quantity::Angle));
+        assert_eq!(c("rad2 / (Hz s2)"), Some(Quantity::Rate));
         assert_eq!(c("rad²/Hz"), Some(Quantity::Angle));
         assert_eq!(c("rad**2/s**2/Hz"), Some(Quantity::Rate));
     }

@@ -23,6 +23,7 @@ mod mseed;
 mod series_csv;
 mod source;
 mod spectra_csv;
+mod spectra_gwpy;
 mod spectra_hdf5;
 
 pub use measured::{
@@ -57,11 +58,15 @@ pub fn read_tilt(path: &Path, opts: &ReadOptions) -> Result<TiltInput, InputErro
             }
         }
         InputFormat::Hdf5 => {
-            if split_hdf5_address(path).1.is_some() {
-                let mut src = TiltSeriesSource::open(path, opts)?;
+            let (file_path, object) = split_hdf5_address(path);
+            let file = h5::open(&file_path)?;
+            if let Some(s) = gwpy_spectra(&file_path, &file, object.as_deref(), opts)? {
+                return Ok(TiltInput::Spectra(s));
+            }
+            if object.is_some() {
+                let mut src = TiltSeriesSource::from_file(&file_path, file, opts, object.as_deref())?;
                 return src.read_all().map(TiltInput::Series);
             }
-            let file = h5::open(path)?;
             match h5::detect_kind(path, &file, None)? {
                 InputKind::Series => {
                     let mut src = TiltSeriesSource::from_file(path, file, opts, None)?;
@@ -102,7 +107,14 @@ pub fn read_tilt_series(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, I
 pub fn read_tilt_spectra(path: &Path, opts: &ReadOptions) -> Result<TiltSpectra, InputError> {
     match InputFormat::from_path(path)? {
         InputFormat::Hdf5 => {
-            let file = h5::open(path)?;
+            let (file_path, object) = split_hdf5_address(path);
+            let file = h5::open(&file_path)?;
+            if let Some(s) = gwpy_spectra(&file_path, &file, object.as_deref(), opts)? {
+                return Ok(s);
+            }
+            if object.is_some() {
+                return Err(wrong_kind(path, InputKind::Spectra, InputKind::Series));
+            }
             match h5::detect_kind(path, &file, Some(InputKind::Spectra))? {
                 InputKind::Spectra => spectra_hdf5::read(path, &file, opts),
                 InputKind::Series => Err(wrong_kind(path, InputKind::Spectra, InputKind::Series)),
@@ -157,4 +169,44 @@ fn no_scale_for_spectra(path: &Path, opts: &ReadOptions) -> Result<(), InputErro
                 .to_string(),
         }),
     }
+}
+
+/// gwpy FrequencySeries: the datasets `object` names (or the root's, when the root has neither
+/// the `sample_rate_hz` attribute nor a `/frequency_hz` dataset) whose `xunit` is `Hz`, when
+/// none is a TimeSeries (`xunit` `s`). `None` when they are not spectra of that layout.
+fn gwpy_spectra(
+    path: &Path,
+    file: &hdf5::File,
+    object: Option<&str>,
+    opts: &ReadOptions,
+) -> Result<Option<TiltSpectra>, InputError> {
+    if object.is_none() {
+        let native = h5::attr(path, file, "/", "sample_rate_hz")?.is_some()
+            || h5::attr(path, file, "/", "schema")?.is_some()
+            || h5::root_datasets(path, file)?
+                .iter()
+                .any(|n| n == "frequency_hz");
+        if native {
+            return Ok(None);
+        }
+    }
+    let loc = h5::locate(path, file, object)?;
+    let names = match &loc.only {
+        Some(n) => vec![n.clone()],
+        None => h5::root_datasets(path, &loc.group)?,
+    };
+    let units: Vec<Option<String>> = names
+        .iter()
+        .map(|n| h5::xunit(path, &loc.group, n))
+        .collect();
+    let freq: Vec<String> = names
+        .iter()
+        .zip(&units)
+        .filter(|(_, u)| u.as_deref() == Some("Hz"))
+        .map(|(n, _)| n.clone())
+        .collect();
+    if freq.is_empty() || units.iter().any(|u| u.as_deref() == Some("s")) {
+        return Ok(None);
+    }
+    spectra_gwpy::read(path, file, &loc.group, &loc.prefix, &freq, opts).map(Some)
 }

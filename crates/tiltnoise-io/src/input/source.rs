@@ -6,7 +6,6 @@ use super::meta::{decide_quantity, series_factors, series_unit, Declared, SERIES
 use super::Mapped;
 use super::{gap_note, ChannelCtx, Gap, GapScanner, TiltSeries};
 use super::{require_two, InputError};
-use hdf5::LocationType;
 use super::{GapPolicy, InputFormat, InputKind, Provenance, Quantity, ReadOptions, SeriesSource};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::limits::{check_count, MAX_STREAMED_SAMPLES};
@@ -91,35 +90,11 @@ impl TiltSeriesSource {
         object: Option<&str>,
     ) -> Result<Self, InputError> {
         let mut notes = Vec::new();
-        let (group_name, only) = match object {
-            None => ("/".to_string(), None),
-            Some(o) => match file.loc_type_by_name(o) {
-                Ok(LocationType::Group) => (o.to_string(), None),
-                Ok(LocationType::Dataset) => {
-                    let (parent, name) = o.rsplit_once('/').unwrap_or(("", o));
-                    let parent = if parent.is_empty() { "/" } else { parent };
-                    (parent.to_string(), Some(name.to_string()))
-                }
-                _ => {
-                    return Err(InputError::MissingDataset {
-                        path: path.to_path_buf(),
-                        dataset: o.to_string(),
-                        expected: format!(
-                            "a group or a dataset of the file; datasets: {}",
-                            tiltnoise_core::error::shown_list(&h5::all_datasets(&file))
-                        ),
-                    })
-                }
-            },
-        };
-        let group = file
-            .group(&group_name)
-            .map_err(h5err(path, format!("group {group_name}")))?;
-        let prefix = if group_name == "/" {
-            String::new()
-        } else {
-            group_name.trim_end_matches('/').to_string()
-        };
+        let h5::Located {
+            group,
+            prefix,
+            only,
+        } = h5::locate(path, &file, object)?;
         if let Some(o) = object {
             notes.push(format!("HDF5 object {o} of the file"));
         }
