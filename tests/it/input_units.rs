@@ -5,7 +5,9 @@
 use crate::common::assert_fails;
 use hdf5::types::VarLenUnicode;
 use ndarray::{arr0, Array1};
-use tiltnoise_io::input::{read_tilt, read_tilt_series, AxisMap, ChannelScale, Quantity, ReadOptions};
+use tiltnoise_io::input::{
+    read_tilt, read_tilt_series, AxisMap, ChannelScale, Quantity, ReadOptions,
+};
 
 const RAW: [f64; 4] = [1.5, -2.25, 3.0, 0.125];
 
@@ -26,8 +28,11 @@ fn scales(list: &[&str]) -> Vec<ChannelScale> {
 #[test]
 fn prefixed_units_scale_csv_columns() {
     let dir = tempfile::tempdir().unwrap();
-    let s = read_tilt_series(&csv(dir.path(), "E=nrad/s, N=urad/s"), &ReadOptions::default())
-        .unwrap();
+    let s = read_tilt_series(
+        &csv(dir.path(), "E=nrad/s, N=urad/s"),
+        &ReadOptions::default(),
+    )
+    .unwrap();
     assert_eq!(s.quantity(), Quantity::Rate);
     for (k, v) in RAW.iter().enumerate() {
         // Default map: theta_t = -E, eta_t = -N.
@@ -36,7 +41,9 @@ fn prefixed_units_scale_csv_columns() {
     }
     let notes = s.provenance.notes.join("\n");
     assert!(
-        notes.contains("channel `E`: samples multiplied by 1e-9 (units `nrad/s` to rad/s) before the axis map"),
+        notes.contains(
+            "channel `E`: samples multiplied by 1e-9 (units `nrad/s` to rad/s) before the axis map"
+        ),
         "{notes}"
     );
     let e = read_tilt(&csv(dir.path(), "deg"), &ReadOptions::default())
@@ -52,8 +59,13 @@ fn prefixed_units_scale_csv_columns() {
 fn counts_need_a_scale_which_applies_before_the_sign() {
     let dir = tempfile::tempdir().unwrap();
     let path = csv(dir.path(), "E=counts, N=rad");
-    let e = read_tilt(&path, &ReadOptions::default()).unwrap_err().to_string();
-    assert!(e.contains("channel `E` is in counts") && e.contains("CHANNEL=FACTOR"), "{e}");
+    let e = read_tilt(&path, &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("channel `E` is in counts") && e.contains("CHANNEL=FACTOR"),
+        "{e}"
+    );
     let opts = ReadOptions {
         axis_map: Some(AxisMap::parse("theta_t=-E,eta_t=N").unwrap()),
         scale: scales(&["E=2.5e-9"]),
@@ -70,7 +82,10 @@ fn counts_need_a_scale_which_applies_before_the_sign() {
         ..ReadOptions::default()
     };
     let e = read_tilt(&path, &opts).unwrap_err().to_string();
-    assert!(e.contains("channel `X` is not a column of the file; available columns: E, N"), "{e}");
+    assert!(
+        e.contains("channel `X` is not a column of the file; available columns: E, N"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -145,7 +160,10 @@ fn gwpy_timeseries_in_a_group_read_by_address() {
         assert_eq!(s.data[1][k], -(1e-9 * (-kf / 4.0)), "eta_t = -N");
     }
     let notes = s.provenance.notes.join("\n");
-    assert!(notes.contains("from attribute dx = 0.5 s of /tilt/E (gwpy TimeSeries layout)"), "{notes}");
+    assert!(
+        notes.contains("from attribute dx = 0.5 s of /tilt/E (gwpy TimeSeries layout)"),
+        "{notes}"
+    );
     // One dataset of the group by its path.
     let one = format!("{}:/tilt/N", file.display());
     let opts = ReadOptions {
@@ -159,13 +177,18 @@ fn gwpy_timeseries_in_a_group_read_by_address() {
     assert_eq!(s.data.len(), 1);
     assert_eq!(s.data[0][4], 1e-9 * -1.0);
     // Without an address the error lists the datasets inside the group by path.
-    let e = read_tilt(&file, &ReadOptions::default()).unwrap_err().to_string();
+    let e = read_tilt(&file, &ReadOptions::default())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("datasets: /tilt/E, /tilt/N"), "{e}");
     let missing = format!("{}:/nothing", file.display());
     let e = read_tilt(std::path::Path::new(&missing), &ReadOptions::default())
         .unwrap_err()
         .to_string();
-    assert!(e.contains("`/nothing` is missing") && e.contains("/tilt/E, /tilt/N"), "{e}");
+    assert!(
+        e.contains("`/nothing` is missing") && e.contains("/tilt/E, /tilt/N"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -188,7 +211,10 @@ fn gwpy_frequencyseries_asds_are_tilt_spectra() {
         panic!("spectra")
     };
     // The DC bin is dropped; 8 bins remain.
-    assert_eq!(s.freqs_hz, (1..9).map(|k| k as f64 / 4.0).collect::<Vec<_>>());
+    assert_eq!(
+        s.freqs_hz,
+        (1..9).map(|k| k as f64 / 4.0).collect::<Vec<_>>()
+    );
     assert_eq!(s.axes.len(), 2);
     for (i, f) in s.freqs_hz.iter().enumerate() {
         let k = (f * 4.0) as usize;
@@ -200,8 +226,11 @@ fn gwpy_frequencyseries_asds_are_tilt_spectra() {
     }
     let notes = s.provenance.notes.join("\n");
     assert!(notes.contains("1 bins at f <= 0 Hz dropped"), "{notes}");
-    let e = tiltnoise_io::input::read_tilt_series(std::path::Path::new(&address), &ReadOptions::default())
-        .unwrap_err()
-        .to_string();
+    let e = tiltnoise_io::input::read_tilt_series(
+        std::path::Path::new(&address),
+        &ReadOptions::default(),
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("xunit") && e.contains("FrequencySeries"), "{e}");
 }

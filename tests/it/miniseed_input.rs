@@ -6,8 +6,8 @@
 use crate::common::{assert_fails, repo, tiltnoise};
 use tiltnoise_core::model::TiltAxis;
 use tiltnoise_io::input::{
-    read_tilt, read_tilt_series, read_tilt_spectra, AxisMap, ChannelScale, GapPolicy,
-    InputFormat, Quantity, ReadOptions,
+    read_tilt, read_tilt_series, read_tilt_spectra, AxisMap, ChannelScale, GapPolicy, InputFormat,
+    Quantity, ReadOptions,
 };
 
 fn fixture(name: &str) -> std::path::PathBuf {
@@ -73,7 +73,9 @@ fn counts_without_a_scale_are_refused() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("XX.TILT.00.BJE") && e.contains("digitizer counts (Steim-1)") && e.contains("scale"),
+        e.contains("XX.TILT.00.BJE")
+            && e.contains("digitizer counts (Steim-1)")
+            && e.contains("scale"),
         "{e}"
     );
     // A scale for a channel the file does not have names the ones it has.
@@ -84,7 +86,10 @@ fn counts_without_a_scale_are_refused() {
     let e = read_tilt(&fixture("little_endian.mseed"), &opts)
         .unwrap_err()
         .to_string();
-    assert!(e.contains("`LJE` is not a channel") && e.contains("XX.TILT.00.BJN"), "{e}");
+    assert!(
+        e.contains("`LJE` is not a channel") && e.contains("XX.TILT.00.BJN"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -103,8 +108,14 @@ fn default_mapping_takes_the_rotation_channels_and_their_quantity() {
         "theta_t=-XX.TILT.00.BJE,eta_t=-XX.TILT.00.BJN,phi_t=-XX.TILT.00.BJZ"
     );
     let notes = s.provenance.notes.join("\n");
-    assert!(notes.contains("FLOAT32 samples taken to be in rad/s"), "{notes}");
-    assert!(notes.contains("ignored channels: XX.TILT.00.BAE"), "{notes}");
+    assert!(
+        notes.contains("FLOAT32 samples taken to be in rad/s"),
+        "{notes}"
+    );
+    assert!(
+        notes.contains("ignored channels: XX.TILT.00.BAE"),
+        "{notes}"
+    );
     // A tiltmeter channel and a rotation sensor together are refused without a quantity.
     let opts = ReadOptions {
         axis_map: Some(AxisMap::parse("theta_t=BAE,eta_t=-BJN").unwrap()),
@@ -114,7 +125,10 @@ fn default_mapping_takes_the_rotation_channels_and_their_quantity() {
     let e = read_tilt(&fixture("little_endian.mseed"), &opts)
         .unwrap_err()
         .to_string();
-    assert!(e.contains("`XX.TILT.00.BAE` is in rad but `XX.TILT.00.BJN` is in rad/s"), "{e}");
+    assert!(
+        e.contains("`XX.TILT.00.BAE` is in rad but `XX.TILT.00.BJN` is in rad/s"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -128,9 +142,10 @@ fn gaps_follow_the_gap_policy_and_identical_overlaps_are_read_once() {
     };
     let e = read_tilt_series(&path, &reject).unwrap_err().to_string();
     assert!(
-        e.contains("XX.TILT.00.BJE: no records for 60 samples from 2018-01-23T09:32:02.000000Z \
-                    to 2018-01-23T09:32:07.900000Z (sample indices 200..=259")
-            && e.contains("gap interpolation"),
+        e.contains(
+            "XX.TILT.00.BJE: no records for 60 samples from 2018-01-23T09:32:02.000000Z \
+                    to 2018-01-23T09:32:07.900000Z (sample indices 200..=259"
+        ) && e.contains("gap interpolation"),
         "{e}"
     );
     let interpolate = ReadOptions {
@@ -140,7 +155,9 @@ fn gaps_follow_the_gap_policy_and_identical_overlaps_are_read_once() {
     let s = read_tilt_series(&path, &interpolate).unwrap();
     assert_eq!(s.len(), 600);
     let r = reference("gap_overlap");
-    let bje = r["channels"]["XX.TILT.00.BJE"]["samples"].as_array().unwrap();
+    let bje = r["channels"]["XX.TILT.00.BJE"]["samples"]
+        .as_array()
+        .unwrap();
     let (a, b) = (
         -1e-9 * bje[199].as_i64().unwrap() as f64,
         -1e-9 * bje[260].as_i64().unwrap() as f64,
@@ -152,7 +169,10 @@ fn gaps_follow_the_gap_policy_and_identical_overlaps_are_read_once() {
     }
     let notes = s.provenance.notes.join("\n");
     assert!(notes.contains("1 gaps (60 samples"), "{notes}");
-    assert!(notes.contains("50 samples in identical overlaps kept once"), "{notes}");
+    assert!(
+        notes.contains("50 samples in identical overlaps kept once"),
+        "{notes}"
+    );
 
     let e = read_tilt_series(
         &fixture("overlap_differs.mseed"),
@@ -170,7 +190,10 @@ fn gaps_follow_the_gap_policy_and_identical_overlaps_are_read_once() {
     let e = read_tilt_spectra(&path, &ReadOptions::default())
         .unwrap_err()
         .to_string();
-    assert!(e.contains("expected spectra but the file holds series"), "{e}");
+    assert!(
+        e.contains("expected spectra but the file holds series"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -207,7 +230,11 @@ fn budget_reads_miniseed_from_the_command_line() {
             "--scale",
             "BJE=abc",
         ],
-        &["--scale", "factor `abc` of channel `BJE`", "finite, non-zero"],
+        &[
+            "--scale",
+            "factor `abc` of channel `BJE`",
+            "finite, non-zero",
+        ],
     );
     assert_fails(
         &["budget", "--tilt", path.to_str().unwrap()],

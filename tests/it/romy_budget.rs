@@ -146,7 +146,11 @@ fn romy_miniseed_gives_the_budget_of_its_csv_export() {
     assert_eq!(p.start_time.as_deref(), Some("2018-01-23T09:31:42.000000Z"));
     assert_eq!(p.axis_map, "theta_t=-BW.ROMY.11.LJE,eta_t=-BW.ROMY.11.LJN");
     assert_eq!(
-        (from_mseed.len(), from_mseed.sample_rate_hz, &from_mseed.axes),
+        (
+            from_mseed.len(),
+            from_mseed.sample_rate_hz,
+            &from_mseed.axes
+        ),
         (from_csv.len(), from_csv.sample_rate_hz, &from_csv.axes)
     );
 

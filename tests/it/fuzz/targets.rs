@@ -17,8 +17,8 @@ use tiltnoise_core::freq::parse_spec;
 use tiltnoise_core::params::Params;
 use tiltnoise_io::input::{
     read_measured, read_measured_input, read_tilt, read_tilt_series, read_tilt_spectra, AxisMap,
-    ChannelScale, GapPolicy, MeasuredInput, Quantity, ReadOptions, TiltInput, TiltSeries, TiltSeriesSource,
-    TiltSpectra,
+    ChannelScale, GapPolicy, MeasuredInput, Quantity, ReadOptions, TiltInput, TiltSeries,
+    TiltSeriesSource, TiltSpectra,
 };
 use tiltnoise_io::{read_freq_file, read_measured_modes};
 

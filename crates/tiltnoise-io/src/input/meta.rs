@@ -120,10 +120,17 @@ pub(crate) fn series_factors(
             notes.push(super::scale_note(
                 c,
                 d.factor,
-                &format!("units `{}` to {}", d.unit, d.quantity.map_or("", |q| q.unit())),
+                &format!(
+                    "units `{}` to {}",
+                    d.unit,
+                    d.quantity.map_or("", |q| q.unit())
+                ),
             ));
         }
-        match (super::scale_for(scales, c), d.is_some_and(|d| d.quantity.is_none())) {
+        match (
+            super::scale_for(scales, c),
+            d.is_some_and(|d| d.quantity.is_none()),
+        ) {
             (Some(s), _) => {
                 factor *= s;
                 notes.push(super::scale_note(c, s, "given explicitly"));

@@ -64,7 +64,8 @@ pub fn read_tilt(path: &Path, opts: &ReadOptions) -> Result<TiltInput, InputErro
                 return Ok(TiltInput::Spectra(s));
             }
             if object.is_some() {
-                let mut src = TiltSeriesSource::from_file(&file_path, file, opts, object.as_deref())?;
+                let mut src =
+                    TiltSeriesSource::from_file(&file_path, file, opts, object.as_deref())?;
                 return src.read_all().map(TiltInput::Series);
             }
             match h5::detect_kind(path, &file, None)? {

@@ -113,7 +113,11 @@ impl TiltSeriesSource {
             &mut notes,
         )?;
         let has_rate = object.is_none() && h5::attr(path, &file, "/", "sample_rate_hz")?.is_some();
-        let sample_rate_hz = if has_rate || resolved.channels.is_empty() {
+        let gwpy = resolved
+            .channels
+            .first()
+            .is_some_and(|m| h5::is_gwpy_series(path, &group, &m.source));
+        let sample_rate_hz = if has_rate || (object.is_none() && !gwpy) {
             h5::sample_rate_hz(path, &file)?
         } else {
             gwpy_rate(path, &group, &prefix, &resolved.channels, &mut notes)?
@@ -478,7 +482,9 @@ fn gwpy_rate(
     notes.push(format!(
         "sample rate {} Hz from attribute dx = {dx} s of {name} (gwpy TimeSeries layout){}",
         1.0 / dx,
-        x0.map_or(String::new(), |x| format!("; x0 = {x} s (GPS time in gwpy's convention)"))
+        x0.map_or(String::new(), |x| format!(
+            "; x0 = {x} s (GPS time in gwpy's convention)"
+        ))
     ));
     Ok(1.0 / dx)
 }

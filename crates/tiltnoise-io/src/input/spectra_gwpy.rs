@@ -162,15 +162,17 @@ pub(crate) fn read(
             });
         }
         density = Some(this);
-        let v = ds
-            .read_raw::<f64>()
-            .map_err(h5err(path, object.clone()))?;
+        let v = ds.read_raw::<f64>().map_err(h5err(path, object.clone()))?;
         let unit_text = if this == Density::Amplitude {
             ASD_UNITS
         } else {
             CSD_UNITS
         };
-        if let Some((k, &bad)) = v.iter().enumerate().find(|(_, x)| !(x.is_finite() && **x >= 0.0)) {
+        if let Some((k, &bad)) = v
+            .iter()
+            .enumerate()
+            .find(|(_, x)| !(x.is_finite() && **x >= 0.0))
+        {
             return Err(InputError::Asd {
                 path: path.to_path_buf(),
                 location: format!("{name}[{k}]"),
@@ -192,10 +194,13 @@ pub(crate) fn read(
         ));
     }
     let freqs: Vec<f64> = keep.iter().map(|&k| x0 + k as f64 * dx).collect();
-    require_two(path, &format!("dataset {first}"), freqs.len(), "frequencies")?;
-    notes.push(
-        "gwpy spectra: axes taken as uncorrelated (off-diagonal CSD = 0)".to_string(),
-    );
+    require_two(
+        path,
+        &format!("dataset {first}"),
+        freqs.len(),
+        "frequencies",
+    )?;
+    notes.push("gwpy spectra: axes taken as uncorrelated (off-diagonal CSD = 0)".to_string());
     let power = density == Some(Density::Power);
     // values[i] belongs to resolved.channels[i]; `assemble` indexes by source index.
     let by_index = |a: usize| {

@@ -212,11 +212,19 @@ mod tests {
         )
         .unwrap_err();
         assert_eq!(e.0, Some((1, 512)));
-        assert!(e.1.contains("overlapping records differ") && e.1.contains("1.0 before, 1.5"), "{}", e.1);
+        assert!(
+            e.1.contains("overlapping records differ") && e.1.contains("1.0 before, 1.5"),
+            "{}",
+            e.1
+        );
         let mut other = rec(2, vec![2.0], 1);
         other.record.sample_rate_hz = 2.0;
         let e = merge("XX.S..LJE", vec![rec(0, vec![0.0, 1.0], 0), other]).unwrap_err();
-        assert!(e.1.contains("sample rate 2 Hz differs from the 1 Hz"), "{}", e.1);
+        assert!(
+            e.1.contains("sample rate 2 Hz differs from the 1 Hz"),
+            "{}",
+            e.1
+        );
     }
 
     #[test]

@@ -263,7 +263,12 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
         .map(|(c, &k)| c.data.len().saturating_sub(k))
         .min()
         .unwrap_or(0);
-    require_two(path, "the common span of the mapped channels", len, "samples")?;
+    require_two(
+        path,
+        "the common span of the mapped channels",
+        len,
+        "samples",
+    )?;
     let trimmed = chans
         .iter()
         .zip(&spans)
@@ -370,7 +375,10 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
             ));
         }
         let s = m.sign.factor();
-        let mut v: Vec<f64> = ch.data[k..k + len].iter().map(|x| s * (factor * x)).collect();
+        let mut v: Vec<f64> = ch.data[k..k + len]
+            .iter()
+            .map(|x| s * (factor * x))
+            .collect();
         let ctx = ChannelCtx {
             path,
             channel: &m.source,

@@ -143,9 +143,11 @@ pub(crate) fn is_v3(b: &[u8]) -> bool {
 /// record; its length says where the next one starts.
 pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
     if is_v3(b) {
-        return Err("this is a miniSEED 3 record; allowed: miniSEED 2 (SEED 2.4 data records \
+        return Err(
+            "this is a miniSEED 3 record; allowed: miniSEED 2 (SEED 2.4 data records \
                     with blockette 1000)"
-            .to_string());
+                .to_string(),
+        );
     }
     if b.len() < FIXED_HEADER {
         return Err(format!(
@@ -267,9 +269,11 @@ pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
         at = next;
     }
     let Some((encoding_code, word_order, len_exp)) = b1000 else {
-        return Err("no blockette 1000 (data only SEED blockette); allowed: miniSEED 2 \
+        return Err(
+            "no blockette 1000 (data only SEED blockette); allowed: miniSEED 2 \
                     records, which carry one"
-            .to_string());
+                .to_string(),
+        );
     };
     if !(MIN_LEN_EXP..=MAX_LEN_EXP).contains(&len_exp) {
         return Err(format!(
@@ -317,7 +321,9 @@ pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
         let data = if n > 0 { &b[data_offset..len] } else { &[][..] };
         decode_samples(encoding_code, data, n, data_order)?
     };
-    if !matches!(samples, Samples::Text) && n > 0 && !(sample_rate_hz.is_finite() && sample_rate_hz > 0.0)
+    if !matches!(samples, Samples::Text)
+        && n > 0
+        && !(sample_rate_hz.is_finite() && sample_rate_hz > 0.0)
     {
         return Err(format!(
             "sample rate {sample_rate_hz} Hz (factor {factor}, multiplier {multiplier}{}) for \
@@ -331,8 +337,8 @@ pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
     }
 
     let days = days_to_year(i64::from(year)) + i64::from(day) - 1;
-    let mut start_ns = ((days * 24 + i64::from(hour)) * 60 + i64::from(minute)) * 60
-        + i64::from(second);
+    let mut start_ns =
+        ((days * 24 + i64::from(hour)) * 60 + i64::from(minute)) * 60 + i64::from(second);
     start_ns = start_ns * NS_PER_S + i64::from(fract) * 100_000 + i64::from(usec) * 1000;
     // Bit 1 of the activity flags: the time correction is already applied.
     if activity & 0x02 == 0 {
@@ -387,8 +393,14 @@ fn decode_samples(
             let v = (0..n).map(|k| f64::from_bits(u64_at(data, 8 * k, o)));
             ("FLOAT64", Samples::Float(v.collect()))
         }
-        10 => ("Steim-1", Samples::Int(steim::decode(data, n, o, Steim::One)?)),
-        11 => ("Steim-2", Samples::Int(steim::decode(data, n, o, Steim::Two)?)),
+        10 => (
+            "Steim-1",
+            Samples::Int(steim::decode(data, n, o, Steim::One)?),
+        ),
+        11 => (
+            "Steim-2",
+            Samples::Int(steim::decode(data, n, o, Steim::Two)?),
+        ),
         other => {
             return Err(format!(
                 "encoding {other} is not supported; allowed: 1 (INT16), 3 (INT32), 4 \
@@ -435,7 +447,10 @@ mod tests {
         let ns = ((days_to_year(2018) + 22) * 86_400 + 9 * 3600 + 31 * 60 + 42) * NS_PER_S;
         assert_eq!(iso8601(ns), "2018-01-23T09:31:42.000000Z");
         assert_eq!(iso8601(-1000), "1969-12-31T23:59:59.999999Z");
-        assert_eq!(iso8601((days_to_year(2000) + 59) * 86_400 * NS_PER_S), "2000-02-29T00:00:00.000000Z");
+        assert_eq!(
+            iso8601((days_to_year(2000) + 59) * 86_400 * NS_PER_S),
+            "2000-02-29T00:00:00.000000Z"
+        );
     }
 
     #[test]

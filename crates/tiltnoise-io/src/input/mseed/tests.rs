@@ -21,10 +21,9 @@ fn groups(name: &str) -> Vec<(String, Vec<Placed>)> {
 }
 
 fn compare_with_obspy(stem: &str) -> usize {
-    let reference: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(fixture(&format!("{stem}.json"))).unwrap(),
-    )
-    .unwrap();
+    let reference: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(fixture(&format!("{stem}.json"))).unwrap())
+            .unwrap();
     let channels = reference["channels"].as_object().unwrap();
     let groups = groups(&format!("{stem}.mseed"));
     assert_eq!(groups.len(), channels.len());
