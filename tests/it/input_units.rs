@@ -175,7 +175,7 @@ fn gwpy_timeseries_in_a_group_read_by_address() {
         panic!("a series")
     };
     assert_eq!(s.data.len(), 1);
-    assert_eq!(s.data[0][4], 1e-9 * -1.0);
+    assert_eq!(s.data[0][4], 1e-9 * (-4.0 / 4.0), "N[4] = -4/4 nrad/s");
     // Without an address the error lists the datasets inside the group by path.
     let e = read_tilt(&file, &ReadOptions::default())
         .unwrap_err()

@@ -82,7 +82,7 @@ pub fn check_scales(
                 message: "is given a scale twice; allowed: once".to_string(),
             });
         }
-        if !available.iter().any(|a| *a == s.channel) {
+        if !available.contains(&s.channel) {
             return Err(InputError::Scale {
                 path: path.to_path_buf(),
                 channel: s.channel.clone(),

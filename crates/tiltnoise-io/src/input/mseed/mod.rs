@@ -58,10 +58,13 @@ fn read_bytes(path: &Path) -> Result<Vec<u8>, InputError> {
     Ok(bytes)
 }
 
+/// The records of each SEED code, in order of first appearance.
+type Groups = Vec<(String, Vec<Placed>)>;
+
 /// The data records of the file grouped by SEED code, in order of first appearance; the
 /// number of ASCII log records skipped.
-fn records(path: &Path, bytes: &[u8]) -> Result<(Vec<(String, Vec<Placed>)>, usize), InputError> {
-    let mut groups: Vec<(String, Vec<Placed>)> = Vec::new();
+fn records(path: &Path, bytes: &[u8]) -> Result<(Groups, usize), InputError> {
+    let mut groups: Groups = Vec::new();
     let mut text = 0;
     let mut offset = 0usize;
     let mut index = 0usize;

@@ -13,7 +13,7 @@ fn fixture(name: &str) -> PathBuf {
 }
 
 /// Every record of the file, grouped by SEED code in order of appearance.
-fn groups(name: &str) -> Vec<(String, Vec<Placed>)> {
+fn groups(name: &str) -> super::Groups {
     let bytes = std::fs::read(fixture(name)).unwrap();
     let (groups, text) = super::records(&fixture(name), &bytes).unwrap();
     assert_eq!(text, 0);
