@@ -295,12 +295,18 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
     let mut declared = Vec::new();
     for ch in &chans {
         match code_quantity(&ch.id) {
-            Some((q, why)) => declared.push(Declared {
-                channel: ch.id.clone(),
-                unit: format!("{} ({why})", q.unit()),
-                quantity: Some(q),
-                factor: 1.0,
-            }),
+            Some((q, why)) => {
+                notes.push(format!(
+                    "channel {}: {why} (miniSEED stores no units)",
+                    ch.id
+                ));
+                declared.push(Declared {
+                    channel: ch.id.clone(),
+                    unit: q.unit().to_string(),
+                    quantity: Some(q),
+                    factor: 1.0,
+                })
+            }
             None if opts.quantity.is_none() => {
                 return Err(fault(
                     path,
