@@ -433,12 +433,14 @@ pub fn budget(
 }
 
 /// Noise budget of X, phi and phi_a from a tilt file (the command line's ``tiltnoise budget
-/// --tilt FILE``): HDF5 or CSV time series (angle or rate) or spectra, as described in
+/// --tilt FILE``): HDF5 (``FILE.h5:/group`` addresses gwpy layouts), CSV or miniSEED time
+/// series (angle or rate) or spectra, as described in
 /// ``docs/input_formats.md``; an HDF5 series is streamed from disk in bounded memory.
 ///
 /// ``axes`` is the axis map (``"theta_t=-E,eta_t=-N"``; default from the file, else that),
 /// ``quantity`` ``"angle"``/``"rate"`` (default from the file, else angle), ``gaps``
-/// ``"reject"``/``"interpolate"``; ``freq`` is the model grid of spectra input (``"FLO:N:FHI"``
+/// ``"reject"``/``"interpolate"``, ``scale`` a dict ``{channel: factor}`` (rad or rad/s per
+/// count, required for channels in counts, applied before the axis map); ``freq`` is the model grid of spectra input (``"FLO:N:FHI"``
 /// or an array of Hz; default 1e-4..30 Hz plus points around every resonance). The Welch,
 /// segment, readout and measured options are those of :func:`budget`; series options are
 /// refused for spectra and ``freq`` for a series, as on the command line.
@@ -447,7 +449,7 @@ pub fn budget(
 /// (an ``OSError``) if it is not a valid tilt input (the message names the file, the dataset
 /// or column and what is allowed), ``ValueError`` for options that do not fit.
 #[pyfunction]
-#[pyo3(signature = (path, *, axes=None, quantity=None, gaps=None, params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, readout=None, freq=None, measured=None))]
+#[pyo3(signature = (path, *, axes=None, quantity=None, gaps=None, params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, readout=None, freq=None, measured=None, scale=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn budget_from_file(
     py: Python<'_>,
@@ -464,8 +466,15 @@ pub fn budget_from_file(
     readout: Option<&Bound<'_, PyDict>>,
     freq: Option<&Bound<'_, PyAny>>,
     measured: Option<PathBuf>,
+    scale: Option<std::collections::BTreeMap<String, f64>>,
 ) -> PyResult<Budget> {
     let (model, params) = model_of(params)?;
+    let scale = scale
+        .unwrap_or_default()
+        .iter()
+        .map(|(c, f)| format!("{c}={f:?}").parse())
+        .collect::<Result<Vec<_>, String>>()
+        .map_err(|e| value_error(format!("scale: {e}")))?;
     let ropts = ReadOptions {
         axis_map: axes
             .map(AxisMap::parse)
@@ -473,6 +482,7 @@ pub fn budget_from_file(
             .map_err(|e| value_error(e.to_string()))?,
         quantity: quantity.map(str::parse).transpose().map_err(value_error)?,
         gaps: gaps.unwrap_or("reject").parse().map_err(value_error)?,
+        scale,
     };
     let series_opts = SeriesOptions {
         nperseg,
@@ -512,7 +522,7 @@ pub fn budget_from_file(
     let (report, provenance) = py.detach(|| -> PyResult<_> {
         let streamed = match InputFormat::from_path(&path).py()? {
             InputFormat::Hdf5 => TiltSeriesSource::open(&path, &ropts).ok(),
-            InputFormat::Csv => None,
+            InputFormat::Csv | InputFormat::Miniseed => None,
         };
         let (report, provenance) = match streamed {
             Some(mut source) => {

@@ -189,4 +189,5 @@ def budget_from_file(
     readout: Optional[Mapping[str, float]] = None,
     freq: Union[str, npt.ArrayLike, None] = None,
     measured: Optional[_Path] = None,
+    scale: Optional[Mapping[str, float]] = None,
 ) -> Budget: ...

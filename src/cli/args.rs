@@ -87,12 +87,14 @@ pub fn parse_readout_item(item: &str) -> Result<(Observable, f64)> {
     Ok((o, asd))
 }
 
-/// How to read a tilt file from the `--axes MAP`, `--quantity angle|rate` and
-/// `--gaps reject|interpolate` options (each optional; gaps default to reject).
+/// How to read a tilt file from the `--axes MAP`, `--quantity angle|rate`,
+/// `--gaps reject|interpolate` and `--scale CHANNEL=FACTOR` options (each optional; gaps
+/// default to reject). The one reading of these options for every command that reads tilt.
 pub fn tilt_read_options(
     axes: Option<&str>,
     quantity: Option<&str>,
     gaps: Option<&str>,
+    scale: &[String],
 ) -> Result<ReadOptions> {
     Ok(ReadOptions {
         axis_map: axes.map(AxisMap::parse).transpose()?,
@@ -104,5 +106,10 @@ pub fn tilt_read_options(
             .unwrap_or("reject")
             .parse()
             .map_err(|e: String| anyhow!("--gaps: {e}"))?,
+        scale: scale
+            .iter()
+            .map(|s| s.parse())
+            .collect::<Result<_, String>>()
+            .map_err(|e| anyhow!("--scale: {e}"))?,
     })
 }

@@ -39,6 +39,11 @@ pub struct BudgetArgs {
     /// interior gaps.
     #[arg(long, value_name = "reject|interpolate")]
     pub gaps: Option<String>,
+    /// Scale factor of a source channel of a time series, `CHANNEL=FACTOR` (rad or rad/s per
+    /// count, or per unit of the file), applied before the axis map; required for miniSEED
+    /// channels in counts. Repeat for several channels.
+    #[arg(long, value_name = "CHANNEL=FACTOR")]
+    pub scale: Vec<String>,
     /// Welch segment length in samples (default 2^14, or the largest power of two <= N/4).
     #[arg(long, value_name = "N", allow_negative_numbers = true)]
     pub nperseg: Option<usize>,
@@ -152,25 +157,12 @@ fn parse_percentiles(text: &str) -> Result<(f64, f64)> {
 }
 
 fn read_options(args: &BudgetArgs) -> Result<ReadOptions> {
-    Ok(ReadOptions {
-        axis_map: args
-            .axes
-            .as_deref()
-            .map(tiltnoise_io::input::AxisMap::parse)
-            .transpose()?,
-        quantity: args
-            .quantity
-            .as_deref()
-            .map(str::parse)
-            .transpose()
-            .map_err(|e: String| anyhow!("--quantity: {e}"))?,
-        gaps: args
-            .gaps
-            .as_deref()
-            .unwrap_or("reject")
-            .parse()
-            .map_err(|e: String| anyhow!("--gaps: {e}"))?,
-    })
+    super::args::tilt_read_options(
+        args.axes.as_deref(),
+        args.quantity.as_deref(),
+        args.gaps.as_deref(),
+        &args.scale,
+    )
 }
 
 /// Options of a time series, refused for spectra input rather than ignored.
@@ -181,6 +173,7 @@ fn refuse_series_options(args: &BudgetArgs, path: &std::path::Path) -> Result<()
         ("--average", args.average.is_some()),
         ("--segment-duration", args.segment_duration.is_some()),
         ("--gaps", args.gaps.is_some()),
+        ("--scale", !args.scale.is_empty()),
     ];
     if let Some((name, _)) = given.iter().find(|(_, g)| *g) {
         bail!(
@@ -256,7 +249,7 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     // (which reports why an HDF5 file is not a series).
     let streamed = match InputFormat::from_path(path)? {
         InputFormat::Hdf5 => TiltSeriesSource::open(path, &ropts).ok(),
-        InputFormat::Csv => None,
+        InputFormat::Csv | InputFormat::Miniseed => None,
     };
     let (report, provenance) = if let Some(mut source) = streamed {
         refuse_spectra_options(&args, path)?;

@@ -143,6 +143,7 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
         args.axes.as_deref(),
         args.quantity.as_deref(),
         args.gaps.as_deref(),
+        &[],
     )?;
     let tilt = read_tilt_series(&args.tilt, &ropts)?;
     let opts = CoherenceOptions {

@@ -20,8 +20,8 @@ use tiltnoise_core::subtract::{
     subtract, MeasuredRecord, StartTime, Status, SubtractConfig, SubtractResult, TiltRecord,
 };
 use tiltnoise_io::input::{
-    iso8601_to_unix, read_measured_input, read_tilt, unix_to_iso8601, AxisMap, MeasuredInput,
-    ReadOptions, TiltInput,
+    iso8601_to_unix, read_measured_input, read_tilt, unix_to_iso8601, MeasuredInput, ReadOptions,
+    TiltInput,
 };
 use tiltnoise_io::{write_atomic, write_subtract_hdf5, InputMeta, RunMeta, SubtractMeta};
 use tiltnoise_plot::subtract_figure::{subtract_figure, ObservablePanel, SubtractFigureData};
@@ -170,21 +170,12 @@ fn parse_tilt_noise(items: &[String]) -> Result<Vec<(TiltAxis, f64)>> {
 }
 
 fn read_options(args: &SubtractArgs) -> Result<ReadOptions> {
-    Ok(ReadOptions {
-        axis_map: args.axes.as_deref().map(AxisMap::parse).transpose()?,
-        quantity: args
-            .quantity
-            .as_deref()
-            .map(str::parse)
-            .transpose()
-            .map_err(|e: String| anyhow!("--quantity: {e}"))?,
-        gaps: args
-            .gaps
-            .as_deref()
-            .unwrap_or("reject")
-            .parse()
-            .map_err(|e: String| anyhow!("--gaps: {e}"))?,
-    })
+    super::args::tilt_read_options(
+        args.axes.as_deref(),
+        args.quantity.as_deref(),
+        args.gaps.as_deref(),
+        &[],
+    )
 }
 
 fn start_of(path: &Path, what: &str, start: &Option<String>) -> Result<Option<StartTime>> {

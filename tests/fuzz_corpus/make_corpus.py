@@ -176,3 +176,8 @@ def zero_free_space(src, dst):
 
 zero_free_space(path("tilt_h5_bytes", "series_angle.h5"),
                 path("tilt_h5_bytes/known_hangs", "global_heap_free_space_of_size_0.h5"))
+
+# miniSEED: the synthetic fixtures of the reader (written with ObsPy by
+# tests/fixtures/input/miniseed/make_miniseed_fixtures.py).
+for name in ("gap_overlap.mseed", "little_endian.mseed"):
+    shutil.copy(os.path.join(ROOT, "tests/fixtures/input/miniseed", name), path("miniseed", name))

@@ -396,6 +396,11 @@ fn measured_csv() {
 }
 
 #[test]
+fn miniseed() {
+    fuzz(targets::MINISEED, Source::Corpus);
+}
+
+#[test]
 fn measured_modes() {
     fuzz(targets::MEASURED_MODES, Source::Corpus);
 }

@@ -95,6 +95,7 @@ fn opts(map: Option<&str>, quantity: Option<Quantity>, gaps: GapPolicy) -> ReadO
         axis_map: map.map(|m| AxisMap::parse(m).unwrap()),
         quantity,
         gaps,
+        scale: Vec::new(),
     }
 }
 

@@ -100,3 +100,123 @@ fn romy_x_tilt_noise_is_the_lever_times_eta_t_below_the_torsion_modes() {
     let ratio = (tilt[k] / s_eta).sqrt();
     assert!((ratio - 1.664).abs() < 1e-3, "|X|/|eta_t| = {ratio}");
 }
+
+/// Half a unit in the last of the 10 significant digits the ROMY CSV export prints: the most
+/// its values can differ from the float64 samples of the miniSEED file they were printed from.
+fn csv_print_bound(printed: f64) -> f64 {
+    if printed == 0.0 {
+        return 0.0;
+    }
+    let exponent = printed.abs().log10().floor();
+    0.5 * 10f64.powf(exponent - 9.0)
+}
+
+#[test]
+fn romy_miniseed_gives_the_budget_of_its_csv_export() {
+    // The verbatim miniSEED file beside the CSV export: channels chosen by SEED code, the
+    // quantity (rate) from the instrument code J, FLOAT64 samples taken as rad/s.
+    let test = "romy_miniseed_gives_the_budget_of_its_csv_export";
+    let Some(mseed) = shared_tilt_data(
+        test,
+        "romy_6c_teleseism_20180123/ROMY_gulf_of_alaska_teleseism.mseed",
+    ) else {
+        return;
+    };
+    let csv = mseed.with_extension("csv");
+    let map = AxisMap::parse("theta_t=-LJE,eta_t=-LJN").unwrap();
+    let from_mseed = read_tilt_series(
+        &mseed,
+        &ReadOptions {
+            axis_map: Some(map.clone()),
+            ..ReadOptions::default()
+        },
+    )
+    .unwrap();
+    let from_csv = read_tilt_series(
+        &csv,
+        &ReadOptions {
+            axis_map: Some(map),
+            quantity: Some(Quantity::Rate),
+            ..ReadOptions::default()
+        },
+    )
+    .unwrap();
+    let p = &from_mseed.provenance;
+    assert_eq!(p.quantity, Quantity::Rate);
+    assert_eq!(p.start_time.as_deref(), Some("2018-01-23T09:31:42.000000Z"));
+    assert_eq!(p.axis_map, "theta_t=-BW.ROMY.11.LJE,eta_t=-BW.ROMY.11.LJN");
+    assert_eq!(
+        (
+            from_mseed.len(),
+            from_mseed.sample_rate_hz,
+            &from_mseed.axes
+        ),
+        (from_csv.len(), from_csv.sample_rate_hz, &from_csv.axes)
+    );
+
+    // Sample by sample: equal within the CSV's printed precision.
+    let mut difference = from_mseed.clone();
+    for (a, (m, c)) in from_mseed.data.iter().zip(&from_csv.data).enumerate() {
+        for (k, (&x, &y)) in m.iter().zip(c).enumerate() {
+            assert!(
+                (x - y).abs() <= csv_print_bound(y),
+                "axis {a}, sample {k}: miniSEED {x:e}, CSV {y:e}"
+            );
+            difference.data[a][k] = x - y;
+        }
+    }
+
+    // The budget terms are quadratic forms of the (linear) Welch transforms of the samples, so
+    // with d = miniSEED - CSV, |P(csv + d) - P(csv)| <= 2 sqrt(P(csv) P(d)) + P(d) bin by bin
+    // (Cauchy-Schwarz over the segments), plus the pipeline's own rounding (PEAK_FLOOR).
+    let model = Model::new(&Params::table_i()).unwrap();
+    let budget_opts = BudgetOptions {
+        welch_segment_len: Some(2048),
+        ..BudgetOptions::default()
+    };
+    let budget = |s: &mut tiltnoise_io::input::TiltSeries| {
+        budget_from_series(&model, s, &budget_opts, &mut |_, _| {})
+            .unwrap()
+            .budget
+    };
+    let (mut m, mut c) = (from_mseed.clone(), from_csv.clone());
+    let (bm, bc, bd) = (budget(&mut m), budget(&mut c), budget(&mut difference));
+    assert_eq!(bm.freqs_hz, bc.freqs_hz);
+    for o in [Observable::X, Observable::Phi, Observable::PhiA] {
+        let (om, oc, od) = (
+            bm.observable(o).unwrap(),
+            bc.observable(o).unwrap(),
+            bd.observable(o).unwrap(),
+        );
+        for term in ["tilt", "tilt.theta_t", "tilt.eta_t"] {
+            let (pm, pc, pd) = (
+                &om.term_named(term).unwrap().psd,
+                &oc.term_named(term).unwrap().psd,
+                &od.term_named(term).unwrap().psd,
+            );
+            let peak = pc.iter().cloned().fold(0.0, f64::max);
+            let mut worst_rel: f64 = 0.0;
+            for k in 0..pc.len() {
+                let bound = 2.0 * (pc[k] * pd[k]).sqrt() + pd[k] + PEAK_FLOOR * peak;
+                let diff = (pm[k] - pc[k]).abs();
+                assert!(
+                    diff <= bound,
+                    "{}.{term} at {} Hz: miniSEED {:e}, CSV {:e}, bound {bound:e}",
+                    o.name(),
+                    bc.freqs_hz[k],
+                    pm[k],
+                    pc[k]
+                );
+                if pc[k] > 0.0 {
+                    worst_rel = worst_rel.max(diff / pc[k]);
+                }
+            }
+            println!(
+                "ROMY miniSEED vs CSV: {}.{term} PSD, largest relative difference {worst_rel:.2e} \
+                 over {} bins",
+                o.name(),
+                pc.len()
+            );
+        }
+    }
+}

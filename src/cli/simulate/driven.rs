@@ -17,7 +17,7 @@ use tiltnoise_core::simulate::driven::{
     drive_from_record, quasi_static_start, simulate_driven, DrivenConfig,
 };
 use tiltnoise_core::spectral::{welch, WelchConfig};
-use tiltnoise_io::input::{read_tilt, AxisMap, ReadOptions, TiltInput};
+use tiltnoise_io::input::{read_tilt, TiltInput};
 use tiltnoise_io::{write_observable_series_hdf5, OutputKind, RunMeta, SeriesAsd, SimulationMeta};
 use tiltnoise_plot::simulate_figure::{asd_figure, ModeMark, SimAsdData};
 
@@ -67,21 +67,12 @@ pub(super) fn run(
     }
     let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
     run.check_outputs(&saves, &[("--tilt", path)])?;
-    let opts = ReadOptions {
-        axis_map: args.axes.as_deref().map(AxisMap::parse).transpose()?,
-        quantity: args
-            .quantity
-            .as_deref()
-            .map(str::parse)
-            .transpose()
-            .map_err(|e: String| anyhow!("--quantity: {e}"))?,
-        gaps: args
-            .gaps
-            .as_deref()
-            .unwrap_or("reject")
-            .parse()
-            .map_err(|e: String| anyhow!("--gaps: {e}"))?,
-    };
+    let opts = crate::cli::args::tilt_read_options(
+        args.axes.as_deref(),
+        args.quantity.as_deref(),
+        args.gaps.as_deref(),
+        &[],
+    )?;
     let series = match read_tilt(path, &opts)? {
         TiltInput::Series(s) => s.into_angle(),
         TiltInput::Spectra(_) => bail!(

@@ -17,8 +17,8 @@ use tiltnoise_core::freq::parse_spec;
 use tiltnoise_core::params::Params;
 use tiltnoise_io::input::{
     read_asd_column, read_measured, read_measured_input, read_tilt, read_tilt_series,
-    read_tilt_spectra, AxisMap, GapPolicy, MeasuredInput, Quantity, ReadOptions, TiltInput,
-    TiltSeries, TiltSeriesSource, TiltSpectra,
+    read_tilt_spectra, AxisMap, ChannelScale, GapPolicy, MeasuredInput, Quantity, ReadOptions,
+    TiltInput, TiltSeries, TiltSeriesSource, TiltSpectra,
 };
 use tiltnoise_io::{read_freq_file, read_measured_modes};
 
@@ -95,8 +95,15 @@ pub const PARAMS_OVERRIDE: Target = Target {
     read: apply_overrides,
 };
 
+/// miniSEED 2 tilt series (the decoder, the merge of records, the channel selection).
+pub const MINISEED: Target = Target {
+    name: "miniseed",
+    ext: "mseed",
+    read: read_miniseed,
+};
+
 /// Every target.
-pub const ALL: [Target; 10] = [
+pub const ALL: [Target; 11] = [
     TILT_CSV,
     TILT_H5_BYTES,
     H5_STRUCTURED,
@@ -107,6 +114,7 @@ pub const ALL: [Target; 10] = [
     FREQ_SPEC,
     PARAMS_TOML,
     PARAMS_OVERRIDE,
+    MINISEED,
 ];
 
 /// Whether the promise checks with open findings run (`TILTNOISE_FUZZ_STRICT` set).
@@ -241,6 +249,30 @@ fn read_tilt_any(path: &Path) {
     }
     if let Some(s) = shown(read_tilt_spectra(path, &opts)) {
         check_spectra(&s);
+    }
+}
+
+/// The tilt readers on a miniSEED file, and once more with every channel of the seed files
+/// scaled (counts need a scale to reach the merge) and gaps bridged.
+fn read_miniseed(path: &Path) {
+    read_tilt_any(path);
+    let scale = ["BJE", "BJN", "BJZ", "BAE"]
+        .iter()
+        .map(|c| ChannelScale {
+            channel: format!("XX.TILT.00.{c}"),
+            factor: 1e-9,
+        })
+        .collect::<Vec<_>>();
+    for gaps in [GapPolicy::Reject, GapPolicy::Interpolate] {
+        let opts = ReadOptions {
+            axis_map: Some(AxisMap::parse("theta_t=-BJE,eta_t=-BJN").expect("a valid axis map")),
+            quantity: Some(Quantity::Rate),
+            gaps,
+            scale: scale.clone(),
+        };
+        if let Some(s) = shown(read_tilt_series(path, &opts)) {
+            check_series(&s);
+        }
     }
 }
 

@@ -236,11 +236,18 @@ pub struct Resolved {
 
 /// The default assignment of a channel name: tiltnoise names map to themselves; the
 /// seismological rotation channels `E`, `N`, `Z` (or SEED rotation codes `?JE`, `?JN`, `?JZ`)
-/// map with lab x = East, y = North, z = Up and the minus sign of `t = -(floor rotation)`.
+/// map with lab x = East, y = North, z = Up and the minus sign of `t = -(floor rotation)`; a
+/// full SEED code `NET.STA.LOC.CHA` maps as its channel code `CHA` does.
 pub fn default_assignment(name: &str) -> Option<(TiltAxis, Sign)> {
     if let Some(a) = TiltAxis::ALL.into_iter().find(|a| a.name() == name) {
         return Some((a, Sign::Plus));
     }
+    // A full SEED code `NET.STA.LOC.CHA` is judged by its channel code.
+    let parts: Vec<&str> = name.split('.').collect();
+    let name = match parts.as_slice() {
+        [_, _, _, cha] => cha,
+        _ => name,
+    };
     let orientation = match name.as_bytes() {
         [o] => *o,
         [band, b'J', o] if band.is_ascii_uppercase() => *o,
@@ -395,6 +402,11 @@ mod tests {
             default_assignment("BJZ"),
             Some((TiltAxis::PhiT, Sign::Minus))
         );
+        assert_eq!(
+            default_assignment("BW.ROMY.11.LJE"),
+            Some((TiltAxis::ThetaT, Sign::Minus))
+        );
+        assert_eq!(default_assignment("BW.ROMY.11.LHE"), None);
         assert_eq!(default_assignment("LHN"), None);
         assert_eq!(default_assignment("lJN"), None);
         assert_eq!(default_assignment("X"), None);

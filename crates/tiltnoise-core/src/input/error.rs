@@ -16,6 +16,14 @@ fn at_line(line: &Option<usize>) -> String {
     }
 }
 
+/// Formats an optional miniSEED record as `, record N (byte offset M)`.
+fn at_record(record: &Option<(usize, u64)>) -> String {
+    match record {
+        Some((index, offset)) => format!(", record {index} (byte offset {offset})"),
+        None => String::new(),
+    }
+}
+
 /// An input file (floor tilt, or a measured series or spectrum) that cannot be read or is not valid.
 #[derive(Debug, thiserror::Error)]
 pub enum InputError {
@@ -35,7 +43,7 @@ pub enum InputError {
     /// The extension names no supported format.
     #[error(
         "input file {path}: extension `{}` is not supported; allowed: .h5 or .hdf5 \
-         (HDF5), .csv (comma-separated text)",
+         (HDF5), .csv (comma-separated text), .mseed, .miniseed or .ms (miniSEED 2)",
         Shown(.extension)
     )]
     Extension {
@@ -498,6 +506,30 @@ pub enum InputError {
         /// What is wrong, with the values and their unit, and what is allowed, with the
         /// tolerance.
         problem: String,
+    },
+
+    /// A `--scale CHANNEL=FACTOR` that names no channel of the file, or a channel in counts
+    /// without one.
+    #[error("input file {path}: channel `{}` {message}", Shown(.channel))]
+    Scale {
+        /// The file.
+        path: PathBuf,
+        /// The channel named.
+        channel: String,
+        /// What is wrong and what is allowed.
+        message: String,
+    },
+
+    /// A miniSEED record that cannot be decoded, or records that do not form one uniformly
+    /// sampled series per channel.
+    #[error("input file {path}{}: {message}", at_record(.record))]
+    Miniseed {
+        /// The file.
+        path: PathBuf,
+        /// The record (0-based index in the file) and its byte offset, when one is at fault.
+        record: Option<(usize, u64)>,
+        /// What is wrong and what is allowed.
+        message: String,
     },
 
     /// A chunk request outside the series.

@@ -57,12 +57,14 @@
 mod axis_map;
 mod error;
 pub mod rate;
+mod scale;
 mod series;
 mod source;
 mod spectra;
 
 pub use axis_map::{resolve, AxisMap, AxisMapEntry, MapOrigin, Mapped, Resolved, Sign};
 pub use error::{require_two, InputError};
+pub use scale::{check_scales, scale_for, scale_note, ChannelScale};
 pub use series::{gap_note, process_channel, ChannelCtx, Gap, GapScanner, TiltSeries};
 pub use source::SeriesSource;
 pub use spectra::{assemble, check_csd_finite, TiltSpectra, CSD_RTOL};
@@ -83,7 +85,8 @@ pub const INPUT_SCHEMA_VERSION: i64 = 1;
 pub const ACCEPTED_LAYOUTS: &str = "HDF5 time series (root attribute sample_rate_hz, \
      one 1-D dataset per channel), HDF5 spectra (datasets /frequency_hz and /asd or /csd, root \
      attribute axes), CSV time series (header starting with time_s), CSV spectra (header \
-     starting with freq_hz); see docs/input_formats.md";
+     starting with freq_hz), miniSEED 2 time series (.mseed, .miniseed, .ms); see \
+     docs/input_formats.md";
 
 /// Physical quantity of the input channels.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -196,6 +199,9 @@ pub struct ReadOptions {
     pub quantity: Option<Quantity>,
     /// Treatment of NaN / infinite samples (time series only).
     pub gaps: GapPolicy,
+    /// Factors for source channels (time series only): required for channels in counts,
+    /// applied to the samples as read, before the axis map's sign.
+    pub scale: Vec<ChannelScale>,
 }
 
 /// File format of an input.
@@ -205,30 +211,37 @@ pub enum InputFormat {
     Hdf5,
     /// Comma-separated text (`.csv`).
     Csv,
+    /// miniSEED 2 (`.mseed`, `.miniseed`, `.ms`): a time series per SEED channel.
+    Miniseed,
 }
 
 impl InputFormat {
-    /// `hdf5` or `csv`.
+    /// `hdf5`, `csv` or `miniseed`.
     pub fn name(self) -> &'static str {
         match self {
             InputFormat::Hdf5 => "hdf5",
             InputFormat::Csv => "csv",
+            InputFormat::Miniseed => "miniseed",
         }
     }
 
-    /// The format named by the extension of `path` (case-insensitive).
+    /// The format named by the extension of `path` (case-insensitive); an HDF5 address
+    /// `FILE.h5:/group/dataset` is HDF5 ([`split_hdf5_address`]).
     ///
     /// # Errors
     ///
-    /// [`InputError::Extension`] for anything but `.h5`, `.hdf5`, `.csv`.
+    /// [`InputError::Extension`] for anything but `.h5`, `.hdf5`, `.csv`, `.mseed`,
+    /// `.miniseed`, `.ms`.
     pub fn from_path(path: &Path) -> Result<InputFormat, InputError> {
-        let ext = path
+        let (file, _) = split_hdf5_address(path);
+        let ext = file
             .extension()
             .map(|e| e.to_string_lossy().to_ascii_lowercase())
             .unwrap_or_default();
         match ext.as_str() {
             "h5" | "hdf5" => Ok(InputFormat::Hdf5),
             "csv" => Ok(InputFormat::Csv),
+            "mseed" | "miniseed" | "ms" => Ok(InputFormat::Miniseed),
             _ => Err(InputError::Extension {
                 path: path.to_path_buf(),
                 extension: ext,
@@ -340,5 +353,36 @@ impl From<&Provenance> for InputMeta {
             start_time: p.start_time.clone(),
             notes: p.notes.clone(),
         }
+    }
+}
+
+/// Splits an HDF5 address `FILE.h5:/group/dataset` (or `FILE.hdf5:/group`) into the file and
+/// the object path inside it. A path that exists as given, or has no `.h5:/` or `.hdf5:/`,
+/// is returned whole with no object.
+///
+/// ```
+/// use std::path::{Path, PathBuf};
+/// use tiltnoise_core::input::split_hdf5_address;
+/// let (file, object) = split_hdf5_address(Path::new("run/tilt.h5:/gwpy/theta"));
+/// assert_eq!((file, object.as_deref()), (PathBuf::from("run/tilt.h5"), Some("/gwpy/theta")));
+/// assert_eq!(split_hdf5_address(Path::new("tilt.h5")).1, None);
+/// ```
+pub fn split_hdf5_address(path: &Path) -> (PathBuf, Option<String>) {
+    let whole = (path.to_path_buf(), None);
+    if path.exists() {
+        return whole;
+    }
+    let text = path.to_string_lossy();
+    let lower = text.to_ascii_lowercase();
+    let found = [".h5:/", ".hdf5:/"]
+        .iter()
+        .filter_map(|m| lower.rfind(m).map(|i| (i + m.len() - 2, i + m.len() - 1)))
+        .max();
+    match found {
+        Some((colon, object)) => (
+            PathBuf::from(&text[..colon]),
+            Some(text[object..].to_string()),
+        ),
+        None => whole,
     }
 }

@@ -40,6 +40,12 @@ pub fn read_asd_column(
     match InputFormat::from_path(path)? {
         InputFormat::Csv => read_csv(path, quantity, asd_unit),
         InputFormat::Hdf5 => read_hdf5(path, quantity, asd_unit),
+        InputFormat::Miniseed => Err(InputError::UnknownLayout {
+            path: path.to_path_buf(),
+            format: "miniseed",
+            found: "a miniSEED file, which holds time series, not an ASD".to_string(),
+            accepted: "an ASD file as CSV (freq_hz, then the quantity's column or `asd`) or HDF5",
+        }),
     }
 }
 

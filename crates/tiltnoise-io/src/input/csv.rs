@@ -321,7 +321,7 @@ fn declared_units(
     path: &Path,
     prelude: &Prelude,
     mapped: &[String],
-    classify: fn(&str) -> Option<super::Quantity>,
+    classify: fn(&str) -> Option<super::meta::Unit>,
     allowed: &'static str,
 ) -> Result<(Vec<super::meta::Declared>, Vec<String>), InputError> {
     use super::meta::Declared;
@@ -371,21 +371,23 @@ fn declared_units(
                 });
             }
             seen.push(name);
-            let q = classify(unit).ok_or_else(|| bad_unit(Some(name), unit))?;
+            let u = classify(unit).ok_or_else(|| bad_unit(Some(name), unit))?;
             if mapped.iter().any(|c| c == name) {
                 declared.push(Declared {
                     channel: name.to_string(),
                     unit: unit.to_string(),
-                    quantity: q,
+                    quantity: u.quantity,
+                    factor: u.factor,
                 });
             }
         }
     } else {
-        let q = classify(&m.value).ok_or_else(|| bad_unit(None, &m.value))?;
+        let u = classify(&m.value).ok_or_else(|| bad_unit(None, &m.value))?;
         declared.extend(mapped.iter().map(|c| Declared {
             channel: c.clone(),
             unit: m.value.clone(),
-            quantity: q,
+            quantity: u.quantity,
+            factor: u.factor,
         }));
     }
     let undeclared = mapped
@@ -421,8 +423,10 @@ pub(crate) struct Interpreted {
     pub quantity: super::Quantity,
     /// The validated `# start_time:` value.
     pub start_time: Option<String>,
-    /// Axis-map, quantity and description notes, in that order.
+    /// Axis-map, quantity, factor and description notes, in that order.
     pub notes: Vec<String>,
+    /// Per mapped channel: the factor into rad or rad/s (units prefix times scale).
+    pub factors: Vec<f64>,
 }
 
 /// Interprets the prelude of a CSV input: resolves the axis map (explicit, else `# axes:`,
@@ -433,7 +437,7 @@ pub(crate) fn interpret(
     path: &Path,
     prelude: &Prelude,
     opts: &super::ReadOptions,
-    classify: fn(&str) -> Option<super::Quantity>,
+    classify: fn(&str) -> Option<super::meta::Unit>,
     allowed: &'static str,
 ) -> Result<Interpreted, InputError> {
     let file_map = axis_map(path, prelude)?;
@@ -452,6 +456,8 @@ pub(crate) fn interpret(
     let mapped: Vec<String> = resolved.channels.iter().map(|m| m.source.clone()).collect();
     let (declared, undeclared) = declared_units(path, prelude, &mapped, classify, allowed)?;
     let quantity = decide_quantity(path, opts.quantity, &declared, &undeclared, &mut notes)?;
+    super::check_scales(path, &opts.scale, &prelude.header[1..], "column")?;
+    let factors = super::meta::series_factors(path, &mapped, &declared, &opts.scale, &mut notes)?;
     let start_time = start_time(path, prelude)?;
     if let Some(d) = prelude.meta("description") {
         notes.push(format!("description: {}", Shown(&d.value)));
@@ -461,6 +467,7 @@ pub(crate) fn interpret(
         quantity,
         start_time,
         notes,
+        factors,
     })
 }
 

@@ -260,8 +260,10 @@ pub(crate) fn sample_rate_hz(path: &Path, file: &hdf5::File) -> Result<f64, Inpu
 /// The members of the root group that are, or may be, datasets: a member whose type cannot
 /// be read (a dangling soft or external link, say) is kept, so that mapping it as a channel
 /// fails when it is opened, naming it, instead of the channel being dropped silently.
-pub(crate) fn root_datasets(path: &Path, file: &hdf5::File) -> Result<Vec<String>, InputError> {
-    let names = file.member_names().map_err(h5err(path, "root group /"))?;
+pub(crate) fn root_datasets(path: &Path, file: &hdf5::Group) -> Result<Vec<String>, InputError> {
+    let names = file
+        .member_names()
+        .map_err(h5err(path, format!("group {}", file.name())))?;
     Ok(names
         .into_iter()
         .filter(|n| {
@@ -271,6 +273,54 @@ pub(crate) fn root_datasets(path: &Path, file: &hdf5::File) -> Result<Vec<String
             )
         })
         .collect())
+}
+
+/// Paths of the datasets anywhere in the file (`/group/dataset`), depth first, at most 50 (then
+/// `...`): what an error lists when the layout is not found.
+pub(crate) fn all_datasets(file: &hdf5::File) -> Vec<String> {
+    fn walk(g: &hdf5::Group, prefix: &str, out: &mut Vec<String>, depth: usize) {
+        let Ok(names) = g.member_names() else { return };
+        for n in names {
+            if out.len() > 50 {
+                return;
+            }
+            let full = format!("{prefix}/{n}");
+            match g.loc_type_by_name(&n) {
+                Ok(LocationType::Group) if depth < 8 => {
+                    if let Ok(sub) = g.group(&n) {
+                        walk(&sub, &full, out, depth + 1);
+                    }
+                }
+                Ok(LocationType::Dataset) => out.push(full),
+                _ => {}
+            }
+        }
+    }
+    let mut out = Vec::new();
+    if let Ok(root) = file.group("/") {
+        walk(&root, "", &mut out, 0);
+    }
+    if out.len() > 50 {
+        out.truncate(50);
+        out.push("...".to_string());
+    }
+    out
+}
+
+/// Whether dataset `name` of `group` carries gwpy's TimeSeries attributes (`dx`, and `xunit`
+/// `s` if it has one).
+pub(crate) fn is_gwpy_series(path: &Path, group: &hdf5::Group, name: &str) -> bool {
+    let Ok(ds) = group.dataset(name) else {
+        return false;
+    };
+    let object = format!("dataset {name}");
+    let dx = matches!(attr(path, &ds, &object, "dx"), Ok(Some(AttrValue::Num(_))));
+    let xunit = match attr(path, &ds, &object, "xunit") {
+        Ok(Some(AttrValue::Str(u))) => u.trim() == "s",
+        Ok(None) => true,
+        _ => false,
+    };
+    dx && xunit
 }
 
 /// Decides series vs spectra: root attribute `schema` if present, else `sample_rate_hz` ->
@@ -302,6 +352,13 @@ pub(crate) fn detect_kind(
             })
         }
         None => match (has_rate, has_freq) {
+            (false, false)
+                if root_datasets(path, file)?
+                    .iter()
+                    .any(|n| is_gwpy_series(path, file, n)) =>
+            {
+                InputKind::Series
+            }
             (true, false) => InputKind::Series,
             (false, true) => InputKind::Spectra,
             (true, true) => {
@@ -317,13 +374,15 @@ pub(crate) fn detect_kind(
             (false, false) => match fallback {
                 Some(kind) => kind,
                 None => {
-                    let found = root_datasets(path, file)?;
+                    let found = all_datasets(file);
                     return Err(InputError::UnknownLayout {
                         path: path.to_path_buf(),
                         format: "hdf5",
                         found: format!(
                             "neither a root attribute sample_rate_hz (required for a time \
-                             series) nor a dataset /frequency_hz (spectra); root datasets: {}",
+                             series) nor a dataset /frequency_hz (spectra) nor gwpy \
+                             TimeSeries datasets at the root (address one in a group as \
+                             FILE.h5:/group or FILE.h5:/group/dataset); datasets: {}",
                             if found.is_empty() {
                                 "(none)".to_string()
                             } else {
@@ -442,4 +501,61 @@ pub(crate) fn is_complex(ds: &hdf5::Dataset) -> hdf5::Result<(bool, String)> {
         _ => false,
     };
     Ok((ok, d.to_string()))
+}
+
+/// The group an HDF5 address names, or the parent group of the one dataset it names.
+pub(crate) struct Located {
+    pub group: hdf5::Group,
+    /// The group's path without a trailing `/` (empty for the root), to prefix dataset names.
+    pub prefix: String,
+    /// The dataset, when the address names one.
+    pub only: Option<String>,
+}
+
+/// Finds `object` (`None`: the root) in `file`.
+pub(crate) fn locate(
+    path: &Path,
+    file: &hdf5::File,
+    object: Option<&str>,
+) -> Result<Located, InputError> {
+    let (group_name, only) = match object {
+        None => ("/".to_string(), None),
+        Some(o) => match file.loc_type_by_name(o) {
+            Ok(LocationType::Group) => (o.to_string(), None),
+            Ok(LocationType::Dataset) => {
+                let (parent, name) = o.rsplit_once('/').unwrap_or(("", o));
+                let parent = if parent.is_empty() { "/" } else { parent };
+                (parent.to_string(), Some(name.to_string()))
+            }
+            _ => {
+                return Err(InputError::MissingDataset {
+                    path: path.to_path_buf(),
+                    dataset: o.to_string(),
+                    expected: format!(
+                        "a group or a dataset of the file; datasets: {}",
+                        shown_list(&all_datasets(file))
+                    ),
+                })
+            }
+        },
+    };
+    let group = file
+        .group(&group_name)
+        .map_err(h5err(path, format!("group {group_name}")))?;
+    let prefix = group_name.trim_end_matches('/').to_string();
+    Ok(Located {
+        group,
+        prefix,
+        only,
+    })
+}
+
+/// The `xunit` attribute of dataset `name` of `group` (gwpy: `s` for a TimeSeries, `Hz` for a
+/// FrequencySeries), if it has a string one.
+pub(crate) fn xunit(path: &Path, group: &hdf5::Group, name: &str) -> Option<String> {
+    let ds = group.dataset(name).ok()?;
+    match attr(path, &ds, &format!("dataset {name}"), "xunit") {
+        Ok(Some(AttrValue::Str(u))) => Some(u.trim().to_string()),
+        _ => None,
+    }
 }

@@ -54,6 +54,13 @@ pub enum MeasuredInput {
 pub fn read_measured_input(path: &Path) -> Result<MeasuredInput, InputError> {
     match InputFormat::from_path(path)? {
         InputFormat::Hdf5 => read_series_hdf5(path).map(MeasuredInput::Series),
+        InputFormat::Miniseed => Err(InputError::UnknownLayout {
+            path: path.to_path_buf(),
+            format: "miniseed",
+            found: "a miniSEED file, whose channels are named by SEED code, not by observable"
+                .to_string(),
+            accepted: "measured observables as HDF5 or CSV (X, Y, Z, theta, eta, phi, phi_a)",
+        }),
         InputFormat::Csv => {
             let (file, prelude) = CsvFile::open(path)?;
             if prelude.header.first().map(String::as_str) == Some("time_s") {

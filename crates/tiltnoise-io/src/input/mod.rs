@@ -6,8 +6,9 @@
 //!
 //! # Entry points
 //!
-//! * [`read_tilt`]: decides by extension (`.h5`/`.hdf5` vs `.csv`) and content whether the
-//!   file holds a series or spectra, and returns a [`TiltInput`].
+//! * [`read_tilt`]: decides by extension (`.h5`/`.hdf5`, `.csv`, `.mseed`/`.miniseed`/`.ms`)
+//!   and content whether the file holds a series or spectra, and returns a [`TiltInput`]
+//!   (miniSEED always holds a series).
 //! * [`read_tilt_series`] / [`read_tilt_spectra`]: the same, insisting on one kind.
 //! * [`TiltSeriesSource`]: streaming access to an HDF5 series in chunks (bounded memory), with
 //!   results bit-identical to [`read_tilt_series`]; it is a
@@ -21,9 +22,11 @@ mod csv;
 mod h5;
 mod measured;
 mod meta;
+mod mseed;
 mod series_csv;
 mod source;
 mod spectra_csv;
+mod spectra_gwpy;
 mod spectra_hdf5;
 mod start_time;
 
@@ -40,7 +43,8 @@ pub use tiltnoise_core::input::*;
 use std::path::Path;
 use tiltnoise_core::error::Shown;
 
-/// Reads a tilt input of either kind: the format from the extension (`.h5`/`.hdf5`, `.csv`),
+/// Reads a tilt input of either kind: the format from the extension (`.h5`/`.hdf5`, `.csv`,
+/// `.mseed`/`.miniseed`/`.ms`),
 /// the kind from the content (HDF5: `schema` attribute if present, else root attribute
 /// `sample_rate_hz` -> series, dataset `/frequency_hz` -> spectra; CSV: first header column
 /// `time_s` -> series, `freq_hz` -> spectra).
@@ -61,15 +65,25 @@ pub fn read_tilt(path: &Path, opts: &ReadOptions) -> Result<TiltInput, InputErro
             }
         }
         InputFormat::Hdf5 => {
-            let file = h5::open(path)?;
+            let (file_path, object) = split_hdf5_address(path);
+            let file = h5::open(&file_path)?;
+            if let Some(s) = gwpy_spectra(&file_path, &file, object.as_deref(), opts)? {
+                return Ok(TiltInput::Spectra(s));
+            }
+            if object.is_some() {
+                let mut src =
+                    TiltSeriesSource::from_file(&file_path, file, opts, object.as_deref())?;
+                return src.read_all().map(TiltInput::Series);
+            }
             match h5::detect_kind(path, &file, None)? {
                 InputKind::Series => {
-                    let mut src = TiltSeriesSource::from_file(path, file, opts)?;
+                    let mut src = TiltSeriesSource::from_file(path, file, opts, None)?;
                     src.read_all().map(TiltInput::Series)
                 }
                 InputKind::Spectra => spectra_hdf5::read(path, &file, opts).map(TiltInput::Spectra),
             }
         }
+        InputFormat::Miniseed => mseed::read(path, opts).map(TiltInput::Series),
     }
 }
 
@@ -85,6 +99,7 @@ pub fn read_tilt_series(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, I
             let mut src = TiltSeriesSource::open(path, opts)?;
             src.read_all()
         }
+        InputFormat::Miniseed => mseed::read(path, opts),
         InputFormat::Csv => match read_tilt(path, opts)? {
             TiltInput::Series(s) => Ok(s),
             TiltInput::Spectra(_) => Err(wrong_kind(path, InputKind::Series, InputKind::Spectra)),
@@ -100,7 +115,14 @@ pub fn read_tilt_series(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, I
 pub fn read_tilt_spectra(path: &Path, opts: &ReadOptions) -> Result<TiltSpectra, InputError> {
     match InputFormat::from_path(path)? {
         InputFormat::Hdf5 => {
-            let file = h5::open(path)?;
+            let (file_path, object) = split_hdf5_address(path);
+            let file = h5::open(&file_path)?;
+            if let Some(s) = gwpy_spectra(&file_path, &file, object.as_deref(), opts)? {
+                return Ok(s);
+            }
+            if object.is_some() {
+                return Err(wrong_kind(path, InputKind::Spectra, InputKind::Series));
+            }
             match h5::detect_kind(path, &file, Some(InputKind::Spectra))? {
                 InputKind::Spectra => spectra_hdf5::read(path, &file, opts),
                 InputKind::Series => Err(wrong_kind(path, InputKind::Spectra, InputKind::Series)),
@@ -113,6 +135,7 @@ pub fn read_tilt_spectra(path: &Path, opts: &ReadOptions) -> Result<TiltSpectra,
                 InputKind::Series => Err(wrong_kind(path, InputKind::Spectra, InputKind::Series)),
             }
         }
+        InputFormat::Miniseed => Err(wrong_kind(path, InputKind::Spectra, InputKind::Series)),
     }
 }
 
@@ -139,4 +162,59 @@ fn csv_kind(path: &Path, prelude: &csv::Prelude) -> Result<InputKind, InputError
             accepted: ACCEPTED_LAYOUTS,
         }),
     }
+}
+
+/// Scale factors apply to the samples of a time series; spectra refuse them rather than
+/// ignore them.
+fn no_scale_for_spectra(path: &Path, opts: &ReadOptions) -> Result<(), InputError> {
+    match opts.scale.first() {
+        None => Ok(()),
+        Some(s) => Err(InputError::Scale {
+            path: path.to_path_buf(),
+            channel: s.channel.clone(),
+            message: "is given a scale, but the file holds spectra; allowed: scales for time \
+                      series only"
+                .to_string(),
+        }),
+    }
+}
+
+/// gwpy FrequencySeries: the datasets `object` names (or the root's, when the root has neither
+/// the `sample_rate_hz` attribute nor a `/frequency_hz` dataset) whose `xunit` is `Hz`, when
+/// none is a TimeSeries (`xunit` `s`). `None` when they are not spectra of that layout.
+fn gwpy_spectra(
+    path: &Path,
+    file: &hdf5::File,
+    object: Option<&str>,
+    opts: &ReadOptions,
+) -> Result<Option<TiltSpectra>, InputError> {
+    if object.is_none() {
+        let native = h5::attr(path, file, "/", "sample_rate_hz")?.is_some()
+            || h5::attr(path, file, "/", "schema")?.is_some()
+            || h5::root_datasets(path, file)?
+                .iter()
+                .any(|n| n == "frequency_hz");
+        if native {
+            return Ok(None);
+        }
+    }
+    let loc = h5::locate(path, file, object)?;
+    let names = match &loc.only {
+        Some(n) => vec![n.clone()],
+        None => h5::root_datasets(path, &loc.group)?,
+    };
+    let units: Vec<Option<String>> = names
+        .iter()
+        .map(|n| h5::xunit(path, &loc.group, n))
+        .collect();
+    let freq: Vec<String> = names
+        .iter()
+        .zip(&units)
+        .filter(|(_, u)| u.as_deref() == Some("Hz"))
+        .map(|(n, _)| n.clone())
+        .collect();
+    if freq.is_empty() || units.iter().any(|u| u.as_deref() == Some("s")) {
+        return Ok(None);
+    }
+    spectra_gwpy::read(path, file, &loc.group, &loc.prefix, &freq, opts).map(Some)
 }

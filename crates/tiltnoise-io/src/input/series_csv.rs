@@ -1,7 +1,7 @@
 //! Tilt time series from CSV: header `time_s,CH1,CH2,...`, optional `#` metadata lines.
 
 use super::csv::{self, decimal_resolution, parse_field, CsvFile, Prelude};
-use super::meta::{series_quantity, SERIES_UNITS};
+use super::meta::{series_unit, SERIES_UNITS};
 use super::{gap_note, process_channel, ChannelCtx, TiltSeries};
 use super::{require_two, InputError};
 use super::{GapPolicy, InputFormat, InputKind, Provenance, ReadOptions};
@@ -19,7 +19,8 @@ pub(crate) fn read(
         quantity,
         start_time,
         mut notes,
-    } = csv::interpret(&path, &prelude, opts, series_quantity, SERIES_UNITS)?;
+        factors,
+    } = csv::interpret(&path, &prelude, opts, series_unit, SERIES_UNITS)?;
 
     let unit = quantity.unit();
     let mut times: Vec<f64> = Vec::new();
@@ -55,7 +56,7 @@ pub(crate) fn read(
         times.push(t);
         resolution.push(decimal_resolution(fields[0]));
         lines.push(line);
-        for (m, out) in resolved.channels.iter().zip(data.iter_mut()) {
+        for ((m, out), &factor) in resolved.channels.iter().zip(data.iter_mut()).zip(&factors) {
             let text = fields[m.index + 1];
             let raw = match parse_field(text) {
                 Ok(Some(v)) => v,
@@ -81,7 +82,7 @@ pub(crate) fn read(
                     line: Some(line),
                 });
             }
-            out.push(m.sign.factor() * raw);
+            out.push(m.sign.factor() * (factor * raw));
         }
         Ok(())
     })?;

@@ -2,7 +2,7 @@
 //! `tiltnoise.tilt_series`), chunk by chunk, in bounded memory.
 
 use super::h5::{self, h5err, AttrValue};
-use super::meta::{decide_quantity, series_quantity, Declared, SERIES_UNITS};
+use super::meta::{decide_quantity, series_factors, series_unit, Declared, SERIES_UNITS};
 use super::Mapped;
 use super::{gap_note, ChannelCtx, Gap, GapScanner, TiltSeries};
 use super::{require_two, InputError};
@@ -35,6 +35,8 @@ pub struct TiltSeriesSource {
     _file: hdf5::File,
     datasets: Vec<hdf5::Dataset>,
     channels: Vec<Mapped>,
+    /// Per channel: sign times the factor into rad or rad/s (units prefix, scale).
+    factors: Vec<f64>,
     axes: Vec<TiltAxis>,
     sample_rate_hz: f64,
     len: usize,
@@ -55,17 +57,22 @@ impl TiltSeriesSource {
     /// `docs/input_formats.md`); with gap interpolation, also the errors of the scanning pass
     /// (edge gaps).
     pub fn open(path: &Path, opts: &ReadOptions) -> Result<Self, InputError> {
-        if super::InputFormat::from_path(path)? != InputFormat::Hdf5 {
+        let format = super::InputFormat::from_path(path)?;
+        if format != InputFormat::Hdf5 {
             return Err(InputError::UnknownLayout {
                 path: path.to_path_buf(),
-                format: "csv",
-                found: "a CSV file, which cannot be streamed".to_string(),
-                accepted: "HDF5 time series (use read_tilt_series for CSV)",
+                format: format.name(),
+                found: format!("a {} file, which cannot be streamed", format.name()),
+                accepted: "HDF5 time series (use read_tilt_series for CSV or miniSEED)",
             });
         }
-        let file = h5::open(path)?;
+        let (file_path, object) = super::split_hdf5_address(path);
+        let file = h5::open(&file_path)?;
+        if object.is_some() {
+            return Self::from_file(&file_path, file, opts, object.as_deref());
+        }
         match h5::detect_kind(path, &file, Some(InputKind::Series))? {
-            InputKind::Series => Self::from_file(path, file, opts),
+            InputKind::Series => Self::from_file(path, file, opts, None),
             InputKind::Spectra => Err(InputError::WrongKind {
                 path: path.to_path_buf(),
                 expected: "series",
@@ -74,16 +81,29 @@ impl TiltSeriesSource {
         }
     }
 
+    /// Reads the series of `file`: the root's datasets (root attribute `sample_rate_hz`, or
+    /// gwpy TimeSeries attributes), or those of the group or the one dataset `object` names.
     pub(crate) fn from_file(
         path: &Path,
         file: hdf5::File,
         opts: &ReadOptions,
+        object: Option<&str>,
     ) -> Result<Self, InputError> {
-        let sample_rate_hz = h5::sample_rate_hz(path, &file)?;
         let mut notes = Vec::new();
+        let h5::Located {
+            group,
+            prefix,
+            only,
+        } = h5::locate(path, &file, object)?;
+        if let Some(o) = object {
+            notes.push(format!("HDF5 object {o} of the file"));
+        }
         let start_time = h5::start_and_description(path, &file, &mut notes)?;
         let file_map = h5::axis_map(path, &file)?;
-        let available = h5::root_datasets(path, &file)?;
+        let available = match &only {
+            Some(name) => vec![name.clone()],
+            None => h5::root_datasets(path, &group)?,
+        };
         let resolved = h5::resolve_axes(
             path,
             &available,
@@ -92,14 +112,24 @@ impl TiltSeriesSource {
             file_map.as_ref(),
             &mut notes,
         )?;
+        let has_rate = object.is_none() && h5::attr(path, &file, "/", "sample_rate_hz")?.is_some();
+        let gwpy = resolved
+            .channels
+            .first()
+            .is_some_and(|m| h5::is_gwpy_series(path, &group, &m.source));
+        let sample_rate_hz = if has_rate || (object.is_none() && !gwpy) {
+            h5::sample_rate_hz(path, &file)?
+        } else {
+            gwpy_rate(path, &group, &prefix, &resolved.channels, &mut notes)?
+        };
 
         let mut datasets = Vec::new();
         let mut declared = Vec::new();
         let mut undeclared = Vec::new();
         let mut first_len: Option<(String, usize)> = None;
         for m in &resolved.channels {
-            let name = format!("/{}", m.source);
-            let ds = file
+            let name = format!("{prefix}/{}", m.source);
+            let ds = group
                 .dataset(&m.source)
                 .map_err(h5err(path, format!("dataset {name}")))?;
             let shape = ds.shape();
@@ -128,13 +158,18 @@ impl TiltSeriesSource {
                 Some(_) => {}
             }
             let object = format!("dataset {name}");
-            match h5::attr(path, &ds, &object, "units")? {
+            let units = match h5::attr(path, &ds, &object, "units")? {
+                None => h5::attr(path, &ds, &object, "unit")?,
+                some => some,
+            };
+            match units {
                 None => undeclared.push(m.source.clone()),
-                Some(AttrValue::Str(u)) => match series_quantity(&u) {
+                Some(AttrValue::Str(u)) => match series_unit(&u) {
                     Some(q) => declared.push(Declared {
                         channel: m.source.clone(),
                         unit: u,
-                        quantity: q,
+                        quantity: q.quantity,
+                        factor: q.factor,
                     }),
                     None => {
                         return Err(InputError::Units {
@@ -157,6 +192,9 @@ impl TiltSeriesSource {
             datasets.push(ds);
         }
         let quantity = decide_quantity(path, opts.quantity, &declared, &undeclared, &mut notes)?;
+        super::check_scales(path, &opts.scale, &available, "dataset")?;
+        let mapped: Vec<String> = resolved.channels.iter().map(|m| m.source.clone()).collect();
+        let factors = series_factors(path, &mapped, &declared, &opts.scale, &mut notes)?;
         let (first_name, len) = first_len.unwrap_or_default();
         require_two(path, &format!("dataset /{first_name}"), len, "samples")?;
         check_count(
@@ -165,9 +203,11 @@ impl TiltSeriesSource {
             "samples",
             MAX_STREAMED_SAMPLES,
         )?;
-        notes.push(format!(
-            "sample rate {sample_rate_hz} Hz from root attribute sample_rate_hz"
-        ));
+        if has_rate {
+            notes.push(format!(
+                "sample rate {sample_rate_hz} Hz from root attribute sample_rate_hz"
+            ));
+        }
 
         let mut src = TiltSeriesSource {
             path: path.to_path_buf(),
@@ -175,6 +215,7 @@ impl TiltSeriesSource {
             datasets,
             axes: resolved.channels.iter().map(|m| m.axis).collect(),
             channels: resolved.channels.clone(),
+            factors,
             sample_rate_hz,
             len,
             quantity,
@@ -210,9 +251,9 @@ impl TiltSeriesSource {
             while pos < self.len {
                 let n = SCAN_BLOCK.min(self.len - pos);
                 let mut block = self.read_raw(ch, pos, n)?;
-                let s = self.channels[ch].sign.factor();
+                let (s, f) = (self.channels[ch].sign.factor(), self.factors[ch]);
                 for v in &mut block {
-                    *v *= s;
+                    *v = s * (f * *v);
                 }
                 scanner.push(&block, &ctx)?;
                 pos += n;
@@ -247,15 +288,16 @@ impl TiltSeriesSource {
     /// Signed, validated or gap-bridged samples of channel `ch`.
     fn load(&self, ch: usize, start: usize, len: usize) -> Result<Vec<f64>, InputError> {
         let mut v = self.read_raw(ch, start, len)?;
-        let s = self.channels[ch].sign.factor();
+        let (s, f) = (self.channels[ch].sign.factor(), self.factors[ch]);
         let ctx = ChannelCtx {
             path: &self.path,
             channel: &self.channels[ch].source,
             unit: self.quantity.unit(),
         };
         for (i, x) in v.iter_mut().enumerate() {
-            if x.is_finite() {
-                *x *= s;
+            let y = s * (f * *x);
+            if y.is_finite() {
+                *x = y;
             } else {
                 let k = start + i;
                 let gap = match self.policy {
@@ -366,4 +408,83 @@ impl SeriesSource for TiltSeriesSource {
     fn read_chunk(&mut self, start: usize, len: usize) -> Result<Vec<Vec<f64>>, InputError> {
         TiltSeriesSource::read_chunk(self, start, len)
     }
+}
+
+/// The sample rate of gwpy TimeSeries datasets: `1 / dx` of their attribute `dx` (s), which
+/// must be the same for every mapped dataset, as must `x0` (GPS s).
+fn gwpy_rate(
+    path: &Path,
+    group: &hdf5::Group,
+    prefix: &str,
+    channels: &[Mapped],
+    notes: &mut Vec<String>,
+) -> Result<f64, InputError> {
+    const DX: &str = "the sampling interval in s (gwpy's dx): a finite number > 0, the same for \
+                      every channel (or a root attribute sample_rate_hz)";
+    let mut first: Option<(String, f64, Option<f64>)> = None;
+    for m in channels {
+        let name = format!("{prefix}/{}", m.source);
+        let object = format!("dataset {name}");
+        let ds = group
+            .dataset(&m.source)
+            .map_err(h5err(path, object.clone()))?;
+        let dx = match h5::attr(path, &ds, &object, "dx")? {
+            Some(h5::AttrValue::Num(v)) if v.is_finite() && v > 0.0 => v,
+            None => {
+                return Err(InputError::MissingAttribute {
+                    path: path.to_path_buf(),
+                    object,
+                    attribute: "dx",
+                    expected: DX,
+                })
+            }
+            Some(other) => {
+                return Err(InputError::BadAttribute {
+                    path: path.to_path_buf(),
+                    object,
+                    attribute: "dx",
+                    value: other.describe(),
+                    allowed: DX,
+                })
+            }
+        };
+        if let Some(h5::AttrValue::Str(u)) = h5::attr(path, &ds, &object, "xunit")? {
+            if u.trim() != "s" {
+                return Err(InputError::BadAttribute {
+                    path: path.to_path_buf(),
+                    object,
+                    attribute: "xunit",
+                    value: format!("`{u}`"),
+                    allowed: "`s` (a gwpy TimeSeries; a FrequencySeries is not a tilt series)",
+                });
+            }
+        }
+        let x0 = match h5::attr(path, &ds, &object, "x0")? {
+            Some(h5::AttrValue::Num(v)) => Some(v),
+            _ => None,
+        };
+        match &first {
+            None => first = Some((name, dx, x0)),
+            Some((a, dx_a, x0_a)) => {
+                if dx != *dx_a || x0 != *x0_a {
+                    return Err(InputError::BadAttribute {
+                        path: path.to_path_buf(),
+                        object,
+                        attribute: "dx",
+                        value: format!("dx = {dx} s, x0 = {x0:?} s (dataset {a}: dx = {dx_a} s, x0 = {x0_a:?} s)"),
+                        allowed: "the same dx and x0 for every mapped dataset",
+                    });
+                }
+            }
+        }
+    }
+    let (name, dx, x0) = first.expect("at least one mapped channel");
+    notes.push(format!(
+        "sample rate {} Hz from attribute dx = {dx} s of {name} (gwpy TimeSeries layout){}",
+        1.0 / dx,
+        x0.map_or(String::new(), |x| format!(
+            "; x0 = {x} s (GPS time in gwpy's convention)"
+        ))
+    ));
+    Ok(1.0 / dx)
 }

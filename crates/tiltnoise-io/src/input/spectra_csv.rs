@@ -2,7 +2,7 @@
 //! rad/sqrt(Hz), axes uncorrelated.
 
 use super::csv::{self, parse_field, CsvFile, Prelude};
-use super::meta::{asd_quantity, ASD_UNITS};
+use super::meta::{asd_unit, ASD_UNITS};
 use super::{assemble, check_csd_finite, TiltSpectra};
 use super::{require_two, InputError};
 use super::{InputFormat, InputKind, Provenance, ReadOptions};
@@ -16,12 +16,14 @@ pub(crate) fn read(
     opts: &ReadOptions,
 ) -> Result<TiltSpectra, InputError> {
     let path = file.path.clone();
+    super::no_scale_for_spectra(&path, opts)?;
     let csv::Interpreted {
         resolved,
         quantity,
         start_time,
         mut notes,
-    } = csv::interpret(&path, &prelude, opts, asd_quantity, ASD_UNITS)?;
+        ..
+    } = csv::interpret(&path, &prelude, opts, asd_unit, ASD_UNITS)?;
     notes.push("CSV spectra: axes taken as uncorrelated (off-diagonal CSD = 0)".to_string());
     let unit = quantity.asd_unit();
 

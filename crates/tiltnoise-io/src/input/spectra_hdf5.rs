@@ -2,7 +2,7 @@
 //! `[n, n_axes]` or `/csd` `[n, n_axes, n_axes]` (complex), root attribute `axes`.
 
 use super::h5::{self, h5err, AttrValue};
-use super::meta::{asd_quantity, csd_quantity, decide_quantity, Declared, ASD_UNITS, CSD_UNITS};
+use super::meta::{asd_unit, csd_unit, decide_quantity, Declared, Unit, ASD_UNITS, CSD_UNITS};
 use super::{assemble, check_csd_finite, TiltSpectra, CSD_RTOL};
 use super::{require_two, InputError};
 use super::{InputFormat, InputKind, Provenance, Quantity, ReadOptions, ACCEPTED_LAYOUTS};
@@ -17,6 +17,7 @@ pub(crate) fn read(
     file: &hdf5::File,
     opts: &ReadOptions,
 ) -> Result<TiltSpectra, InputError> {
+    super::no_scale_for_spectra(path, opts)?;
     let mut notes = Vec::new();
     let start_time = h5::start_and_description(path, file, &mut notes)?;
     let datasets = h5::root_datasets(path, file)?;
@@ -185,7 +186,7 @@ fn units(
     path: &Path,
     ds: &hdf5::Dataset,
     name: &str,
-    classify: fn(&str) -> Option<Quantity>,
+    classify: fn(&str) -> Option<Unit>,
     allowed: &'static str,
 ) -> Result<Option<Declared>, InputError> {
     let object = format!("dataset /{name}");
@@ -201,7 +202,8 @@ fn units(
             Some(q) => Ok(Some(Declared {
                 channel: String::new(),
                 unit: u,
-                quantity: q,
+                quantity: q.quantity,
+                factor: q.factor,
             })),
             None => Err(bad(u)),
         },
@@ -216,7 +218,7 @@ struct ValuesKind {
     /// Checks the element type; returns whether it fits and the type's description.
     is_type: fn(&hdf5::Dataset) -> hdf5::Result<(bool, String)>,
     /// Recognises the units of its `units` attribute.
-    classify: fn(&str) -> Option<Quantity>,
+    classify: fn(&str) -> Option<Unit>,
     /// The accepted units, for messages.
     units_allowed: &'static str,
 }
@@ -224,14 +226,14 @@ struct ValuesKind {
 const ASD: ValuesKind = ValuesKind {
     name: "asd",
     is_type: h5::is_float,
-    classify: asd_quantity,
+    classify: asd_unit,
     units_allowed: ASD_UNITS,
 };
 
 const CSD: ValuesKind = ValuesKind {
     name: "csd",
     is_type: h5::is_complex,
-    classify: csd_quantity,
+    classify: csd_unit,
     units_allowed: CSD_UNITS,
 };
 
@@ -262,7 +264,10 @@ fn open_values(
 
 /// The quantity the `units` attribute declares; angle without one.
 fn declared_quantity(declared: &Option<Declared>) -> Quantity {
-    declared.as_ref().map_or(Quantity::Angle, |d| d.quantity)
+    declared
+        .as_ref()
+        .and_then(|d| d.quantity)
+        .unwrap_or(Quantity::Angle)
 }
 
 fn read_asd(

@@ -23,5 +23,13 @@ pub fn read_start_time(path: &Path) -> Result<Option<String>, InputError> {
             let (_, prelude) = CsvFile::open(path)?;
             start_time(path, &prelude)
         }
+        InputFormat::Miniseed => Err(InputError::UnknownLayout {
+            path: path.to_path_buf(),
+            format: "miniseed",
+            found: "a miniSEED file, whose channels are named by SEED code, not by observable"
+                .to_string(),
+            accepted: "a record of the observables as HDF5 or CSV (X, Y, Z, theta, eta, phi, \
+                       phi_a)",
+        }),
     }
 }

@@ -1,0 +1,237 @@
+//! Tilt spectra from gwpy FrequencySeries datasets (HDF5): one 1-D dataset per axis, each with
+//! gwpy's attributes `x0` (first frequency, Hz), `dx` (spacing, Hz), `xunit` (`Hz`) and `unit`
+//! (an ASD such as `rad / Hz(1/2)` or a PSD such as `rad2 / Hz`), in a group addressed as
+//! `FILE.h5:/group` (or one dataset, `FILE.h5:/group/dataset`) or at the root. The axes are
+//! taken as uncorrelated (off-diagonal CSD 0); bins at `f <= 0` (gwpy's spectra start at DC)
+//! are dropped.
+
+use super::h5::{self, h5err, AttrValue};
+use super::meta::{asd_unit, csd_unit, decide_quantity, Declared, ASD_UNITS, CSD_UNITS};
+use super::{assemble, check_csd_finite, require_two, InputError, TiltSpectra};
+use super::{InputFormat, InputKind, Provenance, ReadOptions};
+use num_complex::Complex64;
+use std::path::Path;
+
+/// Whether the values of a dataset are amplitude or power spectral densities.
+#[derive(Clone, Copy, PartialEq)]
+enum Density {
+    Amplitude,
+    Power,
+}
+
+fn num_attr(
+    path: &Path,
+    ds: &hdf5::Dataset,
+    object: &str,
+    name: &'static str,
+    allowed: &'static str,
+) -> Result<f64, InputError> {
+    match h5::attr(path, ds, object, name)? {
+        Some(AttrValue::Num(v)) if v.is_finite() => Ok(v),
+        None => Err(InputError::MissingAttribute {
+            path: path.to_path_buf(),
+            object: object.to_string(),
+            attribute: name,
+            expected: allowed,
+        }),
+        Some(other) => Err(InputError::BadAttribute {
+            path: path.to_path_buf(),
+            object: object.to_string(),
+            attribute: name,
+            value: other.describe(),
+            allowed,
+        }),
+    }
+}
+
+/// Reads the FrequencySeries `available` (dataset names) of `group` (`prefix` its path).
+pub(crate) fn read(
+    path: &Path,
+    file: &hdf5::File,
+    group: &hdf5::Group,
+    prefix: &str,
+    available: &[String],
+    opts: &ReadOptions,
+) -> Result<TiltSpectra, InputError> {
+    super::no_scale_for_spectra(path, opts)?;
+    let mut notes = vec!["gwpy FrequencySeries layout (attributes x0, dx in Hz)".to_string()];
+    let start_time = h5::start_and_description(path, file, &mut notes)?;
+    let file_map = h5::axis_map(path, file)?;
+    let resolved = h5::resolve_axes(
+        path,
+        available,
+        "dataset",
+        opts,
+        file_map.as_ref(),
+        &mut notes,
+    )?;
+    const X0: &str = "the first frequency in Hz (gwpy's x0): finite, the same for every axis";
+    const DX: &str = "the frequency spacing in Hz (gwpy's dx): finite and > 0, the same for \
+                      every axis";
+    let mut grid: Option<(String, f64, f64, usize)> = None;
+    let mut values: Vec<Vec<f64>> = Vec::new();
+    let mut declared = Vec::new();
+    let mut undeclared = Vec::new();
+    let mut density = None;
+    for m in &resolved.channels {
+        let name = format!("{prefix}/{}", m.source);
+        let object = format!("dataset {name}");
+        let ds = group
+            .dataset(&m.source)
+            .map_err(h5err(path, object.clone()))?;
+        let (float, dtype) = h5::is_float(&ds).map_err(h5err(path, object.clone()))?;
+        if ds.shape().len() != 1 || !float {
+            return Err(InputError::BadDataset {
+                path: path.to_path_buf(),
+                dataset: name,
+                found: format!("type {dtype} and shape {:?}", ds.shape()),
+                allowed: "a 1-D float dataset, one value per frequency".to_string(),
+            });
+        }
+        h5::check_storage(path, &ds, &name)?;
+        let len = ds.shape()[0];
+        h5::check_whole_read(path, &name, len, resolved.channels.len(), "frequencies")?;
+        let x0 = num_attr(path, &ds, &object, "x0", X0)?;
+        let dx = num_attr(path, &ds, &object, "dx", DX)?;
+        if dx <= 0.0 {
+            return Err(InputError::BadAttribute {
+                path: path.to_path_buf(),
+                object,
+                attribute: "dx",
+                value: format!("{dx}"),
+                allowed: DX,
+            });
+        }
+        match &grid {
+            None => grid = Some((name.clone(), x0, dx, len)),
+            Some((a, x0_a, dx_a, len_a)) => {
+                if (x0, dx, len) != (*x0_a, *dx_a, *len_a) {
+                    return Err(InputError::BadAttribute {
+                        path: path.to_path_buf(),
+                        object,
+                        attribute: "x0",
+                        value: format!(
+                            "x0 = {x0} Hz, dx = {dx} Hz, {len} values ({a}: x0 = {x0_a} Hz, dx = \
+                             {dx_a} Hz, {len_a} values)"
+                        ),
+                        allowed: "the same frequencies for every mapped dataset",
+                    });
+                }
+            }
+        }
+        let unit = match h5::attr(path, &ds, &object, "unit")? {
+            None => None,
+            Some(AttrValue::Str(u)) => Some(u),
+            Some(other) => Some(other.describe()),
+        };
+        let this = match &unit {
+            None => {
+                undeclared.push(m.source.clone());
+                Density::Amplitude
+            }
+            Some(u) => {
+                let (d, unit) = match (asd_unit(u), csd_unit(u)) {
+                    (Some(unit), _) => (Density::Amplitude, unit),
+                    (None, Some(unit)) => (Density::Power, unit),
+                    (None, None) => {
+                        return Err(InputError::Units {
+                            path: path.to_path_buf(),
+                            location: format!("attribute `unit` of {object}"),
+                            value: u.clone(),
+                            allowed: "an ASD in rad/sqrt(Hz) or rad/s/sqrt(Hz) (gwpy: \
+                                      `rad / Hz(1/2)`), or a PSD in rad^2/Hz or rad^2/s^2/Hz \
+                                      (gwpy: `rad2 / Hz`)",
+                        })
+                    }
+                };
+                declared.push(Declared {
+                    channel: m.source.clone(),
+                    unit: u.clone(),
+                    quantity: unit.quantity,
+                    factor: unit.factor,
+                });
+                d
+            }
+        };
+        if density.is_some_and(|d| d != this) {
+            return Err(InputError::Units {
+                path: path.to_path_buf(),
+                location: format!("attribute `unit` of {object}"),
+                value: unit.unwrap_or_default(),
+                allowed: "ASDs for every axis or PSDs for every axis, not both",
+            });
+        }
+        density = Some(this);
+        let v = ds.read_raw::<f64>().map_err(h5err(path, object.clone()))?;
+        let unit_text = if this == Density::Amplitude {
+            ASD_UNITS
+        } else {
+            CSD_UNITS
+        };
+        if let Some((k, &bad)) = v
+            .iter()
+            .enumerate()
+            .find(|(_, x)| !(x.is_finite() && **x >= 0.0))
+        {
+            return Err(InputError::Asd {
+                path: path.to_path_buf(),
+                location: format!("{name}[{k}]"),
+                column: m.source.clone(),
+                value: bad,
+                unit: unit_text,
+            });
+        }
+        values.push(v);
+    }
+    let quantity = decide_quantity(path, opts.quantity, &declared, &undeclared, &mut notes)?;
+    let (first, x0, dx, len) = grid.expect("resolve maps at least one channel");
+    // f_k = x0 + k dx; bins at f <= 0 are dropped.
+    let keep: Vec<usize> = (0..len).filter(|&k| x0 + k as f64 * dx > 0.0).collect();
+    if keep.len() < len {
+        notes.push(format!(
+            "{} bins at f <= 0 Hz dropped (a spectrum at DC has no tilt information here)",
+            len - keep.len()
+        ));
+    }
+    let freqs: Vec<f64> = keep.iter().map(|&k| x0 + k as f64 * dx).collect();
+    require_two(
+        path,
+        &format!("dataset {first}"),
+        freqs.len(),
+        "frequencies",
+    )?;
+    notes.push("gwpy spectra: axes taken as uncorrelated (off-diagonal CSD = 0)".to_string());
+    let power = density == Some(Density::Power);
+    // values[i] belongs to resolved.channels[i]; `assemble` indexes by source index.
+    let by_index = |a: usize| {
+        resolved
+            .channels
+            .iter()
+            .position(|m| m.index == a)
+            .expect("a mapped source")
+    };
+    let csd = assemble(&freqs, &resolved.channels, quantity, |k, a, b| {
+        if a == b {
+            let v = values[by_index(a)][keep[k]];
+            Complex64::new(if power { v } else { v * v }, 0.0)
+        } else {
+            Complex64::new(0.0, 0.0)
+        }
+    });
+    let axes: Vec<_> = resolved.channels.iter().map(|c| c.axis).collect();
+    check_csd_finite(path, &freqs, &axes, &csd)?;
+    Ok(TiltSpectra {
+        freqs_hz: freqs,
+        axes,
+        csd,
+        provenance: Provenance {
+            path: path.to_path_buf(),
+            format: InputFormat::Hdf5,
+            kind: InputKind::Spectra,
+            quantity,
+            axis_map: resolved.map.to_string(),
+            start_time,
+            notes,
+        },
+    })
+}
