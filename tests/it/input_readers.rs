@@ -1473,10 +1473,11 @@ fn interpolation_zeros_coherence_and_band_restriction() {
     assert!(none.is_empty() && empty.is_empty());
 }
 
-/// Finite values whose spectrum overflows: an ASD whose square is infinite (CSV) and an HDF5
-/// ASD of `f64::MAX` are refused by the readers, naming the entry and frequency.
+/// Finite values whose spectrum overflows: an ASD too large to square (CSV) or of `f64::MAX`
+/// (HDF5) is refused by the ASD bound, and a rate spectrum at a tiny frequency, whose division
+/// by `(2 pi f)^2` overflows, by the CSD check, naming the entry and frequency.
 #[test]
-fn spectra_that_overflow_on_squaring_are_refused() {
+fn spectra_that_overflow_are_refused() {
     let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_corpus");
     for file in [
         "tilt_csv/regressions/asd_whose_square_overflows.csv",
@@ -1486,9 +1487,21 @@ fn spectra_that_overflow_on_squaring_are_refused() {
         err_msg(
             spectra_err(&path, &ReadOptions::default()),
             &path,
-            &["tilt cross-spectral density S(", "overflows f64"],
+            &["ASD", "<= 1e150"],
         );
     }
+    let dir = tmp();
+    let rate = dir.path().join("rate.csv");
+    std::fs::write(&rate, "freq_hz,theta_t\n1e-160,1e-3\n1e-3,1e-3\n").unwrap();
+    let opts = ReadOptions {
+        quantity: Some(Quantity::Rate),
+        ..ReadOptions::default()
+    };
+    err_msg(
+        spectra_err(&rate, &opts),
+        &rate,
+        &["tilt cross-spectral density S(theta_t, theta_t) at 1e-160 Hz overflows f64"],
+    );
 }
 
 /// A contiguous dataset whose storage is shorter than its extent (a damaged file): HDF5 would
