@@ -3,7 +3,9 @@
 
 use crate::errors::{value_error, PyResultExt};
 use crate::params::PyParams;
-use numpy::{Complex64, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{
+    Complex64, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods,
+};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 use std::collections::HashMap;
@@ -12,11 +14,16 @@ use tiltnoise_core::freq::DEFAULT_F_LO_HZ;
 use tiltnoise_core::mc::{self, McConfig};
 use tiltnoise_core::model::{Coord, ForceInput, Input, Model, Observable, Request};
 use tiltnoise_core::modes::NormalModes;
-use tiltnoise_core::tf::{self, eval_grid_threads, Method, Scene, TransferFunction};
+use tiltnoise_core::tf::{self, eval_grid_threads, Destination, Method, Scene, TransferFunction};
 
 /// Share of a mode's kinetic energy above which a coordinate is listed as dominant (the
 /// command line's `modes` table and JSON).
 const DOMINANT_SHARE: f64 = 0.05;
+
+/// Grids of at most this many points are evaluated without releasing the GIL: releasing and
+/// taking it back costs more than their evaluation, which takes at most tens of microseconds
+/// with the slowest method (`statespace`, about 6 us per point).
+const HOLD_GIL_MAX_POINTS: usize = 16;
 
 /// Grids at least this long are evaluated on every core: below it, starting a thread costs
 /// more than the points it takes over (about 10 ns each).
@@ -44,6 +51,18 @@ pub struct PyModel {
     modes: OnceLock<NormalModes>,
     plans: Mutex<PlanCache>,
     choices: Mutex<ChoiceCache>,
+    last: Mutex<Option<LastPlan>>,
+}
+
+/// The plan of the last call of `transfer`: a repeated call (the same names, method, band
+/// and tolerance) finds it by comparing these, without hashing into the caches.
+struct LastPlan {
+    request: Request,
+    /// The method asked for (`None`: `auto`).
+    asked: Option<Method>,
+    /// For `auto`: the band's and the tolerance's bits (the planner's choice depends on them).
+    scene: [u64; 3],
+    plan: Arc<dyn TransferFunction>,
 }
 
 impl PyModel {
@@ -55,6 +74,7 @@ impl PyModel {
             modes: OnceLock::new(),
             plans: Mutex::new(HashMap::new()),
             choices: Mutex::new(HashMap::new()),
+            last: Mutex::new(None),
         })
     }
 
@@ -62,27 +82,19 @@ impl PyModel {
         self.modes.get_or_init(|| NormalModes::new(&self.model))
     }
 
-    /// The method `auto` takes for `request` on `freqs` (the command line's `--method auto`:
-    /// the band of the positive frequencies), remembered per request, band and tolerance.
+    /// The method `auto` takes for `request` on `band` (see [`auto_band`]) and `rel_tol`,
+    /// remembered per request, band and tolerance.
     fn auto_method(
         &self,
         py: Python<'_>,
         request: &Request,
-        freqs: &[f64],
+        band: (f64, f64),
         rel_tol: f64,
     ) -> PyResult<Method> {
-        let positive = freqs.iter().copied().filter(|&f| f > 0.0 && f.is_finite());
-        let lo = positive.clone().fold(f64::INFINITY, f64::min);
-        let hi = positive.fold(0.0, f64::max);
-        let band = if hi > 0.0 {
-            (lo, hi)
-        } else {
-            (DEFAULT_F_LO_HZ, DEFAULT_F_LO_HZ)
-        };
         let key = (
             request.inputs.clone(),
             request.outputs.clone(),
-            [band.0.to_bits(), band.1.to_bits(), rel_tol.to_bits()],
+            scene_bits(band, rel_tol),
         );
         if let Some(&m) = lock(&self.choices).get(&key) {
             return Ok(m);
@@ -98,6 +110,38 @@ impl PyModel {
             .map_err(|e| value_error(e.to_string()))?;
         lock(&self.choices).insert(key, choice.method);
         Ok(choice.method)
+    }
+
+    /// The plan `transfer` evaluates: `asked` (`None`: what `auto` picks on the band of
+    /// `freqs`), looked up in the last call's first.
+    fn plan_for(
+        &self,
+        py: Python<'_>,
+        request: Request,
+        asked: Option<Method>,
+        freqs: &[f64],
+        rel_tol: f64,
+    ) -> PyResult<Arc<dyn TransferFunction>> {
+        let band = asked.is_none().then(|| auto_band(freqs));
+        let scene = band.map_or([0; 3], |b| scene_bits(b, rel_tol));
+        if let Some(last) = lock(&self.last).as_ref() {
+            if last.asked == asked && last.scene == scene && last.request == request {
+                return Ok(Arc::clone(&last.plan));
+            }
+        }
+        let method = match (asked, band) {
+            (Some(m), _) => m,
+            (None, Some(band)) => self.auto_method(py, &request, band, rel_tol)?,
+            (None, None) => unreachable!("a band for auto"),
+        };
+        let plan = self.plan(py, &request, method)?;
+        *lock(&self.last) = Some(LastPlan {
+            request,
+            asked,
+            scene,
+            plan: Arc::clone(&plan),
+        });
+        Ok(plan)
     }
 
     /// The plan of `request` with `method`, built once per model.
@@ -125,6 +169,28 @@ impl PyModel {
 /// inserted whole), so a poisoned lock is used as it is.
 fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// The band `auto` plans for (the command line's `--method auto`): that of the positive
+/// frequencies, or the default lowest frequency when there is none.
+fn auto_band(freqs: &[f64]) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0_f64);
+    for &f in freqs {
+        if f > 0.0 && f.is_finite() {
+            lo = lo.min(f);
+            hi = hi.max(f);
+        }
+    }
+    if hi > 0.0 {
+        (lo, hi)
+    } else {
+        (DEFAULT_F_LO_HZ, DEFAULT_F_LO_HZ)
+    }
+}
+
+/// A band and a tolerance as a cache key.
+fn scene_bits(band: (f64, f64), rel_tol: f64) -> [u64; 3] {
+    [band.0.to_bits(), band.1.to_bits(), rel_tol.to_bits()]
 }
 
 /// Every name `inputs` accepts, for error messages.
@@ -237,22 +303,33 @@ fn parse_method(name: &str) -> PyResult<Option<Method>> {
         })
 }
 
-/// Frequencies (Hz) from a number or a 1-D array-like, as `f64`.
+/// Frequencies (Hz) from a number or a 1-D array-like, as `f64`: a float64 array is copied
+/// as it is; a NumPy array is asked before a number (a one-element array converts to a
+/// number only with a deprecation warning, and trying the conversion costs microseconds).
 pub fn frequencies(arg: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
-    if let Ok(f) = arg.extract::<f64>() {
-        return Ok(vec![f]);
+    if let Ok(a) = arg.cast::<PyArray1<f64>>() {
+        // SAFETY: the values are copied at once, holding the GIL, so no Python code runs
+        // meanwhile; no Rust code of this module holds a mutable view of an array here.
+        if let Ok(slice) = unsafe { a.as_slice() } {
+            return Ok(slice.to_vec());
+        }
+    } else if arg.cast::<PyUntypedArray>().is_err() {
+        if let Ok(f) = arg.extract::<f64>() {
+            return Ok(vec![f]);
+        }
     }
     let np = arg.py().import("numpy")?;
     let array = np
         .call_method1("asarray", (arg, "float64"))
         .map_err(|e| value_error(format!("freq_hz: not an array of numbers ({e})")))?;
     let array = array.cast_into::<numpy::PyArrayDyn<f64>>()?;
-    if array.ndim() != 1 {
+    if array.ndim() > 1 {
         return Err(value_error(format!(
             "freq_hz: expected a number or a 1-D array of frequencies in Hz, got {} dimensions",
             array.ndim()
         )));
     }
+    // A 0-d array is one frequency, as a number.
     Ok(array.readonly().as_array().iter().copied().collect())
 }
 
@@ -377,20 +454,25 @@ impl PyModel {
             inputs: parse_inputs(inputs)?,
             outputs: parse_outputs("outputs", outputs, &Observable::ALL)?,
         };
-        let method = parse_method(method)?;
+        let asked = parse_method(method)?;
         check_rel_tol(rel_tol)?;
         let freqs = frequencies(freq_hz)?;
-        let method = match method {
-            Some(m) => m,
-            None => self.auto_method(py, &request, &freqs, rel_tol)?,
-        };
-        let plan = self.plan(py, &request, method)?;
+        let dims = [freqs.len(), request.outputs.len(), request.inputs.len()];
+        let plan = self.plan_for(py, request, asked, &freqs, rel_tol)?;
         let threads = threads.unwrap_or(match freqs.len() >= THREADED_GRID {
             true => std::thread::available_parallelism().map_or(1, |n| n.get()),
             false => 1,
         });
-        let dims = [freqs.len(), request.outputs.len(), request.inputs.len()];
-        let h = match out {
+        let (plan, freqs) = (plan.as_ref(), freqs.as_slice());
+        let eval = |buffer: &mut [Complex64], destination| -> PyResult<()> {
+            let mut run = move || eval_grid_threads(plan, freqs, buffer, threads, destination);
+            match freqs.len() <= HOLD_GIL_MAX_POINTS {
+                true => run(),
+                false => py.detach(run),
+            }
+            .py()
+        };
+        match out {
             Some(h) => {
                 if h.shape() != dims {
                     return Err(value_error(format!(
@@ -398,23 +480,30 @@ impl PyModel {
                         h.shape()
                     )));
                 }
-                h
+                let mut rw = h
+                    .try_readwrite()
+                    .map_err(|e| value_error(format!("out: not writeable ({e})")))?;
+                eval(
+                    rw.as_slice_mut()
+                        .map_err(|_| value_error("out: must be C-contiguous"))?,
+                    Destination::Reused,
+                )?;
+                drop(rw);
+                Ok(h)
             }
-            // SAFETY: every element is written by `eval_grid_threads` before the array is
-            // returned (on error it is dropped unread), and nothing else holds the new array.
-            None => unsafe { PyArray3::<Complex64>::new(py, dims, false) },
-        };
-        {
-            let mut rw = h
-                .try_readwrite()
-                .map_err(|e| value_error(format!("out: not writeable ({e})")))?;
-            let buffer = rw
-                .as_slice_mut()
-                .map_err(|_| value_error("out: must be C-contiguous"))?;
-            py.detach(|| eval_grid_threads(plan.as_ref(), &freqs, buffer, threads))
-                .py()?;
+            None => {
+                // SAFETY: every element is written by `eval_grid_threads` before the array is
+                // returned (on error it is dropped unread).
+                let h = unsafe { PyArray3::<Complex64>::new(py, dims, false) };
+                // SAFETY: the array was just created (C-contiguous, aligned) and nothing else
+                // refers to it until it is returned, so the slice is its only reference; the
+                // borrow tracking of `try_readwrite` has nothing to guard.
+                let buffer = unsafe { h.as_slice_mut() }
+                    .map_err(|_| value_error("a new array that is not contiguous"))?;
+                eval(buffer, Destination::Fresh)?;
+                Ok(h)
+            }
         }
-        Ok(h)
     }
 
     /// Which method ``method="auto"`` picks for this request and grid, and why: every

@@ -30,12 +30,15 @@
 //! A chunk with a frequency that is not finite and >= 0, or on which a block is singular, is
 //! handed to a scalar pass over its points in order ([`Kernel::first_error`]) that returns the
 //! error of the first such point: the error a point-by-point evaluation of the grid reports.
+//! The interleaved output is also checked for values that overflowed, chunk by chunk in the
+//! buffer before it goes to memory ([`TfError::NotFinite`] at the first such point).
 
 use super::super::direct::{omega_sq, SINGULAR_RCOND};
 #[cfg(target_arch = "x86_64")]
 use super::lanes::Avx;
 use super::lanes::{stream_fence, Lanes, Portable, LANES};
 use crate::error::TfError;
+use crate::tf::Destination;
 use num_complex::Complex64;
 
 /// Interleaved outputs of at least this many bytes are written with non-temporal stores
@@ -354,16 +357,28 @@ impl Kernel {
     }
 
     /// `H` at every frequency of `freqs_hz` into `out` (`stride` values per frequency,
-    /// length `freqs_hz.len() * stride`, checked by the caller). On error the contents of
+    /// length `freqs_hz.len() * stride`, checked by the caller), every value finite: else
+    /// the error is [`TfError::NotFinite`] at the first frequency with a value that is not
+    /// (checked chunk by chunk while the values are in cache). Large outputs are written with
+    /// non-temporal stores unless `out` is [`Destination::Fresh`]. On error the contents of
     /// `out` are unspecified.
-    pub fn eval_grid(&self, freqs_hz: &[f64], out: &mut [f64]) -> Result<(), TfError> {
+    pub fn eval_grid(
+        &self,
+        freqs_hz: &[f64],
+        out: &mut [f64],
+        destination: Destination,
+    ) -> Result<(), TfError> {
         if self.stride > 0 && freqs_hz.len() == 1 {
             // One point (`eval_into`): written in place.
             out.fill(0.0);
             return self.dispatch(freqs_hz, out, &mut InPlace);
         }
         let mut chunk = self.chunk_buffer();
-        self.dispatch(freqs_hz, &mut chunk, &mut Interleaved::new(out))
+        self.dispatch(
+            freqs_hz,
+            &mut chunk,
+            &mut Interleaved::new(out, destination),
+        )
     }
 
     /// `H` at every frequency of `freqs_hz` into `planes` (`stride` of them, each as long as
@@ -434,6 +449,15 @@ impl Kernel {
             if result.is_err() {
                 break;
             }
+            // The interleaved values are checked here, in L1 cache, rather than by the caller
+            // after they went to memory; the planar ones by `tf::evaluate_into`, block by block.
+            if !S::PLANAR {
+                let values = &chunk[..fc.len() * self.stride];
+                if !all_finite::<V>(values) {
+                    result = Err(first_not_finite(fc, values, self.stride));
+                    break;
+                }
+            }
             sink.take::<V>(c * LANES, fc.len(), self.stride, chunk);
         }
         sink.finish();
@@ -485,6 +509,41 @@ impl Kernel {
     }
 }
 
+/// Whether every value is finite: `v - v` is 0 for a finite value and NaN for an infinite or
+/// NaN one, and a NaN survives the sums. Plain loops over lanes (see above).
+#[inline(always)]
+fn all_finite<V: Lanes>(values: &[f64]) -> bool {
+    let mut acc = V::splat(0.0);
+    let mut chunks = values.chunks_exact(LANES);
+    for c in chunks.by_ref() {
+        let v = V::load(c.try_into().expect("LANES values"));
+        acc = acc.add(v.sub(v));
+    }
+    let mut sum = 0.0;
+    for v in chunks.remainder() {
+        sum += v - v;
+    }
+    for x in acc.to_array() {
+        sum += x;
+    }
+    sum == 0.0
+}
+
+/// [`TfError::NotFinite`] at the first point of `freqs_hz` (`stride` values each in `values`)
+/// with a value that is not finite: an overflow (a frequency or parameters beyond the range of
+/// `f64`), never a silent NaN.
+#[cold]
+#[inline(never)]
+fn first_not_finite(freqs_hz: &[f64], values: &[f64], stride: usize) -> TfError {
+    let k = values
+        .chunks_exact(stride)
+        .position(|p| p.iter().any(|v| !v.is_finite()))
+        .expect("a value that is not finite");
+    TfError::NotFinite {
+        freq_hz: freqs_hz[k],
+    }
+}
+
 /// Where [`Kernel::eval_with`] puts each chunk of values.
 trait Sink {
     /// Each value's lanes together in the chunk buffer (else each point's values together).
@@ -513,9 +572,11 @@ struct Interleaved<'a> {
 }
 
 impl<'a> Interleaved<'a> {
-    /// Non-temporal stores for outputs of [`STREAM_MIN_BYTES`] or more.
-    fn new(out: &'a mut [f64]) -> Self {
-        let stream = std::mem::size_of_val(out) >= STREAM_MIN_BYTES;
+    /// Non-temporal stores for outputs of [`STREAM_MIN_BYTES`] or more that are not
+    /// [`Destination::Fresh`].
+    fn new(out: &'a mut [f64], destination: Destination) -> Self {
+        let stream =
+            std::mem::size_of_val(out) >= STREAM_MIN_BYTES && destination == Destination::Reused;
         Interleaved { out, stream }
     }
 }
@@ -586,8 +647,8 @@ mod tests {
 
     /// AVX and portable lanes on the same grid, bit for bit: undamped and damped (real and
     /// complex blocks), the dense and the compact kernel, interleaved and planar, a grid small
-    /// enough for ordinary stores and one large enough for the non-temporal ones, with a short
-    /// last chunk.
+    /// enough for ordinary stores and one large enough for the non-temporal ones (and the
+    /// same with ordinary stores into a fresh buffer), with a short last chunk.
     /// Skipped on a CPU without AVX.
     #[cfg(target_arch = "x86_64")]
     #[test]
@@ -619,11 +680,11 @@ mod tests {
                         .eval_with::<super::Portable, _>(
                             &freqs,
                             &mut chunk,
-                            &mut super::Interleaved::new(&mut portable),
+                            &mut super::Interleaved::new(&mut portable, super::Destination::Reused),
                         )
                         .unwrap();
                     let mut chunk = kernel.chunk_buffer();
-                    let mut sink = super::Interleaved::new(&mut avx);
+                    let mut sink = super::Interleaved::new(&mut avx, super::Destination::Reused);
                     // SAFETY: the CPU has AVX (checked above).
                     unsafe { kernel.eval_avx(&freqs, &mut chunk, &mut sink) }.unwrap();
                     for (k, (a, p)) in avx.iter().zip(&portable).enumerate() {
@@ -634,6 +695,15 @@ mod tests {
                             freqs[k / stride]
                         );
                     }
+                    // Ordinary stores into a new buffer (`Destination::Fresh`): the same values.
+                    let mut fresh = vec![f64::NAN; n * stride];
+                    kernel
+                        .eval_grid(&freqs, &mut fresh, super::Destination::Fresh)
+                        .unwrap();
+                    assert!(fresh
+                        .iter()
+                        .zip(&avx)
+                        .all(|(f, a)| f.to_bits() == a.to_bits()));
                     // The planar path (what `evaluate` uses) of the same kernel.
                     let planes_of = |avx: bool| {
                         let mut data = vec![f64::NAN; n * stride];
