@@ -14,7 +14,15 @@ use tiltnoise_core::freq::DEFAULT_F_LO_HZ;
 use tiltnoise_core::mc::{self, McConfig};
 use tiltnoise_core::model::{Coord, ForceInput, Input, Model, Observable, Request};
 use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::options;
+use tiltnoise_core::simulate::DEFAULT_MODE_ENERGY_J;
 use tiltnoise_core::tf::{self, eval_grid_threads, Destination, Method, Scene, TransferFunction};
+
+// The defaults of `transfer`, `explain` and `simulate` are written as literals in their
+// signatures, so that Python's `inspect.signature` (and the type stubs) show the numbers; they
+// are the library's defaults, as the command line's.
+const _: () = assert!(tf::DEFAULT_REL_TOL == 1e-9);
+const _: () = assert!(DEFAULT_MODE_ENERGY_J == 1e-12);
 
 /// Share of a mode's kinetic energy above which a coordinate is listed as dominant (the
 /// command line's `modes` table and JSON).
@@ -193,96 +201,39 @@ fn scene_bits(band: (f64, f64), rel_tol: f64) -> [u64; 3] {
     [band.0.to_bits(), band.1.to_bits(), rel_tol.to_bits()]
 }
 
-/// Every name `inputs` accepts, for error messages.
-fn input_names() -> String {
-    let mut names: Vec<&str> = Input::all_tilts().into_iter().map(Input::name).collect();
-    names.extend(ForceInput::ALL.iter().map(|f| f.name()));
-    format!("{}, or the groups `tilt` and `forces`", names.join(", "))
-}
-
-/// Names from a `str` (comma-separated) or a sequence of `str`.
+/// Names from a `str` (comma-separated, as on the command line) or a sequence of `str`.
 fn names(what: &str, arg: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
     let items: Vec<String> = if let Ok(s) = arg.cast::<PyString>() {
-        s.to_cow()?
-            .split(',')
-            .map(|n| n.trim().to_string())
-            .collect()
+        vec![s.to_cow()?.into_owned()]
     } else {
         arg.extract::<Vec<String>>()
             .map_err(|_| value_error(format!("{what}: expected a str or a sequence of str")))?
     };
-    if items.is_empty() || items.iter().any(String::is_empty) {
+    if items.is_empty() {
         return Err(value_error(format!(
-            "{what}: empty name (give one or more names, e.g. {})",
-            if what == "inputs" {
-                "\"eta_t\" or [\"F_b.x\", \"M_b.z\"]"
-            } else {
-                "\"X\" or [\"phi\", \"phi_a\"]"
-            }
+            "{what}: an empty sequence names nothing; give one or more names, or None for the \
+             default"
         )));
     }
     Ok(items)
 }
 
-/// `inputs` of [`PyModel::transfer`]: names as on the command line's `--input`.
+/// `inputs` of [`PyModel::transfer`]: names as on the command line's `--input`; `None`: the
+/// three tilt angles.
 fn parse_inputs(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Input>> {
-    let Some(arg) = arg else {
-        return Ok(Input::all_tilts());
-    };
-    let mut inputs: Vec<Input> = Vec::new();
-    for name in names("inputs", arg)? {
-        let group: Vec<Input> = match name.as_str() {
-            "tilt" => Input::all_tilts(),
-            "forces" => ForceInput::ALL.into_iter().map(Input::Force).collect(),
-            _ => match Input::from_name(&name) {
-                Some(i) => vec![i],
-                None => {
-                    return Err(value_error(format!(
-                        "inputs: unknown input {name:?}; allowed: {}",
-                        input_names()
-                    )))
-                }
-            },
-        };
-        for i in group {
-            if inputs.contains(&i) {
-                return Err(value_error(format!(
-                    "inputs: {} is given twice; name each input once",
-                    i.name()
-                )));
-            }
-            inputs.push(i);
-        }
+    match arg {
+        None => Ok(Input::all_tilts()),
+        Some(arg) => options::parse_inputs("inputs", &names("inputs", arg)?).py(),
     }
-    Ok(inputs)
 }
 
-/// `outputs` of [`PyModel::transfer`]: names as on the command line's `--output`.
-fn parse_outputs(
-    what: &str,
-    arg: Option<&Bound<'_, PyAny>>,
-    default: &[Observable],
-) -> PyResult<Vec<Observable>> {
-    let Some(arg) = arg else {
-        return Ok(default.to_vec());
-    };
-    let mut outputs = Vec::new();
-    for name in names(what, arg)? {
-        let Some(o) = Observable::from_name(&name) else {
-            let allowed: Vec<&str> = Observable::ALL.iter().map(|o| o.name()).collect();
-            return Err(value_error(format!(
-                "{what}: unknown observable {name:?}; allowed: {}",
-                allowed.join(", ")
-            )));
-        };
-        if outputs.contains(&o) {
-            return Err(value_error(format!(
-                "{what}: {name} is given twice; name each observable once"
-            )));
-        }
-        outputs.push(o);
+/// `outputs` of [`PyModel::transfer`]: names as on the command line's `--output`; `None`:
+/// all seven observables.
+fn parse_outputs(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Observable>> {
+    match arg {
+        None => Ok(Observable::ALL.to_vec()),
+        Some(arg) => options::parse_outputs("outputs", &names("outputs", arg)?).py(),
     }
-    Ok(outputs)
 }
 
 /// `method` of [`PyModel::transfer`]: `auto` (`None`) or a method's command-line name.
@@ -437,7 +388,7 @@ impl PyModel {
     /// name the method (``method="polezero"`` is what it picks for the tilt matrix of Table I).
     /// Raises ``ValueError`` for an unknown name, a frequency that is
     /// negative or not finite, or one on an undamped resonance.
-    #[pyo3(signature = (freq_hz, inputs=None, outputs=None, method="auto", rel_tol=tf::DEFAULT_REL_TOL, threads=None, out=None))]
+    #[pyo3(signature = (freq_hz, inputs=None, outputs=None, method="auto", rel_tol=1e-9, threads=None, out=None))]
     #[allow(clippy::too_many_arguments)]
     fn transfer<'py>(
         &self,
@@ -452,7 +403,7 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyArray3<Complex64>>> {
         let request = Request {
             inputs: parse_inputs(inputs)?,
-            outputs: parse_outputs("outputs", outputs, &Observable::ALL)?,
+            outputs: parse_outputs(outputs)?,
         };
         let asked = parse_method(method)?;
         check_rel_tol(rel_tol)?;
@@ -509,7 +460,7 @@ impl PyModel {
     /// Which method ``method="auto"`` picks for this request and grid, and why: every
     /// candidate's measured error against the double-double reference (the command line's
     /// ``tf --explain``).
-    #[pyo3(signature = (freq_hz, inputs=None, outputs=None, rel_tol=tf::DEFAULT_REL_TOL))]
+    #[pyo3(signature = (freq_hz, inputs=None, outputs=None, rel_tol=1e-9))]
     fn explain(
         &self,
         py: Python<'_>,
@@ -520,7 +471,7 @@ impl PyModel {
     ) -> PyResult<String> {
         let request = Request {
             inputs: parse_inputs(inputs)?,
-            outputs: parse_outputs("outputs", outputs, &Observable::ALL)?,
+            outputs: parse_outputs(outputs)?,
         };
         check_rel_tol(rel_tol)?;
         let scene = Scene {
@@ -624,6 +575,49 @@ impl PyModel {
         prior: bool,
     ) -> PyResult<crate::fit::Fit> {
         crate::fit::run(py, self.model.params(), free, measured, bound_sigmas, prior)
+    }
+
+    /// Free motion of the undamped model (the command line's ``tiltnoise simulate``): exact
+    /// modal propagation sampled every ``step`` seconds for ``duration`` seconds, white
+    /// readout noise, one-sided Welch ASDs and the resonance check. Returns a
+    /// :class:`Simulation`.
+    ///
+    /// The initial state: ``kick_x`` (m), the paper's kick test (the test mass displaced
+    /// statically along X and released from rest); or ``init`` / ``init_rate``, coordinates
+    /// and rates as a dict ``{"theta_a": 1e-5, "phi_b": 0.01}`` or the command line's
+    /// ``"theta_a=1e-5,phi_b=0.01"`` (rad, m; rad/s, m/s; unlisted ones 0); default: the
+    /// energy ``mode_energy`` (J) in each of the eight modes. ``readout``: ``{observable:
+    /// ASD}`` over the default ``{"X": 9e-9}`` (unit/sqrt(Hz); 0 removes one); ``seed`` of
+    /// the noise; ``nperseg``: Welch segment (default the largest power of two <= n/3).
+    /// Raises ``ValueError`` for a damped model or options that do not fit, with the command
+    /// line's messages.
+    #[pyo3(signature = (duration=43_200.0, step=0.1, *, init=None, init_rate=None, kick_x=None, mode_energy=1e-12, readout=None, seed=0, nperseg=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn simulate(
+        &self,
+        py: Python<'_>,
+        duration: f64,
+        step: f64,
+        init: Option<&Bound<'_, PyAny>>,
+        init_rate: Option<&Bound<'_, PyAny>>,
+        kick_x: Option<f64>,
+        mode_energy: f64,
+        readout: Option<&Bound<'_, PyDict>>,
+        seed: u64,
+        nperseg: Option<usize>,
+    ) -> PyResult<crate::simulate::Simulation> {
+        let args = crate::simulate::SimulateArgs {
+            duration,
+            step,
+            init,
+            init_rate,
+            kick_x,
+            mode_energy,
+            readout,
+            seed,
+            nperseg,
+        };
+        crate::simulate::run(py, &self.model, args)
     }
 
     fn __repr__(&self) -> String {

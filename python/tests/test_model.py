@@ -133,7 +133,8 @@ def test_monte_carlo_equals_the_command_lines(model, cli):
     [
         ({"inputs": "F_c.x"}, ["unknown input", "F_c.x", "M_b.z", "theta_t"]),
         ({"inputs": "tilt,eta_t"}, ["eta_t is given twice"]),
-        ({"inputs": ""}, ["inputs: empty name"]),
+        ({"inputs": ""}, ["inputs \"\": empty name in the list"]),
+        ({"inputs": []}, ["inputs: an empty sequence names nothing"]),
         ({"outputs": "x"}, ["unknown observable", "phi_a"]),
         ({"method": "fast"}, ["unknown method", "polezero"]),
         ({"rel_tol": 0.0}, ["rel_tol", "(0, 1)"]),

@@ -4,20 +4,18 @@
 use super::args::{parse_readout_item, AverageArg};
 use super::output::save_budget;
 use super::Run;
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, Context, Result};
 use clap::Args;
 use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use tiltnoise_core::budget::{
-    add_measured, budget_from_series, budget_from_spectra, loglog_at, series_psds, BudgetOptions,
-    MeasuredPsds,
-};
-use tiltnoise_core::error::Shown;
+use tiltnoise_core::budget::option_checks::{self, InputKind};
+use tiltnoise_core::budget::{budget_from_series, budget_from_spectra, loglog_at, BudgetOptions};
 use tiltnoise_core::freq;
-use tiltnoise_core::model::Model;
+use tiltnoise_core::model::{Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::noise::{BudgetReport, Readout, TermKind};
+use tiltnoise_core::options::{self, Spelling};
 use tiltnoise_core::params::Params;
 use tiltnoise_core::spectral::Averaging;
 use tiltnoise_io::input::{read_tilt, InputFormat, ReadOptions, TiltInput, TiltSeriesSource};
@@ -77,34 +75,33 @@ pub struct BudgetArgs {
 /// Frequencies (Hz) at which the terminal summary reads the budget.
 const SUMMARY_FREQS_HZ: [f64; 3] = [1e-3, 2e-3, 5e-3];
 
-fn parse_readout(items: &[String]) -> Result<Readout> {
-    let mut readout = Readout::default();
-    for item in items {
-        let (o, asd) = parse_readout_item(item)?;
-        readout.asd.retain(|(x, _)| *x != o);
-        if asd > 0.0 {
-            readout.asd.push((o, asd));
-        }
-    }
-    Ok(readout)
+/// The readout of `--readout` items over the default, on budgeted observables only.
+fn parse_readout(items: &[String], budgeted: &[Observable]) -> Result<Readout> {
+    let items: Vec<(Observable, f64)> = items
+        .iter()
+        .map(|i| parse_readout_item(i))
+        .collect::<Result<_>>()?;
+    Ok(options::apply_readout(
+        "--readout",
+        Readout::default(),
+        &items,
+        Some(budgeted),
+    )?)
 }
 
 fn parse_percentiles(text: &str) -> Result<(f64, f64)> {
-    let err = || {
-        anyhow!(
-            "--percentiles {}: expected LOWER,UPPER with 0 <= LOWER < UPPER <= 100",
-            Shown(text)
-        )
-    };
+    let err = || option_checks::percentiles_error(Spelling::Flag, text);
     let (a, b) = text.split_once(',').ok_or_else(err)?;
     let (a, b): (f64, f64) = (
         a.trim().parse().map_err(|_| err())?,
         b.trim().parse().map_err(|_| err())?,
     );
-    if !(0.0 <= a && a < b && b <= 100.0) {
-        return Err(err());
-    }
-    Ok((a, b))
+    Ok(option_checks::check_percentiles(
+        Spelling::Flag,
+        text,
+        a,
+        b,
+    )?)
 }
 
 fn read_options(args: &BudgetArgs) -> Result<ReadOptions> {
@@ -167,35 +164,43 @@ fn summary(report: &BudgetReport) -> String {
     s
 }
 
+/// The options given that apply to one kind of input only (snake case).
+fn kind_options_given(args: &BudgetArgs) -> Vec<&'static str> {
+    [
+        ("nperseg", args.nperseg.is_some()),
+        ("overlap", args.overlap.is_some()),
+        ("average", args.average.is_some()),
+        ("segment_duration", args.segment_duration.is_some()),
+        ("gaps", args.gaps.is_some()),
+        ("freq", args.freq.is_some()),
+    ]
+    .into_iter()
+    .filter_map(|(name, given)| given.then_some(name))
+    .collect()
+}
+
 /// Options of a time series, refused for spectra input rather than ignored.
 fn refuse_series_options(args: &BudgetArgs, path: &std::path::Path) -> Result<()> {
-    let given = [
-        ("--nperseg", args.nperseg.is_some()),
-        ("--overlap", args.overlap.is_some()),
-        ("--average", args.average.is_some()),
-        ("--segment-duration", args.segment_duration.is_some()),
-        ("--gaps", args.gaps.is_some()),
-    ];
-    if let Some((name, _)) = given.iter().find(|(_, g)| *g) {
-        bail!(
-            "{name} applies to time-series input, and {} holds spectra; leave it out (the \
-             model grid of spectra input is set with --freq)",
-            path.display()
-        );
-    }
-    Ok(())
+    let source = path.display().to_string();
+    let (given, kind) = (kind_options_given(args), InputKind::Spectra);
+    Ok(option_checks::refuse_options_for_input(
+        &given,
+        kind,
+        &source,
+        Spelling::Flag,
+    )?)
 }
 
 /// Options of spectra input, refused for a time series rather than ignored.
 fn refuse_spectra_options(args: &BudgetArgs, path: &std::path::Path) -> Result<()> {
-    if args.freq.is_some() {
-        bail!(
-            "--freq applies to spectra input, and {} holds a time series, whose budget is on \
-             the Welch grid (set its resolution with --nperseg)",
-            path.display()
-        );
-    }
-    Ok(())
+    let source = path.display().to_string();
+    let (given, kind) = (kind_options_given(args), InputKind::Series);
+    Ok(option_checks::refuse_options_for_input(
+        &given,
+        kind,
+        &source,
+        Spelling::Flag,
+    )?)
 }
 
 /// Runs `tiltnoise budget`.
@@ -208,29 +213,12 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     inputs.extend(args.measured.as_deref().map(|p| ("--measured", p)));
     run.check_outputs(&saves, &inputs)?;
     let model = Model::new(params)?;
-    if args.percentiles.is_some() && args.segment_duration.is_none() {
-        bail!(
-            "--percentiles applies to the per-segment band and needs --segment-duration \
-             (e.g. --segment-duration 3600)"
-        );
+    if args.percentiles.is_some() {
+        let given = args.segment_duration.is_some();
+        option_checks::require_segments_for_percentiles(Spelling::Flag, given)?;
     }
     let defaults = BudgetOptions::default();
-    let readout = parse_readout(&args.readout)?;
-    for (o, _) in &readout.asd {
-        if !defaults.outputs.contains(o) {
-            bail!(
-                "--readout {}=...: {} is not budgeted; allowed: {}",
-                o.name(),
-                o.name(),
-                defaults
-                    .outputs
-                    .iter()
-                    .map(|o| o.name())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            );
-        }
-    }
+    let readout = parse_readout(&args.readout, &defaults.outputs)?;
     let opts = BudgetOptions {
         welch_segment_len: args.nperseg,
         welch_overlap_fraction: args.overlap.unwrap_or(defaults.welch_overlap_fraction),
@@ -286,7 +274,7 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     };
     let mut report = report.with_context(|| format!("budget of {}", path.display()))?;
     if let Some(measured) = &args.measured {
-        add_measured_file(&mut report, measured)?;
+        tiltnoise_io::input::add_measured_file(&mut report, measured, "--measured")?;
     }
     for note in &provenance.notes {
         writeln!(run.out, "input: {note}")?;
@@ -300,36 +288,6 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
         }
         Ok(())
     })
-}
-
-/// Adds the `measured` and `residual` terms from `--measured FILE`: a CSV of ASDs is
-/// interpolated log-log onto the budget grid (NaN where it does not reach); a time series of
-/// the observables (HDF5 from `tiltnoise simulate`, or CSV `time_s,...`) is first turned into
-/// one-sided PSDs by [`series_psds`].
-fn add_measured_file(report: &mut BudgetReport, path: &std::path::Path) -> Result<()> {
-    use tiltnoise_io::input::MeasuredInput;
-    let (freqs_hz, psds, what) = match tiltnoise_io::input::read_measured_input(path)? {
-        MeasuredInput::Spectra(m) => {
-            let psds = m
-                .asd
-                .iter()
-                .map(|(o, asd)| (*o, asd.iter().map(|a| a * a).collect()))
-                .collect();
-            (m.freqs_hz, psds, "measured spectrum".to_string())
-        }
-        MeasuredInput::Series(series) => {
-            let m = series_psds(&series.channels, series.sample_rate_hz, &report.source)
-                .with_context(|| format!("--measured {}", path.display()))?;
-            (m.freqs_hz, m.psds, m.description)
-        }
-    };
-    let measured = MeasuredPsds {
-        freqs_hz,
-        psds,
-        description: what,
-    };
-    add_measured(report, &measured, &path.display().to_string());
-    Ok(())
 }
 
 /// A progress bar on stderr when it is a terminal and the input is long enough to wait for.

@@ -5,28 +5,27 @@
 
 use super::output::save_image;
 use super::Run;
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use tiltnoise_core::error::{Num, Shown};
-use tiltnoise_core::model::{Coord, Model, Observable};
+use tiltnoise_core::model::{Model, Observable};
 use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::noise::Readout;
+use tiltnoise_core::options::{self, Spelling};
 use tiltnoise_core::params::Params;
 use tiltnoise_core::simulate::resonance::check_resonances;
 use tiltnoise_core::simulate::{
-    aliased_frequency_hz, check_samples, equal_energy_init, kick_x, simulate_with_progress,
-    InitialState, ModalPropagator, SimConfig, Simulation, DEFAULT_MODE_ENERGY_J,
+    aliased_frequency_hz, check_sampling, describe_run, parse_coordinates, readout_text,
+    record_description, simulate_with_progress, Excitation, InitialState, ModalPropagator,
+    SimConfig, Simulation, DEFAULT_MODE_ENERGY_J,
 };
 use tiltnoise_core::spectral::{welch, WelchConfig};
 use tiltnoise_io::{write_observable_series_hdf5, OutputKind, RunMeta, SeriesAsd, SimulationMeta};
 use tiltnoise_plot::simulate_figure::{
     asd_figure, time_series_figure, ModeMark, SimAsdData, TimePanel, TimeSeriesData,
 };
-
-/// Default readout: the paper's 9 nm/sqrt(Hz) on X (the angles are noiseless unless given).
-const DEFAULT_X_READOUT_ASD_M: f64 = 9e-9;
 
 /// Runs with at least this many samples get a progress bar on a terminal (about 2 s of work).
 const WORTH_A_BAR: usize = 1 << 23;
@@ -93,127 +92,34 @@ pub(crate) struct SimulateArgs {
 }
 
 fn parse_readout(items: &[String]) -> Result<Vec<(Observable, f64)>> {
-    let mut readout = vec![(Observable::X, DEFAULT_X_READOUT_ASD_M)];
-    for item in items {
-        let (o, asd) = super::args::parse_readout_item(item)?;
-        readout.retain(|(x, _)| *x != o);
-        if asd > 0.0 {
-            readout.push((o, asd));
-        }
-    }
+    let items: Vec<(Observable, f64)> = items
+        .iter()
+        .map(|i| super::args::parse_readout_item(i))
+        .collect::<Result<_>>()?;
+    let mut readout = options::apply_readout("--readout", Readout::default(), &items, None)?.asd;
     readout.sort_by_key(|(o, _)| o.index());
     Ok(readout)
 }
 
-/// Parses `COORD=VALUE,...` lists into `out` (SI units).
-fn parse_coords(option: &str, items: &[String], out: &mut [f64; 8]) -> Result<()> {
-    let names: Vec<&str> = Coord::ALL.iter().map(|c| c.name()).collect();
-    let mut given = [false; 8];
-    for item in items {
-        for entry in item.split(',').map(str::trim).filter(|e| !e.is_empty()) {
-            let shown = Shown(entry);
-            let (name, value) = entry.split_once('=').ok_or_else(|| {
-                anyhow!("{option} {shown}: expected COORD=VALUE, e.g. phi_b=0.01")
-            })?;
-            let c = Coord::ALL
-                .into_iter()
-                .find(|c| c.name() == name.trim())
-                .ok_or_else(|| {
-                    anyhow!(
-                        "{option} {shown}: unknown coordinate `{}`; allowed: {}",
-                        Shown(name.trim()),
-                        names.join(", ")
-                    )
-                })?;
-            let unit = if option == "--init" {
-                c.unit().to_string()
-            } else {
-                format!("{}/s", c.unit())
-            };
-            let v: f64 = value.trim().parse().map_err(|_| {
-                anyhow!(
-                    "{option} {shown}: `{}` is not a number",
-                    Shown(value.trim())
-                )
-            })?;
-            if !v.is_finite() {
-                bail!("{option} {shown}: {v} {unit} is not allowed: must be finite");
-            }
-            if given[c.index()] {
-                bail!("{option} {shown}: coordinate `{}` is given twice", c.name());
-            }
-            given[c.index()] = true;
-            out[c.index()] = v;
-        }
-    }
-    Ok(())
-}
-
-/// Default Welch segment: the largest power of two <= n / 3 (at least 5 half-overlapping
-/// segments), at least 2.
-fn default_nperseg(n: usize) -> usize {
-    let third = (n / 3).max(2);
-    1 << third.ilog2()
-}
-
 /// The run's initial state and a description of where it came from.
 fn initial_state(model: &Model, args: &SimulateArgs) -> Result<(InitialState, String)> {
-    if let Some(x) = args.kick_x {
-        if !(x.is_finite() && x != 0.0) {
-            bail!("--kick-x {x}: the displacement (m) must be finite and non-zero");
+    let excitation = if let Some(x_m) = args.kick_x {
+        Excitation::KickX { x_m }
+    } else if !args.init.is_empty() || !args.init_rate.is_empty() {
+        let (mut q, mut qdot) = ([0.0; 8], [0.0; 8]);
+        parse_coordinates("--init", &args.init, false, &mut q)?;
+        parse_coordinates("--init-rate", &args.init_rate, true, &mut qdot)?;
+        Excitation::Given { q, qdot }
+    } else {
+        Excitation::EqualEnergy {
+            energy_j: args.mode_energy,
         }
-        let init = kick_x(model, x);
-        if init.q.iter().any(|v| !v.is_finite()) {
-            bail!(
-                "--kick-x {x}: X does not respond statically to a force on the test mass along \
-                 x for these parameters, so the kick is undefined"
-            );
-        }
-        if let Err(e) = tiltnoise_core::simulate::check_initial_state(&init) {
-            bail!(
-                "--kick-x {} m: the static deflection it starts from is outside the linear \
-                 model ({e})",
-                tiltnoise_core::error::Num(x)
-            );
-        }
-        return Ok((
-            init,
-            format!("kick: static X displacement of {x:e} m released from rest"),
-        ));
-    }
-    if !args.init.is_empty() || !args.init_rate.is_empty() {
-        let mut init = InitialState {
-            q: [0.0; 8],
-            qdot: [0.0; 8],
-        };
-        parse_coords("--init", &args.init, &mut init.q)?;
-        parse_coords("--init-rate", &args.init_rate, &mut init.qdot)?;
-        if init.q.iter().chain(&init.qdot).all(|&v| v == 0.0) {
-            bail!("--init/--init-rate: every coordinate and rate is 0: nothing moves");
-        }
-        let mut text = String::from("given:");
-        for c in Coord::ALL {
-            let (q, v) = (init.q[c.index()], init.qdot[c.index()]);
-            if q != 0.0 || v != 0.0 {
-                let _ = write!(
-                    text,
-                    " {}={q:e} {}, rate {v:e} {}/s;",
-                    c.name(),
-                    c.unit(),
-                    c.unit()
-                );
-            }
-        }
-        return Ok((init, text.trim_end_matches(';').to_string()));
-    }
-    let e = args.mode_energy;
-    if !(e.is_finite() && e > 0.0) {
-        bail!("--mode-energy {e}: the energy per mode (J) must be finite and > 0");
-    }
-    Ok((
-        equal_energy_init(model, e),
-        format!("equal energy {e:e} J in each of the 8 modes, phases 0.7 + 1.3 k rad"),
-    ))
+    };
+    Ok(tiltnoise_core::simulate::initial_state(
+        model,
+        &excitation,
+        Spelling::Flag,
+    )?)
 }
 
 /// Runs `tiltnoise simulate`.
@@ -226,50 +132,7 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
              loss.*_rad to 0, e.g. with --set"
         );
     }
-    if !(args.step.is_finite() && args.step > 0.0) {
-        bail!(
-            "--step {}: the sampling step (s) must be finite and > 0",
-            args.step
-        );
-    }
-    if !(args.duration.is_finite() && args.duration > 0.0) {
-        bail!(
-            "--duration {}: the duration (s) must be finite and > 0",
-            args.duration
-        );
-    }
-    let n_f = (args.duration / args.step * (1.0 + 1e-9)).floor();
-    if n_f < 2.0 {
-        bail!(
-            "--duration {} s at --step {} s gives {n_f} sample(s): at least 2 are needed",
-            args.duration,
-            args.step
-        );
-    }
-    check_samples(
-        || {
-            format!(
-                "--duration {} s at --step {} s",
-                Num(args.duration),
-                Num(args.step)
-            )
-        },
-        n_f,
-    )?;
-    let n = n_f as usize;
-    let nperseg = args.nperseg.unwrap_or_else(|| default_nperseg(n));
-    if nperseg < 16 {
-        bail!("--nperseg {nperseg}: the Welch segment must have at least 16 samples");
-    }
-    if nperseg > n {
-        bail!(
-            "--duration {} s at --step {} s gives {n} samples, shorter than one Welch segment \
-             (--nperseg {nperseg} = {} s): lengthen --duration or lower --nperseg",
-            Num(args.duration),
-            Num(args.step),
-            Num(nperseg as f64 * args.step)
-        );
-    }
+    let (n, nperseg) = check_sampling(Spelling::Flag, args.duration, args.step, args.nperseg)?;
     for path in &args.save {
         OutputKind::from_path(path)?;
     }
@@ -342,15 +205,7 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
     let asd: Vec<(Observable, Vec<f64>)> = psds.iter().map(|(o, p)| (*o, p.asd())).collect();
     let meta = RunMeta::of_this_run(params, Some(&modes));
     let caption = vec![
-        format!(
-            "{} samples at {} s ({} s), exact modal propagation of the undamped model; initial \
-             state: {init_source}; readout: {}; seed {}.",
-            sim.len(),
-            sim.dt_s,
-            sim.len() as f64 * sim.dt_s,
-            readout_text(&readout),
-            args.seed
-        ),
+        describe_run(&sim, &init_source, &readout, args.seed),
         format!(
             "One-sided Welch ASDs: periodic Hann, {} samples per segment, 50 % overlap, {} \
              segments, mean. Modes above Nyquist ({} Hz) are marked at their aliases.",
@@ -373,11 +228,7 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
                     };
                     let smeta = SimulationMeta {
                         run: meta.clone(),
-                        description: format!(
-                            "SIMULATED free motion of the double torsion pendulum model (not a \
-                         measurement). {}",
-                            caption[0]
-                        ),
+                        description: record_description(&caption[0]),
                         start_time: None,
                         seed: args.seed,
                         init,
@@ -417,18 +268,6 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
         }
         Ok(())
     })
-}
-
-fn readout_text(readout: &[(Observable, f64)]) -> String {
-    if readout.is_empty() {
-        return "none".to_string();
-    }
-    readout
-        .iter()
-        .map(|(o, a)| format!("{} {a:e} {}/sqrt(Hz)", o.name(), o.unit()))
-        .collect::<Vec<_>>()
-        .join(", ")
-        + " (others noiseless)"
 }
 
 fn summary(

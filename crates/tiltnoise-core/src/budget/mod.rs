@@ -9,6 +9,7 @@
 //! Conventions: one-sided spectra, PSD in unit^2/Hz (see [`crate::noise`]).
 
 mod measured;
+pub mod option_checks;
 
 pub use measured::{add_measured, series_psds, MeasuredPsds};
 

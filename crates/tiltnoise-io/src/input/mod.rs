@@ -24,8 +24,8 @@ mod spectra_csv;
 mod spectra_hdf5;
 
 pub use measured::{
-    read_measured, read_measured_input, MeasuredInput, MeasuredSeries, MeasuredSpectra,
-    SCHEMA_OBSERVABLE_SERIES,
+    add_measured_file, read_measured, read_measured_input, MeasuredInput, MeasuredSeries,
+    MeasuredSpectra, SCHEMA_OBSERVABLE_SERIES,
 };
 pub use source::TiltSeriesSource;
 pub use tiltnoise_core::input::*;

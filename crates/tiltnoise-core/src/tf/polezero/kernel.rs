@@ -512,6 +512,7 @@ impl Kernel {
 /// Whether every value is finite: `v - v` is 0 for a finite value and NaN for an infinite or
 /// NaN one, and a NaN survives the sums. Plain loops over lanes (see above).
 #[inline(always)]
+#[allow(clippy::eq_op, reason = "`v - v` is the finiteness test")]
 fn all_finite<V: Lanes>(values: &[f64]) -> bool {
     let mut acc = V::splat(0.0);
     let mut chunks = values.chunks_exact(LANES);
