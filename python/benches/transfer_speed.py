@@ -140,6 +140,9 @@ def main():
             for k, v in ratios.items()
         },
         "small_grids": small,
+        # What the memory floor allows: NumPy's solve over a write of the result's size.
+        "ceiling_new_array": med["numpy_solve"] / med["floor_new_array"],
+        "ceiling_reused": med["numpy_solve"] / med["floor_fill_out"],
     }
     if args.json:
         print(json.dumps(result, indent=2))
@@ -153,6 +156,9 @@ def main():
             r = result["numpy_solve_over"][k]
             ratio = f"{r['median']:7.0f}x ({r['min']:.0f}-{r['max']:.0f})"
         print(f"{k:<34} {med[k] * 1e3:9.2f} {med[k] / args.points * 1e9:9.1f} {ratio:>24}")
+    print(f"memory floor: {h.nbytes / args.points:.0f} bytes per point; numpy_solve over the floor "
+          f"(the most any evaluation can gain): {result['ceiling_new_array']:.0f}x into a new "
+          f"array, {result['ceiling_reused']:.0f}x into a reused one")
     print(f"first call on a new Model (planner + pole-zero factors + grid): {first_call * 1e3:.1f} ms")
     print(f"{'per call, small grids':<22} {'tiltnoise us':>13} {'numpy us':>10}")
     for n, v in small.items():
