@@ -137,10 +137,9 @@ impl PyModel {
                 return Ok(Arc::clone(&last.plan));
             }
         }
-        let method = match (asked, band) {
-            (Some(m), _) => m,
-            (None, Some(band)) => self.auto_method(py, &request, band, rel_tol)?,
-            (None, None) => unreachable!("a band for auto"),
+        let method = match asked {
+            Some(m) => m,
+            None => self.auto_method(py, &request, auto_band(freqs), rel_tol)?,
         };
         let plan = self.plan(py, &request, method)?;
         *lock(&self.last) = Some(LastPlan {
