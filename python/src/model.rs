@@ -29,8 +29,8 @@ const _: () = assert!(DEFAULT_MODE_ENERGY_J == 1e-12);
 const DOMINANT_SHARE: f64 = 0.05;
 
 /// Grids of at most this many points are evaluated without releasing the GIL: releasing and
-/// taking it back costs more than their evaluation, which takes at most tens of microseconds
-/// with the slowest method (`statespace`, about 6 us per point).
+/// taking it back costs more than evaluating so few points, and even the slowest method
+/// (`statespace`) holds it for a short time only.
 const HOLD_GIL_MAX_POINTS: usize = 16;
 
 /// Grids at least this long are evaluated on every core: below it, starting a thread costs
