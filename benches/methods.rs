@@ -42,7 +42,7 @@ use num_complex::Complex64;
 use tiltnoise_core::freq::log_grid;
 use tiltnoise_core::model::Model;
 use tiltnoise_core::params::Params;
-use tiltnoise_core::tf::{self, Method, Request, TransferFunction};
+use tiltnoise_core::tf::{self, Destination, Method, Request, TransferFunction};
 
 /// Environment variable that overrides the grid size.
 const POINTS_VAR: &str = "TILTNOISE_BENCH_METHODS_POINTS";
@@ -152,8 +152,14 @@ fn methods(c: &mut Criterion) {
             });
             g.bench_function(format!("{}_batch/2t", method.name()), |b| {
                 b.iter(|| {
-                    tf::eval_grid_threads(plan, black_box(&grid), black_box(&mut out), 2)
-                        .expect("no singular frequency on the grid")
+                    tf::eval_grid_threads(
+                        plan,
+                        black_box(&grid),
+                        black_box(&mut out),
+                        2,
+                        Destination::Reused,
+                    )
+                    .expect("no singular frequency on the grid")
                 })
             });
             // What `auto` hands the user: the plan's own layout (11 real entries of the 7x3

@@ -14,7 +14,9 @@ here="$(cd "$(dirname "$0")" && pwd)"
 venv="${1:-$(mktemp -d)/venv}"
 python3 -m venv "$venv"
 "$venv/bin/pip" install --quiet --upgrade pip
-"$venv/bin/pip" install --quiet "$here" pytest numpy scipy
+# h5py: the comparisons of HDF5 files with the command line's; mypy: the stubs against the
+# module (mypy.stubtest); matplotlib: the example figure. Without them those tests are skipped.
+"$venv/bin/pip" install --quiet "$here" pytest numpy scipy h5py mypy matplotlib
 # From outside the source tree, so that the installed package is imported and not
 # python/tiltnoise/ (which holds no extension, or a stale one from `maturin develop`).
 cd "$(mktemp -d)"

@@ -18,8 +18,9 @@ eta, phi, phi_a; inputs theta_t, eta_t, phi_t) on --points log-spaced frequencie
 Every timed function runs once untimed, then --rounds rounds in which each runs once, the order
 rotating between rounds; the medians are reported, and the ratio's range over the rounds. The
 machine may be shared: read the ratios, measured side by side, rather than the absolute times.
-Per-call cost on small grids (1, 10, 100 points) is the median of many calls, NumPy including
-the stacking there (it is part of every call).
+Per-call cost on small grids (1, 10, 100 points) is the mean of many calls, NumPy including
+the stacking there (it is part of every call); the arithmetic alone is the same on 1000 points
+into a reused array small enough to stay in the L2 cache.
 """
 
 import argparse
@@ -126,6 +127,11 @@ def main():
             "numpy_us": per_call_us(lambda: so(*st())),
         }
 
+    # The arithmetic alone: 1000 points into a reused array that stays in the L2 cache.
+    f_cache = np.logspace(-5, 2, 1000)
+    out_cache = np.empty((1000, 7, 3), complex)
+    in_cache_ns = per_call_us(lambda: model.transfer(f_cache, out=out_cache, threads=1)) * 1e3 / 1000
+
     result = {
         "points": args.points,
         "rounds": args.rounds,
@@ -140,6 +146,10 @@ def main():
             for k, v in ratios.items()
         },
         "small_grids": small,
+        "in_cache_1thread_ns_per_point": in_cache_ns,
+        # NumPy's solve over one thread's write of the result's size (ordinary stores).
+        "ceiling_new_array": med["numpy_solve"] / med["floor_new_array"],
+        "ceiling_reused": med["numpy_solve"] / med["floor_fill_out"],
     }
     if args.json:
         print(json.dumps(result, indent=2))
@@ -153,6 +163,11 @@ def main():
             r = result["numpy_solve_over"][k]
             ratio = f"{r['median']:7.0f}x ({r['min']:.0f}-{r['max']:.0f})"
         print(f"{k:<34} {med[k] * 1e3:9.2f} {med[k] / args.points * 1e9:9.1f} {ratio:>24}")
+    print(f"result: {h.nbytes / args.points:.0f} bytes per point; numpy_solve over one thread's "
+          f"write of that size (floor_*): {result['ceiling_new_array']:.0f}x into a new array, "
+          f"{result['ceiling_reused']:.0f}x into a reused one")
+    print(f"the arithmetic alone (1000 points into a reused array in L2, one thread): "
+          f"{in_cache_ns:.1f} ns/point")
     print(f"first call on a new Model (planner + pole-zero factors + grid): {first_call * 1e3:.1f} ms")
     print(f"{'per call, small grids':<22} {'tiltnoise us':>13} {'numpy us':>10}")
     for n, v in small.items():

@@ -10,10 +10,9 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use tiltnoise_core::budget::{
-    add_measured, budget_from_series, budget_from_spectra, series_psds, BudgetError, BudgetOptions,
-    MeasuredPsds,
-};
+use tiltnoise_core::budget::option_checks::{self, InputKind};
+use tiltnoise_core::budget::{budget_from_series, budget_from_spectra, BudgetError, BudgetOptions};
+use tiltnoise_core::error::Num;
 use tiltnoise_core::freq;
 use tiltnoise_core::input::{
     process_channel, ChannelCtx, GapPolicy, InputError, InputMeta, Quantity, SeriesSource,
@@ -21,10 +20,10 @@ use tiltnoise_core::input::{
 use tiltnoise_core::model::{Model, Observable, TiltAxis};
 use tiltnoise_core::noise::equivalent::referred_terms;
 use tiltnoise_core::noise::{BudgetReport, Readout, SpectralSource};
+use tiltnoise_core::options::{self, Spelling};
 use tiltnoise_core::params::Params;
 use tiltnoise_io::input::{
-    read_measured_input, read_tilt, AxisMap, InputFormat, MeasuredInput, ReadOptions, TiltInput,
-    TiltSeriesSource,
+    add_measured_file, read_tilt, AxisMap, InputFormat, ReadOptions, TiltInput, TiltSeriesSource,
 };
 use tiltnoise_io::RunMeta;
 
@@ -94,38 +93,22 @@ fn model_of(params: Option<&Bound<'_, PyAny>>) -> PyResult<(Arc<Model>, Params)>
 
 /// The readout of `readout` (`{observable: ASD}`), over the default 9e-9 m/sqrt(Hz) on X as
 /// the command line's `--readout OBS=ASD`: a value replaces the observable's readout, 0
-/// removes it.
+/// removes it; only budgeted observables.
 fn readout(arg: Option<&Bound<'_, PyDict>>, budgeted: &[Observable]) -> PyResult<Readout> {
-    let mut readout = Readout::default();
     let Some(d) = arg else {
-        return Ok(readout);
+        return Ok(Readout::default());
     };
+    let mut items = Vec::new();
     for (name, value) in d.iter() {
-        let name: String = name.extract()?;
-        let names: Vec<&str> = budgeted.iter().map(|o| o.name()).collect();
-        let o = Observable::from_name(&name)
-            .filter(|o| budgeted.contains(o))
-            .ok_or_else(|| {
-                value_error(format!(
-                    "readout {name:?}: not a budgeted observable; allowed: {}",
-                    names.join(", ")
-                ))
-            })?;
+        let name: String = name
+            .extract()
+            .map_err(|_| value_error("readout: the keys must be observable names (str)"))?;
         let asd: f64 = value
             .extract()
             .map_err(|_| value_error(format!("readout {name}: the ASD must be a number")))?;
-        if !(asd.is_finite() && asd >= 0.0) {
-            return Err(value_error(format!(
-                "readout {name}={asd}: ASD {asd} {}/sqrt(Hz) is not allowed: must be finite and >= 0",
-                o.unit()
-            )));
-        }
-        readout.asd.retain(|(x, _)| *x != o);
-        if asd > 0.0 {
-            readout.asd.push((o, asd));
-        }
+        items.push(options::readout_item("readout", &name, asd).py()?);
     }
-    Ok(readout)
+    options::apply_readout("readout", Readout::default(), &items, Some(budgeted)).py()
 }
 
 /// The Welch and segment options common to both entry points, as on the command line.
@@ -138,8 +121,8 @@ struct SeriesOptions {
 }
 
 impl SeriesOptions {
-    /// The first option given, by name, for refusing them with spectra input.
-    fn first_given(&self) -> Option<&'static str> {
+    /// The options given (snake case), for refusing them with spectra input.
+    fn given(&self) -> Vec<&'static str> {
         [
             ("nperseg", self.nperseg.is_some()),
             ("overlap", self.overlap.is_some()),
@@ -147,8 +130,8 @@ impl SeriesOptions {
             ("segment_duration", self.segment_duration.is_some()),
         ]
         .into_iter()
-        .find(|(_, given)| *given)
-        .map(|(name, _)| name)
+        .filter_map(|(name, given)| given.then_some(name))
+        .collect()
     }
 
     fn apply(&self, opts: &mut BudgetOptions) -> PyResult<()> {
@@ -161,48 +144,14 @@ impl SeriesOptions {
         }
         opts.segment_duration_s = self.segment_duration;
         if let Some((lo, hi)) = self.percentiles {
-            if self.segment_duration.is_none() {
-                return Err(value_error(
-                    "percentiles apply to the per-segment band and need segment_duration \
-                     (e.g. segment_duration=3600)",
-                ));
-            }
-            if !(0.0 <= lo && lo < hi && hi <= 100.0) {
-                return Err(value_error(format!(
-                    "percentiles ({lo}, {hi}): expected (LOWER, UPPER) with 0 <= LOWER < UPPER <= 100"
-                )));
-            }
-            opts.percentiles = (lo, hi);
+            let given = self.segment_duration.is_some();
+            option_checks::require_segments_for_percentiles(Spelling::Keyword, given).py()?;
+            let shown = format!("({}, {})", Num(lo), Num(hi));
+            opts.percentiles =
+                option_checks::check_percentiles(Spelling::Keyword, &shown, lo, hi).py()?;
         }
         Ok(())
     }
-}
-
-/// Adds the `measured` and `residual` terms from a measured record of the observables (the
-/// command line's `--measured FILE`).
-fn add_measured_file(report: &mut BudgetReport, path: &Path) -> Result<(), BudgetError> {
-    let (freqs_hz, psds, description, welch) = match read_measured_input(path)? {
-        MeasuredInput::Spectra(m) => {
-            let psds = m
-                .asd
-                .iter()
-                .map(|(o, asd)| (*o, asd.iter().map(|a| a * a).collect()))
-                .collect();
-            (m.freqs_hz, psds, "measured spectrum".to_string(), None)
-        }
-        MeasuredInput::Series(s) => {
-            let m = series_psds(&s.channels, s.sample_rate_hz, &report.source)?;
-            (m.freqs_hz, m.psds, m.description, m.welch)
-        }
-    };
-    let measured = MeasuredPsds {
-        freqs_hz,
-        psds,
-        description,
-        welch,
-    };
-    add_measured(report, &measured, &path.display().to_string());
-    Ok(())
 }
 
 /// The tilt axis of a name, or a `ValueError` naming what is allowed.
@@ -406,7 +355,7 @@ pub fn budget(
         };
         let mut report = budget_from_series(&model, &mut source, &opts, &mut |_, _| {}).py()?;
         if let Some(path) = &measured {
-            add_measured_file(&mut report, path).py()?;
+            add_measured_file(&mut report, path, "measured").py()?;
         }
         Ok(report)
     })?;
@@ -503,22 +452,15 @@ pub fn budget_from_file(
             Err(_) => crate::model::frequencies(f)?,
         }),
     };
-    let refuse_series_options = || match series_opts.first_given().or(gaps.map(|_| "gaps")) {
-        Some(name) => Err(value_error(format!(
-            "{name} applies to time-series input, and {} holds spectra; leave it out (the \
-             model grid of spectra input is set with freq)",
-            path.display()
-        ))),
-        None => Ok(()),
+    let mut given = series_opts.given();
+    given.extend(gaps.map(|_| "gaps"));
+    given.extend(grid.as_ref().map(|_| "freq"));
+    let source = path.display().to_string();
+    let refuse = |kind| {
+        option_checks::refuse_options_for_input(&given, kind, &source, Spelling::Keyword).py()
     };
-    let refuse_spectra_options = || match grid.is_some() {
-        true => Err(value_error(format!(
-            "freq applies to spectra input, and {} holds a time series, whose budget is on the \
-             Welch grid (set its resolution with nperseg)",
-            path.display()
-        ))),
-        false => Ok(()),
-    };
+    let refuse_series_options = || refuse(InputKind::Spectra);
+    let refuse_spectra_options = || refuse(InputKind::Series);
     let (report, provenance) = py.detach(|| -> PyResult<_> {
         let streamed = match InputFormat::from_path(&path).py()? {
             InputFormat::Hdf5 => TiltSeriesSource::open(&path, &ropts).ok(),
@@ -556,7 +498,7 @@ pub fn budget_from_file(
             other => value_error(format!("budget of {}: {other}", path.display())),
         })?;
         if let Some(m) = &measured {
-            add_measured_file(&mut report, m).py()?;
+            add_measured_file(&mut report, m, "measured").py()?;
         }
         Ok((report, provenance))
     })?;

@@ -17,6 +17,7 @@ use tiltnoise_core::budget::BudgetError;
 use tiltnoise_core::error::{FreqError, OutputError, ParamError, TfError};
 use tiltnoise_core::input::InputError;
 use tiltnoise_core::mc::McError;
+use tiltnoise_core::options::OptionError;
 use tiltnoise_core::spectral::SpectralError;
 
 pyo3::create_exception!(
@@ -79,6 +80,12 @@ impl IntoPyErr for TfError {
 }
 
 impl IntoPyErr for FreqError {
+    fn into_py_err(self) -> PyErr {
+        PyValueError::new_err(self.to_string())
+    }
+}
+
+impl IntoPyErr for OptionError {
     fn into_py_err(self) -> PyErr {
         PyValueError::new_err(self.to_string())
     }

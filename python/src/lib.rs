@@ -1,5 +1,6 @@
 //! The Python extension module `tiltnoise._tiltnoise` (PyO3): tiltnoise-core's parameters,
-//! model, modes, transfer functions, Welch spectra and noise budgets, and tiltnoise-io's
+//! model, modes, transfer functions, Welch spectra, noise budgets, Monte Carlo, fit and
+//! simulation, and tiltnoise-io's
 //! tilt readers and budget writers, for the package `tiltnoise` (python/tiltnoise/).
 //!
 //! A thin layer: every number comes from the library crates. It converts arguments (names as
@@ -11,9 +12,32 @@ mod errors;
 mod fit;
 mod model;
 mod params;
+mod simulate;
 mod spectral;
 
 use pyo3::prelude::*;
+
+/// Panics on purpose, for the tests that a Rust panic becomes a Python exception
+/// (`pyo3_runtime.PanicException`) and never ends the interpreter: `where_` is `here` (holding
+/// the GIL), `detached` (with the GIL released, as every computation runs) or `thread` (in a
+/// worker thread of a computation with the GIL released, as a multi-threaded evaluation).
+#[pyfunction]
+fn _panic_for_tests(py: Python<'_>, where_: &str) -> PyResult<()> {
+    let boom = || panic_on_purpose(where_);
+    match where_ {
+        "here" => boom(),
+        "detached" => py.detach(boom),
+        "thread" => py.detach(|| {
+            std::thread::scope(|s| s.spawn(boom).join().expect("the worker thread panicked"))
+        }),
+        _ => return Err(errors::value_error("where_: here, detached or thread")),
+    }
+    Ok(())
+}
+
+fn panic_on_purpose(where_: &str) {
+    panic!("a panic on purpose ({where_})")
+}
 
 #[pymodule]
 #[pyo3(name = "_tiltnoise")]
@@ -29,10 +53,12 @@ fn tiltnoise_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<model::Mode>()?;
     m.add_class::<model::MonteCarlo>()?;
     m.add_class::<fit::Fit>()?;
+    m.add_class::<simulate::Simulation>()?;
     m.add_class::<budget::Budget>()?;
     m.add_function(wrap_pyfunction!(spectral::welch, m)?)?;
     m.add_function(wrap_pyfunction!(spectral::csd, m)?)?;
     m.add_function(wrap_pyfunction!(budget::budget, m)?)?;
     m.add_function(wrap_pyfunction!(budget::budget_from_file, m)?)?;
+    m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
     Ok(())
 }

@@ -3,7 +3,9 @@
 
 use crate::errors::{value_error, PyResultExt};
 use crate::params::PyParams;
-use numpy::{Complex64, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{
+    Complex64, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods,
+};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 use std::collections::HashMap;
@@ -12,11 +14,24 @@ use tiltnoise_core::freq::DEFAULT_F_LO_HZ;
 use tiltnoise_core::mc::{self, McConfig};
 use tiltnoise_core::model::{Coord, ForceInput, Input, Model, Observable, Request};
 use tiltnoise_core::modes::NormalModes;
-use tiltnoise_core::tf::{self, eval_grid_threads, Method, Scene, TransferFunction};
+use tiltnoise_core::options;
+use tiltnoise_core::simulate::DEFAULT_MODE_ENERGY_J;
+use tiltnoise_core::tf::{self, eval_grid_threads, Destination, Method, Scene, TransferFunction};
+
+// The defaults of `transfer`, `explain` and `simulate` are written as literals in their
+// signatures, so that Python's `inspect.signature` (and the type stubs) show the numbers; they
+// are the library's defaults, as the command line's.
+const _: () = assert!(tf::DEFAULT_REL_TOL == 1e-9);
+const _: () = assert!(DEFAULT_MODE_ENERGY_J == 1e-12);
 
 /// Share of a mode's kinetic energy above which a coordinate is listed as dominant (the
 /// command line's `modes` table and JSON).
 const DOMINANT_SHARE: f64 = 0.05;
+
+/// Grids of at most this many points are evaluated without releasing the GIL: releasing and
+/// taking it back costs more than evaluating so few points, and even the slowest method
+/// (`statespace`) holds it for a short time only.
+const HOLD_GIL_MAX_POINTS: usize = 16;
 
 /// Grids at least this long are evaluated on every core: below it, starting a thread costs
 /// more than the points it takes over (about 10 ns each).
@@ -44,6 +59,18 @@ pub struct PyModel {
     modes: OnceLock<NormalModes>,
     plans: Mutex<PlanCache>,
     choices: Mutex<ChoiceCache>,
+    last: Mutex<Option<LastPlan>>,
+}
+
+/// The plan of the last call of `transfer`: a repeated call (the same names, method, band
+/// and tolerance) finds it by comparing these, without hashing into the caches.
+struct LastPlan {
+    request: Request,
+    /// The method asked for (`None`: `auto`).
+    asked: Option<Method>,
+    /// For `auto`: the band's and the tolerance's bits (the planner's choice depends on them).
+    scene: [u64; 3],
+    plan: Arc<dyn TransferFunction>,
 }
 
 impl PyModel {
@@ -55,6 +82,7 @@ impl PyModel {
             modes: OnceLock::new(),
             plans: Mutex::new(HashMap::new()),
             choices: Mutex::new(HashMap::new()),
+            last: Mutex::new(None),
         })
     }
 
@@ -62,27 +90,19 @@ impl PyModel {
         self.modes.get_or_init(|| NormalModes::new(&self.model))
     }
 
-    /// The method `auto` takes for `request` on `freqs` (the command line's `--method auto`:
-    /// the band of the positive frequencies), remembered per request, band and tolerance.
+    /// The method `auto` takes for `request` on `band` (see [`auto_band`]) and `rel_tol`,
+    /// remembered per request, band and tolerance.
     fn auto_method(
         &self,
         py: Python<'_>,
         request: &Request,
-        freqs: &[f64],
+        band: (f64, f64),
         rel_tol: f64,
     ) -> PyResult<Method> {
-        let positive = freqs.iter().copied().filter(|&f| f > 0.0 && f.is_finite());
-        let lo = positive.clone().fold(f64::INFINITY, f64::min);
-        let hi = positive.fold(0.0, f64::max);
-        let band = if hi > 0.0 {
-            (lo, hi)
-        } else {
-            (DEFAULT_F_LO_HZ, DEFAULT_F_LO_HZ)
-        };
         let key = (
             request.inputs.clone(),
             request.outputs.clone(),
-            [band.0.to_bits(), band.1.to_bits(), rel_tol.to_bits()],
+            scene_bits(band, rel_tol),
         );
         if let Some(&m) = lock(&self.choices).get(&key) {
             return Ok(m);
@@ -98,6 +118,37 @@ impl PyModel {
             .map_err(|e| value_error(e.to_string()))?;
         lock(&self.choices).insert(key, choice.method);
         Ok(choice.method)
+    }
+
+    /// The plan `transfer` evaluates: `asked` (`None`: what `auto` picks on the band of
+    /// `freqs`), looked up in the last call's first.
+    fn plan_for(
+        &self,
+        py: Python<'_>,
+        request: Request,
+        asked: Option<Method>,
+        freqs: &[f64],
+        rel_tol: f64,
+    ) -> PyResult<Arc<dyn TransferFunction>> {
+        let band = asked.is_none().then(|| auto_band(freqs));
+        let scene = band.map_or([0; 3], |b| scene_bits(b, rel_tol));
+        if let Some(last) = lock(&self.last).as_ref() {
+            if last.asked == asked && last.scene == scene && last.request == request {
+                return Ok(Arc::clone(&last.plan));
+            }
+        }
+        let method = match asked {
+            Some(m) => m,
+            None => self.auto_method(py, &request, auto_band(freqs), rel_tol)?,
+        };
+        let plan = self.plan(py, &request, method)?;
+        *lock(&self.last) = Some(LastPlan {
+            request,
+            asked,
+            scene,
+            plan: Arc::clone(&plan),
+        });
+        Ok(plan)
     }
 
     /// The plan of `request` with `method`, built once per model.
@@ -127,96 +178,61 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// Every name `inputs` accepts, for error messages.
-fn input_names() -> String {
-    let mut names: Vec<&str> = Input::all_tilts().into_iter().map(Input::name).collect();
-    names.extend(ForceInput::ALL.iter().map(|f| f.name()));
-    format!("{}, or the groups `tilt` and `forces`", names.join(", "))
+/// The band `auto` plans for (the command line's `--method auto`): that of the positive
+/// frequencies, or the default lowest frequency when there is none.
+fn auto_band(freqs: &[f64]) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0_f64);
+    for &f in freqs {
+        if f > 0.0 && f.is_finite() {
+            lo = lo.min(f);
+            hi = hi.max(f);
+        }
+    }
+    if hi > 0.0 {
+        (lo, hi)
+    } else {
+        (DEFAULT_F_LO_HZ, DEFAULT_F_LO_HZ)
+    }
 }
 
-/// Names from a `str` (comma-separated) or a sequence of `str`.
+/// A band and a tolerance as a cache key.
+fn scene_bits(band: (f64, f64), rel_tol: f64) -> [u64; 3] {
+    [band.0.to_bits(), band.1.to_bits(), rel_tol.to_bits()]
+}
+
+/// Names from a `str` (comma-separated, as on the command line) or a sequence of `str`.
 fn names(what: &str, arg: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
     let items: Vec<String> = if let Ok(s) = arg.cast::<PyString>() {
-        s.to_cow()?
-            .split(',')
-            .map(|n| n.trim().to_string())
-            .collect()
+        vec![s.to_cow()?.into_owned()]
     } else {
         arg.extract::<Vec<String>>()
             .map_err(|_| value_error(format!("{what}: expected a str or a sequence of str")))?
     };
-    if items.is_empty() || items.iter().any(String::is_empty) {
+    if items.is_empty() {
         return Err(value_error(format!(
-            "{what}: empty name (give one or more names, e.g. {})",
-            if what == "inputs" {
-                "\"eta_t\" or [\"F_b.x\", \"M_b.z\"]"
-            } else {
-                "\"X\" or [\"phi\", \"phi_a\"]"
-            }
+            "{what}: an empty sequence names nothing; give one or more names, or None for the \
+             default"
         )));
     }
     Ok(items)
 }
 
-/// `inputs` of [`PyModel::transfer`]: names as on the command line's `--input`.
+/// `inputs` of [`PyModel::transfer`]: names as on the command line's `--input`; `None`: the
+/// three tilt angles.
 fn parse_inputs(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Input>> {
-    let Some(arg) = arg else {
-        return Ok(Input::all_tilts());
-    };
-    let mut inputs: Vec<Input> = Vec::new();
-    for name in names("inputs", arg)? {
-        let group: Vec<Input> = match name.as_str() {
-            "tilt" => Input::all_tilts(),
-            "forces" => ForceInput::ALL.into_iter().map(Input::Force).collect(),
-            _ => match Input::from_name(&name) {
-                Some(i) => vec![i],
-                None => {
-                    return Err(value_error(format!(
-                        "inputs: unknown input {name:?}; allowed: {}",
-                        input_names()
-                    )))
-                }
-            },
-        };
-        for i in group {
-            if inputs.contains(&i) {
-                return Err(value_error(format!(
-                    "inputs: {} is given twice; name each input once",
-                    i.name()
-                )));
-            }
-            inputs.push(i);
-        }
+    match arg {
+        None => Ok(Input::all_tilts()),
+        Some(arg) => options::parse_inputs("inputs", &names("inputs", arg)?).py(),
     }
-    Ok(inputs)
 }
 
-/// `outputs` of [`PyModel::transfer`]: names as on the command line's `--output`.
-fn parse_outputs(
-    what: &str,
-    arg: Option<&Bound<'_, PyAny>>,
-    default: &[Observable],
-) -> PyResult<Vec<Observable>> {
-    let Some(arg) = arg else {
-        return Ok(default.to_vec());
-    };
-    let mut outputs = Vec::new();
-    for name in names(what, arg)? {
-        let Some(o) = Observable::from_name(&name) else {
-            let allowed: Vec<&str> = Observable::ALL.iter().map(|o| o.name()).collect();
-            return Err(value_error(format!(
-                "{what}: unknown observable {name:?}; allowed: {}",
-                allowed.join(", ")
-            )));
-        };
-        if outputs.contains(&o) {
-            return Err(value_error(format!(
-                "{what}: {name} is given twice; name each observable once"
-            )));
-        }
-        outputs.push(o);
+/// `outputs` of [`PyModel::transfer`]: names as on the command line's `--output`; `None`:
+/// all seven observables.
+fn parse_outputs(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Observable>> {
+    match arg {
+        None => Ok(Observable::ALL.to_vec()),
+        Some(arg) => options::parse_outputs("outputs", &names("outputs", arg)?).py(),
     }
-    Ok(outputs)
 }
 
 /// `method` of [`PyModel::transfer`]: `auto` (`None`) or a method's command-line name.
@@ -237,22 +253,33 @@ fn parse_method(name: &str) -> PyResult<Option<Method>> {
         })
 }
 
-/// Frequencies (Hz) from a number or a 1-D array-like, as `f64`.
+/// Frequencies (Hz) from a number or a 1-D array-like, as `f64`: a float64 array is copied
+/// as it is; a NumPy array is asked before a number (a one-element array converts to a
+/// number only with a deprecation warning, and trying the conversion costs microseconds).
 pub fn frequencies(arg: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
-    if let Ok(f) = arg.extract::<f64>() {
-        return Ok(vec![f]);
+    if let Ok(a) = arg.cast::<PyArray1<f64>>() {
+        // SAFETY: the values are copied at once, holding the GIL, so no Python code runs
+        // meanwhile; no Rust code of this module holds a mutable view of an array here.
+        if let Ok(slice) = unsafe { a.as_slice() } {
+            return Ok(slice.to_vec());
+        }
+    } else if arg.cast::<PyUntypedArray>().is_err() {
+        if let Ok(f) = arg.extract::<f64>() {
+            return Ok(vec![f]);
+        }
     }
     let np = arg.py().import("numpy")?;
     let array = np
         .call_method1("asarray", (arg, "float64"))
         .map_err(|e| value_error(format!("freq_hz: not an array of numbers ({e})")))?;
     let array = array.cast_into::<numpy::PyArrayDyn<f64>>()?;
-    if array.ndim() != 1 {
+    if array.ndim() > 1 {
         return Err(value_error(format!(
             "freq_hz: expected a number or a 1-D array of frequencies in Hz, got {} dimensions",
             array.ndim()
         )));
     }
+    // A 0-d array is one frequency, as a number.
     Ok(array.readonly().as_array().iter().copied().collect())
 }
 
@@ -360,7 +387,7 @@ impl PyModel {
     /// name the method (``method="polezero"`` is what it picks for the tilt matrix of Table I).
     /// Raises ``ValueError`` for an unknown name, a frequency that is
     /// negative or not finite, or one on an undamped resonance.
-    #[pyo3(signature = (freq_hz, inputs=None, outputs=None, method="auto", rel_tol=tf::DEFAULT_REL_TOL, threads=None, out=None))]
+    #[pyo3(signature = (freq_hz, inputs=None, outputs=None, method="auto", rel_tol=1e-9, threads=None, out=None))]
     #[allow(clippy::too_many_arguments)]
     fn transfer<'py>(
         &self,
@@ -375,22 +402,27 @@ impl PyModel {
     ) -> PyResult<Bound<'py, PyArray3<Complex64>>> {
         let request = Request {
             inputs: parse_inputs(inputs)?,
-            outputs: parse_outputs("outputs", outputs, &Observable::ALL)?,
+            outputs: parse_outputs(outputs)?,
         };
-        let method = parse_method(method)?;
+        let asked = parse_method(method)?;
         check_rel_tol(rel_tol)?;
         let freqs = frequencies(freq_hz)?;
-        let method = match method {
-            Some(m) => m,
-            None => self.auto_method(py, &request, &freqs, rel_tol)?,
-        };
-        let plan = self.plan(py, &request, method)?;
+        let dims = [freqs.len(), request.outputs.len(), request.inputs.len()];
+        let plan = self.plan_for(py, request, asked, &freqs, rel_tol)?;
         let threads = threads.unwrap_or(match freqs.len() >= THREADED_GRID {
             true => std::thread::available_parallelism().map_or(1, |n| n.get()),
             false => 1,
         });
-        let dims = [freqs.len(), request.outputs.len(), request.inputs.len()];
-        let h = match out {
+        let (plan, freqs) = (plan.as_ref(), freqs.as_slice());
+        let eval = |buffer: &mut [Complex64], destination| -> PyResult<()> {
+            let mut run = move || eval_grid_threads(plan, freqs, buffer, threads, destination);
+            match freqs.len() <= HOLD_GIL_MAX_POINTS {
+                true => run(),
+                false => py.detach(run),
+            }
+            .py()
+        };
+        match out {
             Some(h) => {
                 if h.shape() != dims {
                     return Err(value_error(format!(
@@ -398,29 +430,36 @@ impl PyModel {
                         h.shape()
                     )));
                 }
-                h
+                let mut rw = h
+                    .try_readwrite()
+                    .map_err(|e| value_error(format!("out: not writeable ({e})")))?;
+                eval(
+                    rw.as_slice_mut()
+                        .map_err(|_| value_error("out: must be C-contiguous"))?,
+                    Destination::Reused,
+                )?;
+                drop(rw);
+                Ok(h)
             }
-            // SAFETY: every element is written by `eval_grid_threads` before the array is
-            // returned (on error it is dropped unread), and nothing else holds the new array.
-            None => unsafe { PyArray3::<Complex64>::new(py, dims, false) },
-        };
-        {
-            let mut rw = h
-                .try_readwrite()
-                .map_err(|e| value_error(format!("out: not writeable ({e})")))?;
-            let buffer = rw
-                .as_slice_mut()
-                .map_err(|_| value_error("out: must be C-contiguous"))?;
-            py.detach(|| eval_grid_threads(plan.as_ref(), &freqs, buffer, threads))
-                .py()?;
+            None => {
+                // SAFETY: every element is written by `eval_grid_threads` before the array is
+                // returned (on error it is dropped unread).
+                let h = unsafe { PyArray3::<Complex64>::new(py, dims, false) };
+                // SAFETY: the array was just created (C-contiguous, aligned) and nothing else
+                // refers to it until it is returned, so the slice is its only reference; the
+                // borrow tracking of `try_readwrite` has nothing to guard.
+                let buffer = unsafe { h.as_slice_mut() }
+                    .map_err(|_| value_error("a new array that is not contiguous"))?;
+                eval(buffer, Destination::Fresh)?;
+                Ok(h)
+            }
         }
-        Ok(h)
     }
 
     /// Which method ``method="auto"`` picks for this request and grid, and why: every
     /// candidate's measured error against the double-double reference (the command line's
     /// ``tf --explain``).
-    #[pyo3(signature = (freq_hz, inputs=None, outputs=None, rel_tol=tf::DEFAULT_REL_TOL))]
+    #[pyo3(signature = (freq_hz, inputs=None, outputs=None, rel_tol=1e-9))]
     fn explain(
         &self,
         py: Python<'_>,
@@ -431,7 +470,7 @@ impl PyModel {
     ) -> PyResult<String> {
         let request = Request {
             inputs: parse_inputs(inputs)?,
-            outputs: parse_outputs("outputs", outputs, &Observable::ALL)?,
+            outputs: parse_outputs(outputs)?,
         };
         check_rel_tol(rel_tol)?;
         let scene = Scene {
@@ -535,6 +574,49 @@ impl PyModel {
         prior: bool,
     ) -> PyResult<crate::fit::Fit> {
         crate::fit::run(py, self.model.params(), free, measured, bound_sigmas, prior)
+    }
+
+    /// Free motion of the undamped model (the command line's ``tiltnoise simulate``): exact
+    /// modal propagation sampled every ``step`` seconds for ``duration`` seconds, white
+    /// readout noise, one-sided Welch ASDs and the resonance check. Returns a
+    /// :class:`Simulation`.
+    ///
+    /// The initial state: ``kick_x`` (m), the paper's kick test (the test mass displaced
+    /// statically along X and released from rest); or ``init`` / ``init_rate``, coordinates
+    /// and rates as a dict ``{"theta_a": 1e-5, "phi_b": 0.01}`` or the command line's
+    /// ``"theta_a=1e-5,phi_b=0.01"`` (rad, m; rad/s, m/s; unlisted ones 0); default: the
+    /// energy ``mode_energy`` (J) in each of the eight modes. ``readout``: ``{observable:
+    /// ASD}`` over the default ``{"X": 9e-9}`` (unit/sqrt(Hz); 0 removes one); ``seed`` of
+    /// the noise; ``nperseg``: Welch segment (default the largest power of two <= n/3).
+    /// Raises ``ValueError`` for a damped model or options that do not fit, with the command
+    /// line's messages.
+    #[pyo3(signature = (duration=43_200.0, step=0.1, *, init=None, init_rate=None, kick_x=None, mode_energy=1e-12, readout=None, seed=0, nperseg=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn simulate(
+        &self,
+        py: Python<'_>,
+        duration: f64,
+        step: f64,
+        init: Option<&Bound<'_, PyAny>>,
+        init_rate: Option<&Bound<'_, PyAny>>,
+        kick_x: Option<f64>,
+        mode_energy: f64,
+        readout: Option<&Bound<'_, PyDict>>,
+        seed: u64,
+        nperseg: Option<usize>,
+    ) -> PyResult<crate::simulate::Simulation> {
+        let args = crate::simulate::SimulateArgs {
+            duration,
+            step,
+            init,
+            init_rate,
+            kick_x,
+            mode_energy,
+            readout,
+            seed,
+            nperseg,
+        };
+        crate::simulate::run(py, &self.model, args)
     }
 
     fn __repr__(&self) -> String {

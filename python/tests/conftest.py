@@ -47,3 +47,21 @@ def cli():
         return done.stdout
 
     return run
+
+
+@pytest.fixture(scope="session")
+def cli_error(cli):
+    """Runs the command line where it must fail: `cli_error(*args)` returns its one-line error
+    message without the `tiltnoise: error: ` prefix, after checking the exit code 2."""
+    exe = _cli()
+
+    def run(*args, cwd=None):
+        done = subprocess.run(
+            [exe, *map(str, args)], capture_output=True, text=True, cwd=cwd, timeout=600
+        )
+        assert done.returncode == 2, f"tiltnoise {' '.join(map(str, args))}: {done.returncode}"
+        lines = done.stderr.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("tiltnoise: error: "), done.stderr
+        return lines[0][len("tiltnoise: error: "):]
+
+    return run

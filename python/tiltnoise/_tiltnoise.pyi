@@ -1,10 +1,28 @@
 """Type stubs of the extension module tiltnoise._tiltnoise (see the docstrings at run time)."""
 
 import os
-from typing import Any, Literal, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Literal, Mapping, Optional, Sequence, Tuple, Union, final
 
 import numpy as np
 import numpy.typing as npt
+
+__all__ = [
+    "__version__",
+    "_panic_for_tests",
+    "Budget",
+    "Fit",
+    "InputFileError",
+    "Mode",
+    "Model",
+    "MonteCarlo",
+    "Params",
+    "Simulation",
+    "budget",
+    "budget_from_file",
+    "csd",
+    "hdf5_version",
+    "welch",
+]
 
 __version__: str
 hdf5_version: str
@@ -16,6 +34,7 @@ _Freqs = Union[float, npt.ArrayLike]
 class InputFileError(OSError):
     """A file that was read but is not valid (layout, attribute or value)."""
 
+@final
 class Params:
     def __init__(self) -> None: ...
     @staticmethod
@@ -26,8 +45,9 @@ class Params:
     def get(self, key: str) -> float: ...
     def keys(self) -> list[Tuple[str, float, str, str]]: ...
     def to_dict(self) -> dict[str, float]: ...
-    def __eq__(self, other: object) -> bool: ...
+    def __eq__(self, value: object, /) -> bool: ...
 
+@final
 class Mode:
     index: int
     frequency_hz: float
@@ -43,6 +63,7 @@ class Mode:
     @property
     def q(self) -> float: ...
 
+@final
 class MonteCarlo:
     samples: int
     rejected: int
@@ -51,6 +72,7 @@ class MonteCarlo:
     mean_hz: list[float]
     std_hz: list[float]
 
+@final
 class Fit:
     @property
     def params(self) -> Params: ...
@@ -70,8 +92,47 @@ class Fit:
     projected_gradient: float
     measured_origin: str
 
+@final
+class Simulation:
+    @property
+    def dt_s(self) -> float: ...
+    @property
+    def fs_hz(self) -> float: ...
+    @property
+    def n_samples(self) -> int: ...
+    @property
+    def time_s(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def observables(self) -> dict[str, npt.NDArray[np.float64]]: ...
+    @property
+    def coordinates(self) -> dict[str, npt.NDArray[np.float64]]: ...
+    @property
+    def initial_state(self) -> dict[str, dict[str, float]]: ...
+    @property
+    def init_source(self) -> str: ...
+    @property
+    def readout(self) -> dict[str, float]: ...
+    @property
+    def seed(self) -> int: ...
+    @property
+    def freq_hz(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def asd(self) -> dict[str, npt.NDArray[np.float64]]: ...
+    @property
+    def nperseg(self) -> int: ...
+    @property
+    def n_welch_segments(self) -> int: ...
+    @property
+    def resonance_check(self) -> str: ...
+    @property
+    def resonances_agree(self) -> bool: ...
+    @property
+    def description(self) -> str: ...
+    def save(self, path: _Path) -> None: ...
+
+@final
 class Model:
-    def __init__(self, params: Optional[Params] = None) -> None: ...
+    def __new__(cls, params: Optional[Params] = None) -> Model: ...
     @property
     def params(self) -> Params: ...
     def modes(self) -> list[Mode]: ...
@@ -103,7 +164,21 @@ class Model:
         bound_sigmas: float = 1.0,
         prior: bool = False,
     ) -> Fit: ...
+    def simulate(
+        self,
+        duration: float = 43200.0,
+        step: float = 0.1,
+        *,
+        init: Union[Mapping[str, float], str, None] = None,
+        init_rate: Union[Mapping[str, float], str, None] = None,
+        kick_x: Optional[float] = None,
+        mode_energy: float = 1e-12,
+        readout: Optional[Mapping[str, float]] = None,
+        seed: int = 0,
+        nperseg: Optional[int] = None,
+    ) -> Simulation: ...
 
+@final
 class Budget:
     @property
     def freq_hz(self) -> npt.NDArray[np.float64]: ...
@@ -191,3 +266,5 @@ def budget_from_file(
     measured: Optional[_Path] = None,
     scale: Optional[Mapping[str, float]] = None,
 ) -> Budget: ...
+def _panic_for_tests(where_: Literal["here", "detached", "thread"]) -> None:
+    """Panics on purpose (tests only): a Rust panic is a PanicException, never an abort."""

@@ -1,9 +1,8 @@
 //! Value types shared by several subcommands: the method, averaging and output-format
 //! choices, and the `--readout OBS=ASD` item.
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{anyhow, Result};
 use clap::ValueEnum;
-use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::Observable;
 use tiltnoise_core::tf::Method;
 use tiltnoise_io::input::{AxisMap, ReadOptions};
@@ -64,27 +63,10 @@ impl MethodArg {
 /// One `--readout OBS=ASD` item (also used by `simulate`): the observable and its white
 /// readout noise, one-sided ASD in the observable's unit/sqrt(Hz), finite and >= 0.
 pub fn parse_readout_item(item: &str) -> Result<(Observable, f64)> {
-    let shown = Shown(item);
-    let (name, value) = item
-        .split_once('=')
-        .ok_or_else(|| anyhow!("--readout {shown}: expected OBS=ASD, e.g. X=9e-9"))?;
-    let o = Observable::from_name(name.trim()).ok_or_else(|| {
-        anyhow!(
-            "--readout {shown}: unknown observable `{}`; allowed: X, Y, Z, theta, eta, phi, phi_a",
-            Shown(name)
-        )
-    })?;
-    let asd: f64 = value
-        .trim()
-        .parse()
-        .map_err(|_| anyhow!("--readout {shown}: `{}` is not a number", Shown(value)))?;
-    if !(asd.is_finite() && asd >= 0.0) {
-        bail!(
-            "--readout {shown}: ASD {asd} {}/sqrt(Hz) is not allowed: must be finite and >= 0",
-            o.unit()
-        );
-    }
-    Ok((o, asd))
+    Ok(tiltnoise_core::options::parse_readout_item(
+        "--readout",
+        item,
+    )?)
 }
 
 /// How to read a tilt file from the `--axes MAP`, `--quantity angle|rate`,

@@ -14,10 +14,10 @@ use super::Run;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
-use tiltnoise_core::error::Shown;
 use tiltnoise_core::freq;
-use tiltnoise_core::model::{ForceInput, Model, Observable};
+use tiltnoise_core::model::{Model, Observable};
 use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::options;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::tf::planner::{choose, NoChoice, Scene, DEFAULT_REL_TOL};
 use tiltnoise_core::tf::{self, Input, Request};
@@ -71,80 +71,14 @@ pub struct TfArgs {
     explain: bool,
 }
 
-/// Every name `--input` accepts, for error messages.
-fn input_names() -> String {
-    let mut names: Vec<&str> = Input::all_tilts().into_iter().map(Input::name).collect();
-    names.extend(ForceInput::ALL.iter().map(|f| f.name()));
-    format!("{}, or the groups `tilt` and `forces`", names.join(", "))
-}
-
-/// Splits repeated, comma-separated option values into trimmed names.
-fn split_names<'a>(option: &str, specs: &'a [String]) -> Result<Vec<&'a str>> {
-    let mut names = Vec::new();
-    for spec in specs {
-        for name in spec.split(',').map(str::trim) {
-            if name.is_empty() {
-                bail!(
-                    "{option} \"{}\": empty name in the list (names are separated by single commas)",
-                    Shown(spec)
-                );
-            }
-            names.push(name);
-        }
-    }
-    Ok(names)
-}
-
 /// Parses `--input` values (see [`TfArgs`]); empty means the three tilt angles.
 pub fn parse_inputs(specs: &[String]) -> Result<Vec<Input>> {
-    if specs.is_empty() {
-        return Ok(Input::all_tilts());
-    }
-    let mut inputs: Vec<Input> = Vec::new();
-    for name in split_names("--input", specs)? {
-        let group: Vec<Input> = match name {
-            "tilt" => Input::all_tilts(),
-            "forces" => ForceInput::ALL.into_iter().map(Input::Force).collect(),
-            _ => match Input::from_name(name) {
-                Some(i) => vec![i],
-                None => bail!(
-                    "--input: unknown input \"{}\"; allowed: {}",
-                    Shown(name),
-                    input_names()
-                ),
-            },
-        };
-        for i in group {
-            if inputs.contains(&i) {
-                bail!("--input: {} is given twice; name each input once", i.name());
-            }
-            inputs.push(i);
-        }
-    }
-    Ok(inputs)
+    Ok(options::parse_inputs("--input", specs)?)
 }
 
 /// Parses `--output` values (see [`TfArgs`]); empty means all seven observables.
 pub fn parse_outputs(specs: &[String]) -> Result<Vec<Observable>> {
-    if specs.is_empty() {
-        return Ok(Observable::ALL.to_vec());
-    }
-    let mut outputs = Vec::new();
-    for name in split_names("--output", specs)? {
-        let Some(o) = Observable::from_name(name) else {
-            let allowed: Vec<&str> = Observable::ALL.iter().map(|o| o.name()).collect();
-            bail!(
-                "--output: unknown observable \"{}\"; allowed: {}",
-                Shown(name),
-                allowed.join(", ")
-            );
-        };
-        if outputs.contains(&o) {
-            bail!("--output: {name} is given twice; name each observable once");
-        }
-        outputs.push(o);
-    }
-    Ok(outputs)
+    Ok(options::parse_outputs("--output", specs)?)
 }
 
 /// Runs `tiltnoise tf`.
@@ -229,53 +163,4 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
         }
         Ok(())
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn strings(v: &[&str]) -> Vec<String> {
-        v.iter().map(|s| s.to_string()).collect()
-    }
-
-    #[test]
-    fn inputs_parse_lists_groups_and_repeats() {
-        let got = parse_inputs(&strings(&["F_b.x, M_b.z", "theta_t"])).unwrap();
-        let names: Vec<&str> = got.iter().map(|i| i.name()).collect();
-        assert_eq!(names, ["F_b.x", "M_b.z", "theta_t"]);
-        assert_eq!(parse_inputs(&[]).unwrap(), Input::all_tilts());
-        assert_eq!(parse_inputs(&strings(&["forces"])).unwrap().len(), 12);
-        assert_eq!(parse_inputs(&strings(&["tilt,forces"])).unwrap().len(), 15);
-    }
-
-    #[test]
-    fn bad_input_names_are_refused_with_the_allowed_list() {
-        let e = parse_inputs(&strings(&["F_c.x"])).unwrap_err().to_string();
-        assert!(
-            e.contains("\"F_c.x\"") && e.contains("M_b.z") && e.contains("theta_t"),
-            "{e}"
-        );
-        let e = parse_inputs(&strings(&["F_b.x,F_b.x"]))
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("twice"), "{e}");
-        let e = parse_inputs(&strings(&["tilt,eta_t"]))
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("eta_t is given twice"), "{e}");
-        let e = parse_inputs(&strings(&["F_b.x,,M_b.z"]))
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("empty name"), "{e}");
-    }
-
-    #[test]
-    fn outputs_parse_and_refuse_unknown_names() {
-        let got = parse_outputs(&strings(&["phi,X"])).unwrap();
-        assert_eq!(got, [Observable::Phi, Observable::X]);
-        assert_eq!(parse_outputs(&[]).unwrap(), Observable::ALL.to_vec());
-        let e = parse_outputs(&strings(&["x"])).unwrap_err().to_string();
-        assert!(e.contains("\"x\"") && e.contains("phi_a"), "{e}");
-    }
 }

@@ -9,6 +9,7 @@
 //! Conventions: one-sided spectra, PSD in unit^2/Hz (see [`crate::noise`]).
 
 mod measured;
+pub mod option_checks;
 mod summary;
 
 pub use crate::noise::loglog_at;

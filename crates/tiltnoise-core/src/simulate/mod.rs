@@ -47,7 +47,13 @@ use crate::modes::NormalModes;
 use crate::rng::Rng;
 
 pub mod driven;
+mod init;
 pub mod resonance;
+
+pub use init::{
+    check_sampling, default_sim_nperseg, describe_run, initial_state, parse_coordinates,
+    readout_text, record_description, set_coordinate, Excitation, MIN_SIM_NPERSEG,
+};
 
 /// Refuses a simulation of `n_samples` (a float: `floor(duration / dt)` may be beyond any
 /// integer) over [`MAX_SIM_SAMPLES`] or over the memory available ([`SIM_BYTES_PER_SAMPLE`]

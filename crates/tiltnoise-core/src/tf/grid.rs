@@ -48,6 +48,20 @@ fn on_threads<'f, J: Send>(
     })
 }
 
+/// How the output of [`eval_grid_threads`] was obtained, which decides how a large one is
+/// written (the values are the same).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Destination {
+    /// Memory written before (a buffer used again): a large output is written with
+    /// non-temporal stores, which do not first read each cache line from memory and do not
+    /// evict the cache.
+    Reused,
+    /// Memory just allocated and not yet touched (a new NumPy array): the operating system
+    /// zeroes each page at its first touch, which leaves the page in the cache, so ordinary
+    /// stores write into the cache where non-temporal ones would first evict it.
+    Fresh,
+}
+
 /// Grid points per thread: `threads` parts (0 means 1), at least one point each.
 fn part_len(n_freqs: usize, threads: usize) -> usize {
     n_freqs.div_ceil(threads.max(1)).max(1)
@@ -55,8 +69,10 @@ fn part_len(n_freqs: usize, threads: usize) -> usize {
 
 /// [`TransferFunction::eval_grid_into`] (dense `[freq][output][input]` complex values) with
 /// the grid cut into `threads` contiguous parts, one per thread. The values do not depend on
-/// `threads` (every point is evaluated independently); the error is the one of the first
-/// failing frequency in grid order, as with one thread. `threads = 0` means 1.
+/// `threads` (every point is evaluated independently) and are all finite; the error is the one
+/// of the first failing frequency in grid order, as with one thread ([`TfError::NotFinite`]
+/// for a value that overflowed). `threads = 0` means 1. `destination`: how `out` was
+/// obtained ([`Destination`]).
 ///
 /// # Panics
 ///
@@ -66,25 +82,16 @@ pub fn eval_grid_threads(
     freqs_hz: &[f64],
     out: &mut [Complex64],
     threads: usize,
+    destination: Destination,
 ) -> Result<(), TfError> {
     let block = check_grid_len(tf.request(), freqs_hz, out);
     if block == 0 || freqs_hz.is_empty() {
-        return tf.eval_grid_into(freqs_hz, out);
+        return tf.eval_grid_into_dest(freqs_hz, out, destination);
     }
     let part = part_len(freqs_hz.len(), threads);
     let jobs = freqs_hz.chunks(part).zip(out.chunks_mut(part * block));
-    on_threads(jobs, &|f, o| {
-        tf.eval_grid_into(f, o)?;
-        match o
-            .iter()
-            .position(|z| !(z.re.is_finite() && z.im.is_finite()))
-        {
-            None => Ok(()),
-            Some(j) => Err(TfError::NotFinite {
-                freq_hz: f[j / block],
-            }),
-        }
-    })
+    // `eval_grid_into` checks that every value is finite (while it is in cache).
+    on_threads(jobs, &|f, o| tf.eval_grid_into_dest(f, o, destination))
 }
 
 /// Evaluates a plan on every frequency of a grid, on one thread, into a new matrix in the

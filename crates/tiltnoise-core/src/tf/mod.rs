@@ -48,7 +48,7 @@ pub use block::BlockReduced;
 pub use buffer::{zeroed_complex, zeroed_f64};
 pub use direct::{Direct, SINGULAR_RCOND};
 pub(crate) use grid::check_grid_len;
-pub use grid::{eval_grid_threads, evaluate, evaluate_into};
+pub use grid::{eval_grid_threads, evaluate, evaluate_into, Destination};
 pub use matrix::{Layout, TransferMatrix};
 pub use modal::Modal;
 pub use planner::{
@@ -157,10 +157,12 @@ pub trait TransferFunction: Send + Sync {
 
     /// Writes `H` at every frequency of `freqs_hz` into `out`, `[freq][output][input]`
     /// row-major (the dense [`Layout`]), whose length must be
-    /// `freqs_hz.len() * outputs.len() * inputs.len()`. Returns the error of the first
-    /// frequency (in grid order) at which [`TransferFunction::eval_into`] fails; `out` is then
-    /// unspecified. The default calls `eval_into` point by point; a method with a faster
-    /// batch evaluation ([`Method::PoleZero`]) overrides it with the same values and errors.
+    /// `freqs_hz.len() * outputs.len() * inputs.len()`, every value finite. Returns the error
+    /// of the first frequency (in grid order) at which [`TransferFunction::eval_into`] fails
+    /// or gives a value that is not finite ([`TfError::NotFinite`]: an overflow); `out` is
+    /// then unspecified. The default calls `eval_into` point by point and checks each point's
+    /// values while they are in cache; a method with a faster batch evaluation
+    /// ([`Method::PoleZero`]) overrides it with the same values and errors.
     ///
     /// # Panics
     ///
@@ -176,8 +178,28 @@ pub trait TransferFunction: Send + Sync {
         }
         for (&f, h) in freqs_hz.iter().zip(out.chunks_exact_mut(block)) {
             self.eval_into(f, h)?;
+            if h.iter().any(|z| !(z.re.is_finite() && z.im.is_finite())) {
+                return Err(TfError::NotFinite { freq_hz: f });
+            }
         }
         Ok(())
+    }
+
+    /// [`TransferFunction::eval_grid_into`] into memory obtained as `destination` says: the
+    /// same values and errors; only how a large output is written may differ (see
+    /// [`Destination`]). The default ignores `destination`.
+    ///
+    /// # Panics
+    ///
+    /// If `out` has the wrong length.
+    fn eval_grid_into_dest(
+        &self,
+        freqs_hz: &[f64],
+        out: &mut [Complex64],
+        destination: Destination,
+    ) -> Result<(), TfError> {
+        let _ = destination;
+        self.eval_grid_into(freqs_hz, out)
     }
 
     /// The layout [`evaluate`] stores this plan's values in: [`Layout::dense`] unless the plan

@@ -57,7 +57,7 @@
 mod kernel;
 mod lanes;
 
-use super::{Input, Layout, Method, Request, TransferFunction};
+use super::{Destination, Input, Layout, Method, Request, TransferFunction};
 use crate::dd::matrices::{self, Matrices};
 use crate::dd::{CDd, Dd, DD_EPS};
 use crate::error::TfError;
@@ -576,8 +576,19 @@ impl TransferFunction for PoleZero {
     /// The whole grid in chunks of frequencies (see the module docs): the same values, bit
     /// for bit, as [`TransferFunction::eval_into`] at each point, and the same error.
     fn eval_grid_into(&self, freqs_hz: &[f64], out: &mut [Complex64]) -> Result<(), TfError> {
+        self.eval_grid_into_dest(freqs_hz, out, Destination::Reused)
+    }
+
+    /// Non-temporal stores for a large output unless it is [`Destination::Fresh`].
+    fn eval_grid_into_dest(
+        &self,
+        freqs_hz: &[f64],
+        out: &mut [Complex64],
+        destination: Destination,
+    ) -> Result<(), TfError> {
         super::check_grid_len(&self.request, freqs_hz, out);
-        self.kernel.eval_grid(freqs_hz, as_f64_mut(out))
+        self.kernel
+            .eval_grid(freqs_hz, as_f64_mut(out), destination)
     }
 
     /// Only the entries some block reaches, in entry order; real (one `f64` per entry) when

@@ -24,8 +24,8 @@ use tiltnoise_core::model::{ForceInput, Model, Observable};
 use tiltnoise_core::params::Params;
 use tiltnoise_core::reference::{CDd, Dd};
 use tiltnoise_core::tf::{
-    eval_grid_threads, evaluate, evaluate_into, plan, Input, Method, PoleZero, Request,
-    TransferFunction,
+    eval_grid_threads, evaluate, evaluate_into, plan, Destination, Input, Method, PoleZero,
+    Request, TransferFunction,
 };
 
 const LOSS: f64 = 1e-3;
@@ -105,7 +105,7 @@ fn batch(
     let r = tf.request();
     let mut out =
         vec![Complex64::new(f64::NAN, f64::NAN); freqs.len() * r.outputs.len() * r.inputs.len()];
-    eval_grid_threads(tf, freqs, &mut out, threads)?;
+    eval_grid_threads(tf, freqs, &mut out, threads, Destination::Reused)?;
     Ok(out)
 }
 
@@ -479,5 +479,52 @@ fn threads_split_any_method_like_one_thread() {
             &got,
             &want,
         );
+    }
+}
+
+/// A value that overflows `f64` (at a frequency far beyond any physical one, where `w^2` is
+/// infinite) is [`TfError::NotFinite`] at the first such frequency in grid order, on every
+/// path and thread count, never a NaN or an infinity in the output: the pole-zero kernel
+/// checks its chunks in cache, the default `eval_grid_into` each point.
+#[test]
+fn overflowing_values_are_an_error_at_the_first_such_frequency() {
+    let model = Model::new(&Params::table_i()).unwrap();
+    let base: Vec<f64> = (0..40).map(|k| 1e-3 * 1.3_f64.powi(k)).collect();
+    let (huge, huger) = (1e200, 1e250);
+    for method in [Method::PoleZero, Method::Direct] {
+        let tf = plan(&model, &Request::all_tilt(), method).unwrap();
+        assert!(
+            matches!(
+                evaluate(tf.as_ref(), &[huge]),
+                Err(TfError::NotFinite { .. })
+            ),
+            "{}: {huge} Hz must overflow",
+            method.name()
+        );
+        for at in [0, 5, 8, 21, 39] {
+            let mut f = base.clone();
+            f[at] = huge;
+            f[(at + 13) % 40] = huger;
+            let first = if at < (at + 13) % 40 { huge } else { huger };
+            for threads in [1, 2, 3] {
+                match batch(tf.as_ref(), &f, threads) {
+                    Err(TfError::NotFinite { freq_hz }) => assert_eq!(
+                        freq_hz,
+                        first,
+                        "{}, {threads} threads, index {at}",
+                        method.name()
+                    ),
+                    other => panic!(
+                        "{}, {threads} threads, index {at}: expected NotFinite at {first} Hz, \
+                         got {other:?}",
+                        method.name()
+                    ),
+                }
+            }
+            match evaluate(tf.as_ref(), &f) {
+                Err(TfError::NotFinite { freq_hz }) => assert_eq!(freq_hz, first),
+                other => panic!("{}, evaluate: {other:?}", method.name()),
+            }
+        }
     }
 }

@@ -21,8 +21,10 @@ use super::h5::{self, h5err, AttrValue};
 use super::InputError;
 use super::InputFormat;
 use std::path::Path;
+use tiltnoise_core::budget::{add_measured, series_psds, BudgetError, MeasuredPsds};
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::Observable;
+use tiltnoise_core::noise::BudgetReport;
 
 /// Schema name of an HDF5 time series of the observables (root attribute `schema`, optional);
 /// the same string as `crate::io::SCHEMA_OBSERVABLE_SERIES`.
@@ -73,6 +75,47 @@ pub fn read_measured_input(path: &Path) -> Result<MeasuredInput, InputError> {
             }
         }
     }
+}
+
+/// Adds the terms `measured` and `residual` from the measured record in `path` (any layout of
+/// the module docs) to a budget: a spectrum is interpolated log-log onto the budget grid (NaN
+/// where it does not reach); a time series is first turned into one-sided PSDs with the
+/// budget's own Welch settings ([`series_psds`]). `option` names the record in messages
+/// (`--measured` on the command line, `measured` in Python).
+///
+/// # Errors
+///
+/// [`BudgetError::Input`] when the file cannot be read or is not valid;
+/// [`BudgetError::Config`] (prefixed with `option` and the path) when a series does not fit
+/// the budget's Welch settings.
+pub fn add_measured_file(
+    report: &mut BudgetReport,
+    path: &Path,
+    option: &str,
+) -> Result<(), BudgetError> {
+    let (freqs_hz, psds, description, welch) = match read_measured_input(path)? {
+        MeasuredInput::Spectra(m) => {
+            let psds = m
+                .asd
+                .iter()
+                .map(|(o, asd)| (*o, asd.iter().map(|a| a * a).collect()))
+                .collect();
+            (m.freqs_hz, psds, "measured spectrum".to_string(), None)
+        }
+        MeasuredInput::Series(series) => {
+            let m = series_psds(&series.channels, series.sample_rate_hz, &report.source)
+                .map_err(|e| BudgetError::Config(format!("{option} {}: {e}", path.display())))?;
+            (m.freqs_hz, m.psds, m.description, m.welch)
+        }
+    };
+    let measured = MeasuredPsds {
+        freqs_hz,
+        psds,
+        description,
+        welch,
+    };
+    add_measured(report, &measured, &path.display().to_string());
+    Ok(())
 }
 
 const OBSERVABLE_UNITS: &str =

@@ -32,8 +32,8 @@ mod start_time;
 
 pub use asd_file::{read_asd_column, AsdColumn, GENERIC_ASD_COLUMN};
 pub use measured::{
-    read_measured, read_measured_input, MeasuredInput, MeasuredSeries, MeasuredSpectra,
-    SCHEMA_OBSERVABLE_SERIES,
+    add_measured_file, read_measured, read_measured_input, MeasuredInput, MeasuredSeries,
+    MeasuredSpectra, SCHEMA_OBSERVABLE_SERIES,
 };
 pub use meta::{iso8601_to_unix, unix_to_iso8601};
 pub use source::TiltSeriesSource;

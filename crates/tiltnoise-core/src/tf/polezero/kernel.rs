@@ -30,12 +30,16 @@
 //! A chunk with a frequency that is not finite and >= 0, or on which a block is singular, is
 //! handed to a scalar pass over its points in order ([`Kernel::first_error`]) that returns the
 //! error of the first such point: the error a point-by-point evaluation of the grid reports.
+//! The interleaved output is also checked for values that overflowed, each as it is computed
+//! (in registers, before the chunk goes to memory): [`TfError::NotFinite`] at the first such
+//! point.
 
 use super::super::direct::{omega_sq, SINGULAR_RCOND};
 #[cfg(target_arch = "x86_64")]
 use super::lanes::Avx;
 use super::lanes::{stream_fence, Lanes, Portable, LANES};
 use crate::error::TfError;
+use crate::tf::Destination;
 use num_complex::Complex64;
 
 /// Interleaved outputs of at least this many bytes are written with non-temporal stores
@@ -125,8 +129,9 @@ impl BlockForm {
     }
 
     /// Adds the block's entries at the chunk's first `n` frequencies (`s` per lane) to `out`
-    /// (`n` points of `stride` `f64` values); false, with `out` partly written, if the block
-    /// is singular in some lane.
+    /// (`n` points of `stride` `f64` values), and `v - v` of each value added to `finite`
+    /// (interleaved only); false, with `out` partly written, if the block is singular in
+    /// some lane.
     #[inline(always)]
     fn add_chunk<V: Lanes, const PLANAR: bool>(
         &self,
@@ -134,10 +139,11 @@ impl BlockForm {
         n: usize,
         stride: usize,
         out: &mut [f64],
+        finite: &mut V,
     ) -> bool {
         match self {
-            BlockForm::Real(b) => b.add_chunk::<V, PLANAR>(s, n, stride, out),
-            BlockForm::Complex(b) => b.add_chunk::<V, PLANAR>(s, n, stride, out),
+            BlockForm::Real(b) => b.add_chunk::<V, PLANAR>(s, n, stride, out, finite),
+            BlockForm::Complex(b) => b.add_chunk::<V, PLANAR>(s, n, stride, out, finite),
         }
     }
 
@@ -183,6 +189,7 @@ impl RealBlock {
         n: usize,
         stride: usize,
         out: &mut [f64],
+        finite: &mut V,
     ) -> bool {
         let p = self.poles;
         let d = [
@@ -206,7 +213,7 @@ impl RealBlock {
             for k in 0..e.factors {
                 h = h.mul(V::splat(e.a[k]).add(V::splat(e.b[k]).mul(s)));
             }
-            put::<V, PLANAR>(out, e.re, stride, n, e.first_re, h.mul(inv));
+            put::<V, PLANAR>(out, e.re, stride, n, e.first_re, h.mul(inv), finite);
         }
         true
     }
@@ -215,7 +222,10 @@ impl RealBlock {
 /// Lane `l < n` of `v` into `out[l * stride + at]` (interleaved: a point's values together),
 /// or every lane into `out[at * LANES + l]` (`PLANAR`: a value's lanes together): stored as
 /// `0.0 + v` if `first` (what adding to a zeroed output gives: +0.0 for -0.0), else added.
+/// Interleaved, `v - v` (0 if finite, else NaN) is added to `finite`: the check of the value
+/// while it is in a register (see [`Kernel::eval_with`]).
 #[inline(always)]
+#[allow(clippy::eq_op, reason = "`v - v` is the finiteness test")]
 fn put<V: Lanes, const PLANAR: bool>(
     out: &mut [f64],
     at: usize,
@@ -223,6 +233,7 @@ fn put<V: Lanes, const PLANAR: bool>(
     n: usize,
     first: bool,
     v: V,
+    finite: &mut V,
 ) {
     if PLANAR {
         let lanes: &mut [f64; LANES] = (&mut out[at * LANES..(at + 1) * LANES])
@@ -236,6 +247,7 @@ fn put<V: Lanes, const PLANAR: bool>(
         v.store(lanes);
         return;
     }
+    *finite = finite.add(v.sub(v));
     let v = if first { V::splat(0.0).add(v) } else { v }.to_array();
     // One bounds check for the column, none per lane (when `n == LANES`, the usual case, the
     // loop below has a constant count and is unrolled).
@@ -278,6 +290,7 @@ impl ComplexBlock {
         n: usize,
         stride: usize,
         out: &mut [f64],
+        finite: &mut V,
     ) -> bool {
         let p = self.poles;
         let d = [
@@ -308,8 +321,8 @@ impl ComplexBlock {
             // (h_re + i h_im) (inv_re - i inv_im_neg).
             let re = h_re.mul(inv_re).add(h_im.mul(inv_im_neg));
             let im = h_im.mul(inv_re).sub(h_re.mul(inv_im_neg));
-            put::<V, PLANAR>(out, e.re, stride, n, e.first_re, re);
-            put::<V, PLANAR>(out, e.im, stride, n, e.first_im, im);
+            put::<V, PLANAR>(out, e.re, stride, n, e.first_re, re, finite);
+            put::<V, PLANAR>(out, e.im, stride, n, e.first_im, im, finite);
         }
         true
     }
@@ -323,14 +336,20 @@ pub(super) struct Kernel {
     stride: usize,
     /// The CPU has AVX (checked at plan time): the same operations, four lanes per instruction.
     avx: bool,
+    /// Positions that more than one block adds to: a sum of finite contributions can still
+    /// overflow, so these are checked once the chunk is complete.
+    summed: Vec<usize>,
 }
 
 impl Kernel {
     /// The kernel of `blocks`, whose entries write at positions below `stride` in each
     /// point's `f64` values.
     pub fn new(mut blocks: Vec<BlockForm>, stride: usize) -> Kernel {
-        let mut written = vec![false; stride];
-        let mut first = |at: usize| !std::mem::replace(&mut written[at], true);
+        let mut written = vec![0_usize; stride];
+        let mut first = |at: usize| {
+            written[at] += 1;
+            written[at] == 1
+        };
         for b in &mut blocks {
             match b {
                 BlockForm::Real(b) => {
@@ -346,24 +365,38 @@ impl Kernel {
                 }
             }
         }
+        let summed = (0..stride).filter(|&at| written[at] > 1).collect();
         Kernel {
             blocks,
             stride,
             avx: avx_available(),
+            summed,
         }
     }
 
     /// `H` at every frequency of `freqs_hz` into `out` (`stride` values per frequency,
-    /// length `freqs_hz.len() * stride`, checked by the caller). On error the contents of
+    /// length `freqs_hz.len() * stride`, checked by the caller), every value finite: else
+    /// the error is [`TfError::NotFinite`] at the first frequency with a value that is not
+    /// (checked chunk by chunk while the values are in cache). Large outputs are written with
+    /// non-temporal stores unless `out` is [`Destination::Fresh`]. On error the contents of
     /// `out` are unspecified.
-    pub fn eval_grid(&self, freqs_hz: &[f64], out: &mut [f64]) -> Result<(), TfError> {
+    pub fn eval_grid(
+        &self,
+        freqs_hz: &[f64],
+        out: &mut [f64],
+        destination: Destination,
+    ) -> Result<(), TfError> {
         if self.stride > 0 && freqs_hz.len() == 1 {
             // One point (`eval_into`): written in place.
             out.fill(0.0);
             return self.dispatch(freqs_hz, out, &mut InPlace);
         }
         let mut chunk = self.chunk_buffer();
-        self.dispatch(freqs_hz, &mut chunk, &mut Interleaved::new(out))
+        self.dispatch(
+            freqs_hz,
+            &mut chunk,
+            &mut Interleaved::new(out, destination),
+        )
     }
 
     /// `H` at every frequency of `freqs_hz` into `planes` (`stride` of them, each as long as
@@ -426,12 +459,23 @@ impl Kernel {
         }
         let mut result = Ok(());
         for (c, fc) in freqs_hz.chunks(LANES).enumerate() {
-            result = if S::PLANAR {
+            let finite = if S::PLANAR {
                 self.eval_chunk::<V, true>(fc, chunk)
             } else {
                 self.eval_chunk::<V, false>(fc, chunk)
             };
-            if result.is_err() {
+            let finite = match finite {
+                Ok(f) => f,
+                Err(e) => {
+                    result = Err(e);
+                    break;
+                }
+            };
+            // The interleaved values are checked here, as they were computed, rather than by
+            // the caller after they went to memory; the planar ones by `tf::evaluate_into`,
+            // block by block.
+            if !S::PLANAR && !self.chunk_is_finite(finite, &chunk[..fc.len() * self.stride]) {
+                result = Err(first_not_finite(fc, chunk, self.stride));
                 break;
             }
             sink.take::<V>(c * LANES, fc.len(), self.stride, chunk);
@@ -442,13 +486,14 @@ impl Kernel {
 
     /// `H` at the (at most [`LANES`]) frequencies `fc` into `dst` (`fc.len()` points of
     /// `stride`, or `stride` values of [`LANES`] lanes if `PLANAR`), whose structural zeros
-    /// must already be zero.
+    /// must already be zero. Returns the sum of `v - v` over the values added (interleaved;
+    /// 0 if all are finite, else NaN).
     #[inline(always)]
     fn eval_chunk<V: Lanes, const PLANAR: bool>(
         &self,
         fc: &[f64],
         dst: &mut [f64],
-    ) -> Result<(), TfError> {
+    ) -> Result<V, TfError> {
         // A short chunk repeats its last frequency in the unused lanes.
         let last = fc.len() - 1;
         let f = V::from_array(std::array::from_fn(|l| fc[l.min(last)]));
@@ -457,14 +502,35 @@ impl Kernel {
         let w = V::splat(std::f64::consts::TAU).mul(f);
         let s = w.mul(w);
         let mut ok = valid;
+        let mut finite = V::splat(0.0);
         for b in &self.blocks {
-            ok = ok && b.add_chunk::<V, PLANAR>(s, fc.len(), self.stride, dst);
+            ok = ok && b.add_chunk::<V, PLANAR>(s, fc.len(), self.stride, dst, &mut finite);
         }
         if ok {
-            Ok(())
+            Ok(finite)
         } else {
             Err(self.first_error(fc))
         }
+    }
+
+    /// Whether a complete chunk of interleaved `values` is finite, given the sum of `v - v`
+    /// over every value its blocks added (`finite`): the structural zeros are, and a value
+    /// one block wrote is if its contribution is; a value several blocks added to is checked
+    /// itself.
+    #[inline(always)]
+    fn chunk_is_finite<V: Lanes>(&self, finite: V, values: &[f64]) -> bool {
+        // Every lane 0 (one comparison, no chain of additions across the lanes).
+        if !finite.all_finite_nonneg() {
+            return false;
+        }
+        for &at in &self.summed {
+            for point in values.chunks_exact(self.stride) {
+                if !point[at].is_finite() {
+                    return false;
+                }
+            }
+        }
+        true
     }
 
     /// The error of the first point of `freqs_hz` that is invalid or singular, checking the
@@ -482,6 +548,24 @@ impl Kernel {
             }
         }
         unreachable!("a chunk failed its checks but none of its points does")
+    }
+}
+
+/// [`TfError::NotFinite`] at the first point of `freqs_hz` (`stride` values each in `values`)
+/// with a value that is not finite: an overflow (a frequency or parameters beyond the range of
+/// `f64`), never a silent NaN.
+#[cold]
+#[inline(never)]
+fn first_not_finite(freqs_hz: &[f64], values: &[f64], stride: usize) -> TfError {
+    let k = values
+        .chunks_exact(stride)
+        .take(freqs_hz.len())
+        .position(|p| p.iter().any(|v| !v.is_finite()))
+        // A lane past the chunk's points repeats its last point, so a value that is not
+        // finite is in one of the points.
+        .unwrap_or(freqs_hz.len() - 1);
+    TfError::NotFinite {
+        freq_hz: freqs_hz[k],
     }
 }
 
@@ -513,9 +597,11 @@ struct Interleaved<'a> {
 }
 
 impl<'a> Interleaved<'a> {
-    /// Non-temporal stores for outputs of [`STREAM_MIN_BYTES`] or more.
-    fn new(out: &'a mut [f64]) -> Self {
-        let stream = std::mem::size_of_val(out) >= STREAM_MIN_BYTES;
+    /// Non-temporal stores for outputs of [`STREAM_MIN_BYTES`] or more that are not
+    /// [`Destination::Fresh`].
+    fn new(out: &'a mut [f64], destination: Destination) -> Self {
+        let stream =
+            std::mem::size_of_val(out) >= STREAM_MIN_BYTES && destination == Destination::Reused;
         Interleaved { out, stream }
     }
 }
@@ -584,10 +670,55 @@ mod tests {
     use crate::params::Params;
     use crate::tf::{PoleZero, Request};
 
+    /// A value two blocks add to can overflow although each contribution is finite: it is
+    /// checked itself ([`super::Kernel::chunk_is_finite`]), on every point of a chunk and of a
+    /// short last chunk, as is a contribution that overflows alone.
+    #[test]
+    fn sums_of_blocks_that_overflow_are_refused() {
+        use super::{BlockForm, Kernel, RealEntry};
+        use crate::error::TfError;
+        use crate::tf::Destination;
+        // 1 / prod(1 - s): each block adds `gain` at 0 Hz, `gain / 14^4` at s = 15.
+        let block = |gain: f64| {
+            let entry = RealEntry {
+                re: 0,
+                first_re: false,
+                factors: 0,
+                gain,
+                a: [1.0; 4],
+                b: [0.0; 4],
+            };
+            BlockForm::real([1.0; 4], vec![entry])
+        };
+        let two = |gain: f64| Kernel::new(vec![block(gain), block(gain)], 1);
+        let f_15 = 15f64.sqrt() / std::f64::consts::TAU;
+        for n in [1, 3, 8, 11] {
+            let mut f = vec![f_15; n];
+            f[n - 1] = 0.0;
+            let mut out = vec![f64::NAN; n];
+            two(1e307)
+                .eval_grid(&f, &mut out, Destination::Reused)
+                .unwrap();
+            assert_eq!(out[n - 1], 2e307);
+            let cases = [
+                (two(1.5e308), 0.0),
+                (Kernel::new(vec![block(f64::INFINITY)], 1), f[0]),
+            ];
+            for (kernel, first_bad) in cases {
+                match kernel.eval_grid(&f, &mut out, Destination::Reused) {
+                    Err(TfError::NotFinite { freq_hz }) => {
+                        assert_eq!(freq_hz, first_bad, "{n} points")
+                    }
+                    other => panic!("{n} points: {other:?}"),
+                }
+            }
+        }
+    }
+
     /// AVX and portable lanes on the same grid, bit for bit: undamped and damped (real and
     /// complex blocks), the dense and the compact kernel, interleaved and planar, a grid small
-    /// enough for ordinary stores and one large enough for the non-temporal ones, with a short
-    /// last chunk.
+    /// enough for ordinary stores and one large enough for the non-temporal ones (and the
+    /// same with ordinary stores into a fresh buffer), with a short last chunk.
     /// Skipped on a CPU without AVX.
     #[cfg(target_arch = "x86_64")]
     #[test]
@@ -619,11 +750,11 @@ mod tests {
                         .eval_with::<super::Portable, _>(
                             &freqs,
                             &mut chunk,
-                            &mut super::Interleaved::new(&mut portable),
+                            &mut super::Interleaved::new(&mut portable, super::Destination::Reused),
                         )
                         .unwrap();
                     let mut chunk = kernel.chunk_buffer();
-                    let mut sink = super::Interleaved::new(&mut avx);
+                    let mut sink = super::Interleaved::new(&mut avx, super::Destination::Reused);
                     // SAFETY: the CPU has AVX (checked above).
                     unsafe { kernel.eval_avx(&freqs, &mut chunk, &mut sink) }.unwrap();
                     for (k, (a, p)) in avx.iter().zip(&portable).enumerate() {
@@ -634,6 +765,15 @@ mod tests {
                             freqs[k / stride]
                         );
                     }
+                    // Ordinary stores into a new buffer (`Destination::Fresh`): the same values.
+                    let mut fresh = vec![f64::NAN; n * stride];
+                    kernel
+                        .eval_grid(&freqs, &mut fresh, super::Destination::Fresh)
+                        .unwrap();
+                    assert!(fresh
+                        .iter()
+                        .zip(&avx)
+                        .all(|(f, a)| f.to_bits() == a.to_bits()));
                     // The planar path (what `evaluate` uses) of the same kernel.
                     let planes_of = |avx: bool| {
                         let mut data = vec![f64::NAN; n * stride];

@@ -1,0 +1,463 @@
+//! Names and options as a user gives them, parsed and checked once for every front end: the
+//! command line (`--input F_b.x,M_b.z`, `--readout X=9e-9`) and the Python package
+//! (`inputs=["F_b.x", "M_b.z"]`, `readout={"X": 9e-9}`) call these functions and so say the
+//! same thing about the same mistake. A message starts with the option as the caller spells it
+//! ([`Spelling`]), then the value given and what is allowed.
+
+use crate::error::{Num, Shown};
+use crate::limits::LimitError;
+use crate::model::{ForceInput, Input, Observable};
+use crate::noise::Readout;
+
+/// How a front end spells its options in messages.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Spelling {
+    /// The command line's flags: `--segment-duration 3600`.
+    Flag,
+    /// Keyword arguments (Python): `segment_duration=3600`.
+    Keyword,
+}
+
+impl Spelling {
+    /// The option `name` (snake case, as a keyword: `segment_duration`) as this front end
+    /// spells it: `--segment-duration` or `segment_duration`.
+    pub fn option(self, name: &str) -> String {
+        match self {
+            Spelling::Flag => format!("--{}", name.replace('_', "-")),
+            Spelling::Keyword => name.to_string(),
+        }
+    }
+
+    /// The option `name` set to `value`: `--segment-duration 3600` or `segment_duration=3600`.
+    pub fn example(self, name: &str, value: &str) -> String {
+        match self {
+            Spelling::Flag => format!("{} {value}", self.option(name)),
+            Spelling::Keyword => format!("{name}={value}"),
+        }
+    }
+}
+
+/// A name or option value that is not allowed; the message names the option, the value and
+/// what is allowed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum OptionError {
+    /// An empty name in a comma-separated list.
+    #[error("{option} \"{}\": empty name in the list (names are separated by single commas)", Shown(.spec))]
+    EmptyName {
+        /// The option, as spelled by the caller.
+        option: String,
+        /// The list given.
+        spec: String,
+    },
+    /// A name that is no input.
+    #[error("{option}: unknown input \"{}\"; allowed: {}", Shown(.name), input_names())]
+    UnknownInput {
+        /// The option.
+        option: String,
+        /// The name given.
+        name: String,
+    },
+    /// A name that is no observable.
+    #[error("{option}: unknown observable \"{}\"; allowed: {}", Shown(.name), observable_names())]
+    UnknownObservable {
+        /// The option.
+        option: String,
+        /// The name given.
+        name: String,
+    },
+    /// A name given twice (also through a group).
+    #[error("{option}: {name} is given twice; name each {what} once")]
+    Repeated {
+        /// The option.
+        option: String,
+        /// The name.
+        name: &'static str,
+        /// `input` or `observable`.
+        what: &'static str,
+    },
+    /// A readout item that is not `OBS=ASD`.
+    #[error("{option} {}: expected OBS=ASD, e.g. X=9e-9", Shown(.item))]
+    ReadoutSyntax {
+        /// The option.
+        option: String,
+        /// The item given.
+        item: String,
+    },
+    /// A readout item whose observable is unknown.
+    #[error("{option} {}: unknown observable `{}`; allowed: {}", Shown(.item), Shown(.name), observable_names())]
+    ReadoutObservable {
+        /// The option.
+        option: String,
+        /// The item given.
+        item: String,
+        /// The observable's name given.
+        name: String,
+    },
+    /// A value that does not parse as a number.
+    #[error("{option} {}: `{}` is not a number", Shown(.item), Shown(.value))]
+    NotANumber {
+        /// The option.
+        option: String,
+        /// The item given.
+        item: String,
+        /// The value's text.
+        value: String,
+    },
+    /// A readout ASD that is negative or not finite.
+    #[error("{option} {}: ASD {asd} {unit}/sqrt(Hz) is not allowed: must be finite and >= 0", Shown(.item))]
+    ReadoutAsd {
+        /// The option.
+        option: String,
+        /// The item given.
+        item: String,
+        /// The ASD given.
+        asd: f64,
+        /// The observable's unit.
+        unit: &'static str,
+    },
+    /// A readout on an observable the budget does not compute.
+    #[error("{option} {name}=...: {name} is not budgeted; allowed: {allowed}")]
+    NotBudgeted {
+        /// The option.
+        option: String,
+        /// The observable.
+        name: &'static str,
+        /// The budgeted observables, comma-separated.
+        allowed: String,
+    },
+    /// An option that does not fit the others or the input, or a value out of its range (the
+    /// message says why and what to do instead).
+    #[error("{0}")]
+    Conflict(String),
+    /// A size beyond a documented limit or the memory available.
+    #[error(transparent)]
+    TooLarge(#[from] LimitError),
+}
+
+/// Every input name, for messages.
+pub fn input_names() -> String {
+    let mut names: Vec<&str> = Input::all_tilts().into_iter().map(Input::name).collect();
+    names.extend(ForceInput::ALL.iter().map(|f| f.name()));
+    format!("{}, or the groups `tilt` and `forces`", names.join(", "))
+}
+
+/// Every observable name, for messages.
+pub fn observable_names() -> String {
+    let names: Vec<&str> = Observable::ALL.iter().map(|o| o.name()).collect();
+    names.join(", ")
+}
+
+/// The names of `specs` (each a comma-separated list, as a repeated option gives them),
+/// trimmed; an empty name is refused.
+pub fn split_names<'a, S: AsRef<str>>(
+    option: &str,
+    specs: &'a [S],
+) -> Result<Vec<&'a str>, OptionError> {
+    let mut names = Vec::new();
+    for spec in specs {
+        let spec = spec.as_ref();
+        for name in spec.split(',').map(str::trim) {
+            if name.is_empty() {
+                return Err(OptionError::EmptyName {
+                    option: option.to_string(),
+                    spec: spec.to_string(),
+                });
+            }
+            names.push(name);
+        }
+    }
+    Ok(names)
+}
+
+/// The inputs named by `specs` ([`split_names`]): tilt angles (`theta_t`, `eta_t`, `phi_t`),
+/// force and torque components (`F_a.x` .. `M_b.z`) and the groups `tilt` and `forces`, in
+/// the order given, each once; no name means the three tilt angles.
+pub fn parse_inputs<S: AsRef<str>>(option: &str, specs: &[S]) -> Result<Vec<Input>, OptionError> {
+    if specs.is_empty() {
+        return Ok(Input::all_tilts());
+    }
+    let mut inputs: Vec<Input> = Vec::new();
+    for name in split_names(option, specs)? {
+        let group: Vec<Input> = match name {
+            "tilt" => Input::all_tilts(),
+            "forces" => ForceInput::ALL.into_iter().map(Input::Force).collect(),
+            _ => match Input::from_name(name) {
+                Some(i) => vec![i],
+                None => {
+                    return Err(OptionError::UnknownInput {
+                        option: option.to_string(),
+                        name: name.to_string(),
+                    })
+                }
+            },
+        };
+        for i in group {
+            if inputs.contains(&i) {
+                return Err(OptionError::Repeated {
+                    option: option.to_string(),
+                    name: i.name(),
+                    what: "input",
+                });
+            }
+            inputs.push(i);
+        }
+    }
+    Ok(inputs)
+}
+
+/// The observables named by `specs` ([`split_names`]), in the order given, each once; no name
+/// means all seven.
+pub fn parse_outputs<S: AsRef<str>>(
+    option: &str,
+    specs: &[S],
+) -> Result<Vec<Observable>, OptionError> {
+    if specs.is_empty() {
+        return Ok(Observable::ALL.to_vec());
+    }
+    let mut outputs = Vec::new();
+    for name in split_names(option, specs)? {
+        let o = Observable::from_name(name).ok_or_else(|| OptionError::UnknownObservable {
+            option: option.to_string(),
+            name: name.to_string(),
+        })?;
+        if outputs.contains(&o) {
+            return Err(OptionError::Repeated {
+                option: option.to_string(),
+                name: o.name(),
+                what: "observable",
+            });
+        }
+        outputs.push(o);
+    }
+    Ok(outputs)
+}
+
+/// One readout item `OBS=ASD` as the command line gives it: the observable and its white
+/// readout noise, one-sided ASD in the observable's unit/sqrt(Hz), finite and >= 0.
+pub fn parse_readout_item(option: &str, item: &str) -> Result<(Observable, f64), OptionError> {
+    let (name, value) = item
+        .split_once('=')
+        .ok_or_else(|| OptionError::ReadoutSyntax {
+            option: option.to_string(),
+            item: item.to_string(),
+        })?;
+    let asd: Result<f64, OptionError> = value.trim().parse().map_err(|_| OptionError::NotANumber {
+        option: option.to_string(),
+        item: item.to_string(),
+        value: value.to_string(),
+    });
+    // The observable is checked first, as it comes first in the item.
+    let o = readout_observable(option, item, name.trim())?;
+    check_readout_asd(option, item, o, asd?)
+}
+
+/// One readout item given as a name and a number (a keyword argument's dict entry), checked
+/// as [`parse_readout_item`] checks `NAME=ASD`.
+pub fn readout_item(option: &str, name: &str, asd: f64) -> Result<(Observable, f64), OptionError> {
+    let item = format!("{name}={}", Num(asd));
+    let o = readout_observable(option, &item, name)?;
+    check_readout_asd(option, &item, o, asd)
+}
+
+fn readout_observable(option: &str, item: &str, name: &str) -> Result<Observable, OptionError> {
+    Observable::from_name(name).ok_or_else(|| OptionError::ReadoutObservable {
+        option: option.to_string(),
+        item: item.to_string(),
+        name: name.to_string(),
+    })
+}
+
+fn check_readout_asd(
+    option: &str,
+    item: &str,
+    o: Observable,
+    asd: f64,
+) -> Result<(Observable, f64), OptionError> {
+    if !(asd.is_finite() && asd >= 0.0) {
+        return Err(OptionError::ReadoutAsd {
+            option: option.to_string(),
+            item: item.to_string(),
+            asd,
+            unit: o.unit(),
+        });
+    }
+    Ok((o, asd))
+}
+
+/// `readout` with the items applied in order: a value replaces the observable's readout (the
+/// default is the paper's 9e-9 m/sqrt(Hz) on X), 0 removes it. With `budgeted`, an
+/// observable outside it is refused.
+pub fn apply_readout(
+    option: &str,
+    mut readout: Readout,
+    items: &[(Observable, f64)],
+    budgeted: Option<&[Observable]>,
+) -> Result<Readout, OptionError> {
+    for &(o, asd) in items {
+        if let Some(budgeted) = budgeted {
+            if !budgeted.contains(&o) {
+                let allowed: Vec<&str> = budgeted.iter().map(|o| o.name()).collect();
+                return Err(OptionError::NotBudgeted {
+                    option: option.to_string(),
+                    name: o.name(),
+                    allowed: allowed.join(", "),
+                });
+            }
+        }
+        readout.asd.retain(|(x, _)| *x != o);
+        if asd > 0.0 {
+            readout.asd.push((o, asd));
+        }
+    }
+    Ok(readout)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spellings_of_an_option() {
+        assert_eq!(
+            Spelling::Flag.option("segment_duration"),
+            "--segment-duration"
+        );
+        assert_eq!(
+            Spelling::Keyword.option("segment_duration"),
+            "segment_duration"
+        );
+        assert_eq!(
+            Spelling::Flag.example("segment_duration", "3600"),
+            "--segment-duration 3600"
+        );
+        assert_eq!(
+            Spelling::Keyword.example("segment_duration", "3600"),
+            "segment_duration=3600"
+        );
+    }
+
+    #[test]
+    fn inputs_parse_lists_groups_and_repeats() {
+        let got = parse_inputs("--input", &["F_b.x, M_b.z", "theta_t"]).unwrap();
+        let names: Vec<&str> = got.iter().map(|i| i.name()).collect();
+        assert_eq!(names, ["F_b.x", "M_b.z", "theta_t"]);
+        assert_eq!(
+            parse_inputs::<&str>("--input", &[]).unwrap(),
+            Input::all_tilts()
+        );
+        assert_eq!(parse_inputs("--input", &["forces"]).unwrap().len(), 12);
+        assert_eq!(parse_inputs("--input", &["tilt,forces"]).unwrap().len(), 15);
+    }
+
+    #[test]
+    fn bad_input_names_are_refused_with_the_allowed_list() {
+        let e = parse_inputs("inputs", &["F_c.x"]).unwrap_err().to_string();
+        assert!(
+            e.starts_with("inputs: unknown input \"F_c.x\"")
+                && e.contains("M_b.z")
+                && e.contains("theta_t"),
+            "{e}"
+        );
+        let e = parse_inputs("--input", &["F_b.x,F_b.x"]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "--input: F_b.x is given twice; name each input once"
+        );
+        let e = parse_inputs("--input", &["tilt,eta_t"]).unwrap_err();
+        assert!(e.to_string().contains("eta_t is given twice"), "{e}");
+        let e = parse_inputs("--input", &["F_b.x,,M_b.z"]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "--input \"F_b.x,,M_b.z\": empty name in the list (names are separated by single \
+             commas)"
+        );
+    }
+
+    #[test]
+    fn outputs_parse_and_refuse_unknown_names() {
+        let got = parse_outputs("--output", &["phi,X"]).unwrap();
+        assert_eq!(got, [Observable::Phi, Observable::X]);
+        assert_eq!(
+            parse_outputs::<&str>("--output", &[]).unwrap(),
+            Observable::ALL.to_vec()
+        );
+        let e = parse_outputs("--output", &["x"]).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "--output: unknown observable \"x\"; allowed: X, Y, Z, theta, eta, phi, phi_a"
+        );
+        let e = parse_outputs("outputs", &["X", "X"])
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "outputs: X is given twice; name each observable once");
+    }
+
+    #[test]
+    fn readout_items_as_text_and_as_keywords() {
+        assert_eq!(
+            parse_readout_item("--readout", "phi = 1e-9").unwrap(),
+            (Observable::Phi, 1e-9)
+        );
+        assert_eq!(
+            readout_item("readout", "phi", 1e-9).unwrap(),
+            (Observable::Phi, 1e-9)
+        );
+        let cases = [
+            ("X", "--readout X: expected OBS=ASD, e.g. X=9e-9"),
+            (
+                "q=1",
+                "--readout q=1: unknown observable `q`; allowed: X, Y, Z, theta, eta, phi, phi_a",
+            ),
+            ("X=abc", "--readout X=abc: `abc` is not a number"),
+            (
+                "X=-1",
+                "--readout X=-1: ASD -1 m/sqrt(Hz) is not allowed: must be finite and >= 0",
+            ),
+        ];
+        for (item, want) in cases {
+            assert_eq!(
+                parse_readout_item("--readout", item)
+                    .unwrap_err()
+                    .to_string(),
+                want
+            );
+        }
+        assert_eq!(
+            readout_item("readout", "phi", f64::NAN)
+                .unwrap_err()
+                .to_string(),
+            "readout phi=NaN: ASD NaN rad/sqrt(Hz) is not allowed: must be finite and >= 0"
+        );
+    }
+
+    #[test]
+    fn readout_items_replace_remove_and_are_checked_against_the_budget() {
+        let budgeted = [Observable::X, Observable::Phi];
+        let r = apply_readout(
+            "--readout",
+            Readout::default(),
+            &[(Observable::Phi, 1e-9), (Observable::X, 0.0)],
+            Some(&budgeted),
+        )
+        .unwrap();
+        assert_eq!(r.asd, [(Observable::Phi, 1e-9)]);
+        let e = apply_readout(
+            "readout",
+            Readout::default(),
+            &[(Observable::Theta, 1e-9)],
+            Some(&budgeted),
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "readout theta=...: theta is not budgeted; allowed: X, phi"
+        );
+        let r = apply_readout(
+            "--readout",
+            Readout::default(),
+            &[(Observable::Theta, 1e-9)],
+            None,
+        );
+        assert_eq!(r.unwrap().asd.len(), 2);
+    }
+}

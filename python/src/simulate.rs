@@ -1,0 +1,364 @@
+//! `Model.simulate`: free motion of the undamped model, its one-sided Welch ASDs and the
+//! resonance check (the command line's `tiltnoise simulate`), and the `Simulation` it returns.
+
+use crate::errors::{value_error, PyResultExt};
+use numpy::PyArray1;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use std::path::PathBuf;
+use tiltnoise_core::model::{Coord, Model, Observable};
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::noise::Readout;
+use tiltnoise_core::options::{self, Spelling};
+use tiltnoise_core::params::Params;
+use tiltnoise_core::simulate::resonance::check_resonances;
+use tiltnoise_core::simulate::{
+    check_sampling, describe_run, initial_state, parse_coordinates, record_description,
+    set_coordinate, simulate_with_progress, Excitation, InitialState, ModalPropagator, SimConfig,
+    SimError, Simulation as CoreSimulation,
+};
+use tiltnoise_core::spectral::{welch, WelchConfig};
+use tiltnoise_io::{OutputKind, RunMeta, SeriesAsd, SimulationMeta};
+
+/// The options of `Model.simulate`, as given.
+pub struct SimulateArgs<'a, 'py> {
+    pub duration: f64,
+    pub step: f64,
+    pub init: Option<&'a Bound<'py, PyAny>>,
+    pub init_rate: Option<&'a Bound<'py, PyAny>>,
+    pub kick_x: Option<f64>,
+    pub mode_energy: f64,
+    pub readout: Option<&'a Bound<'py, PyDict>>,
+    pub seed: u64,
+    pub nperseg: Option<usize>,
+}
+
+/// Coordinates from a dict `{coordinate: value}` or a `str` `"theta_a=1e-5,phi_b=0.01"` (the
+/// command line's syntax) into `out`.
+fn coordinates(
+    option: &str,
+    arg: Option<&Bound<'_, PyAny>>,
+    rate: bool,
+    out: &mut [f64; 8],
+) -> PyResult<()> {
+    let Some(arg) = arg else {
+        return Ok(());
+    };
+    if let Ok(text) = arg.cast::<PyString>() {
+        return parse_coordinates(option, &[text.to_cow()?], rate, out).py();
+    }
+    let d = arg.cast::<PyDict>().map_err(|_| {
+        value_error(format!(
+            "{option}: expected a dict {{coordinate: value}} or a str \"theta_a=1e-5,phi_b=0.01\""
+        ))
+    })?;
+    let mut given = [false; 8];
+    for (name, value) in d.iter() {
+        let name: String = name
+            .extract()
+            .map_err(|_| value_error(format!("{option}: the keys must be coordinate names")))?;
+        let value: f64 = value
+            .extract()
+            .map_err(|_| value_error(format!("{option} {name}: the value must be a number")))?;
+        let item = format!("{name}={value}");
+        set_coordinate(option, &item, &name, value, rate, &mut given, out).py()?;
+    }
+    Ok(())
+}
+
+/// The excitation the options ask for: the kick, given coordinates and rates, or equal energy.
+fn excitation(args: &SimulateArgs<'_, '_>) -> PyResult<Excitation> {
+    let given = args.init.is_some() || args.init_rate.is_some();
+    match args.kick_x {
+        Some(_) if given => Err(value_error(
+            "kick_x: the kick starts from a static deflection at rest; give either kick_x or \
+             init/init_rate, not both",
+        )),
+        Some(x_m) => Ok(Excitation::KickX { x_m }),
+        None if given => {
+            let (mut q, mut qdot) = ([0.0; 8], [0.0; 8]);
+            coordinates("init", args.init, false, &mut q)?;
+            coordinates("init_rate", args.init_rate, true, &mut qdot)?;
+            Ok(Excitation::Given { q, qdot })
+        }
+        None => Ok(Excitation::EqualEnergy {
+            energy_j: args.mode_energy,
+        }),
+    }
+}
+
+/// Runs the simulation of `model` (`Model.simulate`).
+pub fn run(py: Python<'_>, model: &Model, args: SimulateArgs<'_, '_>) -> PyResult<Simulation> {
+    if !model.is_undamped() {
+        return Err(value_error(SimError::Damped.to_string()));
+    }
+    let (_, nperseg) =
+        check_sampling(Spelling::Keyword, args.duration, args.step, args.nperseg).py()?;
+    let mut items = Vec::new();
+    if let Some(d) = args.readout {
+        for (name, value) in d.iter() {
+            let name: String = name
+                .extract()
+                .map_err(|_| value_error("readout: the keys must be observable names (str)"))?;
+            let asd: f64 = value
+                .extract()
+                .map_err(|_| value_error(format!("readout {name}: the ASD must be a number")))?;
+            items.push(options::readout_item("readout", &name, asd).py()?);
+        }
+    }
+    let mut readout = options::apply_readout("readout", Readout::default(), &items, None)
+        .py()?
+        .asd;
+    readout.sort_by_key(|(o, _)| o.index());
+    let (init, init_source) = initial_state(model, &excitation(&args)?, Spelling::Keyword).py()?;
+    let cfg = SimConfig {
+        dt_s: args.step,
+        duration_s: args.duration,
+        readout_asd: readout.clone(),
+        seed: args.seed,
+    };
+    let wcfg = WelchConfig::new(nperseg);
+    let (sim, asd, check, modes) = py.detach(|| -> PyResult<_> {
+        let sim = simulate_with_progress(model, &init, &cfg, &mut |_, _| {})
+            .map_err(|e| value_error(e.to_string()))?;
+        let fs = sim.fs_hz();
+        let mut psds = Vec::new();
+        for (o, x) in &sim.observables {
+            psds.push((*o, welch(x, fs, &wcfg).py()?));
+        }
+        let modes = NormalModes::new(model);
+        let prop =
+            ModalPropagator::new(model, &init, cfg.dt_s).map_err(|e| value_error(e.to_string()))?;
+        let (u0, v0) = prop.initial_modal_state();
+        let amplitude: [f64; 8] = std::array::from_fn(|k| u0[k].hypot(v0[k]));
+        let check = check_resonances(&modes, &amplitude, &psds, fs, nperseg, &readout);
+        let asd = SeriesAsd {
+            freqs_hz: psds[0].1.freqs_hz.clone(),
+            asd: psds.iter().map(|(o, p)| (*o, p.asd())).collect(),
+            segment_len: nperseg,
+            overlap: wcfg.overlap,
+            averaging: "mean".to_string(),
+            n_segments: psds[0].1.n_segments,
+        };
+        let modes: Vec<(usize, f64)> = modes
+            .modes
+            .iter()
+            .map(|m| (m.index, m.frequency_hz))
+            .collect();
+        Ok((sim, asd, (check.table(), check.all_agree()), modes))
+    })?;
+    Ok(Simulation {
+        description: describe_run(&sim, &init_source, &readout, args.seed),
+        sim,
+        asd,
+        init,
+        init_source,
+        readout,
+        seed: args.seed,
+        duration_s: args.duration,
+        check_table: check.0,
+        check_agrees: check.1,
+        params: model.params().clone(),
+        modes,
+    })
+}
+
+/// A simulated record of free motion (see :meth:`Model.simulate`): the seven observables with
+/// their readout noise, the coordinates, the one-sided Welch ASDs and the resonance check.
+///
+/// ``time_s``, ``observables`` (``{observable: samples}``, m or rad), ``coordinates``
+/// (``{coordinate: samples}``, noiseless, rad or m), ``freq_hz`` and ``asd``
+/// (``{observable: ASD}`` in unit/sqrt(Hz), periodic Hann, ``nperseg`` samples, 50 % overlap,
+/// mean), ``resonance_check`` (the command line's table: which modes each channel shows,
+/// against the observability table) and ``resonances_agree``. :meth:`save` writes the
+/// command line's files; an ``.h5`` file is a measured record for ``budget(measured=...)``.
+#[pyclass(module = "tiltnoise", frozen)]
+pub struct Simulation {
+    sim: CoreSimulation,
+    asd: SeriesAsd,
+    init: InitialState,
+    init_source: String,
+    readout: Vec<(Observable, f64)>,
+    seed: u64,
+    duration_s: f64,
+    description: String,
+    check_table: String,
+    check_agrees: bool,
+    params: Params,
+    modes: Vec<(usize, f64)>,
+}
+
+#[pymethods]
+impl Simulation {
+    /// Sampling step (s).
+    #[getter]
+    fn dt_s(&self) -> f64 {
+        self.sim.dt_s
+    }
+
+    /// Sample rate (Hz).
+    #[getter]
+    fn fs_hz(&self) -> f64 {
+        self.sim.fs_hz()
+    }
+
+    /// Number of samples.
+    #[getter]
+    fn n_samples(&self) -> usize {
+        self.sim.len()
+    }
+
+    /// Sample times ``i * dt_s`` (s).
+    #[getter]
+    fn time_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let dt = self.sim.dt_s;
+        PyArray1::from_iter(py, (0..self.sim.len()).map(|i| i as f64 * dt))
+    }
+
+    /// ``{observable: samples}`` of all seven observables (m for X, Y, Z; rad for the angles),
+    /// with readout noise where there is one.
+    #[getter]
+    fn observables<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (o, x) in &self.sim.observables {
+            d.set_item(o.name(), PyArray1::from_slice(py, x))?;
+        }
+        Ok(d)
+    }
+
+    /// ``{coordinate: samples}`` of the eight generalized coordinates (rad; m for the
+    /// elongations ``delta_a``, ``delta_b``), noiseless.
+    #[getter]
+    fn coordinates<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for c in Coord::ALL {
+            d.set_item(
+                c.name(),
+                PyArray1::from_vec(py, self.sim.coordinate(c.index())),
+            )?;
+        }
+        Ok(d)
+    }
+
+    /// ``{"q": {coordinate: value}, "qdot": {coordinate: rate}}`` at t = 0 (SI units).
+    #[getter]
+    fn initial_state<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (key, values) in [("q", &self.init.q), ("qdot", &self.init.qdot)] {
+            let v = PyDict::new(py);
+            for c in Coord::ALL {
+                v.set_item(c.name(), values[c.index()])?;
+            }
+            d.set_item(key, v)?;
+        }
+        Ok(d)
+    }
+
+    /// Where the initial state came from (kick, given values, or equal energy per mode).
+    #[getter]
+    fn init_source(&self) -> &str {
+        &self.init_source
+    }
+
+    /// ``{observable: white readout ASD}`` (unit/sqrt(Hz)); the others are noiseless.
+    #[getter]
+    fn readout<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (o, a) in &self.readout {
+            d.set_item(o.name(), a)?;
+        }
+        Ok(d)
+    }
+
+    /// Seed of the readout noise.
+    #[getter]
+    fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// Frequencies of the ASDs (Hz): ``k fs / nperseg``, DC included.
+    #[getter]
+    fn freq_hz<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.asd.freqs_hz)
+    }
+
+    /// ``{observable: one-sided ASD}`` (unit/sqrt(Hz)) of each observable's samples.
+    #[getter]
+    fn asd<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (o, a) in &self.asd.asd {
+            d.set_item(o.name(), PyArray1::from_slice(py, a))?;
+        }
+        Ok(d)
+    }
+
+    /// Welch segment of the ASDs (samples).
+    #[getter]
+    fn nperseg(&self) -> usize {
+        self.asd.segment_len
+    }
+
+    /// Welch segments averaged.
+    #[getter]
+    fn n_welch_segments(&self) -> usize {
+        self.asd.n_segments
+    }
+
+    /// The resonance check as the command line prints it: for each channel, the modes its
+    /// ASD shows and whether that agrees with the observability table.
+    #[getter]
+    fn resonance_check(&self) -> &str {
+        &self.check_table
+    }
+
+    /// Whether every tested mode is seen exactly where the observability table says.
+    #[getter]
+    fn resonances_agree(&self) -> bool {
+        self.check_agrees
+    }
+
+    /// One sentence on the run (samples, step, initial state, readout, seed).
+    #[getter]
+    fn description(&self) -> &str {
+        &self.description
+    }
+
+    /// Writes the run as the command line's ``simulate --save`` does, atomically: ``.h5`` /
+    /// ``.hdf5`` (the series, the ASDs and the run's provenance; schema
+    /// ``tiltnoise.observable_series``, readable by ``budget(measured=...)``) or ``.csv``
+    /// (the ASDs, ``freq_hz,X,...``). Raises ``OSError`` if it cannot be written,
+    /// ``ValueError`` for another extension.
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let kind = OutputKind::from_path(&path).py()?;
+        py.detach(|| match kind {
+            OutputKind::Hdf5 => {
+                let meta = SimulationMeta {
+                    run: RunMeta {
+                        modes: self.modes.clone(),
+                        ..RunMeta::of_this_run(&self.params, None)
+                    },
+                    description: record_description(&self.description),
+                    start_time: None,
+                    seed: self.seed,
+                    init: self.init,
+                    init_source: self.init_source.clone(),
+                    readout_asd: self.readout.clone(),
+                    duration_s: self.duration_s,
+                };
+                tiltnoise_io::write_observable_series_hdf5(&path, &self.sim, &self.asd, &meta)
+            }
+            OutputKind::Csv => {
+                tiltnoise_io::write_asd_csv(&path, &self.asd.freqs_hz, &self.asd.asd)
+            }
+            OutputKind::Png | OutputKind::Svg => Err(tiltnoise_io::OutputError::UnknownFormat {
+                path: path.clone(),
+                allowed: ".h5, .hdf5, .csv (figures: plot the arrays with matplotlib)",
+            }),
+        })
+        .py()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("Simulation({})", self.description)
+    }
+}
