@@ -45,6 +45,11 @@ pub struct CoherenceArgs {
     /// Non-finite tilt samples: reject (default) or interpolate linearly across interior gaps.
     #[arg(long, value_name = "reject|interpolate")]
     pub gaps: Option<String>,
+    /// Scale factor of a source channel of the tilt record, `CHANNEL=FACTOR` (rad or rad/s per
+    /// count, or per unit of the file), applied before the axis map; required for miniSEED
+    /// channels in counts. Repeat for several channels.
+    #[arg(long, value_name = "CHANNEL=FACTOR")]
+    pub scale: Vec<String>,
     /// Observables to analyse, comma-separated (default: every observable in the measured file).
     #[arg(long = "output", value_name = "NAME[,NAME...]")]
     pub outputs: Vec<String>,
@@ -143,7 +148,7 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
         args.axes.as_deref(),
         args.quantity.as_deref(),
         args.gaps.as_deref(),
-        &[],
+        &args.scale,
     )?;
     let tilt = read_tilt_series(&args.tilt, &ropts)?;
     let opts = CoherenceOptions {

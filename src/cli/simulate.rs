@@ -112,6 +112,11 @@ pub(crate) struct SimulateArgs {
     /// Non-finite tilt samples (with --tilt): reject or interpolate.
     #[arg(long, value_name = "reject|interpolate", requires = "tilt")]
     gaps: Option<String>,
+    /// Scale factor of a source channel of the tilt record (with --tilt), `CHANNEL=FACTOR` (rad or rad/s per
+    /// count, or per unit of the file), applied before the axis map; required for miniSEED
+    /// channels in counts. Repeat for several channels.
+    #[arg(long, value_name = "CHANNEL=FACTOR", requires = "tilt")]
+    scale: Vec<String>,
     /// Fine steps per record sample of the driven propagation (with --tilt).
     #[arg(
         long,

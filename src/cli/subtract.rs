@@ -51,6 +51,11 @@ pub(crate) struct SubtractArgs {
     /// Non-finite samples of the tilt record: reject (default) or interpolate.
     #[arg(long, value_name = "reject|interpolate")]
     gaps: Option<String>,
+    /// Scale factor of a source channel of the tilt record, `CHANNEL=FACTOR` (rad or rad/s per
+    /// count, or per unit of the file), applied before the axis map; required for miniSEED
+    /// channels in counts. Repeat for several channels.
+    #[arg(long, value_name = "CHANNEL=FACTOR")]
+    scale: Vec<String>,
     /// Model parameters to fit besides a gain per tilt axis and the delay, comma-separated
     /// parameter-file keys (e.g. `length.h_m`).
     #[arg(long, value_name = "KEY,...", value_delimiter = ',')]
@@ -174,7 +179,7 @@ fn read_options(args: &SubtractArgs) -> Result<ReadOptions> {
         args.axes.as_deref(),
         args.quantity.as_deref(),
         args.gaps.as_deref(),
-        &[],
+        &args.scale,
     )
 }
 

@@ -234,3 +234,61 @@ fn gwpy_frequencyseries_asds_are_tilt_spectra() {
     .to_string();
     assert!(e.contains("xunit") && e.contains("FrequencySeries"), "{e}");
 }
+
+/// A record of `n` samples at 1 Hz with `E` in counts (`e_scale` times the angle in rad) and
+/// `N` in rad.
+fn record_in_counts(path: &std::path::Path, e_unit: &str, e_scale: f64, n: usize) {
+    let mut text = format!("# units: E={e_unit}, N=rad\ntime_s,E,N\n");
+    for k in 0..n {
+        let t = k as f64;
+        let e = 1e-7 * (0.05 * t).sin();
+        let nn = 2e-7 * (0.03 * t).cos();
+        text.push_str(&format!("{k},{:e},{nn:e}\n", e_scale * e));
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+/// The data lines of a CSV output (comment lines and the header left out).
+fn csv_values(path: &std::path::Path) -> Vec<String> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .map(str::to_string)
+        .collect()
+}
+
+#[test]
+fn every_command_that_reads_tilt_takes_scale() {
+    let dir = tempfile::tempdir().unwrap();
+    let counts = dir.path().join("counts.csv");
+    let rad = dir.path().join("rad.csv");
+    // 2 counts per rad: a factor of 0.5 recovers the angle exactly
+    // (a power of two), so the driven simulations below agree bit for bit.
+    record_in_counts(&counts, "counts", 2.0, 4096);
+    record_in_counts(&rad, "rad", 1.0, 4096);
+    let (c, r) = (counts.to_str().unwrap(), rad.to_str().unwrap());
+    for command in [
+        vec!["coherence", "--tilt", c, "--measured", r],
+        vec!["subtract", "--tilt", c, "--measured", r],
+        vec!["simulate", "--tilt", c],
+    ] {
+        assert_fails(&command, &["channel `E` is in counts", "CHANNEL=FACTOR"]);
+    }
+    let simulate = |tilt: &str, scale: Option<&str>, save: &std::path::Path| {
+        let mut args = vec!["simulate", "--tilt", tilt, "--seed", "3"];
+        if let Some(s) = scale {
+            args.extend(["--scale", s]);
+        }
+        args.extend(["--save", save.to_str().unwrap()]);
+        let out = crate::common::tiltnoise(&args);
+        assert!(out.status.success(), "{}", crate::common::stderr(&out));
+    };
+    let (from_counts, from_rad) = (dir.path().join("c.csv"), dir.path().join("r.csv"));
+    simulate(c, Some("E=0.5"), &from_counts);
+    simulate(r, None, &from_rad);
+    let values = csv_values(&from_counts);
+    assert!(values.len() > 100, "{} lines", values.len());
+    assert_eq!(values, csv_values(&from_rad));
+}

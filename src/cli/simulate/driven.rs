@@ -71,7 +71,7 @@ pub(super) fn run(
         args.axes.as_deref(),
         args.quantity.as_deref(),
         args.gaps.as_deref(),
-        &[],
+        &args.scale,
     )?;
     let series = match read_tilt(path, &opts)? {
         TiltInput::Series(s) => s.into_angle(),
