@@ -15,7 +15,8 @@ eta, phi, phi_a; inputs theta_t, eta_t, phi_t) on --points log-spaced frequencie
   ``D = K - w^2 M``, ``G = G0 + w^2 G2``; the stacking is timed separately and not included
   in the ratio (in NumPy's favour).
 
-Every timed function runs once untimed, then --rounds rounds in which each runs once, the order
+Every timed function runs once untimed, then --rounds rounds in which each runs once (or
+--number times in a row, the mean of which is the round's sample, as timeit does), the order
 rotating between rounds; the medians are reported, and the ratio's range over the rounds. The
 machine may be shared: read the ratios, measured side by side, rather than the absolute times.
 Per-call cost on small grids (1, 10, 100 points) is the mean of many calls, NumPy including
@@ -38,6 +39,9 @@ def parse_args():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--points", type=int, default=100_000, help="grid size (default 1e5)")
     ap.add_argument("--rounds", type=int, default=7, help="timed rounds (default 7)")
+    ap.add_argument("--number", type=int, default=1,
+                    help="calls in a row per timed sample, as timeit's number (default 1: each "
+                         "sample is one call right after the other functions' calls)")
     ap.add_argument("--json", action="store_true", help="print one JSON object instead of tables")
     return ap.parse_args()
 
@@ -57,10 +61,11 @@ def numpy_parts(mats, f):
     return stack, solve
 
 
-def timed(fn):
+def timed(fn, number=1):
     t = time.perf_counter()
-    fn()
-    return time.perf_counter() - t
+    for _ in range(number):
+        fn()
+    return (time.perf_counter() - t) / number
 
 
 def per_call_us(fn, budget_s=0.3):
@@ -111,7 +116,7 @@ def main():
     for r in range(args.rounds):
         order = names[r % len(names):] + names[: r % len(names)]
         for k in order:
-            times[k].append(timed(runs[k]))
+            times[k].append(timed(runs[k], args.number))
     med = {k: statistics.median(v) for k, v in times.items()}
     ratios = {
         k: [n / t for n, t in zip(times["numpy_solve"], times[k])]
@@ -135,6 +140,7 @@ def main():
     result = {
         "points": args.points,
         "rounds": args.rounds,
+        "number": args.number,
         "machine": f"{platform.machine()}, {platform.python_version()}",
         "tiltnoise_version": tiltnoise.__version__,
         "max_rel_difference_numpy_vs_tiltnoise": agree,
@@ -155,7 +161,7 @@ def main():
         print(json.dumps(result, indent=2))
         return
     print(f"7x3 tilt matrix, {args.points} log points 1e-5..100 Hz, {args.rounds} rounds "
-          f"(median); NumPy and tiltnoise agree to {agree:.1e} relative where |H| > 1e-6 max")
+          f"of {args.number} call(s) in a row (median); NumPy and tiltnoise agree to {agree:.1e} relative where |H| > 1e-6 max")
     print(f"{'what':<34} {'ms':>9} {'ns/point':>9} {'numpy_solve / this':>24}")
     for k in names:
         ratio = ""
