@@ -178,6 +178,7 @@ pub fn build_asd_figure(data: &SimAsdData) -> Result<LogLogFigure, String> {
         panels,
         columns: 3,
         caption: data.caption.clone(),
+        shared_legend: false,
     })
 }
 

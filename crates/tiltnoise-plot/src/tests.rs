@@ -153,6 +153,7 @@ fn budget_like_chart_with_band() {
         panels: vec![panel],
         columns: 1,
         caption: vec!["A caption strip under a single panel.".to_string()],
+        shared_legend: false,
     };
     for format in [ImageFormat::Png, ImageFormat::Svg] {
         let bytes = render(format, &fig).unwrap();
@@ -189,6 +190,7 @@ fn crowded_panel_legend() {
         panels: vec![panel, outside],
         columns: 1,
         caption: Vec::new(),
+        shared_legend: false,
     };
     let svg = String::from_utf8(render(ImageFormat::Svg, &fig).unwrap()).unwrap();
     assert!(svg.contains("term 6: slope -0.5"));
