@@ -266,7 +266,13 @@ pub fn build_budget_figure(
                 .map(|(&f, p)| (f, p.sqrt()))
                 .collect();
             let mut trace = Trace::new(label, points, style);
-            if matches!(component, Component::Term(kind) if kind != TermKind::Measured) {
+            // The tilt term, the tool's main result, is always in range; the others where they
+            // contribute.
+            let always = matches!(
+                component,
+                Component::Total | Component::Term(TermKind::Measured | TermKind::Tilt)
+            );
+            if !always {
                 trace.range_mask = Some(contributes(&psd, &total));
             }
             panel.traces.push(trace);
@@ -376,7 +382,16 @@ fn equivalent_panel(report: &BudgetReport, options: &BudgetFigureOptions) -> Opt
         panel.y_range = Some((lo, lo * 1e6));
     }
     for (component, psd) in terms {
-        let (label, style) = term_style(component, None);
+        // The readout's label as in the X panel, so the shared legend lists it once.
+        let readout = match (
+            report.readout.of(Observable::X),
+            report.readout.given_of(Observable::X),
+        ) {
+            (Some(a), _) => Some(ReadoutLabel::White(a, Observable::X)),
+            (None, Some(_)) => Some(ReadoutLabel::Given),
+            (None, None) => None,
+        };
+        let (label, style) = term_style(component, readout);
         let identically_zero = match component {
             Component::Total => ob.total().iter().all(|&p| p == 0.0),
             Component::Term(kind) => ob.term(kind)?.psd.iter().all(|&p| p == 0.0),

@@ -170,10 +170,10 @@ pub fn build_tf_figure(
                     &unit,
                 ),
             );
-            // Undamped peaks reach 1e6 while phi/eta_t falls as f^4 to 1e-10 at 0.1 mHz: the
-            // automatic range clips the peaks, and up to 18 decades keep the low-frequency
-            // cancellation visible.
-            panel.max_decades = Some(18.0);
+            // Undamped peaks reach 1e6 while phi/eta_t falls as f^4 to 1e-10 at 0.1 mHz and
+            // force responses as f^-4 to 1e-14 at 30 Hz: the automatic range clips the peaks,
+            // and up to 24 decades keep those tails visible.
+            panel.max_decades = Some(24.0);
             let mut phase = Panel::new(
                 format!("{}{suffix}: phase", observable_symbol(o)),
                 ("frequency", "Hz"),
