@@ -2,8 +2,8 @@
 //! Owns the progress bar (only when stderr is a terminal).
 
 use super::args::{AverageArg, Format};
-use super::figure_args::FigureArgs;
 use super::budget_terms::{parse_observables, parse_readout, parse_terms};
+use super::figure_args::FigureArgs;
 use super::output::save_budget;
 use super::Run;
 use anyhow::{anyhow, bail, Context, Result};

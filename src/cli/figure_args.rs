@@ -109,7 +109,12 @@ fn parse_size(text: &str) -> Result<(u32, u32)> {
     let Some((w, h)) = text.trim().split_once(['x', 'X']) else {
         bail!("--size {}: {expected}", Shown(text));
     };
-    let side = |s: &str| s.trim().parse::<u32>().ok().filter(|v| (lo..=hi).contains(v));
+    let side = |s: &str| {
+        s.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|v| (lo..=hi).contains(v))
+    };
     match (side(w), side(h)) {
         (Some(w), Some(h)) => Ok((w, h)),
         _ => bail!("--size {}: {expected}", Shown(text)),
@@ -122,7 +127,10 @@ mod tests {
 
     #[test]
     fn limits_and_sizes_parse_or_say_why_not() {
-        assert_eq!(parse_limits("--xlim", "1e-3, 1", "Hz").unwrap(), (1e-3, 1.0));
+        assert_eq!(
+            parse_limits("--xlim", "1e-3, 1", "Hz").unwrap(),
+            (1e-3, 1.0)
+        );
         for bad in ["1", "0,1", "2,1", "a,1", "1,inf", "1,2,3"] {
             let e = parse_limits("--xlim", bad, "Hz").unwrap_err().to_string();
             assert!(e.starts_with("--xlim ") && e.contains("0 < LO < HI"), "{e}");
@@ -130,7 +138,10 @@ mod tests {
         assert_eq!(parse_size("1600x1200").unwrap(), (1600, 1200));
         for bad in ["1600", "10x1000", "1600x", "axb", "20000x1000"] {
             let e = parse_size(bad).unwrap_err().to_string();
-            assert!(e.starts_with("--size ") && e.contains("200 to 10000"), "{e}");
+            assert!(
+                e.starts_with("--size ") && e.contains("200 to 10000"),
+                "{e}"
+            );
         }
     }
 }

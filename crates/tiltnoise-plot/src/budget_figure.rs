@@ -282,7 +282,7 @@ pub fn build_budget_figure(
             let (band, mut median) = segment_band(freqs, band, report.segment_duration_s);
             panel.band = Some(band);
             // The median of the segments sets the range where it contributes to the total.
-                        median.range_mask = Some(median_mask);
+            median.range_mask = Some(median_mask);
             panel.traces.push(median);
         }
         panels.push(panel);

@@ -473,8 +473,8 @@ impl Figure for LogLogFigure {
         }
         let mut caption_lines = 0;
         if !self.caption.is_empty() && !caption_in_cell {
-            caption_lines = wrap_lines(&area, &self.caption, ts.caption, aw as f64 - 2.0 * margin)?
-                .len();
+            caption_lines =
+                wrap_lines(&area, &self.caption, ts.caption, aw as f64 - 2.0 * margin)?.len();
             strip_parts.push(caption_lines as f64 * line_h + 1.5 * margin);
         }
         if !strip_parts.is_empty() {
@@ -577,7 +577,12 @@ pub(crate) struct PlotRect {
 
 impl PlotRect {
     /// Pixel position (relative to the plotting rectangle) of a data point.
-    pub(crate) fn map(&self, (x, y): (f64, f64), (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> (f64, f64) {
+    pub(crate) fn map(
+        &self,
+        (x, y): (f64, f64),
+        (x0, x1): (f64, f64),
+        (y0, y1): (f64, f64),
+    ) -> (f64, f64) {
         let fx = (x.log10() - x0.log10()) / (x1.log10() - x0.log10());
         let fy = (y.log10() - y0.log10()) / (y1.log10() - y0.log10());
         (fx * (self.width - 1.0), (1.0 - fy) * (self.height - 1.0))
@@ -743,8 +748,12 @@ fn draw_log_panel<DB: DrawingBackend>(
     }
     for (line, style) in &lines {
         let line = decimate(line, &rect, xr, yr);
-        for run in split_at_reversals(&line, &rect, xr, yr) {
-            draw_polyline(&mut chart, run, *style)?;
+        if RASTER.with(|r| r.get()) {
+            for run in split_at_reversals(&line, &rect, xr, yr) {
+                draw_polyline(&mut chart, run, *style)?;
+            }
+        } else {
+            draw_polyline(&mut chart, line, *style)?;
         }
     }
 
@@ -1210,11 +1219,10 @@ pub(crate) fn decimate(
 /// sides of a resonance peak drawn in one pixel column): a thick plotters path joins such a
 /// U-turn with a degenerate miter and drops the segments around it, so an undamped peak would
 /// look capped far below its height. Consecutive runs share the turning vertex.
-/// In vector output, strokes shorter than this (pixels) on either side of a reversal do not
-/// split a polyline: SVG viewers bevel sharp joins themselves, and a noisy curve stays one
-/// element instead of thousands. Raster output splits at every reversal (the bitmap backend
-/// draws unlimited miters, spikes above a noisy thick line).
-const REVERSAL_MIN_PX: f64 = 12.0;
+/// Vector output never splits a polyline at reversals: SVG viewers limit miters themselves
+/// (stroke-miterlimit 4), and a noisy curve stays one element instead of thousands. Raster
+/// output splits at every reversal (the bitmap backend draws unlimited miters: spikes above
+/// a noisy thick line, capped undamped peaks).
 
 thread_local! {
     /// Whether the figure being drawn on this thread is a raster image (set by
@@ -1246,10 +1254,7 @@ fn split_at_reversals(
         if k >= 2 {
             let a = (px[k - 1].0 - px[k - 2].0, px[k - 1].1 - px[k - 2].1);
             let b = (px[k].0 - px[k - 1].0, px[k].1 - px[k - 1].1);
-            // In SVG only long strokes (see REVERSAL_MIN_PX).
-            let long = RASTER.with(|r| r.get())
-                || a.0.hypot(a.1).min(b.0.hypot(b.1)) > REVERSAL_MIN_PX;
-            if a.0 * b.0 + a.1 * b.1 < 0.0 && long {
+            if a.0 * b.0 + a.1 * b.1 < 0.0 {
                 runs.push(std::mem::replace(&mut current, vec![line[k - 1]]));
             }
         }
@@ -1579,7 +1584,92 @@ mod tests {
         assert!((lo - 1e-10).abs() < 1e-22, "{lo}");
         p.max_decades = None;
         let (lo, _) = p.resolved_y_range();
-        assert!((lo - 1e-30).abs() < 1e-42);
+        // 1e-30 padded by a tenth of a decade, rounded out to whole decades.
+        assert!((lo - 1e-31).abs() < 1e-43, "{lo}");
+    }
+
+    /// A budget-like panel: a broadband term at 1e-13..1e-12 with an undamped resonance peak
+    /// of 1e-3 covering 1 % of the axis, and a white readout at 9e-9 over part of the band.
+    /// Every curve stays visible where it lies, the peak is clipped at the top.
+    #[test]
+    fn auto_range_keeps_broadband_terms_and_clips_peaks() {
+        let f: Vec<f64> = (0..2000)
+            .map(|k| 1e-4 * 10f64.powf(k as f64 * 5.0 / 1999.0))
+            .collect();
+        let tilt: Vec<(f64, f64)> = f
+            .iter()
+            .map(|&x| {
+                let peak = if (0.40..0.41).contains(&x) { 1e-3 } else { 0.0 };
+                (x, 1e-13 * (1.0 + 9.0 * (x / 10.0)) + peak)
+            })
+            .collect();
+        let readout: Vec<(f64, f64)> = f.iter().map(|&x| (x, 9e-9)).collect();
+        let curves = [tilt.as_slice(), readout.as_slice()];
+        let (lo, hi) = auto_log_range(curves, (1e-4, 10.0), Some(12.0));
+        assert!(
+            lo <= 1e-13,
+            "the broadband floor 1e-13 is below the axis: {lo}"
+        );
+        assert!(hi >= 9e-9, "the readout 9e-9 is above the axis: {hi}");
+        // Peak clipped: at most PEAK_HEADROOM_DECADES (+ rounding) above the broadband tops.
+        assert!(hi <= 9e-9 * 10f64.powf(PEAK_HEADROOM_DECADES + 1.1), "{hi}");
+        assert!(hi < 1e-3);
+        // A lone notch covering less than BOTTOM_QUANTILE of the columns does not set the floor.
+        let mut notched = tilt.clone();
+        notched[1000].1 = 1e-30;
+        let (lo2, _) = auto_log_range([notched.as_slice()], (1e-4, 10.0), None);
+        assert!(lo2 >= 1e-14, "{lo2}");
+    }
+
+    /// Pixel-grid decimation keeps, per pixel column, the least and greatest value and the
+    /// endpoints, and at most four vertices per column.
+    #[test]
+    fn decimation_keeps_min_and_max_per_column() {
+        let rect = PlotRect {
+            width: 100.0,
+            height: 100.0,
+        };
+        let (xr, yr) = ((1.0, 10.0), (1e-3, 1e3));
+        let n = 10_000;
+        let line: Vec<(f64, f64)> = (0..n)
+            .map(|k| {
+                let x = 10f64.powf(k as f64 / (n - 1) as f64);
+                // A zigzag of 2 decades with a spike in the middle.
+                let y = if k == n / 2 {
+                    900.0
+                } else if k % 2 == 0 {
+                    0.1
+                } else {
+                    10.0
+                };
+                (x, y)
+            })
+            .collect();
+        let out = decimate(&line, &rect, xr, yr);
+        assert!(out.len() <= 4 * 100, "{} vertices", out.len());
+        assert_eq!(out[0], line[0]);
+        assert_eq!(*out.last().unwrap(), line[n - 1]);
+        assert!(out.contains(&line[n / 2]), "the spike is lost");
+        let column = |p: (f64, f64)| rect.map(p, xr, yr).0.floor() as i64;
+        for c in 0..100 {
+            let in_col: Vec<f64> = line
+                .iter()
+                .filter(|p| column(**p) == c)
+                .map(|p| p.1)
+                .collect();
+            if in_col.is_empty() {
+                continue;
+            }
+            let kept: Vec<f64> = out
+                .iter()
+                .filter(|p| column(**p) == c)
+                .map(|p| p.1)
+                .collect();
+            let max = |v: &[f64]| v.iter().copied().fold(f64::MIN, f64::max);
+            let min = |v: &[f64]| v.iter().copied().fold(f64::MAX, f64::min);
+            assert_eq!(max(&kept), max(&in_col), "column {c}");
+            assert_eq!(min(&kept), min(&in_col), "column {c}");
+        }
     }
 
     #[test]

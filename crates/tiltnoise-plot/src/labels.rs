@@ -58,7 +58,11 @@ const SI_PREFIXES: [(i32, &str); 9] = [
 /// (`2 k`). Values outside femto..giga keep the nearest prefix.
 pub fn si_value(v: f64, unit: &str) -> String {
     if v == 0.0 || !v.is_finite() {
-        return if v == 0.0 { "0".to_string() } else { format!("{v}") };
+        return if v == 0.0 {
+            "0".to_string()
+        } else {
+            format!("{v}")
+        };
     }
     // Round to three significant digits first, so 999.96 reads `1 k`, not `1000`.
     let digits = v.abs().log10().floor() as i32;

@@ -5,9 +5,9 @@
 
 use super::chart::{Dash, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
 // Re-exported: `plot::tf_figure::observable_symbol` is a public path.
+use super::chart::{LegendPlacement, YScale};
 pub use super::labels::observable_symbol;
 use super::labels::{observable_title, tilt_symbol};
-use super::chart::{LegendPlacement, YScale};
 use super::{render, DrawError, ImageFormat, View};
 use tiltnoise_core::model::{ForceInput, Input, Observable, TiltAxis};
 use tiltnoise_core::tf::TransferMatrix;
@@ -177,7 +177,10 @@ pub fn build_tf_figure(
             let mut phase = Panel::new(
                 format!("{}{suffix}: phase", observable_symbol(o)),
                 ("frequency", "Hz"),
-                (&format!("arg({} / {input_symbol})", observable_symbol(o)), "deg"),
+                (
+                    &format!("arg({} / {input_symbol})", observable_symbol(o)),
+                    "deg",
+                ),
             );
             phase.y_scale = YScale::Linear {
                 tick_step: Some(90.0),
@@ -341,8 +344,33 @@ mod tests {
     #[test]
     fn structural_zero_goes_to_legend_note() {
         let tf = matrix();
-        let fig = build_tf_figure(&tf, &TfFigureOptions::default()).unwrap();
+        let options = TfFigureOptions {
+            observables: Some(vec![Observable::X, Observable::Phi, Observable::PhiA]),
+            ..TfFigureOptions::default()
+        };
+        let fig = build_tf_figure(&tf, &options).unwrap();
         assert_eq!(fig.panels.len(), 3);
+        // The caption names the outputs left out.
+        assert!(
+            fig.caption.iter().any(|c| c.contains("Y, Z, theta, eta")),
+            "{:?}",
+            fig.caption
+        );
+        // Every output by default; with --phase a phase panel beside each.
+        let all = build_tf_figure(&tf, &TfFigureOptions::default()).unwrap();
+        assert_eq!(all.panels.len(), 7);
+        let bode = TfFigureOptions {
+            phase: true,
+            ..options
+        };
+        let fig = build_tf_figure(&tf, &bode).unwrap();
+        assert_eq!(fig.panels.len(), 6);
+        assert_eq!(
+            fig.panels[1].y_scale,
+            YScale::Linear {
+                tick_step: Some(90.0)
+            }
+        );
         let x = &fig.panels[0];
         assert!(x.y_unit == "m/rad");
         let total = x.traces.len() + x.notes.len();
@@ -395,14 +423,41 @@ mod tests {
     }
 
     #[test]
-    fn absent_observables_are_skipped() {
+    fn absent_observables_are_refused_by_name() {
         let tf = matrix();
         let keep = tf.output_index(Observable::Phi).unwrap();
-        let mut tf = tf.select_outputs(&[keep]);
+        let tf = tf.select_outputs(&[keep]);
         assert_eq!(tf.outputs, vec![Observable::Phi]);
         let fig = build_tf_figure(&tf, &TfFigureOptions::default()).unwrap();
         assert_eq!(fig.panels.len(), 1);
-        tf.outputs = vec![Observable::Z];
-        assert!(build_tf_figure(&tf, &TfFigureOptions::default()).is_err());
+        let options = TfFigureOptions {
+            observables: Some(vec![Observable::Z]),
+            ..TfFigureOptions::default()
+        };
+        let e = build_tf_figure(&tf, &options).unwrap_err();
+        assert!(e.contains("Z is not an output") && e.contains("phi"), "{e}");
+    }
+
+    #[test]
+    fn the_caption_says_whether_the_model_is_damped() {
+        let tf = matrix();
+        let undamped = build_tf_figure(&tf, &TfFigureOptions::default()).unwrap();
+        assert!(undamped
+            .caption
+            .iter()
+            .any(|c| c.contains("Without loss angles")));
+        let options = TfFigureOptions {
+            damped: true,
+            ..TfFigureOptions::default()
+        };
+        let damped = build_tf_figure(&tf, &options).unwrap();
+        assert!(!damped
+            .caption
+            .iter()
+            .any(|c| c.contains("Without loss angles")));
+        assert!(damped
+            .caption
+            .iter()
+            .any(|c| c.contains("damping of the parameters")));
     }
 }
