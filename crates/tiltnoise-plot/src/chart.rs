@@ -1215,15 +1215,10 @@ pub(crate) fn decimate(
     out
 }
 
-/// Cuts a polyline where it turns back on itself by more than 90 degrees in pixel space (the two
-/// sides of a resonance peak drawn in one pixel column): a thick plotters path joins such a
-/// U-turn with a degenerate miter and drops the segments around it, so an undamped peak would
-/// look capped far below its height. Consecutive runs share the turning vertex.
-/// Vector output never splits a polyline at reversals: SVG viewers limit miters themselves
-/// (stroke-miterlimit 4), and a noisy curve stays one element instead of thousands. Raster
-/// output splits at every reversal (the bitmap backend draws unlimited miters: spikes above
-/// a noisy thick line, capped undamped peaks).
-
+// Vector output never splits a polyline at reversals: SVG viewers limit miters themselves
+// (stroke-miterlimit 4), and a noisy curve stays one element instead of thousands. Raster
+// output splits at every reversal (the bitmap backend draws unlimited miters: spikes above a
+// noisy thick line, capped undamped peaks).
 thread_local! {
     /// Whether the figure being drawn on this thread is a raster image (set by
     /// [`super::render`] for the duration of one drawing).
@@ -1241,6 +1236,10 @@ pub(crate) fn raster_scope(raster: bool) -> impl Drop {
     Restore(RASTER.with(|r| r.replace(raster)))
 }
 
+/// Cuts a polyline where it turns back on itself by more than 90 degrees in pixel space (the two
+/// sides of a resonance peak drawn in one pixel column): a thick plotters path joins such a
+/// U-turn with a degenerate miter and drops the segments around it, so an undamped peak would
+/// look capped far below its height. Consecutive runs share the turning vertex.
 fn split_at_reversals(
     line: &[(f64, f64)],
     rect: &PlotRect,

@@ -94,6 +94,20 @@ pub fn si_unit(unit: &str) -> bool {
     !unit.is_empty() && unit.chars().all(|c| c.is_alphabetic())
 }
 
+/// The SI prefix (exponent, symbol) for an axis whose largest magnitude is `v`: the axis title
+/// then names the prefixed unit (`frequency (mHz)`) and the ticks are plain numbers.
+pub fn si_prefix(v: f64) -> (i32, &'static str) {
+    if !(v.is_finite() && v != 0.0) {
+        return (0, "");
+    }
+    let e = (v.abs().log10().floor() as i32).div_euclid(3) * 3;
+    SI_PREFIXES
+        .iter()
+        .copied()
+        .min_by_key(|(p, _)| (p - e).abs())
+        .unwrap_or((0, ""))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -114,18 +128,4 @@ mod tests {
         assert_eq!(si_value(1e-20, "m"), "0.00001 fm");
         assert!(si_unit("Hz") && si_unit("rad") && !si_unit("m/rad") && !si_unit(""));
     }
-}
-
-/// The SI prefix (exponent, symbol) for an axis whose largest magnitude is `v`: the axis title
-/// then names the prefixed unit (`frequency (mHz)`) and the ticks are plain numbers.
-pub fn si_prefix(v: f64) -> (i32, &'static str) {
-    if !(v.is_finite() && v != 0.0) {
-        return (0, "");
-    }
-    let e = (v.abs().log10().floor() as i32).div_euclid(3) * 3;
-    SI_PREFIXES
-        .iter()
-        .copied()
-        .min_by_key(|(p, _)| (p - e).abs())
-        .unwrap_or((0, ""))
 }
