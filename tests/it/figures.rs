@@ -191,7 +191,10 @@ mod options {
         assert_eq!(out.status.code(), Some(0), "{out:?}");
         let text = std::fs::read_to_string(&svg).unwrap();
         assert!(!text.contains("Without loss angles"));
-        assert!(text.contains("With the damping"), "the damped caption is missing");
+        assert!(
+            text.contains("With the damping"),
+            "the damped caption is missing"
+        );
         // The last words of the caption are drawn (the caption is not cut).
         assert!(text.contains("frequency grid") || text.contains("resolves them."));
     }
