@@ -3,6 +3,7 @@
 
 use super::args::{AverageArg, Format};
 use super::budget_terms::{parse_observables, parse_readout, parse_terms};
+use super::figure_args::FigureArgs;
 use super::output::save_budget;
 use super::Run;
 use anyhow::{anyhow, bail, Context, Result};
@@ -100,6 +101,8 @@ pub struct BudgetArgs {
     /// Output file (.h5, .csv, .png, .svg), repeatable.
     #[arg(long, value_name = "PATH")]
     pub save: Vec<PathBuf>,
+    #[command(flatten)]
+    pub figure: FigureArgs,
 }
 
 /// The `--at` and `--at-band` request: explicit frequencies are refused when the budget cannot
@@ -202,6 +205,12 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     for path in &args.save {
         OutputKind::from_path(path)?;
     }
+    let figure = tiltnoise_plot::BudgetFigureOptions {
+        view: args
+            .figure
+            .view_for(tiltnoise_plot::BudgetFigureOptions::default().size)?,
+        ..tiltnoise_plot::BudgetFigureOptions::default()
+    };
     let defaults = BudgetOptions::default();
     let outputs = match &args.observables {
         Some(text) => parse_observables(text)?,
@@ -298,7 +307,7 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     let input = InputMeta::from(&provenance);
     run.write_outputs(json, || {
         for out in &args.save {
-            save_budget(out, &report, &meta, &input)?;
+            save_budget(out, &report, &meta, &input, &figure)?;
         }
         Ok(())
     })

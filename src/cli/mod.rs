@@ -9,6 +9,7 @@ mod budget;
 mod budget_summary;
 mod budget_terms;
 mod coherence;
+mod figure_args;
 mod fit;
 mod mc;
 mod methods;

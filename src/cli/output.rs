@@ -42,18 +42,24 @@ pub fn save_image(
 ///
 /// [`OutputError::UnknownFormat`] for an unsupported extension (nothing is written), or the
 /// writer's [`OutputError::Write`].
-pub fn save_tf(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> Result<(), OutputError> {
+pub fn save_tf(
+    path: &Path,
+    tf: &TransferMatrix,
+    meta: &RunMeta,
+    figure: &tiltnoise_plot::TfFigureOptions,
+) -> Result<(), OutputError> {
     match OutputKind::from_path(path)? {
         OutputKind::Hdf5 => write_tf_hdf5(path, tf, meta),
         OutputKind::Csv => write_tf_csv(path, tf),
-        OutputKind::Png | OutputKind::Svg => {
-            save_image(path, |format| tiltnoise_plot::tf_figure(tf, format))
-        }
+        OutputKind::Png | OutputKind::Svg => save_image(path, |format| {
+            tiltnoise_plot::tf_figure_with(tf, format, figure)
+        }),
     }
 }
 
 /// Saves a noise budget in the format named by the extension of `path`: HDF5 (with `meta` and
-/// `input`), CSV (ASDs only), or a PNG/SVG figure with the input named in the caption.
+/// `input`), CSV (ASDs only), or a PNG/SVG figure drawn with `figure` and the input named in
+/// the caption.
 ///
 /// # Errors
 ///
@@ -64,6 +70,7 @@ pub fn save_budget(
     report: &BudgetReport,
     meta: &RunMeta,
     input: &InputMeta,
+    figure: &tiltnoise_plot::BudgetFigureOptions,
 ) -> Result<(), OutputError> {
     match OutputKind::from_path(path)? {
         OutputKind::Hdf5 => write_budget_hdf5(path, report, meta, input),
@@ -71,7 +78,7 @@ pub fn save_budget(
         OutputKind::Png | OutputKind::Svg => {
             let options = tiltnoise_plot::BudgetFigureOptions {
                 input: Some(input.clone()),
-                ..tiltnoise_plot::BudgetFigureOptions::default()
+                ..figure.clone()
             };
             save_image(path, |format| {
                 tiltnoise_plot::budget_figure_with(report, format, &options)

@@ -9,6 +9,7 @@
 //! `phi_a` (rad). Entries are complex responses per unit input: m/rad, rad/rad, m/N, rad/(N m), ...
 
 use super::args::MethodArg;
+use super::figure_args::FigureArgs;
 use super::output::save_tf;
 use super::Run;
 use anyhow::{bail, Context, Result};
@@ -69,6 +70,15 @@ pub struct TfArgs {
     /// measured error, on standard error).
     #[arg(long)]
     explain: bool,
+    /// Observables drawn in the figures, a subset of --output (default: every --output; with
+    /// neither option X, phi, phi_a as the paper's Figure 5).
+    #[arg(long, value_name = "NAME[,NAME...]")]
+    observables: Vec<String>,
+    /// Bode figure: a phase panel (degrees) beside every magnitude panel.
+    #[arg(long)]
+    phase: bool,
+    #[command(flatten)]
+    figure: FigureArgs,
 }
 
 /// Parses `--input` values (see [`TfArgs`]); empty means the three tilt angles.
@@ -79,6 +89,43 @@ pub fn parse_inputs(specs: &[String]) -> Result<Vec<Input>> {
 /// Parses `--output` values (see [`TfArgs`]); empty means all seven observables.
 pub fn parse_outputs(specs: &[String]) -> Result<Vec<Observable>> {
     Ok(options::parse_outputs("--output", specs)?)
+}
+
+/// The figure's options: panels from `--observables` (each one of the outputs), else every
+/// `--output`, else the paper's Figure 5 (X, phi, phi_a); phase, limits, size, resolution.
+fn figure_options(
+    args: &TfArgs,
+    request: &Request,
+    params: &Params,
+) -> Result<tiltnoise_plot::TfFigureOptions> {
+    let observables = if !args.observables.is_empty() {
+        let chosen = options::parse_outputs("--observables", &args.observables)?;
+        if let Some(o) = chosen.iter().find(|o| !request.outputs.contains(o)) {
+            let have: Vec<&str> = request.outputs.iter().map(|o| o.name()).collect();
+            bail!(
+                "--observables: {} is not among the computed outputs ({}); add it to --output",
+                o.name(),
+                have.join(", ")
+            );
+        }
+        chosen
+    } else if !args.outputs.is_empty() {
+        request.outputs.clone()
+    } else {
+        vec![Observable::X, Observable::Phi, Observable::PhiA]
+    };
+    let options = tiltnoise_plot::TfFigureOptions {
+        observables: Some(observables),
+        phase: args.phase,
+        damped: !Model::new(params)?.is_undamped(),
+        view: tiltnoise_plot::View::default(),
+        note: None,
+    };
+    let size = tiltnoise_plot::tf_figure::default_size(&options, &request.inputs);
+    Ok(tiltnoise_plot::TfFigureOptions {
+        view: args.figure.view_for(size)?,
+        ..options
+    })
 }
 
 /// Runs `tiltnoise tf`.
@@ -97,6 +144,7 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
     for path in &args.save {
         tiltnoise_io::OutputKind::from_path(path)?;
     }
+    let figure = figure_options(&args, &request, params)?;
     let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
     let inputs: Vec<(&str, &Path)> = args
         .freq_file
@@ -159,7 +207,7 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
     }
     run.write_outputs(false, || {
         for path in &args.save {
-            save_tf(path, &tf, &meta)?;
+            save_tf(path, &tf, &meta, &figure)?;
         }
         Ok(())
     })

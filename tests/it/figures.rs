@@ -72,3 +72,130 @@ fn overwrite_replaces_target() {
     assert!(std::fs::read_to_string(&path).unwrap().starts_with("<svg"));
     assert_eq!(listing(dir.path()), vec![path]);
 }
+
+/// The figure options of the command line: every requested observable drawn, phase panels,
+/// limits, size and resolution; bad values refused in one line before anything is computed.
+mod options {
+    use crate::common::{assert_fails_without_output, listing, tiltnoise};
+
+    /// Width and height of a PNG file's IHDR.
+    fn png_size(bytes: &[u8]) -> (u32, u32) {
+        assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+        let w = u32::from_be_bytes(bytes[16..20].try_into().unwrap());
+        let h = u32::from_be_bytes(bytes[20..24].try_into().unwrap());
+        (w, h)
+    }
+
+    #[test]
+    fn tf_draws_every_requested_observable_with_phase() {
+        let dir = tempfile::tempdir().unwrap();
+        let svg = dir.path().join("x.svg");
+        let out = tiltnoise(&[
+            "tf",
+            "--freq",
+            "1e-3:40:1",
+            "--output",
+            "Y,Z,theta,eta",
+            "--phase",
+            "--save",
+            svg.to_str().unwrap(),
+        ]);
+        assert_eq!(out.status.code(), Some(0), "{out:?}");
+        let text = std::fs::read_to_string(&svg).unwrap();
+        for panel in [
+            "|Y / tilt|",
+            "|Z / tilt|",
+            "|θ / tilt|",
+            "|η / tilt|",
+            "arg(Y / tilt)",
+        ] {
+            assert!(text.contains(panel), "{panel} missing");
+        }
+        assert!(text.contains("1 mHz"), "SI tick labels");
+    }
+
+    #[test]
+    fn size_dpi_and_limits_shape_the_png() {
+        let dir = tempfile::tempdir().unwrap();
+        let png = dir.path().join("x.png");
+        let out = tiltnoise(&[
+            "tf",
+            "--freq",
+            "1e-3:40:1",
+            "--size",
+            "800x600",
+            "--dpi",
+            "150",
+            "--xlim",
+            "2e-3,0.5",
+            "--ylim",
+            "1e-6,1e3",
+            "--save",
+            png.to_str().unwrap(),
+        ]);
+        assert_eq!(out.status.code(), Some(0), "{out:?}");
+        assert_eq!(png_size(&std::fs::read(&png).unwrap()), (1200, 900));
+    }
+
+    #[test]
+    fn bad_figure_options_fail_in_one_line_and_write_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let png = dir.path().join("x.png");
+        let png = png.to_str().unwrap();
+        for (args, needles) in [
+            (vec!["--xlim", "1,0.1"], vec!["--xlim 1,0.1", "0 < LO < HI"]),
+            (vec!["--ylim", "0,1"], vec!["--ylim 0,1", "0 < LO < HI"]),
+            (
+                vec!["--xlim", "a,1"],
+                vec!["--xlim", "`a` is not a finite number"],
+            ),
+            (
+                vec!["--size", "50x50"],
+                vec!["--size 50x50", "200 to 10000"],
+            ),
+            (vec!["--dpi", "0"], vec!["--dpi 0", "30 to 600"]),
+            (
+                vec!["--size", "10000x10000", "--dpi", "600"],
+                vec!["too large"],
+            ),
+            (
+                vec!["--output", "X", "--observables", "phi"],
+                vec!["--observables", "phi", "--output"],
+            ),
+        ] {
+            let mut all = vec!["tf", "--freq", "1e-3:10:1"];
+            all.extend(args);
+            all.extend(["--save", png]);
+            assert_fails_without_output(&all, dir.path(), &needles);
+        }
+        assert!(listing(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn damped_caption_does_not_claim_no_losses_and_long_captions_wrap() {
+        let dir = tempfile::tempdir().unwrap();
+        let svg = dir.path().join("d.svg");
+        let out = tiltnoise(&[
+            "--set",
+            "loss.torsion_b_rad=1e-3",
+            "tf",
+            "--freq",
+            "1e-3:40:1",
+            "--input",
+            "tilt,forces",
+            "--output",
+            "X",
+            "--save",
+            svg.to_str().unwrap(),
+        ]);
+        assert_eq!(out.status.code(), Some(0), "{out:?}");
+        let text = std::fs::read_to_string(&svg).unwrap();
+        assert!(!text.contains("Without loss angles"));
+        assert!(
+            text.contains("With the damping"),
+            "the damped caption is missing"
+        );
+        // The last words of the caption are drawn (the caption is not cut).
+        assert!(text.contains("frequency grid") || text.contains("resolves them."));
+    }
+}

@@ -45,7 +45,7 @@ fn hdf5_round_trip_is_bit_exact_and_self_describing() {
     let path = dir.path().join("tf.h5");
     let tf = table_i_tf(&freqs());
     let meta = meta();
-    save_tf(&path, &tf, &meta).unwrap();
+    save_tf(&path, &tf, &meta, &Default::default()).unwrap();
     assert_eq!(
         listing(dir.path()),
         vec![path.clone()],
@@ -152,7 +152,7 @@ fn csv_round_trip_is_bit_exact() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("tf.csv");
     let tf = table_i_tf(&freqs());
-    save_tf(&path, &tf, &meta()).unwrap();
+    save_tf(&path, &tf, &meta(), &Default::default()).unwrap();
     assert_eq!(
         listing(dir.path()),
         vec![path.clone()],
@@ -225,7 +225,7 @@ fn extension_picks_the_format_case_insensitively() {
     }
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("tf.H5");
-    save_tf(&path, &table_i_tf(&[1.0]), &meta()).unwrap();
+    save_tf(&path, &table_i_tf(&[1.0]), &meta(), &Default::default()).unwrap();
     assert!(hdf5::File::open(&path).is_ok());
 }
 
@@ -235,7 +235,7 @@ fn unknown_extension_is_rejected_naming_the_allowed_ones() {
     let tf = table_i_tf(&[1.0]);
     for name in ["tf.xyz", "tf", "tf.h5.bak"] {
         let path = dir.path().join(name);
-        let err = save_tf(&path, &tf, &meta()).unwrap_err();
+        let err = save_tf(&path, &tf, &meta(), &Default::default()).unwrap_err();
         match &err {
             OutputError::UnknownFormat { path: p, allowed } => {
                 assert_eq!(p, &path);
@@ -258,7 +258,7 @@ fn missing_directory_is_an_error_naming_the_path_and_leaves_nothing() {
     let tf = table_i_tf(&[1.0]);
     for name in ["tf.h5", "tf.csv"] {
         let path = dir.path().join("no_such_dir").join(name);
-        let err = save_tf(&path, &tf, &meta()).unwrap_err();
+        let err = save_tf(&path, &tf, &meta(), &Default::default()).unwrap_err();
         match &err {
             OutputError::Write { path: p, message } => {
                 assert_eq!(p, &path);
@@ -281,8 +281,8 @@ fn overwriting_an_existing_file_works() {
     let h5 = dir.path().join("tf.h5");
     let csv = dir.path().join("tf.csv");
     for tf in [&tf1, &tf2] {
-        save_tf(&h5, tf, &meta()).unwrap();
-        save_tf(&csv, tf, &meta()).unwrap();
+        save_tf(&h5, tf, &meta(), &Default::default()).unwrap();
+        save_tf(&csv, tf, &meta(), &Default::default()).unwrap();
     }
     let file = hdf5::File::open(&h5).unwrap();
     assert_eq!(
@@ -356,8 +356,8 @@ fn figures_are_dispatched_to_the_plot_module() {
     let tf = table_i_tf(&freqs()[1..]);
     let svg = dir.path().join("tf.SVG");
     let png = dir.path().join("tf.png");
-    save_tf(&svg, &tf, &meta()).unwrap();
-    save_tf(&png, &tf, &meta()).unwrap();
+    save_tf(&svg, &tf, &meta(), &Default::default()).unwrap();
+    save_tf(&png, &tf, &meta(), &Default::default()).unwrap();
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.contains("<svg"), "an SVG document");
     let bytes = std::fs::read(&png).unwrap();

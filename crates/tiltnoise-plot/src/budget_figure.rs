@@ -4,7 +4,7 @@
 
 use super::chart::{Band, Dash, LegendPlacement, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
 use super::labels::{observable_symbol, observable_title, tilt_symbol};
-use super::{render, DrawError, ImageFormat};
+use super::{render, DrawError, ImageFormat, View};
 use plotters::style::RGBColor;
 use std::path::Path;
 use tiltnoise_core::input::InputMeta;
@@ -23,9 +23,12 @@ pub struct BudgetFigureOptions {
     pub note: Option<String>,
     /// The tilt input, named in the caption.
     pub input: Option<InputMeta>,
-    /// Decades shown below the top of each panel's y axis (default 8). Noise budgets span
-    /// fewer decades than transfer functions; terms far below the total are cut off.
+    /// At most this many decades below the top of each panel's y axis (default 12). The
+    /// range follows the curves where they contribute (see [`CONTRIBUTION_PSD_RATIO`]), so
+    /// this only guards against pathological spans.
     pub max_decades: f64,
+    /// Axis limits, size, resolution.
+    pub view: View,
 }
 
 impl Default for BudgetFigureOptions {
@@ -34,7 +37,8 @@ impl Default for BudgetFigureOptions {
             size: (1400, 1100),
             note: None,
             input: None,
-            max_decades: 8.0,
+            max_decades: 12.0,
+            view: View::default(),
         }
     }
 }
@@ -64,7 +68,20 @@ pub fn budget_figure_with(
     options: &BudgetFigureOptions,
 ) -> Result<Vec<u8>, DrawError> {
     let figure = build_budget_figure(report, options).map_err(DrawError)?;
-    render(format, &figure)
+    render(format, &options.view.apply(figure))
+}
+
+/// A term sets the automatic y range where its PSD is at least this fraction of the total's
+/// (1 % in ASD): every term is visible where it contributes, and terms many decades below
+/// the total do not stretch the axis.
+pub const CONTRIBUTION_PSD_RATIO: f64 = 1e-4;
+
+/// Where `psd` contributes to `total` (see [`CONTRIBUTION_PSD_RATIO`]).
+fn contributes(psd: &[f64], total: &[f64]) -> Vec<bool> {
+    psd.iter()
+        .zip(total)
+        .map(|(&p, &t)| p >= CONTRIBUTION_PSD_RATIO * t)
+        .collect()
 }
 
 /// Colour of the whole tilt term and of its segment band.
@@ -211,6 +228,7 @@ pub fn build_budget_figure(
             // A legend beside a third of the width would leave the curves no room.
             panel.legend = LegendPlacement::Inside;
         }
+        let total = ob.total();
         let mut components = ob.components();
         components.sort_by_key(|(c, _)| draw_rank(c));
         for (component, psd) in components {
@@ -247,11 +265,24 @@ pub fn build_budget_figure(
                 .zip(&psd)
                 .map(|(&f, p)| (f, p.sqrt()))
                 .collect();
-            panel.traces.push(Trace::new(label, points, style));
+            let mut trace = Trace::new(label, points, style);
+            // The tilt term, the tool's main result, is always in range; the others where they
+            // contribute.
+            let always = matches!(
+                component,
+                Component::Total | Component::Term(TermKind::Measured | TermKind::Tilt)
+            );
+            if !always {
+                trace.range_mask = Some(contributes(&psd, &total));
+            }
+            panel.traces.push(trace);
         }
         if let Some((_, band)) = report.segment_bands.iter().find(|(b, _)| *b == o) {
-            let (band, median) = segment_band(freqs, band, report.segment_duration_s);
+            let median_mask = contributes(&band.median, &total);
+            let (band, mut median) = segment_band(freqs, band, report.segment_duration_s);
             panel.band = Some(band);
+            // The median of the segments sets the range where it contributes to the total.
+            median.range_mask = Some(median_mask);
             panel.traces.push(median);
         }
         panels.push(panel);
@@ -297,6 +328,7 @@ pub fn build_budget_figure(
         // Three columns for more than four panels: the caption then takes a free cell.
         columns: if compact { 3 } else { 2 },
         caption,
+        shared_legend: true,
     })
 }
 
@@ -350,7 +382,16 @@ fn equivalent_panel(report: &BudgetReport, options: &BudgetFigureOptions) -> Opt
         panel.y_range = Some((lo, lo * 1e6));
     }
     for (component, psd) in terms {
-        let (label, style) = term_style(component, None);
+        // The readout's label as in the X panel, so the shared legend lists it once.
+        let readout = match (
+            report.readout.of(Observable::X),
+            report.readout.given_of(Observable::X),
+        ) {
+            (Some(a), _) => Some(ReadoutLabel::White(a, Observable::X)),
+            (None, Some(_)) => Some(ReadoutLabel::Given),
+            (None, None) => None,
+        };
+        let (label, style) = term_style(component, readout);
         let identically_zero = match component {
             Component::Total => ob.total().iter().all(|&p| p == 0.0),
             Component::Term(kind) => ob.term(kind)?.psd.iter().all(|&p| p == 0.0),

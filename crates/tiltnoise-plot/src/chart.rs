@@ -74,16 +74,30 @@ pub struct Trace {
     pub points: Vec<(f64, f64)>,
     /// Colour, pattern, width.
     pub style: TraceStyle,
+    /// Which points the automatic y range must show (same length as `points`); `None`: all.
+    /// A noise term, for instance, matters only where it contributes to the total.
+    pub range_mask: Option<Vec<bool>>,
 }
 
 impl Trace {
-    /// A trace from its parts.
+    /// A trace from its parts; every point counts for the automatic y range.
     pub fn new(label: impl Into<String>, points: Vec<(f64, f64)>, style: TraceStyle) -> Trace {
         Trace {
             label: label.into(),
             points,
             style,
+            range_mask: None,
         }
+    }
+
+    /// The points the automatic y range must show (all, or those of [`Trace::range_mask`]).
+    fn range_points(&self) -> impl Iterator<Item = &(f64, f64)> {
+        let mask = self.range_mask.as_deref();
+        self.points
+            .iter()
+            .enumerate()
+            .filter(move |(k, _)| mask.is_none_or(|m| m.get(*k).copied().unwrap_or(false)))
+            .map(|(_, p)| p)
     }
 }
 
@@ -222,24 +236,16 @@ impl Panel {
         if let Some(r) = self.y_range.filter(|r| valid_range(*r)) {
             return r;
         }
-        let (x0, x1) = self.resolved_x_range();
-        let ys = self
-            .all_points()
-            .filter(|p| p.0 >= x0 && p.0 <= x1)
-            .map(|p| p.1)
-            .filter(|y| positive(*y));
-        let Some((lo, hi)) = min_max(ys) else {
-            return (0.1, 10.0);
-        };
-        let top = hi.log10().ceil();
-        let mut bottom = lo.log10().floor();
-        if let Some(d) = self.max_decades.filter(|d| d.is_finite() && *d >= 1.0) {
-            bottom = bottom.max(top - d.floor());
-        }
-        if bottom >= top {
-            bottom = top - 1.0;
-        }
-        (10f64.powf(bottom), 10f64.powf(top))
+        let curves: Vec<Vec<(f64, f64)>> = self
+            .traces
+            .iter()
+            .map(|t| t.range_points().copied().collect())
+            .collect();
+        auto_log_range(
+            curves.iter().map(Vec::as_slice),
+            self.resolved_x_range(),
+            self.max_decades,
+        )
     }
 
     fn all_points(&self) -> impl Iterator<Item = &(f64, f64)> {
@@ -249,6 +255,81 @@ impl Panel {
             .flat_map(|b| b.lower.iter().chain(b.upper.iter()));
         self.traces.iter().flat_map(|t| t.points.iter()).chain(band)
     }
+}
+
+/// Columns (in log x) over which the automatic y range takes its quantiles: the resolution of
+/// a typical panel, so a curve counts by how much of the axis it covers, not by how many
+/// points its grid puts there (a grid refined around a resonance does not make it weigh more).
+pub const RANGE_COLUMNS: usize = 200;
+/// Quantile of a curve's column maxima taken as its broadband top: a resonance covering fewer
+/// than 5 % of the columns does not set it.
+pub const TOP_QUANTILE: f64 = 0.95;
+/// Quantile of a curve's column minima taken as its floor: notches covering fewer than 3 % of
+/// the columns do not pull the axis down.
+pub const BOTTOM_QUANTILE: f64 = 0.03;
+/// Peaks are shown up to this many decades above the highest broadband top, clipped above.
+pub const PEAK_HEADROOM_DECADES: f64 = 2.0;
+
+/// The automatic range of a log y axis for `curves` over the x range `(x0, x1)`: from the
+/// lowest floor of any curve ([`BOTTOM_QUANTILE`] of its minima per log-x column) to the
+/// highest peak, but at most [`PEAK_HEADROOM_DECADES`] above the highest broadband top
+/// ([`TOP_QUANTILE`] of a curve's maxima per column), padded by a tenth of a decade and
+/// rounded out to whole decades; at most `max_decades` deep (counted from the top). Non-finite
+/// and non-positive values are ignored; `(0.1, 10)` without data.
+///
+/// Every curve is thus visible over at least 97 % of the columns it occupies, and a resonance
+/// peak is clipped at the top rather than pushing the floor down.
+pub fn auto_log_range<'a>(
+    curves: impl IntoIterator<Item = &'a [(f64, f64)]>,
+    (x0, x1): (f64, f64),
+    max_decades: Option<f64>,
+) -> (f64, f64) {
+    let (lx0, lx1) = (x0.log10(), x1.log10());
+    let span = (lx1 - lx0).max(f64::MIN_POSITIVE);
+    let (mut top_broad, mut peak, mut floor) =
+        (f64::NEG_INFINITY, f64::NEG_INFINITY, f64::INFINITY);
+    for curve in curves {
+        let mut hi = vec![f64::NEG_INFINITY; RANGE_COLUMNS];
+        let mut lo = vec![f64::INFINITY; RANGE_COLUMNS];
+        for &(x, y) in curve {
+            if !(positive(x) && positive(y) && x >= x0 && x <= x1) {
+                continue;
+            }
+            let c = (((x.log10() - lx0) / span) * RANGE_COLUMNS as f64) as usize;
+            let c = c.min(RANGE_COLUMNS - 1);
+            let ly = y.log10();
+            hi[c] = hi[c].max(ly);
+            lo[c] = lo[c].min(ly);
+        }
+        let mut hi: Vec<f64> = hi.into_iter().filter(|v| v.is_finite()).collect();
+        let mut lo: Vec<f64> = lo.into_iter().filter(|v| v.is_finite()).collect();
+        if hi.is_empty() {
+            continue;
+        }
+        hi.sort_by(f64::total_cmp);
+        lo.sort_by(f64::total_cmp);
+        top_broad = top_broad.max(quantile(&hi, TOP_QUANTILE));
+        peak = peak.max(hi[hi.len() - 1]);
+        floor = floor.min(quantile(&lo, BOTTOM_QUANTILE));
+    }
+    if !peak.is_finite() {
+        return (0.1, 10.0);
+    }
+    let top = (peak.min(top_broad + PEAK_HEADROOM_DECADES) + 0.1).ceil();
+    let mut bottom = (floor - 0.1).floor();
+    if let Some(d) = max_decades.filter(|d| d.is_finite() && *d >= 1.0) {
+        bottom = bottom.max(top - d.floor());
+    }
+    if bottom >= top {
+        bottom = top - 1.0;
+    }
+    (10f64.powf(bottom), 10f64.powf(top))
+}
+
+/// The `q` quantile of sorted, non-empty `v` (nearest rank).
+fn quantile(v: &[f64], q: f64) -> f64 {
+    let k = (q * (v.len() - 1) as f64).round() as usize;
+    v[k.min(v.len() - 1)]
 }
 
 /// Several panels in a grid, with an optional figure title and caption.
@@ -262,9 +343,91 @@ pub struct LogLogFigure {
     pub panels: Vec<Panel>,
     /// Number of grid columns (>= 1); rows follow from the number of cells needed.
     pub columns: usize,
-    /// Caption paragraphs, word-wrapped. Drawn in the first free grid cell if there is one,
-    /// else in a strip below the grid.
+    /// Caption paragraphs, word-wrapped. Drawn in the first free grid cell if there is one
+    /// and it fits there, else in a strip below the grid.
     pub caption: Vec<String>,
+    /// One legend for the whole figure (every distinct entry of the panels once) instead of
+    /// one per panel: in the free grid cell above the caption if there is one, else in columns
+    /// in a strip below the grid. No legend then covers a curve.
+    pub shared_legend: bool,
+}
+
+impl LogLogFigure {
+    /// A figure with one legend per panel.
+    pub fn new(
+        size: (u32, u32),
+        title: Option<String>,
+        panels: Vec<Panel>,
+        columns: usize,
+        caption: Vec<String>,
+    ) -> LogLogFigure {
+        LogLogFigure {
+            size,
+            title,
+            panels,
+            columns,
+            caption,
+            shared_legend: false,
+        }
+    }
+
+    /// The same figure at `factor` times the pixel size: text scales with the size, line
+    /// widths are multiplied here (at least 1 px), so the layout is unchanged.
+    pub fn scaled(mut self, factor: f64) -> LogLogFigure {
+        if !(factor.is_finite() && factor > 0.0) || factor == 1.0 {
+            return self;
+        }
+        let px = |v: u32| ((v as f64 * factor).round() as u32).max(1);
+        self.size = (px(self.size.0), px(self.size.1));
+        for panel in &mut self.panels {
+            for t in &mut panel.traces {
+                t.style.width = px(t.style.width);
+            }
+        }
+        self
+    }
+
+    /// Applies axis limits to every panel: `x` (Hz) to all, `y` to the panels with a log y
+    /// axis (magnitudes, ASDs; not phase or coherence).
+    pub fn with_limits(mut self, x: Option<(f64, f64)>, y: Option<(f64, f64)>) -> LogLogFigure {
+        for panel in &mut self.panels {
+            if x.is_some() {
+                panel.x_range = x;
+            }
+            if y.is_some() && panel.y_scale == YScale::Log {
+                panel.y_range = y;
+            }
+        }
+        self
+    }
+
+    /// The distinct legend rows of all panels, in order of first appearance. A note that not
+    /// every panel has names the panels it belongs to (the part of their titles before `:`).
+    fn shared_rows(&self) -> Vec<(Sample, String)> {
+        let mut rows: Vec<(Sample, String)> = Vec::new();
+        for panel in &self.panels {
+            for row in legend_rows(panel) {
+                if !rows.iter().any(|r| r.1 == row.1) {
+                    rows.push(row);
+                }
+            }
+        }
+        for (sample, text) in &mut rows {
+            if !matches!(sample, Sample::None) {
+                continue;
+            }
+            let owners: Vec<&str> = self
+                .panels
+                .iter()
+                .filter(|p| p.notes.contains(text))
+                .map(|p| p.title.split(':').next().unwrap_or(&p.title))
+                .collect();
+            if owners.len() < self.panels.len() {
+                *text = format!("{text} ({})", owners.join(", "));
+            }
+        }
+        rows
+    }
 }
 
 impl Figure for LogLogFigure {
@@ -285,23 +448,69 @@ impl Figure for LogLogFigure {
         }
         let columns = self.columns.max(1);
         let n = self.panels.len();
-        let caption_in_cell = !self.caption.is_empty() && n % columns != 0;
-        let rows = (n + usize::from(caption_in_cell)).div_ceil(columns).max(1);
+        let free_cell = n % columns != 0;
+        let rows = (n + usize::from(free_cell)).div_ceil(columns).max(1);
+        let margin = ts.caption * 1.5;
+        let line_h = ts.caption * 1.45;
+        let (aw, ah) = area.dim_in_pixel();
+        let (cell_w, cell_h) = (aw as f64 / columns as f64, ah as f64 / rows as f64);
+        let shared = if self.shared_legend {
+            let width = if free_cell { cell_w } else { aw as f64 } - 2.0 * margin;
+            LegendBox::measure_rows(&area, self.shared_rows(), ts.legend, Some(width))?
+        } else {
+            None
+        };
+        let legend_h = shared.as_ref().map_or(0.0, |lb| lb.height as f64 + margin);
+        // The caption goes into the free cell only if it fits there (below the legend).
+        let caption_in_cell = !self.caption.is_empty() && free_cell && {
+            let lines = wrap_lines(&area, &self.caption, ts.caption, cell_w - 2.0 * margin)?;
+            legend_h + lines.len() as f64 * line_h + 2.0 * margin <= cell_h
+        };
+        let legend_in_cell = shared.is_some() && free_cell;
+        let mut strip_parts: Vec<f64> = Vec::new();
+        if let (Some(lb), false) = (&shared, legend_in_cell) {
+            strip_parts.push(lb.height as f64 + margin);
+        }
+        let mut caption_lines = 0;
         if !self.caption.is_empty() && !caption_in_cell {
-            let margin = ts.caption * 1.5;
-            let lines = wrap_lines(&area, &self.caption, ts.caption, w as f64 - 2.0 * margin)?;
-            let strip = (lines.len() as f64 * ts.caption * 1.45 + 1.5 * margin).ceil() as u32;
-            let height = area.dim_in_pixel().1;
-            let (upper, lower) = area.split_vertically(height.saturating_sub(strip));
-            draw_caption(&lower, &self.caption, ts.caption, margin * 0.5)?;
+            caption_lines =
+                wrap_lines(&area, &self.caption, ts.caption, aw as f64 - 2.0 * margin)?.len();
+            strip_parts.push(caption_lines as f64 * line_h + 1.5 * margin);
+        }
+        if !strip_parts.is_empty() {
+            let strip = strip_parts.iter().sum::<f64>().ceil() as u32;
+            let (upper, lower) = area.split_vertically(ah.saturating_sub(strip));
+            let mut rest = lower;
+            if let (Some(lb), false) = (&shared, legend_in_cell) {
+                lb.draw(&rest, (margin as i32, (margin * 0.5) as i32))?;
+                let (_, below) = rest.split_vertically((lb.height as f64 + margin) as u32);
+                rest = below;
+            }
+            if caption_lines > 0 {
+                draw_caption(&rest, &self.caption, ts.caption, margin * 0.5)?;
+            }
             area = upper;
         }
         let cells = area.split_evenly((rows, columns));
         for (panel, cell) in self.panels.iter().zip(cells.iter()) {
-            draw_panel(cell, panel, &ts)?;
+            if self.shared_legend {
+                let mut quiet = panel.clone();
+                quiet.legend = LegendPlacement::Hidden;
+                draw_panel(cell, &quiet, &ts)?;
+            } else {
+                draw_panel(cell, panel, &ts)?;
+            }
         }
-        if caption_in_cell {
-            draw_caption(&cells[n], &self.caption, ts.caption, ts.caption * 1.5)?;
+        if free_cell {
+            let mut cell = cells[n].clone();
+            if let (Some(lb), true) = (&shared, legend_in_cell) {
+                lb.draw(&cell, (margin as i32, margin as i32))?;
+                let (_, below) = cell.split_vertically((lb.height as f64 + margin) as u32);
+                cell = below;
+            }
+            if caption_in_cell {
+                draw_caption(&cell, &self.caption, ts.caption, margin)?;
+            }
         }
         Ok(())
     }
@@ -361,14 +570,19 @@ pub enum LegendPlacement {
 
 /// Size of a plotting rectangle; positions are relative to its top-left corner.
 #[derive(Debug, Clone, Copy)]
-struct PlotRect {
-    width: f64,
-    height: f64,
+pub(crate) struct PlotRect {
+    pub(crate) width: f64,
+    pub(crate) height: f64,
 }
 
 impl PlotRect {
     /// Pixel position (relative to the plotting rectangle) of a data point.
-    fn map(&self, (x, y): (f64, f64), (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> (f64, f64) {
+    pub(crate) fn map(
+        &self,
+        (x, y): (f64, f64),
+        (x0, x1): (f64, f64),
+        (y0, y1): (f64, f64),
+    ) -> (f64, f64) {
         let fx = (x.log10() - x0.log10()) / (x1.log10() - x0.log10());
         let fy = (y.log10() - y0.log10()) / (y1.log10() - y0.log10());
         (fx * (self.width - 1.0), (1.0 - fy) * (self.height - 1.0))
@@ -428,6 +642,7 @@ fn draw_log_panel<DB: DrawingBackend>(
             minor: Vec::new(),
             step: 1,
             labels: labelled,
+            unit: None,
         },
         None => decade_ticks(yr.0, yr.1, plot_h, 2.5 * tick_h),
     };
@@ -476,12 +691,16 @@ fn draw_log_panel<DB: DrawingBackend>(
         width: (inside_rect.width - outside_w).max(10.0),
         ..inside_rect
     };
-    let x_ticks = decade_ticks(
-        xr.0,
-        xr.1,
-        rect.width,
-        x_label_spacing(&body, xr, &tick_style)?,
-    );
+    let x_unit = super::labels::si_unit(&panel.x_unit).then(|| panel.x_unit.clone());
+    let x_ticks = Ticks {
+        unit: x_unit.clone(),
+        ..decade_ticks(
+            xr.0,
+            xr.1,
+            rect.width,
+            x_label_spacing(&body, xr, x_unit.as_deref(), &tick_style)?,
+        )
+    };
 
     let mut chart = ChartBuilder::on(&body)
         .margin_top(m_top as u32)
@@ -510,7 +729,11 @@ fn draw_log_panel<DB: DrawingBackend>(
         .set_all_tick_mark_size(TICK)
         .label_style(tick_style.clone())
         .axis_desc_style(axis_style.clone())
-        .x_desc(axis_title(&panel.x_label, &panel.x_unit))
+        // Ticks that carry the unit (`1 mHz`) leave it out of the axis title.
+        .x_desc(match x_unit {
+            Some(_) => panel.x_label.clone(),
+            None => axis_title(&panel.x_label, &panel.x_unit),
+        })
         .y_desc(axis_title(&panel.y_label, &panel.y_unit))
         .x_label_formatter(&x_fmt)
         .y_label_formatter(&y_fmt)
@@ -524,9 +747,13 @@ fn draw_log_panel<DB: DrawingBackend>(
         }
     }
     for (line, style) in &lines {
-        let line = decimate(line, &rect, xr, yr, 1.5);
-        for run in split_at_reversals(&line, &rect, xr, yr) {
-            draw_polyline(&mut chart, run, *style)?;
+        let line = decimate(line, &rect, xr, yr);
+        if RASTER.with(|r| r.get()) {
+            for run in split_at_reversals(&line, &rect, xr, yr) {
+                draw_polyline(&mut chart, run, *style)?;
+            }
+        } else {
+            draw_polyline(&mut chart, line, *style)?;
         }
     }
 
@@ -563,16 +790,22 @@ fn draw_log_panel<DB: DrawingBackend>(
 /// (about one pixel of curve per unit, band area counts 1 % per pixel).
 const AUTO_INSIDE_MAX_COST: f64 = 12.0;
 
-/// Minimum distance between x tick labels: the widest label plus a gap.
+/// Minimum distance between x tick labels: the widest label (with `unit`: SI-prefixed) plus a
+/// gap.
 fn x_label_spacing<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     (x0, x1): (f64, f64),
+    unit: Option<&str>,
     style: &TextStyle,
 ) -> Result<f64, DrawError> {
     let mut widest: f64 = 0.0;
     let (e0, e1) = (x0.log10().floor() as i32, x1.log10().ceil() as i32);
     for e in e0..=e1 {
-        widest = widest.max(area.estimate_text_size(&pow10_label(e), style)?.0 as f64);
+        let label = match unit {
+            Some(u) => super::labels::si_value(10f64.powi(e), u),
+            None => pow10_label(e),
+        };
+        widest = widest.max(area.estimate_text_size(&label, style)?.0 as f64);
     }
     Ok(widest + style.font.get_size() * 1.2)
 }
@@ -643,6 +876,8 @@ struct Ticks {
     step: i32,
     /// Explicit labels of a linear axis mapped onto a log one: `(position, text)`.
     labels: Vec<(f64, String)>,
+    /// Unit written on every label with an SI prefix (`1 mHz`); `None`: powers of ten (`10⁻³`).
+    unit: Option<String>,
 }
 
 impl Ticks {
@@ -657,7 +892,10 @@ impl Ticks {
         }
         let e = v.log10().round() as i32;
         if e.rem_euclid(self.step) == 0 {
-            pow10_label(e)
+            match &self.unit {
+                Some(unit) => super::labels::si_value(10f64.powi(e), unit),
+                None => pow10_label(e),
+            }
         } else {
             String::new()
         }
@@ -690,6 +928,7 @@ fn decade_ticks(lo: f64, hi: f64, pixels: f64, min_spacing: f64) -> Ticks {
         minor,
         step,
         labels: Vec::new(),
+        unit: None,
     }
 }
 
@@ -931,28 +1170,70 @@ fn column_profile(
     out
 }
 
-/// Drops points closer than `min_px` pixels to the previously kept one (the last point is
-/// always kept): dense curves then rasterise without integer-rounding zigzags, and SVG output
-/// stays small.
-fn decimate(
+/// Reduces a polyline to the pixel grid: within each pixel column it keeps the first and last
+/// point and the points of least and greatest y, in their original order, so every peak and
+/// notch keeps its full height while a curve costs at most four vertices per column (SVG files
+/// stay small, PNG lines rasterise without integer-rounding zigzags).
+pub(crate) fn decimate(
     line: &[(f64, f64)],
     rect: &PlotRect,
     xr: (f64, f64),
     yr: (f64, f64),
-    min_px: f64,
 ) -> Vec<(f64, f64)> {
-    let mut out: Vec<(f64, f64)> = Vec::with_capacity(line.len());
-    let mut last_px = (f64::NAN, f64::NAN);
-    for (k, &p) in line.iter().enumerate() {
-        let q = rect.map(p, xr, yr);
-        // NaN distance (first point) counts as far.
-        let near = (q.0 - last_px.0).hypot(q.1 - last_px.1) < min_px;
-        if !near || k + 1 == line.len() {
-            out.push(p);
-            last_px = q;
+    let mut out: Vec<(f64, f64)> = Vec::with_capacity(line.len().min(4 * rect.width as usize + 4));
+    let mut k = 0;
+    while k < line.len() {
+        let column = rect.map(line[k], xr, yr).0.floor();
+        let start = k;
+        let (mut lo, mut hi) = (k, k);
+        while k < line.len() && rect.map(line[k], xr, yr).0.floor() == column {
+            // Pixel y grows downwards: the least pixel y is the greatest value.
+            if line[k].1 < line[lo].1 {
+                lo = k;
+            }
+            if line[k].1 > line[hi].1 {
+                hi = k;
+            }
+            k += 1;
+        }
+        if k == start {
+            // A point without a pixel column (non-finite; clipping removes those): kept as is.
+            out.push(line[k]);
+            k += 1;
+            continue;
+        }
+        let mut keep = [start, lo, hi, k - 1];
+        keep.sort_unstable();
+        let mut last = usize::MAX;
+        for i in keep {
+            if i != last {
+                out.push(line[i]);
+                last = i;
+            }
         }
     }
     out
+}
+
+// Vector output never splits a polyline at reversals: SVG viewers limit miters themselves
+// (stroke-miterlimit 4), and a noisy curve stays one element instead of thousands. Raster
+// output splits at every reversal (the bitmap backend draws unlimited miters: spikes above a
+// noisy thick line, capped undamped peaks).
+thread_local! {
+    /// Whether the figure being drawn on this thread is a raster image (set by
+    /// [`super::render`] for the duration of one drawing).
+    static RASTER: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+/// Marks this thread's drawing as raster (`true`) or vector until the guard is dropped.
+pub(crate) fn raster_scope(raster: bool) -> impl Drop {
+    struct Restore(bool);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            RASTER.with(|r| r.set(self.0));
+        }
+    }
+    Restore(RASTER.with(|r| r.replace(raster)))
 }
 
 /// Cuts a polyline where it turns back on itself by more than 90 degrees in pixel space (the two
@@ -991,7 +1272,7 @@ enum Sample {
     None,
 }
 
-/// A measured legend.
+/// A measured legend, its rows in `columns` columns (filled column by column).
 struct LegendBox {
     rows: Vec<(Sample, String)>,
     font: f64,
@@ -1001,6 +1282,24 @@ struct LegendBox {
     sample_len: i32,
     row_h: i32,
     text_x: i32,
+    /// Width of one column (sample, text, gap).
+    column_w: i32,
+    columns: usize,
+}
+
+/// Legend rows of a panel: its traces, band and notes.
+fn legend_rows(panel: &Panel) -> Vec<(Sample, String)> {
+    let mut rows: Vec<(Sample, String)> = Vec::new();
+    for t in &panel.traces {
+        rows.push((Sample::Line(t.style), t.label.clone()));
+    }
+    if let Some(b) = &panel.band {
+        rows.push((Sample::Swatch(b.color, b.opacity), b.label.clone()));
+    }
+    for n in &panel.notes {
+        rows.push((Sample::None, n.clone()));
+    }
+    rows
 }
 
 impl LegendBox {
@@ -1010,16 +1309,16 @@ impl LegendBox {
         panel: &Panel,
         font: f64,
     ) -> Result<Option<LegendBox>, DrawError> {
-        let mut rows: Vec<(Sample, String)> = Vec::new();
-        for t in &panel.traces {
-            rows.push((Sample::Line(t.style), t.label.clone()));
-        }
-        if let Some(b) = &panel.band {
-            rows.push((Sample::Swatch(b.color, b.opacity), b.label.clone()));
-        }
-        for n in &panel.notes {
-            rows.push((Sample::None, n.clone()));
-        }
+        LegendBox::measure_rows(area, legend_rows(panel), font, None)
+    }
+
+    /// A legend of `rows`, in as many columns as fit in `max_width` pixels (one without).
+    fn measure_rows<DB: DrawingBackend>(
+        area: &DrawingArea<DB, Shift>,
+        rows: Vec<(Sample, String)>,
+        font: f64,
+        max_width: Option<f64>,
+    ) -> Result<Option<LegendBox>, DrawError> {
         if rows.is_empty() {
             return Ok(None);
         }
@@ -1033,15 +1332,23 @@ impl LegendBox {
         for (_, text) in &rows {
             text_w = text_w.max(area.estimate_text_size(text, &style)?.0 as i32);
         }
+        let column_w = text_x + text_w + 2 * pad;
+        let columns = match max_width {
+            Some(w) => ((w as i32 - pad) / column_w.max(1)).clamp(1, rows.len() as i32) as usize,
+            None => 1,
+        };
+        let per_column = rows.len().div_ceil(columns);
         Ok(Some(LegendBox {
-            width: text_x + text_w + pad + 2,
-            height: 2 * pad + row_h * rows.len() as i32 - pad / 2,
+            width: column_w * columns as i32 - pad + 2,
+            height: 2 * pad + row_h * per_column as i32 - pad / 2,
             rows,
             font,
             pad,
             sample_len,
             row_h,
             text_x,
+            column_w,
+            columns,
         }))
     }
 
@@ -1085,9 +1392,12 @@ impl LegendBox {
         let style = text_style(self.font, &BLACK).pos(Pos::new(HPos::Left, VPos::Center));
         let note_style =
             text_style(self.font, &RGBColor(85, 85, 85)).pos(Pos::new(HPos::Left, VPos::Center));
+        let per_column = self.rows.len().div_ceil(self.columns.max(1));
         for (i, (sample, text)) in self.rows.iter().enumerate() {
-            let cy = by + self.pad + self.row_h * i as i32 + self.row_h / 2;
-            let sx = bx + self.pad;
+            let (col, row) = ((i / per_column) as i32, (i % per_column) as i32);
+            let cx = bx + col * self.column_w;
+            let cy = by + self.pad + self.row_h * row + self.row_h / 2;
+            let sx = cx + self.pad;
             let len = self.sample_len;
             match sample {
                 Sample::Line(s) => {
@@ -1129,7 +1439,7 @@ impl LegendBox {
             } else {
                 &style
             };
-            area.draw_text(text, st, (bx + self.text_x, cy))?;
+            area.draw_text(text, st, (cx + self.text_x, cy))?;
         }
         Ok(())
     }
@@ -1273,7 +1583,92 @@ mod tests {
         assert!((lo - 1e-10).abs() < 1e-22, "{lo}");
         p.max_decades = None;
         let (lo, _) = p.resolved_y_range();
-        assert!((lo - 1e-30).abs() < 1e-42);
+        // 1e-30 padded by a tenth of a decade, rounded out to whole decades.
+        assert!((lo - 1e-31).abs() < 1e-43, "{lo}");
+    }
+
+    /// A budget-like panel: a broadband term at 1e-13..1e-12 with an undamped resonance peak
+    /// of 1e-3 covering 1 % of the axis, and a white readout at 9e-9 over part of the band.
+    /// Every curve stays visible where it lies, the peak is clipped at the top.
+    #[test]
+    fn auto_range_keeps_broadband_terms_and_clips_peaks() {
+        let f: Vec<f64> = (0..2000)
+            .map(|k| 1e-4 * 10f64.powf(k as f64 * 5.0 / 1999.0))
+            .collect();
+        let tilt: Vec<(f64, f64)> = f
+            .iter()
+            .map(|&x| {
+                let peak = if (0.40..0.41).contains(&x) { 1e-3 } else { 0.0 };
+                (x, 1e-13 * (1.0 + 9.0 * (x / 10.0)) + peak)
+            })
+            .collect();
+        let readout: Vec<(f64, f64)> = f.iter().map(|&x| (x, 9e-9)).collect();
+        let curves = [tilt.as_slice(), readout.as_slice()];
+        let (lo, hi) = auto_log_range(curves, (1e-4, 10.0), Some(12.0));
+        assert!(
+            lo <= 1e-13,
+            "the broadband floor 1e-13 is below the axis: {lo}"
+        );
+        assert!(hi >= 9e-9, "the readout 9e-9 is above the axis: {hi}");
+        // Peak clipped: at most PEAK_HEADROOM_DECADES (+ rounding) above the broadband tops.
+        assert!(hi <= 9e-9 * 10f64.powf(PEAK_HEADROOM_DECADES + 1.1), "{hi}");
+        assert!(hi < 1e-3);
+        // A lone notch covering less than BOTTOM_QUANTILE of the columns does not set the floor.
+        let mut notched = tilt.clone();
+        notched[1000].1 = 1e-30;
+        let (lo2, _) = auto_log_range([notched.as_slice()], (1e-4, 10.0), None);
+        assert!(lo2 >= 1e-14, "{lo2}");
+    }
+
+    /// Pixel-grid decimation keeps, per pixel column, the least and greatest value and the
+    /// endpoints, and at most four vertices per column.
+    #[test]
+    fn decimation_keeps_min_and_max_per_column() {
+        let rect = PlotRect {
+            width: 100.0,
+            height: 100.0,
+        };
+        let (xr, yr) = ((1.0, 10.0), (1e-3, 1e3));
+        let n = 10_000;
+        let line: Vec<(f64, f64)> = (0..n)
+            .map(|k| {
+                let x = 10f64.powf(k as f64 / (n - 1) as f64);
+                // A zigzag of 2 decades with a spike in the middle.
+                let y = if k == n / 2 {
+                    900.0
+                } else if k % 2 == 0 {
+                    0.1
+                } else {
+                    10.0
+                };
+                (x, y)
+            })
+            .collect();
+        let out = decimate(&line, &rect, xr, yr);
+        assert!(out.len() <= 4 * 100, "{} vertices", out.len());
+        assert_eq!(out[0], line[0]);
+        assert_eq!(*out.last().unwrap(), line[n - 1]);
+        assert!(out.contains(&line[n / 2]), "the spike is lost");
+        let column = |p: (f64, f64)| rect.map(p, xr, yr).0.floor() as i64;
+        for c in 0..100 {
+            let in_col: Vec<f64> = line
+                .iter()
+                .filter(|p| column(**p) == c)
+                .map(|p| p.1)
+                .collect();
+            if in_col.is_empty() {
+                continue;
+            }
+            let kept: Vec<f64> = out
+                .iter()
+                .filter(|p| column(**p) == c)
+                .map(|p| p.1)
+                .collect();
+            let max = |v: &[f64]| v.iter().copied().fold(f64::MIN, f64::max);
+            let min = |v: &[f64]| v.iter().copied().fold(f64::MAX, f64::min);
+            assert_eq!(max(&kept), max(&in_col), "column {c}");
+            assert_eq!(min(&kept), min(&in_col), "column {c}");
+        }
     }
 
     #[test]

@@ -169,6 +169,7 @@ pub fn build_coherence_figure(
         panels,
         columns: 3,
         caption,
+        shared_legend: false,
     })
 }
 

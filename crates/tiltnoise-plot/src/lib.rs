@@ -94,6 +94,56 @@ impl ImageFormat {
     }
 }
 
+/// What the reader asks of a figure beyond its data: axis limits, pixel size, resolution.
+/// Every field is optional; the default leaves the figure as its builder made it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct View {
+    /// Frequency range (Hz) of every panel; `None`: the data's.
+    pub x_range: Option<(f64, f64)>,
+    /// Range of every log y axis (magnitudes, ASDs; not phase or coherence), in the panels'
+    /// units; `None`: chosen from the curves ([`chart::auto_log_range`]).
+    pub y_range: Option<(f64, f64)>,
+    /// Layout size in pixels at the nominal resolution; `None`: the figure's default.
+    pub size: Option<(u32, u32)>,
+    /// Resolution in dots per inch; the image has `size * dpi / 100` pixels with text and
+    /// lines scaled alike, so the layout does not change ([`NOMINAL_DPI`] by default).
+    pub dpi: f64,
+}
+
+/// The resolution at which a figure's size is given: `--dpi 200` doubles the pixels.
+pub const NOMINAL_DPI: f64 = 100.0;
+
+impl Default for View {
+    fn default() -> Self {
+        View {
+            x_range: None,
+            y_range: None,
+            size: None,
+            dpi: NOMINAL_DPI,
+        }
+    }
+}
+
+impl View {
+    /// `figure` with these limits, size and resolution.
+    pub fn apply(&self, mut figure: LogLogFigure) -> LogLogFigure {
+        if let Some(size) = self.size {
+            figure.size = size;
+        }
+        figure
+            .with_limits(self.x_range, self.y_range)
+            .scaled(self.dpi / NOMINAL_DPI)
+    }
+
+    /// A figure's pixel size under this view: `default` or [`View::size`], times the resolution.
+    pub fn pixels(&self, default: (u32, u32)) -> (u32, u32) {
+        let (w, h) = self.size.unwrap_or(default);
+        let s = self.dpi / NOMINAL_DPI;
+        let px = |v: u32| ((v as f64 * s).round() as u32).max(1);
+        (px(w), px(h))
+    }
+}
+
 /// A failure while drawing: a backend error, a font that cannot be used, or data that cannot be
 /// plotted. The caller turns it into an error naming the file.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -160,6 +210,7 @@ pub fn ensure_font() -> Result<(), DrawError> {
 /// [`DrawError`] if the font cannot be registered, drawing fails or the PNG cannot be encoded.
 pub fn render(format: ImageFormat, figure: &impl Figure) -> Result<Vec<u8>, DrawError> {
     ensure_font()?;
+    let _raster = chart::raster_scope(format == ImageFormat::Png);
     let (w, h) = figure.size();
     match format {
         ImageFormat::Png => {

@@ -51,8 +51,10 @@ pub struct SimAsdData {
 }
 
 const ASD_COLOR: RGBColor = PALETTE[0];
-const SEEN_COLOR: RGBColor = PALETTE[1];
-const OTHER_MODE_COLOR: RGBColor = RGBColor(170, 170, 170);
+/// Mode markers: thin and light, drawn under the spectrum, so they never hide a peak. A tint
+/// of the vermillion for the modes the observable sees, light grey for the others.
+const SEEN_COLOR: RGBColor = RGBColor(236, 160, 110);
+const OTHER_MODE_COLOR: RGBColor = RGBColor(200, 200, 200);
 const READOUT_COLOR: RGBColor = PALETTE[2];
 
 /// Vertical marker lines at `xs` spanning `(lo, hi)`, as one broken trace.
@@ -129,7 +131,7 @@ pub fn build_asd_figure(data: &SimAsdData) -> Result<LogLogFigure, String> {
         let x_range = panel.resolved_x_range();
         if let Some(r) = readout {
             panel.traces.push(Trace::new(
-                format!("readout {r:.1e}"),
+                format!("readout {}/√Hz", super::labels::si_value(r, o.unit())),
                 vec![(x_range.0, r), (x_range.1, r)],
                 TraceStyle::new(READOUT_COLOR, Dash::Dashed, 2),
             ));
@@ -164,7 +166,7 @@ pub fn build_asd_figure(data: &SimAsdData) -> Result<LogLogFigure, String> {
                 Trace::new(
                     format!("seen: {}", mode_list(&seen)),
                     markers(&xs, y_range),
-                    TraceStyle::new(SEEN_COLOR, Dash::Dotted, 2),
+                    TraceStyle::new(SEEN_COLOR, Dash::Dashed, 1),
                 ),
             );
         }
@@ -178,6 +180,7 @@ pub fn build_asd_figure(data: &SimAsdData) -> Result<LogLogFigure, String> {
         panels,
         columns: 3,
         caption: data.caption.clone(),
+        shared_legend: false,
     })
 }
 
@@ -301,11 +304,7 @@ impl Figure for TimeSeriesData {
             chart
                 .configure_mesh()
                 .x_desc("time (s)")
-                .y_desc(format!(
-                    "{} ({})",
-                    observable_symbol(p.observable),
-                    p.observable.unit()
-                ))
+                .y_desc(observable_symbol(p.observable))
                 .axis_desc_style((FONT_FAMILY, ts.axis))
                 .label_style((FONT_FAMILY, ts.ticks))
                 .y_label_formatter(&|v| {
@@ -313,9 +312,10 @@ impl Figure for TimeSeriesData {
                     if v.abs() < 1e-9 * (y1 - y0) {
                         "0".to_string()
                     } else {
-                        format!("{v:.2e}")
+                        super::labels::si_value(*v, p.observable.unit())
                     }
                 })
+                .x_label_formatter(&|v| format!("{v:.0}"))
                 .light_line_style(RGBColor(235, 235, 235))
                 .draw()?;
             chart.draw_series(LineSeries::new(pts, ASD_COLOR.stroke_width(2)))?;

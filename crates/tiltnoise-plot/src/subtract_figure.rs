@@ -160,6 +160,7 @@ pub fn build_subtract_figure(data: &SubtractFigureData) -> Result<LogLogFigure, 
         panels,
         columns,
         caption: data.caption.clone(),
+        shared_legend: true,
     })
 }
 

@@ -5,32 +5,28 @@
 
 use super::chart::{Dash, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
 // Re-exported: `plot::tf_figure::observable_symbol` is a public path.
+use super::chart::{LegendPlacement, YScale};
 pub use super::labels::observable_symbol;
 use super::labels::{observable_title, tilt_symbol};
-use super::{render, DrawError, ImageFormat};
+use super::{render, DrawError, ImageFormat, View};
 use tiltnoise_core::model::{ForceInput, Input, Observable, TiltAxis};
 use tiltnoise_core::tf::TransferMatrix;
 
 /// Options of [`tf_figure_with`].
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct TfFigureOptions {
-    /// Image size in pixels.
-    pub size: (u32, u32),
     /// Appended to the figure title in parentheses, e.g. `undamped, Table I parameters`.
     pub note: Option<String>,
-    /// Observables to draw, one panel each, in this order; those absent from the matrix are
-    /// skipped.
-    pub observables: Vec<Observable>,
-}
-
-impl Default for TfFigureOptions {
-    fn default() -> Self {
-        TfFigureOptions {
-            size: (1200, 1000),
-            note: None,
-            observables: vec![Observable::X, Observable::Phi, Observable::PhiA],
-        }
-    }
+    /// Observables to draw, one row of panels each, in this order; each must be an output of
+    /// the matrix. `None`: every output of the matrix.
+    pub observables: Option<Vec<Observable>>,
+    /// Bode plot: a phase panel (degrees) beside every magnitude panel.
+    pub phase: bool,
+    /// Whether the model has loss angles or viscous damping (said in the caption: an undamped
+    /// model's peak heights are set by the frequency grid alone).
+    pub damped: bool,
+    /// Axis limits, size, resolution; the default size grows with the number of panels.
+    pub view: View,
 }
 
 /// Draws Figure 5 of the paper as a PNG or SVG file's bytes: |H| of X (m/rad), φ (rad/rad)
@@ -53,7 +49,7 @@ pub fn tf_figure_with(
     options: &TfFigureOptions,
 ) -> Result<Vec<u8>, DrawError> {
     let figure = build_tf_figure(tf, options).map_err(DrawError)?;
-    render(format, &figure)
+    render(format, &options.view.apply(figure))
 }
 
 /// Display name and line style of a tilt axis: θₜ solid, ηₜ dashed, φₜ dotted (as in the paper).
@@ -114,6 +110,23 @@ pub fn force_symbol_style(f: ForceInput) -> (String, TraceStyle) {
     (name.to_string(), TraceStyle::new(PALETTE[axis], dash, 2))
 }
 
+/// The default pixel size of the figure for `inputs` under `options` (observables `None`:
+/// counted as the paper's three): two columns, rows of about 320 px, at least 1200 x 1000.
+pub fn default_size(options: &TfFigureOptions, inputs: &[Input]) -> (u32, u32) {
+    let kinds = [InputKind::Tilt, InputKind::Force, InputKind::Torque]
+        .into_iter()
+        .filter(|&k| inputs.iter().any(|&i| InputKind::of(i) == k))
+        .count();
+    let observables = options.observables.as_ref().map_or(3, Vec::len);
+    size_for_panels(observables * kinds.max(1) * if options.phase { 2 } else { 1 })
+}
+
+/// Two columns, the caption in a free cell or a strip below; rows of about 320 px.
+fn size_for_panels(panels: usize) -> (u32, u32) {
+    let rows = (panels + 1).div_ceil(2) as u32;
+    (1200, (110 + 320 * rows).max(1000))
+}
+
 /// The figure as data, ready for [`render`]; errors are plain messages.
 ///
 /// One panel per requested observable and kind of input present (tilt in rad, forces in N,
@@ -130,10 +143,22 @@ pub fn build_tf_figure(
     if kinds.is_empty() {
         return Err("the transfer matrix has no input".to_string());
     }
+    let observables = match &options.observables {
+        None => tf.outputs.clone(),
+        Some(list) => list.clone(),
+    };
+    if observables.is_empty() {
+        return Err("no observable to draw".to_string());
+    }
     let mut panels = Vec::new();
-    for &o in &options.observables {
+    for &o in &observables {
         let Some(oi) = tf.output_index(o) else {
-            continue;
+            let have: Vec<&str> = tf.outputs.iter().map(|o| o.name()).collect();
+            return Err(format!(
+                "observable {} is not an output of the transfer matrix (outputs: {})",
+                o.name(),
+                have.join(", ")
+            ));
         };
         for &kind in &kinds {
             let (input_symbol, unit, suffix) = kind.labels(o);
@@ -145,9 +170,23 @@ pub fn build_tf_figure(
                     &unit,
                 ),
             );
-            // Undamped peaks reach 1e6 while phi/eta_t falls as f^4 to 1e-10 at 0.1 mHz: show
-            // 18 decades so the low-frequency cancellation stays visible.
-            panel.max_decades = Some(18.0);
+            // Undamped peaks reach 1e6 while phi/eta_t falls as f^4 to 1e-10 at 0.1 mHz and
+            // force responses as f^-4 to 1e-14 at 30 Hz: the automatic range clips the peaks,
+            // and up to 24 decades keep those tails visible.
+            panel.max_decades = Some(24.0);
+            let mut phase = Panel::new(
+                format!("{}{suffix}: phase", observable_symbol(o)),
+                ("frequency", "Hz"),
+                (
+                    &format!("arg({} / {input_symbol})", observable_symbol(o)),
+                    "deg",
+                ),
+            );
+            phase.y_scale = YScale::Linear {
+                tick_step: Some(90.0),
+            };
+            phase.y_range = Some((-180.0, 180.0));
+            phase.legend = LegendPlacement::Hidden;
             for (ii, &input) in tf.inputs.iter().enumerate() {
                 if InputKind::of(input) != kind {
                     continue;
@@ -171,17 +210,20 @@ pub fn build_tf_figure(
                     .enumerate()
                     .map(|(k, &f)| (f, tf.get(k, oi, ii).norm()))
                     .collect();
-                panel.traces.push(Trace::new(name, points, style));
+                panel.traces.push(Trace::new(name.clone(), points, style));
+                let degrees = tf
+                    .freqs_hz
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &f)| (f, tf.get(k, oi, ii).arg().to_degrees()))
+                    .collect();
+                phase.traces.push(Trace::new(name, degrees, style));
             }
             panels.push(panel);
+            if options.phase {
+                panels.push(phase);
+            }
         }
-    }
-    if panels.is_empty() {
-        let names: Vec<&str> = options.observables.iter().map(|o| o.name()).collect();
-        return Err(format!(
-            "the transfer matrix has none of the observables {}",
-            names.join(", ")
-        ));
     }
     let has_tilt = kinds.contains(&InputKind::Tilt);
     let has_forces = kinds.len() > usize::from(has_tilt);
@@ -190,7 +232,12 @@ pub fn build_tf_figure(
         (false, _) => "Forces and torques",
         (true, true) => "Floor tilt, forces and torques",
     };
-    let mut title = format!("{what} → observables: |H(f)|, method {}", tf.method.name());
+    let shown = if options.phase {
+        "|H(f)| and phase"
+    } else {
+        "|H(f)|"
+    };
+    let mut title = format!("{what} → observables: {shown}, method {}", tf.method.name());
     if let Some(note) = &options.note {
         title.push_str(&format!(" ({note})"));
     }
@@ -217,20 +264,44 @@ pub fn build_tf_figure(
         );
     }
     if let (Some(first), Some(last)) = (tf.freqs_hz.first(), tf.freqs_hz.last()) {
+        let peaks = if options.damped {
+            "With the damping of the parameters (loss angles, viscous terms) the peak heights \
+             are the model's, where the grid resolves them."
+        } else {
+            "Without loss angles the resonance peaks are limited only by the frequency grid."
+        };
         caption.push(format!(
-            "Evaluated at {} frequencies from {} to {} Hz. Without loss angles the resonance \
-             peaks are limited only by the frequency grid.",
+            "Evaluated at {} frequencies from {} to {} Hz. {peaks}",
             tf.freqs_hz.len(),
             compact_number(*first),
             compact_number(*last)
         ));
     }
+    if options.phase {
+        caption.push(
+            "Phase: arg H in degrees, time dependence exp(+iωt); a lag is a negative phase."
+                .to_string(),
+        );
+    }
+    let omitted: Vec<&str> = tf
+        .outputs
+        .iter()
+        .filter(|o| !observables.contains(o))
+        .map(|o| o.name())
+        .collect();
+    if !omitted.is_empty() {
+        caption.push(format!(
+            "Not drawn (in the files): {}; --observables chooses the panels.",
+            omitted.join(", ")
+        ));
+    }
     Ok(LogLogFigure {
-        size: options.size,
+        size: size_for_panels(panels.len()),
         title: Some(title),
         panels,
         columns: 2,
         caption,
+        shared_legend: false,
     })
 }
 
@@ -273,8 +344,33 @@ mod tests {
     #[test]
     fn structural_zero_goes_to_legend_note() {
         let tf = matrix();
-        let fig = build_tf_figure(&tf, &TfFigureOptions::default()).unwrap();
+        let options = TfFigureOptions {
+            observables: Some(vec![Observable::X, Observable::Phi, Observable::PhiA]),
+            ..TfFigureOptions::default()
+        };
+        let fig = build_tf_figure(&tf, &options).unwrap();
         assert_eq!(fig.panels.len(), 3);
+        // The caption names the outputs left out.
+        assert!(
+            fig.caption.iter().any(|c| c.contains("Y, Z, theta, eta")),
+            "{:?}",
+            fig.caption
+        );
+        // Every output by default; with --phase a phase panel beside each.
+        let all = build_tf_figure(&tf, &TfFigureOptions::default()).unwrap();
+        assert_eq!(all.panels.len(), 7);
+        let bode = TfFigureOptions {
+            phase: true,
+            ..options
+        };
+        let fig = build_tf_figure(&tf, &bode).unwrap();
+        assert_eq!(fig.panels.len(), 6);
+        assert_eq!(
+            fig.panels[1].y_scale,
+            YScale::Linear {
+                tick_step: Some(90.0)
+            }
+        );
         let x = &fig.panels[0];
         assert!(x.y_unit == "m/rad");
         let total = x.traces.len() + x.notes.len();
@@ -327,14 +423,41 @@ mod tests {
     }
 
     #[test]
-    fn absent_observables_are_skipped() {
+    fn absent_observables_are_refused_by_name() {
         let tf = matrix();
         let keep = tf.output_index(Observable::Phi).unwrap();
-        let mut tf = tf.select_outputs(&[keep]);
+        let tf = tf.select_outputs(&[keep]);
         assert_eq!(tf.outputs, vec![Observable::Phi]);
         let fig = build_tf_figure(&tf, &TfFigureOptions::default()).unwrap();
         assert_eq!(fig.panels.len(), 1);
-        tf.outputs = vec![Observable::Z];
-        assert!(build_tf_figure(&tf, &TfFigureOptions::default()).is_err());
+        let options = TfFigureOptions {
+            observables: Some(vec![Observable::Z]),
+            ..TfFigureOptions::default()
+        };
+        let e = build_tf_figure(&tf, &options).unwrap_err();
+        assert!(e.contains("Z is not an output") && e.contains("phi"), "{e}");
+    }
+
+    #[test]
+    fn the_caption_says_whether_the_model_is_damped() {
+        let tf = matrix();
+        let undamped = build_tf_figure(&tf, &TfFigureOptions::default()).unwrap();
+        assert!(undamped
+            .caption
+            .iter()
+            .any(|c| c.contains("Without loss angles")));
+        let options = TfFigureOptions {
+            damped: true,
+            ..TfFigureOptions::default()
+        };
+        let damped = build_tf_figure(&tf, &options).unwrap();
+        assert!(!damped
+            .caption
+            .iter()
+            .any(|c| c.contains("Without loss angles")));
+        assert!(damped
+            .caption
+            .iter()
+            .any(|c| c.contains("damping of the parameters")));
     }
 }

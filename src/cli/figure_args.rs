@@ -1,0 +1,147 @@
+//! Figure options shared by every command that draws: `--xlim`, `--ylim`, `--size`, `--dpi`.
+//! One parser and one set of messages, so the options mean the same everywhere.
+
+use anyhow::{bail, Result};
+use clap::Args;
+use tiltnoise_core::error::Shown;
+use tiltnoise_plot::View;
+
+/// Smallest and largest figure side accepted by `--size` (pixels at 100 dpi).
+const SIZE_RANGE_PX: (u32, u32) = (200, 10_000);
+/// Resolutions accepted by `--dpi`.
+const DPI_RANGE: (f64, f64) = (30.0, 600.0);
+/// Largest image accepted after `--dpi` scaling (pixels): 100 megapixels, 300 MB of RGB.
+const MAX_PIXELS: f64 = 1e8;
+
+/// Axis limits, size and resolution of the figures a command saves (.png, .svg).
+#[derive(Debug, Clone, Default, Args)]
+pub struct FigureArgs {
+    /// Frequency range of the figures, LO,HI in Hz with 0 < LO < HI (e.g. 1e-3,1).
+    #[arg(long, value_name = "LO,HI", allow_hyphen_values = true)]
+    pub xlim: Option<String>,
+    /// Range of the figures' log y axes (ASDs, |H|), LO,HI in the panels' units with
+    /// 0 < LO < HI (e.g. 1e-14,1e-6); default: chosen so every curve is visible where it
+    /// matters, resonance peaks clipped at the top.
+    #[arg(long, value_name = "LO,HI", allow_hyphen_values = true)]
+    pub ylim: Option<String>,
+    /// Figure size WxH in pixels at 100 dpi, each side 200 to 10000 (e.g. 1600x1200).
+    #[arg(long, value_name = "WxH")]
+    pub size: Option<String>,
+    /// Resolution of PNG figures, 30 to 600 (default 100): the image has size x DPI/100
+    /// pixels with text and lines scaled alike.
+    #[arg(long, value_name = "DPI", allow_negative_numbers = true)]
+    pub dpi: Option<f64>,
+}
+
+impl FigureArgs {
+    /// The validated view.
+    ///
+    /// # Errors
+    ///
+    /// One line naming the option, the value and what is allowed.
+    pub fn view(&self) -> Result<View> {
+        let mut view = View::default();
+        if let Some(text) = &self.xlim {
+            view.x_range = Some(parse_limits("--xlim", text, "Hz")?);
+        }
+        if let Some(text) = &self.ylim {
+            view.y_range = Some(parse_limits("--ylim", text, "the panels' unit")?);
+        }
+        if let Some(text) = &self.size {
+            view.size = Some(parse_size(text)?);
+        }
+        if let Some(dpi) = self.dpi {
+            if !(dpi.is_finite() && (DPI_RANGE.0..=DPI_RANGE.1).contains(&dpi)) {
+                bail!(
+                    "--dpi {dpi}: the resolution must be a number from {} to {}",
+                    DPI_RANGE.0,
+                    DPI_RANGE.1
+                );
+            }
+            view.dpi = dpi;
+        }
+        Ok(view)
+    }
+
+    /// [`FigureArgs::view`], also checking that the image of `default` size (when `--size`
+    /// is absent) stays below the pixel bound at the chosen resolution.
+    pub fn view_for(&self, default: (u32, u32)) -> Result<View> {
+        let view = self.view()?;
+        let (w, h) = view.pixels(default);
+        if w as f64 * h as f64 > MAX_PIXELS {
+            bail!(
+                "--size/--dpi: a {w} x {h} pixel image is too large (at most {} megapixels)",
+                MAX_PIXELS / 1e6
+            );
+        }
+        Ok(view)
+    }
+}
+
+/// `LO,HI` with 0 < LO < HI, both finite.
+fn parse_limits(option: &str, text: &str, unit: &str) -> Result<(f64, f64)> {
+    let expected = format!("expected LO,HI in {unit} with 0 < LO < HI (log axes), e.g. 1e-3,1");
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    if parts.len() != 2 {
+        bail!("{option} {}: {expected}", Shown(text));
+    }
+    let mut v = [0.0; 2];
+    for (slot, part) in v.iter_mut().zip(&parts) {
+        *slot = match part.parse::<f64>() {
+            Ok(x) if x.is_finite() => x,
+            _ => bail!(
+                "{option} {}: `{}` is not a finite number; {expected}",
+                Shown(text),
+                Shown(part)
+            ),
+        };
+    }
+    if !(v[0] > 0.0 && v[1] > v[0]) {
+        bail!("{option} {}: {expected}", Shown(text));
+    }
+    Ok((v[0], v[1]))
+}
+
+/// `WxH` in pixels, each side within [`SIZE_RANGE_PX`].
+fn parse_size(text: &str) -> Result<(u32, u32)> {
+    let (lo, hi) = SIZE_RANGE_PX;
+    let expected = format!("expected WxH in pixels, each side {lo} to {hi}, e.g. 1600x1200");
+    let Some((w, h)) = text.trim().split_once(['x', 'X']) else {
+        bail!("--size {}: {expected}", Shown(text));
+    };
+    let side = |s: &str| {
+        s.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|v| (lo..=hi).contains(v))
+    };
+    match (side(w), side(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => bail!("--size {}: {expected}", Shown(text)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn limits_and_sizes_parse_or_say_why_not() {
+        assert_eq!(
+            parse_limits("--xlim", "1e-3, 1", "Hz").unwrap(),
+            (1e-3, 1.0)
+        );
+        for bad in ["1", "0,1", "2,1", "a,1", "1,inf", "1,2,3"] {
+            let e = parse_limits("--xlim", bad, "Hz").unwrap_err().to_string();
+            assert!(e.starts_with("--xlim ") && e.contains("0 < LO < HI"), "{e}");
+        }
+        assert_eq!(parse_size("1600x1200").unwrap(), (1600, 1200));
+        for bad in ["1600", "10x1000", "1600x", "axb", "20000x1000"] {
+            let e = parse_size(bad).unwrap_err().to_string();
+            assert!(
+                e.starts_with("--size ") && e.contains("200 to 10000"),
+                "{e}"
+            );
+        }
+    }
+}
