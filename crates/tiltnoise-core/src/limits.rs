@@ -53,7 +53,8 @@ pub const MC_BYTES_PER_DRAW: u64 = 160;
 /// reserves a stack; 1024 is beyond any workstation's core count.
 pub const MAX_THREADS: usize = 1024;
 
-/// Most samples of a simulation (`simulate --duration / --step`). A sample costs 64 bytes of
+/// Most samples of a simulation held in memory whole (the library's `simulate`, the Python
+/// package's `Model.simulate`). A sample costs 64 bytes of
 /// coordinates and 56 of observables; with the spectra and the outputs (HDF5, figures) 175
 /// bytes were measured, so 2^24 samples take 3 GB: 19 days at the paper's 0.1 s, 39 times its
 /// 12-hour run.
@@ -61,6 +62,12 @@ pub const MAX_SIM_SAMPLES: usize = 1 << 24;
 
 /// Bytes planned per simulated sample, outputs included ([`MAX_SIM_SAMPLES`]).
 pub const SIM_BYTES_PER_SAMPLE: u64 = 192;
+
+/// Most samples of a simulation produced in chunks and written as it goes (`tiltnoise
+/// simulate`, whose memory does not grow with the duration): 2^25, a file of 1.9 GB of
+/// observables, which is what the budget reads back whole as a measured record
+/// ([`MAX_SERIES_SAMPLES`]). 38 days at the paper's 0.1 s.
+pub const MAX_STREAMED_SIM_SAMPLES: usize = MAX_SERIES_SAMPLES;
 
 /// Most samples (or frequency points) per channel of an input held in memory whole: a CSV
 /// tilt series or spectrum, an HDF5 spectrum, a measured series (`budget --measured`), an HDF5
