@@ -63,6 +63,11 @@ pub const MAX_SIM_SAMPLES: usize = 1 << 24;
 /// Bytes planned per simulated sample, outputs included ([`MAX_SIM_SAMPLES`]).
 pub const SIM_BYTES_PER_SAMPLE: u64 = 192;
 
+/// Bytes per sample of a Welch segment while a record streams through one accumulator per
+/// channel: the segment, the windowed copy, the spectrum and its running sum (8 bytes each
+/// per sample) and the FFT's scratch and twiddles (measured: about as much again).
+pub const STREAMED_WELCH_BYTES_PER_SAMPLE: u64 = 64;
+
 /// Most samples of a simulation produced in chunks and written as it goes (`tiltnoise
 /// simulate`, whose memory does not grow with the duration): 2^25, a file of 1.9 GB of
 /// observables, which is what the budget reads back whole as a measured record

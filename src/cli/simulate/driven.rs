@@ -3,7 +3,8 @@
 //! (`--drive-gain`, `--drive-delay`): a controlled record of the observables, for example to
 //! test `tiltnoise subtract`, which should find those gains and that delay.
 
-use super::{default_nperseg, parse_readout, readout_text, SimulateArgs};
+use super::{parse_readout, readout_text, SimulateArgs};
+use tiltnoise_core::simulate::default_sim_nperseg as default_nperseg;
 use crate::cli::output::save_image;
 use crate::cli::Run;
 use anyhow::{anyhow, bail, Result};

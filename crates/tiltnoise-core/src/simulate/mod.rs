@@ -55,7 +55,8 @@ pub mod stream;
 
 pub use init::{
     check_sampling, default_sim_nperseg, describe_run, initial_state, parse_coordinates,
-    readout_text, record_description, set_coordinate, Excitation, MIN_SIM_NPERSEG,
+    readout_text, record_description, set_coordinate, Excitation, MAX_DEFAULT_SIM_NPERSEG,
+    MIN_SIM_NPERSEG,
 };
 
 /// Refuses a simulation of `n_samples` (a float: `floor(duration / dt)` may be beyond any
