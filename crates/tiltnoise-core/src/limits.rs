@@ -36,6 +36,13 @@ const DOCS: &str = "docs/limits.md";
 /// 30 Hz, 500 times more than the 2000-point default grid.
 pub const MAX_GRID_POINTS: usize = 1_000_000;
 
+/// Most points of a log-spaced grid that `tf` evaluates and writes block by block, in memory
+/// that does not grow with the grid (`--freq FLO:N:FHI` without a figure): 10^8 points take
+/// about 10 minutes per tilt matrix and write 34 GB of HDF5 (7 x 3 complex values a point),
+/// the most a run of the tool sensibly produces; beyond that the bound is the disk, and a
+/// typo in N.
+pub const MAX_STREAMED_GRID_POINTS: usize = 100_000_000;
+
 /// Bytes planned per complex entry and frequency point of a transfer-function result: the
 /// 16-byte value and as much again for the output written from it ([`MAX_GRID_POINTS`]).
 pub const GRID_BYTES_PER_ENTRY: u64 = 32;
@@ -126,6 +133,7 @@ const _: () = {
     assert!(MAX_SIM_SAMPLES <= MAX_SERIES_SAMPLES);
     assert!(MAX_SERIES_SAMPLES <= MAX_STREAMED_SAMPLES);
     assert!(MAX_GRID_POINTS as u64 * 64 <= MAX_FREQ_FILE_BYTES);
+    assert!(MAX_GRID_POINTS <= MAX_STREAMED_GRID_POINTS);
 };
 
 /// A size over its limit. The message names the option or file (`what`), the value and the

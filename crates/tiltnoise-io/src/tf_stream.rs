@@ -18,7 +18,8 @@ use std::path::Path;
 use tiltnoise_core::error::OutputError;
 use tiltnoise_core::tf::TransferMatrix;
 
-/// Frequencies per HDF5 chunk of the growing datasets.
+/// Frequencies per HDF5 chunk of `/frequency_hz`, and complex values (about) per chunk of
+/// `/transfer` (64 KiB).
 pub const TF_CHUNK_FREQS: usize = 4096;
 
 fn h5_error(e: hdf5::Error) -> String {
