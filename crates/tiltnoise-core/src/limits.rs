@@ -84,7 +84,8 @@ pub const MAX_STREAMED_SIM_SAMPLES: usize = MAX_SERIES_SAMPLES;
 /// Most samples (or frequency points) per channel of an input held in memory whole: a CSV
 /// tilt series or spectrum, an HDF5 spectrum, a measured series (`budget --measured`), an HDF5
 /// series read at once. 2^25 samples are a year at 1 Hz or 39 days at 10 Hz, 8 bytes each per
-/// channel: 1 GiB for four columns. Twice [`MAX_SIM_SAMPLES`], so that every simulation can be
+/// channel: 1 GiB for four columns. Twice [`MAX_SIM_SAMPLES`] and equal to
+/// [`MAX_STREAMED_SIM_SAMPLES`], so that every simulation can be
 /// read back. HDF5 tilt series streamed by the budget are not held whole and not limited by it.
 pub const MAX_SERIES_SAMPLES: usize = 1 << 25;
 
@@ -131,6 +132,7 @@ pub const MAX_LINE_BYTES: u64 = 64 << 10;
 // grid at 64 characters a line.
 const _: () = {
     assert!(MAX_SIM_SAMPLES <= MAX_SERIES_SAMPLES);
+    assert!(MAX_STREAMED_SIM_SAMPLES <= MAX_SERIES_SAMPLES);
     assert!(MAX_SERIES_SAMPLES <= MAX_STREAMED_SAMPLES);
     assert!(MAX_GRID_POINTS as u64 * 64 <= MAX_FREQ_FILE_BYTES);
     assert!(MAX_GRID_POINTS <= MAX_STREAMED_GRID_POINTS);
