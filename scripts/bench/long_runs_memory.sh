@@ -16,5 +16,5 @@ measure() {
     ls -l -- *.h5 *.csv 2>/dev/null | awk '{print "  " $5 " bytes  " $9}'
     rm -f -- *.h5 *.csv *.png
 }
-measure simulate --duration 2592000 --save sim.h5 --save asd.csv --save fig3.png
+measure simulate --duration 2592000 --save sim.h5 --save asd.csv --save fig3.png --save-time t.png
 measure tf --freq 1e-4:10000000:30 --save tf.h5 --save tf.csv

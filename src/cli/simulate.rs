@@ -11,17 +11,17 @@ use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::{Num, Shown};
+use tiltnoise_core::limits::{check_memory, planned_bytes, STREAMED_WELCH_BYTES_PER_SAMPLE};
 use tiltnoise_core::model::{Coord, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::simulate::resonance::check_resonances;
-use tiltnoise_core::limits::{check_memory, planned_bytes, STREAMED_WELCH_BYTES_PER_SAMPLE};
 use tiltnoise_core::simulate::stream::{
     check_streamed_samples, FreeMotion, MinMaxEnvelope, SimChunk,
 };
 use tiltnoise_core::simulate::{
-    aliased_frequency_hz, default_sim_nperseg, equal_energy_init, kick_x,
-    InitialState, ModalPropagator, SimConfig, DEFAULT_MODE_ENERGY_J,
+    aliased_frequency_hz, default_sim_nperseg, equal_energy_init, kick_x, InitialState,
+    ModalPropagator, SimConfig, DEFAULT_MODE_ENERGY_J,
 };
 use tiltnoise_core::spectral::{Psd, WelchAccumulator, WelchConfig};
 use tiltnoise_io::{
@@ -496,11 +496,7 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
     };
     let time_data = phi.map(|phi| {
         let (values, spacing) = phi.finish();
-        time_series_data(
-            (values, spacing * dt_s),
-            (x_start, dt_s),
-            &init_source,
-        )
+        time_series_data((values, spacing * dt_s), (x_start, dt_s), &init_source)
     });
     run.write_outputs(false, || {
         for writer in writers {

@@ -309,7 +309,12 @@ fn stream_tf(
     if args.save.is_empty() {
         return Ok(());
     }
-    write_report(&mut run.out, model, &NormalModes::new(model), plan.request())?;
+    write_report(
+        &mut run.out,
+        model,
+        &NormalModes::new(model),
+        plan.request(),
+    )?;
     run.write_outputs(false, || {
         for w in hdf5 {
             w.finish()?;

@@ -110,7 +110,15 @@ fn frequency_grids_over_the_limit() {
     let png = arg(dir.path(), "tf.png");
     refused_in(
         dir.path(),
-        &["tf", "--freq", "1e-4:1000001:30", "--save", &save, "--save", &png],
+        &[
+            "tf",
+            "--freq",
+            "1e-4:1000001:30",
+            "--save",
+            &save,
+            "--save",
+            &png,
+        ],
         &[&format!(
             "--save {png}: a figure is drawn from at most 1000000 frequency points and --freq \
              asks for 1000001"

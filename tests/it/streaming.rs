@@ -93,9 +93,18 @@ fn a_simulation_written_in_chunks_is_the_one_shot_record() {
     }
     // Without --with-coordinates only the observables are written.
     let h5 = d.join("plain.h5");
-    ok(&["simulate", "--duration", "600", "--save", h5.to_str().unwrap()]);
+    ok(&[
+        "simulate",
+        "--duration",
+        "600",
+        "--save",
+        h5.to_str().unwrap(),
+    ]);
     let file = hdf5::File::open(&h5).unwrap();
-    assert!(file.group("coordinates").is_err(), "coordinates not asked for");
+    assert!(
+        file.group("coordinates").is_err(),
+        "coordinates not asked for"
+    );
     assert_eq!(read_f64(&file, "X").len(), 6000);
 }
 

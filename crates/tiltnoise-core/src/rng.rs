@@ -122,7 +122,16 @@ mod tests {
 
     #[test]
     fn skipping_equals_drawing() {
-        for (before, skip) in [(0, 0), (0, 1), (0, 2), (0, 7), (1, 0), (1, 1), (1, 4), (3, 6)] {
+        for (before, skip) in [
+            (0, 0),
+            (0, 1),
+            (0, 2),
+            (0, 7),
+            (1, 0),
+            (1, 1),
+            (1, 4),
+            (3, 6),
+        ] {
             let mut drawn = Rng::stream(3, 0);
             let mut skipped = Rng::stream(3, 0);
             for _ in 0..before {

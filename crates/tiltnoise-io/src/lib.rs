@@ -57,8 +57,8 @@ pub use series_hdf5::{
 pub use series_hdf5_stream::{ObservableSeriesWriter, COORDINATES_GROUP, SERIES_CHUNK_SAMPLES};
 pub use subtract_hdf5::{write_subtract_hdf5, SubtractMeta};
 pub use tf_csv::{format_f64, push_tf_csv_rows, tf_csv_header, tf_csv_string, write_tf_csv};
-pub use tf_stream::{TfCsvWriter, TfHdf5Writer, TF_CHUNK_FREQS};
 pub use tf_hdf5::{write_tf_hdf5, SCHEMA_TF, SCHEMA_VERSION_TF, SIGN_CONVENTION, TIME_DEPENDENCE};
+pub use tf_stream::{TfCsvWriter, TfHdf5Writer, TF_CHUNK_FREQS};
 
 use std::path::Path;
 pub use tiltnoise_core::error::OutputError;

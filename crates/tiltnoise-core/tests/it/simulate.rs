@@ -732,7 +732,11 @@ fn readout_noise_is_one_block_of_the_seed_stream_per_noisy_entry() {
     )
     .unwrap();
     let n = clean.len();
-    assert_eq!(n % 2, 1, "an odd length puts a block boundary inside a pair");
+    assert_eq!(
+        n % 2,
+        1,
+        "an odd length puts a block boundary inside a pair"
+    );
     let mut expected: Vec<Vec<f64>> = clean.observables.iter().map(|(_, x)| x.clone()).collect();
     let mut rng = tiltnoise_core::rng::Rng::stream(cfg.seed, 0);
     for &(o, asd) in &cfg.readout_asd {
@@ -746,7 +750,12 @@ fn readout_noise_is_one_block_of_the_seed_stream_per_noisy_entry() {
     }
     for ((o, got), want) in noisy.observables.iter().zip(&expected) {
         for (i, (g, w)) in got.iter().zip(want).enumerate() {
-            assert_eq!(g.to_bits(), w.to_bits(), "{} sample {i}: {g} vs {w}", o.name());
+            assert_eq!(
+                g.to_bits(),
+                w.to_bits(),
+                "{} sample {i}: {g} vs {w}",
+                o.name()
+            );
         }
     }
 }
@@ -759,7 +768,13 @@ fn chunks_equal_the_whole_record() {
     let init = generic_init();
     let cfg = noisy_config();
     let whole = simulate(&model, &init, &cfg).unwrap();
-    for (max_len, keep) in [(1, true), (7, false), (64, true), (1000, false), (5000, true)] {
+    for (max_len, keep) in [
+        (1, true),
+        (7, false),
+        (64, true),
+        (1000, false),
+        (5000, true),
+    ] {
         let mut motion = FreeMotion::new(&model, &init, &cfg, keep).unwrap();
         assert_eq!(motion.len(), whole.len());
         let mut chunk = SimChunk::default();
@@ -771,7 +786,9 @@ fn chunks_equal_the_whole_record() {
                 let part = &x[at..at + chunk.len()];
                 let got = chunk.observable(*o);
                 assert!(
-                    part.iter().zip(got).all(|(a, b)| a.to_bits() == b.to_bits()),
+                    part.iter()
+                        .zip(got)
+                        .all(|(a, b)| a.to_bits() == b.to_bits()),
                     "{} in the chunk at {at} of at most {max_len}",
                     o.name()
                 );
