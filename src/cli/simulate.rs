@@ -11,16 +11,22 @@ use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::{Num, Shown};
+use tiltnoise_core::limits::{check_memory, planned_bytes, STREAMED_WELCH_BYTES_PER_SAMPLE};
 use tiltnoise_core::model::{Coord, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::simulate::resonance::check_resonances;
-use tiltnoise_core::simulate::{
-    aliased_frequency_hz, check_samples, equal_energy_init, kick_x, simulate_with_progress,
-    InitialState, ModalPropagator, SimConfig, Simulation, DEFAULT_MODE_ENERGY_J,
+use tiltnoise_core::simulate::stream::{
+    check_streamed_samples, FreeMotion, MinMaxEnvelope, SimChunk,
 };
-use tiltnoise_core::spectral::{welch, WelchConfig};
-use tiltnoise_io::{write_observable_series_hdf5, OutputKind, RunMeta, SeriesAsd, SimulationMeta};
+use tiltnoise_core::simulate::{
+    aliased_frequency_hz, default_sim_nperseg, equal_energy_init, kick_x, InitialState,
+    ModalPropagator, SimConfig, DEFAULT_MODE_ENERGY_J,
+};
+use tiltnoise_core::spectral::{Psd, WelchAccumulator, WelchConfig};
+use tiltnoise_io::{
+    ObservableSeriesWriter, OutputKind, RunMeta, SeriesAsd, SimulationMeta, SERIES_CHUNK_SAMPLES,
+};
 use tiltnoise_plot::simulate_figure::{
     asd_figure, time_series_figure, ModeMark, SimAsdData, TimePanel, TimeSeriesData,
 };
@@ -88,6 +94,15 @@ pub(crate) struct SimulateArgs {
     /// it), .csv ASDs (freq_hz,X,...), .png/.svg Figure 3 (ASDs).
     #[arg(long, value_name = "PATH")]
     save: Vec<PathBuf>,
+    /// Also write the eight generalized coordinates (noiseless; rad, m) to the HDF5 output,
+    /// group /coordinates. By default only the seven observables are written.
+    #[arg(long, conflicts_with = "tilt")]
+    with_coordinates: bool,
+    /// Samples computed and written per chunk (default 65536). The record streams through
+    /// the outputs and the spectra chunk by chunk; the numbers do not depend on the chunk size,
+    /// only the memory and the speed do.
+    #[arg(long, value_name = "N", conflicts_with = "tilt")]
+    chunk_samples: Option<usize>,
     /// Time-series figure (.png/.svg, repeatable): phi over the whole run and X over the first
     /// quarter of the nu_1 period, as the paper's Figures 4 and 5 for --kick-x.
     #[arg(long = "save-time", value_name = "PATH")]
@@ -203,13 +218,6 @@ fn parse_coords(option: &str, items: &[String], out: &mut [f64; 8]) -> Result<()
     Ok(())
 }
 
-/// Default Welch segment: the largest power of two <= n / 3 (at least 5 half-overlapping
-/// segments), at least 2.
-fn default_nperseg(n: usize) -> usize {
-    let third = (n / 3).max(2);
-    1 << third.ilog2()
-}
-
 /// The run's initial state and a description of where it came from.
 fn initial_state(model: &Model, args: &SimulateArgs) -> Result<(InitialState, String)> {
     if let Some(x) = args.kick_x {
@@ -303,7 +311,7 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
             args.step
         );
     }
-    check_samples(
+    check_streamed_samples(
         || {
             format!(
                 "--duration {} s at --step {} s",
@@ -314,7 +322,7 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
         n_f,
     )?;
     let n = n_f as usize;
-    let nperseg = args.nperseg.unwrap_or_else(|| default_nperseg(n));
+    let nperseg = args.nperseg.unwrap_or_else(|| default_sim_nperseg(n));
     if nperseg < 16 {
         bail!("--nperseg {nperseg}: the Welch segment must have at least 16 samples");
     }
@@ -327,12 +335,29 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
             Num(nperseg as f64 * args.step)
         );
     }
+    check_memory(
+        || format!("--nperseg {nperseg}: Welch segments of the 7 observables"),
+        planned_bytes(nperseg, 7 * STREAMED_WELCH_BYTES_PER_SAMPLE),
+    )?;
     for path in &args.save {
         OutputKind::from_path(path)?;
     }
     for path in &args.save_time {
         tiltnoise_plot::ImageFormat::from_path(path)?;
     }
+    let hdf5_paths: Vec<&PathBuf> = args
+        .save
+        .iter()
+        .filter(|p| matches!(OutputKind::from_path(p), Ok(OutputKind::Hdf5)))
+        .collect();
+    if args.with_coordinates && hdf5_paths.is_empty() {
+        bail!("--with-coordinates: the coordinates go to an HDF5 file; add --save FILE.h5");
+    }
+    let chunk_samples = match args.chunk_samples {
+        Some(0) => bail!("--chunk-samples 0: a chunk must hold at least 1 sample"),
+        Some(c) => c,
+        None => SERIES_CHUNK_SAMPLES,
+    };
     let saves: Vec<&Path> = args
         .save
         .iter()
@@ -348,7 +373,47 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
         readout_asd: readout.clone(),
         seed: args.seed,
     };
+    let mut motion = FreeMotion::new(&model, &init, &cfg, args.with_coordinates)?;
+    let dt_s = motion.dt_s();
+    let fs = 1.0 / dt_s;
+    let wcfg = WelchConfig::new(nperseg);
+    let modes = NormalModes::new(&model);
+    let meta = RunMeta::of_this_run(params, Some(&modes));
+    let run_caption = format!(
+        "{n} samples at {dt_s} s ({} s), exact modal propagation of the undamped model; initial \
+         state: {init_source}; readout: {}; seed {}.",
+        n as f64 * dt_s,
+        readout_text(&readout),
+        args.seed
+    );
+    let smeta = SimulationMeta {
+        run: meta.clone(),
+        description: format!(
+            "SIMULATED free motion of the double torsion pendulum model (not a measurement). \
+             {run_caption}"
+        ),
+        start_time: None,
+        seed: args.seed,
+        init,
+        init_source: init_source.clone(),
+        readout_asd: readout.clone(),
+        duration_s: args.duration,
+    };
 
+    // The record streams through the HDF5 writers, the Welch accumulators and the pieces the
+    // time-series figure needs; it is never held whole.
+    let mut writers = hdf5_paths
+        .iter()
+        .map(|p| ObservableSeriesWriter::create(p, dt_s, &smeta, args.with_coordinates))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut accumulators = Observable::ALL
+        .iter()
+        .map(|_| WelchAccumulator::new(1, fs, &wcfg))
+        .collect::<Result<Vec<_>, _>>()?;
+    let want_time = !args.save_time.is_empty();
+    let mut phi = want_time.then(|| MinMaxEnvelope::new(n, TIME_FIGURE_BLOCKS));
+    let n_x = x_samples_shown(&modes, dt_s, n);
+    let mut x_start = Vec::new();
     let bar = (n >= WORTH_A_BAR && std::io::stderr().is_terminal()).then(|| {
         let b = indicatif::ProgressBar::new(n as u64);
         b.set_style(
@@ -359,22 +424,41 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
         );
         b
     });
-    let sim = simulate_with_progress(&model, &init, &cfg, &mut |done, _| {
-        if let Some(b) = &bar {
-            b.set_position(done as u64);
+    let mut chunk = SimChunk::default();
+    while motion.next_chunk(chunk_samples, &mut chunk) {
+        for w in &mut writers {
+            w.append(&chunk)?;
         }
-    })?;
+        for (acc, x) in accumulators.iter_mut().zip(&chunk.observables) {
+            acc.push(&[x])?;
+        }
+        if let Some(e) = &mut phi {
+            e.push(chunk.observable(Observable::Phi));
+        }
+        if want_time && x_start.len() < n_x {
+            let x = chunk.observable(Observable::X);
+            x_start.extend_from_slice(&x[..x.len().min(n_x - x_start.len())]);
+        }
+        if let Some(b) = &bar {
+            b.set_position(motion.samples_done() as u64);
+        }
+    }
     if let Some(b) = bar {
         b.finish_and_clear();
     }
 
-    let fs = sim.fs_hz();
-    let wcfg = WelchConfig::new(nperseg);
-    let mut psds = Vec::new();
-    for (o, x) in &sim.observables {
-        psds.push((*o, welch(x, fs, &wcfg)?));
+    let mut psds = Vec::with_capacity(7);
+    for (o, acc) in Observable::ALL.into_iter().zip(accumulators) {
+        let m = acc.finish()?;
+        psds.push((
+            o,
+            Psd {
+                psd: m.psd(0),
+                freqs_hz: m.freqs_hz,
+                n_segments: m.n_segments,
+            },
+        ));
     }
-    let modes = NormalModes::new(&model);
     let prop = ModalPropagator::new(&model, &init, cfg.dt_s)?;
     let (u0, v0) = prop.initial_modal_state();
     let amplitude: [f64; 8] = std::array::from_fn(|k| u0[k].hypot(v0[k]));
@@ -384,7 +468,7 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
         run.out,
         "{}",
         summary(
-            &sim,
+            (n, dt_s),
             &modes,
             &init_source,
             &readout,
@@ -397,17 +481,8 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
 
     let freqs_hz = psds[0].1.freqs_hz.clone();
     let asd: Vec<(Observable, Vec<f64>)> = psds.iter().map(|(o, p)| (*o, p.asd())).collect();
-    let meta = RunMeta::of_this_run(params, Some(&modes));
     let caption = vec![
-        format!(
-            "{} samples at {} s ({} s), exact modal propagation of the undamped model; initial \
-             state: {init_source}; readout: {}; seed {}.",
-            sim.len(),
-            sim.dt_s,
-            sim.len() as f64 * sim.dt_s,
-            readout_text(&readout),
-            args.seed
-        ),
+        run_caption,
         format!(
             "One-sided Welch ASDs: periodic Hann, {} samples per segment, 50 % overlap, {} \
              segments, mean. Modes above Nyquist ({} Hz) are marked at their aliases.",
@@ -416,34 +491,25 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
             fs / 2.0
         ),
     ];
+    let series_asd = SeriesAsd {
+        freqs_hz: freqs_hz.clone(),
+        asd: asd.clone(),
+        segment_len: nperseg,
+        overlap: wcfg.overlap,
+        averaging: "mean".to_string(),
+        n_segments: psds[0].1.n_segments,
+    };
+    let time_data = phi.map(|phi| {
+        let (values, spacing) = phi.finish();
+        time_series_data((values, spacing * dt_s), (x_start, dt_s), &init_source)
+    });
     run.write_outputs(false, || {
+        for writer in writers {
+            writer.finish(&series_asd)?;
+        }
         for path in &args.save {
             match OutputKind::from_path(path)? {
-                OutputKind::Hdf5 => {
-                    let series_asd = SeriesAsd {
-                        freqs_hz: freqs_hz.clone(),
-                        asd: asd.clone(),
-                        segment_len: nperseg,
-                        overlap: wcfg.overlap,
-                        averaging: "mean".to_string(),
-                        n_segments: psds[0].1.n_segments,
-                    };
-                    let smeta = SimulationMeta {
-                        run: meta.clone(),
-                        description: format!(
-                            "SIMULATED free motion of the double torsion pendulum model (not a \
-                         measurement). {}",
-                            caption[0]
-                        ),
-                        start_time: None,
-                        seed: args.seed,
-                        init,
-                        init_source: init_source.clone(),
-                        readout_asd: readout.clone(),
-                        duration_s: args.duration,
-                    };
-                    write_observable_series_hdf5(path, &sim, &series_asd, &smeta)?;
-                }
+                OutputKind::Hdf5 => {}
                 OutputKind::Csv => tiltnoise_io::write_asd_csv(path, &freqs_hz, &asd)
                     .with_context(|| format!("writing {}", path.display()))?,
                 OutputKind::Png | OutputKind::Svg => {
@@ -468,9 +534,10 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
                 }
             }
         }
-        for path in &args.save_time {
-            let data = time_series_data(&sim, &modes, &init_source);
-            save_image(path, |format| time_series_figure(&data, format))?;
+        if let Some(data) = &time_data {
+            for path in &args.save_time {
+                save_image(path, |format| time_series_figure(data, format))?;
+            }
         }
         Ok(())
     })
@@ -489,7 +556,7 @@ fn readout_text(readout: &[(Observable, f64)]) -> String {
 }
 
 fn summary(
-    sim: &Simulation,
+    (n, dt_s): (usize, f64),
     modes: &NormalModes,
     init_source: &str,
     readout: &[(Observable, f64)],
@@ -497,14 +564,14 @@ fn summary(
     wcfg: &WelchConfig,
     n_segments: usize,
 ) -> String {
-    let fs = sim.fs_hz();
+    let fs = 1.0 / dt_s;
     let mut s = String::new();
     let _ = writeln!(
         s,
         "free motion: {} samples at dt = {} s ({} s), Nyquist {} Hz",
-        sim.len(),
-        sim.dt_s,
-        sim.len() as f64 * sim.dt_s,
+        n,
+        dt_s,
+        n as f64 * dt_s,
         fs / 2.0
     );
     let _ = writeln!(s, "initial state: {init_source}");
@@ -546,30 +613,43 @@ fn summary(
     s
 }
 
-/// Figures 4 and 5: phi over the whole run, X over the first quarter of the nu_1 period (a
-/// fraction of a torsion period, to show the swinging oscillations).
-fn time_series_data(sim: &Simulation, modes: &NormalModes, init_source: &str) -> TimeSeriesData {
+/// Points of the whole-run panel of the time-series figure: the minimum and maximum of at most
+/// this many blocks of samples (the figure shows 4000 columns).
+const TIME_FIGURE_BLOCKS: usize = 1 << 15;
+
+/// Samples of X in the second panel of the time-series figure: the first quarter of the nu_1
+/// period (a fraction of a torsion period, to show the swinging oscillations).
+fn x_samples_shown(modes: &NormalModes, dt_s: f64, n: usize) -> usize {
     let quarter_s = 0.25 / modes.modes[0].frequency_hz;
-    let n_x = ((quarter_s / sim.dt_s).ceil() as usize).clamp(2, sim.len());
+    ((quarter_s / dt_s).ceil() as usize).clamp(2, n)
+}
+
+/// Figures 4 and 5: phi over the whole run (`(values, spacing in s)`: the series, or its
+/// min/max envelope for a long run), X over the first quarter of the nu_1 period.
+fn time_series_data(
+    (phi, phi_dt_s): (Vec<f64>, f64),
+    (x, dt_s): (Vec<f64>, f64),
+    init_source: &str,
+) -> TimeSeriesData {
     TimeSeriesData {
         title: format!("Simulated free motion ({init_source})"),
         panels: vec![
             TimePanel {
                 title: "φ: test-mass torsion, whole run (cf. Figure 4)".to_string(),
                 observable: Observable::Phi,
-                dt_s: sim.dt_s,
+                dt_s: phi_dt_s,
                 t0_s: 0.0,
-                values: sim.observable(Observable::Phi).to_vec(),
+                values: phi,
             },
             TimePanel {
                 title: format!(
                     "X: test-mass displacement, first {:.0} s = 1/4 of the ν1 period (cf. Figure 5)",
-                    n_x as f64 * sim.dt_s
+                    x.len() as f64 * dt_s
                 ),
                 observable: Observable::X,
-                dt_s: sim.dt_s,
+                dt_s,
                 t0_s: 0.0,
-                values: sim.observable(Observable::X)[..n_x].to_vec(),
+                values: x,
             },
         ],
     }

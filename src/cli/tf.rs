@@ -14,8 +14,10 @@ use super::output::save_tf;
 use super::Run;
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::freq;
+use tiltnoise_core::limits::{MAX_GRID_POINTS, MAX_STREAMED_GRID_POINTS};
 use tiltnoise_core::model::{Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::options;
@@ -66,6 +68,11 @@ pub struct TfArgs {
         allow_negative_numbers = true
     )]
     rel_tol: f64,
+    /// Frequencies evaluated and written per block (default 16384). Without a figure the
+    /// grid is computed and written block by block, in memory that does not grow with it
+    /// (`--freq` up to 10^8 points); the numbers do not depend on the block size.
+    #[arg(long, value_name = "N")]
+    block_freqs: Option<usize>,
     /// Say which method `auto` picked and why, or why none qualifies (every candidate's
     /// measured error, on standard error).
     #[arg(long)]
@@ -152,23 +159,39 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
         .map(|p| ("--freq-file", p.as_path()))
         .collect();
     run.check_outputs(&saves, &inputs)?;
-    let model = Model::new(params)?;
-    let freqs = match (&args.freq, &args.freq_file) {
-        (Some(spec), _) => freq::parse_spec(spec)?,
-        (None, Some(path)) => read_freq_file(path)?,
-        (None, None) => freq::default_grid(&model),
+    let block_freqs = match args.block_freqs {
+        Some(0) => bail!("--block-freqs 0: a block must hold at least 1 frequency"),
+        Some(b) => b,
+        None => TF_BLOCK_FREQS,
     };
+    let figure = args.save.iter().find(|p| {
+        matches!(
+            tiltnoise_io::OutputKind::from_path(p),
+            Ok(tiltnoise_io::OutputKind::Png | tiltnoise_io::OutputKind::Svg)
+        )
+    });
+    let model = Model::new(params)?;
+    let grid = match (&args.freq, &args.freq_file) {
+        (Some(spec), _) => Grid::Log(freq::parse_log_spec(spec, MAX_STREAMED_GRID_POINTS)?),
+        (None, Some(path)) => Grid::Points(read_freq_file(path)?),
+        (None, None) => Grid::Points(freq::default_grid(&model)),
+    };
+    if let (Some(path), Grid::Log(g)) = (figure, &grid) {
+        if g.len() > MAX_GRID_POINTS {
+            bail!(
+                "--save {}: a figure is drawn from at most {MAX_GRID_POINTS} frequency points \
+                 and --freq asks for {}; draw it from a smaller grid (the default grid \
+                 resolves every resonance) and write the large one to .h5 or .csv only (see \
+                 docs/limits.md)",
+                path.display(),
+                g.len()
+            );
+        }
+    }
     let method = match args.method.fixed() {
         Some(m) => m,
         None => {
-            let positive: Vec<f64> = freqs.iter().copied().filter(|&f| f > 0.0).collect();
-            let band = match positive.is_empty() {
-                true => (freq::DEFAULT_F_LO_HZ, freq::DEFAULT_F_LO_HZ),
-                false => (
-                    positive.iter().copied().fold(f64::INFINITY, f64::min),
-                    positive.iter().copied().fold(0.0, f64::max),
-                ),
-            };
+            let band = grid.positive_band();
             let scene = Scene {
                 request: request.clone(),
                 band_hz: band,
@@ -192,22 +215,160 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
         }
     };
     let plan = tf::plan(&model, &request, method)?;
-    let tf = tf::evaluate(plan.as_ref(), &freqs).context("evaluating the transfer functions")?;
-    let out = &mut run.out;
-    if args.save.is_empty() {
-        write!(out, "{}", tiltnoise_io::tf_csv_string(&tf))?;
-        return Ok(());
-    }
     let modes = NormalModes::new(&model);
     let meta = RunMeta::of_this_run(params, Some(&modes));
-    write!(out, "{}", super::report::modes_table(&modes))?;
-    if request.inputs.iter().any(|i| matches!(i, Input::Tilt(_))) {
-        writeln!(out)?;
-        write!(out, "{}", super::report::static_limits(&model))?;
+    if figure.is_none() {
+        return stream_tf(plan.as_ref(), &grid, block_freqs, &args, &model, &meta, run);
     }
+    let freqs = grid.block(0, grid.len());
+    let tf = tf::evaluate(plan.as_ref(), &freqs).context("evaluating the transfer functions")?;
+    write_report(&mut run.out, &model, &modes, &request)?;
     run.write_outputs(false, || {
         for path in &args.save {
             save_tf(path, &tf, &meta, &figure)?;
+        }
+        Ok(())
+    })
+}
+
+/// Frequencies per block of a streamed grid: 16384 points of the largest request (7 x 15
+/// complex values) are 27 MB with the CSV text of the block.
+const TF_BLOCK_FREQS: usize = 1 << 14;
+
+/// Grids with at least this many points get a progress bar on a terminal (about 2 s).
+const TF_WORTH_A_BAR: usize = 1 << 19;
+
+/// A frequency grid: held (a file, the default grid) or computed point by point (`--freq`).
+enum Grid {
+    Points(Vec<f64>),
+    Log(freq::LogGrid),
+}
+
+impl Grid {
+    fn len(&self) -> usize {
+        match self {
+            Grid::Points(v) => v.len(),
+            Grid::Log(g) => g.len(),
+        }
+    }
+
+    fn block(&self, start: usize, len: usize) -> Vec<f64> {
+        match self {
+            Grid::Points(v) => {
+                let end = start.saturating_add(len).min(v.len());
+                v[start.min(end)..end].to_vec()
+            }
+            Grid::Log(g) => g.block(start, len),
+        }
+    }
+
+    /// The lowest and highest positive frequencies (Hz), for the planner.
+    fn positive_band(&self) -> (f64, f64) {
+        match self {
+            Grid::Log(g) => (g.lo_hz(), g.hi_hz()),
+            Grid::Points(freqs) => {
+                let positive: Vec<f64> = freqs.iter().copied().filter(|&f| f > 0.0).collect();
+                match positive.is_empty() {
+                    true => (freq::DEFAULT_F_LO_HZ, freq::DEFAULT_F_LO_HZ),
+                    false => (
+                        positive.iter().copied().fold(f64::INFINITY, f64::min),
+                        positive.iter().copied().fold(0.0, f64::max),
+                    ),
+                }
+            }
+        }
+    }
+}
+
+/// The modes table and, for tilt inputs, the static limits (printed when files are saved).
+fn write_report(
+    out: &mut super::stdout::Out,
+    model: &Model,
+    modes: &NormalModes,
+    request: &Request,
+) -> Result<()> {
+    write!(out, "{}", super::report::modes_table(modes))?;
+    if request.inputs.iter().any(|i| matches!(i, Input::Tilt(_))) {
+        writeln!(out)?;
+        write!(out, "{}", super::report::static_limits(model))?;
+    }
+    Ok(())
+}
+
+/// Evaluates the grid block by block and writes each block to every HDF5 and CSV output (or
+/// as CSV to standard output without --save) before the next is computed.
+fn stream_tf(
+    plan: &dyn tf::TransferFunction,
+    grid: &Grid,
+    block_freqs: usize,
+    args: &TfArgs,
+    model: &Model,
+    meta: &RunMeta,
+    run: &mut Run,
+) -> Result<()> {
+    use tiltnoise_io::{OutputKind, TfCsvWriter, TfHdf5Writer};
+    let mut hdf5 = Vec::new();
+    let mut csv = Vec::new();
+    for path in &args.save {
+        match OutputKind::from_path(path)? {
+            OutputKind::Hdf5 => hdf5.push(TfHdf5Writer::create(path, meta)?),
+            OutputKind::Csv => csv.push(TfCsvWriter::create(path)?),
+            OutputKind::Png | OutputKind::Svg => unreachable!("figures are drawn from memory"),
+        }
+    }
+    let n = grid.len();
+    let bar = (n >= TF_WORTH_A_BAR && std::io::stderr().is_terminal()).then(|| {
+        let b = indicatif::ProgressBar::new(n as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{spinner} {wide_bar} {pos}/{len} frequencies ({percent}%, eta {eta})",
+            )
+            .expect("valid template"),
+        );
+        b
+    });
+    let mut text = String::new();
+    let mut start = 0;
+    while start < n {
+        let freqs = grid.block(start, block_freqs);
+        let block = tf::evaluate(plan, &freqs).context("evaluating the transfer functions")?;
+        for w in &mut hdf5 {
+            w.append(&block)?;
+        }
+        for w in &mut csv {
+            w.append(&block)?;
+        }
+        if args.save.is_empty() {
+            text.clear();
+            if start == 0 {
+                text.push_str(&tiltnoise_io::tf_csv_header(&block.outputs, &block.inputs));
+            }
+            tiltnoise_io::push_tf_csv_rows(&mut text, &block);
+            write!(run.out, "{text}")?;
+        }
+        start += freqs.len();
+        if let Some(b) = &bar {
+            b.set_position(start as u64);
+        }
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    if args.save.is_empty() {
+        return Ok(());
+    }
+    write_report(
+        &mut run.out,
+        model,
+        &NormalModes::new(model),
+        plan.request(),
+    )?;
+    run.write_outputs(false, || {
+        for w in hdf5 {
+            w.finish()?;
+        }
+        for w in csv {
+            w.finish()?;
         }
         Ok(())
     })

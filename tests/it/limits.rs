@@ -102,10 +102,28 @@ fn frequency_grids_over_the_limit() {
             &["tf", "--freq", spec, "--save", &save],
             &[
                 &format!("--freq {spec}: "),
-                "frequency points, more than the 1000000 allowed",
+                "frequency points, more than the 100000000 allowed",
             ],
         );
     }
+    // Held in memory for a figure: the in-memory limit, before anything is computed.
+    let png = arg(dir.path(), "tf.png");
+    refused_in(
+        dir.path(),
+        &[
+            "tf",
+            "--freq",
+            "1e-4:1000001:30",
+            "--save",
+            &save,
+            "--save",
+            &png,
+        ],
+        &[&format!(
+            "--save {png}: a figure is drawn from at most 1000000 frequency points and --freq \
+             asks for 1000001"
+        )],
+    );
     refused(
         &["methods", "--freq", "1e-5:1000000000:100"],
         &[
@@ -205,15 +223,15 @@ fn simulations_over_the_sample_limit() {
             "--save-time",
             &png,
         ],
-        &["--duration 9e7 s at --step 0.1 s: 900000000 samples, more than the 16777216 allowed"],
+        &["--duration 9e7 s at --step 0.1 s: 900000000 samples, more than the 33554432 allowed"],
     );
     refused(
         &["simulate", "--duration", "1e300", "--step", "1e-300"],
-        &["--duration 1e300 s at --step 1e-300 s: inf samples, more than the 16777216 allowed"],
+        &["--duration 1e300 s at --step 1e-300 s: inf samples, more than the 33554432 allowed"],
     );
     refused(
-        &["simulate", "--duration", "1677721.7"],
-        &["16777217 samples, more than the 16777216 allowed"],
+        &["simulate", "--duration", "3355443.3"],
+        &["33554433 samples, more than the 33554432 allowed"],
     );
 }
 

@@ -35,5 +35,6 @@ mod process;
 mod romy_budget;
 mod simulate_cli;
 mod simulate_roundtrip;
+mod streaming;
 mod subtract;
 mod thermal;

@@ -36,42 +36,80 @@ const POINTS: &str = "frequency points";
 /// `n` log-spaced frequencies from `lo` to `hi` inclusive (`n = 1` gives `[lo]`), at most
 /// [`MAX_GRID_POINTS`].
 pub fn log_grid(lo: f64, hi: f64, n: usize) -> Result<Vec<f64>, FreqError> {
-    let spec = || format!("log grid {}:{n}:{}", Num(lo), Num(hi));
-    check_count(spec, n as f64, POINTS, MAX_GRID_POINTS)?;
-    if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi >= lo && n >= 1) {
-        return Err(FreqError::Spec {
-            origin: spec(),
-            message: "need 0 < FLO <= FHI, both finite, and N >= 1".into(),
-        });
+    Ok(LogGrid::new(lo, hi, n, MAX_GRID_POINTS)?.block(0, n))
+}
+
+/// A log-spaced grid of `len()` frequencies from `lo_hz()` to `hi_hz()` inclusive, each point
+/// computed when asked for: a grid too large to hold (`tf` streams up to
+/// [`crate::limits::MAX_STREAMED_GRID_POINTS`]) is evaluated and written block by block, with the points of
+/// [`log_grid`] to the last bit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LogGrid {
+    lo: f64,
+    hi: f64,
+    n: usize,
+}
+
+impl LogGrid {
+    /// The grid `lo:n:hi` (Hz, count, Hz), refused over `limit` points, unless
+    /// `0 < lo <= hi <= MAX_FREQUENCY_HZ`, both finite, and `n >= 1`.
+    pub fn new(lo: f64, hi: f64, n: usize, limit: usize) -> Result<LogGrid, FreqError> {
+        let spec = || format!("log grid {}:{n}:{}", Num(lo), Num(hi));
+        check_count(spec, n as f64, POINTS, limit)?;
+        if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi >= lo && n >= 1) {
+            return Err(FreqError::Spec {
+                origin: spec(),
+                message: "need 0 < FLO <= FHI, both finite, and N >= 1".into(),
+            });
+        }
+        if hi > MAX_FREQUENCY_HZ {
+            return Err(FreqError::TooHigh {
+                value: hi,
+                origin: format!("FHI of {}", spec()),
+            });
+        }
+        Ok(LogGrid { lo, hi, n })
     }
-    if hi > MAX_FREQUENCY_HZ {
-        return Err(FreqError::TooHigh {
-            value: hi,
-            origin: format!("FHI of {}", spec()),
-        });
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.n
     }
-    if n > MAX_GRID_POINTS {
-        return Err(FreqError::Spec {
-            origin: spec(),
-            message: format!("N = {n} points is too many: at most {MAX_GRID_POINTS} allowed"),
-        });
+
+    /// Never true: a grid has at least one point.
+    pub fn is_empty(&self) -> bool {
+        self.n == 0
     }
-    if n == 1 {
-        return Ok(vec![lo]);
+
+    /// The first point (Hz).
+    pub fn lo_hz(&self) -> f64 {
+        self.lo
     }
-    let (a, b) = (lo.ln(), hi.ln());
-    Ok((0..n)
-        .map(|k| {
-            // Endpoints exactly as given (exp(ln x) is not always x).
-            if k == 0 {
-                lo
-            } else if k + 1 == n {
-                hi
-            } else {
-                (a + (b - a) * k as f64 / (n - 1) as f64).exp()
-            }
-        })
-        .collect())
+
+    /// The last point (Hz).
+    pub fn hi_hz(&self) -> f64 {
+        self.hi
+    }
+
+    /// Point `k` (Hz), `k < len()`.
+    pub fn point(&self, k: usize) -> f64 {
+        let n = self.n;
+        // Endpoints exactly as given (exp(ln x) is not always x).
+        if k == 0 {
+            self.lo
+        } else if k + 1 == n {
+            self.hi
+        } else {
+            let (a, b) = (self.lo.ln(), self.hi.ln());
+            (a + (b - a) * k as f64 / (n - 1) as f64).exp()
+        }
+    }
+
+    /// Points `start .. start + len`, cut at the end of the grid.
+    pub fn block(&self, start: usize, len: usize) -> Vec<f64> {
+        let end = start.saturating_add(len).min(self.n);
+        (start.min(end)..end).map(|k| self.point(k)).collect()
+    }
 }
 
 /// Checks frequencies given by a caller (an array from Python, say): each finite, >= 0 and at
@@ -96,6 +134,13 @@ pub fn check_frequencies(freqs_hz: &[f64], origin: &str) -> Result<(), FreqError
 /// Parses `FLO:N:FHI` (Hz, count, Hz), e.g. `1e-4:2000:30`; N is at most
 /// [`MAX_GRID_POINTS`].
 pub fn parse_spec(spec: &str) -> Result<Vec<f64>, FreqError> {
+    let grid = parse_log_spec(spec, MAX_GRID_POINTS)?;
+    Ok(grid.block(0, grid.len()))
+}
+
+/// Parses `FLO:N:FHI` as [`parse_spec`] into a [`LogGrid`] of at most `limit` points (for a
+/// grid evaluated block by block, [`crate::limits::MAX_STREAMED_GRID_POINTS`]).
+pub fn parse_log_spec(spec: &str, limit: usize) -> Result<LogGrid, FreqError> {
     let origin = || format!("--freq {}", Shown(spec));
     let err = |message: &str| FreqError::Spec {
         origin: origin(),
@@ -113,8 +158,8 @@ pub fn parse_spec(spec: &str) -> Result<Vec<f64>, FreqError> {
         Err(e) if *e.kind() == std::num::IntErrorKind::PosOverflow => usize::MAX,
         Err(_) => return Err(err("N is not a positive whole number")),
     };
-    check_count(origin, n as f64, POINTS, MAX_GRID_POINTS)?;
-    log_grid(lo, hi, n).map_err(|e| match e {
+    check_count(origin, n as f64, POINTS, limit)?;
+    LogGrid::new(lo, hi, n, limit).map_err(|e| match e {
         FreqError::Spec { message, .. } => err(&message),
         other => other,
     })

@@ -36,6 +36,13 @@ const DOCS: &str = "docs/limits.md";
 /// 30 Hz, 500 times more than the 2000-point default grid.
 pub const MAX_GRID_POINTS: usize = 1_000_000;
 
+/// Most points of a log-spaced grid that `tf` evaluates and writes block by block, in memory
+/// that does not grow with the grid (`--freq FLO:N:FHI` without a figure): 10^8 points take
+/// about 10 minutes per tilt matrix and write 34 GB of HDF5 (7 x 3 complex values a point),
+/// the most a run of the tool sensibly produces; beyond that the bound is the disk, and a
+/// typo in N.
+pub const MAX_STREAMED_GRID_POINTS: usize = 100_000_000;
+
 /// Bytes planned per complex entry and frequency point of a transfer-function result: the
 /// 16-byte value and as much again for the output written from it ([`MAX_GRID_POINTS`]).
 pub const GRID_BYTES_PER_ENTRY: u64 = 32;
@@ -53,7 +60,8 @@ pub const MC_BYTES_PER_DRAW: u64 = 160;
 /// reserves a stack; 1024 is beyond any workstation's core count.
 pub const MAX_THREADS: usize = 1024;
 
-/// Most samples of a simulation (`simulate --duration / --step`). A sample costs 64 bytes of
+/// Most samples of a simulation held in memory whole (the library's `simulate`, the Python
+/// package's `Model.simulate`). A sample costs 64 bytes of
 /// coordinates and 56 of observables; with the spectra and the outputs (HDF5, figures) 175
 /// bytes were measured, so 2^24 samples take 3 GB: 19 days at the paper's 0.1 s, 39 times its
 /// 12-hour run.
@@ -62,10 +70,22 @@ pub const MAX_SIM_SAMPLES: usize = 1 << 24;
 /// Bytes planned per simulated sample, outputs included ([`MAX_SIM_SAMPLES`]).
 pub const SIM_BYTES_PER_SAMPLE: u64 = 192;
 
+/// Bytes per sample of a Welch segment while a record streams through one accumulator per
+/// channel: the segment, the windowed copy, the spectrum and its running sum (8 bytes each
+/// per sample) and the FFT's scratch and twiddles (measured: about as much again).
+pub const STREAMED_WELCH_BYTES_PER_SAMPLE: u64 = 64;
+
+/// Most samples of a simulation produced in chunks and written as it goes (`tiltnoise
+/// simulate`, whose memory does not grow with the duration): 2^25, a file of 1.9 GB of
+/// observables, which is what the budget reads back whole as a measured record
+/// ([`MAX_SERIES_SAMPLES`]). 38 days at the paper's 0.1 s.
+pub const MAX_STREAMED_SIM_SAMPLES: usize = MAX_SERIES_SAMPLES;
+
 /// Most samples (or frequency points) per channel of an input held in memory whole: a CSV
 /// tilt series or spectrum, an HDF5 spectrum, a measured series (`budget --measured`), an HDF5
 /// series read at once. 2^25 samples are a year at 1 Hz or 39 days at 10 Hz, 8 bytes each per
-/// channel: 1 GiB for four columns. Twice [`MAX_SIM_SAMPLES`], so that every simulation can be
+/// channel: 1 GiB for four columns. Twice [`MAX_SIM_SAMPLES`] and equal to
+/// [`MAX_STREAMED_SIM_SAMPLES`], so that every simulation can be
 /// read back. HDF5 tilt series streamed by the budget are not held whole and not limited by it.
 pub const MAX_SERIES_SAMPLES: usize = 1 << 25;
 
@@ -112,8 +132,10 @@ pub const MAX_LINE_BYTES: u64 = 64 << 10;
 // grid at 64 characters a line.
 const _: () = {
     assert!(MAX_SIM_SAMPLES <= MAX_SERIES_SAMPLES);
+    assert!(MAX_STREAMED_SIM_SAMPLES <= MAX_SERIES_SAMPLES);
     assert!(MAX_SERIES_SAMPLES <= MAX_STREAMED_SAMPLES);
     assert!(MAX_GRID_POINTS as u64 * 64 <= MAX_FREQ_FILE_BYTES);
+    assert!(MAX_GRID_POINTS <= MAX_STREAMED_GRID_POINTS);
 };
 
 /// A size over its limit. The message names the option or file (`what`), the value and the

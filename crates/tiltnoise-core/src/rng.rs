@@ -50,6 +50,26 @@ impl Rng {
         (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
     }
 
+    /// Skips the next `count` values of [`Rng::gaussian`]: afterwards the generator returns
+    /// exactly what it would have returned after `count` calls. Each Box-Muller pair consumes
+    /// two raw draws, so the skip costs `count` raw draws and no logarithm or sine (a few
+    /// nanoseconds per skipped value): the readout noise of a long simulation is drawn in
+    /// chunks, each observable's part of the stream located by skipping the parts before it.
+    pub fn skip_gaussians(&mut self, mut count: u64) {
+        if count == 0 {
+            return;
+        }
+        if self.spare.take().is_some() {
+            count -= 1;
+        }
+        for _ in 0..(count / 2) * 2 {
+            self.next_u64();
+        }
+        if count % 2 == 1 {
+            self.gaussian();
+        }
+    }
+
     /// Standard normal (Box-Muller; the second variate of each pair is returned next).
     pub fn gaussian(&mut self) -> f64 {
         if let Some(z) = self.spare.take() {
@@ -98,6 +118,38 @@ mod tests {
         });
         let mut long = Rng::stream(7, 0);
         check(&mut |_| long.gaussian());
+    }
+
+    #[test]
+    fn skipping_equals_drawing() {
+        for (before, skip) in [
+            (0, 0),
+            (0, 1),
+            (0, 2),
+            (0, 7),
+            (1, 0),
+            (1, 1),
+            (1, 4),
+            (3, 6),
+        ] {
+            let mut drawn = Rng::stream(3, 0);
+            let mut skipped = Rng::stream(3, 0);
+            for _ in 0..before {
+                drawn.gaussian();
+                skipped.gaussian();
+            }
+            for _ in 0..skip {
+                drawn.gaussian();
+            }
+            skipped.skip_gaussians(skip);
+            for _ in 0..5 {
+                assert_eq!(
+                    drawn.gaussian().to_bits(),
+                    skipped.gaussian().to_bits(),
+                    "{before} drawn, {skip} skipped"
+                );
+            }
+        }
     }
 
     #[test]

@@ -2,6 +2,8 @@
 //! onto it only when complete, so that a failed run never leaves a partial file.
 //!
 //! * [`write_atomic`]: one file.
+//! * [`AtomicFile`]: one file written over time (a long record, chunk by chunk), renamed when
+//!   finished, removed if dropped before.
 //! * [`Staging`]: every output of a run. While a `Staging` is active on the calling thread,
 //!   [`write_atomic`] leaves each finished temporary file in place, and [`Staging::commit`]
 //!   renames them all at the end; if the run fails before, dropping the `Staging` removes them,
@@ -104,63 +106,121 @@ pub fn write_atomic(
     path: &Path,
     write: impl FnOnce(&Path) -> Result<(), String>,
 ) -> Result<(), OutputError> {
-    let fail = |message: String| OutputError::Write {
-        path: path.to_path_buf(),
-        message,
-    };
-    let file_name = path
-        .file_name()
-        .ok_or_else(|| fail("the path does not name a file".to_string()))?;
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let mut suffix = OsString::new();
-    if let Some(ext) = path.extension() {
-        suffix.push(".");
-        suffix.push(ext);
-    }
-    // `.` + name + `.` + 6 random characters + suffix <= NAME_MAX.
-    let room = NAME_MAX.saturating_sub(2 + RANDOM_LEN + suffix.len());
-    let mut prefix = OsString::from(".");
-    prefix.push(shortened(file_name, room));
-    prefix.push(".");
+    let file = AtomicFile::create(path)?;
+    write(file.temp_path()).map_err(|message| file.fail(message))?;
+    file.finish()
+}
 
-    // `make_in` (unlike `tempfile_in`) returns the operating system's error unchanged, and lets
-    // the file be created with the ordinary umask-controlled mode instead of 0o600.
-    // Close our handle; keep the path, which deletes the file when dropped.
-    let temp = Registered::create(|| {
-        tempfile::Builder::new()
-            .prefix(&prefix)
-            .suffix(&suffix)
-            .rand_bytes(RANDOM_LEN)
-            .make_in(&dir, create_new)
-            .map(|t| t.into_temp_path())
-    })
-    .map_err(|e| fail(e.to_string()))?;
+/// An output written over time, atomically as by [`write_atomic`]: from
+/// [`AtomicFile::create`] to [`AtomicFile::finish`] the data go to a temporary file next to
+/// the target, which the interrupt handler knows; dropping an unfinished `AtomicFile` (the run
+/// failed) removes it, and `path` is left as it was. For a long record written chunk by chunk
+/// while it is computed.
+#[must_use = "an AtomicFile that is not finished removes its output"]
+pub struct AtomicFile {
+    temp: Registered,
+    target: PathBuf,
+}
 
-    write(temp.path()).map_err(fail)?;
-    OpenOptions::new()
-        .write(true)
-        .open(temp.path())
-        .and_then(|f| f.sync_all())
-        .map_err(|e| fail(format!("cannot flush temporary file: {e}")))?;
-    let staged = STAGED.with(|s| {
-        let mut s = s.borrow_mut();
-        match s.as_mut() {
-            Some(list) => {
-                list.push(Staged {
-                    temp,
-                    target: path.to_path_buf(),
-                });
-                None
-            }
-            None => Some(temp),
+impl AtomicFile {
+    /// Creates the empty temporary file for `path` (named as by [`write_atomic`]).
+    ///
+    /// # Errors
+    ///
+    /// [`OutputError::Write`] naming `path` when the temporary file cannot be created.
+    pub fn create(path: &Path) -> Result<AtomicFile, OutputError> {
+        let fail = |message: String| OutputError::Write {
+            path: path.to_path_buf(),
+            message,
+        };
+        let file_name = path
+            .file_name()
+            .ok_or_else(|| fail("the path does not name a file".to_string()))?;
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let mut suffix = OsString::new();
+        if let Some(ext) = path.extension() {
+            suffix.push(".");
+            suffix.push(ext);
         }
-    });
-    match staged {
-        Some(temp) => temp.persist(path).map_err(|e| fail(e.to_string())),
-        None => Ok(()),
+        // `.` + name + `.` + 6 random characters + suffix <= NAME_MAX.
+        let room = NAME_MAX.saturating_sub(2 + RANDOM_LEN + suffix.len());
+        let mut prefix = OsString::from(".");
+        prefix.push(shortened(file_name, room));
+        prefix.push(".");
+
+        // `make_in` (unlike `tempfile_in`) returns the operating system's error unchanged, and
+        // lets the file be created with the ordinary umask-controlled mode instead of 0o600.
+        // Close our handle; keep the path, which deletes the file when dropped.
+        let temp = Registered::create(|| {
+            tempfile::Builder::new()
+                .prefix(&prefix)
+                .suffix(&suffix)
+                .rand_bytes(RANDOM_LEN)
+                .make_in(&dir, create_new)
+                .map(|t| t.into_temp_path())
+        })
+        .map_err(|e| fail(e.to_string()))?;
+        Ok(AtomicFile {
+            temp,
+            target: path.to_path_buf(),
+        })
+    }
+
+    /// The temporary file to write (it may be replaced, as HDF5's `File::create` does, and
+    /// must be closed before [`AtomicFile::finish`]).
+    pub fn temp_path(&self) -> &Path {
+        self.temp.path()
+    }
+
+    /// The path the output is renamed to.
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+
+    /// [`OutputError::Write`] naming the target with `message`.
+    pub fn fail(&self, message: String) -> OutputError {
+        OutputError::Write {
+            path: self.target.clone(),
+            message,
+        }
+    }
+
+    /// Flushes the temporary file to disk and renames it onto the target: at once, or by
+    /// [`Staging::commit`] when a [`Staging`] is active on this thread.
+    ///
+    /// # Errors
+    ///
+    /// [`OutputError::Write`] naming the target; the temporary file is then removed.
+    pub fn finish(self) -> Result<(), OutputError> {
+        OpenOptions::new()
+            .write(true)
+            .open(self.temp.path())
+            .and_then(|f| f.sync_all())
+            .map_err(|e| self.fail(format!("cannot flush temporary file: {e}")))?;
+        let AtomicFile { temp, target } = self;
+        let staged = STAGED.with(|s| {
+            let mut s = s.borrow_mut();
+            match s.as_mut() {
+                Some(list) => {
+                    list.push(Staged {
+                        temp,
+                        target: target.clone(),
+                    });
+                    None
+                }
+                None => Some(temp),
+            }
+        });
+        match staged {
+            Some(temp) => temp.persist(&target).map_err(|e| OutputError::Write {
+                path: target,
+                message: e.to_string(),
+            }),
+            None => Ok(()),
+        }
     }
 }
 
@@ -395,6 +455,26 @@ mod tests {
         // Without a Staging, a write is renamed at once.
         write_text(&dir.path().join("c.csv"), "c").unwrap();
         assert!(dir.path().join("c.csv").exists());
+    }
+
+    #[test]
+    fn an_unfinished_file_is_removed_and_a_finished_one_staged() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("long.h5");
+        {
+            let file = AtomicFile::create(&target).unwrap();
+            std::fs::write(file.temp_path(), "part").unwrap();
+            assert_eq!(listing(dir.path()).len(), 1);
+        } // dropped unfinished
+        assert!(listing(dir.path()).is_empty());
+        let stage = Staging::begin();
+        let file = AtomicFile::create(&target).unwrap();
+        std::fs::write(file.temp_path(), "all").unwrap();
+        file.finish().unwrap();
+        assert!(!target.exists(), "staged until the commit");
+        stage.commit().unwrap();
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "all");
+        assert_eq!(listing(dir.path()), vec!["long.h5"]);
     }
 
     #[test]

@@ -29,12 +29,14 @@ mod mc_hdf5;
 mod measured_modes;
 mod output_paths;
 mod series_hdf5;
+mod series_hdf5_stream;
 mod subtract_hdf5;
 mod tf_csv;
 mod tf_hdf5;
+mod tf_stream;
 
 pub use asd_csv::write_asd_csv;
-pub use atomic::{remove_temporaries_on_interrupt, write_atomic, Staging};
+pub use atomic::{remove_temporaries_on_interrupt, write_atomic, AtomicFile, Staging};
 pub use budget_csv::{budget_csv_string, write_budget_csv};
 pub use budget_hdf5::{
     write_budget_hdf5, SCHEMA_BUDGET, SCHEMA_VERSION_BUDGET, SPECTRAL_CONVENTION,
@@ -52,9 +54,11 @@ pub use series_hdf5::{
     write_observable_series_hdf5, SeriesAsd, SimulationMeta, SCHEMA_OBSERVABLE_SERIES,
     SCHEMA_VERSION_OBSERVABLE_SERIES,
 };
+pub use series_hdf5_stream::{ObservableSeriesWriter, COORDINATES_GROUP, SERIES_CHUNK_SAMPLES};
 pub use subtract_hdf5::{write_subtract_hdf5, SubtractMeta};
-pub use tf_csv::{format_f64, tf_csv_string, write_tf_csv};
+pub use tf_csv::{format_f64, push_tf_csv_rows, tf_csv_header, tf_csv_string, write_tf_csv};
 pub use tf_hdf5::{write_tf_hdf5, SCHEMA_TF, SCHEMA_VERSION_TF, SIGN_CONVENTION, TIME_DEPENDENCE};
+pub use tf_stream::{TfCsvWriter, TfHdf5Writer, TF_CHUNK_FREQS};
 
 use std::path::Path;
 pub use tiltnoise_core::error::OutputError;

@@ -74,17 +74,23 @@ pub fn write_observable_series_hdf5(
     meta: &SimulationMeta,
 ) -> Result<(), OutputError> {
     write_atomic(path, |temp| {
-        if let Some((o, a)) = asd.asd.iter().find(|(_, a)| a.len() != asd.freqs_hz.len()) {
-            return Err(format!(
-                "ASD of {} has {} values but the frequency grid {}",
-                o.name(),
-                a.len(),
-                asd.freqs_hz.len()
-            ));
-        }
+        check_asd(asd)?;
         write_file(temp, sim, asd, meta)
             .map_err(|e| format!("HDF5: {}", crate::first_line(&e.to_string())))
     })
+}
+
+/// Refuses ASDs whose lengths differ from their frequency grid's.
+pub(crate) fn check_asd(asd: &SeriesAsd) -> Result<(), String> {
+    match asd.asd.iter().find(|(_, a)| a.len() != asd.freqs_hz.len()) {
+        Some((o, a)) => Err(format!(
+            "ASD of {} has {} values but the frequency grid {}",
+            o.name(),
+            a.len(),
+            asd.freqs_hz.len()
+        )),
+        None => Ok(()),
+    }
 }
 
 fn write_file(
@@ -94,33 +100,56 @@ fn write_file(
     meta: &SimulationMeta,
 ) -> hdf5::Result<()> {
     let file = hdf5::File::create(path)?;
-    str_attr(&file, "schema", SCHEMA_OBSERVABLE_SERIES)?;
-    scalar_attr(&file, "schema_version", SCHEMA_VERSION_OBSERVABLE_SERIES)?;
-    scalar_attr(&file, "sample_rate_hz", sim.fs_hz())?;
-    scalar_attr(&file, "dt_s", sim.dt_s)?;
-    scalar_attr(&file, "duration_s", meta.duration_s)?;
-    str_attr(&file, "description", &meta.description)?;
-    if let Some(t) = &meta.start_time {
-        str_attr(&file, "start_time", t)?;
-    }
-    str_attr(&file, "tool_version", &meta.run.tool_version)?;
-    str_attr(&file, "created_by", &meta.run.command_line)?;
-    str_attr(&file, "parameters_toml", &meta.run.params_toml)?;
-    scalar_attr(&file, "seed", meta.seed)?;
-    str_attr(&file, "spectral_convention", SPECTRAL_CONVENTION)?;
-
+    write_root(&file, sim.dt_s, meta)?;
     for (o, series) in &sim.observables {
         let ds = dataset(&file, o.name(), series)?;
-        str_attr(&ds, "units", o.unit())?;
-        let r = meta
-            .readout_asd
-            .iter()
-            .find(|(x, _)| x == o)
-            .map_or(0.0, |r| r.1);
-        scalar_attr(&ds, "readout_asd", r)?;
-        str_attr(&ds, "readout_asd_units", &format!("{}/sqrt(Hz)", o.unit()))?;
+        series_attrs(&ds, *o, meta)?;
     }
+    write_groups(&file, asd, meta)
+}
 
+/// The root attributes of a series of step `dt_s` (s).
+pub(crate) fn write_root(file: &hdf5::File, dt_s: f64, meta: &SimulationMeta) -> hdf5::Result<()> {
+    str_attr(file, "schema", SCHEMA_OBSERVABLE_SERIES)?;
+    scalar_attr(file, "schema_version", SCHEMA_VERSION_OBSERVABLE_SERIES)?;
+    scalar_attr(file, "sample_rate_hz", 1.0 / dt_s)?;
+    scalar_attr(file, "dt_s", dt_s)?;
+    scalar_attr(file, "duration_s", meta.duration_s)?;
+    str_attr(file, "description", &meta.description)?;
+    if let Some(t) = &meta.start_time {
+        str_attr(file, "start_time", t)?;
+    }
+    str_attr(file, "tool_version", &meta.run.tool_version)?;
+    str_attr(file, "created_by", &meta.run.command_line)?;
+    str_attr(file, "parameters_toml", &meta.run.params_toml)?;
+    scalar_attr(file, "seed", meta.seed)?;
+    str_attr(file, "spectral_convention", SPECTRAL_CONVENTION)?;
+    Ok(())
+}
+
+/// The attributes of the series dataset of observable `o`.
+pub(crate) fn series_attrs(
+    ds: &hdf5::Dataset,
+    o: Observable,
+    meta: &SimulationMeta,
+) -> hdf5::Result<()> {
+    str_attr(ds, "units", o.unit())?;
+    let r = meta
+        .readout_asd
+        .iter()
+        .find(|(x, _)| *x == o)
+        .map_or(0.0, |r| r.1);
+    scalar_attr(ds, "readout_asd", r)?;
+    str_attr(ds, "readout_asd_units", &format!("{}/sqrt(Hz)", o.unit()))?;
+    Ok(())
+}
+
+/// The groups `/asd`, `/initial_state` and `/modes`.
+pub(crate) fn write_groups(
+    file: &hdf5::File,
+    asd: &SeriesAsd,
+    meta: &SimulationMeta,
+) -> hdf5::Result<()> {
     let g = file.create_group("asd")?;
     str_attr(&g, "spectral_convention", SPECTRAL_CONVENTION)?;
     str_attr(&g, "window", "hann (periodic)")?;

@@ -5,7 +5,8 @@ use std::fmt::Write as _;
 use std::io::{BufWriter, Write as _};
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
-use tiltnoise_core::tf::TransferMatrix;
+use tiltnoise_core::model::Observable;
+use tiltnoise_core::tf::{Input, TransferMatrix};
 
 /// Writes `tf` as CSV, atomically (see [`super::write_atomic`]).
 ///
@@ -32,28 +33,42 @@ pub fn write_tf_csv(path: &Path, tf: &TransferMatrix) -> Result<(), OutputError>
 pub fn tf_csv_string(tf: &TransferMatrix) -> String {
     let (nf, no, ni) = (tf.freqs_hz.len(), tf.outputs.len(), tf.inputs.len());
     let mut s = String::with_capacity((nf + 1) * (1 + 2 * no * ni) * 24);
+    s.push_str(&tf_csv_header(&tf.outputs, &tf.inputs));
+    push_tf_csv_rows(&mut s, tf);
+    s
+}
+
+/// The header line of [`tf_csv_string`] (with its newline) for these outputs and inputs.
+pub fn tf_csv_header(outputs: &[Observable], inputs: &[Input]) -> String {
+    let mut s = String::new();
     s.push_str("freq_hz");
-    for o in &tf.outputs {
-        for i in &tf.inputs {
+    for o in outputs {
+        for i in inputs {
             let (o, i) = (o.name(), i.name());
             let _ = write!(s, ",{o}.{i}.re,{o}.{i}.im");
         }
     }
     s.push('\n');
+    s
+}
+
+/// Appends the data lines of [`tf_csv_string`] for every frequency of `tf` to `s`: a grid
+/// written in parts gives the same text as at once.
+pub fn push_tf_csv_rows(s: &mut String, tf: &TransferMatrix) {
+    let (no, ni) = (tf.outputs.len(), tf.inputs.len());
     for (k, &f) in tf.freqs_hz.iter().enumerate() {
-        push_f64(&mut s, f);
+        push_f64(s, f);
         for o in 0..no {
             for i in 0..ni {
                 let h = tf.get(k, o, i);
                 s.push(',');
-                push_f64(&mut s, h.re);
+                push_f64(s, h.re);
                 s.push(',');
-                push_f64(&mut s, h.im);
+                push_f64(s, h.im);
             }
         }
         s.push('\n');
     }
-    s
 }
 
 fn push_f64(s: &mut String, x: f64) {

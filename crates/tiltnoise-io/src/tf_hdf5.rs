@@ -52,22 +52,7 @@ fn write_file(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> hdf5::Result<
     }
     // The file is dense whatever the matrix's layout: structural zeros as 0.
     let file = hdf5::File::create(path)?;
-
-    str_attr(&file, "schema", SCHEMA_TF)?;
-    scalar_attr(&file, "schema_version", SCHEMA_VERSION_TF)?;
-    str_attr(&file, "tool_version", &meta.tool_version)?;
-    str_attr(&file, "created_by", &meta.command_line)?;
-    str_attr(&file, "method", tf.method.name())?;
-    str_attr(&file, "parameters_toml", &meta.params_toml)?;
-    str_attr(&file, "sign_convention", SIGN_CONVENTION)?;
-    str_attr(&file, "time_dependence", TIME_DEPENDENCE)?;
-
-    let output_names: Vec<&str> = tf.outputs.iter().map(|o| o.name()).collect();
-    let input_names: Vec<&str> = tf.inputs.iter().map(|i| i.name()).collect();
-    let units: Vec<String> = (0..no)
-        .flat_map(|o| (0..ni).map(move |i| (o, i)))
-        .map(|(o, i)| tf.unit(o, i))
-        .collect();
+    write_root(&file, tf, meta)?;
 
     let freq = dataset(&file, "frequency_hz", &tf.freqs_hz)?;
     str_attr(&freq, "units", "Hz")?;
@@ -78,23 +63,66 @@ fn write_file(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> hdf5::Result<
         .new_dataset_builder()
         .with_data(values)
         .create("transfer")?;
-    strs_attr(&transfer, "outputs", output_names.iter().copied())?;
-    strs_attr(&transfer, "inputs", input_names.iter().copied())?;
-    strs_attr(&transfer, "units", units.iter().map(String::as_str))?;
+    transfer_attrs(&transfer, tf)?;
+    write_labels(&file, tf)?;
+    write_modes(&file, meta)?;
+    file.close()
+}
 
-    dataset(&file, "outputs", &strings(output_names.iter().copied())?)?;
-    dataset(&file, "inputs", &strings(input_names.iter().copied())?)?;
+/// The root attributes of a file of `tf`'s labels and method (`tf` may hold any part of the
+/// grid).
+pub(crate) fn write_root(
+    file: &hdf5::File,
+    tf: &TransferMatrix,
+    meta: &RunMeta,
+) -> hdf5::Result<()> {
+    str_attr(file, "schema", SCHEMA_TF)?;
+    scalar_attr(file, "schema_version", SCHEMA_VERSION_TF)?;
+    str_attr(file, "tool_version", &meta.tool_version)?;
+    str_attr(file, "created_by", &meta.command_line)?;
+    str_attr(file, "method", tf.method.name())?;
+    str_attr(file, "parameters_toml", &meta.params_toml)?;
+    str_attr(file, "sign_convention", SIGN_CONVENTION)?;
+    str_attr(file, "time_dependence", TIME_DEPENDENCE)?;
+    Ok(())
+}
+
+/// The attributes of the `/transfer` dataset.
+pub(crate) fn transfer_attrs(transfer: &hdf5::Dataset, tf: &TransferMatrix) -> hdf5::Result<()> {
+    let (no, ni) = (tf.outputs.len(), tf.inputs.len());
+    let output_names: Vec<&str> = tf.outputs.iter().map(|o| o.name()).collect();
+    let input_names: Vec<&str> = tf.inputs.iter().map(|i| i.name()).collect();
+    let units: Vec<String> = (0..no)
+        .flat_map(|o| (0..ni).map(move |i| (o, i)))
+        .map(|(o, i)| tf.unit(o, i))
+        .collect();
+    strs_attr(transfer, "outputs", output_names.iter().copied())?;
+    strs_attr(transfer, "inputs", input_names.iter().copied())?;
+    strs_attr(transfer, "units", units.iter().map(String::as_str))?;
+    Ok(())
+}
+
+/// The datasets `/outputs`, `/inputs`, `/output_units`, `/input_units`.
+pub(crate) fn write_labels(file: &hdf5::File, tf: &TransferMatrix) -> hdf5::Result<()> {
+    let output_names: Vec<&str> = tf.outputs.iter().map(|o| o.name()).collect();
+    let input_names: Vec<&str> = tf.inputs.iter().map(|i| i.name()).collect();
+    dataset(file, "outputs", &strings(output_names.iter().copied())?)?;
+    dataset(file, "inputs", &strings(input_names.iter().copied())?)?;
     dataset(
-        &file,
+        file,
         "output_units",
         &strings(tf.outputs.iter().map(|o| o.unit()))?,
     )?;
     dataset(
-        &file,
+        file,
         "input_units",
         &strings(tf.inputs.iter().map(|i| i.unit()))?,
     )?;
+    Ok(())
+}
 
+/// The group `/modes`, when `meta.modes` is not empty.
+pub(crate) fn write_modes(file: &hdf5::File, meta: &RunMeta) -> hdf5::Result<()> {
     if !meta.modes.is_empty() {
         let modes = file.create_group("modes")?;
         let index: Vec<i64> = meta
@@ -107,6 +135,5 @@ fn write_file(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> hdf5::Result<
         let mf = dataset(&modes, "frequency_hz", &freqs)?;
         str_attr(&mf, "units", "Hz")?;
     }
-
-    file.close()
+    Ok(())
 }

@@ -3,7 +3,7 @@
 //! (`--drive-gain`, `--drive-delay`): a controlled record of the observables, for example to
 //! test `tiltnoise subtract`, which should find those gains and that delay.
 
-use super::{default_nperseg, parse_readout, readout_text, SimulateArgs};
+use super::{parse_readout, readout_text, SimulateArgs};
 use crate::cli::output::save_image;
 use crate::cli::Run;
 use anyhow::{anyhow, bail, Result};
@@ -13,6 +13,7 @@ use tiltnoise_core::model::{Model, Observable, TiltAxis};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::simulate::aliased_frequency_hz;
+use tiltnoise_core::simulate::default_sim_nperseg as default_nperseg;
 use tiltnoise_core::simulate::driven::{
     drive_from_record, quasi_static_start, simulate_driven, DrivenConfig,
 };

@@ -199,11 +199,19 @@ pub fn initial_state(
 }
 
 /// Default Welch segment of a simulation's ASDs: the largest power of two <= n / 3 (at least
-/// 5 half-overlapping segments), at least 2.
+/// 5 half-overlapping segments), at least 2 and at most [`MAX_DEFAULT_SIM_NPERSEG`].
 pub fn default_sim_nperseg(n_samples: usize) -> usize {
     let third = (n_samples / 3).max(2);
-    1 << third.ilog2()
+    (1 << third.ilog2()).min(MAX_DEFAULT_SIM_NPERSEG)
 }
+
+/// Longest default Welch segment of a simulation: 2^18 samples (7.3 h at 0.1 s, bins of
+/// 38 uHz, 500 times finer than the closest pair of modes, nu_1 and nu_2, is wide). A segment
+/// is held per observable while a long record streams through the Welch accumulators, so the
+/// default stops growing with the record there (at 2^18, about 70 MB for the seven); a longer
+/// record averages more segments instead. Records up to 9 days at 0.1 s keep the uncapped
+/// default (2^17 for the paper's 12 h).
+pub const MAX_DEFAULT_SIM_NPERSEG: usize = 1 << 18;
 
 /// The number of samples of `duration_s` at `step_s` and the Welch segment (`nperseg`, or
 /// [`default_sim_nperseg`]), checked: a finite positive step and duration, at least two

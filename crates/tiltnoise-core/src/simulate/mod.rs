@@ -27,7 +27,9 @@
 //!
 //! White Gaussian noise of one-sided ASD `a` (unit/sqrt(Hz)) sampled at `fs = 1 / dt` has the
 //! per-sample standard deviation `a sqrt(fs / 2)`. The normals come from [`crate::rng`]
-//! (stream 0 of the seed): the same seed gives the same series on every platform.
+//! (stream 0 of the seed, one block of `n` normals per noisy observable in the order of
+//! [`SimConfig::readout_asd`]): the same seed gives the same series on every platform, held
+//! whole or produced in chunks ([`stream`]).
 //!
 //! # Resonance check
 //!
@@ -44,15 +46,17 @@ use crate::limits::{
 };
 use crate::model::{Coord, Model, Observable, Vec8};
 use crate::modes::NormalModes;
-use crate::rng::Rng;
+use stream::{FreeMotion, SimChunk};
 
 pub mod driven;
 mod init;
 pub mod resonance;
+pub mod stream;
 
 pub use init::{
     check_sampling, default_sim_nperseg, describe_run, initial_state, parse_coordinates,
-    readout_text, record_description, set_coordinate, Excitation, MIN_SIM_NPERSEG,
+    readout_text, record_description, set_coordinate, Excitation, MAX_DEFAULT_SIM_NPERSEG,
+    MIN_SIM_NPERSEG,
 };
 
 /// Refuses a simulation of `n_samples` (a float: `floor(duration / dt)` may be beyond any
@@ -413,86 +417,43 @@ pub fn simulate(
 pub const PROGRESS_STRIDE: usize = 1 << 16;
 
 /// [`simulate`], calling `progress(samples_done, n_samples)` every [`PROGRESS_STRIDE`] samples
-/// and once at the end (the library never draws to the terminal).
+/// and once at the end (the library never draws to the terminal). The whole record is held in
+/// memory (at most [`MAX_SIM_SAMPLES`] samples, and what the memory available allows); a long
+/// record is better produced chunk by chunk with [`stream::FreeMotion`], which gives the same
+/// numbers.
 pub fn simulate_with_progress(
     model: &Model,
     init: &InitialState,
     cfg: &SimConfig,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Simulation, SimError> {
-    let (dt_s, duration_s) = (cfg.dt_s, cfg.duration_s);
-    if !(dt_s.is_finite() && dt_s > 0.0) {
-        return Err(SimError::InvalidStep { dt_s });
-    }
-    if !(duration_s.is_finite() && duration_s > 0.0) {
-        return Err(SimError::InvalidDuration { duration_s });
-    }
-    let n_samples = cfg.n_samples_f64();
-    if n_samples.is_nan() || n_samples < 2.0 {
-        return Err(SimError::TooFewSamples {
-            duration_s,
-            dt_s,
-            n_samples,
-        });
-    }
+    let n = stream::sample_count(cfg, MAX_SIM_SAMPLES)?;
     check_samples(
-        || format!("duration {} s at dt = {} s", Num(duration_s), Num(dt_s)),
-        n_samples,
+        || {
+            format!(
+                "duration {} s at dt = {} s",
+                Num(cfg.duration_s),
+                Num(cfg.dt_s)
+            )
+        },
+        n as f64,
     )?;
-    for &(o, asd) in &cfg.readout_asd {
-        if !(asd.is_finite() && asd >= 0.0) {
-            return Err(SimError::InvalidReadout {
-                observable: o.name(),
-                asd,
-            });
-        }
-    }
-    check_initial_state(init)?;
-    let n = n_samples as usize;
-    let mut prop = ModalPropagator::new(model, init, dt_s)?;
-
-    // Observables straight from the modal coordinates: P = C V (7 x 8).
-    let c = model.observation();
-    let p: [[f64; 8]; 7] = std::array::from_fn(|o| {
-        std::array::from_fn(|k| (0..8).map(|i| c[(o, i)] * prop.shapes[k][i]).sum())
-    });
-
+    let mut motion = FreeMotion::with_limit(model, init, cfg, true, MAX_SIM_SAMPLES)?;
     let mut q = Vec::with_capacity(n);
     let mut obs: Vec<Vec<f64>> = (0..7).map(|_| Vec::with_capacity(n)).collect();
-    for i in 0..n {
-        if i > 0 {
-            prop.step();
-            if i % PROGRESS_STRIDE == 0 {
-                progress(i, n);
-            }
+    let mut chunk = SimChunk::default();
+    while motion.next_chunk(PROGRESS_STRIDE, &mut chunk) {
+        q.extend_from_slice(&chunk.q);
+        for (all, part) in obs.iter_mut().zip(&chunk.observables) {
+            all.extend_from_slice(part);
         }
-        let a = &prop.u;
-        q.push(prop.combine(a, 1.0));
-        for (o, row) in p.iter().enumerate() {
-            let mut y = 0.0;
-            for k in 0..8 {
-                y += row[k] * a[k];
-            }
-            obs[o].push(y);
+        if motion.samples_done() < n {
+            progress(motion.samples_done(), n);
         }
     }
-
-    let mut rng = Rng::stream(cfg.seed, 0);
-    let sigma_per_asd = (0.5 / dt_s).sqrt();
-    for &(o, asd) in &cfg.readout_asd {
-        if asd == 0.0 {
-            continue;
-        }
-        let sigma = asd * sigma_per_asd;
-        let series = &mut obs[o.index()];
-        for x in series.iter_mut() {
-            *x += sigma * rng.gaussian();
-        }
-    }
-
     progress(n, n);
     Ok(Simulation {
-        dt_s,
+        dt_s: cfg.dt_s,
         q,
         observables: Observable::ALL.into_iter().zip(obs).collect(),
     })

@@ -696,3 +696,110 @@ fn resonance_check_reports_a_wrong_table() {
     assert_eq!(d, vec![(Observable::X, 6), (Observable::Y, 1)]);
     assert!(check.table().contains("DISAGREES: X nu_6"));
 }
+
+/// Readout on several observables (one given twice), with the record's length odd so that a
+/// block of normals starts in the middle of a Box-Muller pair.
+fn noisy_config() -> SimConfig {
+    SimConfig {
+        dt_s: 0.1,
+        duration_s: 100.1,
+        readout_asd: vec![
+            (Observable::X, 9e-9),
+            (Observable::Phi, 0.0),
+            (Observable::Theta, 1e-9),
+            (Observable::X, 2e-9),
+            (Observable::PhiA, 3e-10),
+        ],
+        seed: 11,
+    }
+}
+
+/// The readout noise is the `j`-th block of `n` normals of stream 0 for the `j`-th noisy entry,
+/// added entry after entry: drawn here sequentially, independently of the library's skipping.
+#[test]
+fn readout_noise_is_one_block_of_the_seed_stream_per_noisy_entry() {
+    let model = model();
+    let init = generic_init();
+    let cfg = noisy_config();
+    let noisy = simulate(&model, &init, &cfg).unwrap();
+    let clean = simulate(
+        &model,
+        &init,
+        &SimConfig {
+            readout_asd: Vec::new(),
+            ..cfg.clone()
+        },
+    )
+    .unwrap();
+    let n = clean.len();
+    assert_eq!(
+        n % 2,
+        1,
+        "an odd length puts a block boundary inside a pair"
+    );
+    let mut expected: Vec<Vec<f64>> = clean.observables.iter().map(|(_, x)| x.clone()).collect();
+    let mut rng = tiltnoise_core::rng::Rng::stream(cfg.seed, 0);
+    for &(o, asd) in &cfg.readout_asd {
+        if asd == 0.0 {
+            continue;
+        }
+        let sigma = asd * (0.5 / cfg.dt_s).sqrt();
+        for x in &mut expected[o.index()] {
+            *x += sigma * rng.gaussian();
+        }
+    }
+    for ((o, got), want) in noisy.observables.iter().zip(&expected) {
+        for (i, (g, w)) in got.iter().zip(want).enumerate() {
+            assert_eq!(
+                g.to_bits(),
+                w.to_bits(),
+                "{} sample {i}: {g} vs {w}",
+                o.name()
+            );
+        }
+    }
+}
+
+/// Chunks of any length, crossing every boundary, give the one-shot record bit for bit.
+#[test]
+fn chunks_equal_the_whole_record() {
+    use tiltnoise_core::simulate::stream::{FreeMotion, SimChunk};
+    let model = model();
+    let init = generic_init();
+    let cfg = noisy_config();
+    let whole = simulate(&model, &init, &cfg).unwrap();
+    for (max_len, keep) in [
+        (1, true),
+        (7, false),
+        (64, true),
+        (1000, false),
+        (5000, true),
+    ] {
+        let mut motion = FreeMotion::new(&model, &init, &cfg, keep).unwrap();
+        assert_eq!(motion.len(), whole.len());
+        let mut chunk = SimChunk::default();
+        let mut at = 0;
+        while motion.next_chunk(max_len, &mut chunk) {
+            assert_eq!(chunk.start, at);
+            assert!(chunk.len() <= max_len);
+            for (o, x) in &whole.observables {
+                let part = &x[at..at + chunk.len()];
+                let got = chunk.observable(*o);
+                assert!(
+                    part.iter()
+                        .zip(got)
+                        .all(|(a, b)| a.to_bits() == b.to_bits()),
+                    "{} in the chunk at {at} of at most {max_len}",
+                    o.name()
+                );
+            }
+            match keep {
+                true => assert_eq!(chunk.q, whole.q[at..at + chunk.len()]),
+                false => assert!(chunk.q.is_empty()),
+            }
+            at += chunk.len();
+        }
+        assert_eq!(at, whole.len());
+        assert!(chunk.is_empty());
+    }
+}
