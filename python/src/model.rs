@@ -587,7 +587,8 @@ impl PyModel {
     /// ``"theta_a=1e-5,phi_b=0.01"`` (rad, m; rad/s, m/s; unlisted ones 0); default: the
     /// energy ``mode_energy`` (J) in each of the eight modes. ``readout``: ``{observable:
     /// ASD}`` over the default ``{"X": 9e-9}`` (unit/sqrt(Hz); 0 removes one); ``seed`` of
-    /// the noise; ``nperseg``: Welch segment (default the largest power of two <= n/3).
+    /// the noise; ``nperseg``: Welch segment (default the largest power of two <= n/3, at most
+    /// 2**18).
     /// Raises ``ValueError`` for a damped model or options that do not fit, with the command
     /// line's messages.
     #[pyo3(signature = (duration=43_200.0, step=0.1, *, init=None, init_rate=None, kick_x=None, mode_energy=1e-12, readout=None, seed=0, nperseg=None))]

@@ -164,7 +164,7 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
         Some(b) => b,
         None => TF_BLOCK_FREQS,
     };
-    let figure = args.save.iter().find(|p| {
+    let figure_path = args.save.iter().find(|p| {
         matches!(
             tiltnoise_io::OutputKind::from_path(p),
             Ok(tiltnoise_io::OutputKind::Png | tiltnoise_io::OutputKind::Svg)
@@ -176,7 +176,7 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
         (None, Some(path)) => Grid::Points(read_freq_file(path)?),
         (None, None) => Grid::Points(freq::default_grid(&model)),
     };
-    if let (Some(path), Grid::Log(g)) = (figure, &grid) {
+    if let (Some(path), Grid::Log(g)) = (figure_path, &grid) {
         if g.len() > MAX_GRID_POINTS {
             bail!(
                 "--save {}: a figure is drawn from at most {MAX_GRID_POINTS} frequency points \
@@ -217,7 +217,7 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
     let plan = tf::plan(&model, &request, method)?;
     let modes = NormalModes::new(&model);
     let meta = RunMeta::of_this_run(params, Some(&modes));
-    if figure.is_none() {
+    if figure_path.is_none() {
         return stream_tf(plan.as_ref(), &grid, block_freqs, &args, &model, &meta, run);
     }
     let freqs = grid.block(0, grid.len());
