@@ -218,39 +218,86 @@ pub struct TimeSeriesData {
     pub panels: Vec<TimePanel>,
 }
 
-/// Most points drawn per panel: the series is reduced to the minimum and maximum of each of
-/// `MAX_COLUMNS / 2` time bins, which keeps the envelope of oscillations faster than a pixel.
+/// Most points drawn per panel as a line; a longer series is drawn as the band between the
+/// minimum and the maximum of each of `MAX_COLUMNS / 2` time bins, which keeps the envelope of
+/// oscillations faster than a pixel (a thick polyline zigzagging that fast would draw spikes
+/// at its sharp corners, far outside the frame in a bitmap).
 const MAX_COLUMNS: usize = 4000;
 
-/// Min/max decimation (see [`MAX_COLUMNS`]).
-fn decimate(p: &TimePanel) -> Vec<(f64, f64)> {
+/// What a panel draws: its samples as a line, or the min/max band of time bins.
+enum TimeTrace {
+    Line(Vec<(f64, f64)>),
+    /// `(t, min, max)` per bin, in time order.
+    Band(Vec<(f64, f64, f64)>),
+}
+
+impl TimeTrace {
+    /// Time and value range `((t0, t1), (lo, hi))`.
+    fn extent(&self) -> ((f64, f64), (f64, f64)) {
+        let (ts, lo, hi): (Vec<f64>, f64, f64) = match self {
+            TimeTrace::Line(p) => (
+                p.iter().map(|q| q.0).collect(),
+                p.iter().map(|q| q.1).fold(f64::INFINITY, f64::min),
+                p.iter().map(|q| q.1).fold(f64::NEG_INFINITY, f64::max),
+            ),
+            TimeTrace::Band(b) => (
+                b.iter().map(|q| q.0).collect(),
+                b.iter().map(|q| q.1).fold(f64::INFINITY, f64::min),
+                b.iter().map(|q| q.2).fold(f64::NEG_INFINITY, f64::max),
+            ),
+        };
+        let t0 = ts.first().copied().unwrap_or(0.0);
+        let t1 = ts.last().copied().unwrap_or(0.0);
+        ((t0, t1), (lo, hi))
+    }
+}
+
+impl TimeTrace {
+    /// The same trace with its times divided by `per_unit_s`.
+    fn in_time_unit(self, per_unit_s: f64) -> TimeTrace {
+        match self {
+            TimeTrace::Line(p) => {
+                TimeTrace::Line(p.into_iter().map(|(t, v)| (t / per_unit_s, v)).collect())
+            }
+            TimeTrace::Band(b) => TimeTrace::Band(
+                b.into_iter()
+                    .map(|(t, lo, hi)| (t / per_unit_s, lo, hi))
+                    .collect(),
+            ),
+        }
+    }
+}
+
+/// The panel's samples as a line, or as a min/max band when there are more than
+/// [`MAX_COLUMNS`] (see there).
+fn decimate(p: &TimePanel) -> TimeTrace {
     let n = p.values.len();
     let t = |i: usize| p.t0_s + i as f64 * p.dt_s;
     if n <= MAX_COLUMNS {
-        return (0..n).map(|i| (t(i), p.values[i])).collect();
+        return TimeTrace::Line((0..n).map(|i| (t(i), p.values[i])).collect());
     }
     let bins = MAX_COLUMNS / 2;
-    let mut out = Vec::with_capacity(MAX_COLUMNS);
-    for b in 0..bins {
-        let (lo, hi) = (b * n / bins, ((b + 1) * n / bins).max(b * n / bins + 1));
-        let (mut imin, mut imax) = (lo, lo);
-        for i in lo..hi {
-            if p.values[i] < p.values[imin] {
-                imin = i;
-            }
-            if p.values[i] > p.values[imax] {
-                imax = i;
-            }
-        }
-        let (a, c) = if imin <= imax {
-            (imin, imax)
-        } else {
-            (imax, imin)
-        };
-        out.push((t(a), p.values[a]));
-        out.push((t(c), p.values[c]));
+    let band = (0..bins)
+        .map(|b| {
+            let (lo, hi) = (b * n / bins, ((b + 1) * n / bins).max(b * n / bins + 1));
+            let values = &p.values[lo..hi];
+            let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+            let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            (t((lo + hi - 1) / 2), min, max)
+        })
+        .collect();
+    TimeTrace::Band(band)
+}
+
+/// The unit of a time axis spanning `span_s`: seconds, hours beyond 3 h, days beyond 3 d.
+fn time_unit(span_s: f64) -> (&'static str, f64) {
+    if span_s >= 3.0 * 86_400.0 {
+        ("d", 86_400.0)
+    } else if span_s >= 3.0 * 3_600.0 {
+        ("h", 3_600.0)
+    } else {
+        ("s", 1.0)
     }
-    out
 }
 
 impl Figure for TimeSeriesData {
@@ -272,16 +319,16 @@ impl Figure for TimeSeriesData {
         top.draw_text(&self.title, &style, (tw as i32 / 2, th as i32 / 2))?;
         let cells = rest.split_evenly((self.panels.len().max(1), 1));
         for (p, cell) in self.panels.iter().zip(cells.iter()) {
-            let pts = decimate(p);
-            if pts.is_empty() {
+            if p.values.is_empty() {
                 return Err(DrawError(format!("panel `{}` has no samples", p.title)));
             }
-            let (x0, x1) = (pts[0].0, pts[pts.len() - 1].0.max(pts[0].0 + p.dt_s));
-            let (mut y0, mut y1) = pts
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
-                    (a.min(q.1), b.max(q.1))
-                });
+            let trace = decimate(p);
+            let ((x0, x1), (mut y0, mut y1)) = trace.extent();
+            let x1 = x1.max(x0 + p.dt_s);
+            // Time drawn in the axis's unit, so that the ticks fall on round values of it.
+            let (unit, per_unit_s) = time_unit(x1 - x0);
+            let (x0, x1) = (x0 / per_unit_s, x1 / per_unit_s);
+            let trace = trace.in_time_unit(per_unit_s);
             if !(y0.is_finite() && y1.is_finite()) {
                 return Err(DrawError(format!(
                     "panel `{}` has non-finite samples",
@@ -301,9 +348,10 @@ impl Figure for TimeSeriesData {
                 .x_label_area_size((ts.axis * 3.0) as u32)
                 .y_label_area_size((ts.axis * 6.0) as u32)
                 .build_cartesian_2d(x0..x1, y0..y1)?;
+            let x_desc = format!("time ({unit})");
             chart
                 .configure_mesh()
-                .x_desc("time (s)")
+                .x_desc(x_desc)
                 .y_desc(observable_symbol(p.observable))
                 .axis_desc_style((FONT_FAMILY, ts.axis))
                 .label_style((FONT_FAMILY, ts.ticks))
@@ -315,10 +363,33 @@ impl Figure for TimeSeriesData {
                         super::labels::si_value(*v, p.observable.unit())
                     }
                 })
-                .x_label_formatter(&|v| format!("{v:.0}"))
+                .x_label_formatter(&|v| {
+                    // Whole values of the unit; a fraction only when the ticks need one.
+                    if (v - v.round()).abs() < 1e-9 * (x1 - x0) {
+                        format!("{:.0}", v.round())
+                    } else {
+                        format!("{v:.1}")
+                    }
+                })
                 .light_line_style(RGBColor(235, 235, 235))
                 .draw()?;
-            chart.draw_series(LineSeries::new(pts, ASD_COLOR.stroke_width(2)))?;
+            match trace {
+                TimeTrace::Line(pts) => {
+                    chart.draw_series(LineSeries::new(pts, ASD_COLOR.stroke_width(2)))?;
+                }
+                TimeTrace::Band(band) => {
+                    // The band's outline: the maxima forward, the minima backward.
+                    let outline: Vec<(f64, f64)> = band
+                        .iter()
+                        .map(|q| (q.0, q.2))
+                        .chain(band.iter().rev().map(|q| (q.0, q.1)))
+                        .collect();
+                    chart.draw_series(std::iter::once(Polygon::new(
+                        outline,
+                        ASD_COLOR.mix(0.85).filled(),
+                    )))?;
+                }
+            }
         }
         Ok(())
     }
@@ -334,4 +405,53 @@ pub fn time_series_figure(
     format: ImageFormat,
 ) -> Result<Vec<u8>, DrawError> {
     render(format, data)
+}
+
+#[cfg(test)]
+mod time_figure_tests {
+    use super::*;
+
+    fn panel(values: Vec<f64>, dt_s: f64) -> TimePanel {
+        TimePanel {
+            title: "t".into(),
+            observable: Observable::Phi,
+            dt_s,
+            t0_s: 0.0,
+            values,
+        }
+    }
+
+    #[test]
+    fn long_series_become_a_band_that_keeps_every_extreme() {
+        // An oscillation far faster than a pixel, with one spike in each direction.
+        let n = 100 * MAX_COLUMNS;
+        let mut values: Vec<f64> = (0..n)
+            .map(|i| if i % 2 == 0 { 1.0 } else { -1.0 })
+            .collect();
+        values[12_345] = 5.0;
+        values[300_001] = -7.0;
+        let TimeTrace::Band(band) = decimate(&panel(values.clone(), 0.1)) else {
+            panic!("a long series is drawn as a band");
+        };
+        assert_eq!(band.len(), MAX_COLUMNS / 2);
+        let hi = band.iter().map(|b| b.2).fold(f64::NEG_INFINITY, f64::max);
+        let lo = band.iter().map(|b| b.1).fold(f64::INFINITY, f64::min);
+        assert_eq!((lo, hi), (-7.0, 5.0));
+        assert!(
+            band.windows(2).all(|w| w[0].0 < w[1].0),
+            "bins in time order"
+        );
+        // Short series stay a line through every sample.
+        let TimeTrace::Line(line) = decimate(&panel(values[..100].to_vec(), 0.1)) else {
+            panic!("a short series is drawn as a line");
+        };
+        assert_eq!(line.len(), 100);
+    }
+
+    #[test]
+    fn time_axes_read_in_seconds_hours_or_days() {
+        assert_eq!(time_unit(3600.0), ("s", 1.0));
+        assert_eq!(time_unit(12.0 * 3600.0), ("h", 3600.0));
+        assert_eq!(time_unit(30.0 * 86_400.0), ("d", 86_400.0));
+    }
 }
