@@ -579,6 +579,16 @@ fn asd<'py>(py: Python<'py>, psd: &[f64]) -> Bound<'py, PyArray1<f64>> {
     PyArray1::from_iter(py, psd.iter().map(|p| p.sqrt()))
 }
 
+impl Budget {
+    /// The provenance written into files: this process, the budget's parameters and modes.
+    fn run_meta(&self) -> RunMeta {
+        RunMeta {
+            modes: self.modes.clone(),
+            ..RunMeta::of_this_run(&self.params, None)
+        }
+    }
+}
+
 #[pymethods]
 impl Budget {
     /// Frequencies (Hz), increasing, all > 0.
@@ -789,27 +799,32 @@ impl Budget {
         }
     }
 
-    /// The budget as the command line's CSV (ASD columns ``OBS.TERM``; ``docs/schemas.md``).
-    fn to_csv(&self) -> PyResult<String> {
-        tiltnoise_io::budget_csv_string(&self.report).map_err(value_error)
+    /// The budget as the command line's CSV (``#`` lines ending with ``# units:``, then ASD
+    /// columns ``OBS.TERM``; ``docs/schemas.md``): columns that are zero at every frequency
+    /// are left out and named in a ``# note:`` line unless ``keep_zero_columns``.
+    #[pyo3(signature = (*, keep_zero_columns=false))]
+    fn to_csv(&self, keep_zero_columns: bool) -> PyResult<String> {
+        tiltnoise_io::budget_csv_string(&self.report, &self.run_meta(), keep_zero_columns)
+            .map_err(value_error)
     }
 
     /// Writes the budget as the command line's ``--save`` does: ``.h5``/``.hdf5`` (schema
     /// ``tiltnoise.budget``, with the parameters and the input's provenance) or ``.csv``;
     /// atomically (nothing is left at ``path`` on failure). Raises ``OSError`` if it cannot
-    /// be written, ``ValueError`` for another extension.
-    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+    /// be written, ``ValueError`` for another extension. ``keep_zero_columns``: as
+    /// ``to_csv``.
+    #[pyo3(signature = (path, *, keep_zero_columns=false))]
+    fn save(&self, py: Python<'_>, path: PathBuf, keep_zero_columns: bool) -> PyResult<()> {
         use tiltnoise_io::OutputKind;
         let kind = OutputKind::from_path(&path).py()?;
-        let meta = RunMeta {
-            modes: self.modes.clone(),
-            ..RunMeta::of_this_run(&self.params, None)
-        };
+        let meta = self.run_meta();
         py.detach(|| match kind {
             OutputKind::Hdf5 => {
                 tiltnoise_io::write_budget_hdf5(&path, &self.report, &meta, &self.input)
             }
-            OutputKind::Csv => tiltnoise_io::write_budget_csv(&path, &self.report),
+            OutputKind::Csv => {
+                tiltnoise_io::write_budget_csv(&path, &self.report, &meta, keep_zero_columns)
+            }
             OutputKind::Png | OutputKind::Svg => Err(tiltnoise_io::OutputError::UnknownFormat {
                 path: path.clone(),
                 allowed: ".h5, .hdf5, .csv (figures: see examples/budget_matplotlib.py)",

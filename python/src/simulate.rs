@@ -330,13 +330,14 @@ impl Simulation {
     /// ``ValueError`` for another extension.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let kind = OutputKind::from_path(&path).py()?;
+        let run = RunMeta {
+            modes: self.modes.clone(),
+            ..RunMeta::of_this_run(&self.params, None)
+        };
         py.detach(|| match kind {
             OutputKind::Hdf5 => {
                 let meta = SimulationMeta {
-                    run: RunMeta {
-                        modes: self.modes.clone(),
-                        ..RunMeta::of_this_run(&self.params, None)
-                    },
+                    run: run.clone(),
                     description: record_description(&self.description),
                     start_time: None,
                     seed: self.seed,
@@ -348,7 +349,7 @@ impl Simulation {
                 tiltnoise_io::write_observable_series_hdf5(&path, &self.sim, &self.asd, &meta)
             }
             OutputKind::Csv => {
-                tiltnoise_io::write_asd_csv(&path, &self.asd.freqs_hz, &self.asd.asd)
+                tiltnoise_io::write_asd_csv(&path, &self.asd.freqs_hz, &self.asd.asd, &run)
             }
             OutputKind::Png | OutputKind::Svg => Err(tiltnoise_io::OutputError::UnknownFormat {
                 path: path.clone(),

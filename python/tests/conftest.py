@@ -8,6 +8,13 @@ from pathlib import Path
 import pytest
 
 REPO = Path(__file__).resolve().parents[2]
+
+
+def without_command_line(csv_text):
+    """A CSV written by tiltnoise without its `# created_by:` line: the command line that
+    wrote it, which differs between this process and the command line's."""
+    return "".join(l for l in csv_text.splitlines(keepends=True)
+                   if not l.startswith("# created_by:"))
 LAB_TILT = REPO / "tilt_data" / "lab_tilt_24h.h5"
 
 

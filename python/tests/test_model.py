@@ -20,8 +20,10 @@ def model():
 def read_tf_csv(path):
     """`tiltnoise tf --save tf.csv` as (freq, H[n_freq, n_entries], entry names)."""
     with open(path) as fh:
-        header = fh.readline().rstrip("\n").split(",")
-    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+        lines = fh.read().splitlines()
+    at = next(i for i, l in enumerate(lines) if not l.startswith("#"))
+    header = lines[at].split(",")
+    data = np.loadtxt(path, delimiter=",", skiprows=at + 1, ndmin=2)
     return data[:, 0], data[:, 1::2] + 1j * data[:, 2::2], [n[: -len(".re")] for n in header[1::2]]
 
 

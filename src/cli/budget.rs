@@ -66,7 +66,7 @@ pub struct BudgetArgs {
     pub observables: Option<String>,
     /// Readout noise of an observable (repeatable): OBS=ASD white, in the observable's
     /// unit/sqrt(Hz) (default X=9e-9 m/sqrt(Hz) from the paper; OBS=0 removes it), or OBS=FILE
-    /// coloured, a CSV (freq_hz,OBS or freq_hz,asd) or HDF5 (/frequency_hz, /OBS or /asd) ASD
+    /// coloured, a CSV (frequency_hz,OBS or frequency_hz,asd) or HDF5 (/frequency_hz, /OBS or /asd) ASD
     /// file that covers the budget's band.
     #[arg(long, value_name = "OBS=ASD|FILE", allow_hyphen_values = true)]
     pub readout: Vec<String>,
@@ -80,7 +80,7 @@ pub struct BudgetArgs {
     /// restricted to the band the data cover.
     #[arg(long, value_name = "FLO:N:FHI", allow_hyphen_values = true)]
     pub freq: Option<String>,
-    /// Measured record of the observables for comparison: CSV `freq_hz,X[,phi,phi_a]` of
+    /// Measured record of the observables for comparison: CSV `frequency_hz,X[,phi,phi_a]` of
     /// one-sided ASDs (m/sqrt(Hz), rad/sqrt(Hz)), or a time series (HDF5 as written by
     /// `tiltnoise simulate`, or CSV `time_s,X,...` in m, rad) turned into ASDs with the
     /// budget's Welch settings; adds the terms `measured` and `residual`.
@@ -101,6 +101,10 @@ pub struct BudgetArgs {
     /// Output file (.h5, .csv, .png, .svg), repeatable.
     #[arg(long, value_name = "PATH")]
     pub save: Vec<PathBuf>,
+    /// Keep the CSV columns that are zero at every frequency (left out by default and named in
+    /// a `# note:` line; the HDF5 file always has every term).
+    #[arg(long)]
+    pub keep_zero_columns: bool,
     #[command(flatten)]
     pub figure: FigureArgs,
 }
@@ -307,7 +311,7 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     let input = InputMeta::from(&provenance);
     run.write_outputs(json, || {
         for out in &args.save {
-            save_budget(out, &report, &meta, &input, &figure)?;
+            save_budget(out, &report, &meta, &input, &figure, args.keep_zero_columns)?;
         }
         Ok(())
     })

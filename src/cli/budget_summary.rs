@@ -147,7 +147,7 @@ struct SummaryJson<'a> {
 #[derive(Serialize)]
 struct FrequencyJson {
     band_hz: [f64; 2],
-    freq_hz: f64,
+    frequency_hz: f64,
     observables: Vec<ObservableJson>,
 }
 
@@ -199,7 +199,7 @@ pub fn json(report: &BudgetReport, input_notes: &[String]) -> serde_json::Result
             .iter()
             .map(|at| FrequencyJson {
                 band_hz: [at.band_hz.0, at.band_hz.1],
-                freq_hz: at.freq_hz,
+                frequency_hz: at.freq_hz,
                 observables: at
                     .observables
                     .iter()

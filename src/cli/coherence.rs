@@ -158,7 +158,7 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
     let measured = match read_measured_input(&args.measured)? {
         MeasuredInput::Series(s) => s,
         MeasuredInput::Spectra(_) => bail!(
-            "--measured {}: the file holds spectra (header freq_hz); coherence needs a time \
+            "--measured {}: the file holds spectra (header frequency_hz); coherence needs a time \
              series of the observables (header time_s, or HDF5)",
             args.measured.display()
         ),

@@ -90,7 +90,10 @@ pub(crate) fn run_fit(params: &Params, args: FitArgs, run: &mut Run) -> Result<(
                         std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
                     })?
                 }
-                SaveKind::Hdf5 => write_fit_hdf5(path, &result, &measured.origin)?,
+                SaveKind::Hdf5 => {
+                    let meta = tiltnoise_io::RunMeta::of_this_run(params, None);
+                    write_fit_hdf5(path, &result, &measured.origin, &meta)?
+                }
             }
         }
         Ok(())

@@ -50,7 +50,7 @@ pub fn save_tf(
 ) -> Result<(), OutputError> {
     match OutputKind::from_path(path)? {
         OutputKind::Hdf5 => write_tf_hdf5(path, tf, meta),
-        OutputKind::Csv => write_tf_csv(path, tf),
+        OutputKind::Csv => write_tf_csv(path, tf, meta),
         OutputKind::Png | OutputKind::Svg => save_image(path, |format| {
             tiltnoise_plot::tf_figure_with(tf, format, figure)
         }),
@@ -58,7 +58,7 @@ pub fn save_tf(
 }
 
 /// Saves a noise budget in the format named by the extension of `path`: HDF5 (with `meta` and
-/// `input`), CSV (ASDs only), or a PNG/SVG figure drawn with `figure` and the input named in
+/// `input`), CSV (ASDs only; identically-zero columns left out unless `keep_zero_columns`), or a PNG/SVG figure drawn with `figure` and the input named in
 /// the caption.
 ///
 /// # Errors
@@ -71,10 +71,11 @@ pub fn save_budget(
     meta: &RunMeta,
     input: &InputMeta,
     figure: &tiltnoise_plot::BudgetFigureOptions,
+    keep_zero_columns: bool,
 ) -> Result<(), OutputError> {
     match OutputKind::from_path(path)? {
         OutputKind::Hdf5 => write_budget_hdf5(path, report, meta, input),
-        OutputKind::Csv => write_budget_csv(path, report),
+        OutputKind::Csv => write_budget_csv(path, report, meta, keep_zero_columns),
         OutputKind::Png | OutputKind::Svg => {
             let options = tiltnoise_plot::BudgetFigureOptions {
                 input: Some(input.clone()),
@@ -103,7 +104,7 @@ pub fn save_coherence(
 ) -> Result<(), OutputError> {
     match OutputKind::from_path(path)? {
         OutputKind::Hdf5 => write_coherence_hdf5(path, report, meta, inputs),
-        OutputKind::Csv => write_coherence_csv(path, report),
+        OutputKind::Csv => write_coherence_csv(path, report, meta),
         OutputKind::Png | OutputKind::Svg => {
             let options = tiltnoise_plot::CoherenceFigureOptions {
                 tilt_name: tilt.clone(),

@@ -91,7 +91,7 @@ pub(crate) struct SimulateArgs {
     #[arg(long, value_name = "N", allow_negative_numbers = true)]
     nperseg: Option<usize>,
     /// Output (repeatable): .h5/.hdf5 time series + ASDs + run (the budget's --measured reads
-    /// it), .csv ASDs (freq_hz,X,...), .png/.svg Figure 3 (ASDs).
+    /// it), .csv ASDs (frequency_hz,X,...), .png/.svg Figure 3 (ASDs).
     #[arg(long, value_name = "PATH")]
     save: Vec<PathBuf>,
     /// Also write the eight generalized coordinates (noiseless; rad, m) to the HDF5 output,
@@ -510,7 +510,7 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
         for path in &args.save {
             match OutputKind::from_path(path)? {
                 OutputKind::Hdf5 => {}
-                OutputKind::Csv => tiltnoise_io::write_asd_csv(path, &freqs_hz, &asd)
+                OutputKind::Csv => tiltnoise_io::write_asd_csv(path, &freqs_hz, &asd, &meta)
                     .with_context(|| format!("writing {}", path.display()))?,
                 OutputKind::Png | OutputKind::Svg => {
                     let data = SimAsdData {

@@ -312,7 +312,7 @@ fn stream_tf(
     for path in &args.save {
         match OutputKind::from_path(path)? {
             OutputKind::Hdf5 => hdf5.push(TfHdf5Writer::create(path, meta)?),
-            OutputKind::Csv => csv.push(TfCsvWriter::create(path)?),
+            OutputKind::Csv => csv.push(TfCsvWriter::create(path, meta)?),
             OutputKind::Png | OutputKind::Svg => unreachable!("figures are drawn from memory"),
         }
     }
@@ -341,7 +341,11 @@ fn stream_tf(
         if args.save.is_empty() {
             text.clear();
             if start == 0 {
-                text.push_str(&tiltnoise_io::tf_csv_header(&block.outputs, &block.inputs));
+                text.push_str(&tiltnoise_io::tf_csv_header(
+                    &block.outputs,
+                    &block.inputs,
+                    meta,
+                ));
             }
             tiltnoise_io::push_tf_csv_rows(&mut text, &block);
             write!(run.out, "{text}")?;

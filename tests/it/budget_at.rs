@@ -67,7 +67,7 @@ fn thermal_at_f_is_exact_not_interpolated_between_bins() {
         .enumerate()
     {
         let f = row["freq_hz"].as_f64().unwrap();
-        assert_eq!(doc["summary"][i]["freq_hz"].as_f64(), Some(f));
+        assert_eq!(doc["summary"][i]["frequency_hz"].as_f64(), Some(f));
         // sum_j w_j |y^T v_j|^2 with D y = c: y carries LU_GAMMA cond of the solve, the PSD
         // twice that; the reference (40 digits) is exact in comparison.
         let tol = 2.0 * LU_GAMMA * model.condition_number(f).unwrap();
@@ -126,7 +126,7 @@ fn welch_band_of_one_bin_is_the_reference_bin_with_its_degrees_of_freedom() {
     let k = 42.0;
     let nu = 36.0 * k * k / (19.0 * k - 1.0);
     for (i, &f) in floats(&day["freqs_hz"]).iter().enumerate() {
-        assert_eq!(doc["summary"][i]["freq_hz"].as_f64(), Some(f));
+        assert_eq!(doc["summary"][i]["frequency_hz"].as_f64(), Some(f));
         for obs in ["X", "phi", "phi_a"] {
             let want = floats(&day["tilt_psd"][obs])[i];
             let got = psd(&doc, i, obs, "tilt");
@@ -158,7 +158,7 @@ fn welch_band_of_one_bin_is_the_reference_bin_with_its_degrees_of_freedom() {
     let freq: f64 = file
         .group("summary/1")
         .unwrap()
-        .attr("freq_hz")
+        .attr("frequency_hz")
         .unwrap()
         .read_scalar()
         .unwrap();

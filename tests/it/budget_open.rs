@@ -126,7 +126,7 @@ fn user_terms_and_coloured_readout_add_in_quadrature_with_their_groups() {
         }
         let act = g.group("user.actuation").unwrap();
         assert_eq!(str_attr(&act, "source"), "F_b.x");
-        assert_eq!(str_attr(&act, "source_asd_units"), "N/sqrt(Hz)");
+        assert_eq!(str_attr(&act, "source_asd_unit"), "N/sqrt(Hz)");
         let user = psd(&file, &format!("{obs}/user"));
         let named: Vec<String> = common::strs_attr(&g, "terms")
             .into_iter()
@@ -157,7 +157,7 @@ fn user_terms_and_coloured_readout_add_in_quadrature_with_their_groups() {
     let reference = ReferenceModel::new(&Params::from_file(&damped).unwrap());
     let f_b_x = Input::Force(ForceInput::from_name("F_b.x").unwrap());
     for at in doc["summary"].as_array().unwrap() {
-        let f = at["freq_hz"].as_f64().unwrap();
+        let f = at["frequency_hz"].as_f64().unwrap();
         for ob in at["observables"].as_array().unwrap() {
             let o = Observable::from_name(ob["observable"].as_str().unwrap()).unwrap();
             let term = |name: &str| {

@@ -17,7 +17,8 @@ use tiltnoise_core::noise::{
 use tiltnoise_core::params::Params;
 use tiltnoise_core::tf::{evaluate, plan, Input, Method, Request, TransferFunction};
 use tiltnoise_io::{
-    budget_csv_string, write_budget_hdf5, InputMeta, RunMeta, SCHEMA_BUDGET, TOOL_VERSION,
+    budget_csv_string, write_budget_hdf5, InputMeta, RunMeta, SCHEMA_BUDGET, SCHEMA_VERSION_BUDGET,
+    TOOL_VERSION,
 };
 use tiltnoise_plot::budget_figure;
 
@@ -138,7 +139,7 @@ fn read(group: &hdf5::Group, name: &str) -> (Vec<f64>, String) {
     let d = group
         .dataset(name)
         .unwrap_or_else(|e| panic!("dataset {name}: {e}"));
-    (d.read_raw::<f64>().unwrap(), str_attr(&d, "units"))
+    (d.read_raw::<f64>().unwrap(), str_attr(&d, "unit"))
 }
 
 #[test]
@@ -146,13 +147,21 @@ fn hdf5_round_trip_is_bit_exact_and_self_describing() {
     let report = synthetic_report();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("budget.h5");
-    save_budget(&path, &report, &meta(), &input_meta(), &Default::default()).unwrap();
+    save_budget(
+        &path,
+        &report,
+        &meta(),
+        &input_meta(),
+        &Default::default(),
+        true,
+    )
+    .unwrap();
     assert_eq!(listing(dir.path()), vec![path.clone()], "no temporary file");
 
     let file = hdf5::File::open(&path).unwrap();
     assert_eq!(str_attr(&file, "schema"), SCHEMA_BUDGET);
     assert_eq!(SCHEMA_BUDGET, "tiltnoise.budget");
-    assert_eq!(i64_attr(&file, "schema_version"), 1);
+    assert_eq!(i64_attr(&file, "schema_version"), SCHEMA_VERSION_BUDGET);
     assert_eq!(str_attr(&file, "tool_version"), env!("CARGO_PKG_VERSION"));
     assert_eq!(str_attr(&file, "created_by"), meta().command_line);
     assert_eq!(
@@ -216,7 +225,7 @@ fn hdf5_round_trip_is_bit_exact_and_self_describing() {
     }
     let x = file.group("X").unwrap();
     assert_eq!(f64_attr(&x, "readout_asd"), 9e-9);
-    assert_eq!(str_attr(&x, "readout_asd_units"), "m/sqrt(Hz)");
+    assert_eq!(str_attr(&x, "readout_asd_unit"), "m/sqrt(Hz)");
     assert!(file.group("phi").unwrap().attr("readout_asd").is_err());
 
     let seg = file.group("segments").unwrap();
@@ -272,16 +281,23 @@ fn csv_header_and_values_round_trip() {
     let report = synthetic_report();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("budget.csv");
-    save_budget(&path, &report, &meta(), &input_meta(), &Default::default()).unwrap();
+    save_budget(
+        &path,
+        &report,
+        &meta(),
+        &input_meta(),
+        &Default::default(),
+        true,
+    )
+    .unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
-    assert_eq!(text, budget_csv_string(&report).unwrap());
-    assert!(!text.contains('#'));
-    let mut lines = text.lines();
+    assert_eq!(text, budget_csv_string(&report, &meta(), true).unwrap());
+    let mut lines = text.lines().skip_while(|l| l.starts_with('#'));
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     assert_eq!(
         header,
         vec![
-            "freq_hz",
+            "frequency_hz",
             "X.tilt",
             "X.tilt.theta_t",
             "X.tilt.eta_t",
@@ -337,16 +353,17 @@ fn csv_equivalent_columns_follow_the_bands() {
         input: ForceInput::from_name("F_b.x").unwrap(),
         response_psd: response.clone(),
     });
-    let text = budget_csv_string(&report).unwrap();
-    let plain_header = budget_csv_string(&plain)
+    let text = budget_csv_string(&report, &meta(), true).unwrap();
+    let plain_header = budget_csv_string(&plain, &meta(), true)
         .unwrap()
         .lines()
-        .next()
+        .filter(|l| !l.starts_with('#'))
+        .find(|l| !l.starts_with('#'))
         .unwrap()
         .to_string();
     let header: Vec<String> = text
         .lines()
-        .next()
+        .find(|l| !l.starts_with('#'))
         .unwrap()
         .split(',')
         .map(String::from)
@@ -379,6 +396,7 @@ fn csv_equivalent_columns_follow_the_bands() {
     );
     let rows: Vec<Vec<f64>> = text
         .lines()
+        .filter(|l| !l.starts_with('#'))
         .skip(1)
         .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
         .collect();
@@ -406,8 +424,8 @@ fn csv_percentile_names_follow_the_band() {
         b.lower_pct = 2.5;
         b.upper_pct = 97.5;
     }
-    let text = budget_csv_string(&report).unwrap();
-    let header = text.lines().next().unwrap();
+    let text = budget_csv_string(&report, &meta(), true).unwrap();
+    let header = text.lines().find(|l| !l.starts_with('#')).unwrap();
     assert!(
         header.ends_with("phi.tilt.median,phi.tilt.p2.5,phi.tilt.p97.5"),
         "{header}"
@@ -421,8 +439,15 @@ fn inconsistent_report_is_rejected_and_leaves_nothing() {
     let dir = tempfile::tempdir().unwrap();
     for name in ["b.h5", "b.csv", "b.png", "b.svg"] {
         let path = dir.path().join(name);
-        let err =
-            save_budget(&path, &report, &meta(), &input_meta(), &Default::default()).unwrap_err();
+        let err = save_budget(
+            &path,
+            &report,
+            &meta(),
+            &input_meta(),
+            &Default::default(),
+            true,
+        )
+        .unwrap_err();
         let text = err.to_string();
         assert!(text.contains("phi.tilt") && text.contains(name), "{text}");
     }
@@ -435,8 +460,24 @@ fn figures_are_written() {
     let dir = tempfile::tempdir().unwrap();
     let png = dir.path().join("budget.png");
     let svg = dir.path().join("budget.svg");
-    save_budget(&png, &report, &meta(), &input_meta(), &Default::default()).unwrap();
-    save_budget(&svg, &report, &meta(), &input_meta(), &Default::default()).unwrap();
+    save_budget(
+        &png,
+        &report,
+        &meta(),
+        &input_meta(),
+        &Default::default(),
+        true,
+    )
+    .unwrap();
+    save_budget(
+        &svg,
+        &report,
+        &meta(),
+        &input_meta(),
+        &Default::default(),
+        true,
+    )
+    .unwrap();
     let bytes = std::fs::read(&png).unwrap();
     assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
     assert!(bytes.len() > 30_000, "PNG only {} bytes", bytes.len());
@@ -469,8 +510,15 @@ fn missing_directory_is_an_error_naming_the_path() {
     let dir = tempfile::tempdir().unwrap();
     for name in ["b.h5", "b.hdf5", "b.csv", "b.png", "b.svg"] {
         let path = dir.path().join("no-such-dir").join(name);
-        let err =
-            save_budget(&path, &report, &meta(), &input_meta(), &Default::default()).unwrap_err();
+        let err = save_budget(
+            &path,
+            &report,
+            &meta(),
+            &input_meta(),
+            &Default::default(),
+            true,
+        )
+        .unwrap_err();
         match &err {
             OutputError::Write { path: p, .. } => assert_eq!(p, &path),
             other => panic!("{name}: unexpected error {other:?}"),
@@ -494,6 +542,7 @@ fn unknown_extension_is_rejected_before_writing() {
         &meta(),
         &input_meta(),
         &Default::default(),
+        true,
     )
     .unwrap_err();
     assert!(matches!(err, OutputError::UnknownFormat { .. }), "{err:?}");
@@ -619,7 +668,7 @@ fn realistic_budget_renders() {
     for (stem, r) in [("budget", &report), ("budget_measured", &measured)] {
         for ext in ["png", "svg", "h5", "csv"] {
             let path = dir.path().join(format!("{stem}.{ext}"));
-            save_budget(&path, r, &meta(), &input_meta(), &Default::default()).unwrap();
+            save_budget(&path, r, &meta(), &input_meta(), &Default::default(), true).unwrap();
             assert!(std::fs::metadata(&path).unwrap().len() > 1000);
             if let Some(out) = &out {
                 save_budget(
@@ -628,6 +677,7 @@ fn realistic_budget_renders() {
                     &meta(),
                     &input_meta(),
                     &Default::default(),
+                    true,
                 )
                 .unwrap();
             }

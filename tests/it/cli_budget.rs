@@ -69,9 +69,15 @@ fn main_job_on_default_input_writes_every_format() {
         assert!(std::fs::metadata(o).unwrap().len() > 1000, "{o}");
     }
     let csv = std::fs::read_to_string(&outs[1]).unwrap();
-    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let header: Vec<&str> = csv
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .next()
+        .unwrap()
+        .split(',')
+        .collect();
     for col in [
-        "freq_hz",
+        "frequency_hz",
         "X.tilt",
         "X.readout",
         "X.total",
@@ -217,6 +223,7 @@ fn spectra_input_reports_band_restriction() {
     // X at 2 mHz = |H_X,eta_t| * 2e-9 with |H| ~ 1.664 m/rad below the swing modes.
     let line = stdout
         .lines()
+        .filter(|l| !l.starts_with('#'))
         .find(|l| l.contains("X") && l.contains("at    2 mHz"))
         .unwrap();
     let tilt: f64 = line
@@ -255,11 +262,11 @@ fn measured_spectrum_adds_measured_and_residual_terms() {
         String::from_utf8_lossy(&out.stderr)
     );
     let text = std::fs::read_to_string(&out_csv).unwrap();
-    let mut lines = text.lines();
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
     let (f, m, r, t) = (
-        col("freq_hz"),
+        col("frequency_hz"),
         col("X.measured"),
         col("X.residual"),
         col("X.total"),
@@ -350,10 +357,17 @@ fn rate_series_budget_is_the_library_budget_of_the_rate() {
         .unwrap()
         .asd();
     let text = std::fs::read_to_string(&csv).unwrap();
-    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let header: Vec<&str> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .next()
+        .unwrap()
+        .split(',')
+        .collect();
     let col = header.iter().position(|h| *h == "X.tilt").unwrap();
     let got: Vec<f64> = text
         .lines()
+        .filter(|l| !l.starts_with('#'))
         .skip(1)
         .map(|l| l.split(',').nth(col).unwrap().parse().unwrap())
         .collect();

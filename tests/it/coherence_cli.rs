@@ -123,13 +123,13 @@ fn the_model_times_the_gain_comes_back_in_every_format() {
     assert_eq!(str_attr(&file, "time_dependence"), "exp(+i w t)");
     assert_eq!(str_attr(&file, "alignment"), "start_times");
     let freqs = file.dataset("frequency_hz").unwrap();
-    assert_eq!(str_attr(&freqs, "units"), "Hz");
+    assert_eq!(str_attr(&freqs, "unit"), "Hz");
     let nf = freqs.read_raw::<f64>().unwrap().len();
     assert_eq!(nf, 512);
     for (obs, unit) in [("X", "m"), ("phi_a", "rad")] {
         let g = file.group(&format!("observables/{obs}/eta_t")).unwrap();
         assert_eq!(
-            str_attr(&g.dataset("tf").unwrap(), "units"),
+            str_attr(&g.dataset("tf").unwrap(), "unit"),
             format!("{unit}/rad")
         );
         let attr = |name: &str| g.attr(name).unwrap().read_scalar::<f64>().unwrap();
@@ -156,20 +156,44 @@ fn the_model_times_the_gain_comes_back_in_every_format() {
     assert!(g.attr("agreement_factor_re").is_err());
 
     let csv = std::fs::read_to_string(&outs[1]).unwrap();
-    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let header: Vec<&str> = csv
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .next()
+        .unwrap()
+        .split(',')
+        .collect();
     for col in [
-        "freq_hz",
+        "frequency_hz",
         "estimable",
-        "eta_t.psd[rad^2/Hz]",
-        "X.psd[m^2/Hz]",
-        "X.eta_t.coherence[1]",
-        "X.eta_t.tf_re[m/rad]",
-        "phi_a.eta_t.tf_radius[rad/rad]",
-        "phi_a.multiple_coherence_lower[1]",
+        "eta_t.psd",
+        "X.psd",
+        "X.eta_t.coherence",
+        "X.eta_t.tf_re",
+        "phi_a.eta_t.tf_radius",
+        "phi_a.multiple_coherence_lower",
     ] {
         assert!(header.contains(&col), "{col} missing from {header:?}");
     }
-    assert_eq!(csv.lines().count(), nf + 1);
+    // The units line: one `COLUMN=UNIT` per column after the frequency.
+    let units = csv
+        .lines()
+        .find_map(|l| l.strip_prefix("# units: "))
+        .unwrap();
+    for unit in [
+        "eta_t.psd=rad^2/Hz",
+        "X.psd=m^2/Hz",
+        "X.eta_t.coherence=1",
+        "X.eta_t.tf_re=m/rad",
+        "phi_a.eta_t.tf_radius=rad/rad",
+    ] {
+        assert!(
+            units.split(", ").any(|u| u == unit),
+            "{unit} missing from {units}"
+        );
+    }
+    assert_eq!(units.split(", ").count(), header.len() - 1);
+    assert_eq!(csv.lines().filter(|l| !l.starts_with('#')).count(), nf + 1);
     let png = std::fs::read(&outs[2]).unwrap();
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     let svg = std::fs::read_to_string(&outs[3]).unwrap();
@@ -422,13 +446,17 @@ fn saved_files_hold_the_report_exactly() {
     assert_eq!(tf, x.axes[1].tf);
     // CSV: every value parses back to the same f64.
     let text = std::fs::read_to_string(&csv).unwrap();
-    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    let col = header
-        .iter()
-        .position(|h| *h == "X.eta_t.tf_im[m/rad]")
-        .unwrap();
+    let header: Vec<&str> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .next()
+        .unwrap()
+        .split(',')
+        .collect();
+    let col = header.iter().position(|h| *h == "X.eta_t.tf_im").unwrap();
     let back: Vec<f64> = text
         .lines()
+        .filter(|l| !l.starts_with('#'))
         .skip(1)
         .map(|l| l.split(',').nth(col).unwrap().parse().unwrap())
         .collect();

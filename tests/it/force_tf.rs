@@ -32,7 +32,7 @@ fn params_damped() -> Params {
 
 /// Parses the CSV that `tf` prints: header, then rows `f, (re, im) per entry`.
 fn parse_csv(text: &str) -> (Vec<String>, Vec<f64>, Vec<Vec<Complex64>>) {
-    let mut lines = text.lines();
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
     let header: Vec<String> = lines
         .next()
         .unwrap()

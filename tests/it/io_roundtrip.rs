@@ -59,7 +59,10 @@ fn hdf5_round_trip_is_bit_exact_and_self_describing() {
         version.dtype().unwrap().to_descriptor().unwrap(),
         hdf5::types::TypeDescriptor::Integer(_)
     ));
-    assert_eq!(version.read_scalar::<i64>().unwrap(), 1);
+    assert_eq!(
+        version.read_scalar::<i64>().unwrap(),
+        tiltnoise_io::SCHEMA_VERSION_TF
+    );
     assert_eq!(str_attr(&file, "tool_version"), env!("CARGO_PKG_VERSION"));
     assert_eq!(str_attr(&file, "created_by"), meta.command_line);
     assert_eq!(str_attr(&file, "method"), "direct");
@@ -78,7 +81,7 @@ fn hdf5_round_trip_is_bit_exact_and_self_describing() {
     assert_eq!(str_attr(&file, "time_dependence"), "exp(+i w t)");
 
     let f = file.dataset("frequency_hz").unwrap();
-    assert_eq!(str_attr(&f, "units"), "Hz");
+    assert_eq!(str_attr(&f, "unit"), "Hz");
     let f = f.read_1d::<f64>().unwrap();
     assert_eq!(f.len(), tf.freqs_hz.len());
     for (a, b) in f.iter().zip(&tf.freqs_hz) {
@@ -91,7 +94,7 @@ fn hdf5_round_trip_is_bit_exact_and_self_describing() {
     assert_eq!(h.shape(), vec![tf.freqs_hz.len(), 7, 3]);
     assert_eq!(strs_attr(&h, "outputs"), outputs);
     assert_eq!(strs_attr(&h, "inputs"), inputs);
-    let units = strs_attr(&h, "units");
+    let units = strs_attr(&h, "unit");
     assert_eq!(units.len(), 21);
     assert_eq!(&units[..3], ["m/rad"; 3]);
     assert_eq!(&units[9..12], ["rad/rad"; 3]);
@@ -129,7 +132,7 @@ fn hdf5_round_trip_is_bit_exact_and_self_describing() {
     ));
     assert_eq!(idx.read_1d::<i64>().unwrap().to_vec(), [1, 2, 8]);
     let mf = file.dataset("modes/frequency_hz").unwrap();
-    assert_eq!(str_attr(&mf, "units"), "Hz");
+    assert_eq!(str_attr(&mf, "unit"), "Hz");
     assert_eq!(mf.read_1d::<f64>().unwrap().to_vec(), [0.0123, 0.5, 17.25]);
 }
 
@@ -161,14 +164,14 @@ fn csv_round_trip_is_bit_exact() {
 
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(text.ends_with('\n'));
-    let mut lines = text.lines();
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
     let header = lines.next().unwrap();
     assert!(header.starts_with(
-        "freq_hz,X.theta_t.re,X.theta_t.im,X.eta_t.re,X.eta_t.im,X.phi_t.re,X.phi_t.im,\
+        "frequency_hz,X.theta_t.re,X.theta_t.im,X.eta_t.re,X.eta_t.im,X.phi_t.re,X.phi_t.im,\
          Y.theta_t.re,Y.theta_t.im,"
     ));
     assert!(header.ends_with(",phi_a.phi_t.re,phi_a.phi_t.im"));
-    let mut expected = vec!["freq_hz".to_string()];
+    let mut expected = vec!["frequency_hz".to_string()];
     for o in &tf.outputs {
         for i in &tf.inputs {
             for part in ["re", "im"] {
@@ -295,8 +298,13 @@ fn overwriting_an_existing_file_works() {
     );
     drop(file);
     let text = std::fs::read_to_string(&csv).unwrap();
-    assert_eq!(text.lines().count(), 2);
-    assert!(text.lines().nth(1).unwrap().starts_with("2,"));
+    assert_eq!(text.lines().filter(|l| !l.starts_with('#')).count(), 2);
+    assert!(text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .nth(1)
+        .unwrap()
+        .starts_with("2,"));
     assert_eq!(listing(dir.path()), vec![csv, h5]);
 }
 
@@ -345,8 +353,15 @@ fn failed_write_does_not_clobber_an_existing_file() {
 fn csv_writer_can_be_called_directly() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("direct.csv");
-    write_tf_csv(&path, &table_i_tf(&[1.0])).unwrap();
-    assert_eq!(std::fs::read_to_string(&path).unwrap().lines().count(), 2);
+    write_tf_csv(
+        &path,
+        &table_i_tf(&[1.0]),
+        &tiltnoise_io::RunMeta::default(),
+    )
+    .unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    // The `#` lines, the header and one line per frequency.
+    assert_eq!(text.lines().filter(|l| !l.starts_with('#')).count(), 2);
     assert_eq!(listing(dir.path()), vec![path]);
 }
 

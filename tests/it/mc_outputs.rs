@@ -255,7 +255,7 @@ fn hdf5_png_svg_round_trip() {
             .unwrap()
             .read_scalar::<i64>()
             .unwrap(),
-        1
+        tiltnoise_io::SCHEMA_VERSION_MC
     );
     let int = |name: &str| f.attr(name).unwrap().read_scalar::<i64>().unwrap();
     assert_eq!(f.attr("seed").unwrap().read_scalar::<u64>().unwrap(), 9);

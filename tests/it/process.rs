@@ -74,7 +74,7 @@ fn a_reader_that_goes_away_ends_the_run_quietly() {
         .unwrap();
     let mut first = [0u8; 1];
     child.stdout.take().unwrap().read_exact(&mut first).unwrap();
-    assert_eq!(&first, b"f", "the CSV starts with its header freq_hz,...");
+    assert_eq!(&first, b"#", "the CSV starts with its `#` lines");
     // The read end is closed here, with the rest unread.
     let status = wait_bounded(&mut child, Duration::from_secs(120));
     let err = child_stderr(&mut child);

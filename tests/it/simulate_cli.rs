@@ -65,7 +65,7 @@ fn default_run_agrees_with_the_table_and_writes_the_budget_layout() {
     for o in Observable::ALL {
         let ds = f.dataset(o.name()).unwrap();
         assert_eq!(ds.shape(), vec![432_000]);
-        assert_eq!(str_attr(&ds, "units"), o.unit());
+        assert_eq!(str_attr(&ds, "unit"), o.unit());
     }
     let q0 = f
         .dataset("initial_state/q")
@@ -90,7 +90,7 @@ fn default_run_agrees_with_the_table_and_writes_the_budget_layout() {
     let units: VarLenUnicode = f
         .dataset("asd/X")
         .unwrap()
-        .attr("units")
+        .attr("unit")
         .unwrap()
         .read_scalar()
         .unwrap();

@@ -252,7 +252,7 @@ fn verification_end_to_end() {
     ]);
     assert!(out.status.success(), "{}", common::stderr(&out));
     let text = std::fs::read_to_string(&csv).unwrap();
-    let mut lines = text.lines();
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
     let col = header
         .iter()

@@ -3,31 +3,48 @@
 
 use super::format_f64;
 use crate::atomic::write_atomic;
+use crate::budget_hdf5::SPECTRAL_CONVENTION;
+use crate::csv_layout::{csv_head, drop_zero_columns, zero_columns_note, CsvPreamble};
+use crate::RunMeta;
 use std::io::{BufWriter, Write as _};
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
 use tiltnoise_core::noise::BudgetReport;
 
+/// Value of the `# schema:` line of a budget CSV.
+pub const SCHEMA_BUDGET_CSV: &str = "tiltnoise.budget_csv";
+
+/// Value of the `# schema_version:` line. Bumped on any change that can break a reader.
+pub const SCHEMA_VERSION_BUDGET_CSV: u32 = 2;
+
 /// Writes the budget's ASDs as CSV, atomically (see [`super::write_atomic`]).
 ///
-/// One header line, `freq_hz` followed by `OBS.TERM` for every observable `OBS` and term `TERM`
-/// in the report's order (`X.tilt,X.tilt.eta_t,X.readout,X.total,phi.tilt,...`), then, if the
-/// report has segment bands, `OBS.tilt.median,OBS.tilt.pLO,OBS.tilt.pHI` per band (`LO`, `HI`:
-/// the percentiles, e.g. `X.tilt.p10`), then, for observables whose budget carries the response
-/// to their equivalent input (damped models), `OBS.equivalent.TERM` for the terms referred to
-/// that input (`X`: test-mass acceleration, m s^-2/sqrt(Hz); `phi`, `phi_a`: torque, N
-/// m/sqrt(Hz); see [`tiltnoise_core::noise::equivalent`]). Then one line per frequency. Every value is
-/// an ASD, `sqrt(PSD)`, in the observable's unit/sqrt(Hz) except the `equivalent` columns,
-/// written so that it parses back to exactly the same `f64` ([`format_f64`]). No comment lines:
-/// the file loads directly into pandas or NumPy.
+/// The layout of every tiltnoise CSV ([`crate::csv_layout`]): `#` lines (schema, provenance,
+/// notes, `# units:`), then one header line, `frequency_hz` followed by `OBS.TERM` for every
+/// observable `OBS` and term `TERM` in the report's order
+/// (`X.tilt,X.tilt.eta_t,X.readout,X.total,phi.tilt,...`), then, if the report has segment
+/// bands, `OBS.tilt.median,OBS.tilt.pLO,OBS.tilt.pHI` per band (`LO`, `HI`: the percentiles,
+/// e.g. `X.tilt.p10`), then, for observables whose budget carries the response to their
+/// equivalent input (damped models), `OBS.equivalent.TERM` for the terms referred to that
+/// input (`X`: test-mass acceleration, m s^-2/sqrt(Hz); `phi`, `phi_a`: torque, N
+/// m/sqrt(Hz); see [`tiltnoise_core::noise::equivalent`]). Then one line per frequency. Every
+/// value is a one-sided ASD, `sqrt(PSD)`, in the unit the `# units:` line gives, written so
+/// that it parses back to exactly the same `f64` ([`format_f64`]). Columns that are zero at
+/// every frequency (a term the model has but this run does not excite) are left out and named
+/// in a `# note:` line, unless `keep_zero_columns`.
 ///
 /// # Errors
 ///
 /// [`OutputError::Write`] naming `path` if the report is inconsistent (a spectrum whose length
 /// differs from the frequency grid) or on any I/O failure; nothing is left at `path`.
-pub fn write_budget_csv(path: &Path, report: &BudgetReport) -> Result<(), OutputError> {
+pub fn write_budget_csv(
+    path: &Path,
+    report: &BudgetReport,
+    meta: &RunMeta,
+    keep_zero_columns: bool,
+) -> Result<(), OutputError> {
     write_atomic(path, |temp| {
-        let text = budget_csv_string(report)?;
+        let text = budget_csv_string(report, meta, keep_zero_columns)?;
         let file = std::fs::File::create(temp).map_err(|e| e.to_string())?;
         let mut out = BufWriter::new(file);
         out.write_all(text.as_bytes())
@@ -41,20 +58,32 @@ pub fn write_budget_csv(path: &Path, report: &BudgetReport) -> Result<(), Output
 /// # Errors
 ///
 /// A message naming the first spectrum whose length differs from the frequency grid.
-pub fn budget_csv_string(report: &BudgetReport) -> Result<String, String> {
+pub fn budget_csv_string(
+    report: &BudgetReport,
+    meta: &RunMeta,
+    keep_zero_columns: bool,
+) -> Result<String, String> {
     report.check()?;
-    let (names, columns) = asd_columns(report);
+    let mut columns = asd_columns(report);
+    let dropped = drop_zero_columns(&mut columns, keep_zero_columns);
+    let mut notes = vec![format!("every column an ASD; {SPECTRAL_CONVENTION}")];
+    notes.extend(zero_columns_note(&dropped, "--keep-zero-columns"));
+    let preamble = CsvPreamble {
+        schema: SCHEMA_BUDGET_CSV,
+        schema_version: SCHEMA_VERSION_BUDGET_CSV,
+        meta,
+        notes,
+    };
+    let heads: Vec<(String, String)> = columns
+        .iter()
+        .map(|(n, u, _)| (n.clone(), u.clone()))
+        .collect();
     let n_f = report.budget.freqs_hz.len();
-    let mut s = String::with_capacity((n_f + 1) * (1 + columns.len()) * 24);
-    s.push_str("freq_hz");
-    for name in &names {
-        s.push(',');
-        s.push_str(name);
-    }
-    s.push('\n');
+    let mut s = csv_head(&preamble, &heads);
+    s.reserve((n_f + 1) * (1 + columns.len()) * 24);
     for (k, &f) in report.budget.freqs_hz.iter().enumerate() {
         s.push_str(&format_f64(f));
-        for column in &columns {
+        for (_, _, column) in &columns {
             s.push(',');
             s.push_str(&format_f64(column[k]));
         }
@@ -63,25 +92,26 @@ pub fn budget_csv_string(report: &BudgetReport) -> Result<String, String> {
     Ok(s)
 }
 
-/// Column names and ASD values (without the frequency column), in file order.
-fn asd_columns(report: &BudgetReport) -> (Vec<String>, Vec<Vec<f64>>) {
-    let mut names = Vec::new();
+/// `(name, unit, ASD values)` of every column after the frequency, in file order.
+fn asd_columns(report: &BudgetReport) -> Vec<(String, String, Vec<f64>)> {
+    let sqrt = |v: &[f64]| v.iter().map(|p| p.sqrt()).collect::<Vec<f64>>();
+    let asd_unit = |u: &str| format!("{u}/sqrt(Hz)");
     let mut columns = Vec::new();
     for ob in &report.budget.observables {
+        let unit = asd_unit(ob.observable.unit());
         for (component, psd) in ob.components() {
-            names.push(format!("{}.{}", ob.observable.name(), component.name()));
-            columns.push(psd.iter().map(|p| p.sqrt()).collect());
+            let name = format!("{}.{}", ob.observable.name(), component.name());
+            columns.push((name, unit.clone(), sqrt(&psd)));
         }
     }
     for (o, band) in &report.segment_bands {
+        let unit = asd_unit(o.unit());
         let o = o.name();
-        let sqrt = |v: &[f64]| v.iter().map(|p| p.sqrt()).collect::<Vec<f64>>();
-        names.push(format!("{o}.tilt.median"));
-        columns.push(sqrt(&band.median));
-        names.push(format!("{o}.tilt.p{}", format_f64(band.lower_pct)));
-        columns.push(sqrt(&band.lower));
-        names.push(format!("{o}.tilt.p{}", format_f64(band.upper_pct)));
-        columns.push(sqrt(&band.upper));
+        columns.push((format!("{o}.tilt.median"), unit.clone(), sqrt(&band.median)));
+        let lower = format!("{o}.tilt.p{}", format_f64(band.lower_pct));
+        columns.push((lower, unit.clone(), sqrt(&band.lower)));
+        let upper = format!("{o}.tilt.p{}", format_f64(band.upper_pct));
+        columns.push((upper, unit, sqrt(&band.upper)));
     }
     // Last, so that the columns above keep their places: the noise referred to the test
     // mass's actuation input (damped models), in that input's unit.
@@ -89,11 +119,11 @@ fn asd_columns(report: &BudgetReport) -> (Vec<String>, Vec<Vec<f64>>) {
         let Some(referred) = tiltnoise_core::noise::equivalent::referred_terms(ob) else {
             continue;
         };
+        let unit = asd_unit(referred.unit);
         for (component, psd) in &referred.terms {
-            let name = component.name();
-            names.push(format!("{}.equivalent.{name}", ob.observable.name()));
-            columns.push(psd.iter().map(|p| p.sqrt()).collect());
+            let name = format!("{}.equivalent.{}", ob.observable.name(), component.name());
+            columns.push((name, unit.clone(), sqrt(psd)));
         }
     }
-    (names, columns)
+    columns
 }

@@ -14,7 +14,7 @@ use tiltnoise_core::noise::{
 pub const SCHEMA_BUDGET: &str = "tiltnoise.budget";
 
 /// Value of the root attribute `schema_version`. Bumped on any change that can break a reader.
-pub const SCHEMA_VERSION_BUDGET: i64 = 1;
+pub const SCHEMA_VERSION_BUDGET: i64 = 2;
 
 /// Value of the root attribute `spectral_convention`.
 pub const SPECTRAL_CONVENTION: &str =
@@ -116,8 +116,9 @@ fn write_file(
         .collect();
     strs_attr(&file, "observables", &observables)?;
 
+    let grid = even_grid(&report.budget.freqs_hz);
     let freq = dataset(&file, "frequency_hz", &report.budget.freqs_hz)?;
-    str_attr(&freq, "units", "Hz")?;
+    str_attr(&freq, "unit", "Hz")?;
 
     for ob in &report.budget.observables {
         let o = ob.observable;
@@ -130,14 +131,14 @@ fn write_file(
         strs_attr(&group, "terms", &terms)?;
         if let Some(asd) = report.readout.of(o) {
             scalar_attr(&group, "readout_asd", asd)?;
-            str_attr(&group, "readout_asd_units", &asd_unit(unit))?;
+            str_attr(&group, "readout_asd_unit", &asd_unit(unit))?;
         }
         if let Some(given) = report.readout.given_of(o) {
             str_attr(&group, "readout_given", given.origin())?;
         }
         for (component, psd) in &components {
             let g = group.create_group(&component.name())?;
-            write_psd_asd(&g, "psd", "asd", psd, unit)?;
+            write_psd_asd(&g, "psd", "asd", psd, unit, grid)?;
             let Component::Term(kind) = component else {
                 str_attr(&g, "group", TOTAL_NAME)?;
                 continue;
@@ -146,13 +147,13 @@ fn write_file(
             if let TermKind::UserNamed(name) = kind {
                 if let Some(t) = report.user_terms.iter().find(|t| &t.name == name) {
                     str_attr(&g, "source", t.source.name())?;
-                    str_attr(&g, "source_asd_units", &t.source.asd_unit())?;
+                    str_attr(&g, "source_asd_unit", &t.source.asd_unit())?;
                     str_attr(&g, "given", t.asd.origin())?;
                 }
             }
         }
         if let Some(referred) = referred_terms(ob) {
-            write_equivalent(&group, &referred, unit)?;
+            write_equivalent(&group, &referred, unit, grid)?;
         }
     }
 
@@ -183,6 +184,7 @@ fn write_file(
                     &format!("tilt_asd_{suffix}"),
                     psd,
                     unit,
+                    grid,
                 )?;
             }
         }
@@ -208,12 +210,12 @@ fn write_summary(file: &hdf5::File, summary: &[SummaryAt]) -> hdf5::Result<()> {
     let rel = |psd: f64, std: f64| if psd > 0.0 { std / (2.0 * psd) } else { 0.0 };
     for (i, at) in summary.iter().enumerate() {
         let g = root.create_group(&i.to_string())?;
-        scalar_attr(&g, "freq_hz", at.freq_hz)?;
+        scalar_attr(&g, "frequency_hz", at.freq_hz)?;
         scalar_attr(&g, "band_lo_hz", at.band_hz.0)?;
         scalar_attr(&g, "band_hi_hz", at.band_hz.1)?;
         for ob in &at.observables {
             let og = g.create_group(ob.observable.name())?;
-            str_attr(&og, "asd_units", &asd_unit(ob.observable.unit()))?;
+            str_attr(&og, "asd_unit", &asd_unit(ob.observable.unit()))?;
             let mut names: Vec<String> = ob.terms.iter().map(|t| t.kind.name()).collect();
             names.push(tiltnoise_core::noise::TOTAL_NAME.to_string());
             let names: Vec<&str> = names.iter().map(String::as_str).collect();
@@ -251,6 +253,7 @@ fn write_equivalent(
     group: &hdf5::Group,
     referred: &tiltnoise_core::noise::equivalent::Referred<'_>,
     unit: &str,
+    grid: Option<(f64, f64)>,
 ) -> hdf5::Result<()> {
     let g = group.create_group("equivalent")?;
     str_attr(&g, "input", referred.input)?;
@@ -261,10 +264,10 @@ fn write_equivalent(
     strs_attr(&g, "terms", &names)?;
     let abs: Vec<f64> = referred.response_psd.iter().map(|p| p.sqrt()).collect();
     let d = dataset(&g, "response_abs", &abs)?;
-    str_attr(&d, "units", &format!("{unit}/({})", referred.unit))?;
+    str_attr(&d, "unit", &format!("{unit}/({})", referred.unit))?;
     for (component, psd) in &referred.terms {
         let t = g.create_group(&component.name())?;
-        write_psd_asd(&t, "psd", "asd", psd, referred.unit)?;
+        write_psd_asd(&t, "psd", "asd", psd, referred.unit, grid)?;
     }
     Ok(())
 }
@@ -274,20 +277,43 @@ fn asd_unit(unit: &str) -> String {
     format!("{unit}/sqrt(Hz)")
 }
 
-/// Datasets `psd_name` (unit^2/Hz) and `asd_name` (sqrt of it, unit/sqrt(Hz)) in `group`.
+/// Datasets `psd_name` (unit^2/Hz) and `asd_name` (sqrt of it, unit/sqrt(Hz)) in `group`,
+/// each with a `unit` attribute and, on an evenly spaced grid, `f0` and `df` (Hz): exactly
+/// the attributes gwpy's `FrequencySeries.read(file, path=...)` takes as keywords.
 fn write_psd_asd(
     group: &hdf5::Group,
     psd_name: &str,
     asd_name: &str,
     psd: &[f64],
     unit: &str,
+    grid: Option<(f64, f64)>,
 ) -> hdf5::Result<()> {
     let asd: Vec<f64> = psd.iter().map(|p| p.sqrt()).collect();
-    let d = dataset(group, psd_name, psd)?;
-    str_attr(&d, "units", &format!("{unit}^2/Hz"))?;
-    let d = dataset(group, asd_name, &asd)?;
-    str_attr(&d, "units", &asd_unit(unit))?;
+    for (name, values, unit) in [
+        (psd_name, psd, format!("{unit}^2/Hz")),
+        (asd_name, asd.as_slice(), asd_unit(unit)),
+    ] {
+        let d = dataset(group, name, values)?;
+        str_attr(&d, "unit", &unit)?;
+        if let Some((f0, df)) = grid {
+            scalar_attr(&d, "f0", f0)?;
+            scalar_attr(&d, "df", df)?;
+        }
+    }
     Ok(())
+}
+
+/// `(f0, df)` if `freqs_hz[k] = f0 + k df` for every `k` to within 4 ulp (a Welch grid), else
+/// `None` (spectra given at arbitrary frequencies).
+pub(crate) fn even_grid(freqs_hz: &[f64]) -> Option<(f64, f64)> {
+    let (&f0, &f1) = (freqs_hz.first()?, freqs_hz.get(1)?);
+    let df = f1 - f0;
+    let even = df > 0.0
+        && freqs_hz.iter().enumerate().all(|(k, &f)| {
+            let expected = f0 + k as f64 * df;
+            (f - expected).abs() <= 4.0 * f64::EPSILON * f.abs()
+        });
+    even.then_some((f0, df))
 }
 
 fn int(n: usize) -> hdf5::Result<i64> {

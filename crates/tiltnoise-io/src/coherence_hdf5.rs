@@ -14,7 +14,7 @@ use tiltnoise_core::error::OutputError;
 pub const SCHEMA_COHERENCE: &str = "tiltnoise.coherence";
 
 /// Value of the root attribute `schema_version`. Bumped on any change that can break a reader.
-pub const SCHEMA_VERSION_COHERENCE: i64 = 1;
+pub const SCHEMA_VERSION_COHERENCE: i64 = 2;
 
 /// Where the two records of a coherence run came from.
 #[derive(Debug, Clone, PartialEq)]
@@ -59,7 +59,7 @@ fn unit_dataset<T: hdf5::H5Type>(
     units: &str,
 ) -> hdf5::Result<()> {
     let ds = dataset(group, name, data)?;
-    str_attr(&ds, "units", units)
+    str_attr(&ds, "unit", units)
 }
 
 fn write_file(
@@ -131,7 +131,7 @@ fn write_file(
     )?;
     if let Some((lo, hi)) = report.fit_band_hz {
         let band = dataset(&file, "fit_band_hz", &[lo, hi])?;
-        str_attr(&band, "units", "Hz")?;
+        str_attr(&band, "unit", "Hz")?;
     }
     let notes: Vec<&str> = tilt
         .notes
@@ -149,14 +149,14 @@ fn write_file(
     let tilt_group = file.create_group("tilt")?;
     for (axis, psd) in report.axes.iter().zip(&report.tilt_psd) {
         let g = tilt_group.create_group(axis.name())?;
-        str_attr(&g, "units", "rad")?;
+        str_attr(&g, "unit", "rad")?;
         unit_dataset(&g, "psd", psd, "rad^2/Hz")?;
     }
     let observables = file.create_group("observables")?;
     for ob in &report.observables {
         let unit = ob.observable.unit();
         let g = observables.create_group(ob.observable.name())?;
-        str_attr(&g, "units", unit)?;
+        str_attr(&g, "unit", unit)?;
         unit_dataset(&g, "psd", &ob.psd, &format!("{unit}^2/Hz"))?;
         unit_dataset(
             &g,

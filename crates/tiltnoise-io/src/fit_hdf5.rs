@@ -1,75 +1,77 @@
-//! The fit's HDF5 file (`tiltnoise fit --save fit.h5`; layout in `docs/fit.md`).
+//! The fit's HDF5 file (`tiltnoise fit --save fit.h5`; schema `tiltnoise.fit`, layout in
+//! `docs/fit.md` and `docs/schemas.md`).
 
+use super::h5util::{dataset, scalar_attr, str_attr, strings, strs_attr};
+use super::RunMeta;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
 use tiltnoise_core::fit::{Bound, FitResult};
 
-/// Writes the result of a fit to `path` as HDF5, atomically: root attributes (tool version,
-/// origin of the measured frequencies, stop reason, fitted parameter file, chi^2), group
-/// `/parameters` (one entry per free parameter) and `/modes` (one per measured mode), and the
-/// singular values of the weighted Jacobian.
+/// Value of the root attribute `schema`.
+pub const SCHEMA_FIT: &str = "tiltnoise.fit";
+
+/// Value of the root attribute `schema_version`. Bumped on any change that can break a reader.
+pub const SCHEMA_VERSION_FIT: i64 = 2;
+
+/// Writes the result of a fit to `path` as HDF5, atomically: root attributes (schema and
+/// provenance, origin of the measured frequencies, stop reason, fitted parameter file, chi^2),
+/// group `/parameters` (one entry per free parameter) and `/modes` (one per measured mode),
+/// and the singular values of the weighted Jacobian. Every numeric dataset has a `unit`
+/// attribute (an array of one unit per entry where the entries differ); indices and counts
+/// are integers.
 ///
 /// # Errors
 ///
 /// [`OutputError::Write`] naming `path`; nothing is left there.
-pub fn write_fit_hdf5(path: &Path, r: &FitResult, origin: &str) -> Result<(), OutputError> {
+pub fn write_fit_hdf5(
+    path: &Path,
+    r: &FitResult,
+    origin: &str,
+    meta: &RunMeta,
+) -> Result<(), OutputError> {
     crate::write_atomic(path, |tmp| {
-        write_h5(tmp, r, origin).map_err(|e| crate::first_line(&e.to_string()))
+        write_h5(tmp, r, origin, meta).map_err(|e| crate::first_line(&e.to_string()))
     })
 }
 
-fn write_h5(path: &Path, r: &FitResult, origin: &str) -> hdf5::Result<()> {
-    use hdf5::types::VarLenUnicode;
-    use ndarray::{arr0, ArrayView1};
+fn write_h5(path: &Path, r: &FitResult, origin: &str, meta: &RunMeta) -> hdf5::Result<()> {
     let file = hdf5::File::create(path)?;
-    let vstr = |s: &str| -> hdf5::Result<VarLenUnicode> {
-        s.parse::<VarLenUnicode>().map_err(|e| e.to_string().into())
+    str_attr(&file, "schema", SCHEMA_FIT)?;
+    scalar_attr(&file, "schema_version", SCHEMA_VERSION_FIT)?;
+    str_attr(&file, "tool_version", &meta.tool_version)?;
+    str_attr(&file, "created_by", &meta.command_line)?;
+    str_attr(&file, "measured_origin", origin)?;
+    str_attr(&file, "stop", r.stop.describe())?;
+    str_attr(&file, "fitted_params_toml", &r.fitted_params.to_toml())?;
+    scalar_attr(&file, "bound_sigmas", r.config.bound_sigmas)?;
+    scalar_attr(&file, "chi2_nominal", r.chi2_nominal)?;
+    scalar_attr(&file, "chi2", r.chi2)?;
+    scalar_attr(&file, "prior_term", r.prior_term)?;
+    scalar_attr(&file, "dof", int(r.dof)?)?;
+    scalar_attr(&file, "prior", u8::from(r.config.prior))?;
+    let with_unit = |g: &hdf5::Group, name: &str, data: &[f64], unit: &str| {
+        let d = dataset(g, name, data)?;
+        str_attr(&d, "unit", unit)
     };
-    let attr_str = |loc: &hdf5::Location, name: &str, value: &str| -> hdf5::Result<()> {
-        loc.new_attr_builder()
-            .with_data(&arr0(vstr(value)?))
-            .create(name)?;
-        Ok(())
+    let units: Vec<&str> = r.params.iter().map(|x| x.unit.as_str()).collect();
+    let per_param = |g: &hdf5::Group, name: &str, data: Vec<f64>| -> hdf5::Result<()> {
+        let d = dataset(g, name, &data)?;
+        strs_attr(&d, "unit", &units)
     };
-    let attr_f64 = |loc: &hdf5::Location, name: &str, value: f64| -> hdf5::Result<()> {
-        loc.new_attr_builder()
-            .with_data(&arr0(value))
-            .create(name)?;
-        Ok(())
-    };
-    attr_str(&file, "tool_version", crate::TOOL_VERSION)?;
-    attr_str(&file, "measured_origin", origin)?;
-    attr_str(&file, "stop", r.stop.describe())?;
-    attr_str(&file, "fitted_params_toml", &r.fitted_params.to_toml())?;
-    attr_f64(&file, "bound_sigmas", r.config.bound_sigmas)?;
-    attr_f64(&file, "chi2_nominal", r.chi2_nominal)?;
-    attr_f64(&file, "chi2", r.chi2)?;
-    attr_f64(&file, "prior_term", r.prior_term)?;
-    attr_f64(&file, "dof", r.dof as f64)?;
-    attr_f64(&file, "prior", if r.config.prior { 1.0 } else { 0.0 })?;
-    let ds_f64 = |g: &hdf5::Group, name: &str, data: Vec<f64>| -> hdf5::Result<()> {
-        g.new_dataset_builder()
-            .with_data(ArrayView1::from(&data))
-            .create(name)?;
-        Ok(())
-    };
-    let ds_str = |g: &hdf5::Group, name: &str, data: Vec<String>| -> hdf5::Result<()> {
-        let v: Vec<VarLenUnicode> = data.iter().map(|s| vstr(s)).collect::<Result<_, _>>()?;
-        g.new_dataset_builder()
-            .with_data(ArrayView1::from(&v))
-            .create(name)?;
+    let strs = |g: &hdf5::Group, name: &str, data: Vec<String>| -> hdf5::Result<()> {
+        dataset(g, name, &strings(&data)?)?;
         Ok(())
     };
     let p = file.create_group("parameters")?;
-    ds_str(&p, "key", r.params.iter().map(|x| x.key.clone()).collect())?;
-    ds_str(
+    strs(&p, "key", r.params.iter().map(|x| x.key.clone()).collect())?;
+    strs(
         &p,
         "unit",
         r.params.iter().map(|x| x.unit.clone()).collect(),
     )?;
-    ds_f64(&p, "nominal", r.params.iter().map(|x| x.nominal).collect())?;
-    ds_f64(&p, "fitted", r.params.iter().map(|x| x.fitted).collect())?;
-    ds_f64(
+    per_param(&p, "nominal", r.params.iter().map(|x| x.nominal).collect())?;
+    per_param(&p, "fitted", r.params.iter().map(|x| x.fitted).collect())?;
+    per_param(
         &p,
         "fitted_sigma",
         r.params
@@ -77,12 +79,12 @@ fn write_h5(path: &Path, r: &FitResult, origin: &str) -> hdf5::Result<()> {
             .map(|x| x.fitted_sigma.unwrap_or(f64::NAN))
             .collect(),
     )?;
-    ds_f64(
+    per_param(
         &p,
         "prior_sigma",
         r.params.iter().map(|x| x.prior_sigma).collect(),
     )?;
-    ds_str(
+    strs(
         &p,
         "at_bound",
         r.params
@@ -90,42 +92,29 @@ fn write_h5(path: &Path, r: &FitResult, origin: &str) -> hdf5::Result<()> {
             .map(|x| x.at_bound.map_or("", Bound::name).to_string())
             .collect(),
     )?;
-    ds_f64(
-        &p,
-        "data_sigma_rel",
-        r.params.iter().map(|x| x.data_sigma_rel).collect(),
-    )?;
+    let rel: Vec<f64> = r.params.iter().map(|x| x.data_sigma_rel).collect();
+    with_unit(&p, "data_sigma_rel", &rel, "1")?;
     let m = file.create_group("modes")?;
-    ds_f64(
-        &m,
-        "index",
-        r.modes.iter().map(|x| x.measured.mode as f64).collect(),
-    )?;
-    ds_f64(
-        &m,
-        "measured_hz",
-        r.modes.iter().map(|x| x.measured.frequency_hz).collect(),
-    )?;
-    ds_f64(
-        &m,
-        "sigma_hz",
-        r.modes.iter().map(|x| x.measured.sigma_hz).collect(),
-    )?;
-    ds_f64(
-        &m,
-        "nominal_hz",
-        r.modes.iter().map(|x| x.nominal_hz).collect(),
-    )?;
-    ds_f64(
-        &m,
-        "fitted_hz",
-        r.modes.iter().map(|x| x.fitted_hz).collect(),
-    )?;
-    ds_f64(
-        &m,
-        "residual_hz",
-        r.modes.iter().map(|x| x.residual_hz()).collect(),
-    )?;
-    ds_f64(&file, "singular_values", r.singular_values.clone())?;
+    let index: Vec<i64> = r
+        .modes
+        .iter()
+        .map(|x| int(x.measured.mode))
+        .collect::<hdf5::Result<_>>()?;
+    let d = dataset(&m, "index", &index)?;
+    str_attr(&d, "unit", "1")?;
+    let hz = |f: fn(&tiltnoise_core::fit::ModeFit) -> f64| -> Vec<f64> {
+        r.modes.iter().map(f).collect()
+    };
+    with_unit(&m, "measured_hz", &hz(|x| x.measured.frequency_hz), "Hz")?;
+    with_unit(&m, "sigma_hz", &hz(|x| x.measured.sigma_hz), "Hz")?;
+    with_unit(&m, "nominal_hz", &hz(|x| x.nominal_hz), "Hz")?;
+    with_unit(&m, "fitted_hz", &hz(|x| x.fitted_hz), "Hz")?;
+    with_unit(&m, "residual_hz", &hz(|x| x.residual_hz()), "Hz")?;
+    // Of the Jacobian weighted by the measurement errors: dimensionless.
+    with_unit(&file, "singular_values", &r.singular_values, "1")?;
     Ok(())
+}
+
+fn int(n: usize) -> hdf5::Result<i64> {
+    i64::try_from(n).map_err(|e| e.to_string().into())
 }

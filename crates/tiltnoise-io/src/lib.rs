@@ -21,6 +21,7 @@ mod budget_csv;
 mod budget_hdf5;
 mod coherence_csv;
 mod coherence_hdf5;
+pub mod csv_layout;
 mod fit_hdf5;
 mod freq_file;
 mod h5util;
@@ -35,17 +36,21 @@ mod tf_csv;
 mod tf_hdf5;
 mod tf_stream;
 
-pub use asd_csv::write_asd_csv;
+pub use asd_csv::{write_asd_csv, SCHEMA_OBSERVABLE_ASD_CSV, SCHEMA_VERSION_OBSERVABLE_ASD_CSV};
 pub use atomic::{remove_temporaries_on_interrupt, write_atomic, AtomicFile, Staging};
-pub use budget_csv::{budget_csv_string, write_budget_csv};
+pub use budget_csv::{
+    budget_csv_string, write_budget_csv, SCHEMA_BUDGET_CSV, SCHEMA_VERSION_BUDGET_CSV,
+};
 pub use budget_hdf5::{
     write_budget_hdf5, SCHEMA_BUDGET, SCHEMA_VERSION_BUDGET, SPECTRAL_CONVENTION,
 };
-pub use coherence_csv::{coherence_csv_string, write_coherence_csv};
+pub use coherence_csv::{
+    coherence_csv_string, write_coherence_csv, SCHEMA_COHERENCE_CSV, SCHEMA_VERSION_COHERENCE_CSV,
+};
 pub use coherence_hdf5::{
     write_coherence_hdf5, CoherenceInputs, SCHEMA_COHERENCE, SCHEMA_VERSION_COHERENCE,
 };
-pub use fit_hdf5::write_fit_hdf5;
+pub use fit_hdf5::{write_fit_hdf5, SCHEMA_FIT, SCHEMA_VERSION_FIT};
 pub use freq_file::read_freq_file;
 pub use mc_hdf5::{write_mc_hdf5, REJECTED_DRAWS, SCHEMA_MC, SCHEMA_VERSION_MC};
 pub use measured_modes::read_measured_modes;
@@ -56,7 +61,10 @@ pub use series_hdf5::{
 };
 pub use series_hdf5_stream::{ObservableSeriesWriter, COORDINATES_GROUP, SERIES_CHUNK_SAMPLES};
 pub use subtract_hdf5::{write_subtract_hdf5, SubtractMeta};
-pub use tf_csv::{format_f64, push_tf_csv_rows, tf_csv_header, tf_csv_string, write_tf_csv};
+pub use tf_csv::{
+    format_f64, push_tf_csv_rows, tf_csv_header, tf_csv_string, write_tf_csv, SCHEMA_TF_CSV,
+    SCHEMA_VERSION_TF_CSV,
+};
 pub use tf_hdf5::{write_tf_hdf5, SCHEMA_TF, SCHEMA_VERSION_TF, SIGN_CONVENTION, TIME_DEPENDENCE};
 pub use tf_stream::{TfCsvWriter, TfHdf5Writer, TF_CHUNK_FREQS};
 

@@ -13,7 +13,7 @@ use tiltnoise_core::mc::{McConfig, McResult};
 pub const SCHEMA_MC: &str = "tiltnoise.mc";
 
 /// Value of the root attribute `schema_version`. Bumped on any change that can break a reader.
-pub const SCHEMA_VERSION_MC: i64 = 1;
+pub const SCHEMA_VERSION_MC: i64 = 2;
 
 /// Value of the root attribute `rejected_draws`: what happens to rejected draws in `draws_hz`.
 pub const REJECTED_DRAWS: &str = "excluded: draws_hz holds the accepted draws only, in sample \
@@ -72,7 +72,7 @@ fn write_file(
         .new_dataset_builder()
         .with_data(&draws)
         .create("draws_hz")?;
-    str_attr(&d, "units", "Hz")?;
+    str_attr(&d, "unit", "Hz")?;
     let index: Vec<i64> = result
         .sample_index
         .iter()
@@ -87,7 +87,7 @@ fn write_file(
         ("nominal_hz", nominal_hz),
     ] {
         let d = dataset(&file, name, values)?;
-        str_attr(&d, "units", "Hz")?;
+        str_attr(&d, "unit", "Hz")?;
     }
 
     let group = file.create_group("uncertainty")?;
@@ -95,7 +95,7 @@ fn write_file(
     dataset(&group, "key", &keys)?;
     let sigma: Vec<f64> = cfg.uncertainties.iter().map(|u| u.rel_sigma).collect();
     let d = dataset(&group, "rel_sigma", &sigma)?;
-    str_attr(&d, "units", "1 (relative standard deviation)")?;
+    str_attr(&d, "unit", "1 (relative standard deviation)")?;
     let dists = strings(cfg.uncertainties.iter().map(|u| u.distribution.name()))?;
     dataset(&group, "distribution", &dists)?;
     file.close()

@@ -20,7 +20,7 @@ use tiltnoise_core::simulate::{InitialState, Simulation};
 pub const SCHEMA_OBSERVABLE_SERIES: &str = "tiltnoise.observable_series";
 
 /// Value of the root attribute `schema_version`.
-pub const SCHEMA_VERSION_OBSERVABLE_SERIES: i64 = 1;
+pub const SCHEMA_VERSION_OBSERVABLE_SERIES: i64 = 2;
 
 /// One-sided Welch ASDs of the observables, stored in the group `/asd`.
 #[derive(Debug, Clone, PartialEq)]
@@ -133,7 +133,7 @@ pub(crate) fn series_attrs(
     o: Observable,
     meta: &SimulationMeta,
 ) -> hdf5::Result<()> {
-    str_attr(ds, "units", o.unit())?;
+    str_attr(ds, "unit", o.unit())?;
     let r = meta
         .readout_asd
         .iter()
@@ -160,13 +160,13 @@ pub(crate) fn write_groups(
     dataset(&g, "frequency_hz", &asd.freqs_hz)?;
     for (o, a) in &asd.asd {
         let ds = dataset(&g, o.name(), a)?;
-        str_attr(&ds, "units", &format!("{}/sqrt(Hz)", o.unit()))?;
+        str_attr(&ds, "unit", &format!("{}/sqrt(Hz)", o.unit()))?;
     }
 
     let g = file.create_group("initial_state")?;
     str_attr(&g, "source", &meta.init_source)?;
     strs_attr(&g, "coordinates", Coord::ALL.iter().map(|c| c.name()))?;
-    strs_attr(&g, "units", Coord::ALL.iter().map(|c| c.unit()))?;
+    strs_attr(&g, "unit", Coord::ALL.iter().map(|c| c.unit()))?;
     dataset(&g, "q", &meta.init.q)?;
     dataset(&g, "qdot", &meta.init.qdot)?;
 

@@ -94,7 +94,7 @@ impl ObservableSeriesWriter {
                 )?;
                 for c in Coord::ALL {
                     let ds = growing(&g, c.name())?;
-                    str_attr(&ds, "units", c.unit())?;
+                    str_attr(&ds, "unit", c.unit())?;
                     coordinates.push(ds);
                 }
             }

@@ -74,7 +74,7 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
     str_attr(&file, "spectral_convention", SPECTRAL_CONVENTION)?;
     for (o, series) in &r.cleaned {
         let ds = dataset(&file, o.name(), series)?;
-        str_attr(&ds, "units", o.unit())?;
+        str_attr(&ds, "unit", o.unit())?;
     }
     let g = file.create_group("predicted_tilt")?;
     str_attr(
@@ -84,7 +84,7 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
     )?;
     for (o, series) in &r.prediction.series {
         let ds = dataset(&g, o.name(), series)?;
-        str_attr(&ds, "units", o.unit())?;
+        str_attr(&ds, "unit", o.unit())?;
         let bands = r
             .prediction
             .guarded
@@ -149,7 +149,7 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
         let o = s.observable;
         let h = g.create_group(o.name())?;
         let unit = format!("{}/sqrt(Hz)", o.unit());
-        str_attr(&h, "units", &unit)?;
+        str_attr(&h, "unit", &unit)?;
         dataset(&h, "frequency_hz", &s.freqs_hz)?;
         for (name, psd) in [
             ("measured_asd", &s.measured_psd),

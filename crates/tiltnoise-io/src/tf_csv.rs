@@ -1,7 +1,9 @@
 //! Transfer matrix as CSV (schema `docs/schemas.md`, section "Transfer functions, CSV").
 
 use crate::atomic::write_atomic;
-use std::fmt::Write as _;
+use crate::csv_layout::{csv_head, CsvPreamble};
+use crate::tf_hdf5::{SIGN_CONVENTION, TIME_DEPENDENCE};
+use crate::RunMeta;
 use std::io::{BufWriter, Write as _};
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
@@ -10,19 +12,21 @@ use tiltnoise_core::tf::{Input, TransferMatrix};
 
 /// Writes `tf` as CSV, atomically (see [`super::write_atomic`]).
 ///
-/// One header line, `freq_hz` followed by `OUT.IN.re,OUT.IN.im` for every output `OUT` (in the
-/// matrix's row order) and input `IN` (column order, innermost), then one line per frequency.
-/// Every number is written so that it parses back to exactly the same `f64`; see
+/// The layout of every tiltnoise CSV ([`crate::csv_layout`]): `#` lines (schema, provenance,
+/// conventions, `# units:`), one header line, `frequency_hz` followed by `OUT.IN.re,OUT.IN.im`
+/// for every output `OUT` (in the matrix's row order) and input `IN` (column order,
+/// innermost), in the output's unit per the input's (`m/rad`, `rad/(N m)`), then one line per
+/// frequency. Every number is written so that it parses back to exactly the same `f64`; see
 /// [`format_f64`].
 ///
 /// # Errors
 ///
 /// [`OutputError::Write`] naming `path` on any I/O failure; nothing is left at `path`.
-pub fn write_tf_csv(path: &Path, tf: &TransferMatrix) -> Result<(), OutputError> {
+pub fn write_tf_csv(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> Result<(), OutputError> {
     write_atomic(path, |temp| {
         let file = std::fs::File::create(temp).map_err(|e| e.to_string())?;
         let mut out = BufWriter::new(file);
-        let text = tf_csv_string(tf);
+        let text = tf_csv_string(tf, meta);
         out.write_all(text.as_bytes())
             .and_then(|()| out.flush())
             .map_err(|e| e.to_string())
@@ -30,26 +34,51 @@ pub fn write_tf_csv(path: &Path, tf: &TransferMatrix) -> Result<(), OutputError>
 }
 
 /// The CSV text of [`write_tf_csv`] (also what `tiltnoise tf` prints without `--save`).
-pub fn tf_csv_string(tf: &TransferMatrix) -> String {
+pub fn tf_csv_string(tf: &TransferMatrix, meta: &RunMeta) -> String {
     let (nf, no, ni) = (tf.freqs_hz.len(), tf.outputs.len(), tf.inputs.len());
     let mut s = String::with_capacity((nf + 1) * (1 + 2 * no * ni) * 24);
-    s.push_str(&tf_csv_header(&tf.outputs, &tf.inputs));
+    s.push_str(&tf_csv_header(&tf.outputs, &tf.inputs, meta));
     push_tf_csv_rows(&mut s, tf);
     s
 }
 
-/// The header line of [`tf_csv_string`] (with its newline) for these outputs and inputs.
-pub fn tf_csv_header(outputs: &[Observable], inputs: &[Input]) -> String {
-    let mut s = String::new();
-    s.push_str("freq_hz");
+/// Value of the `# schema:` line of a transfer-function CSV.
+pub const SCHEMA_TF_CSV: &str = "tiltnoise.transfer_functions_csv";
+
+/// Value of the `# schema_version:` line. Bumped on any change that can break a reader.
+pub const SCHEMA_VERSION_TF_CSV: u32 = 2;
+
+/// The `#` lines and the header line of [`tf_csv_string`] (each with its newline) for these
+/// outputs and inputs.
+pub fn tf_csv_header(outputs: &[Observable], inputs: &[Input], meta: &RunMeta) -> String {
+    let mut columns = Vec::new();
     for o in outputs {
         for i in inputs {
+            let unit = format!("{}/{}", o.unit(), parenthesized(i.unit()));
             let (o, i) = (o.name(), i.name());
-            let _ = write!(s, ",{o}.{i}.re,{o}.{i}.im");
+            columns.push((format!("{o}.{i}.re"), unit.clone()));
+            columns.push((format!("{o}.{i}.im"), unit));
         }
     }
-    s.push('\n');
-    s
+    let preamble = CsvPreamble {
+        schema: SCHEMA_TF_CSV,
+        schema_version: SCHEMA_VERSION_TF_CSV,
+        meta,
+        notes: vec![
+            format!("H(f) per unit input, time dependence {TIME_DEPENDENCE}"),
+            format!("tilt sign convention: {SIGN_CONVENTION}"),
+        ],
+    };
+    csv_head(&preamble, &columns)
+}
+
+/// `N m` -> `(N m)`: a compound unit as a divisor.
+fn parenthesized(unit: &str) -> String {
+    if unit.contains(' ') || unit.contains('/') {
+        format!("({unit})")
+    } else {
+        unit.to_string()
+    }
 }
 
 /// Appends the data lines of [`tf_csv_string`] for every frequency of `tf` to `s`: a grid

@@ -12,7 +12,7 @@ use tiltnoise_core::tf::TransferMatrix;
 pub const SCHEMA_TF: &str = "tiltnoise.tf";
 
 /// Value of the root attribute `schema_version`. Bumped on any change that can break a reader.
-pub const SCHEMA_VERSION_TF: i64 = 1;
+pub const SCHEMA_VERSION_TF: i64 = 2;
 
 /// Value of the root attribute `sign_convention` (see [`tiltnoise_core::model::tilt`]).
 pub const SIGN_CONVENTION: &str = "tilt t = small right-handed rotation taking the floor frame \
@@ -55,7 +55,7 @@ fn write_file(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> hdf5::Result<
     write_root(&file, tf, meta)?;
 
     let freq = dataset(&file, "frequency_hz", &tf.freqs_hz)?;
-    str_attr(&freq, "units", "Hz")?;
+    str_attr(&freq, "unit", "Hz")?;
 
     let dense = tf.dense_values();
     let values = ArrayView3::from_shape((nf, no, ni), &dense).map_err(|e| e.to_string())?;
@@ -98,7 +98,7 @@ pub(crate) fn transfer_attrs(transfer: &hdf5::Dataset, tf: &TransferMatrix) -> h
         .collect();
     strs_attr(transfer, "outputs", output_names.iter().copied())?;
     strs_attr(transfer, "inputs", input_names.iter().copied())?;
-    strs_attr(transfer, "units", units.iter().map(String::as_str))?;
+    strs_attr(transfer, "unit", units.iter().map(String::as_str))?;
     Ok(())
 }
 
@@ -133,7 +133,7 @@ pub(crate) fn write_modes(file: &hdf5::File, meta: &RunMeta) -> hdf5::Result<()>
         let freqs: Vec<f64> = meta.modes.iter().map(|&(_, f)| f).collect();
         dataset(&modes, "index", &index)?;
         let mf = dataset(&modes, "frequency_hz", &freqs)?;
-        str_attr(&mf, "units", "Hz")?;
+        str_attr(&mf, "unit", "Hz")?;
     }
     Ok(())
 }

@@ -91,7 +91,7 @@ impl TfHdf5Writer {
                     .chunk(TF_CHUNK_FREQS)
                     .shape(0..)
                     .create("frequency_hz")?;
-                str_attr(&freq, "units", "Hz")?;
+                str_attr(&freq, "unit", "Hz")?;
                 let transfer = self
                     .file
                     .new_dataset::<Complex64>()
@@ -155,6 +155,7 @@ impl TfHdf5Writer {
 /// [`crate::write_tf_csv`] of the whole grid.
 pub struct TfCsvWriter {
     out: AtomicFile,
+    meta: RunMeta,
     writer: BufWriter<File>,
     header: Option<String>,
     text: String,
@@ -174,11 +175,12 @@ impl TfCsvWriter {
     /// # Errors
     ///
     /// [`OutputError::Write`] naming `path`; nothing is left there.
-    pub fn create(path: &Path) -> Result<TfCsvWriter, OutputError> {
+    pub fn create(path: &Path, meta: &RunMeta) -> Result<TfCsvWriter, OutputError> {
         let out = AtomicFile::create(path)?;
         let file = File::create(out.temp_path()).map_err(|e| out.fail(e.to_string()))?;
         Ok(TfCsvWriter {
             out,
+            meta: meta.clone(),
             writer: BufWriter::with_capacity(1 << 20, file),
             header: None,
             text: String::new(),
@@ -192,7 +194,7 @@ impl TfCsvWriter {
     ///
     /// [`OutputError::Write`] naming the target.
     pub fn append(&mut self, block: &TransferMatrix) -> Result<(), OutputError> {
-        let header = tf_csv_header(&block.outputs, &block.inputs);
+        let header = tf_csv_header(&block.outputs, &block.inputs, &self.meta);
         self.text.clear();
         match &self.header {
             None => self.text.push_str(&header),

@@ -190,7 +190,7 @@ pub(super) fn run(
                         duration_s: n as f64 / fs,
                     },
                 )?,
-                OutputKind::Csv => tiltnoise_io::write_asd_csv(out, &freqs_hz, &asd)?,
+                OutputKind::Csv => tiltnoise_io::write_asd_csv(out, &freqs_hz, &asd, &meta)?,
                 OutputKind::Png | OutputKind::Svg => {
                     let data = SimAsdData {
                         freqs_hz: freqs_hz.clone(),

@@ -44,7 +44,8 @@ pub fn read_asd_column(
             path: path.to_path_buf(),
             format: "miniseed",
             found: "a miniSEED file, which holds time series, not an ASD".to_string(),
-            accepted: "an ASD file as CSV (freq_hz, then the quantity's column or `asd`) or HDF5",
+            accepted:
+                "an ASD file as CSV (frequency_hz, then the quantity's column or `asd`) or HDF5",
         }),
     }
 }
@@ -57,11 +58,11 @@ fn read_csv(path: &Path, quantity: &str, asd_unit: &'static str) -> Result<AsdCo
         message,
     };
     let header = &prelude.header;
-    if header.first().map(String::as_str) != Some("freq_hz") {
+    if !super::csv::is_frequency_column(header.first()) {
         return Err(csv_err(
             prelude.header_line,
             format!(
-                "ASD file: the header must start with freq_hz, then a column `{}` (or `{}`)",
+                "ASD file: the header must start with frequency_hz (or freq_hz), then a column `{}` (or `{}`)",
                 Shown(quantity),
                 GENERIC_ASD_COLUMN
             ),
@@ -99,14 +100,16 @@ fn read_csv(path: &Path, quantity: &str, asd_unit: &'static str) -> Result<AsdCo
             )),
         };
         let f = number(0)?;
-        check_frequency(path, &freqs, f, || format!("line {line}, column freq_hz"))?;
+        check_frequency(path, &freqs, f, || {
+            format!("line {line}, column {}", header[0])
+        })?;
         let a = number(c)?;
         check_asd(path, a, &column, asd_unit, || format!("line {line}"))?;
         freqs.push(f);
         asd.push(a);
         Ok(())
     })?;
-    super::require_two(path, "column freq_hz", freqs.len(), "frequencies")?;
+    super::require_two(path, "column frequency_hz", freqs.len(), "frequencies")?;
     Ok(AsdColumn {
         freqs_hz: freqs,
         asd,

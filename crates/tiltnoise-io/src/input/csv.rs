@@ -28,6 +28,12 @@ const DATA_FILE: &str = "a CSV input";
 /// The file as read: bounded in bytes and line length.
 type Source = BufReader<BoundedReader<File>>;
 
+/// Whether a header's first column names the frequency: `frequency_hz`, the name in every
+/// file tiltnoise writes, or `freq_hz`, the name in files written before.
+pub(crate) fn is_frequency_column(name: Option<&String>) -> bool {
+    matches!(name.map(String::as_str), Some("frequency_hz" | "freq_hz"))
+}
+
 /// Metadata keys recognised in `# key: value` lines before the header.
 pub(crate) const META_KEYS: [&str; 4] = ["units", "axes", "start_time", "description"];
 
@@ -168,7 +174,7 @@ impl CsvFile {
             path: path.to_path_buf(),
             line,
             message: "no header line; allowed: optional `#` comment lines, then a header such as \
-                 time_s,theta_t,eta_t or freq_hz,theta_t,eta_t, then data rows"
+                 time_s,theta_t,eta_t or frequency_hz,theta_t,eta_t, then data rows"
                 .to_string(),
         };
         let mut meta: Vec<MetaLine> = Vec::new();

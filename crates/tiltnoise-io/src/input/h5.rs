@@ -165,6 +165,18 @@ fn text(path: &Path, what: &str, bytes: Vec<u8>) -> Result<String, InputError> {
     })
 }
 
+/// The unit attribute of `loc`: `unit` (what tiltnoise writes, gwpy's name) or `units`.
+pub(crate) fn unit_attr(
+    path: &Path,
+    loc: &Location,
+    object: &str,
+) -> Result<Option<AttrValue>, InputError> {
+    match attr(path, loc, object, "unit")? {
+        None => attr(path, loc, object, "units"),
+        some => Ok(some),
+    }
+}
+
 /// Reads attribute `name` of `loc` (`None` if absent).
 pub(crate) fn attr(
     path: &Path,

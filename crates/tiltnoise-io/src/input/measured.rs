@@ -174,13 +174,13 @@ fn read_series_hdf5(path: &Path) -> Result<MeasuredSeries, InputError> {
             });
         }
         h5::check_storage(path, &ds, &format!("/{name}"))?;
-        match h5::attr(path, &ds, &object, "units")? {
+        match h5::unit_attr(path, &ds, &object)? {
             None => {}
             Some(AttrValue::Str(u)) if u.trim() == o.unit() => {}
             Some(other) => {
                 return Err(InputError::Units {
                     path: path.to_path_buf(),
-                    location: format!("attribute `units` of {object}"),
+                    location: format!("unit attribute of {object}"),
                     value: other.describe(),
                     allowed: OBSERVABLE_UNITS,
                 })
@@ -374,10 +374,10 @@ fn read_spectra_csv(
         line,
         message,
     };
-    if prelude.header.first().map(String::as_str) != Some("freq_hz") {
+    if !super::csv::is_frequency_column(prelude.header.first()) {
         return Err(csv_err(
             prelude.header_line,
-            "measured spectrum: the header must start with freq_hz, then observables \
+            "measured spectrum: the header must start with frequency_hz (or freq_hz), then observables \
              (X, Y, Z, theta, eta, phi, phi_a)"
                 .into(),
         ));
@@ -415,7 +415,7 @@ fn read_spectra_csv(
         if !(f.is_finite() && f > previous) {
             return Err(InputError::Frequency {
                 path: path.to_path_buf(),
-                location: format!("line {line}, column freq_hz"),
+                location: format!("line {line}, column {}", prelude.header[0]),
                 value: f,
                 allowed: format!("finite, > 0 and greater than the previous {previous} Hz"),
             });

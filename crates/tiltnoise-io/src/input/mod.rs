@@ -150,12 +150,12 @@ fn wrong_kind(path: &Path, expected: InputKind, found: InputKind) -> InputError 
 fn csv_kind(path: &Path, prelude: &csv::Prelude) -> Result<InputKind, InputError> {
     match prelude.header.first().map(String::as_str) {
         Some("time_s") => Ok(InputKind::Series),
-        Some("freq_hz") => Ok(InputKind::Spectra),
+        Some("frequency_hz" | "freq_hz") => Ok(InputKind::Spectra),
         other => Err(InputError::UnknownLayout {
             path: path.to_path_buf(),
             format: "csv",
             found: format!(
-                "the header (line {}) starts with column `{}`, not time_s or freq_hz",
+                "the header (line {}) starts with column `{}`, not time_s or frequency_hz (or freq_hz)",
                 prelude.header_line,
                 Shown(other.unwrap_or(""))
             ),

@@ -32,14 +32,14 @@ pub(crate) fn read(
     let mut asd: Vec<Vec<f64>> = vec![Vec::new(); prelude.header.len() - 1];
     file.for_each_record(prelude.header.len(), |line, fields| {
         let row = freqs.len();
-        let location = || format!("line {line} (row {row}), column freq_hz");
+        let location = || format!("line {line} (row {row}), column {}", prelude.header[0]);
         let f = match parse_field(fields[0]) {
             Ok(Some(f)) => f,
             _ => {
                 return Err(InputError::CsvNumber {
                     path: path.clone(),
                     line,
-                    column: "freq_hz".to_string(),
+                    column: prelude.header[0].clone(),
                     text: fields[0].to_string(),
                     unit: "Hz",
                     empty_allowed: false,
@@ -93,7 +93,7 @@ pub(crate) fn read(
         }
         Ok(())
     })?;
-    require_two(&path, "column freq_hz", freqs.len(), "frequencies")?;
+    require_two(&path, "column frequency_hz", freqs.len(), "frequencies")?;
     let csd = assemble(&freqs, &resolved.channels, quantity, |k, a, b| {
         if a == b {
             Complex64::new(asd[a][k] * asd[a][k], 0.0)

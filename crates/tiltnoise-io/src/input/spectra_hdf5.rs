@@ -192,11 +192,11 @@ fn units(
     let object = format!("dataset /{name}");
     let bad = |value: String| InputError::Units {
         path: path.to_path_buf(),
-        location: format!("attribute `units` of {object}"),
+        location: format!("unit attribute of {object}"),
         value,
         allowed,
     };
-    match h5::attr(path, ds, &object, "units")? {
+    match h5::unit_attr(path, ds, &object)? {
         None => Ok(None),
         Some(AttrValue::Str(u)) => match classify(&u) {
             Some(q) => Ok(Some(Declared {
