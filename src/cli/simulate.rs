@@ -3,6 +3,7 @@
 //! and the outputs (HDF5 series + ASDs, CSV ASDs, Figure 3, Figures 4/5). Owns the progress
 //! bar (only when stderr is a terminal and the run is long). Documented in `docs/simulate.md`.
 
+use super::figure_args::FigureArgs;
 use super::output::save_image;
 use super::Run;
 use anyhow::{anyhow, bail, Context, Result};
@@ -22,7 +23,7 @@ use tiltnoise_core::simulate::{
 use tiltnoise_core::spectral::{welch, WelchConfig};
 use tiltnoise_io::{write_observable_series_hdf5, OutputKind, RunMeta, SeriesAsd, SimulationMeta};
 use tiltnoise_plot::simulate_figure::{
-    asd_figure, time_series_figure, ModeMark, SimAsdData, TimePanel, TimeSeriesData,
+    asd_figure, time_series_figure, ModeMark, SimAsdData, TimePanel, TimeSeriesData, ASD_SIZE,
 };
 
 mod driven;
@@ -144,6 +145,8 @@ pub(crate) struct SimulateArgs {
         requires = "tilt"
     )]
     drive_delay: Option<f64>,
+    #[command(flatten)]
+    figure: FigureArgs,
 }
 
 fn parse_readout(items: &[String]) -> Result<Vec<(Observable, f64)>> {
@@ -280,6 +283,7 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
              loss.*_rad to 0, e.g. with --set"
         );
     }
+    let view = args.figure.view_for(ASD_SIZE)?;
     if let Some(path) = &args.tilt {
         return driven::run(params, &model, &args, path, run);
     }
@@ -464,13 +468,13 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
                             .collect(),
                         caption: caption.clone(),
                     };
-                    save_image(path, |format| asd_figure(&data, format))?;
+                    save_image(path, |format| asd_figure(&data, &view, format))?;
                 }
             }
         }
         for path in &args.save_time {
             let data = time_series_data(&sim, &modes, &init_source);
-            save_image(path, |format| time_series_figure(&data, format))?;
+            save_image(path, |format| time_series_figure(&data, &view, format))?;
         }
         Ok(())
     })

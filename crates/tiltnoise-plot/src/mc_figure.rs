@@ -3,7 +3,7 @@
 //! and the band mean +/- 1 standard deviation are marked.
 
 use super::chart::{TextSizes, PALETTE};
-use super::{render, DrawError, Figure, ImageFormat, FONT_FAMILY};
+use super::{DrawError, Figure, ImageFormat, View, FONT_FAMILY};
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
@@ -233,9 +233,12 @@ fn subscript(k: usize) -> String {
         .collect()
 }
 
+/// Default size of the Monte Carlo figure (pixels at 100 dpi).
+pub const DEFAULT_SIZE: (u32, u32) = (1400, 1800);
+
 impl Figure for McFigure {
     fn size(&self) -> (u32, u32) {
-        (1400, 1800)
+        DEFAULT_SIZE
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
@@ -281,12 +284,13 @@ pub fn mc_figure(
     result: &McResult,
     nominal_hz: &[f64; 8],
     caption: &str,
+    view: &View,
     format: ImageFormat,
 ) -> Result<Vec<u8>, DrawError> {
     let panels = (0..8)
         .map(|k| ModeHistogram::new(result, nominal_hz[k], k))
         .collect();
-    render(
+    view.render_resized(
         format,
         &McFigure {
             panels,

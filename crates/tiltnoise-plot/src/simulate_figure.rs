@@ -7,7 +7,7 @@
 
 use super::chart::{Dash, LegendPlacement, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
 use super::labels::{observable_symbol, observable_title};
-use super::{render, DrawError, Figure, ImageFormat, TextSizes, FONT_FAMILY};
+use super::{render, DrawError, Figure, ImageFormat, TextSizes, View, FONT_FAMILY};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use tiltnoise_core::model::Observable;
@@ -173,7 +173,7 @@ pub fn build_asd_figure(data: &SimAsdData) -> Result<LogLogFigure, String> {
         panels.push(panel);
     }
     Ok(LogLogFigure {
-        size: (1800, 1150),
+        size: ASD_SIZE,
         title: Some(
             "Simulated free motion: one-sided amplitude spectral densities (Figure 3)".to_string(),
         ),
@@ -184,14 +184,22 @@ pub fn build_asd_figure(data: &SimAsdData) -> Result<LogLogFigure, String> {
     })
 }
 
-/// Draws Figure 3 as a PNG or SVG file's bytes.
+/// Default size of Figure 3 (pixels at 100 dpi).
+pub const ASD_SIZE: (u32, u32) = (1800, 1150);
+
+/// Draws Figure 3 as a PNG or SVG file's bytes, with the limits, size and resolution of
+/// `view`.
 ///
 /// # Errors
 ///
 /// [`DrawError`] for inconsistent data or any drawing failure.
-pub fn asd_figure(data: &SimAsdData, format: ImageFormat) -> Result<Vec<u8>, DrawError> {
+pub fn asd_figure(
+    data: &SimAsdData,
+    view: &View,
+    format: ImageFormat,
+) -> Result<Vec<u8>, DrawError> {
     let figure = build_asd_figure(data).map_err(DrawError)?;
-    render(format, &figure)
+    render(format, &view.apply(figure))
 }
 
 /// One time-series panel: `(t_s, value)` samples of one observable.
@@ -324,14 +332,16 @@ impl Figure for TimeSeriesData {
     }
 }
 
-/// Draws the time-series figure as a PNG or SVG file's bytes.
+/// Draws the time-series figure as a PNG or SVG file's bytes at the size and resolution of
+/// `view` (its axes are the run's: the view's frequency and ASD limits do not apply).
 ///
 /// # Errors
 ///
 /// [`DrawError`] for any drawing failure.
 pub fn time_series_figure(
     data: &TimeSeriesData,
+    view: &View,
     format: ImageFormat,
 ) -> Result<Vec<u8>, DrawError> {
-    render(format, data)
+    view.render_resized(format, data)
 }
