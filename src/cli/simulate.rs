@@ -269,7 +269,9 @@ fn initial_state(model: &Model, args: &SimulateArgs) -> Result<(InitialState, St
     }
     Ok((
         equal_energy_init(model, e),
-        format!("equal energy {e:e} J in each of the 8 modes, phases 0.7 + 1.3 k rad"),
+        format!(
+            "equal energy {e:e} J in each of the 8 modes, phases 0.7 + 1.3·k rad for mode k = 0..7"
+        ),
     ))
 }
 
