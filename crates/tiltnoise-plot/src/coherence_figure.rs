@@ -167,12 +167,14 @@ pub fn build_coherence_figure(
         options.measured_name, options.tilt_name
     );
     Ok(LogLogFigure {
-        size: (options.width, options.row_height * rows.len() as u32 + 190),
+        size: (options.width, options.row_height * rows.len() as u32 + 290),
         title: Some(title),
         panels,
         columns: 3,
         caption,
-        shared_legend: false,
+        // One legend below the grid: inside, it covers the low-frequency estimates and the
+        // coherence near 1.
+        shared_legend: true,
     })
 }
 
