@@ -3,6 +3,7 @@
 //! files and a terminal summary.
 
 use super::args::tilt_read_options;
+use super::figure_args::FigureArgs;
 use super::output::save_coherence;
 use super::tf::parse_outputs;
 use super::Run;
@@ -69,7 +70,12 @@ pub struct CoherenceArgs {
     /// Output file (.h5, .csv, .png, .svg), repeatable.
     #[arg(long, value_name = "PATH")]
     pub save: Vec<PathBuf>,
+    #[command(flatten)]
+    pub figure: FigureArgs,
 }
+
+/// Size of a coherence figure of two rows at 100 dpi, for the early check of `--dpi`.
+const COHERENCE_SIZE: (u32, u32) = (1650, 900);
 
 fn parse_fit_band(text: &str) -> Result<(f64, f64)> {
     let shown = Shown(text);
@@ -128,6 +134,7 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
     for path in &args.save {
         OutputKind::from_path(path)?;
     }
+    let view = args.figure.view_for(COHERENCE_SIZE)?;
     let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
     run.check_outputs(
         &saves,
@@ -200,7 +207,7 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
     );
     run.write_outputs(false, || {
         for out in &args.save {
-            save_coherence(out, &report, &meta, &inputs, &names)?;
+            save_coherence(out, &report, &meta, &inputs, &names, &view)?;
         }
         Ok(())
     })

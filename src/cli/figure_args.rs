@@ -10,8 +10,6 @@ use tiltnoise_plot::View;
 const SIZE_RANGE_PX: (u32, u32) = (200, 10_000);
 /// Resolutions accepted by `--dpi`.
 const DPI_RANGE: (f64, f64) = (30.0, 600.0);
-/// Largest image accepted after `--dpi` scaling (pixels): 100 megapixels, 300 MB of RGB.
-const MAX_PIXELS: f64 = 1e8;
 
 /// Axis limits, size and resolution of the figures a command saves (.png, .svg).
 #[derive(Debug, Clone, Default, Args)]
@@ -68,13 +66,31 @@ impl FigureArgs {
     pub fn view_for(&self, default: (u32, u32)) -> Result<View> {
         let view = self.view()?;
         let (w, h) = view.pixels(default);
-        if w as f64 * h as f64 > MAX_PIXELS {
+        if u64::from(w) * u64::from(h) > tiltnoise_plot::MAX_PIXELS {
             bail!(
                 "--size/--dpi: a {w} x {h} pixel image is too large (at most {} megapixels)",
-                MAX_PIXELS / 1e6
+                tiltnoise_plot::MAX_PIXELS / 1_000_000
             );
         }
         Ok(view)
+    }
+}
+
+impl FigureArgs {
+    /// [`FigureArgs::view_for`] for a figure without a frequency axis shared by its panels
+    /// (`what`, e.g. "the Monte Carlo histograms"): `--size` and `--dpi` apply, `--xlim` and
+    /// `--ylim` are refused in one line saying why.
+    pub fn size_only_view(&self, what: &str, default: (u32, u32)) -> Result<View> {
+        for (option, value) in [("--xlim", &self.xlim), ("--ylim", &self.ylim)] {
+            if let Some(text) = value {
+                bail!(
+                    "{option} {}: {what} have axes chosen from the results; --xlim and --ylim \
+                     apply to spectra and transfer-function figures (use --size and --dpi here)",
+                    Shown(text)
+                );
+            }
+        }
+        self.view_for(default)
     }
 }
 

@@ -2,6 +2,7 @@
 //! the parameter file, see [`tiltnoise_core::params::uncertainty`]); a table or JSON on stdout, histograms
 //! (PNG/SVG) and HDF5 with `--save`.
 
+use super::figure_args::FigureArgs;
 use super::Run;
 use anyhow::Result;
 use serde::Serialize;
@@ -28,6 +29,8 @@ pub(crate) struct McOptions {
     pub(crate) json: bool,
     /// Output files (format from the extension).
     pub(crate) save: Vec<PathBuf>,
+    /// Size and resolution of the histograms.
+    pub(crate) figure: FigureArgs,
 }
 
 /// What `--save PATH` writes.
@@ -60,6 +63,10 @@ pub(crate) fn run_mc(params: &Params, opts: McOptions, run: &mut Run) -> Result<
         .iter()
         .map(|p| output_kind(p))
         .collect::<Result<Vec<_>, _>>()?;
+    let view = opts.figure.size_only_view(
+        "the Monte Carlo histograms (one frequency axis per mode)",
+        tiltnoise_plot::mc_figure::DEFAULT_SIZE,
+    )?;
     tiltnoise_core::mc::check_size(opts.samples, opts.threads, ("--samples", "--threads"))?;
     let saves: Vec<&Path> = opts.save.iter().map(PathBuf::as_path).collect();
     run.check_outputs(&saves, &[])?;
@@ -99,7 +106,7 @@ pub(crate) fn run_mc(params: &Params, opts: McOptions, run: &mut Run) -> Result<
             match kind {
                 McOutput::Hdf5 => write_mc_hdf5(path, &result, &cfg, &nominal, &meta)?,
                 McOutput::Figure => super::output::save_image(path, |format| {
-                    tiltnoise_plot::mc_figure::mc_figure(&result, &nominal, &caption, format)
+                    tiltnoise_plot::mc_figure::mc_figure(&result, &nominal, &caption, &view, format)
                 })?,
             }
         }

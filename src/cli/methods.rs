@@ -2,6 +2,7 @@
 //! reference and its time per point (table, JSON, chart).
 
 use super::args::Format;
+use super::figure_args::FigureArgs;
 use super::output::save_image;
 use super::Run;
 use anyhow::Result;
@@ -29,6 +30,9 @@ pub struct MethodsArgs {
     /// Chart of time per point against error (.png or .svg), repeatable.
     #[arg(long, value_name = "PATH")]
     save: Vec<PathBuf>,
+    // Size and resolution of the chart (its axes follow the results).
+    #[command(flatten)]
+    figure: FigureArgs,
 }
 
 /// One method's row of the JSON output (keys in alphabetical order, as documented).
@@ -58,6 +62,7 @@ pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> 
         freq: spec,
         format,
         save,
+        figure,
     } = args;
     let (spec, save) = (spec.as_str(), save.as_slice());
     use tiltnoise_core::methods::methods_table;
@@ -65,6 +70,10 @@ pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> 
     for path in save {
         tiltnoise_plot::ImageFormat::from_path(path)?;
     }
+    let view = figure.size_only_view(
+        "the methods chart's time and error axes",
+        tiltnoise_plot::methods_figure::DEFAULT_SIZE,
+    )?;
     let saves: Vec<&Path> = save.iter().map(PathBuf::as_path).collect();
     run.check_outputs(&saves, &[])?;
     let out = &mut run.out;
@@ -164,6 +173,7 @@ pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> 
                     &points,
                     DEFAULT_REL_TOL,
                     &format!("Speed against accuracy, 7x3 tilt matrix, {spec} Hz"),
+                    &view,
                     format,
                 )
             })?;

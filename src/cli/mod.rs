@@ -105,6 +105,9 @@ enum Command {
         /// Histograms (.png, .svg) or all draws (.h5), repeatable; see docs/schemas.md.
         #[arg(long, value_name = "PATH")]
         save: Vec<PathBuf>,
+        // Size and resolution of the histograms (their axes follow the draws).
+        #[command(flatten)]
+        figure: figure_args::FigureArgs,
     },
     /// Every evaluation method's worst error against the double-double reference and its time
     /// per point, for the 7x3 tilt matrix on the given grid (table, JSON, chart).
@@ -209,6 +212,7 @@ fn run_command(cli: Cli, run: &mut Run) -> Result<()> {
             threads,
             format,
             save,
+            figure,
         } => mc::run_mc(
             &params,
             mc::McOptions {
@@ -217,6 +221,7 @@ fn run_command(cli: Cli, run: &mut Run) -> Result<()> {
                 threads,
                 json: format == Format::Json,
                 save,
+                figure,
             },
             run,
         ),

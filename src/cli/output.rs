@@ -101,6 +101,7 @@ pub fn save_coherence(
     meta: &RunMeta,
     inputs: &CoherenceInputs,
     (tilt, measured): &(String, String),
+    view: &tiltnoise_plot::View,
 ) -> Result<(), OutputError> {
     match OutputKind::from_path(path)? {
         OutputKind::Hdf5 => write_coherence_hdf5(path, report, meta, inputs),
@@ -109,6 +110,7 @@ pub fn save_coherence(
             let options = tiltnoise_plot::CoherenceFigureOptions {
                 tilt_name: tilt.clone(),
                 measured_name: measured.clone(),
+                view: view.clone(),
                 ..tiltnoise_plot::CoherenceFigureOptions::default()
             };
             save_image(path, |format| {

@@ -3,6 +3,7 @@
 //! and the outputs (HDF5 series + ASDs, CSV ASDs, Figure 3, Figures 4/5). Owns the progress
 //! bar (only when stderr is a terminal and the run is long). Documented in `docs/simulate.md`.
 
+use super::figure_args::FigureArgs;
 use super::output::save_image;
 use super::Run;
 use anyhow::{anyhow, bail, Context, Result};
@@ -28,7 +29,7 @@ use tiltnoise_io::{
     ObservableSeriesWriter, OutputKind, RunMeta, SeriesAsd, SimulationMeta, SERIES_CHUNK_SAMPLES,
 };
 use tiltnoise_plot::simulate_figure::{
-    asd_figure, time_series_figure, ModeMark, SimAsdData, TimePanel, TimeSeriesData,
+    asd_figure, time_series_figure, ModeMark, SimAsdData, TimePanel, TimeSeriesData, ASD_SIZE,
 };
 
 mod driven;
@@ -159,6 +160,8 @@ pub(crate) struct SimulateArgs {
         requires = "tilt"
     )]
     drive_delay: Option<f64>,
+    #[command(flatten)]
+    figure: FigureArgs,
 }
 
 fn parse_readout(items: &[String]) -> Result<Vec<(Observable, f64)>> {
@@ -274,7 +277,9 @@ fn initial_state(model: &Model, args: &SimulateArgs) -> Result<(InitialState, St
     }
     Ok((
         equal_energy_init(model, e),
-        format!("equal energy {e:e} J in each of the 8 modes, phases 0.7 + 1.3 k rad"),
+        format!(
+            "equal energy {e:e} J in each of the 8 modes, phases 0.7 + 1.3·k rad for mode k = 0..7"
+        ),
     ))
 }
 
@@ -288,6 +293,7 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
              loss.*_rad to 0, e.g. with --set"
         );
     }
+    let view = args.figure.view_for(ASD_SIZE)?;
     if let Some(path) = &args.tilt {
         return driven::run(params, &model, &args, path, run);
     }
@@ -530,13 +536,13 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
                             .collect(),
                         caption: caption.clone(),
                     };
-                    save_image(path, |format| asd_figure(&data, format))?;
+                    save_image(path, |format| asd_figure(&data, &view, format))?;
                 }
             }
         }
         if let Some(data) = &time_data {
             for path in &args.save_time {
-                save_image(path, |format| time_series_figure(data, format))?;
+                save_image(path, |format| time_series_figure(data, &view, format))?;
             }
         }
         Ok(())

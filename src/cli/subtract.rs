@@ -5,6 +5,7 @@
 //! in `docs/subtract.md`.
 
 use super::args::{parse_readout_item, Format};
+use super::figure_args::FigureArgs;
 use super::output::save_image;
 use super::Run;
 use anyhow::{anyhow, bail, Context, Result};
@@ -98,6 +99,8 @@ pub(crate) struct SubtractArgs {
     /// the figure.
     #[arg(long, value_name = "PATH")]
     save: Vec<PathBuf>,
+    #[command(flatten)]
+    figure: FigureArgs,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -255,6 +258,8 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
     for path in &args.save {
         save_kind(path)?;
     }
+    // A figure of two rows of panels at 100 dpi, for the early check of `--dpi`.
+    let view = args.figure.view_for((1800, 1360))?;
     let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
     run.check_outputs(
         &saves,
@@ -358,7 +363,7 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
                 }
                 SaveKind::Image => {
                     let data = figure_data(&result);
-                    save_image(path, |format| subtract_figure(&data, format))?
+                    save_image(path, |format| subtract_figure(&data, &view, format))?
                 }
             }
         }

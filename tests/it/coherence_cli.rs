@@ -427,7 +427,15 @@ fn saved_files_hold_the_report_exactly() {
     };
     let names = ("t".to_string(), "m".to_string());
     for path in [&h5, &csv] {
-        crate::output::save_coherence(path, &report, &RunMeta::default(), &inputs, &names).unwrap();
+        crate::output::save_coherence(
+            path,
+            &report,
+            &RunMeta::default(),
+            &inputs,
+            &names,
+            &tiltnoise_plot::View::default(),
+        )
+        .unwrap();
     }
     let file = hdf5::File::open(&h5).unwrap();
     assert_eq!(str_attr(&file, "alignment"), "assumed_simultaneous");
@@ -464,6 +472,14 @@ fn saved_files_hold_the_report_exactly() {
     assert_eq!(back, want);
     // A figure drawn from the same report.
     let png = dir.path().join("r.png");
-    crate::output::save_coherence(&png, &report, &RunMeta::default(), &inputs, &names).unwrap();
+    crate::output::save_coherence(
+        &png,
+        &report,
+        &RunMeta::default(),
+        &inputs,
+        &names,
+        &tiltnoise_plot::View::default(),
+    )
+    .unwrap();
     assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
 }

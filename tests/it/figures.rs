@@ -171,6 +171,151 @@ mod options {
         assert!(listing(dir.path()).is_empty());
     }
 
+    /// A tilt record `tilt.h5` (theta_t, eta_t: white noise of about 1e-8 rad, 1 Hz, 2^13
+    /// samples) and the pendulum's response to it, `pendulum.h5`, written by `simulate --tilt`:
+    /// the inputs of `coherence` and `subtract`.
+    fn tilt_and_response(dir: &std::path::Path) -> (String, String) {
+        use hdf5::types::VarLenUnicode;
+        let n = 1 << 13;
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut noise = || {
+            // xorshift64: uniform in [-1, 1) scaled to 1e-8 rad.
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            ((state >> 11) as f64 / (1u64 << 52) as f64 - 1.0) * 1e-8
+        };
+        let theta: Vec<f64> = (0..n).map(|_| noise()).collect();
+        let eta: Vec<f64> = (0..n).map(|_| noise()).collect();
+        let tilt = dir.join("tilt.h5");
+        let file = hdf5::File::create(&tilt).unwrap();
+        file.new_attr::<f64>()
+            .create("sample_rate_hz")
+            .unwrap()
+            .write_scalar(&1.0)
+            .unwrap();
+        let text = |s: &str| s.parse::<VarLenUnicode>().unwrap();
+        for (name, value) in [
+            ("schema", "tiltnoise.tilt_series"),
+            ("start_time", "2024-03-20T00:00:00Z"),
+        ] {
+            file.new_attr::<VarLenUnicode>()
+                .create(name)
+                .unwrap()
+                .write_scalar(&text(value))
+                .unwrap();
+        }
+        for (name, data) in [("theta_t", &theta), ("eta_t", &eta)] {
+            let ds = file
+                .new_dataset_builder()
+                .with_data(data)
+                .create(name)
+                .unwrap();
+            ds.new_attr::<VarLenUnicode>()
+                .create("units")
+                .unwrap()
+                .write_scalar(&text("rad"))
+                .unwrap();
+        }
+        drop(file);
+        let pendulum = dir.join("pendulum.h5");
+        let (tilt, pendulum) = (
+            tilt.to_str().unwrap().to_string(),
+            pendulum.to_str().unwrap().to_string(),
+        );
+        let out = tiltnoise(&["simulate", "--tilt", &tilt, "--save", &pendulum]);
+        assert_eq!(out.status.code(), Some(0), "{out:?}");
+        (tilt, pendulum)
+    }
+
+    /// Every command that draws, with its inputs and the flag that saves its figure; the
+    /// figure's path is appended. `spectra`: its figures have frequency axes (--xlim, --ylim).
+    fn drawing_commands(tilt: &str, pendulum: &str) -> Vec<(Vec<String>, bool)> {
+        let owned = |v: &[&str]| v.iter().map(|a| a.to_string()).collect::<Vec<_>>();
+        vec![
+            (owned(&["tf", "--freq", "1e-3:40:1", "--save"]), true),
+            (owned(&["budget", "--tilt", tilt, "--save"]), true),
+            (
+                owned(&[
+                    "coherence",
+                    "--tilt",
+                    tilt,
+                    "--measured",
+                    pendulum,
+                    "--save",
+                ]),
+                true,
+            ),
+            (
+                owned(&["subtract", "--tilt", tilt, "--measured", pendulum, "--save"]),
+                true,
+            ),
+            (owned(&["simulate", "--duration", "3600", "--save"]), true),
+            (
+                owned(&["simulate", "--duration", "3600", "--save-time"]),
+                false,
+            ),
+            (owned(&["mc", "--samples", "200", "--save"]), false),
+            (owned(&["methods", "--freq", "1e-3:20:1", "--save"]), false),
+        ]
+    }
+
+    #[test]
+    fn every_drawing_command_takes_the_figure_options() {
+        let dir = tempfile::tempdir().unwrap();
+        let (tilt, pendulum) = tilt_and_response(dir.path());
+        let out_dir = dir.path().join("out");
+        std::fs::create_dir(&out_dir).unwrap();
+        for (i, (command, spectra)) in drawing_commands(&tilt, &pendulum).iter().enumerate() {
+            let png = out_dir.join(format!("{i}.png"));
+            let mut args: Vec<&str> = command.iter().map(String::as_str).collect();
+            args.extend([png.to_str().unwrap(), "--size", "640x480", "--dpi", "50"]);
+            if *spectra {
+                args.extend(["--xlim", "2e-3,0.2", "--ylim", "1e-15,1e-3"]);
+            }
+            let out = tiltnoise(&args);
+            assert_eq!(out.status.code(), Some(0), "{args:?}: {out:?}");
+            // 640 x 480 at 100 dpi drawn at 50 dpi.
+            assert_eq!(
+                png_size(&std::fs::read(&png).unwrap()),
+                (320, 240),
+                "{args:?}"
+            );
+            // Bad values: one line, exit 2, no file.
+            let bad = out_dir.join(format!("bad{i}.png"));
+            let base: Vec<&str> = command
+                .iter()
+                .map(String::as_str)
+                .chain([bad.to_str().unwrap()])
+                .collect();
+            let mut cases = vec![
+                (
+                    vec!["--size", "50x50"],
+                    vec!["--size 50x50", "200 to 10000"],
+                ),
+                (vec!["--dpi", "nan"], vec!["--dpi NaN", "30 to 600"]),
+                (
+                    vec!["--size", "10000x10000", "--dpi", "600"],
+                    vec!["too large"],
+                ),
+            ];
+            if *spectra {
+                cases.push((vec!["--xlim", "1,0.1"], vec!["--xlim 1,0.1", "0 < LO < HI"]));
+                cases.push((vec!["--ylim", "0,1"], vec!["--ylim 0,1", "0 < LO < HI"]));
+            } else if command[0] != "simulate" {
+                cases.push((
+                    vec!["--xlim", "1e-3,1"],
+                    vec!["--xlim 1e-3,1", "--size and --dpi"],
+                ));
+            }
+            for (extra, needles) in cases {
+                let mut all = base.clone();
+                all.extend(extra);
+                assert_fails_without_output(&all, &out_dir, &needles);
+            }
+        }
+    }
+
     #[test]
     fn damped_caption_does_not_claim_no_losses_and_long_captions_wrap() {
         let dir = tempfile::tempdir().unwrap();

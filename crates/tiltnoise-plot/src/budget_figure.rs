@@ -366,21 +366,13 @@ fn equivalent_panel(report: &BudgetReport, options: &BudgetFigureOptions) -> Opt
         })
         .collect();
     terms.sort_by_key(|(c, _)| draw_rank(c));
-    // The response has zeros (antiresonances), where every equivalent term peaks: scale the y
-    // axis on the floor of the total instead, from a decade below its minimum up 6 decades.
+    // The range rule of the other panels: the total and the tilt term everywhere, every other
+    // term where it contributes. The response's zeros (antiresonances), where every
+    // equivalent term peaks, are narrow: the automatic range clips them at the top.
     let (_, total) = referred
         .terms
         .iter()
         .find(|(c, _)| *c == Component::Total)?;
-    let floor = total
-        .iter()
-        .map(|p| p.sqrt())
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .fold(f64::INFINITY, f64::min);
-    if floor.is_finite() {
-        let lo = 10f64.powf(floor.log10().floor() - 1.0);
-        panel.y_range = Some((lo, lo * 1e6));
-    }
     for (component, psd) in terms {
         // The readout's label as in the X panel, so the shared legend lists it once.
         let readout = match (
@@ -406,7 +398,14 @@ fn equivalent_panel(report: &BudgetReport, options: &BudgetFigureOptions) -> Opt
             .zip(psd)
             .map(|(&f, p)| (f, p.sqrt()))
             .collect();
-        panel.traces.push(Trace::new(label, points, style));
+        let mut trace = Trace::new(label, points, style);
+        if !matches!(
+            component,
+            Component::Total | Component::Term(TermKind::Tilt)
+        ) {
+            trace.range_mask = Some(contributes(psd, total));
+        }
+        panel.traces.push(trace);
     }
     Some(panel)
 }

@@ -451,7 +451,6 @@ impl Figure for LogLogFigure {
         let free_cell = n % columns != 0;
         let rows = (n + usize::from(free_cell)).div_ceil(columns).max(1);
         let margin = ts.caption * 1.5;
-        let line_h = ts.caption * 1.45;
         let (aw, ah) = area.dim_in_pixel();
         let (cell_w, cell_h) = (aw as f64 / columns as f64, ah as f64 / rows as f64);
         let shared = if self.shared_legend {
@@ -464,7 +463,7 @@ impl Figure for LogLogFigure {
         // The caption goes into the free cell only if it fits there (below the legend).
         let caption_in_cell = !self.caption.is_empty() && free_cell && {
             let lines = wrap_lines(&area, &self.caption, ts.caption, cell_w - 2.0 * margin)?;
-            legend_h + lines.len() as f64 * line_h + 2.0 * margin <= cell_h
+            legend_h + caption_height(&lines, ts.caption) + 2.0 * margin <= cell_h
         };
         let legend_in_cell = shared.is_some() && free_cell;
         let mut strip_parts: Vec<f64> = Vec::new();
@@ -473,9 +472,9 @@ impl Figure for LogLogFigure {
         }
         let mut caption_lines = 0;
         if !self.caption.is_empty() && !caption_in_cell {
-            caption_lines =
-                wrap_lines(&area, &self.caption, ts.caption, aw as f64 - 2.0 * margin)?.len();
-            strip_parts.push(caption_lines as f64 * line_h + 1.5 * margin);
+            let lines = wrap_lines(&area, &self.caption, ts.caption, aw as f64 - 2.0 * margin)?;
+            caption_lines = lines.len();
+            strip_parts.push(caption_height(&lines, ts.caption) + 1.5 * margin);
         }
         if !strip_parts.is_empty() {
             let strip = strip_parts.iter().sum::<f64>().ceil() as u32;
@@ -742,6 +741,11 @@ fn draw_log_panel<DB: DrawingBackend>(
     if let Some(band) = &panel.band {
         let fill = band.color.mix(band.opacity.clamp(0.0, 1.0)).filled();
         if let Some((upper, lower)) = &band_outline {
+            // Both edges reduced to the pixel grid, as the curves are.
+            let (upper, lower) = (
+                decimate(upper, &rect, xr, yr),
+                decimate(lower, &rect, xr, yr),
+            );
             let poly: Vec<_> = upper.iter().chain(lower.iter().rev()).copied().collect();
             chart.draw_series(std::iter::once(Polygon::new(poly, fill)))?;
         }
@@ -1486,14 +1490,35 @@ fn draw_caption<DB: DrawingBackend>(
     let (w, _) = area.dim_in_pixel();
     let lines = wrap_lines(area, paragraphs, fs, w as f64 - 2.0 * margin)?;
     let style = text_style(fs, &BLACK).pos(Pos::new(HPos::Left, VPos::Top));
-    let line_h = fs * 1.45;
-    for (i, line) in lines.iter().enumerate() {
+    let mut y = margin;
+    for line in &lines {
         if !line.is_empty() {
-            let y = margin + line_h * i as f64;
             area.draw_text(line, &style, (margin as i32, y as i32))?;
         }
+        y += line_advance(line, fs);
     }
     Ok(())
+}
+
+/// Distance between the tops of two caption lines, in units of the font size.
+const CAPTION_LINE_SPACING: f64 = 1.3;
+/// Extra space between caption paragraphs (the empty line [`wrap_lines`] puts between them),
+/// in units of the font size.
+const CAPTION_PARAGRAPH_GAP: f64 = 0.45;
+
+/// Vertical advance after a caption line: a text line's spacing, or the paragraph gap for the
+/// empty separator line.
+fn line_advance(line: &str, fs: f64) -> f64 {
+    fs * if line.is_empty() {
+        CAPTION_PARAGRAPH_GAP
+    } else {
+        CAPTION_LINE_SPACING
+    }
+}
+
+/// Height of wrapped caption `lines` (as [`draw_caption`] sets them), in pixels.
+fn caption_height(lines: &[String], fs: f64) -> f64 {
+    lines.iter().map(|l| line_advance(l, fs)).sum()
 }
 
 #[cfg(test)]

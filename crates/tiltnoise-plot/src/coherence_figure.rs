@@ -6,7 +6,7 @@ use super::chart::{
     Band, Dash, LegendPlacement, LogLogFigure, Panel, Trace, TraceStyle, YScale, PALETTE,
 };
 use super::labels::{observable_symbol, tilt_symbol};
-use super::{render, DrawError, ImageFormat};
+use super::{render, DrawError, ImageFormat, View};
 use num_complex::Complex64;
 use plotters::style::RGBColor;
 use tiltnoise_core::coherence::{with_error, AxisEstimate, CoherenceReport, ObservableEstimate};
@@ -22,6 +22,8 @@ pub struct CoherenceFigureOptions {
     pub tilt_name: String,
     /// The measured record's name for the title.
     pub measured_name: String,
+    /// Axis limits, size (replacing `width` x rows) and resolution.
+    pub view: View,
 }
 
 impl Default for CoherenceFigureOptions {
@@ -31,6 +33,7 @@ impl Default for CoherenceFigureOptions {
             row_height: 430,
             tilt_name: "tilt".into(),
             measured_name: "measured".into(),
+            view: View::default(),
         }
     }
 }
@@ -52,7 +55,7 @@ pub fn coherence_figure(
     options: &CoherenceFigureOptions,
 ) -> Result<Vec<u8>, DrawError> {
     let figure = build_coherence_figure(report, options).map_err(DrawError)?;
-    render(format, &figure)
+    render(format, &options.view.apply(figure))
 }
 
 /// The rows drawn: every (observable, axis) pair whose model entry is not identically zero;
@@ -164,12 +167,14 @@ pub fn build_coherence_figure(
         options.measured_name, options.tilt_name
     );
     Ok(LogLogFigure {
-        size: (options.width, options.row_height * rows.len() as u32 + 190),
+        size: (options.width, options.row_height * rows.len() as u32 + 290),
         title: Some(title),
         panels,
         columns: 3,
         caption,
-        shared_legend: false,
+        // One legend below the grid: inside, it covers the low-frequency estimates and the
+        // coherence near 1.
+        shared_legend: true,
     })
 }
 

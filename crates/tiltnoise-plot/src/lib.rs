@@ -110,6 +110,9 @@ pub struct View {
     pub dpi: f64,
 }
 
+/// Largest image drawn (pixels): 100 megapixels, 300 MB of RGB.
+pub const MAX_PIXELS: u64 = 100_000_000;
+
 /// The resolution at which a figure's size is given: `--dpi 200` doubles the pixels.
 pub const NOMINAL_DPI: f64 = 100.0;
 
@@ -135,12 +138,50 @@ impl View {
             .scaled(self.dpi / NOMINAL_DPI)
     }
 
+    /// Draws a figure whose layout follows its drawing area (histograms, time series, the
+    /// methods chart) at this view's size and resolution. Axis limits do not apply to it: the
+    /// caller refuses or ignores them.
+    ///
+    /// # Errors
+    ///
+    /// [`DrawError`] as [`render`].
+    pub fn render_resized(
+        &self,
+        format: ImageFormat,
+        figure: &impl Figure,
+    ) -> Result<Vec<u8>, DrawError> {
+        let size = self.pixels(figure.size());
+        render(
+            format,
+            &Resized {
+                inner: figure,
+                size,
+            },
+        )
+    }
+
     /// A figure's pixel size under this view: `default` or [`View::size`], times the resolution.
     pub fn pixels(&self, default: (u32, u32)) -> (u32, u32) {
         let (w, h) = self.size.unwrap_or(default);
         let s = self.dpi / NOMINAL_DPI;
         let px = |v: u32| ((v as f64 * s).round() as u32).max(1);
         (px(w), px(h))
+    }
+}
+
+/// A figure drawn at another pixel size; its drawing reads the size from the drawing area.
+struct Resized<'a, F> {
+    inner: &'a F,
+    size: (u32, u32),
+}
+
+impl<F: Figure> Figure for Resized<'_, F> {
+    fn size(&self) -> (u32, u32) {
+        self.size
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
+        self.inner.draw(root)
     }
 }
 
@@ -212,6 +253,12 @@ pub fn render(format: ImageFormat, figure: &impl Figure) -> Result<Vec<u8>, Draw
     ensure_font()?;
     let _raster = chart::raster_scope(format == ImageFormat::Png);
     let (w, h) = figure.size();
+    if u64::from(w) * u64::from(h) > MAX_PIXELS {
+        return Err(DrawError(format!(
+            "a {w} x {h} pixel image is too large (at most {} megapixels; lower --size or --dpi)",
+            MAX_PIXELS / 1_000_000
+        )));
+    }
     match format {
         ImageFormat::Png => {
             let n = (w as usize)

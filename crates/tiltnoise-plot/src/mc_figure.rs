@@ -3,7 +3,7 @@
 //! and the band mean +/- 1 standard deviation are marked.
 
 use super::chart::{TextSizes, PALETTE};
-use super::{render, DrawError, Figure, ImageFormat, FONT_FAMILY};
+use super::{DrawError, Figure, ImageFormat, View, FONT_FAMILY};
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
@@ -91,11 +91,7 @@ fn draw_panel<DB: DrawingBackend>(
     let (x0, x1) = h.range_hz;
     let bins = h.counts.len();
     let width = (x1 - x0) / bins as f64;
-    let mut lines = vec![
-        format!("nominal {} Hz", sig(h.nominal_hz)),
-        format!("mean {} Hz", sig(h.mean_hz)),
-        format!("std {} Hz", sig(h.std_hz)),
-    ];
+    let mut lines = statistics(h).to_vec();
     if h.outside > 0 {
         let s = if h.outside == 1 { "" } else { "s" };
         lines.push(format!("{} draw{s} beyond ±5 std, not shown", h.outside));
@@ -213,15 +209,26 @@ fn wrap(text: &str, width: usize) -> Vec<String> {
     lines
 }
 
-/// Five significant digits, in decimal notation between 0.01 and 1000.
-fn sig(v: f64) -> String {
-    let exp = v.abs().log10().floor();
-    if (-2.0..3.0).contains(&exp) {
-        let decimals = (4.0 - exp) as usize;
-        format!("{v:.decimals$}")
+/// The nominal frequency, mean and standard deviation of a histogram in the SI-prefixed unit
+/// of its frequency axis (`1.3102 mHz`): the nominal value to five significant digits, the
+/// mean and the deviation with as many decimals, so the three read against each other and
+/// against the ticks.
+fn statistics(h: &ModeHistogram) -> [String; 3] {
+    let (x0, x1) = h.range_hz;
+    let (e, prefix) = super::labels::si_prefix(x1.abs().max(x0.abs()));
+    let scale = 10f64.powi(e);
+    let mantissa = (h.nominal_hz / scale).abs();
+    let decimals = if mantissa > 0.0 && mantissa.is_finite() {
+        (4 - mantissa.log10().floor() as i32).max(0) as usize
     } else {
-        format!("{v:.4e}")
-    }
+        4
+    };
+    let text = |v: f64| format!("{:.decimals$} {prefix}Hz", v / scale);
+    [
+        format!("nominal {}", text(h.nominal_hz)),
+        format!("mean {}", text(h.mean_hz)),
+        format!("std {}", text(h.std_hz)),
+    ]
 }
 
 /// `k` in Unicode subscript digits.
@@ -233,9 +240,12 @@ fn subscript(k: usize) -> String {
         .collect()
 }
 
+/// Default size of the Monte Carlo figure (pixels at 100 dpi).
+pub const DEFAULT_SIZE: (u32, u32) = (1400, 1800);
+
 impl Figure for McFigure {
     fn size(&self) -> (u32, u32) {
-        (1400, 1800)
+        DEFAULT_SIZE
     }
 
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
@@ -281,12 +291,13 @@ pub fn mc_figure(
     result: &McResult,
     nominal_hz: &[f64; 8],
     caption: &str,
+    view: &View,
     format: ImageFormat,
 ) -> Result<Vec<u8>, DrawError> {
     let panels = (0..8)
         .map(|k| ModeHistogram::new(result, nominal_hz[k], k))
         .collect();
-    render(
+    view.render_resized(
         format,
         &McFigure {
             panels,
@@ -306,9 +317,29 @@ mod tests {
     #[test]
     fn labels_keep_the_digits_the_step_needs() {
         assert_eq!(subscript(8), "₈");
-        assert_eq!(sig(0.414912), "0.41491");
-        assert_eq!(sig(1.31023e-3), "1.3102e-3");
         assert_eq!(wrap("aa bb cc", 5), ["aa bb", "cc"]);
+    }
+
+    #[test]
+    fn statistics_use_the_prefixed_unit_of_the_axis() {
+        let draws = |centre: f64, spread: f64| McResult {
+            samples: 3,
+            rejected: 0,
+            sample_index: vec![0, 1, 2],
+            freqs_hz: vec![[centre - spread; 8], [centre; 8], [centre + spread; 8]],
+            mean_hz: [centre; 8],
+            std_hz: [spread; 8],
+        };
+        let h = ModeHistogram::new(&draws(1.31023e-3, 3.2e-5), 1.31023e-3, 0);
+        assert_eq!(
+            statistics(&h),
+            ["nominal 1.3102 mHz", "mean 1.3102 mHz", "std 0.0320 mHz"]
+        );
+        let h = ModeHistogram::new(&draws(0.414912, 0.01), 0.414912, 1);
+        assert_eq!(
+            statistics(&h),
+            ["nominal 414.91 mHz", "mean 414.91 mHz", "std 10.00 mHz"]
+        );
     }
 
     #[test]

@@ -5,9 +5,9 @@
 //! Plain data in ([`SimAsdData`], [`TimeSeriesData`]), a [`Figure`] out; written by
 //! [`render`] (PNG or SVG bytes).
 
-use super::chart::{Dash, LegendPlacement, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
+use super::chart::{Dash, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
 use super::labels::{observable_symbol, observable_title};
-use super::{render, DrawError, Figure, ImageFormat, TextSizes, FONT_FAMILY};
+use super::{render, DrawError, Figure, ImageFormat, TextSizes, View, FONT_FAMILY};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use tiltnoise_core::model::Observable;
@@ -81,7 +81,7 @@ fn mode_list(marks: &[&ModeMark]) -> String {
 }
 
 /// Builds Figure 3: one panel per observable of [`FIGURE3_OBSERVABLES`], ASD on log-log axes,
-/// dotted lines at the modes the panel's observable sees (vermillion) and at the others (grey),
+/// dashed lines at the modes the panel's observable sees (vermillion), dotted at the others (grey),
 /// at their apparent (aliased) frequencies, and the readout level where there is one.
 pub fn build_asd_figure(data: &SimAsdData) -> Result<LogLogFigure, String> {
     let mut panels = Vec::new();
@@ -118,8 +118,6 @@ pub fn build_asd_figure(data: &SimAsdData) -> Result<LogLogFigure, String> {
             points,
             TraceStyle::new(ASD_COLOR, Dash::Solid, 1),
         ));
-        // The legend goes inside: the full-height mode markers would otherwise push it out.
-        panel.legend = LegendPlacement::Inside;
         let last = data.freqs_hz.len() - 1;
         panel.x_range = Some((data.freqs_hz[1], data.freqs_hz[last]));
         let readout = data
@@ -153,7 +151,7 @@ pub fn build_asd_figure(data: &SimAsdData) -> Result<LogLogFigure, String> {
             panel.traces.insert(
                 0,
                 Trace::new(
-                    "other modes (not seen)",
+                    "other modes (not seen by the panel's observable)",
                     markers(&xs, y_range),
                     TraceStyle::new(OTHER_MODE_COLOR, Dash::Dotted, 1),
                 ),
@@ -164,34 +162,49 @@ pub fn build_asd_figure(data: &SimAsdData) -> Result<LogLogFigure, String> {
             panel.traces.insert(
                 0,
                 Trace::new(
-                    format!("seen: {}", mode_list(&seen)),
+                    "modes seen by the panel's observable",
                     markers(&xs, y_range),
                     TraceStyle::new(SEEN_COLOR, Dash::Dashed, 1),
                 ),
             );
         }
+        if !seen.is_empty() {
+            panel
+                .notes
+                .push(format!("modes seen: {}", mode_list(&seen)));
+        }
         panels.push(panel);
     }
     Ok(LogLogFigure {
-        size: (1800, 1150),
+        size: ASD_SIZE,
         title: Some(
             "Simulated free motion: one-sided amplitude spectral densities (Figure 3)".to_string(),
         ),
         panels,
         columns: 3,
         caption: data.caption.clone(),
-        shared_legend: false,
+        // One legend below the panels: inside, it would cover the low-frequency curve and
+        // the peaks; each panel's list of the modes it sees is a row naming the panels.
+        shared_legend: true,
     })
 }
 
-/// Draws Figure 3 as a PNG or SVG file's bytes.
+/// Default size of Figure 3 (pixels at 100 dpi).
+pub const ASD_SIZE: (u32, u32) = (1800, 1250);
+
+/// Draws Figure 3 as a PNG or SVG file's bytes, with the limits, size and resolution of
+/// `view`.
 ///
 /// # Errors
 ///
 /// [`DrawError`] for inconsistent data or any drawing failure.
-pub fn asd_figure(data: &SimAsdData, format: ImageFormat) -> Result<Vec<u8>, DrawError> {
+pub fn asd_figure(
+    data: &SimAsdData,
+    view: &View,
+    format: ImageFormat,
+) -> Result<Vec<u8>, DrawError> {
     let figure = build_asd_figure(data).map_err(DrawError)?;
-    render(format, &figure)
+    render(format, &view.apply(figure))
 }
 
 /// One time-series panel: `(t_s, value)` samples of one observable.
@@ -395,16 +408,18 @@ impl Figure for TimeSeriesData {
     }
 }
 
-/// Draws the time-series figure as a PNG or SVG file's bytes.
+/// Draws the time-series figure as a PNG or SVG file's bytes at the size and resolution of
+/// `view` (its axes are the run's: the view's frequency and ASD limits do not apply).
 ///
 /// # Errors
 ///
 /// [`DrawError`] for any drawing failure.
 pub fn time_series_figure(
     data: &TimeSeriesData,
+    view: &View,
     format: ImageFormat,
 ) -> Result<Vec<u8>, DrawError> {
-    render(format, data)
+    view.render_resized(format, data)
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@
 
 use super::chart::{Dash, LegendPlacement, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
 use super::labels::{observable_symbol, observable_title};
-use super::{render, DrawError, ImageFormat};
+use super::{render, DrawError, ImageFormat, View};
 use plotters::style::RGBColor;
 use tiltnoise_core::model::Observable;
 
@@ -164,15 +164,17 @@ pub fn build_subtract_figure(data: &SubtractFigureData) -> Result<LogLogFigure, 
     })
 }
 
-/// Draws the figure as a PNG or SVG file's bytes.
+/// Draws the figure as a PNG or SVG file's bytes, with the limits, size and resolution of
+/// `view`.
 ///
 /// # Errors
 ///
 /// [`DrawError`] for inconsistent data or any drawing failure.
 pub fn subtract_figure(
     data: &SubtractFigureData,
+    view: &View,
     format: ImageFormat,
 ) -> Result<Vec<u8>, DrawError> {
     let figure = build_subtract_figure(data).map_err(DrawError)?;
-    render(format, &figure)
+    render(format, &view.apply(figure))
 }

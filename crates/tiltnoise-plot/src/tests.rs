@@ -233,7 +233,7 @@ fn subtract_figure_png_and_svg() {
         band_hz: (3e-3, 3e-2),
         caption: vec!["Fit: gain.eta_t = 0.97 ± 1e-4.".into()],
     };
-    let png = subtract_figure(&data, ImageFormat::Png).unwrap();
+    let png = subtract_figure(&data, &View::default(), ImageFormat::Png).unwrap();
     assert_eq!(&png[..8], PNG_SIGNATURE);
     let (w, h) = (
         u32::from_be_bytes(png[16..20].try_into().unwrap()),
@@ -241,7 +241,9 @@ fn subtract_figure_png_and_svg() {
     );
     assert_eq!((w, h), (1800, 120 + 620 * 2));
     preview("subtract.png", &png);
-    let svg = String::from_utf8(subtract_figure(&data, ImageFormat::Svg).unwrap()).unwrap();
+    let svg =
+        String::from_utf8(subtract_figure(&data, &View::default(), ImageFormat::Svg).unwrap())
+            .unwrap();
     for text in [
         "cleaned (model)",
         "coherence limit",
@@ -252,7 +254,7 @@ fn subtract_figure_png_and_svg() {
     }
     let mut bad = data.clone();
     bad.panels[0].cleaned.pop();
-    let e = subtract_figure(&bad, ImageFormat::Png).unwrap_err();
+    let e = subtract_figure(&bad, &View::default(), ImageFormat::Png).unwrap_err();
     assert!(e.0.contains("cleaned ASD of X has 256 values"), "{}", e.0);
 }
 

@@ -185,7 +185,8 @@ pub fn build_tf_figure(
             phase.y_scale = YScale::Linear {
                 tick_step: Some(90.0),
             };
-            phase.y_range = Some((-180.0, 180.0));
+            // A little beyond ±180 so a phase of 180 (an undamped sign) is not on the frame.
+            phase.y_range = Some((-200.0, 200.0));
             phase.legend = LegendPlacement::Hidden;
             for (ii, &input) in tf.inputs.iter().enumerate() {
                 if InputKind::of(input) != kind {
@@ -202,6 +203,7 @@ pub fn build_tf_figure(
                     (0..tf.freqs_hz.len()).all(|k| tf.get(k, oi, ii).norm() == 0.0);
                 if identically_zero {
                     panel.notes.push(format!("{name}: identically 0"));
+                    phase.notes.push(format!("{name}: identically 0"));
                     continue;
                 }
                 let points = tf
@@ -211,12 +213,10 @@ pub fn build_tf_figure(
                     .map(|(k, &f)| (f, tf.get(k, oi, ii).norm()))
                     .collect();
                 panel.traces.push(Trace::new(name.clone(), points, style));
-                let degrees = tf
-                    .freqs_hz
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &f)| (f, tf.get(k, oi, ii).arg().to_degrees()))
-                    .collect();
+                let degrees = phase_points(
+                    &tf.freqs_hz,
+                    (0..tf.freqs_hz.len()).map(|k| tf.get(k, oi, ii).arg().to_degrees()),
+                );
                 phase.traces.push(Trace::new(name, degrees, style));
             }
             panels.push(panel);
@@ -301,8 +301,34 @@ pub fn build_tf_figure(
         panels,
         columns: 2,
         caption,
-        shared_legend: false,
+        // With phase panels, one legend below the grid: beside each magnitude panel it would
+        // take half its width.
+        shared_legend: options.phase,
     })
+}
+
+/// Largest phase step (degrees) drawn as a line between neighbouring frequencies: a larger
+/// step (a wrap from +180 to −180, an undamped sign change, a resonance narrower than the
+/// grid) is not resolved by the grid, so the line breaks there instead of drawing a vertical
+/// stroke across the panel.
+pub const PHASE_JUMP_DEG: f64 = 90.0;
+
+/// `(f, phase)` points with the phase wrapped to (−180, 180] degrees and a break (a NaN
+/// point, which the chart does not connect) wherever it steps by more than [`PHASE_JUMP_DEG`].
+fn phase_points(freqs_hz: &[f64], degrees: impl Iterator<Item = f64>) -> Vec<(f64, f64)> {
+    let mut out: Vec<(f64, f64)> = Vec::with_capacity(freqs_hz.len());
+    let mut prev: Option<(f64, f64)> = None;
+    for (&f, d) in freqs_hz.iter().zip(degrees) {
+        let wrapped = if d <= -180.0 { d + 360.0 } else { d };
+        if let Some((pf, pd)) = prev {
+            if (wrapped - pd).abs() > PHASE_JUMP_DEG {
+                out.push((0.5 * (pf + f), f64::NAN));
+            }
+        }
+        out.push((f, wrapped));
+        prev = Some((f, wrapped));
+    }
+    out
 }
 
 /// A frequency for prose: `10⁻⁴` for exact powers of ten, else 3 significant digits.
@@ -339,6 +365,19 @@ mod tests {
         let tf = plan(&model, &Request::all_tilt(), Method::Direct).unwrap();
         let freqs: Vec<f64> = (0..4).map(|k| 10f64.powi(k - 3)).collect();
         evaluate(&*tf, &freqs).unwrap()
+    }
+
+    #[test]
+    fn phase_wraps_and_breaks_at_unresolved_jumps() {
+        let f = [1.0, 2.0, 3.0, 4.0, 5.0];
+        let p = phase_points(&f, [170.0, 179.0, -180.0, -170.0, 0.0].into_iter());
+        let ys: Vec<f64> = p.iter().map(|q| q.1).collect();
+        // -180 is drawn as 180, continuing the line; 180 -> -170 and -170 -> 0 break.
+        assert_eq!(ys[..3], [170.0, 179.0, 180.0]);
+        assert!(ys[3].is_nan());
+        assert_eq!(ys[4], -170.0);
+        assert!(ys[5].is_nan());
+        assert_eq!((p.len(), ys[6]), (7, 0.0));
     }
 
     #[test]

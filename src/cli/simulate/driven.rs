@@ -20,7 +20,7 @@ use tiltnoise_core::simulate::driven::{
 use tiltnoise_core::spectral::{welch, WelchConfig};
 use tiltnoise_io::input::{read_tilt, TiltInput};
 use tiltnoise_io::{write_observable_series_hdf5, OutputKind, RunMeta, SeriesAsd, SimulationMeta};
-use tiltnoise_plot::simulate_figure::{asd_figure, ModeMark, SimAsdData};
+use tiltnoise_plot::simulate_figure::{asd_figure, ModeMark, SimAsdData, ASD_SIZE};
 
 /// `--drive-gain AXIS=GAIN,...` for the axes of the record (others 1).
 fn parse_gains(items: &[String], axes: &[TiltAxis]) -> Result<Vec<f64>> {
@@ -68,6 +68,7 @@ pub(super) fn run(
     }
     let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
     run.check_outputs(&saves, &[("--tilt", path)])?;
+    let view = args.figure.view_for(ASD_SIZE)?;
     let opts = crate::cli::args::tilt_read_options(
         args.axes.as_deref(),
         args.quantity.as_deref(),
@@ -209,7 +210,7 @@ pub(super) fn run(
                             .collect(),
                         caption: caption.clone(),
                     };
-                    save_image(out, |format| asd_figure(&data, format))?;
+                    save_image(out, |format| asd_figure(&data, &view, format))?;
                 }
             }
         }

@@ -192,7 +192,7 @@ pub fn initial_state(
             }
             Ok((
                 equal_energy_init(model, e),
-                format!("equal energy {e:e} J in each of the 8 modes, phases 0.7 + 1.3 k rad"),
+                format!("equal energy {e:e} J in each of the 8 modes, phases 0.7 + 1.3·k rad for mode k = 0..7"),
             ))
         }
     }
