@@ -71,8 +71,7 @@ fn main_job_on_default_input_writes_every_format() {
     let csv = std::fs::read_to_string(&outs[1]).unwrap();
     let header: Vec<&str> = csv
         .lines()
-        .filter(|l| !l.starts_with('#'))
-        .next()
+        .find(|l| !l.starts_with('#'))
         .unwrap()
         .split(',')
         .collect();
@@ -359,8 +358,7 @@ fn rate_series_budget_is_the_library_budget_of_the_rate() {
     let text = std::fs::read_to_string(&csv).unwrap();
     let header: Vec<&str> = text
         .lines()
-        .filter(|l| !l.starts_with('#'))
-        .next()
+        .find(|l| !l.starts_with('#'))
         .unwrap()
         .split(',')
         .collect();

@@ -158,8 +158,7 @@ fn the_model_times_the_gain_comes_back_in_every_format() {
     let csv = std::fs::read_to_string(&outs[1]).unwrap();
     let header: Vec<&str> = csv
         .lines()
-        .filter(|l| !l.starts_with('#'))
-        .next()
+        .find(|l| !l.starts_with('#'))
         .unwrap()
         .split(',')
         .collect();
@@ -456,8 +455,7 @@ fn saved_files_hold_the_report_exactly() {
     let text = std::fs::read_to_string(&csv).unwrap();
     let header: Vec<&str> = text
         .lines()
-        .filter(|l| !l.starts_with('#'))
-        .next()
+        .find(|l| !l.starts_with('#'))
         .unwrap()
         .split(',')
         .collect();
