@@ -31,6 +31,31 @@ pub(super) fn dataset<T: H5Type>(
         .create(name)
 }
 
+/// A 1-D dataset with a `unit` attribute (`1` for a dimensionless or counting quantity).
+pub(super) fn unit_dataset<T: H5Type>(
+    group: &hdf5::Group,
+    name: &str,
+    data: &[T],
+    unit: &str,
+) -> hdf5::Result<hdf5::Dataset> {
+    let d = dataset(group, name, data)?;
+    str_attr(&d, "unit", unit)?;
+    Ok(d)
+}
+
+/// A 1-D dataset whose entries have each their unit: a `unit` attribute of one string per
+/// entry.
+pub(super) fn units_dataset<T: H5Type, S: AsRef<str>>(
+    group: &hdf5::Group,
+    name: &str,
+    data: &[T],
+    units: impl IntoIterator<Item = S>,
+) -> hdf5::Result<hdf5::Dataset> {
+    let d = dataset(group, name, data)?;
+    strs_attr(&d, "unit", units)?;
+    Ok(d)
+}
+
 /// A scalar attribute.
 pub(super) fn scalar_attr<T: H5Type>(loc: &Location, name: &str, value: T) -> hdf5::Result<()> {
     loc.new_attr_builder()

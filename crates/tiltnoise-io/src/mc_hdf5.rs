@@ -1,7 +1,7 @@
 //! Monte Carlo of the normal modes as HDF5 (schema `tiltnoise.mc`, documented in
 //! `docs/schemas.md`).
 
-use super::h5util::{dataset, scalar_attr, str_attr, strings};
+use super::h5util::{dataset, scalar_attr, str_attr, strings, unit_dataset};
 use super::RunMeta;
 use crate::atomic::write_atomic;
 use ndarray::Array2;
@@ -78,9 +78,9 @@ fn write_file(
         .iter()
         .map(|&i| int(i))
         .collect::<hdf5::Result<_>>()?;
-    dataset(&file, "sample_index", &index)?;
+    unit_dataset(&file, "sample_index", &index, "1")?;
     let modes: Vec<i64> = (1..=8).collect();
-    dataset(&file, "mode_index", &modes)?;
+    unit_dataset(&file, "mode_index", &modes, "1")?;
     for (name, values) in [
         ("mean_hz", &result.mean_hz),
         ("std_hz", &result.std_hz),

@@ -8,7 +8,7 @@
 //! `--tilt` refuses it by its schema. Everything else (ASDs, initial state, parameters) lives in
 //! groups, which series readers ignore.
 
-use super::h5util::{dataset, scalar_attr, str_attr, strs_attr};
+use super::h5util::{dataset, scalar_attr, str_attr, strs_attr, unit_dataset, units_dataset};
 use super::{RunMeta, SPECTRAL_CONVENTION};
 use crate::atomic::write_atomic;
 use std::path::Path;
@@ -157,7 +157,7 @@ pub(crate) fn write_groups(
     scalar_attr(&g, "overlap", asd.overlap as u64)?;
     str_attr(&g, "averaging", &asd.averaging)?;
     scalar_attr(&g, "n_segments", asd.n_segments as u64)?;
-    dataset(&g, "frequency_hz", &asd.freqs_hz)?;
+    unit_dataset(&g, "frequency_hz", &asd.freqs_hz, "Hz")?;
     for (o, a) in &asd.asd {
         let ds = dataset(&g, o.name(), a)?;
         str_attr(&ds, "unit", &format!("{}/sqrt(Hz)", o.unit()))?;
@@ -167,15 +167,19 @@ pub(crate) fn write_groups(
     str_attr(&g, "source", &meta.init_source)?;
     strs_attr(&g, "coordinates", Coord::ALL.iter().map(|c| c.name()))?;
     strs_attr(&g, "unit", Coord::ALL.iter().map(|c| c.unit()))?;
-    dataset(&g, "q", &meta.init.q)?;
-    dataset(&g, "qdot", &meta.init.qdot)?;
+    units_dataset(&g, "q", &meta.init.q, Coord::ALL.iter().map(|c| c.unit()))?;
+    let rates: Vec<String> = Coord::ALL
+        .iter()
+        .map(|c| format!("{}/s", c.unit()))
+        .collect();
+    units_dataset(&g, "qdot", &meta.init.qdot, &rates)?;
 
     if !meta.run.modes.is_empty() {
         let g = file.create_group("modes")?;
         let index: Vec<u64> = meta.run.modes.iter().map(|m| m.0 as u64).collect();
         let f: Vec<f64> = meta.run.modes.iter().map(|m| m.1).collect();
-        dataset(&g, "index", &index)?;
-        dataset(&g, "frequency_hz", &f)?;
+        unit_dataset(&g, "index", &index, "1")?;
+        unit_dataset(&g, "frequency_hz", &f, "Hz")?;
     }
     Ok(())
 }

@@ -6,7 +6,7 @@
 //! held-out residual spectra (`/residuals/<observable>`), the alignment and the provenance.
 //! Documented in `docs/subtract.md`.
 
-use super::h5util::{dataset, scalar_attr, str_attr, strs_attr};
+use super::h5util::{dataset, scalar_attr, str_attr, strs_attr, unit_dataset, units_dataset};
 use super::series_hdf5::{SCHEMA_OBSERVABLE_SERIES, SCHEMA_VERSION_OBSERVABLE_SERIES};
 use super::{InputMeta, RunMeta, SPECTRAL_CONVENTION};
 use crate::atomic::write_atomic;
@@ -111,34 +111,67 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
     let nums = |get: fn(&tiltnoise_core::subtract::Estimate) -> f64| -> Vec<f64> {
         e.iter().map(|x| stored(get(x))).collect()
     };
-    dataset(&g, "nominal", &nums(|x| x.nominal))?;
-    dataset(&g, "value", &nums(|x| x.value))?;
-    dataset(&g, "sigma", &nums(|x| x.sigma))?;
-    dataset(&g, "scale", &nums(|x| x.scale))?;
-    dataset(&g, "lower", &nums(|x| x.bounds.0))?;
-    dataset(&g, "upper", &nums(|x| x.bounds.1))?;
+    units_dataset(
+        &g,
+        "nominal",
+        &nums(|x| x.nominal),
+        e.iter().map(|x| x.unit.as_str()),
+    )?;
+    units_dataset(
+        &g,
+        "value",
+        &nums(|x| x.value),
+        e.iter().map(|x| x.unit.as_str()),
+    )?;
+    units_dataset(
+        &g,
+        "sigma",
+        &nums(|x| x.sigma),
+        e.iter().map(|x| x.unit.as_str()),
+    )?;
+    units_dataset(
+        &g,
+        "scale",
+        &nums(|x| x.scale),
+        e.iter().map(|x| x.unit.as_str()),
+    )?;
+    units_dataset(
+        &g,
+        "lower",
+        &nums(|x| x.bounds.0),
+        e.iter().map(|x| x.unit.as_str()),
+    )?;
+    units_dataset(
+        &g,
+        "upper",
+        &nums(|x| x.bounds.1),
+        e.iter().map(|x| x.unit.as_str()),
+    )?;
     scalar_attr(&g, "chi2", f.chi2)?;
     scalar_attr(&g, "dof", f.dof as u64)?;
     scalar_attr(&g, "sigma_factor", f.sigma_factor)?;
-    dataset(&g, "fit_band_hz", &[f.band_hz.0, f.band_hz.1])?;
+    unit_dataset(&g, "fit_band_hz", &[f.band_hz.0, f.band_hz.1], "Hz")?;
     strs_attr(&g, "bins_observable", f.bins.iter().map(|b| b.0.name()))?;
-    dataset(
+    unit_dataset(
         &g,
         "bins",
         &f.bins.iter().map(|b| b.1 as u64).collect::<Vec<_>>(),
+        "1",
     )?;
-    dataset(&g, "witness_bias", &f.witness_bias)?;
+    unit_dataset(&g, "witness_bias", &f.witness_bias, "1")?;
     scalar_attr(&g, "iterations", f.iterations as u64)?;
     str_attr(&g, "stop", f.stop.describe())?;
     strs_attr(&g, "fitted", f.fitted.iter().map(String::as_str))?;
     let flat: Vec<f64> = f.correlation.iter().flatten().map(|&v| stored(v)).collect();
     let n = f.fitted.len();
-    g.new_dataset_builder()
+    let d = g
+        .new_dataset_builder()
         .with_data(
             &ndarray::ArrayView2::from_shape((n, n), &flat)
                 .map_err(|e| hdf5::Error::from(e.to_string()))?,
         )
         .create("correlation")?;
+    str_attr(&d, "unit", "1")?;
 
     let g = file.create_group("residuals")?;
     str_attr(&g, "spectral_convention", SPECTRAL_CONVENTION)?;
@@ -150,7 +183,7 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
         let h = g.create_group(o.name())?;
         let unit = format!("{}/sqrt(Hz)", o.unit());
         str_attr(&h, "unit", &unit)?;
-        dataset(&h, "frequency_hz", &s.freqs_hz)?;
+        unit_dataset(&h, "frequency_hz", &s.freqs_hz, "Hz")?;
         for (name, psd) in [
             ("measured_asd", &s.measured_psd),
             ("predicted_asd", &s.predicted_psd),
@@ -159,11 +192,11 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
             ("expected_asd", &s.expected_psd),
         ] {
             let asd: Vec<f64> = psd.iter().map(|p| p.max(0.0).sqrt()).collect();
-            dataset(&h, name, &asd)?;
+            unit_dataset(&h, name, &asd, &unit)?;
         }
         scalar_attr(&h, "readout_asd", stored(s.readout_asd.unwrap_or(f64::NAN)))?;
         let b = &s.band;
-        dataset(&h, "band_hz", &[b.band_hz.0, b.band_hz.1])?;
+        unit_dataset(&h, "band_hz", &[b.band_hz.0, b.band_hz.1], "Hz")?;
         scalar_attr(&h, "band_bins", b.bins as u64)?;
         for (name, v) in [
             ("band_measured_asd", b.measured_asd),

@@ -1,6 +1,6 @@
 //! Transfer matrix as HDF5 (schema `tiltnoise.tf`, documented in `docs/schemas.md`).
 
-use super::h5util::{dataset, scalar_attr, str_attr, strings, strs_attr};
+use super::h5util::{dataset, scalar_attr, str_attr, strings, strs_attr, unit_dataset};
 use super::RunMeta;
 use crate::atomic::write_atomic;
 use ndarray::ArrayView3;
@@ -131,7 +131,7 @@ pub(crate) fn write_modes(file: &hdf5::File, meta: &RunMeta) -> hdf5::Result<()>
             .map(|&(n, _)| i64::try_from(n).map_err(|e| e.to_string()))
             .collect::<Result<_, _>>()?;
         let freqs: Vec<f64> = meta.modes.iter().map(|&(_, f)| f).collect();
-        dataset(&modes, "index", &index)?;
+        unit_dataset(&modes, "index", &index, "1")?;
         let mf = dataset(&modes, "frequency_hz", &freqs)?;
         str_attr(&mf, "unit", "Hz")?;
     }
