@@ -53,7 +53,7 @@ def duration(seconds):
 
 
 def draw(ax, b, obs):
-    f, terms = b.freq_hz, b.terms[obs]
+    f, terms = b.frequency_hz, b.terms[obs]
     hours = b.segment_duration_s / 3600
     curves = [b.total[obs], terms["tilt"]]
     ax.loglog(f, b.total[obs], color="black", lw=3.5, label="total")

@@ -591,10 +591,16 @@ impl Budget {
 
 #[pymethods]
 impl Budget {
-    /// Frequencies (Hz), increasing, all > 0.
+    /// Frequencies (Hz), increasing, all > 0: the files' ``frequency_hz``.
+    #[getter]
+    fn frequency_hz<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.report.budget.freqs_hz)
+    }
+
+    /// The same as ``frequency_hz`` (the name of ``transfer``'s argument).
     #[getter]
     fn freq_hz<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_slice(py, &self.report.budget.freqs_hz)
+        self.frequency_hz(py)
     }
 
     /// The observables, in report order (``X``, ``phi``, ``phi_a``).

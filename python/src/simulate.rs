@@ -276,10 +276,17 @@ impl Simulation {
         self.seed
     }
 
-    /// Frequencies of the ASDs (Hz): ``k fs / nperseg``, DC included.
+    /// Frequencies of the ASDs (Hz): ``k fs / nperseg``, DC included (the files'
+    /// ``frequency_hz``).
+    #[getter]
+    fn frequency_hz<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_slice(py, &self.asd.freqs_hz)
+    }
+
+    /// The same as ``frequency_hz``.
     #[getter]
     fn freq_hz<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_slice(py, &self.asd.freqs_hz)
+        self.frequency_hz(py)
     }
 
     /// ``{observable: one-sided ASD}`` (unit/sqrt(Hz)) of each observable's samples.

@@ -17,7 +17,7 @@ def to_gwpy(budget):
             "Budget.to_gwpy() needs gwpy, which is not installed: pip install gwpy "
             f"(or pip install './python[gwpy]'); the arrays are in Budget.terms ({e})"
         ) from e
-    f = budget.freq_hz
+    f = budget.frequency_hz
     # A Welch grid is regular (f0 = df, no DC): give gwpy f0 and df, which its methods use;
     # interpolated spectra sit on a log grid and keep their frequencies.
     df = np.diff(f)
