@@ -92,6 +92,8 @@ fn draw_panel<DB: DrawingBackend>(
     let bins = h.counts.len();
     let width = (x1 - x0) / bins as f64;
     let mut lines = statistics(h).to_vec();
+    // The bin width here rather than in the axis title, which would run into the next panel.
+    lines.push(format!("bin {}", super::labels::si_value(width, "Hz")));
     if h.outside > 0 {
         let s = if h.outside == 1 { "" } else { "s" };
         lines.push(format!("{} draw{s} beyond ±5 std, not shown", h.outside));
@@ -132,10 +134,7 @@ fn draw_panel<DB: DrawingBackend>(
         .x_labels(5)
         .y_labels(5)
         .x_desc(format!("frequency ({prefix}Hz)"))
-        .y_desc(format!(
-            "draws per bin ({})",
-            super::labels::si_value(width, "Hz")
-        ))
+        .y_desc("draws per bin")
         .x_label_formatter(&|x| {
             let text = format!("{:.decimals$}", x / scale);
             match text.contains('.') {
