@@ -59,6 +59,7 @@ pub mod methods;
 pub mod model;
 pub mod modes;
 pub mod noise;
+mod num_text;
 pub mod options;
 pub mod params;
 pub mod reference;

@@ -20,7 +20,7 @@
 //!
 //! Depends on `error` (number formatting) only; reads no file except `/proc/meminfo`.
 
-use crate::error::Num;
+use crate::num_text::Num;
 use std::fmt;
 use std::io::{self, Read};
 use std::path::Path;

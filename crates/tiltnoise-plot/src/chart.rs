@@ -597,8 +597,7 @@ pub fn draw_panel<DB: DrawingBackend>(
     match panel.y_scale {
         YScale::Log => draw_log_panel(area, panel, ts, None),
         YScale::Linear { tick_step } => {
-            let (log, ticks) =
-                super::linear_axis::as_log(panel, panel.resolved_y_range(), tick_step);
+            let (log, ticks) = linear_as_log(panel, panel.resolved_y_range(), tick_step);
             draw_log_panel(area, &log, ts, Some(ticks))
         }
     }
@@ -1521,6 +1520,37 @@ fn caption_height(lines: &[String], fs: f64) -> f64 {
     lines.iter().map(|l| line_advance(l, fs)).sum()
 }
 
+/// `panel` (linear y over `(y0, y1)`) as a log-y panel of `10^((y - y0) / (y1 - y0))` over
+/// `(1, 10)`, and its ticks `(position on the log axis, label)`.
+fn linear_as_log(
+    panel: &Panel,
+    (y0, y1): (f64, f64),
+    step: Option<f64>,
+) -> (Panel, Vec<(f64, String)>) {
+    let map = |y: f64| 10f64.powf((y - y0) / (y1 - y0));
+    let points =
+        |p: &[(f64, f64)]| -> Vec<(f64, f64)> { p.iter().map(|&(x, y)| (x, map(y))).collect() };
+    let mut log = panel.clone();
+    log.y_scale = YScale::Log;
+    log.y_range = Some((1.0, 10.0));
+    log.max_decades = None;
+    log.traces = panel
+        .traces
+        .iter()
+        .map(|t| Trace::new(t.label.clone(), points(&t.points), t.style))
+        .collect();
+    log.band = panel.band.as_ref().map(|b| Band {
+        lower: points(&b.lower),
+        upper: points(&b.upper),
+        ..b.clone()
+    });
+    let ticks = super::linear_axis::ticks(y0, y1, step)
+        .into_iter()
+        .map(|(v, label)| (map(v), label))
+        .collect();
+    (log, ticks)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1705,5 +1735,20 @@ mod tests {
         let t = decade_ticks(1e-4, 30.0, 500.0, 60.0);
         assert_eq!(t.step, 1);
         assert_eq!(t.label(1e-4), "10⁻⁴");
+    }
+
+    #[test]
+    fn the_mapping_is_linear_on_the_log_axis() {
+        let mut p = Panel::new("t", ("f", "Hz"), ("y", ""));
+        p.traces.push(Trace::new(
+            "a",
+            vec![(1.0, 0.0), (2.0, 0.5), (3.0, 1.0)],
+            TraceStyle::new(PALETTE[0], Dash::Solid, 1),
+        ));
+        let (log, ticks) = linear_as_log(&p, (0.0, 1.0), Some(0.5));
+        let ys: Vec<f64> = log.traces[0].points.iter().map(|q| q.1.log10()).collect();
+        assert_eq!(ys, [0.0, 0.5, 1.0]);
+        assert_eq!(ticks.len(), 3);
+        assert_eq!(log.resolved_y_range(), (1.0, 10.0));
     }
 }

@@ -1,10 +1,7 @@
-//! Linear y axes for the log-x charts of [`super::chart`] (phase in degrees, coherence from 0
-//! to 1): a linear axis is a logarithmic axis of `10^y`, so a panel with
-//! [`YScale::Linear`](super::chart::YScale) is mapped onto one of `10^((y - y0) / (y1 - y0))`
-//! in `[1, 10]` and drawn by the log-log machinery (clipping, decimation, legend placement)
-//! unchanged, with ticks at nice linear values labelled in the original units.
-
-use super::chart::{Band, Panel, Trace, YScale};
+//! Linear y axes for the log-x charts of `chart` (phase in degrees, coherence from 0 to 1):
+//! nice tick steps, ranges and labels in the original units. `chart` maps a linear panel onto a
+//! logarithmic axis of `10^((y - y0) / (y1 - y0))` in `[1, 10]` and draws it with the log-log
+//! machinery (clipping, decimation, legend placement) unchanged.
 
 /// A nice tick step for `[lo, hi]`: the smallest of 1, 2 or 5 times a power of ten that
 /// divides the span into at most 8 intervals.
@@ -56,37 +53,6 @@ pub(crate) fn ticks(lo: f64, hi: f64, step: Option<f64>) -> Vec<(f64, String)> {
         .collect()
 }
 
-/// `panel` (linear y over `(y0, y1)`) as a log-y panel of `10^((y - y0) / (y1 - y0))` over
-/// `(1, 10)`, and its ticks `(position on the log axis, label)`.
-pub(crate) fn as_log(
-    panel: &Panel,
-    (y0, y1): (f64, f64),
-    step: Option<f64>,
-) -> (Panel, Vec<(f64, String)>) {
-    let map = |y: f64| 10f64.powf((y - y0) / (y1 - y0));
-    let points =
-        |p: &[(f64, f64)]| -> Vec<(f64, f64)> { p.iter().map(|&(x, y)| (x, map(y))).collect() };
-    let mut log = panel.clone();
-    log.y_scale = YScale::Log;
-    log.y_range = Some((1.0, 10.0));
-    log.max_decades = None;
-    log.traces = panel
-        .traces
-        .iter()
-        .map(|t| Trace::new(t.label.clone(), points(&t.points), t.style))
-        .collect();
-    log.band = panel.band.as_ref().map(|b| Band {
-        lower: points(&b.lower),
-        upper: points(&b.upper),
-        ..b.clone()
-    });
-    let ticks = ticks(y0, y1, step)
-        .into_iter()
-        .map(|(v, label)| (map(v), label))
-        .collect();
-    (log, ticks)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -106,20 +72,5 @@ mod tests {
             (-90.0, 180.0)
         );
         assert_eq!(auto_range(std::iter::empty(), None), (0.0, 1.0));
-    }
-
-    #[test]
-    fn the_mapping_is_linear_on_the_log_axis() {
-        let mut p = Panel::new("t", ("f", "Hz"), ("y", ""));
-        p.traces.push(Trace::new(
-            "a",
-            vec![(1.0, 0.0), (2.0, 0.5), (3.0, 1.0)],
-            crate::chart::TraceStyle::new(crate::chart::PALETTE[0], crate::chart::Dash::Solid, 1),
-        ));
-        let (log, ticks) = as_log(&p, (0.0, 1.0), Some(0.5));
-        let ys: Vec<f64> = log.traces[0].points.iter().map(|q| q.1.log10()).collect();
-        assert_eq!(ys, [0.0, 0.5, 1.0]);
-        assert_eq!(ticks.len(), 3);
-        assert_eq!(log.resolved_y_range(), (1.0, 10.0));
     }
 }

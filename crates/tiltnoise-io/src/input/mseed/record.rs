@@ -4,14 +4,8 @@
 //! Everything the header says is checked against the bytes there are, so a damaged record
 //! is an error, never a read out of bounds.
 
+pub(crate) use super::steim::WordOrder;
 use super::steim::{self, Steim};
-
-/// Byte order of the header fields or of the data words.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum WordOrder {
-    Big,
-    Little,
-}
 
 /// Length of the fixed header section.
 const FIXED_HEADER: usize = 48;

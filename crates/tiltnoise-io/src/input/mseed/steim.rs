@@ -3,7 +3,12 @@
 //! differences bytes or half-words in memory order), the first difference gives way to the forward integration constant
 //! `X0`, and the last sample must equal the reverse integration constant `Xn`.
 
-use super::record::WordOrder;
+/// Byte order of the header fields or of the data words.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum WordOrder {
+    Big,
+    Little,
+}
 
 /// Bytes of one Steim frame: sixteen 32-bit words, the first of them the nibble word.
 const FRAME_BYTES: usize = 64;
