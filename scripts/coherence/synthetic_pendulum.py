@@ -59,7 +59,7 @@ def main():
         cmd += ["tf", "--freq-file", grid, "--input", ",".join(axes),
                 "--output", ",".join(READOUT)]
         text = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
-    lines = text.strip().split("\n")
+    lines = [l for l in text.strip().split("\n") if not l.startswith("#")]
     header = lines[0].split(",")
     table = np.array([[float(v) for v in line.split(",")] for line in lines[1:]])
     rng = np.random.default_rng(a.seed)

@@ -639,6 +639,7 @@ fn draw_log_panel<DB: DrawingBackend>(
             major: labelled.iter().map(|t| t.0).collect(),
             minor: Vec::new(),
             step: 1,
+            anchor: 0,
             labels: labelled,
             unit: None,
         },
@@ -875,8 +876,11 @@ struct Ticks {
     major: Vec<f64>,
     /// 2..9 times each decade, when there is room for them (light grid lines).
     minor: Vec<f64>,
-    /// Label every `step`-th decade (exponents divisible by `step`).
+    /// Label every `step`-th decade: exponents `e` with `e - anchor` divisible by `step`.
     step: i32,
+    /// See `step`: 0 (exponents divisible by `step`, `10⁻⁶, 10⁻⁴, ...`) unless that labels
+    /// fewer decades of the range than starting at its first decade does.
+    anchor: i32,
     /// Explicit labels of a linear axis mapped onto a log one: `(position, text)`.
     labels: Vec<(f64, String)>,
     /// Unit written on every label with an SI prefix (`1 mHz`); `None`: powers of ten (`10⁻³`).
@@ -894,7 +898,7 @@ impl Ticks {
                 .unwrap_or_default();
         }
         let e = v.log10().round() as i32;
-        if e.rem_euclid(self.step) == 0 {
+        if (e - self.anchor).rem_euclid(self.step) == 0 {
             match &self.unit {
                 Some(unit) => super::labels::si_value(10f64.powi(e), unit),
                 None => pow10_label(e),
@@ -915,6 +919,15 @@ fn decade_ticks(lo: f64, hi: f64, pixels: f64, min_spacing: f64) -> Ticks {
     let step = (1..=12)
         .find(|&k| per_decade * k as f64 >= min_spacing)
         .unwrap_or(12);
+    // Divisible exponents when they label as many decades as possible, else from the first
+    // (three decades with every second labelled: 1 mHz and 100 mHz rather than 10 mHz alone).
+    let divisible = (first..=last).filter(|e| e.rem_euclid(step) == 0).count() as i32;
+    let most = if last >= first {
+        (last - first) / step + 1
+    } else {
+        0
+    };
+    let anchor = if divisible >= most { 0 } else { first };
     let mut minor = Vec::new();
     if per_decade >= 45.0 {
         for e in (first - 1)..=last {
@@ -930,6 +943,7 @@ fn decade_ticks(lo: f64, hi: f64, pixels: f64, min_spacing: f64) -> Ticks {
         major,
         minor,
         step,
+        anchor,
         labels: Vec::new(),
         unit: None,
     }
@@ -1735,6 +1749,17 @@ mod tests {
         let t = decade_ticks(1e-4, 30.0, 500.0, 60.0);
         assert_eq!(t.step, 1);
         assert_eq!(t.label(1e-4), "10⁻⁴");
+        // Three decades, room for every second label: the first and the third, not the
+        // middle one alone.
+        let t = decade_ticks(2.4e-4, 0.5, 170.0, 94.0);
+        assert_eq!(t.step, 2);
+        let labelled: Vec<f64> = t
+            .major
+            .iter()
+            .copied()
+            .filter(|&v| !t.label(v).is_empty())
+            .collect();
+        assert_eq!(labelled, [1e-3, 1e-1]);
     }
 
     #[test]
