@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Speed of tiltnoise.Model.transfer against numpy.linalg.solve, side by side in one process.
 
-    python python/benches/transfer_speed.py [--points 100000] [--rounds 7] [--json]
+    python python/benches/transfer_speed.py [--points 100000] [--rounds 7] [--number 1]
+                                            [--warmup 0] [--json]
 
 The 7x3 tilt matrix H(f) = C (K - w^2 M)^-1 (G0 + w^2 G2) of Table I (outputs X, Y, Z, theta,
 eta, phi, phi_a; inputs theta_t, eta_t, phi_t) on --points log-spaced frequencies from 1e-5 to
@@ -16,8 +17,8 @@ eta, phi, phi_a; inputs theta_t, eta_t, phi_t) on --points log-spaced frequencie
   in the ratio (in NumPy's favour).
 
 Every timed function runs once untimed, then --rounds rounds in which each runs once (or
---number times in a row, the mean of which is the round's sample, as timeit does), the order
-rotating between rounds; the medians are reported, and the ratio's range over the rounds. The
+--number times in a row, the mean of which is the round's sample, as timeit does; --warmup
+untimed calls first), the order rotating between rounds; the medians are reported, and the ratio's range over the rounds. The
 machine may be shared: read the ratios, measured side by side, rather than the absolute times.
 Per-call cost on small grids (1, 10, 100 points) is the mean of many calls, NumPy including
 the stacking there (it is part of every call); the arithmetic alone is the same on 1000 points
@@ -39,6 +40,9 @@ def parse_args():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--points", type=int, default=100_000, help="grid size (default 1e5)")
     ap.add_argument("--rounds", type=int, default=7, help="timed rounds (default 7)")
+    ap.add_argument("--warmup", type=int, default=0,
+                    help="untimed calls of the same function right before each timed sample "
+                         "(default 0: the sample follows the other functions' calls)")
     ap.add_argument("--number", type=int, default=1,
                     help="calls in a row per timed sample, as timeit's number (default 1: each "
                          "sample is one call right after the other functions' calls)")
@@ -116,6 +120,8 @@ def main():
     for r in range(args.rounds):
         order = names[r % len(names):] + names[: r % len(names)]
         for k in order:
+            for _ in range(args.warmup):
+                runs[k]()
             times[k].append(timed(runs[k], args.number))
     med = {k: statistics.median(v) for k, v in times.items()}
     ratios = {
@@ -141,6 +147,7 @@ def main():
         "points": args.points,
         "rounds": args.rounds,
         "number": args.number,
+        "warmup": args.warmup,
         "machine": f"{platform.machine()}, {platform.python_version()}",
         "tiltnoise_version": tiltnoise.__version__,
         "max_rel_difference_numpy_vs_tiltnoise": agree,
@@ -161,7 +168,7 @@ def main():
         print(json.dumps(result, indent=2))
         return
     print(f"7x3 tilt matrix, {args.points} log points 1e-5..100 Hz, {args.rounds} rounds "
-          f"of {args.number} call(s) in a row (median); NumPy and tiltnoise agree to {agree:.1e} relative where |H| > 1e-6 max")
+          f"of {args.warmup} untimed + {args.number} timed call(s) in a row (median); NumPy and tiltnoise agree to {agree:.1e} relative where |H| > 1e-6 max")
     print(f"{'what':<34} {'ms':>9} {'ns/point':>9} {'numpy_solve / this':>24}")
     for k in names:
         ratio = ""
