@@ -140,7 +140,7 @@ pub(crate) fn series_attrs(
         .find(|(x, _)| *x == o)
         .map_or(0.0, |r| r.1);
     scalar_attr(ds, "readout_asd", r)?;
-    str_attr(ds, "readout_asd_units", &format!("{}/sqrt(Hz)", o.unit()))?;
+    str_attr(ds, "readout_asd_unit", &format!("{}/sqrt(Hz)", o.unit()))?;
     Ok(())
 }
 
