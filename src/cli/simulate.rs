@@ -549,17 +549,8 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
     })
 }
 
-fn readout_text(readout: &[(Observable, f64)]) -> String {
-    if readout.is_empty() {
-        return "none".to_string();
-    }
-    readout
-        .iter()
-        .map(|(o, a)| format!("{} {a:e} {}/sqrt(Hz)", o.name(), o.unit()))
-        .collect::<Vec<_>>()
-        .join(", ")
-        + " (others noiseless)"
-}
+/// The readout as the summary and the files describe it (the library's wording).
+pub(crate) use tiltnoise_core::simulate::readout_text;
 
 fn summary(
     (n, dt_s): (usize, f64),
