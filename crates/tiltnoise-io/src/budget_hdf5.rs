@@ -290,7 +290,7 @@ fn write_psd_asd(
 ) -> hdf5::Result<()> {
     let asd: Vec<f64> = psd.iter().map(|p| p.sqrt()).collect();
     for (name, values, unit) in [
-        (psd_name, psd, format!("{unit}^2/Hz")),
+        (psd_name, psd, format!("{}/Hz", squared(unit))),
         (asd_name, asd.as_slice(), asd_unit(unit)),
     ] {
         let d = dataset(group, name, values)?;
@@ -301,6 +301,22 @@ fn write_psd_asd(
         }
     }
     Ok(())
+}
+
+/// The square of a unit written as space-separated factors `base` or `base^exp`:
+/// `m` -> `m^2`, `m s^-2` -> `m^2 s^-4`, `N m` -> `N^2 m^2` (the form astropy parses; `m s^-2^2`
+/// would not be a unit).
+fn squared(unit: &str) -> String {
+    unit.split_whitespace()
+        .map(|factor| match factor.split_once('^') {
+            Some((base, exp)) => match exp.parse::<i32>() {
+                Ok(e) => format!("{base}^{}", 2 * e),
+                Err(_) => format!("({factor})^2"),
+            },
+            None => format!("{factor}^2"),
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 /// `(f0, df)` if `freqs_hz[k] = f0 + k df` for every `k` to within 4 ulp (a Welch grid), else
@@ -318,4 +334,17 @@ pub(crate) fn even_grid(freqs_hz: &[f64]) -> Option<(f64, f64)> {
 
 fn int(n: usize) -> hdf5::Result<i64> {
     i64::try_from(n).map_err(|e| e.to_string().into())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::squared;
+
+    #[test]
+    fn units_are_squared_factor_by_factor() {
+        assert_eq!(squared("m"), "m^2");
+        assert_eq!(squared("rad"), "rad^2");
+        assert_eq!(squared("m s^-2"), "m^2 s^-4");
+        assert_eq!(squared("N m"), "N^2 m^2");
+    }
 }
