@@ -1,6 +1,6 @@
 //! Noise budget as HDF5 (schema `tiltnoise.budget`, documented in `docs/schemas.md`).
 
-use super::h5util::{dataset, scalar_attr, str_attr, strs_attr};
+use super::h5util::{dataset, provenance, scalar_attr, str_attr, strs_attr};
 use super::{InputMeta, RunMeta, SIGN_CONVENTION};
 use crate::atomic::write_atomic;
 use std::path::Path;
@@ -57,10 +57,7 @@ fn write_file(
 ) -> hdf5::Result<()> {
     let file = hdf5::File::create(path)?;
 
-    str_attr(&file, "schema", SCHEMA_BUDGET)?;
-    scalar_attr(&file, "schema_version", SCHEMA_VERSION_BUDGET)?;
-    str_attr(&file, "tool_version", &meta.tool_version)?;
-    str_attr(&file, "created_by", &meta.command_line)?;
+    provenance(&file, SCHEMA_BUDGET, SCHEMA_VERSION_BUDGET, meta)?;
     str_attr(&file, "parameters_toml", &meta.params_toml)?;
     str_attr(&file, "sign_convention", SIGN_CONVENTION)?;
     str_attr(&file, "spectral_convention", SPECTRAL_CONVENTION)?;

@@ -1,7 +1,7 @@
 //! Coherence and measured transfer functions as HDF5 (schema `tiltnoise.coherence`, documented
 //! in `docs/schemas.md` and `docs/coherence.md`).
 
-use super::h5util::{dataset, scalar_attr, str_attr, strs_attr};
+use super::h5util::{dataset, provenance, scalar_attr, str_attr, strs_attr};
 use super::{InputMeta, RunMeta, SIGN_CONVENTION, SPECTRAL_CONVENTION, TIME_DEPENDENCE};
 use crate::atomic::write_atomic;
 use num_complex::Complex64;
@@ -69,10 +69,7 @@ fn write_file(
     inputs: &CoherenceInputs,
 ) -> hdf5::Result<()> {
     let file = hdf5::File::create(path)?;
-    str_attr(&file, "schema", SCHEMA_COHERENCE)?;
-    scalar_attr(&file, "schema_version", SCHEMA_VERSION_COHERENCE)?;
-    str_attr(&file, "tool_version", &meta.tool_version)?;
-    str_attr(&file, "created_by", &meta.command_line)?;
+    provenance(&file, SCHEMA_COHERENCE, SCHEMA_VERSION_COHERENCE, meta)?;
     str_attr(&file, "parameters_toml", &meta.params_toml)?;
     str_attr(&file, "sign_convention", SIGN_CONVENTION)?;
     str_attr(&file, "time_dependence", TIME_DEPENDENCE)?;

@@ -1,7 +1,7 @@
 //! The fit's HDF5 file (`tiltnoise fit --save fit.h5`; schema `tiltnoise.fit`, layout in
 //! `docs/fit.md` and `docs/schemas.md`).
 
-use super::h5util::{dataset, scalar_attr, str_attr, strings, strs_attr};
+use super::h5util::{dataset, provenance, scalar_attr, str_attr, strings, strs_attr};
 use super::RunMeta;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
@@ -36,10 +36,7 @@ pub fn write_fit_hdf5(
 
 fn write_h5(path: &Path, r: &FitResult, origin: &str, meta: &RunMeta) -> hdf5::Result<()> {
     let file = hdf5::File::create(path)?;
-    str_attr(&file, "schema", SCHEMA_FIT)?;
-    scalar_attr(&file, "schema_version", SCHEMA_VERSION_FIT)?;
-    str_attr(&file, "tool_version", &meta.tool_version)?;
-    str_attr(&file, "created_by", &meta.command_line)?;
+    provenance(&file, SCHEMA_FIT, SCHEMA_VERSION_FIT, meta)?;
     str_attr(&file, "measured_origin", origin)?;
     str_attr(&file, "stop", r.stop.describe())?;
     str_attr(&file, "fitted_params_toml", &r.fitted_params.to_toml())?;

@@ -56,6 +56,20 @@ pub(super) fn units_dataset<T: H5Type, S: AsRef<str>>(
     Ok(d)
 }
 
+/// The root attributes every output file has: `schema`, `schema_version`, `tool_version` and
+/// `created_by` (the command line), from `meta` (`docs/schemas.md`, "Every output").
+pub(super) fn provenance(
+    file: &hdf5::File,
+    schema: &str,
+    schema_version: i64,
+    meta: &super::RunMeta,
+) -> hdf5::Result<()> {
+    str_attr(file, "schema", schema)?;
+    scalar_attr(file, "schema_version", schema_version)?;
+    str_attr(file, "tool_version", &meta.tool_version)?;
+    str_attr(file, "created_by", &meta.command_line)
+}
+
 /// A scalar attribute.
 pub(super) fn scalar_attr<T: H5Type>(loc: &Location, name: &str, value: T) -> hdf5::Result<()> {
     loc.new_attr_builder()

@@ -1,7 +1,7 @@
 //! Monte Carlo of the normal modes as HDF5 (schema `tiltnoise.mc`, documented in
 //! `docs/schemas.md`).
 
-use super::h5util::{dataset, scalar_attr, str_attr, strings, unit_dataset};
+use super::h5util::{dataset, provenance, scalar_attr, str_attr, strings, unit_dataset};
 use super::RunMeta;
 use crate::atomic::write_atomic;
 use ndarray::Array2;
@@ -49,10 +49,7 @@ fn write_file(
     meta: &RunMeta,
 ) -> hdf5::Result<()> {
     let file = hdf5::File::create(path)?;
-    str_attr(&file, "schema", SCHEMA_MC)?;
-    scalar_attr(&file, "schema_version", SCHEMA_VERSION_MC)?;
-    str_attr(&file, "tool_version", &meta.tool_version)?;
-    str_attr(&file, "created_by", &meta.command_line)?;
+    provenance(&file, SCHEMA_MC, SCHEMA_VERSION_MC, meta)?;
     str_attr(&file, "parameters_toml", &meta.params_toml)?;
     scalar_attr(&file, "seed", cfg.seed)?;
     scalar_attr(&file, "samples", int(result.samples)?)?;

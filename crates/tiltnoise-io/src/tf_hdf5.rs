@@ -1,6 +1,6 @@
 //! Transfer matrix as HDF5 (schema `tiltnoise.tf`, documented in `docs/schemas.md`).
 
-use super::h5util::{dataset, scalar_attr, str_attr, strings, strs_attr, unit_dataset};
+use super::h5util::{dataset, provenance, str_attr, strings, strs_attr, unit_dataset};
 use super::RunMeta;
 use crate::atomic::write_atomic;
 use ndarray::ArrayView3;
@@ -76,10 +76,7 @@ pub(crate) fn write_root(
     tf: &TransferMatrix,
     meta: &RunMeta,
 ) -> hdf5::Result<()> {
-    str_attr(file, "schema", SCHEMA_TF)?;
-    scalar_attr(file, "schema_version", SCHEMA_VERSION_TF)?;
-    str_attr(file, "tool_version", &meta.tool_version)?;
-    str_attr(file, "created_by", &meta.command_line)?;
+    provenance(file, SCHEMA_TF, SCHEMA_VERSION_TF, meta)?;
     str_attr(file, "method", tf.method.name())?;
     str_attr(file, "parameters_toml", &meta.params_toml)?;
     str_attr(file, "sign_convention", SIGN_CONVENTION)?;
