@@ -45,10 +45,7 @@
 //! bit-identical whatever the output, the grid, the lane, the number of threads
 //! ([`super::evaluate_into`], [`super::eval_grid_threads`]) or the CPU (AVX, chosen at run
 //! time, or portable: the same IEEE operations in the same order, no fused multiply-add).
-//! Measured on Table I, 7x3 tilt matrix, 1e5 points (`benches/methods.rs`,
-//! `scripts/bench/README.md`): 7.7 ns per point into a reused matrix on one thread (about
-//! 150x NumPy), 12 ns for the dense complex output, which is at the memory floor of its 336
-//! bytes per point.
+//! Its speed is measured by `benches/methods.rs` (figures in `scripts/bench/README.md`).
 //!
 //! Singularity: an undamped block with `|lambda_k - s| < SINGULAR_RCOND lambda_k` (the rounding
 //! of `s` and of `lambda_k` then leaves fewer than three digits of the factor) is reported as

@@ -13,7 +13,7 @@
 //! * interleaved ([`Kernel::eval_grid`], the dense complex matrix, a point's values
 //!   together): each lane's values are scattered into the buffer, which is copied in one
 //!   sequential pass, with non-temporal stores for outputs larger than the cache
-//!   ([`STREAM_MIN_BYTES`]); one point alone ([`TransferFunction::eval_into`]) is written in
+//!   ([`Destination::streams`]); one point alone ([`TransferFunction::eval_into`]) is written in
 //!   place into the zeroed output;
 //! * planar ([`Kernel::eval_planes`], a plane per value over the grid, the layout of
 //!   `tf::evaluate`): a value's eight lanes are stored together with vector moves, and copied
@@ -41,14 +41,6 @@ use super::lanes::{stream_fence, Lanes, Portable, LANES};
 use crate::error::TfError;
 use crate::tf::Destination;
 use num_complex::Complex64;
-
-/// Interleaved outputs of at least this many bytes are written with non-temporal stores
-/// ([`Lanes::stream_copy`]): well above a core's L2 (1 to 2 MiB), about where the output stops
-/// fitting in a typical L3 next to other work. Below it, ordinary stores leave the output in
-/// the cache for the caller. At 1e5 points of 21 values (34 MB) on the 2-core EPYC VM of
-/// `scripts/bench/README.md`, a copy test alone: 12.5 ns per point with non-temporal stores,
-/// 18 to 22 with ordinary ones (which read each line before writing it).
-const STREAM_MIN_BYTES: usize = 8 << 20;
 
 /// One entry of an undamped block: `gain prod_k (a_k + b_k s)` times the block's
 /// `1 / prod(lambda - s)`, added at value `re` (its real part). Factors: `s` for a zero at the origin
@@ -597,11 +589,9 @@ struct Interleaved<'a> {
 }
 
 impl<'a> Interleaved<'a> {
-    /// Non-temporal stores for outputs of [`STREAM_MIN_BYTES`] or more that are not
-    /// [`Destination::Fresh`].
+    /// Non-temporal stores where `destination` says so ([`Destination::streams`]).
     fn new(out: &'a mut [f64], destination: Destination) -> Self {
-        let stream =
-            std::mem::size_of_val(out) >= STREAM_MIN_BYTES && destination == Destination::Reused;
+        let stream = destination.streams(std::mem::size_of_val(out));
         Interleaved { out, stream }
     }
 }
@@ -626,9 +616,8 @@ impl Sink for Interleaved<'_> {
 
 /// One plane per value. Ordinary stores: a chunk writes 64 bytes to each plane, a whole
 /// cache line only if the plane is 64-byte aligned, and partial lines written non-temporally
-/// cost ~30 ns per point on the VM of `scripts/bench/README.md` (ordinary stores: ~1.3 ns per
-/// point of 11 planes in a copy test); a compact result is also small enough to stay in L3
-/// (8.8 MB at 1e5 points of Table I's tilt matrix).
+/// are an order of magnitude slower than ordinary stores in a copy test; a compact result is
+/// also small enough to stay in L3 (8.8 MB at 1e5 points of Table I's tilt matrix).
 struct Planar<'a, 'p>(&'a mut [&'p mut [f64]]);
 
 impl Sink for Planar<'_, '_> {
@@ -735,7 +724,7 @@ mod tests {
             for kernel in [&pz.kernel, &pz.compact] {
                 let stride = kernel.stride;
                 // 0 Hz, then log-spaced to 1e5 Hz; the second grid exceeds STREAM_MIN_BYTES.
-                let big = super::STREAM_MIN_BYTES / (8 * stride) + 1001;
+                let big = crate::tf::STREAM_MIN_BYTES / (8 * stride) + 1001;
                 for n in [1001, big] {
                     let freqs: Vec<f64> = (0..n)
                         .map(|k| match k {
