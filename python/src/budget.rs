@@ -449,7 +449,7 @@ pub fn budget_from_file(
         None => None,
         Some(f) => Some(match f.cast::<PyString>() {
             Ok(spec) => freq::parse_spec(&spec.to_cow()?).py()?,
-            Err(_) => crate::model::frequencies(f)?,
+            Err(_) => crate::grid::frequencies(f)?,
         }),
     };
     let mut given = series_opts.given();

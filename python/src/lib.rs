@@ -10,6 +10,7 @@
 mod budget;
 mod errors;
 mod fit;
+mod grid;
 mod model;
 mod params;
 mod simulate;

@@ -2,15 +2,13 @@
 //! the model's matrices and the Monte Carlo of the modes (`mc`).
 
 use crate::errors::{value_error, PyResultExt};
+use crate::grid::{self, GridBuffer};
 use crate::params::PyParams;
-use numpy::{
-    Complex64, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods,
-};
+use numpy::{Complex64, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, OnceLock};
-use tiltnoise_core::freq::DEFAULT_F_LO_HZ;
 use tiltnoise_core::mc::{self, McConfig};
 use tiltnoise_core::model::{Coord, ForceInput, Input, Model, Observable, Request};
 use tiltnoise_core::modes::NormalModes;
@@ -60,6 +58,8 @@ pub struct PyModel {
     plans: Mutex<PlanCache>,
     choices: Mutex<ChoiceCache>,
     last: Mutex<Option<LastPlan>>,
+    /// The frequencies of the last call of `transfer`, kept for the next one's copy.
+    grid: Mutex<Vec<f64>>,
 }
 
 /// The plan of the last call of `transfer`: a repeated call (the same names, method, band
@@ -83,6 +83,7 @@ impl PyModel {
             plans: Mutex::new(HashMap::new()),
             choices: Mutex::new(HashMap::new()),
             last: Mutex::new(None),
+            grid: Mutex::new(Vec::new()),
         })
     }
 
@@ -90,7 +91,7 @@ impl PyModel {
         self.modes.get_or_init(|| NormalModes::new(&self.model))
     }
 
-    /// The method `auto` takes for `request` on `band` (see [`auto_band`]) and `rel_tol`,
+    /// The method `auto` takes for `request` on `band` (see [`grid::auto_band`]) and `rel_tol`,
     /// remembered per request, band and tolerance.
     fn auto_method(
         &self,
@@ -120,18 +121,20 @@ impl PyModel {
         Ok(choice.method)
     }
 
-    /// The plan `transfer` evaluates: `asked` (`None`: what `auto` picks on the band of
-    /// `freqs`), looked up in the last call's first.
+    /// The plan `transfer` evaluates: `asked` (`None`: what `auto` picks on `band`, the
+    /// grid's [`grid::auto_band`]), looked up in the last call's first.
     fn plan_for(
         &self,
         py: Python<'_>,
         request: Request,
         asked: Option<Method>,
-        freqs: &[f64],
+        band: (f64, f64),
         rel_tol: f64,
     ) -> PyResult<Arc<dyn TransferFunction>> {
-        let band = asked.is_none().then(|| auto_band(freqs));
-        let scene = band.map_or([0; 3], |b| scene_bits(b, rel_tol));
+        let scene = match asked {
+            None => scene_bits(band, rel_tol),
+            Some(_) => [0; 3],
+        };
         if let Some(last) = lock(&self.last).as_ref() {
             if last.asked == asked && last.scene == scene && last.request == request {
                 return Ok(Arc::clone(&last.plan));
@@ -139,7 +142,7 @@ impl PyModel {
         }
         let method = match asked {
             Some(m) => m,
-            None => self.auto_method(py, &request, auto_band(freqs), rel_tol)?,
+            None => self.auto_method(py, &request, band, rel_tol)?,
         };
         let plan = self.plan(py, &request, method)?;
         *lock(&self.last) = Some(LastPlan {
@@ -176,23 +179,6 @@ impl PyModel {
 /// inserted whole), so a poisoned lock is used as it is.
 fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-/// The band `auto` plans for (the command line's `--method auto`): that of the positive
-/// frequencies, or the default lowest frequency when there is none.
-fn auto_band(freqs: &[f64]) -> (f64, f64) {
-    let (mut lo, mut hi) = (f64::INFINITY, 0.0_f64);
-    for &f in freqs {
-        if f > 0.0 && f.is_finite() {
-            lo = lo.min(f);
-            hi = hi.max(f);
-        }
-    }
-    if hi > 0.0 {
-        (lo, hi)
-    } else {
-        (DEFAULT_F_LO_HZ, DEFAULT_F_LO_HZ)
-    }
 }
 
 /// A band and a tolerance as a cache key.
@@ -251,36 +237,6 @@ fn parse_method(name: &str) -> PyResult<Option<Method>> {
                 allowed.join(", ")
             ))
         })
-}
-
-/// Frequencies (Hz) from a number or a 1-D array-like, as `f64`: a float64 array is copied
-/// as it is; a NumPy array is asked before a number (a one-element array converts to a
-/// number only with a deprecation warning, and trying the conversion costs microseconds).
-pub fn frequencies(arg: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
-    if let Ok(a) = arg.cast::<PyArray1<f64>>() {
-        // SAFETY: the values are copied at once, holding the GIL, so no Python code runs
-        // meanwhile; no Rust code of this module holds a mutable view of an array here.
-        if let Ok(slice) = unsafe { a.as_slice() } {
-            return Ok(slice.to_vec());
-        }
-    } else if arg.cast::<PyUntypedArray>().is_err() {
-        if let Ok(f) = arg.extract::<f64>() {
-            return Ok(vec![f]);
-        }
-    }
-    let np = arg.py().import("numpy")?;
-    let array = np
-        .call_method1("asarray", (arg, "float64"))
-        .map_err(|e| value_error(format!("freq_hz: not an array of numbers ({e})")))?;
-    let array = array.cast_into::<numpy::PyArrayDyn<f64>>()?;
-    if array.ndim() > 1 {
-        return Err(value_error(format!(
-            "freq_hz: expected a number or a 1-D array of frequencies in Hz, got {} dimensions",
-            array.ndim()
-        )));
-    }
-    // A 0-d array is one frequency, as a number.
-    Ok(array.readonly().as_array().iter().copied().collect())
 }
 
 /// `rel_tol` of [`PyModel::transfer`], as the command line's `--rel-tol`.
@@ -406,14 +362,16 @@ impl PyModel {
         };
         let asked = parse_method(method)?;
         check_rel_tol(rel_tol)?;
-        let freqs = frequencies(freq_hz)?;
+        let mut grid = GridBuffer::borrow(&self.grid);
+        let band = grid.fill(freq_hz)?;
+        let freqs = grid.freqs();
         let dims = [freqs.len(), request.outputs.len(), request.inputs.len()];
-        let plan = self.plan_for(py, request, asked, &freqs, rel_tol)?;
+        let plan = self.plan_for(py, request, asked, band, rel_tol)?;
         let threads = threads.unwrap_or(match freqs.len() >= THREADED_GRID {
             true => std::thread::available_parallelism().map_or(1, |n| n.get()),
             false => 1,
         });
-        let (plan, freqs) = (plan.as_ref(), freqs.as_slice());
+        let plan = plan.as_ref();
         let eval = |buffer: &mut [Complex64], destination| -> PyResult<()> {
             let mut run = move || eval_grid_threads(plan, freqs, buffer, threads, destination);
             match freqs.len() <= HOLD_GIL_MAX_POINTS {
@@ -475,7 +433,7 @@ impl PyModel {
         check_rel_tol(rel_tol)?;
         let scene = Scene {
             rel_tol,
-            ..Scene::over_grid(request, &frequencies(freq_hz)?)
+            ..Scene::over_grid(request, &grid::frequencies(freq_hz)?)
         };
         let model = &self.model;
         let choice = py

@@ -193,3 +193,16 @@ def test_fit_errors(model, tmp_path):
     bad.write_text("mode,frequency_hz\n9,1.0\n")
     with pytest.raises(tiltnoise.InputFileError, match="modes.csv"):
         model.fit(measured=bad)
+
+
+def test_repeated_calls_on_other_grids_give_a_new_models_values():
+    # A model keeps its frequency buffer between calls: grids of other lengths and kinds
+    # (shorter, longer, unsorted with 0 Hz, a number, a list) give the values a new model gives.
+    model = tiltnoise.Model()
+    long = np.logspace(-5, 2, 20_000)
+    grids = [long, long[:7], np.array([5.0, 0.0, 1e-3, 0.2]), 0.01, [1e-4, 3.0], long]
+    for f in grids:
+        got = model.transfer(f)
+        want = tiltnoise.Model().transfer(f)
+        assert got.shape == want.shape
+        assert np.array_equal(got.view(np.float64), want.view(np.float64)), f
