@@ -35,6 +35,13 @@ const HOLD_GIL_MAX_POINTS: usize = 16;
 /// more than the points it takes over (about 10 ns each).
 const THREADED_GRID: usize = 8192;
 
+/// The cores this process may use, asked once: `available_parallelism` reads the cgroup's
+/// CPU quota from files on every call, tens of microseconds.
+fn cores() -> usize {
+    static CORES: OnceLock<usize> = OnceLock::new();
+    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
+
 /// Plans built so far, per request and method: a plan does its per-model work (pole-zero
 /// factors in double-double, factorized forcing) once, so later calls cost only their points.
 type PlanCache = HashMap<(Vec<Input>, Vec<Observable>, Method), Arc<dyn TransferFunction>>;
@@ -368,7 +375,7 @@ impl PyModel {
         let dims = [freqs.len(), request.outputs.len(), request.inputs.len()];
         let plan = self.plan_for(py, request, asked, band, rel_tol)?;
         let threads = threads.unwrap_or(match freqs.len() >= THREADED_GRID {
-            true => std::thread::available_parallelism().map_or(1, |n| n.get()),
+            true => cores(),
             false => 1,
         });
         let plan = plan.as_ref();
