@@ -2,7 +2,7 @@
 """Speed of tiltnoise.Model.transfer against numpy.linalg.solve, side by side in one process.
 
     python python/benches/transfer_speed.py [--points 100000] [--rounds 7] [--number 1]
-                                            [--warmup 0] [--json]
+                                            [--warmup 0] [--json] [--after]
 
 The 7x3 tilt matrix H(f) = C (K - w^2 M)^-1 (G0 + w^2 G2) of Table I (outputs X, Y, Z, theta,
 eta, phi, phi_a; inputs theta_t, eta_t, phi_t) on --points log-spaced frequencies from 1e-5 to
@@ -20,6 +20,9 @@ Every timed function runs once untimed, then --rounds rounds in which each runs 
 --number times in a row, the mean of which is the round's sample, as timeit does; --warmup
 untimed calls first), the order rotating between rounds; the medians are reported, and the ratio's range over the rounds. The
 machine may be shared: read the ratios, measured side by side, rather than the absolute times.
+--after: instead, the reused-array call (2 threads) timed right after each of: nothing, a new
+array from transfer, numpy.ones of the result's size, NumPy's solve, H.fill (what the work
+before a call leaves in the caches and the memory system costs the call).
 Per-call cost on small grids (1, 10, 100 points) is the mean of many calls, NumPy including
 the stacking there (it is part of every call); the arithmetic alone is the same on 1000 points
 into a reused array small enough to stay in the L2 cache.
@@ -47,6 +50,8 @@ def parse_args():
                     help="calls in a row per timed sample, as timeit's number (default 1: each "
                          "sample is one call right after the other functions' calls)")
     ap.add_argument("--json", action="store_true", help="print one JSON object instead of tables")
+    ap.add_argument("--after", action="store_true",
+                    help="time the reused-array call right after each kind of other work")
     return ap.parse_args()
 
 
@@ -81,6 +86,25 @@ def per_call_us(fn, budget_s=0.3):
     return (time.perf_counter() - t) / n * 1e6
 
 
+def after_other_work(args, model, f, out, numpy_solve):
+    before = {
+        "nothing": lambda: None,
+        "a new array from transfer": lambda: model.transfer(f),
+        "numpy.ones of the result's size": lambda: np.ones(out.shape, out.dtype),
+        "NumPy's solve": numpy_solve,
+        "H.fill (the same array)": lambda: out.fill(1.0),
+    }
+    times = {k: [] for k in before}
+    for _ in range(args.rounds):
+        for k, work in before.items():
+            work()
+            times[k].append(timed(lambda: model.transfer(f, out=out)))
+    print(f"model.transfer(f, out=H) on {args.points} points, 2 threads, right after other work "
+          f"(median of {args.rounds} rounds)")
+    for k, v in times.items():
+        print(f"  after {k:<34} {statistics.median(v) / args.points * 1e9:6.1f} ns/point")
+
+
 def main():
     args = parse_args()
     f = np.logspace(-5, 2, args.points)
@@ -100,6 +124,10 @@ def main():
     scale = np.abs(h).max(axis=0, keepdims=True)
     big = np.abs(h) > 1e-6 * scale
     agree = float(np.max(np.abs(h_np - h)[big] / np.abs(h)[big]))
+
+    if args.after:
+        after_other_work(args, model, f, out, lambda: solve(d, g))
+        return
 
     runs = {
         "tiltnoise": lambda: model.transfer(f),
