@@ -247,7 +247,8 @@ fn subtract_figure_png_and_svg() {
     for text in [
         "cleaned (model)",
         "coherence limit",
-        "readout 1.0e-9",
+        "readout 1 nm/√Hz",
+        "readout 1 nrad/√Hz",
         "gain.eta_t",
     ] {
         assert!(svg.contains(text), "{text} missing from the SVG");
