@@ -5,7 +5,7 @@
 use crate::errors::value_error;
 use numpy::{PyArray1, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::prelude::*;
-use std::sync::Mutex;
+use std::cell::RefCell;
 use tiltnoise_core::freq::DEFAULT_F_LO_HZ;
 
 /// Frequencies (Hz) from a number or a 1-D array-like, as `f64`: a float64 array is copied
@@ -135,25 +135,29 @@ impl Band {
     }
 }
 
-/// Grids of at most this many points keep their buffer for the model's next `transfer`
-/// (8 MB): a repeated call on the same grid then copies it into memory it already holds
-/// rather than into a new allocation, whose pages the operating system zeroes first.
+/// Grids of at most this many points keep their buffer for the calling thread's next
+/// `transfer` (8 MB): a repeated call on the same grid then copies it into memory it already
+/// holds rather than into a new allocation, whose pages the operating system zeroes first.
+/// One buffer per Python thread that calls, whatever the number of models.
 const KEPT_GRID_MAX_POINTS: usize = 1 << 20;
 
-/// A model's frequency buffer, borrowed for one call and put back when dropped (a new one
-/// when another thread has it).
-pub struct GridBuffer<'a> {
-    home: &'a Mutex<Vec<f64>>,
+thread_local! {
+    /// The buffer of this thread's last `transfer`.
+    static KEPT_GRID: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
+}
+
+/// The calling thread's frequency buffer, taken for one call and put back when dropped (a
+/// nested call, from Python code run while converting an argument, gets a new one).
+pub struct GridBuffer {
     freqs: Vec<f64>,
 }
 
-impl<'a> GridBuffer<'a> {
-    pub fn borrow(home: &'a Mutex<Vec<f64>>) -> Self {
-        let freqs = home
-            .try_lock()
-            .map(|mut kept| std::mem::take(&mut *kept))
+impl GridBuffer {
+    pub fn take() -> Self {
+        let freqs = KEPT_GRID
+            .try_with(|kept| std::mem::take(&mut *kept.borrow_mut()))
             .unwrap_or_default();
-        GridBuffer { home, freqs }
+        GridBuffer { freqs }
     }
 
     /// The frequencies of `arg` ([`frequencies`]) into the buffer, and their [`auto_band`].
@@ -166,14 +170,17 @@ impl<'a> GridBuffer<'a> {
     }
 }
 
-impl Drop for GridBuffer<'_> {
+impl Drop for GridBuffer {
     fn drop(&mut self) {
         if self.freqs.capacity() <= KEPT_GRID_MAX_POINTS {
-            if let Ok(mut kept) = self.home.try_lock() {
-                if kept.capacity() < self.freqs.capacity() {
-                    *kept = std::mem::take(&mut self.freqs);
+            let freqs = std::mem::take(&mut self.freqs);
+            // Fails only while the thread's locals are destroyed: the buffer is then freed.
+            let _ = KEPT_GRID.try_with(|kept| {
+                let mut kept = kept.borrow_mut();
+                if kept.capacity() < freqs.capacity() {
+                    *kept = freqs;
                 }
-            }
+            });
         }
     }
 }

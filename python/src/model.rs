@@ -65,8 +65,6 @@ pub struct PyModel {
     plans: Mutex<PlanCache>,
     choices: Mutex<ChoiceCache>,
     last: Mutex<Option<LastPlan>>,
-    /// The frequencies of the last call of `transfer`, kept for the next one's copy.
-    grid: Mutex<Vec<f64>>,
 }
 
 /// The plan of the last call of `transfer`: a repeated call (the same names, method, band
@@ -90,7 +88,6 @@ impl PyModel {
             plans: Mutex::new(HashMap::new()),
             choices: Mutex::new(HashMap::new()),
             last: Mutex::new(None),
-            grid: Mutex::new(Vec::new()),
         })
     }
 
@@ -369,7 +366,7 @@ impl PyModel {
         };
         let asked = parse_method(method)?;
         check_rel_tol(rel_tol)?;
-        let mut grid = GridBuffer::borrow(&self.grid);
+        let mut grid = GridBuffer::take();
         let band = grid.fill(freq_hz)?;
         let freqs = grid.freqs();
         let dims = [freqs.len(), request.outputs.len(), request.inputs.len()];

@@ -206,3 +206,27 @@ def test_repeated_calls_on_other_grids_give_a_new_models_values():
         want = tiltnoise.Model().transfer(f)
         assert got.shape == want.shape
         assert np.array_equal(got.view(np.float64), want.view(np.float64)), f
+
+
+def test_threads_sharing_models_get_their_own_grids():
+    # Each calling thread keeps its own frequency buffer: threads calling the same models on
+    # grids of different lengths at once get the values of a single call.
+    import threading
+
+    f = np.logspace(-5, 2, 30_000)
+    want = tiltnoise.Model().transfer(f)
+    models = [tiltnoise.Model(), tiltnoise.Model()]
+    wrong = []
+
+    def work(i):
+        for k in range(10):
+            g = f if (i + k) % 2 == 0 else f[:777]
+            if not np.array_equal(models[i % 2].transfer(g), want[: len(g)]):
+                wrong.append((i, k))
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert wrong == []
