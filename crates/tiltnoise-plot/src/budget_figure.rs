@@ -3,7 +3,7 @@
 //! thick and black, the spread of the tilt noise across segments as a shaded band.
 
 use super::chart::{Band, Dash, LegendPlacement, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
-use super::labels::{observable_symbol, observable_title, tilt_symbol};
+use super::labels::{observable_symbol, observable_title, si_asd, significant, tilt_symbol};
 use super::{render, DrawError, ImageFormat, View};
 use plotters::style::RGBColor;
 use std::path::Path;
@@ -467,31 +467,6 @@ fn compact(v: f64) -> String {
     significant(v, 4)
 }
 
-/// `v` rounded to `digits` significant digits, without trailing zeros; plain decimal from 1e-3
-/// to below 1e6, else scientific (`1.5e-7`).
-fn significant(v: f64, digits: i32) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    let e = v.abs().log10().floor() as i32;
-    let trim = |s: &str| -> String {
-        if s.contains('.') {
-            s.trim_end_matches('0').trim_end_matches('.').to_string()
-        } else {
-            s.to_string()
-        }
-    };
-    if (-3..6).contains(&e) {
-        let decimals = (digits - 1 - e).max(0) as usize;
-        trim(&format!("{v:.decimals$}"))
-    } else {
-        let decimals = (digits - 1).max(0) as usize;
-        let s = format!("{v:.decimals$e}");
-        let (m, x) = s.split_once('e').unwrap_or((&s, "0"));
-        format!("{}e{x}", trim(m))
-    }
-}
-
 /// A number for prose: `0.25`, `30`, `5·10⁻⁵`, `10⁻⁴` (powers of ten outside 1e-3..1e6).
 fn pretty(v: f64) -> String {
     if !(v.is_finite() && v > 0.0) {
@@ -508,30 +483,6 @@ fn pretty(v: f64) -> String {
         super::chart::pow10_label(e + 1)
     } else {
         format!("{m}·{}", super::chart::pow10_label(e))
-    }
-}
-
-/// An ASD with an SI prefix: `9 nm/√Hz`, `1.5 nrad/√Hz`, `20 µrad/√Hz`.
-pub fn si_asd(value: f64, unit: &str) -> String {
-    const PREFIXES: [(i32, &str); 7] = [
-        (-18, "a"),
-        (-15, "f"),
-        (-12, "p"),
-        (-9, "n"),
-        (-6, "µ"),
-        (-3, "m"),
-        (0, ""),
-    ];
-    if !(value.is_finite() && value > 0.0) {
-        return format!("{} {unit}/√Hz", compact(value));
-    }
-    let e3 = ((value.log10() + 1e-9).floor() as i32).div_euclid(3) * 3;
-    match PREFIXES.iter().find(|(p, _)| *p == e3) {
-        Some(&(p, prefix)) => {
-            let scaled = value / 10f64.powi(p);
-            format!("{} {prefix}{unit}/√Hz", compact(scaled))
-        }
-        None => format!("{} {unit}/√Hz", compact(value)),
     }
 }
 
@@ -731,14 +682,5 @@ mod tests {
         assert_eq!(pretty(5e-5), "5·10⁻⁵");
         assert_eq!(pretty(1e-4), "10⁻⁴");
         assert_eq!(pretty(0.5), "0.5");
-    }
-
-    #[test]
-    fn si_prefixes() {
-        assert_eq!(si_asd(9e-9, "m"), "9 nm/√Hz");
-        assert_eq!(si_asd(1.5e-9, "rad"), "1.5 nrad/√Hz");
-        assert_eq!(si_asd(2e-5, "rad"), "20 µrad/√Hz");
-        assert_eq!(si_asd(1e-9, "m"), "1 nm/√Hz");
-        assert_eq!(si_asd(3.0, "m"), "3 m/√Hz");
     }
 }

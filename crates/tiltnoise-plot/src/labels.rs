@@ -88,6 +88,56 @@ pub fn si_value(v: f64, unit: &str) -> String {
     }
 }
 
+/// An ASD with an SI prefix and at most 4 significant digits: `9 nm/√Hz`, `1.5 nrad/√Hz`,
+/// `20 µrad/√Hz` (legends and captions of every figure that names a readout level).
+pub fn si_asd(value: f64, unit: &str) -> String {
+    const PREFIXES: [(i32, &str); 7] = [
+        (-18, "a"),
+        (-15, "f"),
+        (-12, "p"),
+        (-9, "n"),
+        (-6, "µ"),
+        (-3, "m"),
+        (0, ""),
+    ];
+    if !(value.is_finite() && value > 0.0) {
+        return format!("{} {unit}/√Hz", significant(value, 4));
+    }
+    let e3 = ((value.log10() + 1e-9).floor() as i32).div_euclid(3) * 3;
+    match PREFIXES.iter().find(|(p, _)| *p == e3) {
+        Some(&(p, prefix)) => {
+            let scaled = value / 10f64.powi(p);
+            format!("{} {prefix}{unit}/√Hz", significant(scaled, 4))
+        }
+        None => format!("{} {unit}/√Hz", significant(value, 4)),
+    }
+}
+
+/// `v` rounded to `digits` significant digits, without trailing zeros; plain decimal from 1e-3
+/// to below 1e6, else scientific (`1.5e-7`).
+pub(crate) fn significant(v: f64, digits: i32) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let e = v.abs().log10().floor() as i32;
+    let trim = |s: &str| -> String {
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s.to_string()
+        }
+    };
+    if (-3..6).contains(&e) {
+        let decimals = (digits - 1 - e).max(0) as usize;
+        trim(&format!("{v:.decimals$}"))
+    } else {
+        let decimals = (digits - 1).max(0) as usize;
+        let s = format!("{v:.decimals$e}");
+        let (m, x) = s.split_once('e').unwrap_or((&s, "0"));
+        format!("{}e{x}", trim(m))
+    }
+}
+
 /// Whether tick labels of an axis in `unit` can carry the unit with an SI prefix (a plain unit
 /// such as `Hz`, `s`, `m`, `rad`; not a ratio or a product).
 pub fn si_unit(unit: &str) -> bool {
@@ -111,6 +161,17 @@ pub fn si_prefix(v: f64) -> (i32, &'static str) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn asds_carry_an_si_prefix() {
+        assert_eq!(si_asd(9e-9, "m"), "9 nm/√Hz");
+        assert_eq!(si_asd(1.5e-9, "rad"), "1.5 nrad/√Hz");
+        assert_eq!(si_asd(2e-5, "rad"), "20 µrad/√Hz");
+        assert_eq!(si_asd(1e-9, "m"), "1 nm/√Hz");
+        assert_eq!(si_asd(3.0, "m"), "3 m/√Hz");
+        assert_eq!(si_asd(1.23456e-9, "m"), "1.235 nm/√Hz");
+        assert_eq!(si_asd(0.0, "m"), "0 m/√Hz");
+    }
 
     #[test]
     fn si_values_read_as_engineers_write_them() {

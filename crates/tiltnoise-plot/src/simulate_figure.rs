@@ -6,7 +6,7 @@
 //! [`render`] (PNG or SVG bytes).
 
 use super::chart::{Dash, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
-use super::labels::{observable_symbol, observable_title};
+use super::labels::{observable_symbol, observable_title, si_asd};
 use super::{render, DrawError, Figure, ImageFormat, TextSizes, View, FONT_FAMILY};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -129,7 +129,7 @@ pub fn build_asd_figure(data: &SimAsdData) -> Result<LogLogFigure, String> {
         let x_range = panel.resolved_x_range();
         if let Some(r) = readout {
             panel.traces.push(Trace::new(
-                format!("readout {}/√Hz", super::labels::si_value(r, o.unit())),
+                format!("readout {}", si_asd(r, o.unit())),
                 vec![(x_range.0, r), (x_range.1, r)],
                 TraceStyle::new(READOUT_COLOR, Dash::Dashed, 2),
             ));

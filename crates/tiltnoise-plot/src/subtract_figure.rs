@@ -6,7 +6,7 @@
 //! Plain data in ([`SubtractFigureData`]), a [`LogLogFigure`] out; drawn by [`subtract_figure`].
 
 use super::chart::{Dash, LegendPlacement, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
-use super::labels::{observable_symbol, observable_title, si_value};
+use super::labels::{observable_symbol, observable_title, si_asd};
 use super::{render, DrawError, ImageFormat, View};
 use plotters::style::RGBColor;
 use tiltnoise_core::model::Observable;
@@ -121,7 +121,7 @@ pub fn build_subtract_figure(data: &SubtractFigureData) -> Result<LogLogFigure, 
         let x = panel.resolved_x_range();
         if let Some(r) = p.readout.filter(|r| *r > 0.0) {
             panel.traces.push(Trace::new(
-                format!("readout {}/√Hz", si_value(r, p.observable.unit())),
+                format!("readout {}", si_asd(r, p.observable.unit())),
                 vec![(x.0, r), (x.1, r)],
                 TraceStyle::new(READOUT, Dash::Dotted, 2),
             ));
