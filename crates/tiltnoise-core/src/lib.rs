@@ -52,6 +52,7 @@ pub mod dd;
 pub mod error;
 pub mod fit;
 pub mod freq;
+pub mod geometry;
 pub mod input;
 pub mod limits;
 pub mod mc;
