@@ -299,7 +299,7 @@ impl PyModel {
                 omega_sq_rad2_per_s2: m.omega_sq,
                 quality_factor: m.quality_factor,
                 loss_angle_rad: m.loss_angle,
-                block: m.block.name(),
+                block: m.block_name(),
                 dominant_coordinates: m
                     .dominant_coords(DOMINANT_SHARE)
                     .into_iter()

@@ -47,7 +47,7 @@ pub fn modes_table(modes: &NormalModes) -> String {
             m.index,
             format_hz(m.frequency_hz),
             format_q(m.quality_factor),
-            m.block.name(),
+            m.block_name(),
             dominant,
             seen
         );
@@ -75,7 +75,7 @@ pub fn modes_json(modes: &NormalModes) -> String {
         .iter()
         .enumerate()
         .map(|(k, m)| ModeJson {
-            block: m.block.name(),
+            block: m.block_name(),
             dominant_coordinates: m
                 .dominant_coords(DOMINANT_SHARE)
                 .into_iter()

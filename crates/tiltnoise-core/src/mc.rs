@@ -117,28 +117,37 @@ pub enum McError {
     },
 }
 
-/// The eight undamped mode frequencies (Hz) of a model, sorted ascending, or `None` if a block's
-/// mass matrix is not positive definite or an eigenvalue is negative or not finite. Same
-/// arithmetic as [`crate::modes::NormalModes::new`] (eigenvalues only).
+/// The eight undamped mode frequencies (Hz) of a model, sorted ascending, or `None` if a mass
+/// matrix is not positive definite or an eigenvalue is negative or not finite. Same arithmetic
+/// as [`crate::modes::NormalModes::new`] (eigenvalues only): per block when the model is
+/// decoupled, of the full 8x8 pencil otherwise.
 pub fn mode_frequencies_hz(model: &Model) -> Option<[f64; 8]> {
     let mass = model.mass();
     let stiffness = model.stiffness();
-    let mut out = [0.0; 8];
-    for (b, block) in Block::ALL.into_iter().enumerate() {
-        let mb = Model::block_of(mass, block);
-        let kb = Model::block_of(&stiffness, block);
-        let l = mb.cholesky()?.l();
-        let l_inv = l.try_inverse()?;
-        let a = l_inv * kb * l_inv.transpose();
-        let a = (a + a.transpose()) * 0.5;
-        let eig = a.symmetric_eigenvalues();
-        for k in 0..4 {
-            let w2 = eig[k];
-            if !(w2.is_finite() && w2 >= 0.0) {
-                return None;
-            }
-            out[4 * b + k] = w2.sqrt() / std::f64::consts::TAU;
+    let mut w2: Vec<f64> = Vec::with_capacity(8);
+    if model.decoupled() {
+        for block in Block::ALL {
+            let mb = Model::block_of(mass, block);
+            let kb = Model::block_of(&stiffness, block);
+            let l = mb.cholesky()?.l();
+            let l_inv = l.try_inverse()?;
+            let a = l_inv * kb * l_inv.transpose();
+            let a = (a + a.transpose()) * 0.5;
+            w2.extend(a.symmetric_eigenvalues().iter());
         }
+    } else {
+        let l = mass.cholesky()?.l();
+        let l_inv = l.try_inverse()?;
+        let a = l_inv * stiffness * l_inv.transpose();
+        let a = (a + a.transpose()) * 0.5;
+        w2.extend(a.symmetric_eigenvalues().iter());
+    }
+    let mut out = [0.0; 8];
+    for (f, &w2) in out.iter_mut().zip(&w2) {
+        if !(w2.is_finite() && w2 >= 0.0) {
+            return None;
+        }
+        *f = w2.sqrt() / std::f64::consts::TAU;
     }
     out.sort_by(f64::total_cmp);
     Some(out)
