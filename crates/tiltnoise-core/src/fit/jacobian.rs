@@ -14,7 +14,15 @@
 //! `s ~ eps^(1/3) = 6e-6`, where it is `~ eps^(2/3) = 4e-11`. Entries linear in `p` (stiffness
 //! in k, kappa; mass in m, I) have no truncation error at all.
 //!
-//! Modes are identified by rank (sorted frequency), as in Table II.
+//! An `[asymmetry]` offset is 0 at the symmetric pendulum, so its step is absolute:
+//! [`MATRIX_STEP_REL`] times the larger of `|p|` and the offset's bound (a tenth of the body it
+//! moves in, [`crate::params::Asymmetry::limits`]), the length on which the matrices vary with
+//! it. (At exactly 0 the first derivative of a frequency with an offset along x vanishes by the
+//! mirror symmetry; the central difference returns that 0 to rounding.)
+//!
+//! Modes are identified by their label `nu_k` ([`crate::modes`]): the rank (sorted frequency)
+//! for the symmetric pendulum, as in Table II; the symmetric mode a mode continues for the
+//! pendulum as built.
 //! Pure numerics: depends on `params`, `model`, `modes`.
 
 use super::FitError;
@@ -43,7 +51,7 @@ pub fn value_of(params: &Params, key: &str) -> Option<f64> {
         .map(|f| f.value)
 }
 
-/// Mode frequencies (Hz, sorted) and `jac[(k, j)] = d f_k / d p_j` (Hz per unit of parameter
+/// Mode frequencies (Hz, by label nu_1 .. nu_8) and `jac[(k, j)] = d f_k / d p_j` (Hz per unit of parameter
 /// `keys[j]`) at `params`.
 pub fn frequencies_and_jacobian(
     params: &Params,
@@ -70,7 +78,15 @@ fn matrix_derivatives(params: &Params, key: &str) -> Result<(Mat8, Mat8), FitErr
         key: key.to_string(),
         allowed: String::new(),
     })?;
-    let h = MATRIX_STEP_REL * p.abs();
+    let scale = if crate::params::uncertainty::is_absolute_key(key) {
+        let l = &params.length;
+        let limits = params.asymmetry.limits(l.d_m, l.z_a_m, l.z_b_m);
+        let limit = limits.iter().find(|x| x.key == key).map_or(0.0, |x| x.limit);
+        p.abs().max(limit)
+    } else {
+        p.abs()
+    };
+    let h = MATRIX_STEP_REL * scale;
     // The step actually taken is the difference of the two representable values.
     let (lo, hi) = (p - h, p + h);
     let minus = Model::new(&with_value(params, key, lo)?).map_err(FitError::Params)?;

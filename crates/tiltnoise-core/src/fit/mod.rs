@@ -6,9 +6,12 @@
 //! * **Variables.** Each free parameter `p` is fitted in the scaled variable
 //!   `u = (p - p0) / sigma_p`, with `p0` the nominal value and `sigma_p = rel_sigma |p0|` its
 //!   error bar from [`crate::mc::uncertainties`] (the Monte Carlo's error model, overridable in
-//!   the parameter file). Parameters without an error bar (g, h, loss angles) cannot be free.
+//!   the parameter file), or the absolute `sigma` of an `[asymmetry]` offset, whose nominal value
+//!   is 0 (its box is then absolute too: `|p - p0| <= n sigma`). Parameters without an error
+//!   bar (g, h, loss angles, and the offsets unless the file gives them one) cannot be free.
 //! * **Objective.** `chi^2 = sum_k ((f_k(p) - f_k,meas) / sigma_k)^2` over the measured modes,
-//!   mode identity by rank (sorted frequencies, as in Table II). "Constrained within the error
+//!   mode identity by label (the rank, sorted frequencies, as in Table II, for the symmetric
+//!   pendulum; see [`crate::modes`] for the pendulum as built). "Constrained within the error
 //!   bars" is read literally: a hard box `|u| <= n` (`n` = [`FitConfig::bound_sigmas`], 1 by
 //!   default). Optionally ([`FitConfig::prior`]) the Gaussian prior `sum u^2` is added, which
 //!   turns the fit into a maximum a-posteriori estimate that also works for parameters the data
@@ -116,7 +119,7 @@ pub struct FittedParam {
     pub nominal: f64,
     /// Fitted value.
     pub fitted: f64,
-    /// Error bar sigma_p = rel_sigma |p0| (the prior sigma).
+    /// Error bar sigma_p = rel_sigma |p0|, or the absolute sigma of an offset (the prior sigma).
     pub prior_sigma: f64,
     /// Linearized posterior sigma at the solution; `None` on a bound, infinite if the
     /// parameter lies in the null space of the Jacobian.
@@ -465,16 +468,16 @@ fn check_config(
         return Err(FitError::NoFree);
     }
     let fields = params.fields();
-    let rel_sigma = |key: &str| {
+    let sigma_of = |key: &str, value: f64| {
         crate::mc::uncertainties(params)
             .into_iter()
             .find(|u| u.key == key)
-            .map_or(0.0, |u| u.rel_sigma)
+            .map_or(0.0, |u| u.sigma_at(value))
     };
     let allowed: Vec<&str> = fields
         .iter()
+        .filter(|f| sigma_of(f.key, f.value) > 0.0)
         .map(|f| f.key)
-        .filter(|k| rel_sigma(k) > 0.0)
         .collect();
     let allowed = allowed.join(", ");
     let mut out: Vec<Free> = Vec::with_capacity(config.free.len());
@@ -489,7 +492,8 @@ fn check_config(
         if out.iter().any(|f| &f.key == key) {
             return Err(FitError::DuplicateKey { key: key.clone() });
         }
-        let sigma = rel_sigma(key) * field.value.abs();
+        let sigma = sigma_of(key, field.value);
+        let absolute = crate::params::uncertainty::is_absolute_key(key);
         if sigma <= 0.0 {
             return Err(FitError::ExactKey {
                 key: key.clone(),
@@ -498,11 +502,12 @@ fn check_config(
         }
         let (lower, upper) = (field.value - n * sigma, field.value + n * sigma);
         // A box edge that changes the sign of the parameter would also make the matrix
-        // derivative step (relative to |p|) vanish; the physical ranges exclude it anyway.
+        // derivative step (relative to |p|) vanish; the physical ranges exclude it anyway. An
+        // offset may take either sign (its step is absolute).
         let edge_error = [lower, upper].into_iter().find_map(|edge| {
             let reason = match jacobian::with_value(params, key, edge) {
                 Err(e) => Some(e.to_string()),
-                Ok(_) if edge.signum() != field.value.signum() || edge == 0.0 => {
+                Ok(_) if !absolute && (edge.signum() != field.value.signum() || edge == 0.0) => {
                     Some("the parameter changes sign".to_string())
                 }
                 Ok(_) => None,
