@@ -106,6 +106,21 @@ pub struct Scales {
     pub observation: [[f64; 8]; 7],
 }
 
+impl Scales {
+    /// Each datum's own magnitude as its scale (the closed forms).
+    fn of(m: &Matrices) -> Scales {
+        let abs = |x: &Dd| x.to_f64().abs();
+        Scales {
+            mass: m.mass.map(|r| r.map(|x| abs(&x))),
+            stiffness: m.stiffness.map(|r| r.map(|z| z.re.to_f64().abs() + z.im.to_f64().abs())),
+            force: m.force.map(|r| r.map(|x| abs(&x))),
+            g0: m.g0.map(|r| r.map(|x| abs(&x))),
+            g2: m.g2.map(|r| r.map(|x| abs(&x))),
+            observation: m.observation.map(|r| r.map(|x| abs(&x))),
+        }
+    }
+}
+
 /// [`build`] with the rounding scales of the pendulum as built, whose entries come out of the
 /// exact kinematics with cancellations; `None` for the closed forms of the symmetric pendulum,
 /// where each datum's own magnitude is its scale.
@@ -130,6 +145,16 @@ pub fn build_with_scales(p: &Params) -> (Matrices, Option<Scales>) {
 fn as_built(p: &Params) -> Result<(Matrices, Scales), crate::error::ParamError> {
     let tracked = crate::geometry::linearize::<Dd>(p)?;
     let (lin, mag) = (tracked.cleaned(), tracked.magnitudes());
+    if !p.asymmetry.moves_mass() {
+        // A readout rotation alone: the pendulum as drawn, read along turned axes.
+        let mut scales = Scales::of(&symmetric(p));
+        scales.observation = mag.observation;
+        let matrices = Matrices {
+            observation: lin.observation,
+            ..symmetric(p)
+        };
+        return Ok((matrices, scales));
+    }
     let g = dd(p.environment.g_m_per_s2);
     let (m_a, m_b) = (dd(p.mass.m_a_kg), dd(p.mass.m_b_kg));
     let l = &p.length;

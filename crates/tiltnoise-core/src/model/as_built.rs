@@ -48,8 +48,18 @@ impl RestLinear {
     /// tilt columns of `G0` and the columns of `K` they repeat, say): the `f64` model keeps the
     /// structural cancellations of the physics (the `f^4` of phi/eta_t at low frequency) that
     /// an `f64` evaluation of the kinematics would blur with its own rounding.
+    ///
+    /// A readout rotation alone leaves the pendulum as drawn: the closed forms then hold for
+    /// everything but the observation matrix.
     pub fn as_built(p: &Params) -> Result<RestLinear, ParamError> {
         let lin: Linearization<f64> = geometry::linearize::<Dd>(p)?.cleaned().map(|x| x.to_f64());
+        let observation = ObservationMatrix::from_fn(|r, c| lin.observation[r][c]);
+        if !p.asymmetry.moves_mass() {
+            return Ok(RestLinear {
+                observation,
+                ..RestLinear::symmetric(p)
+            });
+        }
         let square = |a: &[[f64; 8]; 8]| Mat8::from_fn(|r, c| a[r][c]);
         let mut derived = matrices::derived(p);
         [derived.r_ga0_m, derived.r_gb0_m] = lin.r_g0;
@@ -63,7 +73,7 @@ impl RestLinear {
                 g0: TiltMatrix::from_fn(|r, c| lin.ground_g0[r][c]),
                 g2: TiltMatrix::from_fn(|r, c| lin.ground_g2[r][c]),
             },
-            observation: ObservationMatrix::from_fn(|r, c| lin.observation[r][c]),
+            observation,
             swing: lin
                 .swing
                 .map(|fibre| fibre.map(|v| Vec8::from_fn(|r, _| v[r]))),
