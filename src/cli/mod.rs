@@ -194,8 +194,8 @@ fn run_command(cli: Cli, run: &mut Run) -> Result<()> {
             let model = Model::new(&params)?;
             let modes = NormalModes::new(&model);
             match format {
-                Format::Table => write!(run.out, "{}", report::modes_table(&modes))?,
-                Format::Json => writeln!(run.out, "{}", report::modes_json(&modes))?,
+                Format::Table => write!(run.out, "{}", report::modes_report(&model, &modes))?,
+                Format::Json => writeln!(run.out, "{}", report::modes_json(&model, &modes))?,
             }
             Ok(())
         }

@@ -335,9 +335,11 @@ impl Params {
         let list = self.effective_uncertainties();
         let mut text = String::from(
             "\n# Effective error model (defaults of tiltnoise, overridden by [uncertainty] above);\n\
-             # rel_sigma is the relative standard deviation (sigma the absolute one of an\n\
-             # [asymmetry] key), uniform is flat on +/- sqrt(3) sigma:\n",
+             # rel_sigma is the relative standard deviation, uniform is flat on +/- sqrt(3) sigma:\n",
         );
+        if list.iter().any(|u| u.abs_sigma > 0.0) {
+            text.push_str("# (sigma: the absolute standard deviation of an [asymmetry] offset)\n");
+        }
         for u in list.iter().filter(|u| !u.is_exact()) {
             let (name, value) = if is_absolute_key(&u.key) {
                 ("sigma", u.abs_sigma)
@@ -600,7 +602,10 @@ mod tests {
         )
         .unwrap();
         let eff = p.effective_uncertainties();
-        let u = eff.iter().find(|u| u.key == "asymmetry.tm_com_x_m").unwrap();
+        let u = eff
+            .iter()
+            .find(|u| u.key == "asymmetry.tm_com_x_m")
+            .unwrap();
         assert_eq!((u.rel_sigma, u.abs_sigma), (0.0, 2e-4));
         assert_eq!(u.sigma_at(0.0), 2e-4);
         assert!(eff
@@ -608,7 +613,10 @@ mod tests {
             .filter(|u| is_absolute_key(&u.key) && u.key != "asymmetry.tm_com_x_m")
             .all(|u| u.is_exact()));
         assert!(p.to_toml().contains("sigma = 0.0002"), "{}", p.to_toml());
-        assert_eq!(Params::from_toml_str(&p.to_toml(), "round trip").unwrap(), p);
+        assert_eq!(
+            Params::from_toml_str(&p.to_toml(), "round trip").unwrap(),
+            p
+        );
         for (entry, needles) in [
             (
                 "\"asymmetry.tm_com_x_m\" = { rel_sigma = 0.1 }",
