@@ -9,6 +9,7 @@ const REPO_ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
 mod common;
 mod tolerances;
 
+mod as_built;
 mod budget_summary;
 mod coherence;
 mod energy_crosscheck;
