@@ -108,11 +108,13 @@ pub struct Scales {
 
 impl Scales {
     /// Each datum's own magnitude as its scale (the closed forms).
-    fn of(m: &Matrices) -> Scales {
+    pub fn own(m: &Matrices) -> Scales {
         let abs = |x: &Dd| x.to_f64().abs();
         Scales {
             mass: m.mass.map(|r| r.map(|x| abs(&x))),
-            stiffness: m.stiffness.map(|r| r.map(|z| z.re.to_f64().abs() + z.im.to_f64().abs())),
+            stiffness: m
+                .stiffness
+                .map(|r| r.map(|z| z.re.to_f64().abs() + z.im.to_f64().abs())),
             force: m.force.map(|r| r.map(|x| abs(&x))),
             g0: m.g0.map(|r| r.map(|x| abs(&x))),
             g2: m.g2.map(|r| r.map(|x| abs(&x))),
@@ -147,7 +149,7 @@ fn as_built(p: &Params) -> Result<(Matrices, Scales), crate::error::ParamError> 
     let (lin, mag) = (tracked.cleaned(), tracked.magnitudes());
     if !p.asymmetry.moves_mass() {
         // A readout rotation alone: the pendulum as drawn, read along turned axes.
-        let mut scales = Scales::of(&symmetric(p));
+        let mut scales = Scales::own(&symmetric(p));
         scales.observation = mag.observation;
         let matrices = Matrices {
             observation: lin.observation,

@@ -202,6 +202,13 @@ pub struct EntryFactors {
     pub poles: Vec<CDd>,
     /// Coefficients of `N` zeroed as structural cancellations: `(power of s, |c| / scale)`.
     pub cancelled: Vec<(usize, f64)>,
+    /// `H = N(s) / P(s)` before factoring: the coefficients of `N` (ascending, after the
+    /// cancellations) and of `P = det(K_c - s M)`, each with the sum of the magnitudes of the
+    /// terms computed into it. A coefficient errs by a few `DD_EPS` of its magnitude (the
+    /// expansion's roundings and the data's own), which bounds the factors' error.
+    pub numerator: Vec<(CDd, f64)>,
+    /// See [`EntryFactors::numerator`].
+    pub denominator: Vec<(CDd, f64)>,
 }
 
 /// A polynomial in `s` (ascending coefficients) with the magnitude sums of its coefficients.
@@ -690,6 +697,8 @@ impl PoleZero {
                         zeros,
                         poles: poles_sorted.clone(),
                         cancelled,
+                        numerator: num.c.iter().copied().zip(num.mag.iter().copied()).collect(),
+                        denominator: p.c.iter().copied().zip(p.mag.iter().copied()).collect(),
                     });
                 }
             }
