@@ -374,10 +374,7 @@ mod tests {
             assert_eq!(changed, [f.key]);
         }
         // Every parameter with a non-zero default error enters the modes.
-        for u in default_uncertainties(&p)
-            .iter()
-            .filter(|u| !u.is_exact())
-        {
+        for u in default_uncertainties(&p).iter().filter(|u| !u.is_exact()) {
             assert!(modal_field(&u.key).is_some(), "{}", u.key);
         }
         assert_eq!(drawn, 26);

@@ -81,7 +81,10 @@ fn matrix_derivatives(params: &Params, key: &str) -> Result<(Mat8, Mat8), FitErr
     let scale = if crate::params::uncertainty::is_absolute_key(key) {
         let l = &params.length;
         let limits = params.asymmetry.limits(l.d_m, l.z_a_m, l.z_b_m);
-        let limit = limits.iter().find(|x| x.key == key).map_or(0.0, |x| x.limit);
+        let limit = limits
+            .iter()
+            .find(|x| x.key == key)
+            .map_or(0.0, |x| x.limit);
         p.abs().max(limit)
     } else {
         p.abs()

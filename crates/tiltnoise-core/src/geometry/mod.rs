@@ -139,13 +139,59 @@ pub fn linearize<S: Real>(p: &Params) -> Result<Linearization<Tracked<S>>, Param
     };
     let rest = equilibrium::rest(&Consts::<f64>::new(p), [0.0; 8]).map_err(fail)?;
     let c = Consts::<S>::new(p);
+    let floor = floors(&Consts::<f64>::new(p), &rest, S::EPSILON);
     let rest = rest.map(S::from_f64);
     let rest = if S::EPSILON < f64::EPSILON {
         equilibrium::rest(&c, rest).map_err(fail)?
     } else {
         rest
     };
+    // A coordinate below the solve's own floor is 0 to its precision, and 0 it is: the noise
+    // of the last Newton step would otherwise seed the linearization with tiny terms of no
+    // cancellation (sin of a 1e-34 rad noise angle) that no rounding scale can tell from
+    // genuine ones.
+    let rest: [S; 8] = std::array::from_fn(|k| {
+        if rest[k].to_f64().abs() <= floor[k] {
+            S::from_f64(0.0)
+        } else {
+            rest[k]
+        }
+    });
     Ok(at_rest(&Consts::new(p), rest.map(Tracked::exact)))
+}
+
+/// The accuracy, per coordinate, of the rest configuration of `p` solved with unit roundoff
+/// `eps` ([`linearize`] sets the coordinates below it to 0). See [`floors`].
+///
+/// # Errors
+///
+/// As [`linearize`].
+pub fn rest_floors(p: &Params, eps: f64) -> Result<[f64; 8], ParamError> {
+    let c = Consts::<f64>::new(p);
+    let rest = equilibrium::rest(&c, [0.0; 8]).map_err(|detail| ParamError::NoEquilibrium {
+        keys: String::new(),
+        detail,
+    })?;
+    Ok(floors(&c, &rest, eps))
+}
+
+/// Newton's method stops at a step energy of about `(CLEAN_DEPTH eps)^2 E` (`E` the gravity
+/// stiffness scale `g (m_a (Z + Z_a) + m_b (Z + Z_b))`), so a coordinate's error is at most
+/// `CLEAN_DEPTH eps sqrt(E (K^-1)_kk)` (Cauchy-Schwarz in the energy norm), `K` the stiffness at
+/// the rest configuration `rest` (rad or m).
+fn floors(c: &Consts<f64>, rest: &[f64; 8], eps: f64) -> [f64; 8] {
+    let (_, mut k) = gravity_derivatives(c, rest);
+    for &(i, stiffness) in &c.elastic {
+        k[i][i] += stiffness;
+    }
+    let k = nalgebra::SMatrix::<f64, 8, 8>::from_fn(|r, j| k[r][j]);
+    let scale = c.g * (c.m_a * (c.z + c.z_a) + c.m_b * (c.z + c.z_b));
+    match k.try_inverse() {
+        Some(inv) => {
+            std::array::from_fn(|i| CLEAN_DEPTH * eps * (scale * inv[(i, i)].abs()).sqrt())
+        }
+        None => [0.0; 8],
+    }
 }
 
 /// The first-order motion per unit `q'_h`, for every `h`.

@@ -13,7 +13,7 @@
 use crate::tolerances::{EIG_GAMMA, EPS, LU_GAMMA, U};
 use nalgebra::SVector;
 use tiltnoise_core::dd::{Dd, DD_EPS};
-use tiltnoise_core::geometry::{self, CLEAN_DEPTH, GROUND_INPUTS};
+use tiltnoise_core::geometry::{self, GROUND_INPUTS};
 use tiltnoise_core::model::{Coord, Model, Observable, TiltAxis};
 use tiltnoise_core::modes::{NormalModes, RATIO_THRESHOLD};
 use tiltnoise_core::params::Params;
@@ -32,15 +32,10 @@ fn offset(key: &str, value: f64) -> Params {
     with(&[format!("asymmetry.{key}={value:e}")])
 }
 
-/// The double-double rest configuration's own floor, for coordinates that are exactly 0: its
-/// Newton iteration stops at step energy `(CLEAN_DEPTH DD_EPS)^2 E` (`E` the gravity stiffness
-/// scale), which bounds a coordinate along the softest direction, the lower fibre's torsion
-/// `k_b`, by `CLEAN_DEPTH DD_EPS sqrt(E / k_b)` (rad or m).
-fn rest_floor(p: &Params) -> f64 {
-    let l = &p.length;
-    let e = p.environment.g_m_per_s2
-        * (p.mass.m_a_kg * (l.z_m + l.z_a_m) + p.mass.m_b_kg * (l.z_m + l.z_b_m));
-    CLEAN_DEPTH * DD_EPS * (e / p.torsion.k_b_n_m_per_rad).sqrt()
+/// The double-double rest configuration's own floor, per coordinate, for coordinates that are
+/// exactly 0 (the library sets those below it to 0).
+fn rest_floor(p: &Params) -> [f64; 8] {
+    geometry::rest_floors(p, DD_EPS).unwrap()
 }
 
 /// The rest angle of a pendulum whose first moment about its pivot is `moment` (kg m) off the
@@ -124,8 +119,9 @@ fn rest_configuration_matches_the_closed_forms() {
             let p = offset(key, value);
             let rest = *Model::new(&p).unwrap().rest_configuration();
             let expected = closed_form(&p, key, value);
-            let floor = rest_floor(&p);
+            let floors = rest_floor(&p);
             for c in Coord::ALL {
+                let floor = floors[c.index()];
                 let got = rest[c.index()];
                 match expected.iter().find(|(e, _)| *e == c) {
                     Some(&(_, want)) => assert!(
@@ -162,7 +158,7 @@ fn mirror_image_offsets_have_the_same_modes() {
             );
             let want = if odd.contains(&c) { -a } else { a };
             assert!(
-                (b - want).abs() <= CLOSED_FORM_REL * a.abs() + rest_floor(&plus),
+                (b - want).abs() <= CLOSED_FORM_REL * a.abs() + rest_floor(&plus)[c.index()],
                 "{key}: rest {} {a:e} vs {b:e}",
                 c.name()
             );

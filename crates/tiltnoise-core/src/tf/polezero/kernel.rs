@@ -766,7 +766,7 @@ mod tests {
     }
 
     /// AVX and portable lanes on the same grid, bit for bit: undamped and damped (real and
-    /// complex blocks), the dense and the compact kernel, interleaved and planar, a grid small
+    /// complex blocks, decoupled 4x4 and coupled 8x8), the dense and the compact kernel, interleaved and planar, a grid small
     /// enough for ordinary stores and one large enough for the non-temporal ones (and the
     /// same with ordinary stores into a fresh buffer), with a short last chunk.
     /// Skipped on a CPU without AVX.
@@ -780,7 +780,11 @@ mod tests {
         for key in ["torsion_a_rad", "bouncing_b_rad"] {
             damped = damped.with_override(&format!("loss.{key}=1e-3")).unwrap();
         }
-        for params in [Params::table_i(), damped] {
+        // The coupled 8x8 system of a pendulum as built (real, with conjugate zero pairs;
+        // and damped, complex).
+        let coupled = |p: &Params| p.with_override("asymmetry.tm_com_x_m=1e-3").unwrap();
+        let (built, built_damped) = (coupled(&Params::table_i()), coupled(&damped));
+        for params in [Params::table_i(), damped, built, built_damped] {
             let pz = PoleZero::new(&Model::new(&params).unwrap(), Request::all_tilt());
             for kernel in [&pz.kernel, &pz.compact] {
                 let stride = kernel.stride;
