@@ -145,7 +145,10 @@ fn caption(result: &McResult, cfg: &McConfig) -> String {
     let absolute = if offsets.is_empty() {
         String::new()
     } else {
-        format!("; absolute errors (1 std, in the key's unit): {}", offsets.join("; "))
+        format!(
+            "; absolute errors (1 std, in the key's unit): {}",
+            offsets.join("; ")
+        )
     };
     format!(
         "Black dashed: nominal parameters; orange: mean; shaded: mean ± 1 std. {} draws, {} \

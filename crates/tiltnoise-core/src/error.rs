@@ -125,9 +125,9 @@ pub enum ParamError {
     },
     /// An offset of the `[asymmetry]` section too large for the body it moves in.
     #[error(
-        "parameter `{key}` = {} {unit} is not allowed: |value| must be < {} {unit} ({reason})",
-        Num(*.value),
-        Num(*.limit)
+        "parameter `{key}` = {} {unit} is not allowed: |value| must be < {limit:.4e} {unit} \
+         ({reason})",
+        Num(*.value)
     )]
     OffsetTooLarge {
         /// Dotted key, e.g. `asymmetry.tm_com_x_m`.
