@@ -24,17 +24,18 @@ pub(super) fn gravity_derivatives<S: Real>(c: &Consts<S>, q: &[S; 8]) -> ([S; 8]
     let ch = c.map(HyperDual::constant);
     let level = [HyperDual::constant(S::from_f64(0.0)); 3];
     let zero = S::from_f64(0.0);
-    let (mut grad, mut hess) = ([zero; 8], [[zero; 8]; 8]);
-    for i in 0..8 {
-        for j in i..8 {
+    let mut grad = [zero; 8];
+    let mut upper = [[zero; 8]; 8];
+    for (i, row) in upper.iter_mut().enumerate() {
+        for (j, entry) in row.iter_mut().enumerate().skip(i) {
             let u = gravity(&ch, &seeded(q, Some(i), Some(j)), &level);
-            hess[i][j] = u.e12;
-            hess[j][i] = u.e12;
+            *entry = u.e12;
             if i == j {
                 grad[i] = u.e1;
             }
         }
     }
+    let hess = std::array::from_fn(|i| std::array::from_fn(|j| upper[i.min(j)][i.max(j)]));
     (grad, hess)
 }
 
@@ -57,12 +58,13 @@ fn solve_linear<S: Real>(mut a: [[S; 8]; 8], mut b: [S; 8]) -> [S; 8] {
             .unwrap_or(k);
         a.swap(k, p);
         b.swap(k, p);
-        for i in k + 1..8 {
-            let l = a[i][k] / a[k][k];
-            for j in k..8 {
-                a[i][j] = a[i][j] - l * a[k][j];
+        let (pivot_row, pivot_b) = (a[k], b[k]);
+        for (row, b_i) in a.iter_mut().zip(b.iter_mut()).skip(k + 1) {
+            let l = row[k] / pivot_row[k];
+            for (x, &y) in row.iter_mut().zip(&pivot_row).skip(k) {
+                *x = *x - l * y;
             }
-            b[i] = b[i] - l * b[k];
+            *b_i = *b_i - l * pivot_b;
         }
     }
     let mut x = b;
@@ -122,10 +124,11 @@ fn newton<S: Real>(c: &Consts<S>, start: [S; 8], free: [bool; 8]) -> Result<[S; 
         let (mut grad, mut hess) = derivatives(c, &q);
         for k in (0..8).filter(|&k| !free[k]) {
             grad[k] = S::from_f64(0.0);
-            for j in 0..8 {
-                hess[k][j] = S::from_f64(if j == k { 1.0 } else { 0.0 });
-                hess[j][k] = hess[k][j];
+            for row in hess.iter_mut() {
+                row[k] = S::from_f64(0.0);
             }
+            hess[k] = [S::from_f64(0.0); 8];
+            hess[k][k] = S::from_f64(1.0);
         }
         let to_f64 = |h: &[[S; 8]; 8]| SMatrix::<f64, 8, 8>::from_fn(|r, k| h[r][k].to_f64());
         let convex = to_f64(&hess).cholesky().is_some();
@@ -178,7 +181,10 @@ fn newton<S: Real>(c: &Consts<S>, start: [S; 8], free: [bool; 8]) -> Result<[S; 
         };
         q = moved;
         let angles = [0, 1, 2, 4, 5, 6].map(|k| q[k].to_f64().abs());
-        if let Some(angle) = angles.into_iter().find(|a| !(*a <= MAX_REST_ANGLE)) {
+        if let Some(angle) = angles
+            .into_iter()
+            .find(|a| a.is_nan() || *a > MAX_REST_ANGLE)
+        {
             return Err(format!(
                 "Newton's method left the small-tilt region (an angle of {angle:.3e} rad, \
                  more than {MAX_REST_ANGLE} rad)"

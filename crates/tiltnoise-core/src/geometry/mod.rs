@@ -161,7 +161,9 @@ pub fn linearize<S: Real>(p: &Params) -> Result<Linearization<Tracked<S>>, Param
 }
 
 /// The accuracy, per coordinate, of the rest configuration of `p` solved with unit roundoff
-/// `eps` ([`linearize`] sets the coordinates below it to 0). See [`floors`].
+/// `eps` ([`linearize`] sets the coordinates below it to 0): Newton's method stops at a step
+/// energy of about `(CLEAN_DEPTH eps)^2 E`, `E` the gravity stiffness scale, so a coordinate
+/// errs by at most `CLEAN_DEPTH eps sqrt(E (K^-1)_kk)` (rad or m).
 ///
 /// # Errors
 ///
@@ -298,17 +300,16 @@ fn at_rest<S: Real>(c: &Consts<S>, rest: [S; 8]) -> Linearization<S> {
 
     // The readout's components of a lab vector: R_s v (R of eq. (matriceR)).
     let sensor = rot(c.sensor[0], c.sensor[1], c.sensor[2]);
-    let mut observation = [[zero; 8]; 7];
-    for h in 0..8 {
-        let position = mat_vec(&sensor, v.r_cube[h]);
-        let tm = mat_vec(&sensor, v.lab[1][h]);
-        let crossbar = mat_vec(&sensor, v.lab[0][h]);
-        for k in 0..3 {
-            observation[k][h] = position[k];
-            observation[3 + k][h] = tm[k];
-        }
-        observation[6][h] = crossbar[2];
-    }
+    let position = v.r_cube.map(|r| mat_vec(&sensor, r));
+    let tm = v.lab[1].map(|w| mat_vec(&sensor, w));
+    let crossbar = v.lab[0].map(|w| mat_vec(&sensor, w));
+    let observation = std::array::from_fn(|row| {
+        std::array::from_fn(|h| match row {
+            0..=2 => position[h][row],
+            3..=5 => tm[h][row - 3],
+            _ => crossbar[h][2],
+        })
+    });
     let swing = [0, 1].map(|b| [0, 1].map(|k| std::array::from_fn(|h| v.body[b][h][k])));
     Linearization {
         rest,

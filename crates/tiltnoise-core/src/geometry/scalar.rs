@@ -63,14 +63,14 @@ impl Real for Dd {
         let mut k = 1.0;
         while term.hi.abs() > DD_EPS / 16.0 * x.hi.abs() {
             term = -(term * x2) / ((k + 1.0) * (k + 2.0));
-            s = s + term;
+            s += term;
             k += 2.0;
         }
         let (mut c, mut term) = (Dd::ONE, Dd::ONE);
         let mut k = 0.0;
         while term.hi.abs() > DD_EPS / 16.0 {
             term = -(term * x2) / ((k + 1.0) * (k + 2.0));
-            c = c + term;
+            c += term;
             k += 2.0;
         }
         for _ in 0..halvings {

@@ -178,7 +178,7 @@ impl Model {
         }
         let decoupled = [mass, stiffness_gravity, stiffness_imag, damping]
             .iter()
-            .all(|m| block_diagonal(m));
+            .all(block_diagonal);
         Ok(Model {
             params: params.clone(),
             derived,

@@ -237,9 +237,9 @@ impl<const N: usize> RealBlock<N> {
     ) -> bool {
         let mut d = [s; N];
         let mut singular = false;
-        for k in 0..N {
-            d[k] = V::splat(self.poles[k]).sub(s);
-            singular |= d[k].abs().any_lt(V::splat(self.thresholds[k]));
+        for ((dk, &p), &t) in d.iter_mut().zip(&self.poles).zip(&self.thresholds) {
+            *dk = V::splat(p).sub(s);
+            singular |= dk.abs().any_lt(V::splat(t));
         }
         if singular {
             return false;
@@ -354,16 +354,10 @@ impl<const N: usize> ComplexBlock<N> {
     ) -> bool {
         let mut d = [(s, s); N];
         let mut singular = false;
-        for k in 0..N {
-            let (re, im) = (
-                V::splat(self.poles[k].re).sub(s),
-                V::splat(self.poles[k].im),
-            );
-            d[k] = (re, im);
-            singular |= re
-                .mul(re)
-                .add(im.mul(im))
-                .any_lt(V::splat(self.thresholds[k]));
+        for ((dk, p), &t) in d.iter_mut().zip(&self.poles).zip(&self.thresholds) {
+            let (re, im) = (V::splat(p.re).sub(s), V::splat(p.im));
+            *dk = (re, im);
+            singular |= re.mul(re).add(im.mul(im)).any_lt(V::splat(t));
         }
         if singular {
             return false;
