@@ -25,6 +25,15 @@
 //!
 //! the second form with `1 / z_j` rounded once to `f64`, in real arithmetic for undamped blocks
 //! whose zeros are all real, in complex arithmetic otherwise (damped blocks, or complex zeros).
+//!
+//! The pendulum as built: with an offset along x the two blocks couple into one system of 8
+//! coordinates, factored as a whole the same way (the determinants then have up to 9 rows: each
+//! minor is expanded once). Its zeros go two by two into quadratic factors
+//! `(1 - s / z_1)(1 - s / z_2) = 1 + c1 s + c2 s^2`, whose coefficients are real for a conjugate
+//! pair too, so an undamped coupled system stays in real arithmetic whatever its zeros; a
+//! coefficient of the polynomials is set to zero as a structural cancellation against the sum
+//! of the rounding scales of its terms, which for the pendulum as built carry the data's own
+//! ([`crate::dd::matrices::Scales`]).
 //! `power + #zeros <= 4`, so every entry is at most four factors `a + b s` (`s` or
 //! `1 - s / z`). Every factor is relatively accurate: the relative error of an entry is a few
 //! `eps (1 + sum |z| / |z - s| + sum |lambda| / |lambda - s|)`, about `1e2 eps` at 1 % from a
@@ -80,46 +89,69 @@ pub struct PoleZero {
 }
 
 /// An entry's product form in double-double, ready for a block of `N` coordinates: gain,
-/// linear factors `(a, b)` (the first `count` of them not padding) and conjugate pairs
-/// `(r, t)` (the first `pairs`), see [`RealEntry`].
+/// `power` of `s`, linear factors `(a, b)` (the first `count` of them not padding) and
+/// quadratic factors `1 + c1 s + c2 s^2` (the first `n_pairs`), see [`RealEntry`].
 struct Prepared<const N: usize> {
     at: usize,
     gain: CDd,
+    power: usize,
     factors: [(CDd, CDd); N],
     count: usize,
     pairs: [(Dd, Dd); N],
     n_pairs: usize,
 }
 
-/// The product form of one entry. With `pair_conjugates`, each zero `z` with `Im z > 0` whose
-/// conjugate is also a zero (exactly: [`symmetrize`] made them so) becomes one pair factor
-/// `|1 - s / z|^2` with `|z|^2` in the gain; every other zero a linear factor `1 - s / z`.
-fn prepare<const N: usize>(f: &EntryFactors, at: usize, pair_conjugates: bool) -> Prepared<N> {
+/// The product form of one entry: each zero `z` a linear factor `1 - s / z` with `z` in the
+/// gain, a zero at the origin the factor `s`. With `quadratic` (the coupled system's real
+/// arithmetic) the zeros at the origin are a `power` instead, and the others go two by two into
+/// `(1 - s / z_1)(1 - s / z_2)`: each conjugate pair (exact conjugates: [`symmetrize`] made
+/// them so), then the real zeros sorted by magnitude, the smallest with the largest; a real
+/// zero left over stays linear.
+fn prepare<const N: usize>(f: &EntryFactors, at: usize, quadratic: bool) -> Prepared<N> {
     let one = CDd::real(Dd::ONE);
     let mut p = Prepared {
         at,
         gain: f.gain,
+        power: 0,
         factors: [(one, CDd::ZERO); N],
         count: 0,
         pairs: [(Dd::ZERO, Dd::ZERO); N],
         n_pairs: 0,
     };
-    for _ in 0..f.power {
-        p.factors[p.count] = (CDd::ZERO, one);
+    let linear = |p: &mut Prepared<N>, z: CDd| {
+        p.factors[p.count] = (one, -(one / z));
+        p.gain = p.gain * z;
         p.count += 1;
-    }
-    for z in &f.zeros {
-        let paired = pair_conjugates && !z.im.is_zero() && f.zeros.contains(&z.conj());
-        if paired && z.im.hi > 0.0 {
-            let w = one / *z;
-            p.pairs[p.n_pairs] = (w.re, w.im);
-            p.n_pairs += 1;
-            p.gain = p.gain.scale(z.norm_sqr());
-        } else if !paired {
-            p.factors[p.count] = (one, -(one / *z));
-            p.gain = p.gain * *z;
+    };
+    if !quadratic {
+        for _ in 0..f.power {
+            p.factors[p.count] = (CDd::ZERO, one);
             p.count += 1;
         }
+        for &z in &f.zeros {
+            linear(&mut p, z);
+        }
+        return p;
+    }
+    p.power = f.power as usize;
+    let pair = |p: &mut Prepared<N>, a: CDd, b: CDd| {
+        // 1 - s (1/a + 1/b) + s^2 / (a b): real for a conjugate pair or two real zeros.
+        let (wa, wb) = (one / a, one / b);
+        p.pairs[p.n_pairs] = ((-(wa + wb)).re, (wa * wb).re);
+        p.gain = p.gain * a * b;
+        p.n_pairs += 1;
+    };
+    for &z in f.zeros.iter().filter(|z| z.im.hi > 0.0) {
+        pair(&mut p, z, z.conj());
+    }
+    let mut real: Vec<CDd> = f.zeros.iter().copied().filter(|z| z.im.is_zero()).collect();
+    real.sort_by(|a, b| a.abs_f64().total_cmp(&b.abs_f64()));
+    while real.len() >= 2 {
+        let (small, large) = (real.remove(0), real.pop().expect("two zeros left"));
+        pair(&mut p, small, large);
+    }
+    if let Some(&z) = real.first() {
+        linear(&mut p, z);
     }
     p
 }
@@ -135,11 +167,11 @@ fn block_form<const N: usize>(
     position: &dyn Fn(usize) -> (usize, usize),
 ) -> Result<([f64; N], Vec<RealEntry<N>>), ([Complex64; N], Vec<ComplexEntry<N>>)> {
     let poles = &fs[0].poles;
-    let pair_conjugates = N == 8;
+    let quadratic = N == 8;
     let real_zeros = |f: &EntryFactors| {
         f.zeros
             .iter()
-            .all(|z| z.im.is_zero() || (pair_conjugates && f.zeros.contains(&z.conj())))
+            .all(|z| z.im.is_zero() || (quadratic && f.zeros.contains(&z.conj())))
     };
     let real = poles.iter().all(|p| p.im.is_zero())
         && fs.iter().all(|f| f.gain.im.is_zero() && real_zeros(f));
@@ -147,7 +179,7 @@ fn block_form<const N: usize>(
         let entries = fs
             .iter()
             .map(|f| {
-                let p = prepare::<N>(f, f.output * n_in + f.input, true);
+                let p = prepare::<N>(f, f.output * n_in + f.input, quadratic);
                 RealEntry {
                     re: position(p.at).0,
                     first_re: false,
@@ -155,9 +187,10 @@ fn block_form<const N: usize>(
                     gain: p.gain.re.to_f64(),
                     a: p.factors.map(|(a, _)| a.re.to_f64()),
                     b: p.factors.map(|(_, b)| b.re.to_f64()),
+                    power: p.power,
                     pairs: p.n_pairs,
-                    r: p.pairs.map(|(r, _)| r.to_f64()),
-                    t: p.pairs.map(|(_, t)| t.to_f64()),
+                    c1: p.pairs.map(|(c1, _)| c1.to_f64()),
+                    c2: p.pairs.map(|(_, c2)| c2.to_f64()),
                 }
             })
             .collect();

@@ -280,30 +280,45 @@ fn tilt_layout_of_table_i() {
 /// `3 u (1 + |lambda| / |lambda - s|)`; the gain (with `prod z`), the reciprocal, the
 /// final product and the addition into the zeroed output `4 u`. A complex product's relative
 /// error is at most `sqrt(5) u` against `u` for a real one, and a complex sum's `sqrt(2) u`:
-/// a factor 3 covers both. It also covers a conjugate pair of zeros that the coupled system's
-/// real arithmetic evaluates as `(1 - r s)^2 + (t s)^2` (`1 / z = r + i t`): with `a = 1 - r s`,
-/// `b = t s`, its relative error is at most `u (6 + 4 |a| |r s| / (a^2 + b^2)) <= u (10 + 4
-/// |z| / |z - s|)`, below the complex bound of the pair's two factors, `3 x 2 x 4 u (1 + |z| /
-/// |z - s|)`. A factor 2 over the first-order sum covers the second-order terms
+/// a factor 3 covers both. A factor 2 over the first-order sum covers the second-order terms
 /// and the few entries that receive two blocks' contributions.
+///
+/// The coupled system's real arithmetic takes its zeros two by two, `1 + c1 s + c2 s^2`
+/// with `c1`, `c2` and `s^2` rounded (see the kernel): its absolute error is at most
+/// `4 u (1 + |c1 s| + |c2| s^2) + u |q|`, and `1 + |c1 s| + |c2| s^2 <= (1 + |s / z_1|)
+/// (1 + |s / z_2|)` (real or conjugate zeros), so relative to the pair it is at most
+/// `4 u g_1 g_2 + u` with `g = (1 + |s / z|) / |1 - s / z|`. Whatever the pairing,
+/// `sum over pairs g_1 g_2 <= (sum_j g_j)^2 / 2`, which is added for an entry of the coupled
+/// system.
 pub(crate) fn product_form_bound(
     e: &tiltnoise_core::tf::EntryFactors,
     s: f64,
     complex: bool,
 ) -> f64 {
+    let sd = CDd::real(Dd::from(s));
     let zeros: f64 = e
         .zeros
         .iter()
-        .map(|z| 4.0 * (1.0 + z.abs_f64() / (*z - CDd::real(Dd::from(s))).abs_f64()))
+        .map(|z| 4.0 * (1.0 + z.abs_f64() / (*z - sd).abs_f64()))
         .sum();
     let poles: f64 = e
         .poles
         .iter()
-        .map(|l| 3.0 * (1.0 + l.abs_f64() / (*l - CDd::real(Dd::from(s))).abs_f64()))
+        .map(|l| 3.0 * (1.0 + l.abs_f64() / (*l - sd).abs_f64()))
         .sum();
+    let pairs = if e.block.is_none() {
+        let g: f64 = e
+            .zeros
+            .iter()
+            .map(|z| (1.0 + s / z.abs_f64()) / (CDd::real(Dd::ONE) - sd / *z).abs_f64())
+            .sum();
+        4.0 * g * g / 2.0
+    } else {
+        0.0
+    };
     let power = 2.0 * e.power as f64;
     let arith = if complex { 3.0 } else { 1.0 };
-    2.0 * arith * U * (4.0 + power + zeros + poles)
+    2.0 * arith * U * (4.0 + power + zeros + poles + pairs)
 }
 
 #[test]

@@ -42,14 +42,16 @@ use crate::error::TfError;
 use crate::tf::Destination;
 use num_complex::Complex64;
 
-/// One entry of an undamped block: `gain prod_k (a_k + b_k s) prod_j ((1 - r_j s)^2 +
-/// (t_j s)^2)` times the block's `1 / prod(lambda - s)`, added at value `re` (its real part).
-/// Factors: `s` for a zero at the origin (`a = 0, b = 1`), `1 - s / z` for a real zero `z`
-/// (`a = 1, b = -1 / z`, `z` moved into the gain); the first `factors` of the `N` (the block's
-/// size), the others padding (`a = 1, b = 0`), skipped (an exact 1 for every finite `s`). A pair
-/// of complex conjugate zeros `z, conj(z)` of the coupled system is `|1 - s / z|^2` with
-/// `1 / z = r + i t` (`|z|^2` moved into the gain): a sum of two squares, so real arithmetic
-/// with no cancellation between them; the first `pairs` of `r`, `t`.
+/// One entry of an undamped block: `gain s^power prod_k (a_k + b_k s) prod_j (1 + c1_j s +
+/// c2_j s^2)` times the block's `1 / prod(lambda - s)`, added at value `re` (its real part).
+/// Linear factors: `s` for a zero at the origin (`a = 0, b = 1`), `1 - s / z` for a real zero
+/// `z` (`a = 1, b = -1 / z`, `z` moved into the gain); the first `factors` of the `N` (the
+/// block's size), the others padding (`a = 1, b = 0`), skipped (an exact 1 for every finite
+/// `s`). The coupled system (`N = 8`) takes its zeros at the origin as `power` and the others
+/// two by two, `(1 - s / z_1)(1 - s / z_2)` with both zeros moved into the gain: a conjugate
+/// pair (real coefficients, so real arithmetic) or two real zeros (the smallest with the
+/// largest in magnitude, so that two nearby zeros rarely share a factor); five operations per
+/// two zeros against six; the first `pairs` of `c1`, `c2`, a zero left over as a linear factor.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct RealEntry<const N: usize> {
     /// Position of the real part in a point's `f64` values.
@@ -62,9 +64,10 @@ pub(super) struct RealEntry<const N: usize> {
     pub gain: f64,
     pub a: [f64; N],
     pub b: [f64; N],
+    pub power: usize,
     pub pairs: usize,
-    pub r: [f64; N],
-    pub t: [f64; N],
+    pub c1: [f64; N],
+    pub c2: [f64; N],
 }
 
 /// [`RealEntry`] with complex gain and factors (damped blocks, or complex zeros).
@@ -249,17 +252,22 @@ impl<const N: usize> RealBlock<N> {
             a.mul(b)
         }
         let inv = V::splat(1.0).div(product(d, mul::<V>));
+        let s2 = s.mul(s);
         for e in &self.entries {
             // 1 - s / z: relative error ~ 1.5 eps |z| / |z - s| (the rounding of 1 / z and of
             // the product), as z - s with z rounded to f64.
             let mut h = V::splat(e.gain);
+            for _ in 0..e.power {
+                h = h.mul(s);
+            }
             for k in 0..e.factors {
                 h = h.mul(V::splat(e.a[k]).add(V::splat(e.b[k]).mul(s)));
             }
             for k in 0..e.pairs {
-                let u = V::splat(1.0).sub(V::splat(e.r[k]).mul(s));
-                let v = V::splat(e.t[k]).mul(s);
-                h = h.mul(u.mul(u).add(v.mul(v)));
+                let q = V::splat(1.0)
+                    .add(V::splat(e.c1[k]).mul(s))
+                    .add(V::splat(e.c2[k]).mul(s2));
+                h = h.mul(q);
             }
             put::<V, PLANAR>(out, e.re, stride, n, e.first_re, h.mul(inv), finite);
         }
@@ -728,9 +736,10 @@ mod tests {
                 gain,
                 a: [1.0; 4],
                 b: [0.0; 4],
+                power: 0,
                 pairs: 0,
-                r: [0.0; 4],
-                t: [0.0; 4],
+                c1: [0.0; 4],
+                c2: [0.0; 4],
             };
             BlockForm::Real(RealBlock::new([1.0; 4], vec![entry]))
         };
