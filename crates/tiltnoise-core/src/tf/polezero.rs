@@ -25,6 +25,14 @@
 //!
 //! the second form with `1 / z_j` rounded once to `f64`, in real arithmetic for undamped blocks
 //! whose zeros are all real, in complex arithmetic otherwise (damped blocks, or complex zeros).
+//! `power + #zeros <= 4` in a block, so every entry is at most four factors `a + b s` (`s` or
+//! `1 - s / z`). Every factor is relatively accurate: the relative error of an entry is a few
+//! `eps (1 + sum |z| / |z - s| + sum |lambda| / |lambda - s|)`, about `1e2 eps` at 1 % from a
+//! pole or zero and `~eps` elsewhere, with no cancellation at low or high frequency
+//! (`tests/it/polezero.rs` measures 3e-14 at most outside the 1 % zones against the reference;
+//! `tests/it/polezero_batch.rs` checks the f64 evaluation against the same product form in
+//! double-double within this bound, from 0 Hz to 1e5 Hz). Entries whose observation row or
+//! forcing column misses a block get nothing from it; entries no block reaches are exactly 0.0.
 //!
 //! The pendulum as built: with an offset along x the two blocks couple into one system of 8
 //! coordinates, factored as a whole the same way (the determinants then have up to 9 rows: each
@@ -34,14 +42,6 @@
 //! coefficient of the polynomials is set to zero as a structural cancellation against the sum
 //! of the rounding scales of its terms, which for the pendulum as built carry the data's own
 //! ([`crate::dd::matrices::Scales`]).
-//! `power + #zeros <= 4`, so every entry is at most four factors `a + b s` (`s` or
-//! `1 - s / z`). Every factor is relatively accurate: the relative error of an entry is a few
-//! `eps (1 + sum |z| / |z - s| + sum |lambda| / |lambda - s|)`, about `1e2 eps` at 1 % from a
-//! pole or zero and `~eps` elsewhere, with no cancellation at low or high frequency
-//! (`tests/it/polezero.rs` measures 3e-14 at most outside the 1 % zones against the reference;
-//! `tests/it/polezero_batch.rs` checks the f64 evaluation against the same product form in
-//! double-double within this bound, from 0 Hz to 1e5 Hz). Entries whose observation row or
-//! forcing column misses a block get nothing from it; entries no block reaches are exactly 0.0.
 //!
 //! Evaluation (`kernel`): a grid is evaluated eight frequencies at a time in vector lanes, each
 //! block's denominator and its reciprocal once per frequency, each entry a few
