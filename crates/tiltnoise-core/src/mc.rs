@@ -25,7 +25,7 @@
 //!   [`crate::modes::NormalModes`] does), and the eight frequencies are sorted (mode identity by
 //!   rank, as in Table II).
 //!
-//! Pure numerics: depends on `params` and `model` only; no I/O.
+//! Pure numerics: depends on `params`, `model` and `modes` (the reduction of the pencil); no I/O.
 
 use crate::error::ParamError;
 use crate::limits::{
@@ -33,6 +33,7 @@ use crate::limits::{
     MC_BYTES_PER_DRAW,
 };
 use crate::model::{Block, Model};
+use crate::modes::reduced_pencil;
 use crate::params::uncertainty::{check, UncertaintyError};
 use crate::params::Params;
 use crate::rng::Rng;
@@ -131,17 +132,11 @@ pub fn mode_frequencies_hz(model: &Model) -> Option<[f64; 8]> {
         for block in Block::ALL {
             let mb = Model::block_of(mass, block);
             let kb = Model::block_of(&stiffness, block);
-            let l = mb.cholesky()?.l();
-            let l_inv = l.try_inverse()?;
-            let a = l_inv * kb * l_inv.transpose();
-            let a = (a + a.transpose()) * 0.5;
+            let (_, a) = reduced_pencil(&mb, &kb)?;
             w2.extend(a.symmetric_eigenvalues().iter());
         }
     } else {
-        let l = mass.cholesky()?.l();
-        let l_inv = l.try_inverse()?;
-        let a = l_inv * stiffness * l_inv.transpose();
-        let a = (a + a.transpose()) * 0.5;
+        let (_, a) = reduced_pencil(mass, &stiffness)?;
         w2.extend(a.symmetric_eigenvalues().iter());
     }
     let mut out = [0.0; 8];

@@ -30,7 +30,8 @@
 //! Pure numerics: depends on `model` (and `dd` for the refinement) only.
 
 use crate::model::{Block, Coord, Mat8, Model, Observable, Vec8};
-use nalgebra::{DMatrix, DVector, Matrix4, Vector4};
+use nalgebra::allocator::Allocator;
+use nalgebra::{Const, DefaultAllocator, DimDiff, DimMin, DimSub, Matrix4, SMatrix, SVector, U1};
 
 /// An observable "sees" a mode when its amplitude in the mass-normalized shape is at least this
 /// fraction of the largest amplitude of that observable over all modes. Modes outside the
@@ -141,60 +142,60 @@ fn eigenpairs(model: &Model) -> Vec<(Option<Block>, f64, Vec8)> {
     let mass = model.mass();
     let stiffness = model.stiffness();
     if !model.decoupled() {
-        let m = DMatrix::from_column_slice(8, 8, mass.as_slice());
-        let k = DMatrix::from_column_slice(8, 8, stiffness.as_slice());
-        return generalized_eigen(&m, &k)
+        return pencil_eigenpairs(mass, &stiffness)
             .into_iter()
-            .map(|(omega_sq, v)| (None, omega_sq, Vec8::from_column_slice(v.as_slice())))
+            .map(|(omega_sq, shape)| (None, omega_sq, shape))
             .collect();
     }
     let mut pairs = Vec::with_capacity(8);
     for block in Block::ALL {
         let mb = block_matrix(mass, block);
         let kb = block_matrix(&stiffness, block);
-        let l = mb
-            .cholesky()
-            .expect("Model::new checked that M is positive definite")
-            .l();
-        let l_inv = l
-            .try_inverse()
-            .expect("a Cholesky factor with positive diagonal is invertible");
-        let a = l_inv * kb * l_inv.transpose();
-        let a = (a + a.transpose()) * 0.5;
-        let eig = a.symmetric_eigen();
-        for k in 0..4 {
-            let y: Vector4<f64> = eig.eigenvectors.column(k).into();
-            let v4 = l_inv.transpose() * y;
-            let v4 = v4 / (v4.transpose() * mb * v4)[(0, 0)].sqrt();
+        for (omega_sq, v4) in pencil_eigenpairs(&mb, &kb) {
             let mut shape = Vec8::zeros();
             for (i, c) in block.coords().into_iter().enumerate() {
                 shape[c.index()] = v4[i];
             }
-            pairs.push((Some(block), eig.eigenvalues[k], shape));
+            pairs.push((Some(block), omega_sq, shape));
         }
     }
     pairs
 }
 
-/// The eigenpairs of the pencil `(K, M)` of any size (M positive definite), shapes
-/// mass-normalized, by the Cholesky reduction of the block solver.
-fn generalized_eigen(m: &DMatrix<f64>, k: &DMatrix<f64>) -> Vec<(f64, DVector<f64>)> {
-    let l = m
-        .clone()
-        .cholesky()
-        .expect("Model::new checked that M is positive definite")
-        .l();
-    let l_inv = l
-        .try_inverse()
-        .expect("a Cholesky factor with positive diagonal is invertible");
-    let a = &l_inv * k * l_inv.transpose();
-    let a = (&a + a.transpose()) * 0.5;
+/// The Cholesky reduction of the pencil `(K, M)` of `N` coordinates: `L^-1` and the symmetric
+/// `L^-1 K L^-T` (symmetrized), whose eigenvalues are the pencil's; `None` when `M` is not
+/// positive definite.
+pub(crate) fn reduced_pencil<const N: usize>(
+    m: &SMatrix<f64, N, N>,
+    k: &SMatrix<f64, N, N>,
+) -> Option<(SMatrix<f64, N, N>, SMatrix<f64, N, N>)>
+where
+    Const<N>: DimMin<Const<N>, Output = Const<N>>,
+{
+    let l_inv = m.cholesky()?.l().try_inverse()?;
+    let a = l_inv * k * l_inv.transpose();
+    Some((l_inv, (a + a.transpose()) * 0.5))
+}
+
+/// The eigenpairs of the pencil `(K, M)` of `N` coordinates (`M` positive definite, as
+/// [`Model::new`] checked), shapes `v = L^-T y` mass-normalized.
+fn pencil_eigenpairs<const N: usize>(
+    m: &SMatrix<f64, N, N>,
+    k: &SMatrix<f64, N, N>,
+) -> Vec<(f64, SVector<f64, N>)>
+where
+    Const<N>: DimMin<Const<N>, Output = Const<N>> + DimSub<U1>,
+    DefaultAllocator: Allocator<DimDiff<Const<N>, U1>>,
+{
+    let (l_inv, a) = reduced_pencil(m, k)
+        .expect("Model::new checked that M is positive definite (its Cholesky factor inverts)");
     let eig = a.symmetric_eigen();
-    (0..m.nrows())
+    (0..N)
         .map(|j| {
-            let v = l_inv.transpose() * eig.eigenvectors.column(j);
-            let norm = (v.transpose() * m * &v)[(0, 0)].sqrt();
-            (eig.eigenvalues[j], v / norm)
+            let y: SVector<f64, N> = eig.eigenvectors.column(j).into();
+            let v = l_inv.transpose() * y;
+            let v = v / (v.transpose() * m * v)[(0, 0)].sqrt();
+            (eig.eigenvalues[j], v)
         })
         .collect()
 }
@@ -276,7 +277,7 @@ impl NormalModes {
     /// last bit, and every evaluation method reports it as singular.
     pub fn new(model: &Model) -> NormalModes {
         let mut modes = NormalModes::new_f64(model);
-        let m = crate::dd::matrices::build(model.params());
+        let (m, _) = crate::geometry::dd_matrices(model.params());
         for mode in modes.modes.iter_mut() {
             let v: [crate::dd::Dd; 8] =
                 std::array::from_fn(|i| crate::dd::Dd::from_f64(mode.shape[i]));

@@ -75,18 +75,6 @@ fn cross(a: [Dd; 3], b: [Dd; 3]) -> [Dd; 3] {
     ]
 }
 
-/// The matrices of `p`: the closed forms below for the symmetric pendulum, the linearization
-/// about the tilted rest configuration ([`crate::geometry`]) when an `[asymmetry]` key is set.
-///
-/// # Panics
-///
-/// If `p` has `[asymmetry]` offsets with no stable rest configuration, i.e. parameters for
-/// which [`crate::model::Model::new`] fails: every caller in the crate builds from a model's
-/// parameters.
-pub fn build(p: &Params) -> Matrices {
-    build_with_scales(p).0
-}
-
 /// The rounding scale of each datum of [`Matrices`]: the sum of the magnitudes of the terms
 /// computed into it (its rounding is a few [`super::DD_EPS`] of this), where that differs from
 /// the datum's own magnitude.
@@ -123,134 +111,9 @@ impl Scales {
     }
 }
 
-/// [`build`] with the rounding scales of the pendulum as built, whose entries come out of the
-/// exact kinematics with cancellations; `None` for the closed forms of the symmetric pendulum,
-/// where each datum's own magnitude is its scale.
-///
-/// # Panics
-///
-/// As [`build`].
-pub fn build_with_scales(p: &Params) -> (Matrices, Option<Scales>) {
-    if p.asymmetry.is_zero() {
-        (symmetric(p), None)
-    } else {
-        let (m, scales) = as_built(p)
-            .unwrap_or_else(|e| panic!("double-double matrices of a model that fails: {e}"));
-        (m, Some(scales))
-    }
-}
-
-/// The linearization of the pendulum as built, in double-double, with the same dissipation as
-/// the symmetric closed form: the fibres' torsion and bouncing on their own coordinates, each
-/// fibre's swing loss on its swing directions at the rest configuration
-/// (see [`crate::model::damping`]).
-fn as_built(p: &Params) -> Result<(Matrices, Scales), crate::error::ParamError> {
-    let tracked = crate::geometry::linearize::<Dd>(p)?;
-    let (lin, mag) = (tracked.cleaned(), tracked.magnitudes());
-    if !p.asymmetry.moves_mass() {
-        // A readout rotation alone: the pendulum as drawn, read along turned axes.
-        let mut scales = Scales::own(&symmetric(p));
-        scales.observation = mag.observation;
-        let matrices = Matrices {
-            observation: lin.observation,
-            ..symmetric(p)
-        };
-        return Ok((matrices, scales));
-    }
-    let g = dd(p.environment.g_m_per_s2);
-    let (m_a, m_b) = (dd(p.mass.m_a_kg), dd(p.mass.m_b_kg));
-    let l = &p.length;
-    let k_g = [
-        g * (m_a * (dd(l.z_m) + dd(l.z_a_m)) + m_b * dd(l.z_m)),
-        m_b * g * dd(l.z_b_m),
-    ];
-    let lp = &p.loss;
-    let phi_swing = [
-        dd(lp.bending_a_rad) / dd(lp.dilution_a),
-        dd(lp.bending_b_rad) / dd(lp.dilution_b),
-    ];
-    let v = &p.viscous;
-    let c_swing = [dd(v.swing_a_n_m_s_per_rad), dd(v.swing_b_n_m_s_per_rad)];
-    let mut stiffness = lin.stiffness_gravity.map(|row| row.map(CDd::real));
-    let mut damping = [[Dd::ZERO; 8]; 8];
-    for (c, k, phi, coef) in [
-        (
-            PA,
-            p.torsion.k_a_n_m_per_rad,
-            lp.torsion_a_rad,
-            v.torsion_a_n_m_s_per_rad,
-        ),
-        (
-            PB,
-            p.torsion.k_b_n_m_per_rad,
-            lp.torsion_b_rad,
-            v.torsion_b_n_m_s_per_rad,
-        ),
-        (
-            DA,
-            p.bouncing.kappa_a_n_per_m,
-            lp.bouncing_a_rad,
-            v.bouncing_a_n_s_per_m,
-        ),
-        (
-            DB,
-            p.bouncing.kappa_b_n_per_m,
-            lp.bouncing_b_rad,
-            v.bouncing_b_n_s_per_m,
-        ),
-    ] {
-        stiffness[c][c] += CDd::new(dd(k), Dd::mul_f64_exact(k, phi));
-        damping[c][c] = dd(coef);
-    }
-    for fibre in 0..2 {
-        let loss = phi_swing[fibre] * k_g[fibre];
-        for s in &lin.swing[fibre] {
-            for r in 0..8 {
-                for c in 0..8 {
-                    let ss = s[r] * s[c];
-                    if ss.is_zero() {
-                        continue;
-                    }
-                    if !loss.is_zero() {
-                        stiffness[r][c] += CDd::new(Dd::ZERO, loss * ss);
-                    }
-                    if !c_swing[fibre].is_zero() {
-                        damping[r][c] += c_swing[fibre] * ss;
-                    }
-                }
-            }
-        }
-    }
-    let tilts = |g: &[[f64; 6]; 8]| g.map(|row| [row[0], row[1], row[2]]);
-    let scales = Scales {
-        mass: mag.mass,
-        stiffness: std::array::from_fn(|r| {
-            std::array::from_fn(|c| {
-                mag.stiffness_gravity[r][c]
-                    + (stiffness[r][c] - CDd::real(lin.stiffness_gravity[r][c])).abs_f64()
-            })
-        }),
-        force: mag.force,
-        g0: tilts(&mag.ground_g0),
-        g2: tilts(&mag.ground_g2),
-        observation: mag.observation,
-    };
-    let tilts = |g: &[[Dd; 6]; 8]| g.map(|row| [row[0], row[1], row[2]]);
-    let matrices = Matrices {
-        mass: lin.mass,
-        stiffness_gravity: lin.stiffness_gravity,
-        stiffness,
-        damping,
-        force: lin.force,
-        g0: tilts(&lin.ground_g0),
-        g2: tilts(&lin.ground_g2),
-        observation: lin.observation,
-    };
-    Ok((matrices, scales))
-}
-
-/// The closed forms of Appendix A (every `[asymmetry]` key 0).
-fn symmetric(p: &Params) -> Matrices {
+/// The closed forms of Appendix A: the symmetric pendulum (the `[asymmetry]` keys are not read;
+/// [`crate::geometry::dd_matrices`] gives the matrices of any parameter set).
+pub fn build(p: &Params) -> Matrices {
     let (m_a, m_b) = (dd(p.mass.m_a_kg), dd(p.mass.m_b_kg));
     let i = &p.inertia;
     let (a11, a22, a33, a23) = (

@@ -34,10 +34,12 @@
 //!
 //! Depends on `params` and `dd` (the double-double scalar) only.
 
+mod double;
 mod equilibrium;
 mod kinematics;
 pub mod scalar;
 
+pub use double::dd_matrices;
 pub use scalar::{HyperDual, Real, Tracked};
 
 use crate::error::ParamError;

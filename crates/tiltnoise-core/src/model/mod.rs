@@ -1,6 +1,9 @@
 //! The linearized 8-DoF model of the double torsion pendulum (paper, Appendix A): mass and
 //! stiffness matrices, the zeroth-order generalized-force matrix, the tilt forcing and the
-//! observation matrix. Pure numerics: depends on `params` and `nalgebra`, never on I/O.
+//! observation matrix. For the symmetric pendulum these are the Appendix's closed forms; with
+//! `[asymmetry]` offsets, the linearization about the tilted rest configuration of the
+//! pendulum as built ([`crate::geometry`]). Pure numerics: depends on `params`, `geometry` and
+//! `nalgebra`, never on I/O.
 
 mod as_built;
 mod coords;
@@ -129,7 +132,8 @@ impl Model {
     /// Builds the model. Fails if the mass matrix is not positive definite (possible for
     /// parameter sets that pass the per-key checks, e.g. a huge negative I^a_23 coupling), if
     /// the equilibrium is not stable (the stiffness is not positive definite, see
-    /// [`ParamError::Unstable`]), or if a matrix entry overflows.
+    /// [`ParamError::Unstable`]), if the pendulum as built has no stable rest configuration
+    /// near the drawing's ([`ParamError::NoEquilibrium`]), or if a matrix entry overflows.
     pub fn new(params: &Params) -> Result<Model, ParamError> {
         let linear = if params.asymmetry.is_zero() {
             as_built::RestLinear::symmetric(params)

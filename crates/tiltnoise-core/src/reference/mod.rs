@@ -22,7 +22,12 @@
 //! `F_i = -m_i (r_s'' + w' x r_gi0)`, `M_i = -I_i w'` themselves) and the observation matrix are
 //! all rebuilt here from the [`Params`] values in double-double arithmetic. Shared with the rest
 //! of the crate are only the parameter struct, the index order of coordinates, observables and
-//! inputs (the paper's, restated here) and the error types. The tilt forcing is used as defined,
+//! inputs (the paper's, restated here) and the error types. For the pendulum as built
+//! ([`crate::params::asymmetry`]) the matrices are the exact kinematics linearized in
+//! double-double ([`crate::geometry::dd_matrices`]), the same computation the `f64` model
+//! rounds: the independent check of those matrices is the energy cross-check's own kinematics
+//! (`tests/it/energy_crosscheck.rs`), and the reference stays the oracle of the methods' solves.
+//! The tilt forcing is used as defined,
 //! `G0 + w^2 G2`: not the rotation-plus-translation split that some `f64` methods use, so that a
 //! mistake in that reformulation cannot be replicated here.
 //!
@@ -53,8 +58,9 @@
 //!   2e7 at 3 Hz, 2e10 at 100 Hz, error 5e-23 there). [`ReferenceModel::entry_condition`] gives
 //!   `kappa` per entry, so a test can always state the reference's own error bar.
 //!
-//! Exact zeros are kept: the model is block diagonal after a permutation, multipliers across the
-//! blocks are exactly zero and are skipped, so entries such as X/theta_t are exactly 0.
+//! Exact zeros are kept: the symmetric pendulum's model is block diagonal after a permutation,
+//! multipliers across the blocks are exactly zero and are skipped, so entries such as X/theta_t
+//! are exactly 0 (an offset along x couples the blocks, and those entries are not zero then).
 //!
 //! ```
 //! use tiltnoise_core::params::Params;
@@ -344,9 +350,9 @@ impl ReferenceModel {
     /// # Panics
     ///
     /// For parameters with `[asymmetry]` offsets that have no stable rest configuration (those
-    /// [`crate::model::Model::new`] refuses): see [`build::build`].
+    /// [`crate::model::Model::new`] refuses): see [`crate::geometry::dd_matrices`].
     pub fn new(params: &Params) -> ReferenceModel {
-        let (m, scales) = build::build_with_scales(params);
+        let (m, scales) = crate::geometry::dd_matrices(params);
         let scales = scales.unwrap_or_else(|| Scales::own(&m));
         ReferenceModel {
             absolute: Formulation::absolute(&m, &scales),

@@ -64,7 +64,7 @@ mod kernel;
 mod lanes;
 
 use super::{Destination, Input, Layout, Method, Request, TransferFunction};
-use crate::dd::matrices::{self, Matrices, Scales};
+use crate::dd::matrices::{Matrices, Scales};
 use crate::dd::{CDd, Dd, DD_EPS};
 use crate::error::TfError;
 use crate::model::{Block, Coord, Model};
@@ -601,7 +601,7 @@ impl PoleZero {
     /// The factored form in double-double of every entry (and block) of `request` that is not
     /// structurally zero.
     pub fn factors(params: &Params, request: &Request) -> Vec<EntryFactors> {
-        let (m, scales): (Matrices, Option<Scales>) = matrices::build_with_scales(params);
+        let (m, scales): (Matrices, Option<Scales>) = crate::geometry::dd_matrices(params);
         let mass = abs_matrix(&m.mass);
         let stiffness = abs_matrix(&m.stiffness);
         // T^T on forcing rows, C T on observation columns.
