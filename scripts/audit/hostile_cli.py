@@ -130,17 +130,35 @@ TEXT_SCAN_CAP = 256 << 20
 H5_SCAN_CAP = 50_000_000  # elements per file
 ARTIFACT_CAP = 4 << 20
 
-CATEGORIES = ["parameters", "tilt inputs", "frequency options", "outputs", "process", "fuzz"]
-FLAGS = ["crash", "abort_oom", "panic", "hang", "nonfinite", "leftover", "accepted", "refused",
-         "multiline", "silent", "exit_not_2"]
+CATEGORIES = ["parameters", "tilt inputs", "frequency options", "outputs", "miniseed",
+              "gwpy addressing", "coherence/subtract pairs", "option edges", "python", "process",
+              "fuzz"]
+# The categories of the surfaces added after the first audit (surfaces.py); they need the valid
+# pair of records made by the first binary.
+NEW_SURFACES = ["miniseed", "gwpy addressing", "coherence/subtract pairs", "option edges",
+                "python"]
+FLAGS = ["crash", "abort_oom", "panic", "hang", "overwrote", "nonfinite", "leftover", "accepted",
+         "refused", "unclear", "multiline", "silent", "exit_not_2"]
 FLAG_TITLES = {
     "crash": "crash", "abort_oom": "abort/oom", "panic": "panic", "hang": "hang",
-    "nonfinite": "non-finite", "leftover": "leftover files", "accepted": "accepted bad",
-    "refused": "refused valid", "multiline": "multi-line err", "silent": "silent fail",
-    "exit_not_2": "exit!=2",
+    "overwrote": "overwrote input", "nonfinite": "non-finite", "leftover": "leftover files",
+    "accepted": "accepted bad", "refused": "refused valid", "unclear": "unclear err",
+    "multiline": "multi-line err", "silent": "silent fail", "exit_not_2": "exit!=2",
 }
-TABLE_FLAGS = ["crash", "abort_oom", "panic", "nonfinite", "leftover", "multiline", "exit_not_2",
-               "hang", "silent", "accepted", "refused"]
+TABLE_FLAGS = ["crash", "abort_oom", "panic", "overwrote", "nonfinite", "leftover", "unclear",
+               "multiline", "exit_not_2", "hang", "silent", "accepted", "refused"]
+# The defect kinds of the compact table: flags summed per kind.
+KINDS = {
+    "crashes": ["crash", "abort_oom", "panic", "hang"],
+    "overwritten inputs": ["overwrote"],
+    "silent non-finite": ["nonfinite"],
+    "unclear errors": ["unclear", "multiline", "silent", "exit_not_2"],
+    "accepted bad": ["accepted"],
+    "other (leftover, refused valid)": ["leftover", "refused"],
+}
+PY_CASE = str(Path(__file__).resolve().parent / "py_case.py")
+# The Python interpreter of each binary's slot (--python), for the cases of category python.
+PYTHONS: dict[str, tuple[str, dict]] = {}
 
 NONFINITE_RE = re.compile(r"(?<![A-Za-z0-9_])[-+]?(?:nan|inf(?:inity)?)(?![A-Za-z0-9_])", re.I)
 NONFINITE_FIELD_RE = re.compile(r"^\s*\"?[-+]?(?:nan|inf(?:inity)?)\"?\s*$", re.I)
@@ -150,6 +168,10 @@ ALLOWED_STDOUT = [
     re.compile(r"(?m)^(\s*nu_\d+\s+\S+\s+\S+\s+)inf\b"),
     re.compile(r"\"quality_factor\"\s*:\s*\"inf\""),  # before JSON numbers became null
     re.compile(r"\(NaN outside\)"),
+    # Notes that name NaN or infinity as words: gaps filled with NaN before the gap policy, an
+    # unconstrained parameter "the data would give +/- infinity".
+    re.compile(r"filled with NaN before the gap policy"),
+    re.compile(r"\+/- infinity"),
 ]
 ALLOWED_NONFINITE_NAMES = re.compile(r"measured|residual|fitted_sigma")
 TEMP_NAME_RES = [
@@ -190,6 +212,8 @@ class Case:
     sig_when: object = "tempfile"  # "tempfile" (a temporary output appears) or seconds
     artifacts: list = field(default_factory=list)  # files (relative to the scratch dir) to keep
     serial: bool = False
+    culprit: str | None = None  # regex the one-line error must match (what it must name)
+    python: str | None = None  # a Python snippet run by py_case.py instead of the binary
 
 
 def C(cat, name, args, **kw) -> Case:
@@ -216,7 +240,11 @@ def shown(arg: str) -> str:
 
 
 def display_command(case: Case, binary: str) -> str:
-    cmd = shlex.join([binary] + [shown(a) for a in case.args])
+    if case.python is not None:
+        cmd = "python: " + "; ".join(line for line in case.python.splitlines()
+                                     if not line.startswith("import "))
+    else:
+        cmd = shlex.join([binary] + [shown(a) for a in case.args])
     redirs = {
         ("stdin", "closed"): "<&-", ("stdout", "closed"): ">&-",
         ("stdout", "devfull"): "> /dev/full", ("stdout", "close_after_1"): "| head -c 1",
@@ -1937,11 +1965,22 @@ def execute(case: Case, binary: str, workroot: Path, keep_scratch: bool,
     else:
         stderr = subprocess.PIPE
     initial_names = set(os.listdir(cdir))
+    argv, env = [binary] + args, child_env()
+    if case.python is not None:
+        if binary not in PYTHONS:
+            rec.update(classification="setup-error", flags=[],
+                       note="no --python for this binary")
+            if not keep_scratch:
+                remove_tree(cdir)
+            return rec
+        exe, extra_env = PYTHONS[binary]
+        argv = [exe, PY_CASE, case.python]
+        env.update(extra_env)
     t0 = time.monotonic()
     try:
-        proc = subprocess.Popen([binary] + args, cwd=cdir, stdin=stdin, stdout=stdout,
+        proc = subprocess.Popen(argv, cwd=cdir, stdin=stdin, stdout=stdout,
                                 stderr=stderr, preexec_fn=make_preexec(close),
-                                start_new_session=True, env=child_env())
+                                start_new_session=True, env=env)
     except OSError as e:
         rec.update(classification="setup-error", flags=[], note=f"cannot start: {e}")
         for fin in ctx.finalizers:
@@ -2033,6 +2072,13 @@ def execute(case: Case, binary: str, workroot: Path, keep_scratch: bool,
         if ev:
             flags.append("nonfinite")
             rec["nonfinite_evidence"] = ev[:5]
+    # An input overwritten: a regular file that was there before the run and changed (content,
+    # size, time or inode) or went away.
+    overwritten = [k for k, v in before.items()
+                   if v[0] == stat.S_IFREG and after.get(k) != v]
+    if overwritten:
+        flags.append("overwrote")
+        rec["overwritten"] = overwritten[:10]
     temp_new = [k for k in new if is_temp_name(k)]
     if (failed and new) or temp_new:
         flags.append("leftover")
@@ -2050,6 +2096,9 @@ def execute(case: Case, binary: str, workroot: Path, keep_scratch: bool,
             flags.append("silent")
     if controlled and rc != 2 and not case.sig:
         flags.append("exit_not_2")
+    if (case.culprit and controlled and case.must_fail and stderr_text is not None
+            and not re.search(case.culprit, stderr_text, re.S)):
+        flags.append("unclear")
     order = FLAGS
     primary = next((f for f in order if f in flags), None)
     rec.update(
@@ -2155,6 +2204,34 @@ def summarize(records, binaries, labels):
     return "\n".join(lines)
 
 
+def summarize_kinds(records, binaries, labels):
+    """Cases per category and the defects by kind (KINDS): cells `B1 / B2 / ...`."""
+    table: dict = {}
+    for r in records:
+        row = table.setdefault((r["category"], r["binary"]), {k: 0 for k in ["cases", *KINDS]})
+        row["cases"] += 1
+        flags = set(r.get("flags", []))
+        for kind, members in KINDS.items():
+            row[kind] += bool(flags & set(members))
+    head = ["category", "cases", *KINDS]
+    lines = ["| " + " | ".join(head) + " |", "|" + "|".join(["---"] + ["---:"] * (len(head) - 1))
+             + "|"]
+    totals = {b: {k: 0 for k in ["cases", *KINDS]} for b in binaries}
+    for c in [c for c in CATEGORIES if any((c, b) in table for b in binaries)]:
+        cells = [c]
+        for col in ["cases", *KINDS]:
+            vals = []
+            for b in binaries:
+                v = table.get((c, b), {}).get(col, 0)
+                totals[b][col] += v
+                vals.append(str(v))
+            cells.append(" / ".join(vals))
+        lines.append("| " + " | ".join(cells) + " |")
+    lines.append("| **total** | " + " | ".join(" / ".join(str(totals[b][col]) for b in binaries)
+                                               for col in ["cases", *KINDS]) + " |")
+    return "\n".join(lines)
+
+
 def defect_classes(records, binaries, labels):
     out = []
     for b in binaries:
@@ -2203,6 +2280,13 @@ def main(argv=None) -> int:
     ap.add_argument("--keep-scratch", action="store_true")
     ap.add_argument("--keep-inputs", action="store_true")
     ap.add_argument("--list", action="store_true", help="list the cases and exit")
+    ap.add_argument("--python", action="append", default=[],
+                    help="the Python of the binary in the same position: an interpreter with "
+                         "tiltnoise installed, or a directory holding the package (put on "
+                         "PYTHONPATH of this interpreter); repeatable, one per --bin")
+    ap.add_argument("--fast", action="store_true",
+                    help="CI's pass: every category but the signal cases of long writes, "
+                         "the 1 GB and 100 MB inputs and the 4 GiB Python cases")
     a = ap.parse_args(argv)
 
     DEFAULT_TIMEOUT = a.timeout
@@ -2216,6 +2300,19 @@ def main(argv=None) -> int:
             print(f"hostile_cli: missing repository file {p}", file=sys.stderr)
             return 2
     labels = {b: f"B{i + 1}" for i, b in enumerate(binaries)}
+    if len(a.python) > len(binaries):
+        print("hostile_cli: more --python than --bin", file=sys.stderr)
+        return 2
+    for b, py in zip(binaries, a.python):
+        if os.path.isdir(py):
+            path = os.pathsep.join([py, *filter(None, [os.environ.get("PYTHONPATH")])])
+            PYTHONS[b] = (sys.executable, {"PYTHONPATH": path})
+        elif os.path.isfile(py) and os.access(py, os.X_OK):
+            PYTHONS[b] = (py, {})
+        else:
+            print(f"hostile_cli: --python {py}: neither an interpreter nor a directory",
+                  file=sys.stderr)
+            return 2
     out = a.out or Path(tempfile.mkdtemp(prefix="hostile-cli-"))
     out.mkdir(parents=True, exist_ok=True)
     inputs = out / "inputs"
@@ -2238,10 +2335,27 @@ def main(argv=None) -> int:
         cases += cases_frequency(inputs)
     if "outputs" in only:
         cases += cases_outputs(inputs, have_chattr)
+    if only & set(NEW_SURFACES) or "process" in only:
+        # surfaces.py imports this module by name; when run as a script it is __main__.
+        sys.modules.setdefault("hostile_cli", sys.modules[__name__])
+        import surfaces
+        surfaces.pair_inputs(inputs, binaries[0])
+        for cat, build in [("miniseed", surfaces.cases_miniseed),
+                           ("gwpy addressing", surfaces.cases_gwpy),
+                           ("coherence/subtract pairs", surfaces.cases_pairs),
+                           ("option edges", surfaces.cases_option_edges),
+                           ("python", surfaces.cases_python)]:
+            if cat in only:
+                cases += build(inputs)
+        if "process" in only:
+            cases += surfaces.cases_process_new()
     if "process" in only:
         cases += cases_process()
     if "fuzz" in only and a.fuzz_iterations > 0:
         cases += cases_fuzz(fuzz_corpus(binaries[0]), a.fuzz_iterations, a.seed)
+    if a.fast:
+        cases = [c for c in cases if not c.serial and not any(
+            big in c.name for big in ("1 GB", "100 MB", "50 MB", "10 MB"))]
     if a.list:
         for c in cases:
             print(f"{c.cat}\t{c.name}\t{display_command(c, 'tiltnoise')}")
@@ -2279,6 +2393,12 @@ def main(argv=None) -> int:
     print()
     print(f"{len(cases)} cases per binary (fuzz: {a.fuzz_iterations} iterations, seed {a.seed}); "
           f"wall time {wall:.0f} s with {a.jobs} worker(s).")
+    print()
+    print("Defects by kind (a case counts once per kind):")
+    print()
+    print(summarize_kinds(records, binaries, labels))
+    print()
+    print("Every flag:")
     print()
     print(summarize(records, binaries, labels))
     print()
