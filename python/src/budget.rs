@@ -2,6 +2,7 @@
 //! --tilt FILE`), and the `Budget` they return.
 
 use crate::errors::{value_error, IntoPyErr, PyResultExt};
+use crate::inputs::Inputs;
 use crate::model::PyModel;
 use crate::params::PyParams;
 use crate::spectral::{averaging, series};
@@ -71,24 +72,30 @@ impl SeriesSource for ArraySeries {
     }
 }
 
-/// The model of `params`: a `Model` (reused as it is), a `Params`, or Table I for `None`.
-fn model_of(params: Option<&Bound<'_, PyAny>>) -> PyResult<(Arc<Model>, Params)> {
+/// The model of `params`: a `Model` (reused as it is), a `Params`, or Table I for `None`; and
+/// its parameters (with the file they were read from).
+fn model_of(params: Option<&Bound<'_, PyAny>>) -> PyResult<(Arc<Model>, PyParams)> {
     let Some(p) = params else {
         let params = Params::table_i();
-        return Ok((Arc::new(Model::new(&params).py()?), params));
+        return Ok((
+            Arc::new(Model::new(&params).py()?),
+            PyParams::unread(params),
+        ));
     };
     if let Ok(m) = p.cast::<PyModel>() {
-        let model = Arc::clone(&m.get().model);
-        let params = model.params().clone();
-        return Ok((model, params));
+        let m = m.get();
+        let params = PyParams {
+            inner: m.model.params().clone(),
+            file: m.params_file.clone(),
+        };
+        return Ok((Arc::clone(&m.model), params));
     }
     let params = p
         .cast::<PyParams>()
         .map_err(|_| value_error("params: expected a tiltnoise.Params or a tiltnoise.Model"))?
         .get()
-        .inner
         .clone();
-    Ok((Arc::new(Model::new(&params).py()?), params))
+    Ok((Arc::new(Model::new(&params.inner).py()?), params))
 }
 
 /// The readout of `readout` (`{observable: ASD}`), over the default 9e-9 m/sqrt(Hz) on X as
@@ -365,10 +372,12 @@ pub fn budget(
         .map(|a| format!("{0}={0}", a.name()))
         .collect::<Vec<_>>()
         .join(",");
+    let inputs = Inputs::of_params(params.file.as_deref()).with("measured", measured.as_deref());
     Ok(Budget::new(
         &model,
         report,
         params,
+        inputs,
         InputMeta {
             path: "(arrays)".into(),
             format: "numpy".into(),
@@ -502,10 +511,14 @@ pub fn budget_from_file(
         }
         Ok((report, provenance))
     })?;
+    let inputs = Inputs::of_params(params.file.as_deref())
+        .with("path", Some(&path))
+        .with("measured", measured.as_deref());
     Ok(Budget::new(
         &model,
         report,
         params,
+        inputs,
         InputMeta::from(&provenance),
     ))
 }
@@ -522,13 +535,21 @@ pub fn budget_from_file(
 #[pyclass(module = "tiltnoise", frozen)]
 pub struct Budget {
     report: BudgetReport,
-    params: Params,
+    params: PyParams,
     modes: Vec<(usize, f64)>,
     input: InputMeta,
+    /// The files read: no `save` may replace one.
+    inputs: Inputs,
 }
 
 impl Budget {
-    fn new(model: &Model, report: BudgetReport, params: Params, input: InputMeta) -> Budget {
+    fn new(
+        model: &Model,
+        report: BudgetReport,
+        params: PyParams,
+        inputs: Inputs,
+        input: InputMeta,
+    ) -> Budget {
         let modes = tiltnoise_core::modes::NormalModes::new(model)
             .modes
             .iter()
@@ -539,6 +560,7 @@ impl Budget {
             params,
             modes,
             input,
+            inputs,
         }
     }
 
@@ -584,7 +606,7 @@ impl Budget {
     fn run_meta(&self) -> RunMeta {
         RunMeta {
             modes: self.modes.clone(),
-            ..RunMeta::of_this_run(&self.params, None)
+            ..RunMeta::of_this_run(&self.params.inner, None)
         }
     }
 }
@@ -800,9 +822,7 @@ impl Budget {
     /// The parameters of the model the budget was computed with.
     #[getter]
     fn params(&self) -> PyParams {
-        PyParams {
-            inner: self.params.clone(),
-        }
+        self.params.clone()
     }
 
     /// The budget as the command line's CSV (``#`` lines ending with ``# units:``, then ASD
@@ -817,12 +837,14 @@ impl Budget {
     /// Writes the budget as the command line's ``--save`` does: ``.h5``/``.hdf5`` (schema
     /// ``tiltnoise.budget``, with the parameters and the input's provenance) or ``.csv``;
     /// atomically (nothing is left at ``path`` on failure). Raises ``OSError`` if it cannot
-    /// be written, ``ValueError`` for another extension. ``keep_zero_columns``: as
-    /// ``to_csv``.
+    /// be written or is one of the files the budget was computed from (the tilt file, the
+    /// measured record, the parameter file; compared as files, whatever the spelling),
+    /// ``ValueError`` for another extension. ``keep_zero_columns``: as ``to_csv``.
     #[pyo3(signature = (path, *, keep_zero_columns=false))]
     fn save(&self, py: Python<'_>, path: PathBuf, keep_zero_columns: bool) -> PyResult<()> {
         use tiltnoise_io::OutputKind;
         let kind = OutputKind::from_path(&path).py()?;
+        self.inputs.check_save(&path)?;
         let meta = self.run_meta();
         py.detach(|| match kind {
             OutputKind::Hdf5 => {

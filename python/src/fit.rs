@@ -60,9 +60,7 @@ impl Fit {
     /// The fitted parameter set.
     #[getter]
     fn params(&self) -> PyParams {
-        PyParams {
-            inner: self.result.fitted_params.clone(),
-        }
+        PyParams::unread(self.result.fitted_params.clone())
     }
 
     /// Per free parameter: ``key``, ``unit``, ``nominal``, ``fitted``, ``prior_sigma``,

@@ -11,6 +11,7 @@ mod budget;
 mod errors;
 mod fit;
 mod grid;
+mod inputs;
 mod model;
 mod params;
 mod simulate;

@@ -61,6 +61,8 @@ type ChoiceCache = HashMap<(Vec<Input>, Vec<Observable>, [u64; 3]), Method>;
 #[pyclass(name = "Model", module = "tiltnoise", frozen)]
 pub struct PyModel {
     pub model: Arc<Model>,
+    /// The parameter file the model's parameters were read from, if any.
+    pub params_file: Option<std::path::PathBuf>,
     modes: OnceLock<NormalModes>,
     plans: Mutex<PlanCache>,
     choices: Mutex<ChoiceCache>,
@@ -84,6 +86,7 @@ impl PyModel {
         let model = Model::new(&PyParams::or_table_i(params)).py()?;
         Ok(PyModel {
             model: Arc::new(model),
+            params_file: params.and_then(|p| p.file.clone()),
             modes: OnceLock::new(),
             plans: Mutex::new(HashMap::new()),
             choices: Mutex::new(HashMap::new()),
@@ -277,6 +280,7 @@ impl PyModel {
     fn params(&self) -> PyParams {
         PyParams {
             inner: self.model.params().clone(),
+            file: self.params_file.clone(),
         }
     }
 
@@ -579,7 +583,7 @@ impl PyModel {
             seed,
             nperseg,
         };
-        crate::simulate::run(py, &self.model, args)
+        crate::simulate::run(py, &self.model, self.params_file.as_deref(), args)
     }
 
     fn __repr__(&self) -> String {
