@@ -16,7 +16,8 @@ use tiltnoise_core::budget::{budget_from_series, budget_from_spectra, BudgetErro
 use tiltnoise_core::error::Num;
 use tiltnoise_core::freq;
 use tiltnoise_core::input::{
-    process_channel, ChannelCtx, GapPolicy, InputError, InputMeta, Quantity, SeriesSource,
+    parse_scales, process_channel, ChannelCtx, GapPolicy, InputError, InputMeta, Quantity,
+    SeriesSource,
 };
 use tiltnoise_core::model::{Model, Observable, TiltAxis};
 use tiltnoise_core::noise::equivalent::referred_terms;
@@ -427,12 +428,12 @@ pub fn budget_from_file(
     scale: Option<std::collections::BTreeMap<String, f64>>,
 ) -> PyResult<Budget> {
     let (model, params) = model_of(params)?;
-    let scale = scale
+    let scale: Vec<String> = scale
         .unwrap_or_default()
         .iter()
-        .map(|(c, f)| format!("{c}={f:?}").parse())
-        .collect::<Result<Vec<_>, String>>()
-        .map_err(|e| value_error(format!("scale: {e}")))?;
+        .map(|(c, f)| format!("{c}={f:?}"))
+        .collect();
+    let scale = parse_scales("scale", &scale).map_err(value_error)?;
     let ropts = ReadOptions {
         axis_map: axes
             .map(AxisMap::parse)

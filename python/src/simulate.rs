@@ -53,7 +53,6 @@ fn coordinates(
             "{option}: expected a dict {{coordinate: value}} or a str \"theta_a=1e-5,phi_b=0.01\""
         ))
     })?;
-    let mut given = [false; 8];
     for (name, value) in d.iter() {
         let name: String = name
             .extract()
@@ -62,7 +61,7 @@ fn coordinates(
             .extract()
             .map_err(|_| value_error(format!("{option} {name}: the value must be a number")))?;
         let item = format!("{name}={value}");
-        set_coordinate(option, &item, &name, value, rate, &mut given, out).py()?;
+        set_coordinate(option, &item, &name, value, rate, out).py()?;
     }
     Ok(())
 }

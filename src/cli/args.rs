@@ -3,6 +3,7 @@
 
 use anyhow::{anyhow, Result};
 use clap::ValueEnum;
+use tiltnoise_core::input::parse_scales;
 use tiltnoise_core::model::Observable;
 use tiltnoise_core::tf::Method;
 use tiltnoise_io::input::{AxisMap, ReadOptions};
@@ -88,10 +89,6 @@ pub fn tilt_read_options(
             .unwrap_or("reject")
             .parse()
             .map_err(|e: String| anyhow!("--gaps: {e}"))?,
-        scale: scale
-            .iter()
-            .map(|s| s.parse())
-            .collect::<Result<_, String>>()
-            .map_err(|e| anyhow!("--scale: {e}"))?,
+        scale: parse_scales("--scale", scale).map_err(|e| anyhow!(e))?,
     })
 }

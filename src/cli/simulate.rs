@@ -6,23 +6,25 @@
 use super::figure_args::FigureArgs;
 use super::output::save_image;
 use super::Run;
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use tiltnoise_core::error::{Num, Shown};
+use tiltnoise_core::error::Num;
 use tiltnoise_core::limits::{check_memory, planned_bytes, STREAMED_WELCH_BYTES_PER_SAMPLE};
 use tiltnoise_core::model::{Coord, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::noise::Readout;
+use tiltnoise_core::options;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::simulate::resonance::check_resonances;
 use tiltnoise_core::simulate::stream::{
     check_streamed_samples, FreeMotion, MinMaxEnvelope, SimChunk,
 };
 use tiltnoise_core::simulate::{
-    aliased_frequency_hz, default_sim_nperseg, equal_energy_init, kick_x, InitialState,
-    ModalPropagator, SimConfig, DEFAULT_MODE_ENERGY_J,
+    aliased_frequency_hz, default_sim_nperseg, equal_energy_init, kick_x, parse_coordinates,
+    InitialState, ModalPropagator, SimConfig, DEFAULT_MODE_ENERGY_J,
 };
 use tiltnoise_core::spectral::{Psd, WelchAccumulator, WelchConfig};
 use tiltnoise_io::{
@@ -33,9 +35,6 @@ use tiltnoise_plot::simulate_figure::{
 };
 
 mod driven;
-
-/// Default readout: the paper's 9 nm/sqrt(Hz) on X (the angles are noiseless unless given).
-const DEFAULT_X_READOUT_ASD_M: f64 = 9e-9;
 
 /// Runs with at least this many samples get a progress bar on a terminal (about 2 s of work).
 const WORTH_A_BAR: usize = 1 << 23;
@@ -164,61 +163,16 @@ pub(crate) struct SimulateArgs {
     figure: FigureArgs,
 }
 
+/// `--readout OBS=ASD` items over the default (the paper's 9 nm/sqrt(Hz) on X; 0 removes
+/// one), each observable once, in observable order.
 fn parse_readout(items: &[String]) -> Result<Vec<(Observable, f64)>> {
-    let mut readout = vec![(Observable::X, DEFAULT_X_READOUT_ASD_M)];
-    for item in items {
-        let (o, asd) = super::args::parse_readout_item(item)?;
-        readout.retain(|(x, _)| *x != o);
-        if asd > 0.0 {
-            readout.push((o, asd));
-        }
-    }
+    let items = items
+        .iter()
+        .map(|item| super::args::parse_readout_item(item))
+        .collect::<Result<Vec<_>>>()?;
+    let mut readout = options::apply_readout("--readout", Readout::default(), &items, None)?.asd;
     readout.sort_by_key(|(o, _)| o.index());
     Ok(readout)
-}
-
-/// Parses `COORD=VALUE,...` lists into `out` (SI units).
-fn parse_coords(option: &str, items: &[String], out: &mut [f64; 8]) -> Result<()> {
-    let names: Vec<&str> = Coord::ALL.iter().map(|c| c.name()).collect();
-    let mut given = [false; 8];
-    for item in items {
-        for entry in item.split(',').map(str::trim).filter(|e| !e.is_empty()) {
-            let shown = Shown(entry);
-            let (name, value) = entry.split_once('=').ok_or_else(|| {
-                anyhow!("{option} {shown}: expected COORD=VALUE, e.g. phi_b=0.01")
-            })?;
-            let c = Coord::ALL
-                .into_iter()
-                .find(|c| c.name() == name.trim())
-                .ok_or_else(|| {
-                    anyhow!(
-                        "{option} {shown}: unknown coordinate `{}`; allowed: {}",
-                        Shown(name.trim()),
-                        names.join(", ")
-                    )
-                })?;
-            let unit = if option == "--init" {
-                c.unit().to_string()
-            } else {
-                format!("{}/s", c.unit())
-            };
-            let v: f64 = value.trim().parse().map_err(|_| {
-                anyhow!(
-                    "{option} {shown}: `{}` is not a number",
-                    Shown(value.trim())
-                )
-            })?;
-            if !v.is_finite() {
-                bail!("{option} {shown}: {v} {unit} is not allowed: must be finite");
-            }
-            if given[c.index()] {
-                bail!("{option} {shown}: coordinate `{}` is given twice", c.name());
-            }
-            given[c.index()] = true;
-            out[c.index()] = v;
-        }
-    }
-    Ok(())
 }
 
 /// The run's initial state and a description of where it came from.
@@ -251,8 +205,8 @@ fn initial_state(model: &Model, args: &SimulateArgs) -> Result<(InitialState, St
             q: [0.0; 8],
             qdot: [0.0; 8],
         };
-        parse_coords("--init", &args.init, &mut init.q)?;
-        parse_coords("--init-rate", &args.init_rate, &mut init.qdot)?;
+        parse_coordinates("--init", &args.init, false, &mut init.q)?;
+        parse_coordinates("--init-rate", &args.init_rate, true, &mut init.qdot)?;
         if init.q.iter().chain(&init.qdot).all(|&v| v == 0.0) {
             bail!("--init/--init-rate: every coordinate and rate is 0: nothing moves");
         }

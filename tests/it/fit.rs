@@ -298,7 +298,7 @@ fn refusals_name_the_problem() {
         (vec!["mass.m_q_kg"], "unknown parameter key `mass.m_q_kg`"),
         (
             vec!["torsion.k_a_n_m_per_rad", "torsion.k_a_n_m_per_rad"],
-            "listed twice",
+            "torsion.k_a_n_m_per_rad is given twice",
         ),
         (vec![], "no free parameter"),
     ] {

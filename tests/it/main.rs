@@ -31,6 +31,7 @@ mod limits;
 mod mc_outputs;
 mod miniseed_input;
 mod noise_models;
+mod option_repeats;
 mod output_conventions;
 mod process;
 mod romy_budget;

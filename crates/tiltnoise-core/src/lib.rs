@@ -63,6 +63,7 @@ mod num_text;
 pub mod options;
 pub mod params;
 pub mod reference;
+pub mod repeats;
 pub mod rng;
 pub mod simulate;
 pub mod spectral;

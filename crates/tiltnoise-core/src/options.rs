@@ -8,6 +8,7 @@ use crate::error::{Num, Shown};
 use crate::limits::LimitError;
 use crate::model::{ForceInput, Input, Observable};
 use crate::noise::Readout;
+use crate::repeats::{refuse_repeats, Repeated};
 
 /// How a front end spells its options in messages.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -65,16 +66,9 @@ pub enum OptionError {
         /// The name given.
         name: String,
     },
-    /// A name given twice (also through a group).
-    #[error("{option}: {name} is given twice; name each {what} once")]
-    Repeated {
-        /// The option.
-        option: String,
-        /// The name.
-        name: &'static str,
-        /// `input` or `observable`.
-        what: &'static str,
-    },
+    /// A key or name given twice (also through a group).
+    #[error(transparent)]
+    Repeated(#[from] Repeated),
     /// A readout item that is not `OBS=ASD`.
     #[error("{option} {}: expected OBS=ASD, e.g. X=9e-9", Shown(.item))]
     ReadoutSyntax {
@@ -178,30 +172,18 @@ pub fn parse_inputs<S: AsRef<str>>(option: &str, specs: &[S]) -> Result<Vec<Inpu
     }
     let mut inputs: Vec<Input> = Vec::new();
     for name in split_names(option, specs)? {
-        let group: Vec<Input> = match name {
-            "tilt" => Input::all_tilts(),
-            "forces" => ForceInput::ALL.into_iter().map(Input::Force).collect(),
-            _ => match Input::from_name(name) {
-                Some(i) => vec![i],
-                None => {
-                    return Err(OptionError::UnknownInput {
-                        option: option.to_string(),
-                        name: name.to_string(),
-                    })
-                }
-            },
-        };
-        for i in group {
-            if inputs.contains(&i) {
-                return Err(OptionError::Repeated {
+        match name {
+            "tilt" => inputs.extend(Input::all_tilts()),
+            "forces" => inputs.extend(ForceInput::ALL.into_iter().map(Input::Force)),
+            _ => inputs.push(
+                Input::from_name(name).ok_or_else(|| OptionError::UnknownInput {
                     option: option.to_string(),
-                    name: i.name(),
-                    what: "input",
-                });
-            }
-            inputs.push(i);
+                    name: name.to_string(),
+                })?,
+            ),
         }
     }
+    refuse_repeats(option, "input", &inputs, |i| i.name().to_string())?;
     Ok(inputs)
 }
 
@@ -214,21 +196,16 @@ pub fn parse_outputs<S: AsRef<str>>(
     if specs.is_empty() {
         return Ok(Observable::ALL.to_vec());
     }
-    let mut outputs = Vec::new();
-    for name in split_names(option, specs)? {
-        let o = Observable::from_name(name).ok_or_else(|| OptionError::UnknownObservable {
-            option: option.to_string(),
-            name: name.to_string(),
-        })?;
-        if outputs.contains(&o) {
-            return Err(OptionError::Repeated {
+    let outputs = split_names(option, specs)?
+        .into_iter()
+        .map(|name| {
+            Observable::from_name(name).ok_or_else(|| OptionError::UnknownObservable {
                 option: option.to_string(),
-                name: o.name(),
-                what: "observable",
-            });
-        }
-        outputs.push(o);
-    }
+                name: name.to_string(),
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    refuse_repeats(option, "observable", &outputs, |o| o.name().to_string())?;
     Ok(outputs)
 }
 
@@ -284,15 +261,17 @@ fn check_readout_asd(
     Ok((o, asd))
 }
 
-/// `readout` with the items applied in order: a value replaces the observable's readout (the
-/// default is the paper's 9e-9 m/sqrt(Hz) on X), 0 removes it. With `budgeted`, an
-/// observable outside it is refused.
+/// `readout` with the items applied: a value replaces the observable's readout (the default is
+/// the paper's 9e-9 m/sqrt(Hz) on X), 0 removes it. An observable given twice is refused; with
+/// `budgeted`, so is an observable outside it.
 pub fn apply_readout(
     option: &str,
     mut readout: Readout,
     items: &[(Observable, f64)],
     budgeted: Option<&[Observable]>,
 ) -> Result<Readout, OptionError> {
+    let observables: Vec<Observable> = items.iter().map(|(o, _)| *o).collect();
+    refuse_repeats(option, "observable", &observables, |o| o.name().to_string())?;
     for &(o, asd) in items {
         if let Some(budgeted) = budgeted {
             if !budgeted.contains(&o) {
@@ -459,5 +438,16 @@ mod tests {
             None,
         );
         assert_eq!(r.unwrap().asd.len(), 2);
+        let e = apply_readout(
+            "--readout",
+            Readout::default(),
+            &[(Observable::X, 1e-9), (Observable::X, 2e-9)],
+            None,
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "--readout: X is given twice; name each observable once"
+        );
     }
 }

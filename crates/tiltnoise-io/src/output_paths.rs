@@ -223,7 +223,10 @@ mod tests {
         std::fs::write(&file, "x").unwrap();
         let address = d.join("gw.h5:/tilt/theta");
         let e = refusal(&[&file], &[("--tilt", &address)]);
-        assert!(e.contains("--tilt") && e.contains("replace an input"), "{e}");
+        assert!(
+            e.contains("--tilt") && e.contains("replace an input"),
+            "{e}"
+        );
         let roundabout = d.join("sub/../gw.h5");
         std::fs::create_dir(d.join("sub")).unwrap();
         assert!(check_outputs(&[&roundabout], &[("--tilt", &address)]).is_err());

@@ -12,6 +12,7 @@ use tiltnoise_core::error::{Num, Shown};
 use tiltnoise_core::model::{Model, Observable, TiltAxis};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
+use tiltnoise_core::repeats::{list_entries, refuse_repeated_keys};
 use tiltnoise_core::simulate::aliased_frequency_hz;
 use tiltnoise_core::simulate::default_sim_nperseg as default_nperseg;
 use tiltnoise_core::simulate::driven::{
@@ -25,10 +26,9 @@ use tiltnoise_plot::simulate_figure::{asd_figure, ModeMark, SimAsdData, ASD_SIZE
 /// `--drive-gain AXIS=GAIN,...` for the axes of the record (others 1).
 fn parse_gains(items: &[String], axes: &[TiltAxis]) -> Result<Vec<f64>> {
     let mut gains = vec![1.0; axes.len()];
-    for entry in items.iter().flat_map(|i| i.split(',')).map(str::trim) {
-        if entry.is_empty() {
-            continue;
-        }
+    let entries = list_entries(items);
+    refuse_repeated_keys("--drive-gain", "axis", &entries)?;
+    for entry in entries {
         let shown = Shown(entry);
         let (name, value) = entry
             .split_once('=')

@@ -64,7 +64,7 @@ mod spectra;
 
 pub use axis_map::{resolve, AxisMap, AxisMapEntry, MapOrigin, Mapped, Resolved, Sign};
 pub use error::{require_two, InputError};
-pub use scale::{check_scales, scale_for, scale_note, ChannelScale};
+pub use scale::{check_scales, parse_scales, scale_for, scale_note, ChannelScale};
 pub use series::{gap_note, process_channel, ChannelCtx, Gap, GapScanner, TiltSeries};
 pub use source::SeriesSource;
 pub use spectra::{assemble, check_csd_finite, TiltSpectra, CSD_RTOL};
