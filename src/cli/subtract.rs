@@ -14,6 +14,7 @@ use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::{Num, OutputError, Shown};
+use tiltnoise_core::limits::ASDS;
 use tiltnoise_core::model::{Observable, TiltAxis};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::options;
@@ -175,10 +176,12 @@ fn parse_tilt_noise(items: &[String]) -> Result<Vec<(TiltAxis, f64)>> {
             .trim()
             .parse()
             .map_err(|_| anyhow!("--tilt-noise {shown}: `{}` is not a number", Shown(value)))?;
-        if !(asd.is_finite() && asd >= 0.0) {
+        if !ASDS.admits(asd) {
             bail!(
-                "--tilt-noise {shown}: ASD {asd} rad/sqrt(Hz) is not allowed: must be finite \
-                 and >= 0"
+                "--tilt-noise {shown}: ASD {} rad/sqrt(Hz) is not allowed: must be {} (see \
+                 docs/limits.md)",
+                Num(asd),
+                ASDS.allowed("rad/sqrt(Hz)")
             );
         }
         out.push((axis, asd));

@@ -21,6 +21,7 @@ mod cli_budget;
 mod coherence_cli;
 mod damping;
 mod figures;
+mod finiteness;
 mod fit;
 mod force_tf;
 mod fuzz;

@@ -5,7 +5,7 @@
 //! ([`Spelling`]), then the value given and what is allowed.
 
 use crate::error::{Num, Shown};
-use crate::limits::LimitError;
+use crate::limits::{LimitError, ASDS};
 use crate::model::{ForceInput, Input, Observable};
 use crate::noise::Readout;
 use crate::repeats::{refuse_repeats, Repeated};
@@ -97,8 +97,14 @@ pub enum OptionError {
         /// The value's text.
         value: String,
     },
-    /// A readout ASD that is negative or not finite.
-    #[error("{option} {}: ASD {asd} {unit}/sqrt(Hz) is not allowed: must be finite and >= 0", Shown(.item))]
+    /// A readout ASD that is negative, not finite, or outside [`ASDS`] (its PSD would overflow
+    /// or underflow).
+    #[error(
+        "{option} {}: ASD {} {unit}/sqrt(Hz) is not allowed: must be {} (see docs/limits.md)",
+        Shown(.item),
+        Num(*.asd),
+        ASDS.allowed(&format!("{unit}/sqrt(Hz)"))
+    )]
     ReadoutAsd {
         /// The option.
         option: String,
@@ -250,7 +256,7 @@ fn check_readout_asd(
     o: Observable,
     asd: f64,
 ) -> Result<(Observable, f64), OptionError> {
-    if !(asd.is_finite() && asd >= 0.0) {
+    if !ASDS.admits(asd) {
         return Err(OptionError::ReadoutAsd {
             option: option.to_string(),
             item: item.to_string(),
@@ -390,7 +396,8 @@ mod tests {
             ("X=abc", "--readout X=abc: `abc` is not a number"),
             (
                 "X=-1",
-                "--readout X=-1: ASD -1 m/sqrt(Hz) is not allowed: must be finite and >= 0",
+                "--readout X=-1: ASD -1 m/sqrt(Hz) is not allowed: must be 0 or a value from \
+                 1e-40 to 1e40 m/sqrt(Hz) (see docs/limits.md)",
             ),
         ];
         for (item, want) in cases {
@@ -405,7 +412,8 @@ mod tests {
             readout_item("readout", "phi", f64::NAN)
                 .unwrap_err()
                 .to_string(),
-            "readout phi=NaN: ASD NaN rad/sqrt(Hz) is not allowed: must be finite and >= 0"
+            "readout phi=NaN: ASD NaN rad/sqrt(Hz) is not allowed: must be 0 or a value from \
+             1e-40 to 1e40 rad/sqrt(Hz) (see docs/limits.md)"
         );
     }
 

@@ -9,6 +9,7 @@ use crate::cli::Run;
 use anyhow::{anyhow, bail, Result};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::{Num, Shown};
+use tiltnoise_core::limits::GAINS;
 use tiltnoise_core::model::{Model, Observable, TiltAxis};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
@@ -47,8 +48,13 @@ fn parse_gains(items: &[String], axes: &[TiltAxis]) -> Result<Vec<f64>> {
             .trim()
             .parse()
             .map_err(|_| anyhow!("--drive-gain {shown}: `{}` is not a number", Shown(value)))?;
-        if !g.is_finite() {
-            bail!("--drive-gain {shown}: the gain must be finite");
+        if !GAINS.admits(g) {
+            bail!(
+                "--drive-gain {shown}: the gain {} is not allowed: must be {} (see \
+                 docs/limits.md)",
+                Num(g),
+                GAINS.allowed("")
+            );
         }
         gains[i] = g;
     }

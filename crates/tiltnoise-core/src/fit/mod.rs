@@ -248,7 +248,7 @@ pub enum FitError {
         allowed: String,
     },
     /// The same key twice in the free parameters.
-    #[error("fit: {0}")]
+    #[error(transparent)]
     Repeated(#[from] Repeated),
     /// A box width that is not a positive finite number.
     #[error("fit: --bound-sigmas {value} is not allowed: must be finite and > 0")]

@@ -63,11 +63,11 @@ mod source;
 mod spectra;
 
 pub use axis_map::{resolve, AxisMap, AxisMapEntry, MapOrigin, Mapped, Resolved, Sign};
-pub use error::{require_two, InputError};
+pub use error::{check_sample_rate, require_two, InputError};
 pub use scale::{check_scales, parse_scales, scale_for, scale_note, ChannelScale};
 pub use series::{gap_note, process_channel, ChannelCtx, Gap, GapScanner, TiltSeries};
 pub use source::SeriesSource;
-pub use spectra::{assemble, check_csd_finite, TiltSpectra, CSD_RTOL};
+pub use spectra::{assemble, check_csd_finite, frequency_refusal, TiltSpectra, CSD_RTOL};
 
 use crate::error::Shown;
 use std::fmt;

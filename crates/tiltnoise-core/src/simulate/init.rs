@@ -8,6 +8,7 @@ use super::{
     check_initial_state, check_samples, equal_energy_init, kick_x, InitialState, Simulation,
 };
 use crate::error::{Num, Shown};
+use crate::limits::MIN_SAMPLE;
 use crate::model::{Coord, Model, Observable};
 use crate::options::{OptionError, Spelling};
 use crate::repeats::{list_entries, refuse_repeated_keys};
@@ -112,7 +113,46 @@ pub fn parse_coordinates<S: AsRef<str>>(
 }
 
 /// The initial state of `excitation` on `model` and a description of where it came from.
+/// Every coordinate and rate is 0 or at least [`MIN_SAMPLE`] in magnitude: a smaller one
+/// would give observables whose spectra underflow (the error names the option and value).
 pub fn initial_state(
+    model: &Model,
+    excitation: &Excitation,
+    spelling: Spelling,
+) -> Result<(InitialState, String), OptionError> {
+    let (init, text) = excitation_state(model, excitation, spelling)?;
+    let option = match *excitation {
+        Excitation::KickX { x_m } => spelling.example("kick_x", &Num(x_m).to_string()),
+        Excitation::EqualEnergy { energy_j } => {
+            spelling.example("mode_energy", &Num(energy_j).to_string())
+        }
+        Excitation::Given { .. } => format!(
+            "{}/{}",
+            spelling.option("init"),
+            spelling.option("init_rate")
+        ),
+    };
+    for c in Coord::ALL {
+        for (what, value, unit) in [
+            ("value", init.q[c.index()], c.unit().to_string()),
+            ("rate", init.qdot[c.index()], format!("{}/s", c.unit())),
+        ] {
+            if value != 0.0 && value.abs() < MIN_SAMPLE {
+                return Err(OptionError::Conflict(format!(
+                    "{option}: the initial {what} of {} would be {} {unit}, nonzero and \
+                     smaller than {MIN_SAMPLE:e} in magnitude: the spectra of the motion would \
+                     underflow f64 (see docs/limits.md)",
+                    c.name(),
+                    Num(value)
+                )));
+            }
+        }
+    }
+    Ok((init, text))
+}
+
+/// [`initial_state`] before the check of the smallest magnitudes.
+fn excitation_state(
     model: &Model,
     excitation: &Excitation,
     spelling: Spelling,
