@@ -1,12 +1,13 @@
 //! `tiltnoise.budget` (arrays) and `tiltnoise.budget_from_file` (the command line's `budget
 //! --tilt FILE`), and the `Budget` they return.
 
+use crate::arrays::{self, check_size, series};
 use crate::errors::{value_error, IntoPyErr, PyResultExt};
 use crate::inputs::Inputs;
 use crate::model::PyModel;
 use crate::params::PyParams;
-use crate::spectral::{averaging, series};
-use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use crate::spectral::{averaging, check_fs, SERIES};
+use numpy::{PyArray1, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use std::path::{Path, PathBuf};
@@ -24,6 +25,7 @@ use tiltnoise_core::noise::equivalent::referred_terms;
 use tiltnoise_core::noise::{BudgetReport, Readout, SpectralSource};
 use tiltnoise_core::options::{self, Spelling};
 use tiltnoise_core::params::Params;
+use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_io::input::{
     add_measured_file, read_tilt, AxisMap, InputFormat, ReadOptions, TiltInput, TiltSeriesSource,
 };
@@ -188,6 +190,18 @@ fn array_error(e: InputError) -> PyErr {
             "tilt[{channel:?}][{index}] is {value:?} {unit}; allowed: finite values (or \
              gaps=\"interpolate\" to bridge interior gaps linearly)"
         )),
+        InputError::OutOfRange {
+            channel,
+            index,
+            value,
+            unit,
+            ..
+        } => value_error(format!(
+            "tilt[{channel:?}][{index}] is {} {unit}; allowed: {} (beyond that the spectra \
+             overflow or underflow f64; see docs/limits.md)",
+            Num(value),
+            tiltnoise_core::limits::SAMPLES.allowed(unit)
+        )),
         InputError::EdgeGap {
             channel,
             edge,
@@ -204,7 +218,8 @@ fn array_error(e: InputError) -> PyErr {
     }
 }
 
-/// `(axis, samples)` from a dict `{axis: array}` or a 2-D array with `axes`.
+/// `(axis, samples)` from a dict `{axis: array}` or a 2-D array with `axes`, each axis once,
+/// the size of all of them checked before any is copied (views are read in place).
 fn tilt_channels(
     tilt: &Bound<'_, PyAny>,
     axes: Option<&Bound<'_, PyAny>>,
@@ -216,13 +231,20 @@ fn tilt_channels(
                  not both",
             ));
         }
-        return d
-            .iter()
-            .map(|(k, v)| {
-                let name: String = k.extract()?;
-                let axis = tilt_axis(&name)?;
-                Ok((axis, series(&format!("tilt[{name:?}]"), &v)?))
-            })
+        let mut given = Vec::new();
+        for (k, v) in d.iter() {
+            let name: String = k
+                .extract()
+                .map_err(|_| value_error("tilt: the keys must be tilt axis names (str)"))?;
+            let axis = tilt_axis(&name)?;
+            let array = v.cast::<PyUntypedArray>().ok().map(|a| a.len());
+            given.push((axis, name, v, array));
+        }
+        let total = given.iter().map(|g| g.3.unwrap_or(0)).sum();
+        check_size("tilt", total, SERIES)?;
+        return given
+            .into_iter()
+            .map(|(axis, name, v, _)| Ok((axis, series(&format!("tilt[{name:?}]"), &v, SERIES)?)))
             .collect();
     }
     let Some(axes) = axes else {
@@ -239,25 +261,21 @@ fn tilt_channels(
             .collect(),
         Err(_) => axes.extract()?,
     };
-    let np = tilt.py().import("numpy")?;
-    let array = np
-        .call_method1("asarray", (tilt, "float64"))
-        .map_err(|e| value_error(format!("tilt: not an array of numbers ({e})")))?
-        .cast_into::<PyArrayDyn<f64>>()?;
-    let shape = array.shape().to_vec();
-    if shape.len() != 2 || shape[0] != names.len() {
+    let axes = names
+        .iter()
+        .map(|n| tilt_axis(n))
+        .collect::<PyResult<Vec<_>>>()?;
+    refuse_repeats("axes", "tilt axis", &axes, |a| a.name().to_string())
+        .map_err(|e| value_error(e.to_string()))?;
+    let rows = arrays::rows("tilt", tilt, SERIES)?;
+    if rows.len() != axes.len() {
         return Err(value_error(format!(
-            "tilt: expected a 2-D array of shape (len(axes), n_samples) = ({}, n), got shape {shape:?}",
-            names.len()
+            "tilt: expected a 2-D array of shape (len(axes), n_samples) = ({}, n), got {} rows",
+            axes.len(),
+            rows.len()
         )));
     }
-    let view = array.readonly();
-    let view = view.as_array();
-    names
-        .iter()
-        .zip(view.outer_iter())
-        .map(|(name, row)| Ok((tilt_axis(name)?, row.iter().copied().collect())))
-        .collect()
+    Ok(axes.into_iter().zip(rows).collect())
 }
 
 /// Noise budget of X, phi and phi_a from a tilt time series given as arrays.
@@ -301,11 +319,7 @@ pub fn budget(
     let (model, params) = model_of(params)?;
     let quantity: Quantity = quantity.parse().map_err(value_error)?;
     let gaps: GapPolicy = gaps.parse().map_err(value_error)?;
-    if !(fs.is_finite() && fs > 0.0) {
-        return Err(value_error(format!(
-            "fs {fs} Hz is not allowed: the sample rate must be finite and > 0"
-        )));
-    }
+    check_fs(fs)?;
     let mut channels = tilt_channels(tilt, axes)?;
     channels.sort_by_key(|(a, _)| a.index());
     if channels.is_empty() {
@@ -314,12 +328,6 @@ pub fn budget(
         ));
     }
     for w in channels.windows(2) {
-        if w[0].0 == w[1].0 {
-            return Err(value_error(format!(
-                "tilt: axis {} is given twice",
-                w[0].0.name()
-            )));
-        }
         if w[0].1.len() != w[1].1.len() {
             return Err(value_error(format!(
                 "tilt: {} has {} samples but {} has {}: the axes must have equal length",
@@ -459,7 +467,7 @@ pub fn budget_from_file(
         None => None,
         Some(f) => Some(match f.cast::<PyString>() {
             Ok(spec) => freq::parse_spec(&spec.to_cow()?).py()?,
-            Err(_) => crate::grid::frequencies(f)?,
+            Err(_) => crate::grid::frequencies(f, crate::grid::GRID)?,
         }),
     };
     let mut given = series_opts.given();

@@ -1,10 +1,11 @@
 //! `tiltnoise.Model`: normal modes, transfer functions (the command line's `modes` and `tf`),
 //! the model's matrices and the Monte Carlo of the modes (`mc`).
 
+use crate::arrays;
 use crate::errors::{value_error, PyResultExt};
 use crate::grid::{self, GridBuffer};
 use crate::params::PyParams;
-use numpy::{Complex64, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{Complex64, PyArray1, PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 use std::collections::HashMap;
@@ -362,7 +363,7 @@ impl PyModel {
         method: &str,
         rel_tol: f64,
         threads: Option<usize>,
-        out: Option<Bound<'py, PyArray3<Complex64>>>,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArray3<Complex64>>> {
         let request = Request {
             inputs: parse_inputs(inputs)?,
@@ -370,10 +371,16 @@ impl PyModel {
         };
         let asked = parse_method(method)?;
         check_rel_tol(rel_tol)?;
+        // The grid's copy, and the result unless it goes into `out`: 16 bytes an entry.
+        let entries = (request.outputs.len() * request.inputs.len()) as u64;
+        let per_point = 8 + if out.is_none() { 16 * entries } else { 0 };
         let mut grid = GridBuffer::take();
-        let band = grid.fill(freq_hz)?;
+        let band = grid.fill(freq_hz, grid::grid_size(per_point))?;
         let freqs = grid.freqs();
         let dims = [freqs.len(), request.outputs.len(), request.inputs.len()];
+        let out = out
+            .map(|o| arrays::output::<Complex64>("out", o, dims, "complex128"))
+            .transpose()?;
         let plan = self.plan_for(py, request, asked, band, rel_tol)?;
         let threads = threads.unwrap_or(match freqs.len() >= THREADED_GRID {
             true => cores(),
@@ -390,12 +397,6 @@ impl PyModel {
         };
         match out {
             Some(h) => {
-                if h.shape() != dims {
-                    return Err(value_error(format!(
-                        "out: shape {:?} does not fit the result's (n_freq, n_outputs, n_inputs) = {dims:?}",
-                        h.shape()
-                    )));
-                }
                 let mut rw = h
                     .try_readwrite()
                     .map_err(|e| value_error(format!("out: not writeable ({e})")))?;
@@ -441,7 +442,7 @@ impl PyModel {
         check_rel_tol(rel_tol)?;
         let scene = Scene {
             rel_tol,
-            ..Scene::over_grid(request, &grid::frequencies(freq_hz)?)
+            ..Scene::over_grid(request, &grid::frequencies(freq_hz, grid::GRID)?)
         };
         let model = &self.model;
         let choice = py
