@@ -2284,6 +2284,9 @@ def main(argv=None) -> int:
                     help="the Python of the binary in the same position: an interpreter with "
                          "tiltnoise installed, or a directory holding the package (put on "
                          "PYTHONPATH of this interpreter); repeatable, one per --bin")
+    ap.add_argument("--require-clean", action="store_true",
+                    help="exit 1 if any case has a defect flag other than hang (timing "
+                         "depends on the machine's load); for CI")
     ap.add_argument("--fast", action="store_true",
                     help="CI's pass: every category but the signal cases of long writes, "
                          "the 1 GB and 100 MB inputs and the 4 GiB Python cases")
@@ -2420,6 +2423,14 @@ def main(argv=None) -> int:
         remove_tree(scratch)
     if crash_dir.exists():
         print(f"Crashing, aborting, panicking and hanging inputs: {crash_dir}")
+    defective = [r for r in records if set(r.get("flags", [])) - {"hang"}]
+    if a.require_clean and (defective or setup_errors):
+        for r in (defective + setup_errors)[:20]:
+            print(f"hostile_cli: {r['category']} / {r['case']}: {r.get('flags') or r.get('note')}",
+                  file=sys.stderr)
+        print(f"hostile_cli: {len(defective)} case(s) with defects, {len(setup_errors)} could "
+              "not be set up", file=sys.stderr)
+        return 1
     return 0
 
 
