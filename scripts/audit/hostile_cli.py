@@ -1216,7 +1216,7 @@ def cases_frequency(inputs: Path) -> list[Case]:
     small = ["--input", "theta_t", "--output", "X"]
     for spec, mf in [("-1:10:1", True), ("1e-3:0:1", True), ("1e-3:18446744073709551615:1", True),
                      ("1e-3:18446744073709551616:1", True), ("1e-4:1000000000:30", True),
-                     ("1e-4:100000000:30", True), ("nan:10:1", True), ("1:10:nan", True),
+                     ("nan:10:1", True), ("1:10:nan", True),
                      ("1:10:1e300", True), ("1e300:2:1e301", True), ("inf:2:inf", True),
                      ("0:10:1", True), ("1:10:0.5", True), ("1:1:1", False), ("1:2:1", False),
                      ("1e-300:10:1e-299", False), ("4.9e-324:3:1e-323", False),
@@ -1226,6 +1226,10 @@ def cases_frequency(inputs: Path) -> list[Case]:
                      ("1e-3:1e3:1", True), ("1e-3:0x10:1", True)]:
         cases.append(C(cat, f"tf --freq {spec!r}", ["tf", "--freq", spec] + small, must_fail=mf,
                        huge="e300" in spec or "e20" in spec))
+    # 1e8 points is the documented limit of a streamed grid: about 10 minutes by design, so the
+    # timeout stops it (a hang flag here is expected, not a defect; --fast leaves it out).
+    cases.append(C(cat, "tf --freq '1e-4:100000000:30' (streamed, 10 min by design)",
+                   ["tf", "--freq", "1e-4:100000000:30"] + small, serial=True))
     for spec, mf in [("nan:10:1", True), ("1e-4:1000000000:30", True), ("1e-3:0:1", True),
                      ("1e300:2:1e301", True), ("1e-3:18446744073709551615:1", True)]:
         cases.append(C(cat, f"budget spectra --freq {spec!r}",
@@ -1582,6 +1586,16 @@ def fuzz_corpus(first_bin: str) -> dict[str, tuple[bytes, str, list[str]]]:
         repr(float(x)).encode() for x in np.logspace(-4, 1, 20)) + b"\n# end\n"
     fit = (b"mode,frequency_hz,sigma_hz\n1,1.331e-3,1e-5\n2,2.117e-3,1e-5\n3,0.406,0.002\n"
            b"4,0.4065,0.002\n5,0.58815,0.001\n6,0.617,0.001\n7,7.926,0.05\n8,10.393,0.05\n")
+    # The readers added since: miniSEED, gwpy addresses, HDF5 spectra, ASD files.
+    sys.modules.setdefault("hostile_cli", sys.modules[__name__])
+    import surfaces
+    x = (1e-9 * rng.standard_normal(200)).tolist()
+    mseed = (surfaces.mseed_records("XX.TILT.00.BAE", x, 1.0)
+             + surfaces.mseed_records("XX.TILT.00.BAN", x[::-1], 1.0))
+    with tempfile.TemporaryDirectory() as t:
+        gw = surfaces.gwpy_file(Path(t) / "gw.h5", n=256).read_bytes()
+        sp = h5_spectra(Path(t) / "sp.h5", n=20).read_bytes()
+    asd = joined(["frequency_hz,asd"] + [f"{f!r},1e-9" for f in np.logspace(-5, 1, 20).tolist()])
     return {
         "csv_series": (joined(series).encode(), "in.csv", ["budget", "--tilt", "in.csv"]),
         "csv_spectrum": (joined(spectrum).encode(), "in.csv", ["budget", "--tilt", "in.csv"]),
@@ -1592,7 +1606,18 @@ def fuzz_corpus(first_bin: str) -> dict[str, tuple[bytes, str, list[str]]]:
         "measured_csv": (joined(measured_lines(40)).encode(), "m.csv",
                          ["budget", "--tilt", PETERSON, "--measured", "m.csv"]),
         "fit_csv": (fit, "in.csv", ["fit", "--measured", "in.csv", "--format", "json"]),
+        "mseed": (mseed, "in.mseed", ["budget", "--tilt", "in.mseed", "--axes",
+                                      "theta_t=-BAE,eta_t=-BAN", "--nperseg", "64"]),
+        "gwpy": (gw, "in.h5", ["budget", "--tilt", "in.h5:/", "--axes",
+                               "theta_t=theta,eta_t=eta", "--nperseg", "64"]),
+        "h5_spectra": (sp, "in.h5", ["budget", "--tilt", "in.h5"]),
+        "readout_asd": (asd.encode(), "r.csv", ["budget", "--tilt", PETERSON, "--readout",
+                                                "X=r.csv"]),
     }
+
+
+# Fuzz kinds whose seeds are binary files: mutated byte-wise, never number by number.
+BINARY_KINDS = {"h5_series", "mseed", "gwpy", "h5_spectra"}
 
 
 def mutate(data: bytes, rng: random.Random, binary_format: bool) -> tuple[bytes, list[str]]:
@@ -1665,7 +1690,7 @@ def cases_fuzz(corpus, iterations: int, seed: int) -> list[Case]:
         kind = kinds[i % len(kinds)]
         content, name, args = corpus[kind]
         rng = random.Random(f"{seed}:{i}")
-        data, ops = mutate(content, rng, kind.startswith("h5"))
+        data, ops = mutate(content, rng, kind in BINARY_KINDS)
 
         def setup(ctx, data=data, name=name):
             write(ctx.dir / name, data)
