@@ -25,7 +25,7 @@
 //! Depends on `error` (number formatting) only; reads no file except `/proc/meminfo`,
 //! `/proc/self/limits` and `/proc/self/status`.
 
-mod magnitude;
+pub mod magnitude;
 
 pub use magnitude::*;
 
@@ -248,9 +248,18 @@ pub fn planned_bytes(count: usize, bytes_each: u64) -> u64 {
     (count as u64).saturating_mul(bytes_each)
 }
 
+/// Allocations up to this size are not checked against the machine: every machine the tool
+/// runs on has them, and reading `/proc` costs tens of microseconds, more than a small
+/// computation (a Python `transfer` of a few points) takes.
+pub const UNCHECKED_BYTES: u64 = 64 << 20;
+
 /// Refuses an allocation of `needed` bytes larger than half of the memory available now
-/// ([`available_memory_bytes`]); without that information (not Linux) it accepts.
+/// ([`available_memory_bytes`]); without that information (not Linux), or for at most
+/// [`UNCHECKED_BYTES`], it accepts.
 pub fn check_memory(what: impl FnOnce() -> String, needed: u64) -> Result<(), LimitError> {
+    if needed <= UNCHECKED_BYTES {
+        return Ok(());
+    }
     check_memory_against(what, needed, available_memory_bytes())
 }
 

@@ -76,16 +76,15 @@ pub(super) fn check_spectra(
                  Welch segment): a dead channel has no power to fit or subtract; leave it out"
             )));
         }
-        for d in 0..names.len() {
+        for (d, other) in names.iter().enumerate() {
             if spectra
                 .csd(c, d)
                 .iter()
                 .any(|z| !(z.re.is_finite() && z.im.is_finite()))
             {
                 return Err(SubtractError::Record(format!(
-                    "the cross spectrum of {name} and {} over the {stretch} stretch is not \
-                     finite: the samples are far too large for their units",
-                    names[d]
+                    "the cross spectrum of {name} and {other} over the {stretch} stretch is not \
+                     finite: the samples are far too large for their units"
                 )));
             }
         }
