@@ -2190,71 +2190,57 @@ def keep_crasher(rec, case, args, binary, cdir: Path, crash_dir: Path, label: st
 # Report
 
 
-def summarize(records, binaries, labels):
-    table = {}
-    for r in records:
-        key = (r["category"], r["binary"])
-        row = table.setdefault(key, {"cases": 0, **{f: 0 for f in FLAGS}, "time": 0.0})
-        row["cases"] += 1
-        row["time"] += r.get("duration_s") or 0.0
-        for f in r.get("flags", []):
-            row[f] += 1
-    lines = []
-    lines.append("Cells are " + " / ".join(labels[b] for b in binaries) + "; "
-                 + "; ".join(f"{labels[b]} = `{b}`" for b in binaries) + ".")
-    lines.append("")
-    head = ["category", "cases"] + [FLAG_TITLES[f] for f in TABLE_FLAGS]
-    lines.append("| " + " | ".join(head) + " |")
-    lines.append("|" + "|".join(["---"] + ["---:"] * (len(head) - 1)) + "|")
-    cats = [c for c in CATEGORIES if any((c, b) in table for b in binaries)]
-    totals = {b: {"cases": 0, **{f: 0 for f in FLAGS}, "time": 0.0} for b in binaries}
-    for c in cats:
+def category_table(counts, binaries, columns, titles):
+    """A markdown table of `counts[(category, binary)][column]`, one row per category and a
+    total, each cell `B1 / B2 / ...`; returns its lines."""
+    head = ["category", *titles]
+    lines = ["| " + " | ".join(head) + " |",
+             "|" + "|".join(["---"] + ["---:"] * (len(head) - 1)) + "|"]
+    totals = {b: dict.fromkeys(columns, 0) for b in binaries}
+    for c in [c for c in CATEGORIES if any((c, b) in counts for b in binaries)]:
         cells = [c]
-        for col in ["cases"] + TABLE_FLAGS:
+        for col in columns:
             vals = []
             for b in binaries:
-                v = table.get((c, b), {}).get(col, 0)
-                totals[b][col] += v
-                vals.append(str(v))
-            cells.append(" / ".join(vals))
-        for b in binaries:
-            totals[b]["time"] += table.get((c, b), {}).get("time", 0.0)
-        lines.append("| " + " | ".join(cells) + " |")
-    cells = ["**total**"] + [" / ".join(str(totals[b][col]) for b in binaries)
-                             for col in ["cases"] + TABLE_FLAGS]
-    lines.append("| " + " | ".join(cells) + " |")
-    lines.append("")
-    lines.append("Time in the binary (sum over cases): " + ", ".join(
-        f"{labels[b]} {totals[b]['time']:.1f} s" for b in binaries))
-    return "\n".join(lines)
-
-
-def summarize_kinds(records, binaries, labels):
-    """Cases per category and the defects by kind (KINDS): cells `B1 / B2 / ...`."""
-    table: dict = {}
-    for r in records:
-        row = table.setdefault((r["category"], r["binary"]), {k: 0 for k in ["cases", *KINDS]})
-        row["cases"] += 1
-        flags = set(r.get("flags", []))
-        for kind, members in KINDS.items():
-            row[kind] += bool(flags & set(members))
-    head = ["category", "cases", *KINDS]
-    lines = ["| " + " | ".join(head) + " |", "|" + "|".join(["---"] + ["---:"] * (len(head) - 1))
-             + "|"]
-    totals = {b: {k: 0 for k in ["cases", *KINDS]} for b in binaries}
-    for c in [c for c in CATEGORIES if any((c, b) in table for b in binaries)]:
-        cells = [c]
-        for col in ["cases", *KINDS]:
-            vals = []
-            for b in binaries:
-                v = table.get((c, b), {}).get(col, 0)
+                v = counts.get((c, b), {}).get(col, 0)
                 totals[b][col] += v
                 vals.append(str(v))
             cells.append(" / ".join(vals))
         lines.append("| " + " | ".join(cells) + " |")
     lines.append("| **total** | " + " | ".join(" / ".join(str(totals[b][col]) for b in binaries)
-                                               for col in ["cases", *KINDS]) + " |")
+                                               for col in columns) + " |")
+    return lines
+
+
+def summarize(records, binaries, labels):
+    """Every flag per category, and the time spent in each binary."""
+    counts: dict = {}
+    time_s = dict.fromkeys(binaries, 0.0)
+    for r in records:
+        row = counts.setdefault((r["category"], r["binary"]), {"cases": 0, **dict.fromkeys(FLAGS, 0)})
+        row["cases"] += 1
+        time_s[r["binary"]] += r.get("duration_s") or 0.0
+        for f in r.get("flags", []):
+            row[f] += 1
+    lines = ["Cells are " + " / ".join(labels[b] for b in binaries) + "; "
+             + "; ".join(f"{labels[b]} = `{b}`" for b in binaries) + ".", ""]
+    lines += category_table(counts, binaries, ["cases", *TABLE_FLAGS],
+                            ["cases", *(FLAG_TITLES[f] for f in TABLE_FLAGS)])
+    lines += ["", "Time in the binary (sum over cases): " + ", ".join(
+        f"{labels[b]} {time_s[b]:.1f} s" for b in binaries)]
     return "\n".join(lines)
+
+
+def summarize_kinds(records, binaries, labels):
+    """Cases per category and the defects by kind (KINDS; a case counts once per kind)."""
+    counts: dict = {}
+    for r in records:
+        row = counts.setdefault((r["category"], r["binary"]), dict.fromkeys(["cases", *KINDS], 0))
+        row["cases"] += 1
+        flags = set(r.get("flags", []))
+        for kind, members in KINDS.items():
+            row[kind] += bool(flags & set(members))
+    return "\n".join(category_table(counts, binaries, ["cases", *KINDS], ["cases", *KINDS]))
 
 
 def defect_classes(records, binaries, labels):

@@ -18,18 +18,34 @@ fn lab() -> PathBuf {
     repo("tilt_data/lab_tilt_24h.h5")
 }
 
-/// A copy of the lab tilt with `channel[index] = value`.
-fn lab_with(dir: &Path, name: &str, channel: &str, index: usize, value: f64) -> PathBuf {
+/// Rewrites the 1-D dataset `channel` of the HDF5 file `path` through `f`.
+fn edit_dataset(path: &Path, channel: &str, f: impl FnOnce(&mut Vec<f64>)) {
     disable_hdf5_file_locking();
-    let path = dir.join(name);
-    std::fs::copy(lab(), &path).unwrap();
-    let file = hdf5::File::open_rw(&path).unwrap();
+    let file = hdf5::File::open_rw(path).unwrap();
     let ds = file.dataset(channel).unwrap();
     let mut data: Vec<f64> = ds.read_raw().unwrap();
-    data[index] = value;
+    f(&mut data);
     ds.write(&Array1::from(data)).unwrap();
     file.close().unwrap();
+}
+
+/// A copy `dir/name` of the HDF5 file `source` with its dataset `channel` edited by `f`.
+fn copy_edited(
+    source: &Path,
+    dir: &Path,
+    name: &str,
+    channel: &str,
+    f: impl FnOnce(&mut Vec<f64>),
+) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::copy(source, &path).unwrap();
+    edit_dataset(&path, channel, f);
     path
+}
+
+/// A copy of the lab tilt with `channel[index] = value`.
+fn lab_with(dir: &Path, name: &str, channel: &str, index: usize, value: f64) -> PathBuf {
+    copy_edited(&lab(), dir, name, channel, |x| x[index] = value)
 }
 
 /// gwpy TimeSeries datasets `theta`, `eta` (unit `urad`, `dx` 1 s) of `n` samples, `eta[3000]`
@@ -197,13 +213,7 @@ fn measured_series_and_sample_rates_are_checked() {
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(read_measured_input(&meas).is_ok());
-    disable_hdf5_file_locking();
-    let file = hdf5::File::open_rw(&meas).unwrap();
-    let x = file.dataset("X").unwrap();
-    let mut data: Vec<f64> = x.read_raw().unwrap();
-    data[77] = 1e45;
-    x.write(&Array1::from(data)).unwrap();
-    file.close().unwrap();
+    edit_dataset(&meas, "X", |x| x[77] = 1e45);
     assert_eq!(
         out_of_range(read_measured_input(&meas).unwrap_err()),
         ("X".to_string(), 77, 1e45)
@@ -237,19 +247,8 @@ fn commands_refuse_bad_samples_before_printing_and_name_dead_channels() {
         meas.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let edit = |name: &str, channel: &str, f: &dyn Fn(&mut Vec<f64>)| -> String {
-        let path = d.join(name);
-        std::fs::copy(&meas, &path).unwrap();
-        disable_hdf5_file_locking();
-        let file = hdf5::File::open_rw(&path).unwrap();
-        let ds = file.dataset(channel).unwrap();
-        let mut data: Vec<f64> = ds.read_raw().unwrap();
-        f(&mut data);
-        ds.write(&Array1::from(data)).unwrap();
-        file.close().unwrap();
-        path.display().to_string()
-    };
-    let huge = edit("huge.h5", "X", &|x| x[5000] = 1e308);
+    let huge = copy_edited(&meas, d, "huge.h5", "X", |x| x[5000] = 1e308);
+    let huge = huge.display().to_string();
     let out = tiltnoise(&[
         "budget",
         "--tilt",
@@ -281,7 +280,8 @@ fn commands_refuse_bad_samples_before_printing_and_name_dead_channels() {
             ],
         );
     }
-    let dead = edit("dead.h5", "X", &|x| x.fill(0.0));
+    let dead = copy_edited(&meas, d, "dead.h5", "X", |x| x.fill(0.0));
+    let dead = dead.display().to_string();
     assert_fails(
         &["subtract", "--tilt", &lab, "--measured", &dead],
         &["X of the measured record is zero at every sample of the overlap"],
@@ -293,14 +293,7 @@ fn commands_refuse_bad_samples_before_printing_and_name_dead_channels() {
             "is zero at every sample over the common stretch",
         ],
     );
-    let flat_tilt = lab_with(d, "flat.h5", "eta_t", 0, 0.0);
-    disable_hdf5_file_locking();
-    {
-        let file = hdf5::File::open_rw(&flat_tilt).unwrap();
-        let ds = file.dataset("eta_t").unwrap();
-        ds.write(&Array1::from(vec![0.0; 86400])).unwrap();
-        file.close().unwrap();
-    }
+    let flat_tilt = copy_edited(&lab(), d, "flat.h5", "eta_t", |x| x.fill(0.0));
     assert_fails(
         &[
             "subtract",
