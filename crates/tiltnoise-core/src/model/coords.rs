@@ -165,7 +165,11 @@ pub enum TranslationAxis {
 
 impl TranslationAxis {
     /// All translation inputs in the crate's index order.
-    pub const ALL: [TranslationAxis; 3] = [TranslationAxis::XT, TranslationAxis::YT, TranslationAxis::ZT];
+    pub const ALL: [TranslationAxis; 3] = [
+        TranslationAxis::XT,
+        TranslationAxis::YT,
+        TranslationAxis::ZT,
+    ];
 
     /// Index into 3-vectors (the lab axis: 0 for x, 1 for y, 2 for z).
     pub fn index(self) -> usize {
