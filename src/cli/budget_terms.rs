@@ -12,7 +12,8 @@ use tiltnoise_core::noise::{is_term_name, GivenAsd, Readout, UserSource, UserTer
 use tiltnoise_io::input::{read_asd_column, InputFormat};
 
 const OBSERVABLES: &str = "X, Y, Z, theta, eta, phi, phi_a";
-const INPUTS: &str = "theta_t, eta_t, phi_t (rad), F_a.x .. F_b.z (N), M_a.x .. M_b.z (N m)";
+const INPUTS: &str =
+    "theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m), F_a.x .. F_b.z (N), M_a.x .. M_b.z (N m)";
 
 /// `--observables X,phi,...`: known names, each once.
 pub fn parse_observables(text: &str) -> Result<Vec<Observable>> {

@@ -2,11 +2,13 @@
 //! observables, on a frequency grid, with the same outputs (CSV, HDF5, figures) and methods for
 //! every kind of input.
 //!
-//! Inputs are named as in files: the tilt angles `theta_t`, `eta_t`, `phi_t` (rad) and the twelve
-//! components `F_a.x` .. `M_b.z` of the forces (N, applied at the centres of mass) and torques
-//! (N m, about the centres of mass) on the crossbar (`a`) and the test mass (`b`), inertial axes
-//! (Appendix A of the paper, zeroth order). Observables: `X`, `Y`, `Z` (m), `theta`, `eta`, `phi`,
-//! `phi_a` (rad). Entries are complex responses per unit input: m/rad, rad/rad, m/N, rad/(N m), ...
+//! Inputs are named as in files: the tilt angles `theta_t`, `eta_t`, `phi_t` (rad), the floor's
+//! translations `x_t`, `y_t`, `z_t` (m, along the lab axes: the crossbar arm along y), and the
+//! twelve components `F_a.x` .. `M_b.z` of the forces (N, applied at the centres of mass) and
+//! torques (N m, about the centres of mass) on the crossbar (`a`) and the test mass (`b`),
+//! inertial axes (Appendix A of the paper, zeroth order). Observables: `X`, `Y`, `Z` (m), `theta`,
+//! `eta`, `phi`, `phi_a` (rad). Entries are complex responses per unit input: m/rad, rad/rad,
+//! m/m, rad/m, m/N, rad/(N m), ...
 
 use super::args::MethodArg;
 use super::figure_args::FigureArgs;
@@ -42,9 +44,11 @@ pub struct TfArgs {
     #[arg(long, value_name = "FILE")]
     freq_file: Option<PathBuf>,
     /// Inputs (columns), comma-separated and/or repeated: tilt angles theta_t, eta_t, phi_t
-    /// (rad); force components F_a.x, F_a.y, F_a.z, F_b.x, F_b.y, F_b.z (N) and torque components
-    /// M_a.x .. M_b.z (N m) on the crossbar (a) and the test mass (b); the groups `tilt` (the
-    /// three tilt angles) and `forces` (all twelve components). Default: tilt.
+    /// (rad); floor translations x_t, y_t, z_t (m; the crossbar arm along y); force components
+    /// F_a.x, F_a.y, F_a.z, F_b.x, F_b.y, F_b.z (N) and torque components M_a.x .. M_b.z (N m)
+    /// on the crossbar (a) and the test mass (b); the groups `tilt` (the three tilt angles),
+    /// `translation` (the three translations), `ground` (tilt and translation) and `forces`
+    /// (all twelve components). Default: tilt.
     #[arg(long = "input", value_name = "NAME[,NAME...]")]
     inputs: Vec<String>,
     /// Observables (rows), comma-separated and/or repeated: X, Y, Z (m), theta, eta, phi, phi_a
@@ -52,8 +56,8 @@ pub struct TfArgs {
     #[arg(long = "output", value_name = "NAME[,NAME...]")]
     outputs: Vec<String>,
     /// Output file, format from the extension: .h5 (all numbers), .csv, .png/.svg (|H| per
-    /// observable, one panel per kind of input: tilt, forces, torques; tilt alone is the paper's
-    /// Figure 5). Repeatable. Without --save the CSV goes to stdout.
+    /// observable, one panel per kind of input: tilt, translation, forces, torques; tilt alone
+    /// is the paper's Figure 5). Repeatable. Without --save the CSV goes to stdout.
     #[arg(long, value_name = "PATH")]
     save: Vec<PathBuf>,
     /// Evaluation method.
@@ -280,7 +284,8 @@ impl Grid {
     }
 }
 
-/// The modes table and, for tilt inputs, the static limits (printed when files are saved).
+/// The modes table and, for tilt inputs, the static limits, for translations their limits per
+/// unit acceleration (printed when files are saved).
 fn write_report(
     out: &mut super::stdout::Out,
     model: &Model,
@@ -291,6 +296,14 @@ fn write_report(
     if request.inputs.iter().any(|i| matches!(i, Input::Tilt(_))) {
         writeln!(out)?;
         write!(out, "{}", super::report::static_limits(model))?;
+    }
+    if request
+        .inputs
+        .iter()
+        .any(|i| matches!(i, Input::Translation(_)))
+    {
+        writeln!(out)?;
+        write!(out, "{}", super::report::translation_limits(model))?;
     }
     Ok(())
 }

@@ -2,7 +2,7 @@
 
 use crate::atomic::write_atomic;
 use crate::csv_layout::{csv_head, CsvPreamble};
-use crate::tf_hdf5::{SIGN_CONVENTION, TIME_DEPENDENCE};
+use crate::tf_hdf5::{has_translation, SIGN_CONVENTION, TIME_DEPENDENCE, TRANSLATION_CONVENTION};
 use crate::RunMeta;
 use std::io::{BufWriter, Write as _};
 use std::path::Path;
@@ -60,14 +60,18 @@ pub fn tf_csv_header(outputs: &[Observable], inputs: &[Input], meta: &RunMeta) -
             columns.push((format!("{o}.{i}.im"), unit));
         }
     }
+    let mut notes = vec![
+        format!("H(f) per unit input, time dependence {TIME_DEPENDENCE}"),
+        format!("tilt sign convention: {SIGN_CONVENTION}"),
+    ];
+    if has_translation(inputs) {
+        notes.push(format!("floor translation: {TRANSLATION_CONVENTION}"));
+    }
     let preamble = CsvPreamble {
         schema: SCHEMA_TF_CSV,
         schema_version: SCHEMA_VERSION_TF_CSV,
         meta,
-        notes: vec![
-            format!("H(f) per unit input, time dependence {TIME_DEPENDENCE}"),
-            format!("tilt sign convention: {SIGN_CONVENTION}"),
-        ],
+        notes,
     };
     csv_head(&preamble, &columns)
 }

@@ -86,6 +86,24 @@ impl TranslationForcing {
     }
 }
 
+/// The response of every observable per unit floor acceleration as `f -> 0`, `-C K_c^-1 G2`
+/// (rows in the order of [`super::Observable::ALL`], columns x_t, y_t, z_t; units m/(m s^-2),
+/// rad/(m s^-2)): the equivalence principle's values, `X/eta_t / g` for x_t, `-Y/theta_t / g`
+/// for y_t, the fibres' stretch per unit `g` for z_t (see the module docs). Complex with
+/// structural loss (`K_c = K + i Im(K_c)`).
+pub fn acceleration_limit(model: &super::Model) -> nalgebra::SMatrix<num_complex::Complex64, 7, 3> {
+    use num_complex::Complex64;
+    let lu = model.stiffness_complex().lu();
+    let g2 = model
+        .translation_forcing()
+        .g2
+        .map(|v| Complex64::new(-v, 0.0));
+    let q = lu
+        .solve(&g2)
+        .expect("K_c is regular: Model::new checks that K is positive definite");
+    model.observation().map(Complex64::from) * q
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -111,6 +129,51 @@ mod tests {
                 );
                 assert_eq!(model.translation_forcing().g2[(coord.index(), axis)], 0.0);
             }
+        }
+    }
+
+    /// 1-norm condition number of `S K S`, `S = diag(K_ii^-1/2)`.
+    fn equilibrated_cond(model: &Model) -> f64 {
+        let k = model.stiffness();
+        let s: Vec<f64> = (0..8).map(|i| 1.0 / k[(i, i)].sqrt()).collect();
+        let ks = crate::model::Mat8::from_fn(|r, c| k[(r, c)] * s[r] * s[c]);
+        let inv = ks.try_inverse().unwrap();
+        let norm1 =
+            |m: &crate::model::Mat8| (0..8).map(|c| m.column(c).abs().sum()).fold(0.0, f64::max);
+        norm1(&ks) * norm1(&inv)
+    }
+
+    /// The limits per unit acceleration are the equivalence principle's: the tilt's static
+    /// response per g for x_t and y_t (the pendulum hangs along the apparent vertical), Hooke's
+    /// law under the extra weight for z_t; within the LU's rounding.
+    #[test]
+    fn acceleration_limits_are_the_equivalence_principle() {
+        use crate::model::Observable;
+        let p = Params::table_i();
+        let model = Model::new(&p).unwrap();
+        let limit = acceleration_limit(&model);
+        let g = p.environment.g_m_per_s2;
+        let lever = model.derived().lever_m;
+        let (m_a, m_b) = (p.mass.m_a_kg, p.mass.m_b_kg);
+        let hooke = -((m_a + m_b) / p.bouncing.kappa_a_n_per_m + m_b / p.bouncing.kappa_b_n_per_m);
+        for (o, axis, want) in [
+            (Observable::X, 0, -lever / g),
+            (Observable::Eta, 0, 1.0 / g),
+            (Observable::Y, 1, -lever / g),
+            (Observable::Theta, 1, -1.0 / g),
+            (Observable::Z, 2, hooke),
+            (Observable::Y, 2, 0.0),
+            (Observable::Phi, 0, 0.0),
+        ] {
+            let got = limit[(o.index(), axis)];
+            // LU of the 8x8 stiffness: forward error n eps cond on a solution of scale
+            // lever / g, cond that of the symmetrically equilibrated K.
+            let tol = 8.0 * f64::EPSILON * equilibrated_cond(&model) * lever / g;
+            assert!(
+                (got - want).norm() <= tol,
+                "{} per unit acceleration along axis {axis}: {got} vs {want:e}",
+                o.name()
+            );
         }
     }
 }
