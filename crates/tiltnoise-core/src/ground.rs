@@ -112,7 +112,11 @@ mod tests {
             ];
             for (q, amplitude) in amplitudes {
                 let u = amplitude * q.to_displacement(f).unwrap();
-                assert!((u - 1.0).norm() <= 4.0 * f64::EPSILON, "{} at {f}: {u}", q.name());
+                assert!(
+                    (u - 1.0).norm() <= 4.0 * f64::EPSILON,
+                    "{} at {f}: {u}",
+                    q.name()
+                );
                 let psd = q.psd_to_displacement(f).unwrap() * amplitude.norm_sqr();
                 assert!((psd - 1.0).abs() <= 8.0 * f64::EPSILON, "{}", q.name());
             }

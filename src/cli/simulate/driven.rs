@@ -9,7 +9,7 @@ use crate::cli::Run;
 use anyhow::{anyhow, bail, Result};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::{Num, Shown};
-use tiltnoise_core::model::{Model, Observable, TiltAxis};
+use tiltnoise_core::model::{Input, Model, Observable, TiltAxis};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::simulate::aliased_frequency_hz;
@@ -97,9 +97,10 @@ pub(super) fn run(
         );
     }
     let readout = parse_readout(&args.readout)?;
+    let inputs: Vec<Input> = series.axes.iter().map(|&a| Input::Tilt(a)).collect();
     let drive = drive_from_record(
         1.0 / fs,
-        &series.axes,
+        &inputs,
         &series.data,
         m,
         &gains,
