@@ -39,3 +39,4 @@ mod simulate_roundtrip;
 mod streaming;
 mod subtract;
 mod thermal;
+mod translation_cli;

@@ -297,7 +297,8 @@ pub fn build_tf_figure(
                 .to_string(),
             "Equivalence principle, f → 0: per unit floor acceleration a = −ω² u, xₜ acts as the \
              tilt ηₜ = aₓ/g and yₜ as θₜ = −a_y/g; zₜ as a change of g (the fibres' stretch). \
-             Every response per metre falls as f² at low frequency."
+             Every response per metre falls at least as f² at low frequency (φ/xₜ and φₐ/xₜ \
+             as f⁴)."
                 .to_string(),
         ]);
     }
