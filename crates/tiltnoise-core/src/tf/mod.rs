@@ -8,8 +8,8 @@
 //! [`crate::model::tilt`]), the floor-translation forcing `w^2 G2` (columns per axis, see
 //! [`crate::model::translation`]) or the zeroth-order force matrix (columns per force/torque
 //! component). Units of an entry: the observable's unit per the input's unit (m/rad, rad/rad,
-//! m/m, rad/m, m/N, rad/(N m), ...). The response
-//! is the complex amplitude for `e^{+i w t}` time dependence.
+//! m/m, rad/m, m/N, rad/(N m), ...). The response is the complex amplitude for `e^{+i w t}`
+//! time dependence.
 //!
 //! Methods are plain data ([`Method`]); [`plan`] builds a [`TransferFunction`] that does the
 //! per-model work once and then evaluates cheaply at many frequencies
