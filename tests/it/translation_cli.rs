@@ -202,3 +202,75 @@ fn budget_term_of_a_floor_translation() {
     }
     assert!(checked >= 2, "only {checked} values checked");
 }
+
+/// `tf --per acceleration`: the floor's columns per unit acceleration (the displacement's
+/// divided by `-w^2`, to the CSV round trip), in m/(m/s^2) and m/(rad/s^2), force columns
+/// unchanged; as f -> 0 X/x_t tends to the equivalence principle's `-(Z + Z_b + h_c) / g`. A
+/// frequency file with 0 Hz is refused, naming the frequency.
+#[test]
+fn tf_per_unit_floor_acceleration() {
+    let args = [
+        "--input",
+        "x_t,eta_t,F_b.x",
+        "--output",
+        "X",
+        "--freq",
+        "1e-6:4:10",
+    ];
+    let run = |per: &str| {
+        let mut a = vec!["tf"];
+        a.extend(args);
+        a.extend(["--per", per]);
+        let out = tiltnoise(&a);
+        assert!(out.status.success(), "{}", common::stderr(&out));
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let (displacement, acceleration) = (run("displacement"), run("acceleration"));
+    assert!(
+        acceleration.contains("X.x_t.re=m/(m/s^2)"),
+        "{acceleration}"
+    );
+    assert!(acceleration.contains("X.eta_t.re=m/(rad/s^2)"));
+    assert!(acceleration.contains("X.F_b.x.re=m/N"));
+    assert!(acceleration
+        .contains("# note: floor motion (tilt and translation inputs) per unit acceleration"));
+    let (_, freqs, d) = parse_csv(&displacement);
+    let (_, _, a) = parse_csv(&acceleration);
+    for ((f, d), a) in freqs.iter().zip(&d).zip(&a) {
+        let w2 = (std::f64::consts::TAU * f).powi(2);
+        for k in 0..2 {
+            let want = d[k] / -w2;
+            assert!(
+                (a[k] - want).norm() <= 4.0 * CSV_ROUND_TRIP * want.norm(),
+                "entry {k} at {f} Hz: {} vs {want}",
+                a[k]
+            );
+        }
+        assert_eq!(a[2], d[2], "force column at {f} Hz");
+    }
+    let p = Params::table_i();
+    let lever = Model::new(&p).unwrap().derived().lever_m;
+    let limit = -lever / p.environment.g_m_per_s2;
+    // At 1e-6 Hz the approach to the limit is 2.7e-8 relative (tests of the library).
+    assert!(
+        (a[0][0].re - limit).abs() <= 1e-7 * limit.abs(),
+        "{} vs {limit}",
+        a[0][0]
+    );
+
+    let dir = tempfile::tempdir().unwrap();
+    let freq_file = dir.path().join("f.txt");
+    std::fs::write(&freq_file, "1e-3\n0\n1\n").unwrap();
+    let out = tiltnoise(&[
+        "tf",
+        "--input",
+        "x_t",
+        "--per",
+        "velocity",
+        "--freq-file",
+        freq_file.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = common::stderr(&out);
+    assert!(err.contains("--per velocity: frequency 2 of"), "{err}");
+}

@@ -99,6 +99,9 @@ pub(crate) fn write_root(
     if has_translation(&tf.inputs) {
         str_attr(file, "translation_convention", TRANSLATION_CONVENTION)?;
     }
+    if let Some(per) = crate::tf_csv::ground_quantity_note(tf) {
+        str_attr(file, "ground_quantity", &per)?;
+    }
     Ok(())
 }
 
@@ -131,7 +134,7 @@ pub(crate) fn write_labels(file: &hdf5::File, tf: &TransferMatrix) -> hdf5::Resu
     dataset(
         file,
         "input_units",
-        &strings(tf.inputs.iter().map(|i| i.unit()))?,
+        &strings((0..tf.inputs.len()).map(|i| tf.input_unit(i)))?,
     )?;
     Ok(())
 }

@@ -9,6 +9,7 @@ use super::chart::{LegendPlacement, YScale};
 pub use super::labels::observable_symbol;
 use super::labels::{observable_title, tilt_symbol, translation_symbol};
 use super::{render, DrawError, ImageFormat, View};
+use tiltnoise_core::ground::GroundQuantity;
 use tiltnoise_core::model::{ForceInput, Input, Observable, TiltAxis, TranslationAxis};
 use tiltnoise_core::tf::TransferMatrix;
 
@@ -104,14 +105,29 @@ impl InputKind {
         }
     }
 
-    /// `(y-axis symbol of the input, unit of the response per unit input, title suffix)`.
-    fn labels(self, o: Observable) -> (&'static str, String, &'static str) {
+    /// `(y-axis symbol of the input, unit of the response per unit input, title suffix)`, the
+    /// floor's motion per unit `per` (its displacement, velocity or acceleration).
+    fn labels(self, o: Observable, per: GroundQuantity) -> (&'static str, String, &'static str) {
+        let floor = |unit: &str| match per.unit(unit) {
+            u if u.contains('/') => format!("{}/({u})", o.unit()),
+            u => format!("{}/{u}", o.unit()),
+        };
         match self {
-            InputKind::Tilt => ("tilt", format!("{}/rad", o.unit()), ""),
-            InputKind::Translation => ("u", format!("{}/m", o.unit()), ", per floor translation"),
+            InputKind::Tilt => ("tilt", floor("rad"), ""),
+            InputKind::Translation => ("u", floor("m"), ", per floor translation"),
             InputKind::Force => ("F", format!("{}/N", o.unit()), ", per force"),
             InputKind::Torque => ("M", format!("{}/(N m)", o.unit()), ", per torque"),
         }
+    }
+}
+
+/// What a tilt (`radian`) or translation (`metre`) column is per, for the caption.
+fn per_unit_text(per: GroundQuantity, unit: &str) -> String {
+    let symbol = if unit == "radian" { "rad" } else { "m" };
+    match per {
+        GroundQuantity::Displacement => unit.to_string(),
+        GroundQuantity::Velocity => format!("{symbol}/s"),
+        GroundQuantity::Acceleration => format!("{symbol}/s²"),
     }
 }
 
@@ -184,7 +200,7 @@ pub fn build_tf_figure(
             ));
         };
         for &kind in &kinds {
-            let (input_symbol, unit, suffix) = kind.labels(o);
+            let (input_symbol, unit, suffix) = kind.labels(o, tf.ground_quantity());
             let mut panel = Panel::new(
                 format!("{}{suffix}", observable_title(o)),
                 ("frequency", "Hz"),
@@ -278,9 +294,11 @@ pub fn build_tf_figure(
     let mut caption = Vec::new();
     if has_tilt {
         caption.extend([
-            "Tilt lines: θₜ solid, ηₜ dashed, φₜ dotted. |H| is the modulus of the complex \
-             response per radian of floor tilt."
-                .to_string(),
+            format!(
+                "Tilt lines: θₜ solid, ηₜ dashed, φₜ dotted. |H| is the modulus of the complex \
+                 response per {} of floor tilt.",
+                per_unit_text(tf.ground_quantity(), "radian")
+            ),
             "Sign convention: tilt t = small rotation taking the floor frame to the inertial \
              frame (the floor turns by −t); observables are read in the enclosure frame."
                 .to_string(),
@@ -291,16 +309,29 @@ pub fn build_tf_figure(
     }
     if has_translation {
         caption.extend([
-            "Translation lines: xₜ solid, yₜ dashed, zₜ dotted. |H| is the modulus of the \
-             response per metre of floor displacement (the floor, the suspension point and the \
-             housing move together; the crossbar arm lies along y)."
-                .to_string(),
+            format!(
+                "Translation lines: xₜ solid, yₜ dashed, zₜ dotted. |H| is the modulus of the \
+                 response per {} of floor translation (the floor, the suspension point and the \
+                 housing move together; the crossbar arm lies along y).",
+                per_unit_text(tf.ground_quantity(), "metre")
+            ),
             "Equivalence principle, f → 0: per unit floor acceleration a = −ω² u, xₜ acts as the \
              tilt ηₜ = aₓ/g and yₜ as θₜ = −a_y/g; zₜ as a change of g (the fibres' stretch). \
              Every response per metre falls at least as f² at low frequency (φ/xₜ and φₐ/xₜ \
              as f⁴)."
                 .to_string(),
         ]);
+    }
+    if (has_tilt || has_translation) && tf.ground_quantity() != GroundQuantity::Displacement {
+        caption.push(format!(
+            "Per unit {} of the floor's motion: the response per unit displacement divided by \
+             {}.",
+            tf.ground_quantity().name(),
+            match tf.ground_quantity() {
+                GroundQuantity::Velocity => "iω",
+                _ => "−ω²",
+            }
+        ));
     }
     if has_forces {
         caption.push(
