@@ -6,36 +6,13 @@
 use crate::common;
 use crate::tolerances::{CSV_ROUND_TRIP, LOGLOG_REL, POLE_EXCLUSION, TARGET_REL};
 
-use common::{repo, str_attr, tiltnoise};
+use common::{parse_tf_csv, repo, str_attr, tiltnoise};
 use num_complex::Complex64;
 use tiltnoise_core::model::{Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::reference::{relative_errors, ReferenceModel};
 use tiltnoise_core::tf::{Input, Request};
-
-/// The numbers of a CSV `tf` wrote: header, frequencies, rows of complex entries.
-fn parse_csv(text: &str) -> (Vec<String>, Vec<f64>, Vec<Vec<Complex64>>) {
-    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
-    let header = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_string)
-        .collect();
-    let (mut freqs, mut rows) = (Vec::new(), Vec::new());
-    for line in lines {
-        let v: Vec<f64> = line.split(',').map(|s| s.parse().unwrap()).collect();
-        freqs.push(v[0]);
-        rows.push(
-            v[1..]
-                .chunks_exact(2)
-                .map(|c| Complex64::new(c[0], c[1]))
-                .collect(),
-        );
-    }
-    (header, freqs, rows)
-}
 
 /// `tf --input translation` writes CSV, HDF5 and figures: the CSV's numbers are the reference's
 /// within the `auto` tolerance (and the CSV round trip), in m/m and rad/m, with the translation
@@ -71,7 +48,7 @@ fn tf_writes_translation_columns_with_their_units_and_convention() {
         "{csv}"
     );
     assert!(csv.contains("X.x_t.re=m/m") && csv.contains("phi.z_t.im=rad/m"));
-    let (header, freqs, rows) = parse_csv(&csv);
+    let (header, freqs, rows) = parse_tf_csv(&csv);
     assert_eq!(header[1], "X.x_t.re");
     let params = Params::table_i();
     let modes = NormalModes::new(&Model::new(&params).unwrap()).frequencies_hz();
@@ -234,8 +211,8 @@ fn tf_per_unit_floor_acceleration() {
     assert!(acceleration.contains("X.F_b.x.re=m/N"));
     assert!(acceleration
         .contains("# note: floor motion (tilt and translation inputs) per unit acceleration"));
-    let (_, freqs, d) = parse_csv(&displacement);
-    let (_, _, a) = parse_csv(&acceleration);
+    let (_, freqs, d) = parse_tf_csv(&displacement);
+    let (_, _, a) = parse_tf_csv(&acceleration);
     for ((f, d), a) in freqs.iter().zip(&d).zip(&a) {
         let w2 = (std::f64::consts::TAU * f).powi(2);
         for k in 0..2 {

@@ -78,6 +78,19 @@ fn cross(a: [Dd; 3], b: [Dd; 3]) -> [Dd; 3] {
     ]
 }
 
+/// `B loads`: the generalized forces of 12 force and torque components (zero terms skipped).
+fn generalized_forces(force: &[[Dd; 12]; 8], loads: &[Dd]) -> [Dd; 8] {
+    std::array::from_fn(|r| {
+        let mut q = Dd::ZERO;
+        for (c, &load) in loads.iter().enumerate() {
+            if !force[r][c].is_zero() && !load.is_zero() {
+                q += force[r][c] * load;
+            }
+        }
+        q
+    })
+}
+
 pub fn build(p: &Params) -> Matrices {
     let (m_a, m_b) = (dd(p.mass.m_a_kg), dd(p.mass.m_b_kg));
     let i = &p.inertia;
@@ -260,14 +273,8 @@ pub fn build(p: &Params) -> Matrices {
             apparent_torque(inertia_b),
         ];
         let loads: Vec<Dd> = [fa, fb, ma, mb].concat();
-        for r in 0..8 {
-            let mut q = Dd::ZERO;
-            for (c, &load) in loads.iter().enumerate() {
-                if !force[r][c].is_zero() && !load.is_zero() {
-                    q += force[r][c] * load;
-                }
-            }
-            // Q per unit t''; a harmonic tilt has t'' = -w^2 t, so G2 = -Q.
+        // Q per unit t''; a harmonic tilt has t'' = -w^2 t, so G2 = -Q.
+        for (r, q) in generalized_forces(&force, &loads).into_iter().enumerate() {
             g2[r][axis] = -q;
         }
     }
@@ -279,13 +286,7 @@ pub fn build(p: &Params) -> Matrices {
         let mut loads = [Dd::ZERO; 12];
         loads[axis] = -m_a;
         loads[3 + axis] = -m_b;
-        for r in 0..8 {
-            let mut q = Dd::ZERO;
-            for (c, &load) in loads.iter().enumerate() {
-                if !force[r][c].is_zero() && !load.is_zero() {
-                    q += force[r][c] * load;
-                }
-            }
+        for (r, q) in generalized_forces(&force, &loads).into_iter().enumerate() {
             translation_g2[r][axis] = -q;
         }
     }
