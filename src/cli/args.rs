@@ -3,6 +3,7 @@
 
 use anyhow::{anyhow, Result};
 use clap::ValueEnum;
+use tiltnoise_core::ground::GroundQuantity;
 use tiltnoise_core::input::parse_scales;
 use tiltnoise_core::model::Observable;
 use tiltnoise_core::tf::Method;
@@ -43,6 +44,28 @@ pub enum MethodArg {
     Statespace,
     /// The 2-DoF torsional model of section IV.C (no tilt inputs).
     Torsion2,
+}
+
+/// What the floor's motion is per unit of, in `tf`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PerArg {
+    /// Per unit displacement: rad, m (the model's inputs).
+    Displacement,
+    /// Per unit velocity: rad/s, m/s.
+    Velocity,
+    /// Per unit acceleration: rad/s^2, m/s^2.
+    Acceleration,
+}
+
+impl PerArg {
+    /// The library's quantity.
+    pub fn quantity(self) -> GroundQuantity {
+        match self {
+            PerArg::Displacement => GroundQuantity::Displacement,
+            PerArg::Velocity => GroundQuantity::Velocity,
+            PerArg::Acceleration => GroundQuantity::Acceleration,
+        }
+    }
 }
 
 impl MethodArg {

@@ -14,7 +14,8 @@ use tiltnoise_core::repeats::refuse_repeated_keys;
 use tiltnoise_io::input::{read_asd_column, InputFormat};
 
 const OBSERVABLES: &str = "X, Y, Z, theta, eta, phi, phi_a";
-const INPUTS: &str = "theta_t, eta_t, phi_t (rad), F_a.x .. F_b.z (N), M_a.x .. M_b.z (N m)";
+const INPUTS: &str =
+    "theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m), F_a.x .. F_b.z (N), M_a.x .. M_b.z (N m)";
 
 /// `--observables X,phi,...`: known names, each once.
 pub fn parse_observables(text: &str) -> Result<Vec<Observable>> {

@@ -41,3 +41,4 @@ mod simulate_roundtrip;
 mod streaming;
 mod subtract;
 mod thermal;
+mod translation_cli;

@@ -136,9 +136,12 @@ pub enum OptionError {
 
 /// Every input name, for messages.
 pub fn input_names() -> String {
-    let mut names: Vec<&str> = Input::all_tilts().into_iter().map(Input::name).collect();
+    let mut names: Vec<&str> = Input::all_ground().into_iter().map(Input::name).collect();
     names.extend(ForceInput::ALL.iter().map(|f| f.name()));
-    format!("{}, or the groups `tilt` and `forces`", names.join(", "))
+    format!(
+        "{}, or the groups `tilt`, `translation`, `ground` and `forces`",
+        names.join(", ")
+    )
 }
 
 /// Every observable name, for messages.
@@ -170,8 +173,9 @@ pub fn split_names<'a, S: AsRef<str>>(
 }
 
 /// The inputs named by `specs` ([`split_names`]): tilt angles (`theta_t`, `eta_t`, `phi_t`),
-/// force and torque components (`F_a.x` .. `M_b.z`) and the groups `tilt` and `forces`, in
-/// the order given, each once; no name means the three tilt angles.
+/// floor translations (`x_t`, `y_t`, `z_t`), force and torque components (`F_a.x` .. `M_b.z`)
+/// and the groups `tilt`, `translation`, `ground` (tilt and translation) and `forces`, in the
+/// order given, each once; no name means the three tilt angles.
 pub fn parse_inputs<S: AsRef<str>>(option: &str, specs: &[S]) -> Result<Vec<Input>, OptionError> {
     if specs.is_empty() {
         return Ok(Input::all_tilts());
@@ -180,6 +184,8 @@ pub fn parse_inputs<S: AsRef<str>>(option: &str, specs: &[S]) -> Result<Vec<Inpu
     for name in split_names(option, specs)? {
         match name {
             "tilt" => inputs.extend(Input::all_tilts()),
+            "translation" => inputs.extend(Input::all_translations()),
+            "ground" => inputs.extend(Input::all_ground()),
             "forces" => inputs.extend(ForceInput::ALL.into_iter().map(Input::Force)),
             _ => inputs.push(
                 Input::from_name(name).ok_or_else(|| OptionError::UnknownInput {
@@ -332,6 +338,15 @@ mod tests {
         );
         assert_eq!(parse_inputs("--input", &["forces"]).unwrap().len(), 12);
         assert_eq!(parse_inputs("--input", &["tilt,forces"]).unwrap().len(), 15);
+        assert_eq!(
+            parse_inputs("--input", &["translation"]).unwrap(),
+            Input::all_translations()
+        );
+        let ground = parse_inputs("--input", &["ground"]).unwrap();
+        let names: Vec<&str> = ground.iter().map(|i| i.name()).collect();
+        assert_eq!(names, ["theta_t", "eta_t", "phi_t", "x_t", "y_t", "z_t"]);
+        let e = parse_inputs("--input", &["ground,y_t"]).unwrap_err();
+        assert!(e.to_string().contains("y_t is given twice"), "{e}");
     }
 
     #[test]

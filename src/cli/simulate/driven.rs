@@ -10,7 +10,7 @@ use anyhow::{anyhow, bail, Result};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::{Num, Shown};
 use tiltnoise_core::limits::GAINS;
-use tiltnoise_core::model::{Model, Observable, TiltAxis};
+use tiltnoise_core::model::{Input, Model, Observable, TiltAxis};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::repeats::{list_entries, refuse_repeated_keys};
@@ -103,9 +103,10 @@ pub(super) fn run(
         );
     }
     let readout = parse_readout(&args.readout)?;
+    let inputs: Vec<Input> = series.axes.iter().map(|&a| Input::Tilt(a)).collect();
     let drive = drive_from_record(
         1.0 / fs,
-        &series.axes,
+        &inputs,
         &series.data,
         m,
         &gains,

@@ -7,8 +7,9 @@
 //!
 //! **Tilt sign.** The crate's tilt `t = (theta_t, eta_t, phi_t)` (rad) is the small
 //! right-handed rotation taking the **floor** frame to the **inertial** frame: the floor itself
-//! rotates by `-t` (see [`crate::model::tilt`]). Lab axes: `x`, `y` horizontal (`x` along the
-//! crossbar arm, `y` along the other), `z` up. Every value returned by this module is `t` in
+//! rotates by `-t` (see [`crate::model::tilt`]). Lab axes: `x`, `y` horizontal (the crossbar
+//! arm along `y`, the test mass at `(0, -d, .)`; `x` perpendicular to the arm, the test mass's
+//! X), `z` up. Every value returned by this module is `t` in
 //! this convention: a series in rad (angle) or rad/s (its rate), spectra as one-sided PSD/CSD
 //! of the angle in rad²/Hz.
 //!

@@ -26,4 +26,5 @@ mod stability;
 mod subtract;
 mod synthetic;
 mod tilt_tf;
+mod translation_tf;
 mod welch_scipy;
