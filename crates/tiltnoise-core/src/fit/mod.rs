@@ -38,6 +38,7 @@ pub use measured::{Measured, MeasuredMode, SigmaSource};
 
 use crate::error::{ParamError, Shown};
 use crate::params::Params;
+use crate::repeats::{refuse_repeats, Repeated};
 use nalgebra::{DMatrix, DVector};
 
 /// Default free parameters: for each mode, or pair of nearly degenerate modes, the parameter
@@ -249,15 +250,9 @@ pub enum FitError {
         /// The keys that can be free.
         allowed: String,
     },
-    /// The same key twice.
-    #[error(
-        "fit: parameter `{}` is listed twice in --free; give each key once",
-        Shown(.key)
-    )]
-    DuplicateKey {
-        /// The key.
-        key: String,
-    },
+    /// The same key twice in the free parameters.
+    #[error(transparent)]
+    Repeated(#[from] Repeated),
     /// A box width that is not a positive finite number.
     #[error("fit: --bound-sigmas {value} is not allowed: must be finite and > 0")]
     BoundSigmas {
@@ -467,6 +462,7 @@ fn check_config(
     if config.free.is_empty() {
         return Err(FitError::NoFree);
     }
+    refuse_repeats("--free", "parameter key", &config.free, String::clone)?;
     let fields = params.fields();
     let sigma_of = |key: &str, value: f64| {
         crate::mc::uncertainties(params)
@@ -489,9 +485,6 @@ fn check_config(
                 key: key.clone(),
                 allowed: allowed.clone(),
             })?;
-        if out.iter().any(|f| &f.key == key) {
-            return Err(FitError::DuplicateKey { key: key.clone() });
-        }
         let sigma = sigma_of(key, field.value);
         let absolute = crate::params::uncertainty::is_absolute_key(key);
         if sigma <= 0.0 {

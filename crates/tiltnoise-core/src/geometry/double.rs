@@ -112,6 +112,7 @@ fn as_built(p: &Params) -> Result<(Matrices, Scales), ParamError> {
         }
     }
     let tilts = |g: &[[f64; 6]; 8]| g.map(|row| [row[0], row[1], row[2]]);
+    let translations = |g: &[[f64; 6]; 8]| g.map(|row| [row[3], row[4], row[5]]);
     let scales = Scales {
         mass: mag.mass,
         stiffness: std::array::from_fn(|r| {
@@ -123,9 +124,11 @@ fn as_built(p: &Params) -> Result<(Matrices, Scales), ParamError> {
         force: mag.force,
         g0: tilts(&mag.ground_g0),
         g2: tilts(&mag.ground_g2),
+        translation_g2: translations(&mag.ground_g2),
         observation: mag.observation,
     };
     let tilts = |g: &[[Dd; 6]; 8]| g.map(|row| [row[0], row[1], row[2]]);
+    let translations = |g: &[[Dd; 6]; 8]| g.map(|row| [row[3], row[4], row[5]]);
     let matrices = Matrices {
         mass: lin.mass,
         stiffness_gravity: lin.stiffness_gravity,
@@ -134,6 +137,7 @@ fn as_built(p: &Params) -> Result<(Matrices, Scales), ParamError> {
         force: lin.force,
         g0: tilts(&lin.ground_g0),
         g2: tilts(&lin.ground_g2),
+        translation_g2: translations(&lin.ground_g2),
         observation: lin.observation,
     };
     Ok((matrices, scales))

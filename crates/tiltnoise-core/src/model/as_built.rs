@@ -3,7 +3,10 @@
 //! ([`crate::geometry`]).
 
 use super::damping::{self, SwingDirections};
-use super::{matrices, tilt, Derived, ForceMatrix, Mat8, ObservationMatrix, TiltMatrix, Vec8};
+use super::{
+    matrices, tilt, translation, Derived, ForceMatrix, Mat8, ObservationMatrix, TiltMatrix,
+    TranslationMatrix, Vec8,
+};
 use crate::dd::Dd;
 use crate::error::ParamError;
 use crate::geometry::{self, Linearization};
@@ -18,6 +21,7 @@ pub(super) struct RestLinear {
     pub stiffness_gravity: Mat8,
     pub force: ForceMatrix,
     pub tilt: tilt::TiltForcing,
+    pub translation: translation::TranslationForcing,
     pub observation: ObservationMatrix,
     pub swing: SwingDirections,
 }
@@ -30,6 +34,7 @@ impl RestLinear {
         let (stiffness_gravity, _) = matrices::stiffness(p);
         let force = matrices::force_matrix(p, &derived);
         let tilt = tilt::TiltForcing::new(p, &derived, &force, &stiffness_gravity);
+        let translation = translation::TranslationForcing::new(p, &force);
         RestLinear {
             derived,
             rest: Vec8::zeros(),
@@ -37,6 +42,7 @@ impl RestLinear {
             stiffness_gravity,
             force,
             tilt,
+            translation,
             observation: matrices::observation(p),
             swing: damping::symmetric_swing(),
         }
@@ -72,6 +78,9 @@ impl RestLinear {
             tilt: tilt::TiltForcing {
                 g0: TiltMatrix::from_fn(|r, c| lin.ground_g0[r][c]),
                 g2: TiltMatrix::from_fn(|r, c| lin.ground_g2[r][c]),
+            },
+            translation: translation::TranslationForcing {
+                g2: TranslationMatrix::from_fn(|r, c| lin.ground_g2[r][3 + c]),
             },
             observation,
             swing: lin

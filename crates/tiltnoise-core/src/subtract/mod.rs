@@ -30,6 +30,7 @@
 
 pub mod align;
 pub mod estimate;
+mod input_checks;
 pub mod predict;
 pub mod residuals;
 pub mod stats;
@@ -204,6 +205,9 @@ pub enum SubtractError {
     /// An option outside its allowed range.
     #[error("{0}")]
     Config(String),
+    /// A record the estimation cannot use: a non-finite sample or spectrum, a dead channel.
+    #[error("{0}")]
+    Record(String),
     /// A band with no bin.
     #[error(
         "the {what} band {} .. {} Hz holds no bin of the Welch grid {} .. {} Hz; allowed: a band \
@@ -349,10 +353,13 @@ pub fn subtract(
         .map(|(_, x)| &x[alignment.measured_first..alignment.measured_first + n])
         .collect();
     let outputs: Vec<Observable> = measured.channels.iter().map(|c| c.0).collect();
+    let channel_names = input_checks::channel_names(tilt.axes, &outputs);
+    input_checks::check_channels(&channel_names, &w, &y)?;
     let welch_cfg = WelchConfig::new(segment_len);
     let step = segment_len - welch_cfg.overlap;
     let train: Vec<&[f64]> = w.iter().chain(&y).map(|x| &x[..n_train]).collect();
     let training_spectra = csd_matrix(&train, fs, &welch_cfg)?;
+    input_checks::check_spectra(&training_spectra, &channel_names, "training")?;
     let n_eff_train = stats::effective_averages(segment_len, step, training_spectra.n_segments);
     let witness_noise_psd: Vec<f64> = tilt
         .axes
@@ -419,6 +426,7 @@ pub fn subtract(
 
     let held: Vec<&[f64]> = w.iter().chain(&y).map(|x| &x[n_train..]).collect();
     let held_spectra = csd_matrix(&held, fs, &welch_cfg)?;
+    input_checks::check_spectra(&held_spectra, &channel_names, "held-out")?;
     let n_eff_held = stats::effective_averages(segment_len, step, held_spectra.n_segments);
     let psds = |series: &[(Observable, Vec<f64>)]| -> Result<Vec<Vec<f64>>, SubtractError> {
         series

@@ -13,8 +13,8 @@
 use crate::tolerances::{EIG_GAMMA, EPS, LU_GAMMA, U};
 use nalgebra::SVector;
 use tiltnoise_core::dd::{Dd, DD_EPS};
-use tiltnoise_core::geometry::{self, GROUND_INPUTS};
-use tiltnoise_core::model::{Coord, Model, Observable, TiltAxis};
+use tiltnoise_core::geometry;
+use tiltnoise_core::model::{Coord, Model, Observable, TiltAxis, TranslationAxis};
 use tiltnoise_core::modes::{NormalModes, RATIO_THRESHOLD};
 use tiltnoise_core::params::Params;
 
@@ -332,6 +332,14 @@ fn zero_offsets_reproduce_the_closed_forms() {
                 mag.ground_g2[i][j],
             );
         }
+        for t in TranslationAxis::ALL {
+            check(
+                "G2_u",
+                model.translation_forcing().g2[(i, t.index())],
+                lin.ground_g2[i][3 + t.index()],
+                mag.ground_g2[i][3 + t.index()],
+            );
+        }
         for o in 0..7 {
             check(
                 "C",
@@ -402,26 +410,28 @@ fn independent_calculation_agrees_to_its_quoted_digits() {
         1e-3,
     );
 
-    // phi from theta_t (a model input) and from y_t (a ground column of the exact
-    // kinematics), at 0.1 Hz: C (K - w^2 M)^-1 (G0 + w^2 G2). theta is the outermost of the
-    // crossbar's rotations, so a tilt about x is exactly a rigid rotation about x, which phi
-    // does not read, plus the translation of the suspension point by h per radian:
-    // phi/theta_t = h phi/y_t, to the LU's rounding. The notes' 3.6e-4 for y_t is their
-    // 7.3e-4 for theta_t divided by h = 2 m and cut to two digits: the identity fixes it at
-    // 3.65e-4, so it is checked to one unit of its last digit.
-    let lin = geometry::linearize::<Dd>(&p)
-        .unwrap()
-        .cleaned()
-        .map(|x| x.to_f64());
-    let w2 = (std::f64::consts::TAU * 0.1).powi(2);
+    // phi from theta_t and from y_t (the model's tilt and translation forcings), at 0.1 Hz:
+    // C (K - w^2 M)^-1 (G0 + w^2 G2). theta is the outermost of the crossbar's rotations, so
+    // a tilt about x is exactly a rigid rotation about x, which phi does not read, plus the
+    // translation of the suspension point by h per radian: phi/theta_t = h phi/y_t, to the
+    // LU's rounding. The notes' 3.6e-4 for y_t is their 7.3e-4 for theta_t divided by h = 2 m
+    // and cut to two digits: the identity fixes it at 3.65e-4, so it is checked to one unit of
+    // its last digit.
+    let w = std::f64::consts::TAU * 0.1;
+    let w2 = w * w;
     let d = tm.stiffness() - tm.mass() * w2;
     let (lu, d_inv) = (d.lu(), d.try_inverse().unwrap());
     let c = tm.observation().row(Observable::Phi.index()).transpose();
-    let column = |input: &str| {
-        let j = GROUND_INPUTS.iter().position(|&n| n == input).unwrap();
-        SVector::<f64, 8>::from_fn(|r, _| lin.ground_g0[r][j] + w2 * lin.ground_g2[r][j])
-    };
-    let (g_tilt, g_floor) = (column("theta_t"), column("y_t"));
+    let g_tilt: SVector<f64, 8> = tm
+        .tilt_forcing()
+        .at(w)
+        .column(TiltAxis::ThetaT.index())
+        .into_owned();
+    let g_floor: SVector<f64, 8> = tm
+        .translation_forcing()
+        .at(w)
+        .column(TranslationAxis::YT.index())
+        .into_owned();
     let phi = |g: &SVector<f64, 8>| (c.transpose() * lu.solve(g).unwrap())[(0, 0)];
     let (from_tilt, from_floor) = (phi(&g_tilt), phi(&g_floor));
     quoted(

@@ -27,4 +27,5 @@ mod stability;
 mod subtract;
 mod synthetic;
 mod tilt_tf;
+mod translation_tf;
 mod welch_scipy;

@@ -11,7 +11,8 @@
 //!   the blocks). On the coupled ones `block` refuses to plan, and on every one `split` (and
 //!   `torsion2`): the refusal, with its reason, is what is checked there. Their zones are
 //!   their own (the symmetric models share Table I's).
-//! * Entry points: the 7x3 tilt matrix; the 7 observables from 8 force/torque components.
+//! * Entry points: the 7x3 tilt matrix; the 7 observables from 8 force/torque components; the
+//!   7x3 floor-translation matrix.
 //! * Grid: 1e-5 .. 100 Hz, 40 points per decade, plus points 1 % and 5 % above and below every
 //!   mode.
 //!
@@ -138,23 +139,27 @@ fn as_built_cases() -> &'static [Case] {
 
 /// The zones of a pendulum as built, per entry point (its own poles and zeros).
 fn as_built_zones(case: usize, entry_point: &str) -> &'static [Vec<f64>] {
-    static ZONES: OnceLock<Vec<[Vec<Vec<f64>>; 2]>> = OnceLock::new();
+    static ZONES: OnceLock<Vec<[Vec<Vec<f64>>; 3]>> = OnceLock::new();
     let all = ZONES.get_or_init(|| {
         as_built_cases()
             .iter()
             .map(|c| entry_points().map(|(_, r)| poles_and_zeros(c, &r)))
             .collect()
     });
-    &all[case][usize::from(entry_point != "tilt")]
+    let k = entry_points()
+        .iter()
+        .position(|(name, _)| *name == entry_point)
+        .expect("a known entry point");
+    &all[case][k]
 }
 
 fn force(name: &str) -> Input {
     Input::Force(ForceInput::from_name(name).unwrap())
 }
 
-/// The entry points: all tilt inputs, and eight force/torque components that drive both blocks
+/// The entry points: all tilt inputs, eight force/torque components that drive both blocks
 /// through both bodies (forces at the centres of mass and torques about them).
-fn entry_points() -> [(&'static str, Request); 2] {
+fn entry_points() -> [(&'static str, Request); 3] {
     let forces = [
         "F_a.x", "F_b.x", "F_b.y", "F_b.z", "M_a.z", "M_b.x", "M_b.y", "M_b.z",
     ];
@@ -165,6 +170,13 @@ fn entry_points() -> [(&'static str, Request); 2] {
             Request {
                 outputs: Observable::ALL.to_vec(),
                 inputs: forces.iter().map(|n| force(n)).collect(),
+            },
+        ),
+        (
+            "translation",
+            Request {
+                outputs: Observable::ALL.to_vec(),
+                inputs: Input::all_translations(),
             },
         ),
     ]
@@ -269,10 +281,11 @@ fn poles_and_zeros(case: &Case, request: &Request) -> Vec<Vec<f64>> {
 fn zones(entry_point: &str) -> &'static [Vec<f64>] {
     static TILT: OnceLock<Vec<Vec<f64>>> = OnceLock::new();
     static FORCES: OnceLock<Vec<Vec<f64>>> = OnceLock::new();
-    let cell = if entry_point == "tilt" {
-        &TILT
-    } else {
-        &FORCES
+    static TRANSLATION: OnceLock<Vec<Vec<f64>>> = OnceLock::new();
+    let cell = match entry_point {
+        "tilt" => &TILT,
+        "forces" => &FORCES,
+        _ => &TRANSLATION,
     };
     let request = entry_points()
         .into_iter()
@@ -294,7 +307,30 @@ fn in_zone(f: f64, special: &[f64]) -> bool {
 fn forcing(model: &Model, input: Input, w2: f64) -> SVector<f64, 8> {
     match input {
         Input::Tilt(t) => model.tilt_forcing().at(w2.sqrt()).column(t.index()).into(),
+        Input::Translation(t) => model
+            .translation_forcing()
+            .at(w2.sqrt())
+            .column(t.index())
+            .into(),
         Input::Force(f) => model.force_matrix().column(f.index()).into(),
+    }
+}
+
+/// `(G0, G2)` of an input, its forcing being `G0 + w^2 G2`.
+fn forcing_parts(model: &Model, input: Input) -> (SVector<f64, 8>, SVector<f64, 8>) {
+    match input {
+        Input::Tilt(t) => (
+            model.tilt_forcing().g0.column(t.index()).into(),
+            model.tilt_forcing().g2.column(t.index()).into(),
+        ),
+        Input::Translation(t) => (
+            SVector::zeros(),
+            model.translation_forcing().g2.column(t.index()).into(),
+        ),
+        Input::Force(f) => (
+            model.force_matrix().column(f.index()).into(),
+            SVector::zeros(),
+        ),
     }
 }
 
@@ -373,19 +409,12 @@ fn statespace_bound(case: &Case, request: &Request, freq_hz: f64) -> Vec<f64> {
     let mut abs_s = lu.l().map(|z| z.norm()) * lu.u().map(|z| z.norm());
     lu.p().inv_permute_rows(&mut abs_s);
     let abs_sinv = s_inv.map(|z| z.norm());
-    let tilt = m.tilt_forcing();
     let c_obs = m.observation();
     let mut out = Vec::new();
     for o in &request.outputs {
         let row = c_obs.row(o.index()).abs();
         for &i in &request.inputs {
-            let (g0, g2): (SVector<f64, 8>, SVector<f64, 8>) = match i {
-                Input::Tilt(t) => (
-                    tilt.g0.column(t.index()).into(),
-                    tilt.g2.column(t.index()).into(),
-                ),
-                Input::Force(f) => (m.force_matrix().column(f.index()).into(), SVector::zeros()),
-            };
+            let (g0, g2) = forcing_parts(m, i);
             let y = m_inv * g2;
             let dy = g * (abs_minv * (abs_m * y.abs() + g2.abs()));
             let b0 = g0.map(Complex64::from) + k * y.map(Complex64::from);
@@ -453,16 +482,7 @@ fn dual_norm(case: &Case, x: &SVector<f64, 8>) -> f64 {
 /// eigenvalue error times `|term_k| / |mu_k - w^2|`, with `||.||*` the `M^-1` norm.
 fn modal_bound(case: &Case, o: Observable, input: Input, w2: f64) -> f64 {
     let modes = &case.modes.modes;
-    let (g0, g2) = match input {
-        Input::Tilt(t) => (
-            case.model.tilt_forcing().g0.column(t.index()).into(),
-            case.model.tilt_forcing().g2.column(t.index()).into(),
-        ),
-        Input::Force(f) => (
-            case.model.force_matrix().column(f.index()).into(),
-            SVector::<f64, 8>::zeros(),
-        ),
-    };
+    let (g0, g2) = forcing_parts(&case.model, input);
     let g_size = dual_norm(case, &g0) + w2 * dual_norm(case, &g2);
     let c_size = dual_norm(case, &case.model.observation().row(o.index()).transpose());
     (0..modes.len())
