@@ -20,7 +20,8 @@ use tiltnoise_core::model::{Model, Observable, TiltAxis};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
 use tiltnoise_io::input::{
-    read_measured_input, read_start_time, read_tilt_series, MeasuredInput, Quantity,
+    parse_start_time, read_measured_input, read_start_time, read_tilt_series, MeasuredInput,
+    Quantity,
 };
 use tiltnoise_io::{CoherenceInputs, InputMeta, OutputKind, RunMeta};
 
@@ -176,7 +177,11 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
     let tilt_record = Record {
         name: &tilt_name,
         sample_rate_hz: tilt.sample_rate_hz,
-        start_time: tilt.provenance.start_time.as_deref(),
+        start_time: tilt
+            .provenance
+            .start_time
+            .as_deref()
+            .and_then(parse_start_time),
         channels: tilt
             .axes
             .iter()
@@ -187,7 +192,7 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
     let measured_record = Record {
         name: &measured_name,
         sample_rate_hz: measured.sample_rate_hz,
-        start_time: measured_start.as_deref(),
+        start_time: measured_start.as_deref().and_then(parse_start_time),
         channels: select_outputs(&args, &measured.channels)?,
     };
     let report = coherence_from_series(&model, &tilt_record, &measured_record, &opts)?;

@@ -56,8 +56,8 @@ pub struct Record<'a, C> {
     pub name: &'a str,
     /// Sample rate (Hz).
     pub sample_rate_hz: f64,
-    /// ISO 8601 time of sample 0, if the file states one.
-    pub start_time: Option<&'a str>,
+    /// The instant of sample 0, if the file states one.
+    pub start_time: Option<jiff::Timestamp>,
     /// `(label, samples)`: tilt axes (rad, the crate's sign convention) or observables (m, rad).
     pub channels: Vec<(C, &'a [f64])>,
 }

@@ -6,6 +6,7 @@
 
 pub(crate) use super::steim::WordOrder;
 use super::steim::{self, Steim};
+use jiff::{civil, tz::Offset, Timestamp};
 
 /// Length of the fixed header section.
 const FIXED_HEADER: usize = 48;
@@ -89,14 +90,18 @@ fn plausible(year: u16, day: u16) -> bool {
     (1900..=2100).contains(&year) && (1..=366).contains(&day)
 }
 
-/// Days from 1970-01-01 to `year`-01-01 (proleptic Gregorian).
-fn days_to_year(year: i64) -> i64 {
-    let y = year - 1;
-    365 * (year - 1970) + (y / 4 - y / 100 + y / 400) - (1969 / 4 - 1969 / 100 + 1969 / 400)
-}
-
-fn is_leap(year: i64) -> bool {
-    (year % 4 == 0 && year % 100 != 0) || year % 400 == 0
+/// Seconds from 1970-01-01T00:00:00 UTC to the start of day `day` (1-based) of `year`;
+/// `None` for a day the year does not have.
+fn start_of_day_s(year: i16, day: i16) -> Option<i64> {
+    let date = civil::Date::new(year, 1, 1)
+        .and_then(|d| d.with().day_of_year(day).build())
+        .ok()?;
+    Some(
+        Offset::UTC
+            .to_timestamp(date.to_datetime(civil::Time::midnight()))
+            .ok()?
+            .as_second(),
+    )
 }
 
 /// The nominal sample rate of the header's factor and multiplier (SEED manual, fixed header
@@ -198,9 +203,12 @@ pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
              allowed: hour <= 23, minute <= 59, second <= 60, 0.0001 s units <= 9999"
         ));
     }
-    if day == 366 && !is_leap(i64::from(year)) {
-        return Err(format!("start day 366 of {year}, which is not a leap year"));
-    }
+    // `plausible` bounds the year and day, so only day 366 of a common year is refused here.
+    let Some(day_start_s) = start_of_day_s(year as i16, day as i16) else {
+        return Err(format!(
+            "start day {day} of {year}, which is not a leap year"
+        ));
+    };
     let n = usize::from(u16_at(b, 30, order));
     let factor = u16_at(b, 32, order) as i16;
     let multiplier = u16_at(b, 34, order) as i16;
@@ -330,9 +338,9 @@ pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
         ));
     }
 
-    let days = days_to_year(i64::from(year)) + i64::from(day) - 1;
+    // Second 60 (a leap second) runs on into the next minute, as in libmseed.
     let mut start_ns =
-        ((days * 24 + i64::from(hour)) * 60 + i64::from(minute)) * 60 + i64::from(second);
+        day_start_s + (i64::from(hour) * 60 + i64::from(minute)) * 60 + i64::from(second);
     start_ns = start_ns * NS_PER_S + i64::from(fract) * 100_000 + i64::from(usec) * 1000;
     // Bit 1 of the activity flags: the time correction is already applied.
     if activity & 0x02 == 0 {
@@ -407,26 +415,9 @@ fn decode_samples(
 
 /// ISO 8601 UTC text of `ns` since 1970 (`YYYY-MM-DDThh:mm:ss.ffffffZ`, microseconds).
 pub(crate) fn iso8601(ns: i64) -> String {
-    let secs = ns.div_euclid(NS_PER_S);
-    let micros = ns.rem_euclid(NS_PER_S) / 1000;
-    let days = secs.div_euclid(86_400);
-    let sod = secs.rem_euclid(86_400);
-    // Civil date from days since 1970-01-01 (Howard Hinnant's algorithm).
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = doy - (153 * mp + 2) / 5 + 1;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 };
-    let y = yoe + era * 400 + i64::from(m <= 2);
-    format!(
-        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}.{micros:06}Z",
-        sod / 3600,
-        sod % 3600 / 60,
-        sod % 60
-    )
+    // Every i64 of nanoseconds (years 1677..2262) is a valid instant.
+    let instant = Timestamp::from_nanosecond(i128::from(ns)).expect("within jiff's range");
+    super::super::start_time::utc_text_micros(instant)
 }
 
 #[cfg(test)]
@@ -435,14 +426,17 @@ mod tests {
 
     #[test]
     fn times() {
-        assert_eq!(days_to_year(1970), 0);
-        assert_eq!(days_to_year(2018), 17532);
+        assert_eq!(start_of_day_s(1970, 1), Some(0));
+        // Python: datetime(2018, 1, 1, tzinfo=timezone.utc).timestamp()
+        assert_eq!(start_of_day_s(2018, 1), Some(1_514_764_800));
+        assert_eq!(start_of_day_s(2000, 366), Some(978_220_800));
+        assert_eq!(start_of_day_s(2100, 366), None);
         // 2018-01-23T09:31:42 = day 23 of 2018.
-        let ns = ((days_to_year(2018) + 22) * 86_400 + 9 * 3600 + 31 * 60 + 42) * NS_PER_S;
+        let ns = (start_of_day_s(2018, 23).unwrap() + 9 * 3600 + 31 * 60 + 42) * NS_PER_S;
         assert_eq!(iso8601(ns), "2018-01-23T09:31:42.000000Z");
         assert_eq!(iso8601(-1000), "1969-12-31T23:59:59.999999Z");
         assert_eq!(
-            iso8601((days_to_year(2000) + 59) * 86_400 * NS_PER_S),
+            iso8601(start_of_day_s(2000, 60).unwrap() * NS_PER_S),
             "2000-02-29T00:00:00.000000Z"
         );
     }
