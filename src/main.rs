@@ -28,7 +28,7 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => return clap_exit(&e),
     };
-    match cli::run(cli) {
+    match cli::run(cli, tiltnoise_core::cancel::Cancel::never()) {
         Ok(()) => ExitCode::SUCCESS,
         // The reader of standard output has gone (`tiltnoise tf | head -1`): nothing to say.
         Err(e) if cli::is_closed_pipe(&e) => ExitCode::SUCCESS,

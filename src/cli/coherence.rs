@@ -150,6 +150,7 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
         confidence: args.confidence.unwrap_or(0.95),
         fit_band_hz: args.fit_band.as_deref().map(parse_fit_band).transpose()?,
         tilt_quantity: Quantity::Angle,
+        cancel: run.cancel.clone(),
     };
     let model = Model::new(params)?;
     let ropts = tilt_read_options(

@@ -16,6 +16,7 @@ pub use crate::noise::loglog_at;
 pub use measured::{add_measured, series_psds, MeasuredPsds};
 pub use summary::{SummaryRequest, DEFAULT_BAND_FRACTION, DEFAULT_SUMMARY_FREQS_HZ};
 
+use crate::cancel::{Cancel, Cancelled};
 use crate::error::TfError;
 use crate::input::rate::angle_csd_above_dc;
 use crate::input::{InputError, Quantity, SeriesSource, TiltSpectra};
@@ -39,6 +40,9 @@ pub const DEFAULT_WELCH_SEGMENT: usize = 1 << 14;
 /// Failures of a budget run.
 #[derive(Debug, thiserror::Error)]
 pub enum BudgetError {
+    /// Cancelled through [`BudgetOptions::cancel`].
+    #[error(transparent)]
+    Cancelled(#[from] Cancelled),
     /// Reading the tilt input failed.
     #[error(transparent)]
     Input(#[from] InputError),
@@ -85,6 +89,8 @@ pub struct BudgetOptions {
     pub spectra_grid_hz: Vec<f64>,
     /// Frequencies to read the budget at ([`crate::noise::SummaryAt`]).
     pub summary: SummaryRequest,
+    /// Polled before each chunk of a series ([`CHUNK_SAMPLES`]).
+    pub cancel: Cancel,
 }
 
 impl Default for BudgetOptions {
@@ -100,6 +106,7 @@ impl Default for BudgetOptions {
             user_terms: Vec::new(),
             spectra_grid_hz: Vec::new(),
             summary: SummaryRequest::default(),
+            cancel: Cancel::never(),
         }
     }
 }
@@ -212,6 +219,7 @@ pub fn budget_from_series(
     let mut start = 0;
     while start < n {
         let len = CHUNK_SAMPLES.min(n - start);
+        opts.cancel.check()?;
         let chunk = series.read_chunk(start, len)?;
         let views: Vec<&[f64]> = chunk.iter().map(Vec::as_slice).collect();
         whole.push(&views)?;
