@@ -34,6 +34,12 @@ mod grid;
 mod matrix;
 mod modal;
 pub mod planner;
+#[allow(unsafe_code, reason = "the AVX kernel")]
+#[allow(
+    clippy::undocumented_unsafe_blocks,
+    reason = "the intrinsics of polezero/lanes.rs share one SAFETY argument, on its AVX type; \
+              each block gets its own with the type that proves the CPU feature"
+)]
 mod polezero;
 mod split;
 mod statespace;
