@@ -140,7 +140,9 @@ pub(crate) fn is_v3(b: &[u8]) -> bool {
 
 /// Decodes the record at the start of `b` (which holds the rest of the file). Returns the
 /// record; its length says where the next one starts.
-pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
+/// The byte order of the fixed header at the start of `b`, after checking that it looks like a
+/// miniSEED 2 data record at all.
+fn header_order(b: &[u8]) -> Result<WordOrder, String> {
     if is_v3(b) {
         return Err(
             "this is a miniSEED 3 record; allowed: miniSEED 2 (SEED 2.4 data records \
@@ -170,23 +172,27 @@ pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
             b[6]
         ));
     }
-    let order = if plausible(u16_at(b, 20, WordOrder::Big), u16_at(b, 22, WordOrder::Big)) {
-        WordOrder::Big
+    if plausible(u16_at(b, 20, WordOrder::Big), u16_at(b, 22, WordOrder::Big)) {
+        Ok(WordOrder::Big)
     } else if plausible(
         u16_at(b, 20, WordOrder::Little),
         u16_at(b, 22, WordOrder::Little),
     ) {
-        WordOrder::Little
+        Ok(WordOrder::Little)
     } else {
-        return Err(format!(
+        Err(format!(
             "start year {} / day {} (big-endian; little-endian {} / {}) is not plausible in \
              either byte order; allowed: year 1900..=2100, day 1..=366",
             u16_at(b, 20, WordOrder::Big),
             u16_at(b, 22, WordOrder::Big),
             u16_at(b, 20, WordOrder::Little),
             u16_at(b, 22, WordOrder::Little)
-        ));
-    };
+        ))
+    }
+}
+
+pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
+    let order = header_order(b)?;
     let station = code(&b[8..13], "station")?;
     let location = code(&b[13..15], "location")?;
     let channel = code(&b[15..18], "channel")?;
@@ -217,59 +223,13 @@ pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
     let data_offset = usize::from(u16_at(b, 44, order));
     let first_blockette = usize::from(u16_at(b, 46, order));
 
-    // The blockette chain: offsets strictly increasing (no cycle), each inside the bytes there
-    // are; blockette 1000 gives the record length, which bounds them again below.
-    let mut b1000: Option<(u8, u8, u8)> = None;
-    let mut usec: i8 = 0;
-    let mut has_b1001 = false;
-    let mut b100_rate: Option<f32> = None;
-    let mut end_of_blockettes = FIXED_HEADER;
-    let mut at = first_blockette;
-    let mut count = 0;
-    while at != 0 {
-        count += 1;
-        if count > MAX_BLOCKETTES {
-            return Err(format!(
-                "more than {MAX_BLOCKETTES} blockettes; the chain is damaged"
-            ));
-        }
-        if at < end_of_blockettes || at + 4 > b.len() {
-            return Err(format!(
-                "blockette at byte {at} of the record is outside the record or overlaps the \
-                 header or the previous blockette"
-            ));
-        }
-        let kind = u16_at(b, at, order);
-        let next = usize::from(u16_at(b, at + 2, order));
-        let size = match kind {
-            1000 => 8,
-            1001 => 8,
-            100 => 12,
-            _ => 4,
-        };
-        if at + size > b.len() {
-            return Err(format!(
-                "blockette {kind} at byte {at} runs past the end of the file"
-            ));
-        }
-        match kind {
-            1000 => b1000 = Some((b[at + 4], b[at + 5], b[at + 6])),
-            1001 => {
-                usec = b[at + 5] as i8;
-                has_b1001 = true;
-            }
-            100 => b100_rate = Some(f32::from_bits(u32_at(b, at + 4, order))),
-            _ => {}
-        }
-        end_of_blockettes = at + size;
-        if next != 0 && next <= at {
-            return Err(format!(
-                "blockette {kind} at byte {at} points back to byte {next}; allowed: the next \
-                 blockette further on, or 0 for the last"
-            ));
-        }
-        at = next;
-    }
+    let Blockettes {
+        b1000,
+        usec,
+        has_b1001,
+        b100_rate,
+        end: end_of_blockettes,
+    } = blockettes(b, first_blockette, order)?;
     let Some((encoding_code, word_order, len_exp)) = b1000 else {
         return Err(
             "no blockette 1000 (data only SEED blockette); allowed: miniSEED 2 \
@@ -354,6 +314,83 @@ pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
         encoding,
         samples,
         len,
+    })
+}
+
+/// What the blockette chain of a record says.
+struct Blockettes {
+    /// Blockette 1000: encoding, word order, record length exponent.
+    b1000: Option<(u8, u8, u8)>,
+    /// Blockette 1001: microseconds to add to the start time.
+    usec: i8,
+    has_b1001: bool,
+    /// Blockette 100: the actual sample rate.
+    b100_rate: Option<f32>,
+    /// Where the last blockette ends.
+    end: usize,
+}
+
+/// Walks the blockette chain from byte `first`: offsets strictly increasing (no cycle), each
+/// inside the bytes there are; blockette 1000 gives the record length, which bounds them again
+/// in [`decode`].
+fn blockettes(b: &[u8], first: usize, order: WordOrder) -> Result<Blockettes, String> {
+    let mut b1000: Option<(u8, u8, u8)> = None;
+    let mut usec: i8 = 0;
+    let mut has_b1001 = false;
+    let mut b100_rate: Option<f32> = None;
+    let mut end_of_blockettes = FIXED_HEADER;
+    let mut at = first;
+    let mut count = 0;
+    while at != 0 {
+        count += 1;
+        if count > MAX_BLOCKETTES {
+            return Err(format!(
+                "more than {MAX_BLOCKETTES} blockettes; the chain is damaged"
+            ));
+        }
+        if at < end_of_blockettes || at + 4 > b.len() {
+            return Err(format!(
+                "blockette at byte {at} of the record is outside the record or overlaps the \
+                 header or the previous blockette"
+            ));
+        }
+        let kind = u16_at(b, at, order);
+        let next = usize::from(u16_at(b, at + 2, order));
+        let size = match kind {
+            1000 => 8,
+            1001 => 8,
+            100 => 12,
+            _ => 4,
+        };
+        if at + size > b.len() {
+            return Err(format!(
+                "blockette {kind} at byte {at} runs past the end of the file"
+            ));
+        }
+        match kind {
+            1000 => b1000 = Some((b[at + 4], b[at + 5], b[at + 6])),
+            1001 => {
+                usec = b[at + 5] as i8;
+                has_b1001 = true;
+            }
+            100 => b100_rate = Some(f32::from_bits(u32_at(b, at + 4, order))),
+            _ => {}
+        }
+        end_of_blockettes = at + size;
+        if next != 0 && next <= at {
+            return Err(format!(
+                "blockette {kind} at byte {at} points back to byte {next}; allowed: the next \
+                 blockette further on, or 0 for the last"
+            ));
+        }
+        at = next;
+    }
+    Ok(Blockettes {
+        b1000,
+        usec,
+        has_b1001,
+        b100_rate,
+        end: end_of_blockettes,
     })
 }
 
