@@ -10,6 +10,7 @@ mod common;
 mod tolerances;
 
 mod budget_summary;
+mod cancel;
 mod coherence;
 mod energy_crosscheck;
 mod freq_grid;
