@@ -257,6 +257,7 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
             None => freq::default_grid(&model),
         },
         summary: summary_request(&args)?,
+        cancel: run.cancel.clone(),
     };
     let ropts = read_options(&args)?;
     let path = &args.tilt;

@@ -13,6 +13,7 @@ use clap::Args;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 use tiltnoise_core::error::{Num, OutputError, Shown};
 use tiltnoise_core::limits::ASDS;
 use tiltnoise_core::model::{Observable, TiltAxis};
@@ -24,7 +25,7 @@ use tiltnoise_core::subtract::{
     subtract, MeasuredRecord, StartTime, Status, SubtractConfig, SubtractResult, TiltRecord,
 };
 use tiltnoise_io::input::{
-    iso8601_to_unix, read_measured_input, read_tilt, unix_to_iso8601, MeasuredInput, ReadOptions,
+    parse_start_time, read_measured_input, read_tilt, utc_text, MeasuredInput, ReadOptions,
     TiltInput,
 };
 use tiltnoise_io::{write_atomic, write_subtract_hdf5, InputMeta, RunMeta, SubtractMeta};
@@ -202,8 +203,14 @@ fn start_of(path: &Path, what: &str, start: &Option<String>) -> Result<Option<St
     start
         .as_deref()
         .map(|s| {
-            iso8601_to_unix(s)
-                .map(|(unix_s, frac_s)| StartTime { unix_s, frac_s })
+            parse_start_time(s)
+                .map(|t| {
+                    let ns = t.as_nanosecond();
+                    StartTime {
+                        unix_s: ns.div_euclid(1_000_000_000) as i64,
+                        frac_s: ns.rem_euclid(1_000_000_000) as f64 * 1e-9,
+                    }
+                })
                 .ok_or_else(|| {
                     anyhow!(
                         "{what} {}: start time `{}` is not an ISO 8601 date-time",
@@ -331,11 +338,14 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
     )
     .with_context(context)?;
     check_finite(&result).with_context(context)?;
-    let overlap_start = measured_start.map(|s| {
-        let t = s.frac_s + result.alignment.measured_first as f64 / result.alignment.fs_hz;
-        let whole = t.floor();
-        unix_to_iso8601(s.unix_s + whole as i64, t - whole)
-    });
+    let skipped =
+        Duration::from_secs_f64(result.alignment.measured_first as f64 / result.alignment.fs_hz);
+    let overlap_start = measured
+        .start_time
+        .as_deref()
+        .and_then(parse_start_time)
+        .and_then(|t| t.checked_add(skipped).ok())
+        .map(utc_text);
     let input = InputMeta::from(&series.provenance);
     for note in &series.provenance.notes {
         match args.format {

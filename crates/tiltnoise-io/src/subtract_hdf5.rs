@@ -12,7 +12,7 @@ use super::{InputMeta, RunMeta, SPECTRAL_CONVENTION};
 use crate::atomic::write_atomic;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
-use tiltnoise_core::subtract::SubtractResult;
+use tiltnoise_core::subtract::{Estimate, FitReport, SubtractResult};
 
 /// Provenance of a subtraction run.
 #[derive(Debug, Clone, PartialEq)]
@@ -55,27 +55,42 @@ pub fn write_subtract_hdf5(
 
 fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Result<()> {
     let file = hdf5::File::create(path)?;
+    write_cleaned(&file, r, meta)?;
+    write_prediction(&file, r)?;
+    write_estimates(&file, &r.fit)?;
+    write_residuals(&file, r)?;
+    write_alignment(&file, r)?;
+    write_provenance(&file, r, meta)
+}
+
+/// The root: the cleaned series as a series reader reads them, and the run's attributes.
+fn write_cleaned(file: &hdf5::File, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Result<()> {
     let a = &r.alignment;
-    str_attr(&file, "schema", SCHEMA_OBSERVABLE_SERIES)?;
-    scalar_attr(&file, "schema_version", SCHEMA_VERSION_OBSERVABLE_SERIES)?;
-    scalar_attr(&file, "sample_rate_hz", a.fs_hz)?;
+    str_attr(file, "schema", SCHEMA_OBSERVABLE_SERIES)?;
+    scalar_attr(file, "schema_version", SCHEMA_VERSION_OBSERVABLE_SERIES)?;
+    scalar_attr(file, "sample_rate_hz", a.fs_hz)?;
     if let Some(t) = &meta.start_time {
-        str_attr(&file, "start_time", t)?;
+        str_attr(file, "start_time", t)?;
     }
     str_attr(
-        &file,
+        file,
         "description",
         "measured observables minus their tilt part predicted by tiltnoise subtract",
     )?;
-    str_attr(&file, "tool_version", &meta.run.tool_version)?;
-    str_attr(&file, "created_by", &meta.run.command_line)?;
-    str_attr(&file, "parameters_toml", &meta.run.params_toml)?;
-    str_attr(&file, "fitted_parameters_toml", &r.fit.params.to_toml())?;
-    str_attr(&file, "spectral_convention", SPECTRAL_CONVENTION)?;
+    str_attr(file, "tool_version", &meta.run.tool_version)?;
+    str_attr(file, "created_by", &meta.run.command_line)?;
+    str_attr(file, "parameters_toml", &meta.run.params_toml)?;
+    str_attr(file, "fitted_parameters_toml", &r.fit.params.to_toml())?;
+    str_attr(file, "spectral_convention", SPECTRAL_CONVENTION)?;
     for (o, series) in &r.cleaned {
-        let ds = dataset(&file, o.name(), series)?;
+        let ds = dataset(file, o.name(), series)?;
         str_attr(&ds, "unit", o.unit())?;
     }
+    Ok(())
+}
+
+/// `predicted_tilt`: the tilt part of each observable and the bands it is not predicted in.
+fn write_prediction(file: &hdf5::File, r: &SubtractResult) -> hdf5::Result<()> {
     let g = file.create_group("predicted_tilt")?;
     str_attr(
         &g,
@@ -101,52 +116,32 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
             .create("not_predicted_bands_hz")?;
     }
 
-    let f = &r.fit;
+    Ok(())
+}
+
+/// One number of an [`Estimate`].
+type EstimateField = fn(&Estimate) -> f64;
+
+/// `estimates`: the fitted parameters, their errors and correlations, the fit's statistics.
+fn write_estimates(file: &hdf5::File, f: &FitReport) -> hdf5::Result<()> {
     let g = file.create_group("estimates")?;
     let e = &f.estimates;
     strs_attr(&g, "estimator", [ESTIMATOR])?;
     strs_attr(&g, "name", e.iter().map(|x| x.name.as_str()))?;
     strs_attr(&g, "unit", e.iter().map(|x| x.unit.as_str()))?;
     strs_attr(&g, "status", e.iter().map(|x| x.status.name()))?;
-    let nums = |get: fn(&tiltnoise_core::subtract::Estimate) -> f64| -> Vec<f64> {
-        e.iter().map(|x| stored(get(x))).collect()
-    };
-    units_dataset(
-        &g,
-        "nominal",
-        &nums(|x| x.nominal),
-        e.iter().map(|x| x.unit.as_str()),
-    )?;
-    units_dataset(
-        &g,
-        "value",
-        &nums(|x| x.value),
-        e.iter().map(|x| x.unit.as_str()),
-    )?;
-    units_dataset(
-        &g,
-        "sigma",
-        &nums(|x| x.sigma),
-        e.iter().map(|x| x.unit.as_str()),
-    )?;
-    units_dataset(
-        &g,
-        "scale",
-        &nums(|x| x.scale),
-        e.iter().map(|x| x.unit.as_str()),
-    )?;
-    units_dataset(
-        &g,
-        "lower",
-        &nums(|x| x.bounds.0),
-        e.iter().map(|x| x.unit.as_str()),
-    )?;
-    units_dataset(
-        &g,
-        "upper",
-        &nums(|x| x.bounds.1),
-        e.iter().map(|x| x.unit.as_str()),
-    )?;
+    let columns: [(&str, EstimateField); 6] = [
+        ("nominal", |x| x.nominal),
+        ("value", |x| x.value),
+        ("sigma", |x| x.sigma),
+        ("scale", |x| x.scale),
+        ("lower", |x| x.bounds.0),
+        ("upper", |x| x.bounds.1),
+    ];
+    for (name, get) in columns {
+        let values: Vec<f64> = e.iter().map(|x| stored(get(x))).collect();
+        units_dataset(&g, name, &values, e.iter().map(|x| x.unit.as_str()))?;
+    }
     scalar_attr(&g, "chi2", f.chi2)?;
     scalar_attr(&g, "dof", f.dof as u64)?;
     scalar_attr(&g, "sigma_factor", f.sigma_factor)?;
@@ -173,6 +168,11 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
         .create("correlation")?;
     str_attr(&d, "unit", "1")?;
 
+    Ok(())
+}
+
+/// `residuals`: per observable the held-out spectra and their band summary.
+fn write_residuals(file: &hdf5::File, r: &SubtractResult) -> hdf5::Result<()> {
     let g = file.create_group("residuals")?;
     str_attr(&g, "spectral_convention", SPECTRAL_CONVENTION)?;
     str_attr(&g, "stretch", "held-out (the end of the overlap)")?;
@@ -220,6 +220,12 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
         }
     }
 
+    Ok(())
+}
+
+/// `alignment`: where the records overlap and how the overlap was split.
+fn write_alignment(file: &hdf5::File, r: &SubtractResult) -> hdf5::Result<()> {
+    let a = &r.alignment;
     let g = file.create_group("alignment")?;
     scalar_attr(&g, "tilt_first_sample", a.witness_first as u64)?;
     scalar_attr(&g, "measured_first_sample", a.measured_first as u64)?;
@@ -235,6 +241,15 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
     scalar_attr(&g, "holdout_samples", r.n_holdout as u64)?;
     scalar_attr(&g, "max_delay_s", r.max_delay_s)?;
 
+    Ok(())
+}
+
+/// `provenance`: the inputs and the run's notes.
+fn write_provenance(
+    file: &hdf5::File,
+    r: &SubtractResult,
+    meta: &SubtractMeta,
+) -> hdf5::Result<()> {
     let g = file.create_group("provenance")?;
     str_attr(&g, "tilt_path", &meta.tilt.path)?;
     str_attr(&g, "tilt_format", &meta.tilt.format)?;

@@ -16,6 +16,7 @@ pub use crate::noise::loglog_at;
 pub use measured::{add_measured, series_psds, MeasuredPsds};
 pub use summary::{SummaryRequest, DEFAULT_BAND_FRACTION, DEFAULT_SUMMARY_FREQS_HZ};
 
+use crate::cancel::{Cancel, Cancelled};
 use crate::error::TfError;
 use crate::input::rate::angle_csd_above_dc;
 use crate::input::{InputError, Quantity, SeriesSource, TiltSpectra};
@@ -39,6 +40,9 @@ pub const DEFAULT_WELCH_SEGMENT: usize = 1 << 14;
 /// Failures of a budget run.
 #[derive(Debug, thiserror::Error)]
 pub enum BudgetError {
+    /// Cancelled through [`BudgetOptions::cancel`].
+    #[error(transparent)]
+    Cancelled(#[from] Cancelled),
     /// Reading the tilt input failed.
     #[error(transparent)]
     Input(#[from] InputError),
@@ -85,6 +89,8 @@ pub struct BudgetOptions {
     pub spectra_grid_hz: Vec<f64>,
     /// Frequencies to read the budget at ([`crate::noise::SummaryAt`]).
     pub summary: SummaryRequest,
+    /// Polled before each chunk of a series ([`CHUNK_SAMPLES`]).
+    pub cancel: Cancel,
 }
 
 impl Default for BudgetOptions {
@@ -100,6 +106,7 @@ impl Default for BudgetOptions {
             user_terms: Vec::new(),
             spectra_grid_hz: Vec::new(),
             summary: SummaryRequest::default(),
+            cancel: Cancel::never(),
         }
     }
 }
@@ -142,20 +149,9 @@ pub const RATE_BUDGET_NOTE: &str = "tilt rate: the Welch cross-spectra of the ra
      (rad^2/s^2/Hz) divided by (2 pi f)^2 at every bin f > 0, exact up to Nyquist (no time \
      integration); the DC bin carries no angle information and is excluded";
 
-/// Budget from a time series of tilt angle or rate ([`SeriesSource::quantity`]; a rate's
-/// spectra become the angle's by [`crate::input::rate`], the DC bin is dropped for both).
-/// `progress(done, total)` is called with samples processed.
-pub fn budget_from_series(
-    model: &Model,
-    series: &mut dyn SeriesSource,
-    opts: &BudgetOptions,
-    progress: &mut dyn FnMut(u64, u64),
-) -> Result<BudgetReport, BudgetError> {
-    opts.summary.validate()?;
-    let fs = series.sample_rate_hz();
-    let n = series.len();
-    let axes = series.axes().to_vec();
-    let quantity = series.quantity();
+/// The Welch settings of a series of `n` samples: the options' segment (or the default for
+/// `n`) and overlap, checked against the record.
+fn welch_config(opts: &BudgetOptions, n: usize) -> Result<WelchConfig, BudgetError> {
     let seg_len = opts
         .welch_segment_len
         .unwrap_or_else(|| default_segment_len(n));
@@ -171,14 +167,18 @@ pub fn budget_from_series(
         .with_averaging(opts.averaging);
     cfg.validate()?;
     cfg.check_series_len(n)?;
-    // The Welch grid's band, known before the record is read: refuse given spectra that do not
-    // cover it now rather than after a long pass.
-    check_given_spectra(
-        opts,
-        fs / seg_len as f64,
-        (seg_len / 2) as f64 * fs / seg_len as f64,
-    )?;
-    let segment_samples = match opts.segment_duration_s {
+    Ok(cfg)
+}
+
+/// Samples per segment of the percentile band, if asked for: at least one Welch segment of
+/// `seg_len`, at most the record of `n` samples at `fs` Hz.
+fn segment_samples(
+    opts: &BudgetOptions,
+    fs: f64,
+    n: usize,
+    seg_len: usize,
+) -> Result<Option<usize>, BudgetError> {
+    Ok(match opts.segment_duration_s {
         None => None,
         Some(d) => {
             let s = (d * fs).round();
@@ -200,7 +200,33 @@ pub fn budget_from_series(
             }
             Some(s as usize)
         }
-    };
+    })
+}
+
+/// Budget from a time series of tilt angle or rate ([`SeriesSource::quantity`]; a rate's
+/// spectra become the angle's by [`crate::input::rate`], the DC bin is dropped for both).
+/// `progress(done, total)` is called with samples processed.
+pub fn budget_from_series(
+    model: &Model,
+    series: &mut dyn SeriesSource,
+    opts: &BudgetOptions,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<BudgetReport, BudgetError> {
+    opts.summary.validate()?;
+    let fs = series.sample_rate_hz();
+    let n = series.len();
+    let axes = series.axes().to_vec();
+    let quantity = series.quantity();
+    let cfg = welch_config(opts, n)?;
+    let seg_len = cfg.segment_len;
+    // The Welch grid's band, known before the record is read: refuse given spectra that do not
+    // cover it now rather than after a long pass.
+    check_given_spectra(
+        opts,
+        fs / seg_len as f64,
+        (seg_len / 2) as f64 * fs / seg_len as f64,
+    )?;
+    let segment_samples = segment_samples(opts, fs, n, seg_len)?;
     let n_ax = axes.len();
     check_kept_memory(&cfg, n, n_ax, segment_samples, opts.outputs.len())?;
     let mut whole = WelchAccumulator::new(n_ax, fs, &cfg)?;
@@ -212,6 +238,7 @@ pub fn budget_from_series(
     let mut start = 0;
     while start < n {
         let len = CHUNK_SAMPLES.min(n - start);
+        opts.cancel.check()?;
         let chunk = series.read_chunk(start, len)?;
         let views: Vec<&[f64]> = chunk.iter().map(Vec::as_slice).collect();
         whole.push(&views)?;

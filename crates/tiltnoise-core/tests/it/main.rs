@@ -11,6 +11,7 @@ mod tolerances;
 
 mod as_built;
 mod budget_summary;
+mod cancel;
 mod coherence;
 mod energy_crosscheck;
 mod freq_grid;

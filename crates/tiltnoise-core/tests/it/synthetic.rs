@@ -142,6 +142,7 @@ pub fn make(spec: &Spec) -> Record {
             keep_every: m,
             readout_asd: spec.readout.clone(),
             seed: spec.seed,
+            cancel: tiltnoise_core::cancel::Cancel::never(),
         },
     )
     .unwrap();

@@ -464,7 +464,7 @@ pub(crate) fn interpret(
     let quantity = decide_quantity(path, opts.quantity, &declared, &undeclared, &mut notes)?;
     super::check_scales(path, &opts.scale, &prelude.header[1..], "column")?;
     let factors = super::meta::series_factors(path, &mapped, &declared, &opts.scale, &mut notes)?;
-    let start_time = start_time(path, prelude)?;
+    let start_time = start_time(path, prelude, &mut notes)?;
     if let Some(d) = prelude.meta("description") {
         notes.push(format!("description: {}", Shown(&d.value)));
     }
@@ -477,21 +477,24 @@ pub(crate) fn interpret(
     })
 }
 
-/// The `# start_time:` value, validated.
-pub(crate) fn start_time(path: &Path, prelude: &Prelude) -> Result<Option<String>, InputError> {
-    let Some(m) = prelude.meta("start_time") else {
-        return Ok(None);
-    };
-    if !super::meta::is_iso8601(&m.value) {
-        return Err(InputError::BadAttribute {
-            path: path.to_path_buf(),
-            object: format!("line {}", m.line),
-            attribute: "# start_time:",
-            value: format!("`{}`", m.value),
-            allowed: super::meta::ISO8601_ALLOWED,
-        });
-    }
-    Ok(Some(m.value.clone()))
+/// The `# start_time:` value, validated; a note when it has no zone designator.
+pub(crate) fn start_time(
+    path: &Path,
+    prelude: &Prelude,
+    notes: &mut Vec<String>,
+) -> Result<Option<String>, InputError> {
+    prelude
+        .meta("start_time")
+        .map(|m| {
+            super::start_time::checked(
+                path,
+                format!("line {}", m.line),
+                "# start_time:",
+                m.value.clone(),
+                notes,
+            )
+        })
+        .transpose()
 }
 
 #[cfg(test)]

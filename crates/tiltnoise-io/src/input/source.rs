@@ -158,38 +158,7 @@ impl TiltSeriesSource {
                 }
                 Some(_) => {}
             }
-            let object = format!("dataset {name}");
-            let units = match h5::attr(path, &ds, &object, "units")? {
-                None => h5::attr(path, &ds, &object, "unit")?,
-                some => some,
-            };
-            match units {
-                None => undeclared.push(m.source.clone()),
-                Some(AttrValue::Str(u)) => match series_unit(&u) {
-                    Some(q) => declared.push(Declared {
-                        channel: m.source.clone(),
-                        unit: u,
-                        quantity: q.quantity,
-                        factor: q.factor,
-                    }),
-                    None => {
-                        return Err(InputError::Units {
-                            path: path.to_path_buf(),
-                            location: format!("attribute `units` of {object}"),
-                            value: u,
-                            allowed: SERIES_UNITS,
-                        })
-                    }
-                },
-                Some(other) => {
-                    return Err(InputError::Units {
-                        path: path.to_path_buf(),
-                        location: format!("attribute `units` of {object}"),
-                        value: other.describe(),
-                        allowed: SERIES_UNITS,
-                    })
-                }
-            }
+            declare_units(path, &ds, &name, &m.source, &mut declared, &mut undeclared)?;
             datasets.push(ds);
         }
         let quantity = decide_quantity(path, opts.quantity, &declared, &undeclared, &mut notes)?;
@@ -494,4 +463,49 @@ fn gwpy_rate(
         ))
     ));
     Ok(rate)
+}
+
+/// The `units` (or gwpy's `unit`) attribute of dataset `name`: a series unit goes to
+/// `declared`, no attribute puts `source` in `undeclared`.
+fn declare_units(
+    path: &Path,
+    ds: &hdf5::Dataset,
+    name: &str,
+    source: &str,
+    declared: &mut Vec<Declared>,
+    undeclared: &mut Vec<String>,
+) -> Result<(), InputError> {
+    let object = format!("dataset {name}");
+    let units = match h5::attr(path, ds, &object, "units")? {
+        None => h5::attr(path, ds, &object, "unit")?,
+        some => some,
+    };
+    match units {
+        None => undeclared.push(source.to_string()),
+        Some(AttrValue::Str(u)) => match series_unit(&u) {
+            Some(q) => declared.push(Declared {
+                channel: source.to_string(),
+                unit: u,
+                quantity: q.quantity,
+                factor: q.factor,
+            }),
+            None => {
+                return Err(InputError::Units {
+                    path: path.to_path_buf(),
+                    location: format!("attribute `units` of {object}"),
+                    value: u,
+                    allowed: SERIES_UNITS,
+                })
+            }
+        },
+        Some(other) => {
+            return Err(InputError::Units {
+                path: path.to_path_buf(),
+                location: format!("attribute `units` of {object}"),
+                value: other.describe(),
+                allowed: SERIES_UNITS,
+            })
+        }
+    }
+    Ok(())
 }

@@ -17,7 +17,7 @@ mod steim;
 use super::meta::{decide_quantity, Declared};
 use super::{check_sample_rate, Provenance, Quantity, ReadOptions};
 use super::{check_scales, gap_note, process_channel, require_two, scale_for, scale_note};
-use super::{resolve, ChannelCtx, InputError, MapOrigin, TiltSeries};
+use super::{resolve, ChannelCtx, InputError, MapOrigin, Mapped, Resolved, TiltSeries};
 use super::{AxisMap, AxisMapEntry, ChannelScale, GapPolicy, InputFormat, InputKind};
 use channels::{Channel, Placed};
 use std::io::Read;
@@ -204,8 +204,43 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
     )];
     notes.extend(resolved.notes.iter().cloned());
 
-    // Merge the mapped channels only: a file of many channels costs the memory of three.
-    let mut groups: Vec<Option<Vec<Placed>>> = groups.into_iter().map(|(_, v)| Some(v)).collect();
+    let groups: Vec<Option<Vec<Placed>>> = groups.into_iter().map(|(_, v)| Some(v)).collect();
+    let chans = merge_mapped(path, groups, &resolved)?;
+    let span = common_span(path, &chans, &mut notes)?;
+    let quantity = quantity_from_codes(path, &chans, opts.quantity, &mut notes)?;
+    let mut data = Vec::new();
+    for ((m, ch), &k) in resolved.channels.iter().zip(&chans).zip(&span.starts) {
+        let part = ChannelPart {
+            start: k,
+            len: span.len,
+        };
+        data.push(channel_samples(
+            path, m, ch, part, &scales, opts, quantity, &mut notes,
+        )?);
+    }
+    Ok(TiltSeries {
+        sample_rate_hz: span.rate,
+        axes: resolved.channels.iter().map(|m| m.axis).collect(),
+        data,
+        provenance: Provenance {
+            path: path.to_path_buf(),
+            format: InputFormat::Miniseed,
+            kind: InputKind::Series,
+            quantity,
+            axis_map: resolved.map.to_string(),
+            start_time: Some(chans[0].time(span.starts[0])),
+            notes,
+        },
+    })
+}
+
+/// Merges the records of the mapped channels only (a file of many channels costs the memory of
+/// three), each checked for its sample rate and the memory its samples take.
+fn merge_mapped(
+    path: &Path,
+    mut groups: Vec<Option<Vec<Placed>>>,
+    resolved: &Resolved,
+) -> Result<Vec<Channel>, InputError> {
     let mut chans: Vec<Channel> = Vec::new();
     for m in &resolved.channels {
         let recs = groups[m.index].take().unwrap_or_default();
@@ -222,8 +257,26 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
         )?;
         chans.push(ch);
     }
+    Ok(chans)
+}
 
-    // One rate, one grid, the common span.
+/// The stretch every mapped channel covers, on one time grid.
+struct Span {
+    /// The common sample rate (Hz).
+    rate: f64,
+    /// Per channel, its first sample in the span.
+    starts: Vec<usize>,
+    /// Samples in the span.
+    len: usize,
+}
+
+/// One rate, one grid, the common span of `chans` (at least two samples), with a note when
+/// it trims a channel.
+fn common_span(
+    path: &Path,
+    chans: &[Channel],
+    notes: &mut Vec<String>,
+) -> Result<Span, InputError> {
     let first = &chans[0];
     let rate = first.sample_rate_hz;
     for ch in &chans[1..] {
@@ -240,15 +293,15 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
         }
     }
     let start_ns = chans.iter().map(|c| c.start_ns).max().unwrap_or(0);
-    let mut spans = Vec::new();
-    for ch in &chans {
+    let tolerance = chans
+        .iter()
+        .map(|c| c.time_resolution_ns)
+        .max()
+        .unwrap_or(0) as f64;
+    let mut starts = Vec::new();
+    for ch in chans {
         let offset = (start_ns - ch.start_ns) as f64 / ch.period_ns();
         let k = offset.round();
-        let tolerance = chans
-            .iter()
-            .map(|c| c.time_resolution_ns)
-            .max()
-            .unwrap_or(0) as f64;
         if (offset - k).abs() * ch.period_ns() > tolerance {
             return Err(fault(
                 path,
@@ -263,11 +316,11 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
                 ),
             ));
         }
-        spans.push(k as usize);
+        starts.push(k as usize);
     }
     let len = chans
         .iter()
-        .zip(&spans)
+        .zip(&starts)
         .map(|(c, &k)| c.data.len().saturating_sub(k))
         .min()
         .unwrap_or(0);
@@ -279,7 +332,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
     )?;
     let trimmed = chans
         .iter()
-        .zip(&spans)
+        .zip(&starts)
         .any(|(c, &k)| k > 0 || c.data.len() != k + len);
     if trimmed {
         let ranges: Vec<String> = chans
@@ -290,15 +343,24 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
             "channels cover different spans ({}); read over their common span {} to {} \
              ({len} samples)",
             ranges.join(", "),
-            chans[0].time(spans[0]),
-            chans[0].time(spans[0] + len - 1)
+            chans[0].time(starts[0]),
+            chans[0].time(starts[0] + len - 1)
         ));
     }
     notes.push(format!("sample rate {rate} Hz from the records"));
+    Ok(Span { rate, starts, len })
+}
 
-    // Quantity: the options, else the instrument codes.
+/// The quantity: the options', else the one the instrument codes say (miniSEED stores no
+/// units), with a note per channel.
+fn quantity_from_codes(
+    path: &Path,
+    chans: &[Channel],
+    given: Option<Quantity>,
+    notes: &mut Vec<String>,
+) -> Result<Quantity, InputError> {
     let mut declared = Vec::new();
-    for ch in &chans {
+    for ch in chans {
         match code_quantity(&ch.id) {
             Some((q, why)) => {
                 notes.push(format!(
@@ -312,7 +374,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
                     factor: 1.0,
                 })
             }
-            None if opts.quantity.is_none() => {
+            None if given.is_none() => {
                 return Err(fault(
                     path,
                     None,
@@ -327,97 +389,102 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
             None => {}
         }
     }
-    let quantity = decide_quantity(path, opts.quantity, &declared, &[], &mut notes)?;
-    let unit = quantity.unit();
+    decide_quantity(path, given, &declared, &[], notes)
+}
 
-    let mut data = Vec::new();
-    for ((m, ch), &k) in resolved.channels.iter().zip(&chans).zip(&spans) {
-        let factor = match (scale_for(&scales, &ch.id), ch.counts) {
-            (Some(f), _) => {
-                notes.push(scale_note(&ch.id, f, "given explicitly"));
-                f
-            }
-            (None, true) => {
-                return Err(InputError::Scale {
-                    path: path.to_path_buf(),
-                    channel: ch.id.clone(),
-                    message: format!(
-                        "holds digitizer counts ({}); allowed: give a scale CHANNEL=FACTOR \
-                         with the {unit} per count of the instrument's response",
-                        ch.encodings.join(", ")
-                    ),
-                })
-            }
-            (None, false) => {
-                notes.push(format!(
-                    "channel {}: {} samples taken to be in {unit} already (miniSEED stores no \
-                     units); give a scale if they are not",
-                    ch.id,
-                    ch.encodings.join(", ")
-                ));
-                1.0
-            }
-        };
-        if opts.gaps == GapPolicy::Reject {
-            if let Some(&(a, b)) = ch.gaps.iter().find(|&&(a, b)| b > k && a < k + len) {
-                return Err(fault(
-                    path,
-                    None,
-                    format!(
-                        "channel {}: no records for {} samples from {} to {} (sample indices \
-                         {}..={} of the series); allowed: no gaps, or gap interpolation to \
-                         bridge interior gaps linearly",
-                        ch.id,
-                        b - a,
-                        ch.time(a),
-                        ch.time(b - 1),
-                        a.max(k) - k,
-                        b.min(k + len) - 1 - k
-                    ),
-                ));
-            }
+/// Samples `start .. start + len` of a channel.
+#[derive(Clone, Copy)]
+struct ChannelPart {
+    start: usize,
+    len: usize,
+}
+
+/// The samples of channel `ch` (mapped by `m`) in `part`, scaled into the quantity's unit,
+/// signed by the map and with gaps handled by the gap policy; notes for each assumption.
+#[allow(clippy::too_many_arguments)]
+fn channel_samples(
+    path: &Path,
+    m: &Mapped,
+    ch: &Channel,
+    part: ChannelPart,
+    scales: &[ChannelScale],
+    opts: &ReadOptions,
+    quantity: Quantity,
+    notes: &mut Vec<String>,
+) -> Result<Vec<f64>, InputError> {
+    let (k, len) = (part.start, part.len);
+    let unit = quantity.unit();
+    let factor = match (scale_for(scales, &ch.id), ch.counts) {
+        (Some(f), _) => {
+            notes.push(scale_note(&ch.id, f, "given explicitly"));
+            f
         }
-        if !ch.gaps.is_empty() || ch.overlapping > 0 {
+        (None, true) => {
+            return Err(InputError::Scale {
+                path: path.to_path_buf(),
+                channel: ch.id.clone(),
+                message: format!(
+                    "holds digitizer counts ({}); allowed: give a scale CHANNEL=FACTOR \
+                     with the {unit} per count of the instrument's response",
+                    ch.encodings.join(", ")
+                ),
+            })
+        }
+        (None, false) => {
             notes.push(format!(
-                "channel {}: {} records, {} gaps ({} samples, filled with NaN before the gap \
-                 policy), {} samples in identical overlaps kept once",
+                "channel {}: {} samples taken to be in {unit} already (miniSEED stores no \
+                 units); give a scale if they are not",
                 ch.id,
-                ch.records,
-                ch.gaps.len(),
-                ch.gaps.iter().map(|(a, b)| b - a).sum::<usize>(),
-                ch.overlapping
+                ch.encodings.join(", ")
+            ));
+            1.0
+        }
+    };
+    if opts.gaps == GapPolicy::Reject {
+        if let Some(&(a, b)) = ch.gaps.iter().find(|&&(a, b)| b > k && a < k + len) {
+            return Err(fault(
+                path,
+                None,
+                format!(
+                    "channel {}: no records for {} samples from {} to {} (sample indices \
+                     {}..={} of the series); allowed: no gaps, or gap interpolation to \
+                     bridge interior gaps linearly",
+                    ch.id,
+                    b - a,
+                    ch.time(a),
+                    ch.time(b - 1),
+                    a.max(k) - k,
+                    b.min(k + len) - 1 - k
+                ),
             ));
         }
-        let s = m.sign.factor();
-        let mut v: Vec<f64> = ch.data[k..k + len]
-            .iter()
-            .map(|x| s * (factor * x))
-            .collect();
-        let ctx = ChannelCtx {
-            path,
-            channel: &m.source,
-            unit,
-        };
-        let bridged = process_channel(&mut v, opts.gaps, &ctx)?;
-        if bridged > 0 {
-            notes.push(gap_note(&m.source, bridged));
-        }
-        data.push(v);
     }
-    Ok(TiltSeries {
-        sample_rate_hz: rate,
-        axes: resolved.channels.iter().map(|m| m.axis).collect(),
-        data,
-        provenance: Provenance {
-            path: path.to_path_buf(),
-            format: InputFormat::Miniseed,
-            kind: InputKind::Series,
-            quantity,
-            axis_map: resolved.map.to_string(),
-            start_time: Some(chans[0].time(spans[0])),
-            notes,
-        },
-    })
+    if !ch.gaps.is_empty() || ch.overlapping > 0 {
+        notes.push(format!(
+            "channel {}: {} records, {} gaps ({} samples, filled with NaN before the gap \
+             policy), {} samples in identical overlaps kept once",
+            ch.id,
+            ch.records,
+            ch.gaps.len(),
+            ch.gaps.iter().map(|(a, b)| b - a).sum::<usize>(),
+            ch.overlapping
+        ));
+    }
+    let s = m.sign.factor();
+    let mut v: Vec<f64> = ch.data[k..k + len]
+        .iter()
+        .map(|x| s * (factor * x))
+        .collect();
+    let ctx = ChannelCtx {
+        path,
+        channel: &m.source,
+        unit,
+    };
+    let bridged = process_channel(&mut v, opts.gaps, &ctx)?;
+    if bridged > 0 {
+        notes.push(gap_note(&m.source, bridged));
+    }
+    Ok(v)
 }
 
 #[cfg(test)]
