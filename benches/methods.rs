@@ -239,7 +239,6 @@ fn as_built(c: &mut Criterion) {
     g.finish();
 }
 
-
 /// The pole-zero method's cost per point with the six ground inputs against the three tilt
 /// inputs (module docs).
 fn polezero_ground(c: &mut Criterion) {

@@ -29,4 +29,5 @@ mod subtract;
 mod synthetic;
 mod tilt_tf;
 mod translation_tf;
+mod visibility_fit;
 mod welch_scipy;

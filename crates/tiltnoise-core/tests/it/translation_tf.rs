@@ -17,9 +17,9 @@
 //!
 //! Run with `--nocapture` to see the equivalence figures.
 
+use crate::tolerances::U;
 use crate::tolerances::{DD_REF_FACTOR, EPS};
 use num_complex::Complex64;
-use crate::tolerances::U;
 use tiltnoise_core::geometry::dd_matrices;
 use tiltnoise_core::model::{ForceInput, Model, Observable, TiltAxis, TranslationAxis};
 use tiltnoise_core::modes::NormalModes;
@@ -381,7 +381,10 @@ fn planner_and_torsion2_on_translations() {
 fn translation_columns_as_built_are_the_reference_rounded() {
     for (name, params) in as_built_set() {
         let model = Model::new(&params).unwrap();
-        assert!(!model.decoupled(), "{name}: an offset along x couples the blocks");
+        assert!(
+            !model.decoupled(),
+            "{name}: an offset along x couples the blocks"
+        );
         let (reference, _) = dd_matrices(&params);
         let g2 = &model.translation_forcing().g2;
         let mut nonzero = 0;
@@ -400,7 +403,12 @@ fn translation_columns_as_built_are_the_reference_rounded() {
         // Coupled: x_t now drives the swing-y+bounce block too (theta_a, delta_a, ...), so
         // more entries than the symmetric pendulum's 12 are nonzero.
         let symmetric = Model::new(&Params::table_i()).unwrap();
-        let sym_nonzero = symmetric.translation_forcing().g2.iter().filter(|v| **v != 0.0).count();
+        let sym_nonzero = symmetric
+            .translation_forcing()
+            .g2
+            .iter()
+            .filter(|v| **v != 0.0)
+            .count();
         assert!(
             nonzero > sym_nonzero,
             "{name}: {nonzero} nonzero translation entries, the symmetric pendulum has {sym_nonzero}"
