@@ -18,7 +18,7 @@ use tiltnoise_io::{read_measured_modes, read_visibilities, write_atomic, write_f
 #[derive(Debug, Args)]
 pub(crate) struct FitArgs {
     /// Measured frequencies: CSV `mode,frequency_hz[,sigma_hz]` (any subset of modes 1..8; see
-    /// docs/fit.md). Default: the measured column of Table II.
+    /// docs/fit.md). Default: the measured column of Table II, or none with --visibility.
     #[arg(long, value_name = "FILE")]
     measured: Option<PathBuf>,
     /// Measured mode visibilities, fitted together with the frequencies: CSV
@@ -73,9 +73,15 @@ pub(crate) fn run_fit(params: &Params, args: FitArgs, run: &mut Run) -> Result<(
         )
         .collect();
     run.check_outputs(&saves, &inputs)?;
-    let measured = match &args.measured {
-        Some(path) => read_measured_modes(path)?,
-        None => Measured::table_ii(),
+    // Visibilities without a frequency file are fitted alone: Table II's frequencies belong to
+    // the paper's pendulum, not to the one whose record gave the visibilities.
+    let measured = match (&args.measured, &args.visibility) {
+        (Some(path), _) => read_measured_modes(path)?,
+        (None, None) => Measured::table_ii(),
+        (None, Some(_)) => Measured {
+            modes: Vec::new(),
+            origin: "no frequency file".into(),
+        },
     };
     let visibilities = match &args.visibility {
         Some(path) => read_visibilities(path)?,

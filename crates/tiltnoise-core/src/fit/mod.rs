@@ -289,15 +289,17 @@ pub enum FitError {
     NoFree,
     /// More free parameters than measurements.
     #[error(
-        "fit: {free} free parameters but only {measured} measurements (mode frequencies and \
-         visibilities); at most as many free parameters as measurements are allowed (drop some \
+        "fit: {free} free parameters but only {modes} measured modes and {visibilities} \
+         visibilities; at most as many free parameters as measurements are allowed (drop some \
          from --free or measure more)"
     )]
     TooManyFree {
         /// Number of free parameters.
         free: usize,
-        /// Number of measurements.
-        measured: usize,
+        /// Number of measured mode frequencies.
+        modes: usize,
+        /// Number of measured visibilities.
+        visibilities: usize,
     },
     /// A free key that is not a parameter.
     #[error(
@@ -409,7 +411,7 @@ pub fn fit_with_visibilities(
     config: &FitConfig,
 ) -> Result<FitResult, FitError> {
     let vis = &visibilities.items;
-    let free = check_config(params, measured.modes.len() + vis.len(), config)?;
+    let free = check_config(params, (measured.modes.len(), vis.len()), config)?;
     let n = config.bound_sigmas;
     let keys: Vec<String> = free.iter().map(|f| f.key.clone()).collect();
     let m = measured.modes.len();
@@ -663,7 +665,7 @@ fn diag_of_inverse(jac: &DMatrix<f64>) -> Vec<f64> {
 /// Checks the configuration against the parameters and the measurements.
 fn check_config(
     params: &Params,
-    measurements: usize,
+    (modes, visibilities): (usize, usize),
     config: &FitConfig,
 ) -> Result<Vec<Free>, FitError> {
     let n = config.bound_sigmas;
@@ -735,10 +737,11 @@ fn check_config(
             sigma,
         });
     }
-    if out.len() > measurements {
+    if out.len() > modes + visibilities {
         return Err(FitError::TooManyFree {
             free: out.len(),
-            measured: measurements,
+            modes,
+            visibilities,
         });
     }
     Ok(out)
