@@ -318,9 +318,12 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
     );
     let _ = writeln!(
         s,
-        "chi^2: nominal {:.4e} -> fitted {:.4e}, dof {}; {} iterations, stop: {} (projected \
+        "chi^2: nominal {} -> fitted {:.4e}, dof {}; {} iterations, stop: {} (projected \
          gradient {:.1e})",
-        r.chi2_nominal,
+        match r.chi2_nominal.is_finite() {
+            true => format!("{:.4e}", r.chi2_nominal),
+            false => "undefined (a visibility's reference does not see its mode there)".into(),
+        },
         r.chi2,
         r.dof,
         r.iterations,
@@ -351,11 +354,13 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
         );
     }
     let _ = writeln!(s);
-    let _ = writeln!(
-        s,
-        "{:<5} {:>13} {:>11} {:>13} {:>13} {:>12} {:>10}",
-        "mode", "measured Hz", "sigma Hz", "nominal Hz", "fitted Hz", "resid Hz", "resid/sig"
-    );
+    if !r.modes.is_empty() {
+        let _ = writeln!(
+            s,
+            "{:<5} {:>13} {:>11} {:>13} {:>13} {:>12} {:>10}",
+            "mode", "measured Hz", "sigma Hz", "nominal Hz", "fitted Hz", "resid Hz", "resid/sig"
+        );
+    }
     for m in &r.modes {
         let _ = writeln!(
             s,

@@ -232,7 +232,8 @@ pub struct FitResult {
     pub start: Vec<f64>,
     /// The full fitted parameter set.
     pub fitted_params: Params,
-    /// Data chi^2 at the nominal parameters.
+    /// Data chi^2 at the nominal parameters; NaN when a visibility's reference observable does
+    /// not see its mode there (the symmetric pendulum's nu_2 in Y, say).
     pub chi2_nominal: f64,
     /// Data chi^2 at the solution.
     pub chi2: f64,
