@@ -189,7 +189,7 @@ pub fn measure(
             .iter()
             .map(|p| noise_power(p, padded_df, f_k, &aliased, resolution, fs_hz))
             .collect();
-        if noise.iter().any(|&v| !(v > 0.0)) {
+        if noise.iter().any(|&v| v.is_nan() || v <= 0.0) {
             skipped.push((
                 k + 1,
                 "no noise-only bins within an octave of it to estimate the noise from".into(),
