@@ -366,6 +366,27 @@ fn romy_record_as_witness() {
     assert!((ratio - 1.0).abs() < 3.0 * sigma);
 }
 
+/// Writes the noisy-witness case ([`Spec::noisy_witness`]: a tiltmeter whose white noise is
+/// 30 % of the tilt at 10 mHz, the pendulum with h = 1.7 m) as `tilt.h5` and `measured.h5`
+/// into the directory `TILTNOISE_CASE_DIR`, for running any build of the command on it
+/// (`scripts/subtract/band_ratios.py` then judges a cleaned record against the raw one):
+///
+/// ```sh
+/// TILTNOISE_CASE_DIR=/tmp/case cargo test --release --test it write_noisy_witness_case -- --ignored
+/// ```
+#[test]
+#[ignore = "writes files for a manual comparison; needs TILTNOISE_CASE_DIR"]
+fn write_noisy_witness_case() {
+    let dir = std::env::var("TILTNOISE_CASE_DIR").expect("TILTNOISE_CASE_DIR");
+    let dir = Path::new(&dir);
+    std::fs::create_dir_all(dir).unwrap();
+    let spec = Spec::noisy_witness();
+    let rec = make(&spec);
+    let start = Some("2024-03-01T00:00:00Z");
+    write_tilt(&dir.join("tilt.h5"), &rec, spec.fs_hz, 0..spec.n, start);
+    write_measured(&dir.join("measured.h5"), &rec, spec.fs_hz, 0..spec.n, start);
+}
+
 /// Bad input: one line naming the file, channel or key, exit code 2, nothing written.
 #[test]
 fn bad_input_is_refused_without_output() {
