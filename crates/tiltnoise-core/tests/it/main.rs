@@ -24,6 +24,7 @@ mod scenes;
 mod simulate;
 mod stability;
 mod subtract;
+mod subtract_pulls;
 mod synthetic;
 mod tilt_tf;
 mod welch_scipy;

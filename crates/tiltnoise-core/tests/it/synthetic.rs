@@ -40,6 +40,9 @@ pub struct Spec {
     pub readout: Vec<(Observable, f64)>,
     /// White noise of the tilt record per axis (rad/sqrt(Hz)).
     pub witness_noise: [f64; 2],
+    /// Co-located instruments beside the witness: the same tilt with their own white noise
+    /// per axis (rad/sqrt(Hz)), independent of the witness's.
+    pub colocated_noise: Vec<[f64; 2]>,
     /// Seed of every random stream.
     pub seed: u64,
 }
@@ -64,6 +67,7 @@ impl Spec {
                 (Observable::Phi, 1e-9),
             ],
             witness_noise: [0.0, 0.0],
+            colocated_noise: Vec::new(),
             seed: 7,
         }
     }
@@ -88,10 +92,12 @@ impl Spec {
     }
 }
 
-/// The record: the tilt record (theta_t, eta_t) and the measured observables.
+/// The record: the tilt record (theta_t, eta_t), the co-located records and the measured
+/// observables.
 pub struct Record {
     pub axes: Vec<TiltAxis>,
     pub tilt: Vec<Vec<f64>>,
+    pub colocated: Vec<Vec<Vec<f64>>>,
     pub measured: Vec<(Observable, Vec<f64>)>,
 }
 
@@ -164,21 +170,32 @@ pub fn make(spec: &Spec) -> Record {
         .iter()
         .map(|(o, _)| (*o, sim.observable(*o)[..spec.n].to_vec()))
         .collect();
-    let tilt = fine
+    // An instrument's record: the tilt sampled every `m` fine steps plus white noise of
+    // one-sided ASD `noise[a]` from random stream `stream + a`.
+    let record = |noise: [f64; 2], stream: u64| -> Vec<Vec<f64>> {
+        fine.iter()
+            .zip(noise)
+            .enumerate()
+            .map(|(a, (x, noise))| {
+                let mut rng = Rng::stream(spec.seed, stream + a as u64);
+                let sigma = noise * (spec.fs_hz / 2.0).sqrt();
+                (0..spec.n)
+                    .map(|i| x[i * m] + sigma * rng.gaussian())
+                    .collect()
+            })
+            .collect()
+    };
+    let tilt = record(spec.witness_noise, 20);
+    let colocated = spec
+        .colocated_noise
         .iter()
-        .zip(spec.witness_noise)
         .enumerate()
-        .map(|(a, (x, noise))| {
-            let mut rng = Rng::stream(spec.seed, 20 + a as u64);
-            let sigma = noise * (spec.fs_hz / 2.0).sqrt();
-            (0..spec.n)
-                .map(|i| x[i * m] + sigma * rng.gaussian())
-                .collect()
-        })
+        .map(|(c, &noise)| record(noise, 30 + 2 * c as u64))
         .collect();
     Record {
         axes,
         tilt,
+        colocated,
         measured,
     }
 }
