@@ -840,7 +840,10 @@ fn report_table(r: &SubtractResult) -> String {
     );
     for e in &f.estimates {
         let status = match e.status {
-            Status::Fitted => "fitted".to_string(),
+            Status::Fitted => match e.prior_sigma {
+                Some(p) => format!("fitted, with its prior +/- {}", Num(p)),
+                None => "fitted".to_string(),
+            },
             Status::AtBound => format!("on the box [{}, {}]", Num(e.bounds.0), Num(e.bounds.1)),
             Status::NotConstrained if e.prior_sigma.is_some() => format!(
                 "not constrained by the data alone: estimated with its prior {} +/- {}",

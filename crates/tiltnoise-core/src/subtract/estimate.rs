@@ -471,6 +471,8 @@ pub fn fit(
     let data_rows = problem.data_rows();
     let (sig_u, correlation) = covariance(&at_solution, data_rows, sigma_factor);
     let (sig_all, _) = covariance(&problem.evaluate(&theta, &all)?, data_rows, sigma_factor);
+    // What the data alone say of a key with a prior: whether it is constrained.
+    let (sig_data, _) = covariance(&at_solution.data_only(data_rows), data_rows, sigma_factor);
     let params_fit = problem.params_at(&theta)?;
     let estimates = problem
         .params
@@ -479,7 +481,11 @@ pub fn fit(
         .map(|(j, p)| {
             let (lo, hi) = (p.nominal - p.half_width, p.nominal + p.half_width);
             let (status, sigma_int) = match free.iter().position(|&f| f == j) {
-                Some(jj) if matches!(p.kind, Kind::Key(_)) && p.prior.is_some() => {
+                Some(jj)
+                    if matches!(p.kind, Kind::Key(_))
+                        && p.prior.is_some()
+                        && sig_data[jj] * p.half_width >= p.scale =>
+                {
                     (Status::NotConstrained, sig_u[jj] * p.half_width)
                 }
                 Some(jj) => {
@@ -604,8 +610,8 @@ fn coherent_top(
 
 /// The members of `candidates` the fit estimates: those whose Fisher uncertainty at `theta`
 /// (all candidates free together) is below their scale, and the keys that are not, which get a
-/// Gaussian prior of their scale at their nominal value; gains and the delay that are not are
-/// left out (held). Noise scales always stay (their prior constrains them).
+/// Gaussian prior of their scale at their nominal value (if they had none); gains and the
+/// delay that are not are left out (held). Parameters with a prior always stay.
 fn constrained(
     problem: &mut Problem,
     theta: &[f64],

@@ -58,7 +58,8 @@ pub(crate) struct Param {
     /// Scale in internal units.
     pub scale: f64,
     /// Standard deviation of a Gaussian prior at `nominal` (internal units), if any: a noise
-    /// scale's stated uncertainty, or the scale of a key the data do not constrain.
+    /// scale's stated uncertainty, a key's error bar from the parameter file, or the scale of
+    /// a key the data do not constrain.
     pub prior: Option<f64>,
 }
 
@@ -162,7 +163,10 @@ pub(crate) fn key_params(base: &Params, keys: &[String]) -> Result<Vec<Param>, S
             nominal: p0,
             half_width,
             scale,
-            prior: None,
+            // An error bar of the parameter file is what is known of the key before the data:
+            // its prior. A key the file calls exact has none (unless the data cannot
+            // constrain it, see `estimate`).
+            prior: (rel > 0.0).then_some(scale),
         });
     }
     Ok(out)

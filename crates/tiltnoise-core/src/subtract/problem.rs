@@ -173,6 +173,17 @@ pub(crate) fn regular(m: &DMatrix<Complex64>) -> bool {
     hi.is_finite() && hi > 0.0 && lo > hi * crate::fit::RANK_TOL
 }
 
+impl Evaluation {
+    /// The data rows alone (the first `data_rows`): what the data say without the priors.
+    pub fn data_only(&self, data_rows: usize) -> Evaluation {
+        Evaluation {
+            r: self.r.rows(0, data_rows).into_owned(),
+            jac: self.jac.rows(0, data_rows).into_owned(),
+            inst: self.inst.rows(0, data_rows).into_owned(),
+        }
+    }
+}
+
 impl Problem<'_> {
     /// The gains (witness order) and the delay behind the aligned samples,
     /// `tau - fraction_s` (s), at internal values `theta`.

@@ -257,3 +257,73 @@ pub fn evaluate(
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::Rng;
+    use crate::spectral::confidence::equivalent_averages;
+    use crate::spectral::{csd_matrix, WelchConfig};
+
+    /// Two white inputs and an output `y = 0.8 x1 + 0.3 x2 + n` (`1 - gamma^2 = S_nn / S_yy`
+    /// known), Welch over 15 half-overlapping Hann segments, 400 realisations of 128 bins:
+    ///
+    /// * the coherence limit, corrected with the effective number of averages of the
+    ///   overlapped segments (`n_eff = 14.2` for `K = 15`), is unbiased for `S_nn` to its
+    ///   Monte Carlo error (3 standard errors, about 0.4 %); corrected with `K` it would be
+    ///   0.9 % low;
+    /// * a Wiener filter trained on one realisation leaves on the next, in expectation,
+    ///   `1 + A / (n_eff - A)` times `S_nn` (its training-noise excess, 16 % here).
+    #[test]
+    fn coherence_limit_and_wiener_excess_use_the_effective_averages() {
+        let (seg, k) = (256usize, 15usize);
+        let n = seg / 2 * (k + 1);
+        let cfg = WelchConfig::new(seg);
+        let n_eff = equivalent_averages(&cfg, k);
+        let s_nn = 2.0 * 0.5f64.powi(2);
+        let mut rng = Rng::stream(5, 0);
+        let mut draw = || -> Vec<Vec<f64>> {
+            let mut x1 = vec![0.0; n];
+            let mut x2 = vec![0.0; n];
+            let mut y = vec![0.0; n];
+            for i in 0..n {
+                x1[i] = rng.gaussian();
+                x2[i] = rng.gaussian();
+                y[i] = 0.8 * x1[i] + 0.3 * x2[i] + 0.5 * rng.gaussian();
+            }
+            vec![x1, x2, y]
+        };
+        let spectra = |d: &[Vec<f64>]| {
+            let chans: Vec<&[f64]> = d.iter().map(Vec::as_slice).collect();
+            csd_matrix(&chans, 1.0, &cfg).unwrap()
+        };
+        let (mut limit, mut wiener, mut count) = (0.0, 0.0, 0.0);
+        let mut previous = spectra(&draw());
+        for _ in 0..400 {
+            let now = spectra(&draw());
+            assert_eq!(now.n_segments, k);
+            let l = coherence_limit(&now, 2, 2, n_eff);
+            let w = Wiener::train(&previous, 2, 1, n_eff);
+            for b in 1..now.n_freqs() - 1 {
+                limit += l[b] / s_nn;
+                let (sww, s, syy) = blocks(&now, b, 2, 2);
+                let f = w.filters[0][b].as_ref().unwrap();
+                wiener += residual_psd(syy, &s, &sww, f) / s_nn;
+                count += 1.0;
+            }
+            previous = now;
+        }
+        let (limit, wiener) = (limit / count, wiener / count);
+        eprintln!("coherence limit / S_nn = {limit:.5}, Wiener residual / S_nn = {wiener:.4}");
+        // Per bin the ratio scatters by about 1/sqrt(n_eff); neighbouring bins are correlated
+        // (variance factor 1.944 for Hann).
+        let se = (1.944 / (n_eff * count)).sqrt();
+        let excess = 2.0 / (n_eff - 2.0);
+        assert!((limit - 1.0).abs() < 3.0 * se, "{limit} +- {se}");
+        assert!(
+            (wiener / (1.0 + excess) - 1.0).abs() < 3.0 * se * (1.0 + excess),
+            "{wiener} vs {}",
+            1.0 + excess
+        );
+    }
+}
