@@ -22,6 +22,12 @@
 //! * `polezero_evaluate/1t`: `tf::evaluate` itself, which also allocates its result (fresh
 //!   pages: 8.8 MB at 1e5 points) and copies the grid.
 //!
+//! Group `polezero_ground`: the pole-zero method on the 7x3 tilt matrix and on the 7x6 ground
+//! matrix (tilt and the floor's translation x_t, y_t, z_t), side by side in one run:
+//! `tilt_7x3/batch`, `ground_7x6/batch` (`eval_grid_into`, the dense complex matrix) and
+//! `tilt_7x3/matrix`, `ground_7x6/matrix` (`tf::evaluate_into`, the plan's layout: 11 and 21
+//! real entries), one thread each.
+//!
 //! The plan (`tf::plan`: normal modes, block matrices, forcing forms) is built once, outside the
 //! timing; it is amortized over the grid. Throughput is in grid points, so ns per point is the
 //! time per iteration divided by the grid size.
@@ -40,7 +46,7 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode, Throughput};
 use num_complex::Complex64;
 use tiltnoise_core::freq::log_grid;
-use tiltnoise_core::model::Model;
+use tiltnoise_core::model::{Input, Model, Observable};
 use tiltnoise_core::params::Params;
 use tiltnoise_core::tf::{self, Destination, Method, Request, TransferFunction};
 
@@ -178,5 +184,45 @@ fn methods(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, methods);
+/// The pole-zero method's cost per point with the six ground inputs against the three tilt
+/// inputs (module docs).
+fn polezero_ground(c: &mut Criterion) {
+    let model = Model::new(&Params::table_i()).expect("Table I is valid");
+    let n = n_points();
+    let grid = log_grid(F_LO_HZ, F_HI_HZ, n).expect("valid grid");
+    let mut g = c.benchmark_group("polezero_ground");
+    g.sample_size(10)
+        .sampling_mode(SamplingMode::Flat)
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(1))
+        .throughput(Throughput::Elements(n as u64));
+    for (name, inputs) in [
+        ("tilt_7x3", Input::all_tilts()),
+        ("ground_7x6", Input::all_ground()),
+    ] {
+        let request = Request {
+            outputs: Observable::ALL.to_vec(),
+            inputs,
+        };
+        let plan = tf::plan(&model, &request, Method::PoleZero).expect("polezero plans it");
+        let plan = plan.as_ref();
+        let mut out = tf::zeroed_complex(request.outputs.len() * request.inputs.len() * n);
+        g.bench_function(format!("{name}/batch"), |b| {
+            b.iter(|| {
+                plan.eval_grid_into(black_box(&grid), black_box(&mut out))
+                    .expect("no singular frequency on the grid")
+            })
+        });
+        let mut m = tf::evaluate(plan, &grid).expect("no singular frequency");
+        g.bench_function(format!("{name}/matrix"), |b| {
+            b.iter(|| {
+                tf::evaluate_into(plan, black_box(&grid), 1, black_box(&mut m))
+                    .expect("no singular frequency on the grid")
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, methods, polezero_ground);
 criterion_main!(benches);

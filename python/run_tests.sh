@@ -17,7 +17,7 @@ python3 -m venv "$venv"
 # h5py: the comparisons of HDF5 files with the command line's; mypy: the stubs against the
 # module (mypy.stubtest); matplotlib: the example figure; gwpy: the budget's ASDs read as
 # gwpy FrequencySeries. Without them those tests are skipped.
-"$venv/bin/pip" install --quiet "$here" pytest numpy scipy h5py mypy matplotlib gwpy
+"$venv/bin/pip" install --quiet "$here" pytest hypothesis numpy scipy h5py mypy matplotlib gwpy
 # From outside the source tree, so that the installed package is imported and not
 # python/tiltnoise/ (which holds no extension, or a stale one from `maturin develop`).
 cd "$(mktemp -d)"

@@ -1,11 +1,13 @@
 //! `tiltnoise.budget` (arrays) and `tiltnoise.budget_from_file` (the command line's `budget
 //! --tilt FILE`), and the `Budget` they return.
 
+use crate::arrays::{self, check_size, series};
 use crate::errors::{value_error, IntoPyErr, PyResultExt};
+use crate::inputs::Inputs;
 use crate::model::PyModel;
 use crate::params::PyParams;
-use crate::spectral::{averaging, series};
-use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use crate::spectral::{averaging, check_fs, SERIES};
+use numpy::{PyArray1, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use std::path::{Path, PathBuf};
@@ -15,13 +17,15 @@ use tiltnoise_core::budget::{budget_from_series, budget_from_spectra, BudgetErro
 use tiltnoise_core::error::Num;
 use tiltnoise_core::freq;
 use tiltnoise_core::input::{
-    process_channel, ChannelCtx, GapPolicy, InputError, InputMeta, Quantity, SeriesSource,
+    parse_scales, process_channel, ChannelCtx, GapPolicy, InputError, InputMeta, Quantity,
+    SeriesSource,
 };
 use tiltnoise_core::model::{Model, Observable, TiltAxis};
 use tiltnoise_core::noise::equivalent::referred_terms;
 use tiltnoise_core::noise::{BudgetReport, Readout, SpectralSource};
 use tiltnoise_core::options::{self, Spelling};
 use tiltnoise_core::params::Params;
+use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_io::input::{
     add_measured_file, read_tilt, AxisMap, InputFormat, ReadOptions, TiltInput, TiltSeriesSource,
 };
@@ -71,24 +75,30 @@ impl SeriesSource for ArraySeries {
     }
 }
 
-/// The model of `params`: a `Model` (reused as it is), a `Params`, or Table I for `None`.
-fn model_of(params: Option<&Bound<'_, PyAny>>) -> PyResult<(Arc<Model>, Params)> {
+/// The model of `params`: a `Model` (reused as it is), a `Params`, or Table I for `None`; and
+/// its parameters (with the file they were read from).
+fn model_of(params: Option<&Bound<'_, PyAny>>) -> PyResult<(Arc<Model>, PyParams)> {
     let Some(p) = params else {
         let params = Params::table_i();
-        return Ok((Arc::new(Model::new(&params).py()?), params));
+        return Ok((
+            Arc::new(Model::new(&params).py()?),
+            PyParams::unread(params),
+        ));
     };
     if let Ok(m) = p.cast::<PyModel>() {
-        let model = Arc::clone(&m.get().model);
-        let params = model.params().clone();
-        return Ok((model, params));
+        let m = m.get();
+        let params = PyParams {
+            inner: m.model.params().clone(),
+            file: m.params_file.clone(),
+        };
+        return Ok((Arc::clone(&m.model), params));
     }
     let params = p
         .cast::<PyParams>()
         .map_err(|_| value_error("params: expected a tiltnoise.Params or a tiltnoise.Model"))?
         .get()
-        .inner
         .clone();
-    Ok((Arc::new(Model::new(&params).py()?), params))
+    Ok((Arc::new(Model::new(&params.inner).py()?), params))
 }
 
 /// The readout of `readout` (`{observable: ASD}`), over the default 9e-9 m/sqrt(Hz) on X as
@@ -180,6 +190,18 @@ fn array_error(e: InputError) -> PyErr {
             "tilt[{channel:?}][{index}] is {value:?} {unit}; allowed: finite values (or \
              gaps=\"interpolate\" to bridge interior gaps linearly)"
         )),
+        InputError::OutOfRange {
+            channel,
+            index,
+            value,
+            unit,
+            ..
+        } => value_error(format!(
+            "tilt[{channel:?}][{index}] is {} {unit}; allowed: {} (beyond that the spectra \
+             overflow or underflow f64; see docs/limits.md)",
+            Num(value),
+            tiltnoise_core::limits::SAMPLES.allowed(unit)
+        )),
         InputError::EdgeGap {
             channel,
             edge,
@@ -196,7 +218,8 @@ fn array_error(e: InputError) -> PyErr {
     }
 }
 
-/// `(axis, samples)` from a dict `{axis: array}` or a 2-D array with `axes`.
+/// `(axis, samples)` from a dict `{axis: array}` or a 2-D array with `axes`, each axis once,
+/// the size of all of them checked before any is copied (views are read in place).
 fn tilt_channels(
     tilt: &Bound<'_, PyAny>,
     axes: Option<&Bound<'_, PyAny>>,
@@ -208,13 +231,20 @@ fn tilt_channels(
                  not both",
             ));
         }
-        return d
-            .iter()
-            .map(|(k, v)| {
-                let name: String = k.extract()?;
-                let axis = tilt_axis(&name)?;
-                Ok((axis, series(&format!("tilt[{name:?}]"), &v)?))
-            })
+        let mut given = Vec::new();
+        for (k, v) in d.iter() {
+            let name: String = k
+                .extract()
+                .map_err(|_| value_error("tilt: the keys must be tilt axis names (str)"))?;
+            let axis = tilt_axis(&name)?;
+            let array = v.cast::<PyUntypedArray>().ok().map(|a| a.len());
+            given.push((axis, name, v, array));
+        }
+        let total = given.iter().map(|g| g.3.unwrap_or(0)).sum();
+        check_size("tilt", total, SERIES)?;
+        return given
+            .into_iter()
+            .map(|(axis, name, v, _)| Ok((axis, series(&format!("tilt[{name:?}]"), &v, SERIES)?)))
             .collect();
     }
     let Some(axes) = axes else {
@@ -231,25 +261,21 @@ fn tilt_channels(
             .collect(),
         Err(_) => axes.extract()?,
     };
-    let np = tilt.py().import("numpy")?;
-    let array = np
-        .call_method1("asarray", (tilt, "float64"))
-        .map_err(|e| value_error(format!("tilt: not an array of numbers ({e})")))?
-        .cast_into::<PyArrayDyn<f64>>()?;
-    let shape = array.shape().to_vec();
-    if shape.len() != 2 || shape[0] != names.len() {
+    let axes = names
+        .iter()
+        .map(|n| tilt_axis(n))
+        .collect::<PyResult<Vec<_>>>()?;
+    refuse_repeats("axes", "tilt axis", &axes, |a| a.name().to_string())
+        .map_err(|e| value_error(e.to_string()))?;
+    let rows = arrays::rows("tilt", tilt, SERIES)?;
+    if rows.len() != axes.len() {
         return Err(value_error(format!(
-            "tilt: expected a 2-D array of shape (len(axes), n_samples) = ({}, n), got shape {shape:?}",
-            names.len()
+            "tilt: expected a 2-D array of shape (len(axes), n_samples) = ({}, n), got {} rows",
+            axes.len(),
+            rows.len()
         )));
     }
-    let view = array.readonly();
-    let view = view.as_array();
-    names
-        .iter()
-        .zip(view.outer_iter())
-        .map(|(name, row)| Ok((tilt_axis(name)?, row.iter().copied().collect())))
-        .collect()
+    Ok(axes.into_iter().zip(rows).collect())
 }
 
 /// Noise budget of X, phi and phi_a from a tilt time series given as arrays.
@@ -293,11 +319,7 @@ pub fn budget(
     let (model, params) = model_of(params)?;
     let quantity: Quantity = quantity.parse().map_err(value_error)?;
     let gaps: GapPolicy = gaps.parse().map_err(value_error)?;
-    if !(fs.is_finite() && fs > 0.0) {
-        return Err(value_error(format!(
-            "fs {fs} Hz is not allowed: the sample rate must be finite and > 0"
-        )));
-    }
+    check_fs(fs)?;
     let mut channels = tilt_channels(tilt, axes)?;
     channels.sort_by_key(|(a, _)| a.index());
     if channels.is_empty() {
@@ -306,12 +328,6 @@ pub fn budget(
         ));
     }
     for w in channels.windows(2) {
-        if w[0].0 == w[1].0 {
-            return Err(value_error(format!(
-                "tilt: axis {} is given twice",
-                w[0].0.name()
-            )));
-        }
         if w[0].1.len() != w[1].1.len() {
             return Err(value_error(format!(
                 "tilt: {} has {} samples but {} has {}: the axes must have equal length",
@@ -365,10 +381,12 @@ pub fn budget(
         .map(|a| format!("{0}={0}", a.name()))
         .collect::<Vec<_>>()
         .join(",");
+    let inputs = Inputs::of_params(params.file.as_deref()).with("measured", measured.as_deref());
     Ok(Budget::new(
         &model,
         report,
         params,
+        inputs,
         InputMeta {
             path: "(arrays)".into(),
             format: "numpy".into(),
@@ -418,12 +436,12 @@ pub fn budget_from_file(
     scale: Option<std::collections::BTreeMap<String, f64>>,
 ) -> PyResult<Budget> {
     let (model, params) = model_of(params)?;
-    let scale = scale
+    let scale: Vec<String> = scale
         .unwrap_or_default()
         .iter()
-        .map(|(c, f)| format!("{c}={f:?}").parse())
-        .collect::<Result<Vec<_>, String>>()
-        .map_err(|e| value_error(format!("scale: {e}")))?;
+        .map(|(c, f)| format!("{c}={f:?}"))
+        .collect();
+    let scale = parse_scales("scale", &scale).map_err(value_error)?;
     let ropts = ReadOptions {
         axis_map: axes
             .map(AxisMap::parse)
@@ -449,7 +467,7 @@ pub fn budget_from_file(
         None => None,
         Some(f) => Some(match f.cast::<PyString>() {
             Ok(spec) => freq::parse_spec(&spec.to_cow()?).py()?,
-            Err(_) => crate::grid::frequencies(f)?,
+            Err(_) => crate::grid::frequencies(f, crate::grid::GRID)?,
         }),
     };
     let mut given = series_opts.given();
@@ -502,10 +520,14 @@ pub fn budget_from_file(
         }
         Ok((report, provenance))
     })?;
+    let inputs = Inputs::of_params(params.file.as_deref())
+        .with("path", Some(&path))
+        .with("measured", measured.as_deref());
     Ok(Budget::new(
         &model,
         report,
         params,
+        inputs,
         InputMeta::from(&provenance),
     ))
 }
@@ -522,13 +544,21 @@ pub fn budget_from_file(
 #[pyclass(module = "tiltnoise", frozen)]
 pub struct Budget {
     report: BudgetReport,
-    params: Params,
+    params: PyParams,
     modes: Vec<(usize, f64)>,
     input: InputMeta,
+    /// The files read: no `save` may replace one.
+    inputs: Inputs,
 }
 
 impl Budget {
-    fn new(model: &Model, report: BudgetReport, params: Params, input: InputMeta) -> Budget {
+    fn new(
+        model: &Model,
+        report: BudgetReport,
+        params: PyParams,
+        inputs: Inputs,
+        input: InputMeta,
+    ) -> Budget {
         let modes = tiltnoise_core::modes::NormalModes::new(model)
             .modes
             .iter()
@@ -539,6 +569,7 @@ impl Budget {
             params,
             modes,
             input,
+            inputs,
         }
     }
 
@@ -584,7 +615,7 @@ impl Budget {
     fn run_meta(&self) -> RunMeta {
         RunMeta {
             modes: self.modes.clone(),
-            ..RunMeta::of_this_run(&self.params, None)
+            ..RunMeta::of_this_run(&self.params.inner, None)
         }
     }
 }
@@ -800,9 +831,7 @@ impl Budget {
     /// The parameters of the model the budget was computed with.
     #[getter]
     fn params(&self) -> PyParams {
-        PyParams {
-            inner: self.params.clone(),
-        }
+        self.params.clone()
     }
 
     /// The budget as the command line's CSV (``#`` lines ending with ``# units:``, then ASD
@@ -817,12 +846,14 @@ impl Budget {
     /// Writes the budget as the command line's ``--save`` does: ``.h5``/``.hdf5`` (schema
     /// ``tiltnoise.budget``, with the parameters and the input's provenance) or ``.csv``;
     /// atomically (nothing is left at ``path`` on failure). Raises ``OSError`` if it cannot
-    /// be written, ``ValueError`` for another extension. ``keep_zero_columns``: as
-    /// ``to_csv``.
+    /// be written or is one of the files the budget was computed from (the tilt file, the
+    /// measured record, the parameter file; compared as files, whatever the spelling),
+    /// ``ValueError`` for another extension. ``keep_zero_columns``: as ``to_csv``.
     #[pyo3(signature = (path, *, keep_zero_columns=false))]
     fn save(&self, py: Python<'_>, path: PathBuf, keep_zero_columns: bool) -> PyResult<()> {
         use tiltnoise_io::OutputKind;
         let kind = OutputKind::from_path(&path).py()?;
+        self.inputs.check_save(&path)?;
         let meta = self.run_meta();
         py.detach(|| match kind {
             OutputKind::Hdf5 => {

@@ -4,18 +4,22 @@
 //!   `IsADirectoryError` or `OSError`, by what the operating system said.
 //! * A file that was read but is not valid (layout, attributes, values, a parameter file's
 //!   TOML): [`InputFileError`], a subclass of `OSError`.
+//! * A request whose memory the machine does not have (`tiltnoise_core::limits`: more than
+//!   half of what is available, under the process's address-space limit too): `MemoryError`.
 //! * Everything else the caller can fix (a parameter out of range, an unknown name, an option
-//!   that does not fit the data, a file extension that names no format, a frequency on an
-//!   undamped resonance): `ValueError`.
+//!   that does not fit the data, a count over its documented limit, a file extension that
+//!   names no format, a frequency on an undamped resonance): `ValueError`.
 
 use pyo3::exceptions::{
-    PyFileNotFoundError, PyIsADirectoryError, PyOSError, PyPermissionError, PyValueError,
+    PyFileNotFoundError, PyIsADirectoryError, PyMemoryError, PyOSError, PyPermissionError,
+    PyValueError,
 };
 use pyo3::PyErr;
 use std::io::ErrorKind;
 use tiltnoise_core::budget::BudgetError;
 use tiltnoise_core::error::{FreqError, OutputError, ParamError, TfError};
 use tiltnoise_core::input::InputError;
+use tiltnoise_core::limits::LimitError;
 use tiltnoise_core::mc::McError;
 use tiltnoise_core::options::OptionError;
 use tiltnoise_core::spectral::SpectralError;
@@ -44,11 +48,21 @@ pub trait IntoPyErr {
     fn into_py_err(self) -> PyErr;
 }
 
+impl IntoPyErr for LimitError {
+    fn into_py_err(self) -> PyErr {
+        match self {
+            LimitError::Memory { .. } => PyMemoryError::new_err(self.to_string()),
+            _ => PyValueError::new_err(self.to_string()),
+        }
+    }
+}
+
 impl IntoPyErr for ParamError {
     fn into_py_err(self) -> PyErr {
         let message = self.to_string();
         match self {
             ParamError::Read { reason, .. } => os_error(reason.kind(), message),
+            ParamError::TooLarge(e) => e.into_py_err(),
             _ => PyValueError::new_err(message),
         }
     }
@@ -62,45 +76,34 @@ impl IntoPyErr for InputError {
             // A path whose extension names no supported format: the argument is wrong, not
             // the file (which is not opened).
             InputError::Extension { .. } => PyValueError::new_err(message),
+            InputError::TooLarge(e) => e.into_py_err(),
             _ => InputFileError::new_err(message),
         }
     }
 }
 
-impl IntoPyErr for SpectralError {
-    fn into_py_err(self) -> PyErr {
-        PyValueError::new_err(self.to_string())
-    }
+/// `ValueError` for an error that is not about memory, the error of its [`LimitError`] for one
+/// over a limit.
+macro_rules! value_or_limit {
+    ($($ty:ident),*) => {$(
+        impl IntoPyErr for $ty {
+            fn into_py_err(self) -> PyErr {
+                match self {
+                    $ty::TooLarge(e) => e.into_py_err(),
+                    other => PyValueError::new_err(other.to_string()),
+                }
+            }
+        }
+    )*};
 }
 
-impl IntoPyErr for TfError {
-    fn into_py_err(self) -> PyErr {
-        PyValueError::new_err(self.to_string())
-    }
-}
-
-impl IntoPyErr for FreqError {
-    fn into_py_err(self) -> PyErr {
-        PyValueError::new_err(self.to_string())
-    }
-}
-
-impl IntoPyErr for OptionError {
-    fn into_py_err(self) -> PyErr {
-        PyValueError::new_err(self.to_string())
-    }
-}
-
-impl IntoPyErr for McError {
-    fn into_py_err(self) -> PyErr {
-        PyValueError::new_err(self.to_string())
-    }
-}
+value_or_limit!(SpectralError, TfError, FreqError, OptionError, McError);
 
 impl IntoPyErr for BudgetError {
     fn into_py_err(self) -> PyErr {
         match self {
             BudgetError::Input(e) => e.into_py_err(),
+            BudgetError::TooLarge(e) => e.into_py_err(),
             other => PyValueError::new_err(other.to_string()),
         }
     }

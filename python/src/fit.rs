@@ -8,6 +8,7 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 use tiltnoise_core::fit::{self, FitConfig, FitError, FitResult, Measured, SigmaSource};
 use tiltnoise_core::params::Params;
+use tiltnoise_core::repeats::refuse_repeats;
 
 /// The measured modes: Table II's measured column, or a CSV file (`mode,frequency_hz[,sigma_hz]`).
 fn measured(path: Option<PathBuf>) -> PyResult<Measured> {
@@ -30,6 +31,10 @@ pub fn run(
     prior: bool,
 ) -> PyResult<Fit> {
     let measured = measured(measured_path)?;
+    if let Some(keys) = &free {
+        refuse_repeats("free", "parameter key", keys, String::clone)
+            .map_err(|e| value_error(e.to_string()))?;
+    }
     let config = FitConfig {
         free: free.unwrap_or_else(|| FitConfig::default().free),
         bound_sigmas,
@@ -60,9 +65,7 @@ impl Fit {
     /// The fitted parameter set.
     #[getter]
     fn params(&self) -> PyParams {
-        PyParams {
-            inner: self.result.fitted_params.clone(),
-        }
+        PyParams::unread(self.result.fitted_params.clone())
     }
 
     /// Per free parameter: ``key``, ``unit``, ``nominal``, ``fitted``, ``prior_sigma``,

@@ -1,27 +1,46 @@
-//! Frequency grids from Python arguments: a number or a 1-D array-like, copied to `f64`
-//! (every computation runs with the GIL released, while other Python threads could change
-//! the array), and the band `auto` plans for.
+//! Frequency grids from Python arguments: a number or a 1-D array-like, copied to `f64` once
+//! its size is checked ([`crate::arrays`]), and the band `auto` plans for.
 
-use crate::errors::value_error;
+use crate::arrays::{self, check_size, Size};
 use numpy::{PyArray1, PyArrayMethods, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use std::cell::RefCell;
 use tiltnoise_core::freq::DEFAULT_F_LO_HZ;
+use tiltnoise_core::limits::MAX_GRID_POINTS;
 
-/// Frequencies (Hz) from a number or a 1-D array-like, as `f64`: a float64 array is copied
-/// as it is; a NumPy array is asked before a number (a one-element array converts to a
-/// number only with a deprecation warning, and trying the conversion costs microseconds).
-pub fn frequencies(arg: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+/// A grid held in memory with nothing else per point: [`MAX_GRID_POINTS`], 8 bytes a point.
+pub const GRID: Size = grid_size(8);
+
+/// A grid of at most [`MAX_GRID_POINTS`] points costing `bytes_each` bytes per point (the
+/// frequency and what is computed on it).
+pub const fn grid_size(bytes_each: u64) -> Size {
+    Size {
+        limit: MAX_GRID_POINTS,
+        unit: "frequencies",
+        bytes_each,
+    }
+}
+
+/// Frequencies (Hz) from a number or a 1-D array-like, as `f64`, at most `size`: a float64
+/// array is copied as it is; a NumPy array is asked before a number (a one-element array
+/// converts to a number only with a deprecation warning, and trying the conversion costs
+/// microseconds).
+pub fn frequencies(arg: &Bound<'_, PyAny>, size: Size) -> PyResult<Vec<f64>> {
     let mut freqs = Vec::new();
-    frequencies_into(arg, &mut freqs)?;
+    frequencies_into(arg, size, &mut freqs)?;
     Ok(freqs)
 }
 
 /// [`frequencies`] into `freqs` (cleared first, its allocation kept), and their
-/// [`auto_band`] (found while a float64 array is copied, in the same pass).
-fn frequencies_into(arg: &Bound<'_, PyAny>, freqs: &mut Vec<f64>) -> PyResult<(f64, f64)> {
+/// [`auto_band`] (found while a contiguous float64 array is copied, in the same pass).
+fn frequencies_into(
+    arg: &Bound<'_, PyAny>,
+    size: Size,
+    freqs: &mut Vec<f64>,
+) -> PyResult<(f64, f64)> {
     freqs.clear();
     if let Ok(a) = arg.cast::<PyArray1<f64>>() {
+        check_size("freq_hz", a.len(), size)?;
         // SAFETY: the values are copied at once, holding the GIL, so no Python code runs
         // meanwhile; no Rust code of this module holds a mutable view of an array here.
         if let Ok(slice) = unsafe { a.as_slice() } {
@@ -33,19 +52,8 @@ fn frequencies_into(arg: &Bound<'_, PyAny>, freqs: &mut Vec<f64>) -> PyResult<(f
             return Ok(auto_band(freqs));
         }
     }
-    let np = arg.py().import("numpy")?;
-    let array = np
-        .call_method1("asarray", (arg, "float64"))
-        .map_err(|e| value_error(format!("freq_hz: not an array of numbers ({e})")))?;
-    let array = array.cast_into::<numpy::PyArrayDyn<f64>>()?;
-    if array.ndim() > 1 {
-        return Err(value_error(format!(
-            "freq_hz: expected a number or a 1-D array of frequencies in Hz, got {} dimensions",
-            array.ndim()
-        )));
-    }
-    // A 0-d array is one frequency, as a number.
-    freqs.extend(array.readonly().as_array().iter().copied());
+    // A view, another dtype, a sequence; a 0-d array is one frequency, as a number.
+    arrays::grid_into("freq_hz", arg, size, freqs)?;
     Ok(auto_band(freqs))
 }
 
@@ -160,9 +168,10 @@ impl GridBuffer {
         GridBuffer { freqs }
     }
 
-    /// The frequencies of `arg` ([`frequencies`]) into the buffer, and their [`auto_band`].
-    pub fn fill(&mut self, arg: &Bound<'_, PyAny>) -> PyResult<(f64, f64)> {
-        frequencies_into(arg, &mut self.freqs)
+    /// The frequencies of `arg` ([`frequencies`], at most `size`) into the buffer, and their
+    /// [`auto_band`].
+    pub fn fill(&mut self, arg: &Bound<'_, PyAny>, size: Size) -> PyResult<(f64, f64)> {
+        frequencies_into(arg, size, &mut self.freqs)
     }
 
     pub fn freqs(&self) -> &[f64] {

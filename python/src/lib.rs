@@ -7,10 +7,12 @@
 //! on the command line, NumPy arrays), the library's typed errors into Python exceptions with
 //! the command line's messages (module `errors`), and releases the GIL around every computation.
 
+mod arrays;
 mod budget;
 mod errors;
 mod fit;
 mod grid;
+mod inputs;
 mod model;
 mod params;
 mod simulate;

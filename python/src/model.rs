@@ -1,10 +1,11 @@
 //! `tiltnoise.Model`: normal modes, transfer functions (the command line's `modes` and `tf`),
 //! the model's matrices and the Monte Carlo of the modes (`mc`).
 
+use crate::arrays;
 use crate::errors::{value_error, PyResultExt};
 use crate::grid::{self, GridBuffer};
 use crate::params::PyParams;
-use numpy::{Complex64, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{Complex64, PyArray1, PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 use std::collections::HashMap;
@@ -61,6 +62,8 @@ type ChoiceCache = HashMap<(Vec<Input>, Vec<Observable>, [u64; 3]), Method>;
 #[pyclass(name = "Model", module = "tiltnoise", frozen)]
 pub struct PyModel {
     pub model: Arc<Model>,
+    /// The parameter file the model's parameters were read from, if any.
+    pub params_file: Option<std::path::PathBuf>,
     modes: OnceLock<NormalModes>,
     plans: Mutex<PlanCache>,
     choices: Mutex<ChoiceCache>,
@@ -84,6 +87,7 @@ impl PyModel {
         let model = Model::new(&PyParams::or_table_i(params)).py()?;
         Ok(PyModel {
             model: Arc::new(model),
+            params_file: params.and_then(|p| p.file.clone()),
             modes: OnceLock::new(),
             plans: Mutex::new(HashMap::new()),
             choices: Mutex::new(HashMap::new()),
@@ -277,6 +281,7 @@ impl PyModel {
     fn params(&self) -> PyParams {
         PyParams {
             inner: self.model.params().clone(),
+            file: self.params_file.clone(),
         }
     }
 
@@ -327,10 +332,12 @@ impl PyModel {
     ///
     /// ``freq_hz``: a number or a 1-D array of frequencies in Hz, finite and >= 0.
     /// ``inputs``: names as ``--input``, a comma-separated ``str`` or a sequence: the tilt
-    /// angles ``theta_t``, ``eta_t``, ``phi_t`` (rad), the force components ``F_a.x`` ..
-    /// ``F_b.z`` (N) and torque components ``M_a.x`` .. ``M_b.z`` (N m) on the crossbar (a)
-    /// and the test mass (b), and the groups ``tilt`` and ``forces``; default the three tilt
-    /// angles. ``outputs``: ``X``, ``Y``, ``Z`` (m), ``theta``, ``eta``, ``phi``, ``phi_a``
+    /// angles ``theta_t``, ``eta_t``, ``phi_t`` (rad), the floor translations ``x_t``, ``y_t``,
+    /// ``z_t`` (m, along the lab axes: the crossbar arm along y, z up; the floor, the suspension
+    /// point and the housing move together), the force components ``F_a.x`` .. ``F_b.z`` (N)
+    /// and torque components ``M_a.x`` .. ``M_b.z`` (N m) on the crossbar (a) and the test mass
+    /// (b), and the groups ``tilt``, ``translation``, ``ground`` (tilt and translation) and
+    /// ``forces``; default the three tilt angles. ``outputs``: ``X``, ``Y``, ``Z`` (m), ``theta``, ``eta``, ``phi``, ``phi_a``
     /// (rad); default all seven. ``method``: ``auto`` (the cheapest method whose error against
     /// the double-double reference on the grid's band is at most ``rel_tol``), ``direct``,
     /// ``block``, ``split``, ``polezero``, ``modal``, ``statespace`` or ``torsion2``.
@@ -340,8 +347,9 @@ impl PyModel {
     ///
     /// Returns a complex128 array ``H[n_freq, n_outputs, n_inputs]`` in the order asked: the
     /// complex amplitude of each observable per unit input for ``exp(+i w t)`` time
-    /// dependence, in the observable's unit per the input's unit (m/rad, rad/rad, m/N,
-    /// rad/(N m), ...). ``auto`` measures the candidates against the double-double reference
+    /// dependence, in the observable's unit per the input's unit (m/rad, rad/rad, m/m, rad/m,
+    /// m/N, rad/(N m), ...); per unit floor acceleration divide a translation's column by
+    /// ``-(2 pi f)**2``. ``auto`` measures the candidates against the double-double reference
     /// on the grid's band (about 0.1 s) once per request, band and tolerance, and remembers the
     /// pick: the result never depends on earlier calls. For many grids on different bands,
     /// name the method (``method="polezero"`` is what it picks for the tilt matrix of Table I).
@@ -358,7 +366,7 @@ impl PyModel {
         method: &str,
         rel_tol: f64,
         threads: Option<usize>,
-        out: Option<Bound<'py, PyArray3<Complex64>>>,
+        out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArray3<Complex64>>> {
         let request = Request {
             inputs: parse_inputs(inputs)?,
@@ -366,10 +374,16 @@ impl PyModel {
         };
         let asked = parse_method(method)?;
         check_rel_tol(rel_tol)?;
+        // The grid's copy, and the result unless it goes into `out`: 16 bytes an entry.
+        let entries = (request.outputs.len() * request.inputs.len()) as u64;
+        let per_point = 8 + if out.is_none() { 16 * entries } else { 0 };
         let mut grid = GridBuffer::take();
-        let band = grid.fill(freq_hz)?;
+        let band = grid.fill(freq_hz, grid::grid_size(per_point))?;
         let freqs = grid.freqs();
         let dims = [freqs.len(), request.outputs.len(), request.inputs.len()];
+        let out = out
+            .map(|o| arrays::output::<Complex64>("out", o, dims, "complex128"))
+            .transpose()?;
         let plan = self.plan_for(py, request, asked, band, rel_tol)?;
         let threads = threads.unwrap_or(match freqs.len() >= THREADED_GRID {
             true => cores(),
@@ -386,12 +400,6 @@ impl PyModel {
         };
         match out {
             Some(h) => {
-                if h.shape() != dims {
-                    return Err(value_error(format!(
-                        "out: shape {:?} does not fit the result's (n_freq, n_outputs, n_inputs) = {dims:?}",
-                        h.shape()
-                    )));
-                }
                 let mut rw = h
                     .try_readwrite()
                     .map_err(|e| value_error(format!("out: not writeable ({e})")))?;
@@ -437,7 +445,7 @@ impl PyModel {
         check_rel_tol(rel_tol)?;
         let scene = Scene {
             rel_tol,
-            ..Scene::over_grid(request, &grid::frequencies(freq_hz)?)
+            ..Scene::over_grid(request, &grid::frequencies(freq_hz, grid::GRID)?)
         };
         let model = &self.model;
         let choice = py
@@ -447,13 +455,15 @@ impl PyModel {
     }
 
     /// The model's matrices as NumPy arrays, for work outside tiltnoise:
-    /// ``H(w) = C (K + i K_imag + i w D - w^2 M)^-1 G(w)`` with ``G = G0 + w^2 G2`` (tilt)
-    /// or ``F`` (forces and torques).
+    /// ``H(w) = C (K + i K_imag + i w D - w^2 M)^-1 G(w)`` with ``G = G0 + w^2 G2`` (tilt),
+    /// ``w^2 G2_translation`` (floor translation) or ``F`` (forces and torques).
     ///
     /// Keys: ``M`` (8x8 mass matrix), ``K`` (8x8 undamped stiffness), ``K_imag`` (8x8
     /// structural damping, ``Im K_c``), ``D`` (8x8 viscous damping), ``G0``, ``G2`` (8x3 tilt
-    /// forcing), ``F`` (8x12 force/torque forcing), ``C`` (7x8 observation matrix), and the
-    /// labels ``coordinates``, ``observables``, ``tilt_inputs``, ``force_inputs``.
+    /// forcing), ``G2_translation`` (8x3 floor-translation forcing per unit ``w^2``),
+    /// ``F`` (8x12 force/torque forcing), ``C`` (7x8 observation matrix), and the labels
+    /// ``coordinates``, ``observables``, ``tilt_inputs``, ``translation_inputs``,
+    /// ``force_inputs``.
     fn matrices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let m = &self.model;
         let d = PyDict::new(py);
@@ -463,6 +473,7 @@ impl PyModel {
         d.set_item("D", matrix(py, m.damping()))?;
         d.set_item("G0", matrix(py, &m.tilt_forcing().g0))?;
         d.set_item("G2", matrix(py, &m.tilt_forcing().g2))?;
+        d.set_item("G2_translation", matrix(py, &m.translation_forcing().g2))?;
         d.set_item("F", matrix(py, m.force_matrix()))?;
         d.set_item("C", matrix(py, m.observation()))?;
         let names = |v: Vec<&'static str>| PyList::new(py, v);
@@ -477,6 +488,15 @@ impl PyModel {
         d.set_item(
             "tilt_inputs",
             names(Input::all_tilts().into_iter().map(Input::name).collect())?,
+        )?;
+        d.set_item(
+            "translation_inputs",
+            names(
+                Input::all_translations()
+                    .into_iter()
+                    .map(Input::name)
+                    .collect(),
+            )?,
         )?;
         d.set_item(
             "force_inputs",
@@ -579,7 +599,7 @@ impl PyModel {
             seed,
             nperseg,
         };
-        crate::simulate::run(py, &self.model, args)
+        crate::simulate::run(py, &self.model, self.params_file.as_deref(), args)
     }
 
     fn __repr__(&self) -> String {

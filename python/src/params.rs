@@ -18,12 +18,27 @@ use tiltnoise_core::params::Params;
 /// Keys are the command line's (``tiltnoise --set length.h_m=1.5``, the TOML file of
 /// ``tiltnoise params``); :meth:`keys` lists them with value, unit and allowed range.
 #[pyclass(name = "Params", module = "tiltnoise", frozen, eq)]
-#[derive(Clone, PartialEq)]
+#[derive(Clone)]
 pub struct PyParams {
     pub inner: Params,
+    /// The parameter file the set was read from (and derived from by `set`, `update`), which
+    /// no file saved from results of these parameters may replace.
+    pub file: Option<PathBuf>,
+}
+
+/// Equal parameter sets are equal wherever they were read from.
+impl PartialEq for PyParams {
+    fn eq(&self, other: &Self) -> bool {
+        self.inner == other.inner
+    }
 }
 
 impl PyParams {
+    /// A parameter set read from no file.
+    pub fn unread(inner: Params) -> PyParams {
+        PyParams { inner, file: None }
+    }
+
     /// The parameters of `params`, or Table I when `None`.
     pub fn or_table_i(params: Option<&PyParams>) -> Params {
         params.map_or_else(Params::table_i, |p| p.inner.clone())
@@ -49,9 +64,7 @@ impl PyParams {
     /// Table I (the command line's default parameter set).
     #[new]
     fn new() -> Self {
-        PyParams {
-            inner: Params::table_i(),
-        }
+        PyParams::unread(Params::table_i())
     }
 
     /// Reads and validates a parameter set in TOML (the format of ``tiltnoise params``).
@@ -65,14 +78,21 @@ impl PyParams {
     /// what is allowed, as on the command line.
     #[staticmethod]
     fn from_toml(source: &Bound<'_, PyAny>) -> PyResult<Self> {
-        let inner = match toml_source(source)? {
-            Ok(path) => Params::from_file(&path).map_err(|e| match e {
-                ParamError::Read { .. } => e.into_py_err(),
-                other => InputFileError::new_err(other.to_string()),
-            })?,
-            Err(text) => Params::from_toml_str(&text, "TOML text").py()?,
-        };
-        Ok(PyParams { inner })
+        match toml_source(source)? {
+            Ok(path) => {
+                let inner = Params::from_file(&path).map_err(|e| match e {
+                    ParamError::Read { .. } => e.into_py_err(),
+                    other => InputFileError::new_err(other.to_string()),
+                })?;
+                Ok(PyParams {
+                    inner,
+                    file: Some(path),
+                })
+            }
+            Err(text) => Ok(PyParams::unread(
+                Params::from_toml_str(&text, "TOML text").py()?,
+            )),
+        }
     }
 
     /// The parameter set as TOML (units in the keys); it reads back unchanged with
@@ -89,6 +109,7 @@ impl PyParams {
     fn set(&self, key: &str, value: f64) -> PyResult<Self> {
         Ok(PyParams {
             inner: self.inner.with_override(&assignment(key, value)).py()?,
+            file: self.file.clone(),
         })
     }
 
@@ -105,7 +126,10 @@ impl PyParams {
             })?;
             inner = inner.with_override(&assignment(&key, value)).py()?;
         }
-        Ok(PyParams { inner })
+        Ok(PyParams {
+            inner,
+            file: self.file.clone(),
+        })
     }
 
     /// The value of one key, e.g. ``p.get("length.h_m")`` (m). ``KeyError`` for an unknown key.

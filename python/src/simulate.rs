@@ -2,6 +2,7 @@
 //! resonance check (the command line's `tiltnoise simulate`), and the `Simulation` it returns.
 
 use crate::errors::{value_error, PyResultExt};
+use crate::inputs::Inputs;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
@@ -52,7 +53,6 @@ fn coordinates(
             "{option}: expected a dict {{coordinate: value}} or a str \"theta_a=1e-5,phi_b=0.01\""
         ))
     })?;
-    let mut given = [false; 8];
     for (name, value) in d.iter() {
         let name: String = name
             .extract()
@@ -61,7 +61,7 @@ fn coordinates(
             .extract()
             .map_err(|_| value_error(format!("{option} {name}: the value must be a number")))?;
         let item = format!("{name}={value}");
-        set_coordinate(option, &item, &name, value, rate, &mut given, out).py()?;
+        set_coordinate(option, &item, &name, value, rate, out).py()?;
     }
     Ok(())
 }
@@ -88,7 +88,12 @@ fn excitation(args: &SimulateArgs<'_, '_>) -> PyResult<Excitation> {
 }
 
 /// Runs the simulation of `model` (`Model.simulate`).
-pub fn run(py: Python<'_>, model: &Model, args: SimulateArgs<'_, '_>) -> PyResult<Simulation> {
+pub fn run(
+    py: Python<'_>,
+    model: &Model,
+    params_file: Option<&std::path::Path>,
+    args: SimulateArgs<'_, '_>,
+) -> PyResult<Simulation> {
     if !model.is_undamped() {
         return Err(value_error(SimError::Damped.to_string()));
     }
@@ -160,6 +165,7 @@ pub fn run(py: Python<'_>, model: &Model, args: SimulateArgs<'_, '_>) -> PyResul
         check_agrees: check.1,
         params: model.params().clone(),
         modes,
+        inputs: Inputs::of_params(params_file),
     })
 }
 
@@ -186,6 +192,8 @@ pub struct Simulation {
     check_agrees: bool,
     params: Params,
     modes: Vec<(usize, f64)>,
+    /// The parameter file, which no `save` may replace.
+    inputs: Inputs,
 }
 
 #[pymethods]
@@ -333,10 +341,11 @@ impl Simulation {
     /// Writes the run as the command line's ``simulate --save`` does, atomically: ``.h5`` /
     /// ``.hdf5`` (the series, the ASDs and the run's provenance; schema
     /// ``tiltnoise.observable_series``, readable by ``budget(measured=...)``) or ``.csv``
-    /// (the ASDs, ``freq_hz,X,...``). Raises ``OSError`` if it cannot be written,
-    /// ``ValueError`` for another extension.
+    /// (the ASDs, ``freq_hz,X,...``). Raises ``OSError`` if it cannot be written or is the
+    /// parameter file of the model, ``ValueError`` for another extension.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let kind = OutputKind::from_path(&path).py()?;
+        self.inputs.check_save(&path)?;
         let run = RunMeta {
             modes: self.modes.clone(),
             ..RunMeta::of_this_run(&self.params, None)

@@ -2,28 +2,44 @@
 //! the scaling of `scipy.signal.welch` and `scipy.signal.csd` (periodic Hann window, one-sided
 //! density).
 
+use crate::arrays::{self, Size};
 use crate::errors::{value_error, PyResultExt};
-use numpy::{Complex64, PyArray1, PyArrayDyn, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::{Complex64, PyArray1};
 use pyo3::prelude::*;
+use tiltnoise_core::error::Num;
+use tiltnoise_core::limits::{MAX_SERIES_SAMPLES, SAMPLES, SAMPLE_RATES, SERIES_BYTES_PER_SAMPLE};
 use tiltnoise_core::spectral::{self, Averaging, Detrend, WelchConfig};
 
 /// `(f, Pxx)` or `(f, Pxy)`: frequencies (Hz) and one-sided densities, as scipy returns them.
 type Spectrum<'py, T> = PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<T>>)>;
 
-/// A 1-D series of `f64` from any array-like, named `what` in errors.
-pub fn series(what: &str, arg: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
-    let np = arg.py().import("numpy")?;
-    let array = np
-        .call_method1("asarray", (arg, "float64"))
-        .map_err(|e| value_error(format!("{what}: not an array of numbers ({e})")))?
-        .cast_into::<PyArrayDyn<f64>>()?;
-    if array.ndim() != 1 {
-        return Err(value_error(format!(
-            "{what}: expected a 1-D series, got an array of shape {:?}",
-            array.shape()
-        )));
+/// The size of a series held in memory ([`MAX_SERIES_SAMPLES`]).
+pub const SERIES: Size = Size {
+    limit: MAX_SERIES_SAMPLES,
+    unit: "samples",
+    bytes_each: SERIES_BYTES_PER_SAMPLE,
+};
+
+/// The sample rate argument `fs` (Hz), within
+/// [`SAMPLE_RATES`](tiltnoise_core::limits::SAMPLE_RATES).
+pub fn check_fs(fs: f64) -> PyResult<()> {
+    if SAMPLE_RATES.admits(fs) {
+        return Ok(());
     }
-    Ok(array.readonly().as_array().iter().copied().collect())
+    Err(value_error(format!(
+        "fs = {} Hz is not allowed: the sample rate must be {} (the spectra would leave the \
+         range of f64; see docs/limits.md)",
+        Num(fs),
+        SAMPLE_RATES.allowed("Hz")
+    )))
+}
+
+/// A series `what` for a spectral estimate: its size checked before the copy, every value
+/// finite and within [`SAMPLES`] (in the series' own unit).
+fn checked_series(what: &str, arg: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    let x = arrays::series(what, arg, SERIES)?;
+    arrays::check_values(what, &x, &SAMPLES, &format!("in the unit of {what}"))?;
+    Ok(x)
 }
 
 /// `average` as on the command line's `budget --average`.
@@ -100,7 +116,8 @@ pub fn welch<'py>(
         detrend.unwrap_or(&constant),
         average,
     )?;
-    let x = series("x", x)?;
+    check_fs(fs)?;
+    let x = checked_series("x", x)?;
     let psd = py.detach(|| spectral::welch(&x, fs, &cfg)).py()?;
     Ok((
         PyArray1::from_vec(py, psd.freqs_hz),
@@ -137,7 +154,8 @@ pub fn csd<'py>(
         detrend.unwrap_or(&constant),
         average,
     )?;
-    let (x, y) = (series("x", x)?, series("y", y)?);
+    check_fs(fs)?;
+    let (x, y) = (checked_series("x", x)?, checked_series("y", y)?);
     let c = py.detach(|| spectral::csd(&x, &y, fs, &cfg)).py()?;
     Ok((
         PyArray1::from_vec(py, c.freqs_hz),

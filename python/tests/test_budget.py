@@ -107,7 +107,7 @@ def test_gaps_in_arrays():
         (dict(overlap=1.0), ["overlap", "[0, 1)"]),
         (dict(average="max"), ["average", "median"]),
         (dict(readout={"Y": 1e-9}), ["readout", "Y", "X, phi, phi_a"]),
-        (dict(readout={"X": -1.0}), ["readout", ">= 0"]),
+        (dict(readout={"X": -1.0}), ["readout", "0 or a value from 1e-40"]),
         (dict(percentiles=(10, 90)), ["percentiles", "segment_duration"]),
         (dict(segment_duration=1e9), ["segment duration", "longer than the record"]),
         (dict(quantity="speed"), ["quantity", "angle", "rate"]),
@@ -160,7 +160,7 @@ def test_file_errors(tmp_path):
     b = tiltnoise.budget_from_file(LAB_TILT, nperseg=4096)
     with pytest.raises(ValueError, match="unknown extension"):
         b.save(tmp_path / "budget.png")
-    with pytest.raises(OSError, match="cannot write"):
+    with pytest.raises(OSError, match="cannot save .* does not exist"):
         b.save(tmp_path / "no" / "such" / "dir" / "budget.csv")
 
 

@@ -126,6 +126,32 @@ def test_matrices_rebuild_the_transfer_functions(model):
     np.testing.assert_allclose(h_np, forces, rtol=1e-8, atol=1e-12 * np.abs(forces).max())
 
 
+def test_floor_translation_is_the_apparent_force_and_acts_as_tilt(model):
+    """The translation columns are C D^-1 (w^2 G2_translation) in NumPy; per unit floor
+    acceleration they tend to the tilt's static response per g (eta_t = a_x / g,
+    theta_t = -a_y / g) as f -> 0."""
+    m = model.matrices()
+    assert m["translation_inputs"] == ["x_t", "y_t", "z_t"]
+    assert m["G2_translation"].shape == (8, 3)
+    f = np.array([3e-3, 0.05, 0.3, 2.0, 30.0])
+    w2 = (2 * np.pi * f) ** 2
+    d = m["K"] + 1j * m["K_imag"] - w2[:, None, None] * m["M"]
+    g = w2[:, None, None] * m["G2_translation"]
+    h_np = m["C"] @ np.linalg.solve(d, np.broadcast_to(g, (len(f), 8, 3)).astype(complex))
+    h = model.transfer(f, inputs="translation")
+    np.testing.assert_allclose(h_np, h, rtol=0, atol=1e-9 * np.abs(h).max())
+    ground = model.transfer(f, inputs="ground")
+    np.testing.assert_array_equal(ground[:, :, 3:], h)
+    low = 1e-6
+    per_acceleration = model.transfer(low, inputs="x_t,y_t", outputs="X,Y")[0] / -(
+        (2 * np.pi * low) ** 2
+    )
+    static = model.transfer(0.0, inputs="eta_t,theta_t", outputs="X,Y")[0]
+    g_earth = model.params.get("environment.g_m_per_s2")
+    np.testing.assert_allclose(per_acceleration[0, 0], static[0, 0] / g_earth, rtol=1e-6)
+    np.testing.assert_allclose(per_acceleration[1, 1], -static[1, 1] / g_earth, rtol=1e-6)
+
+
 def test_monte_carlo_equals_the_command_lines(model, cli):
     expected = json.loads(cli("mc", "--samples", 300, "--seed", 7, "--format", "json"))
     got = model.monte_carlo(samples=300, seed=7, threads=1)

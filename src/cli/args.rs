@@ -3,6 +3,8 @@
 
 use anyhow::{anyhow, Result};
 use clap::ValueEnum;
+use tiltnoise_core::ground::GroundQuantity;
+use tiltnoise_core::input::parse_scales;
 use tiltnoise_core::model::Observable;
 use tiltnoise_core::tf::Method;
 use tiltnoise_io::input::{AxisMap, ReadOptions};
@@ -42,6 +44,28 @@ pub enum MethodArg {
     Statespace,
     /// The 2-DoF torsional model of section IV.C (no tilt inputs).
     Torsion2,
+}
+
+/// What the floor's motion is per unit of, in `tf`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PerArg {
+    /// Per unit displacement: rad, m (the model's inputs).
+    Displacement,
+    /// Per unit velocity: rad/s, m/s.
+    Velocity,
+    /// Per unit acceleration: rad/s^2, m/s^2.
+    Acceleration,
+}
+
+impl PerArg {
+    /// The library's quantity.
+    pub fn quantity(self) -> GroundQuantity {
+        match self {
+            PerArg::Displacement => GroundQuantity::Displacement,
+            PerArg::Velocity => GroundQuantity::Velocity,
+            PerArg::Acceleration => GroundQuantity::Acceleration,
+        }
+    }
 }
 
 impl MethodArg {
@@ -88,10 +112,6 @@ pub fn tilt_read_options(
             .unwrap_or("reject")
             .parse()
             .map_err(|e: String| anyhow!("--gaps: {e}"))?,
-        scale: scale
-            .iter()
-            .map(|s| s.parse())
-            .collect::<Result<_, String>>()
-            .map_err(|e| anyhow!("--scale: {e}"))?,
+        scale: parse_scales("--scale", scale).map_err(|e| anyhow!(e))?,
     })
 }

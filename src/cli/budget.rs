@@ -15,12 +15,13 @@ use tiltnoise_core::budget::{
     add_measured, budget_from_series, budget_from_spectra, series_psds, BudgetOptions,
     MeasuredPsds, SummaryRequest, DEFAULT_BAND_FRACTION,
 };
-use tiltnoise_core::error::Shown;
+use tiltnoise_core::error::{Num, Shown};
 use tiltnoise_core::freq;
 use tiltnoise_core::model::{Input, Model};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::noise::BudgetReport;
 use tiltnoise_core::params::Params;
+use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_core::spectral::Averaging;
 use tiltnoise_io::input::{read_tilt, InputFormat, ReadOptions, TiltInput, TiltSeriesSource};
 use tiltnoise_io::{InputMeta, OutputKind, RunMeta};
@@ -137,6 +138,7 @@ fn summary_request(args: &BudgetArgs) -> Result<SummaryRequest> {
                 })
             })
             .collect::<Result<_>>()?;
+        refuse_repeats("--at", "frequency", &req.freqs_hz, |f| Num(*f).to_string())?;
     }
     req.validate().map_err(|e| {
         anyhow!(

@@ -9,28 +9,17 @@ use std::path::{Path, PathBuf};
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::{Input, Observable};
 use tiltnoise_core::noise::{is_term_name, GivenAsd, Readout, UserSource, UserTerm};
+use tiltnoise_core::options;
+use tiltnoise_core::repeats::refuse_repeated_keys;
 use tiltnoise_io::input::{read_asd_column, InputFormat};
 
 const OBSERVABLES: &str = "X, Y, Z, theta, eta, phi, phi_a";
-const INPUTS: &str = "theta_t, eta_t, phi_t (rad), F_a.x .. F_b.z (N), M_a.x .. M_b.z (N m)";
+const INPUTS: &str =
+    "theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m), F_a.x .. F_b.z (N), M_a.x .. M_b.z (N m)";
 
 /// `--observables X,phi,...`: known names, each once.
 pub fn parse_observables(text: &str) -> Result<Vec<Observable>> {
-    let mut out = Vec::new();
-    for name in text.split(',').map(str::trim) {
-        let o = Observable::from_name(name).ok_or_else(|| {
-            anyhow!(
-                "--observables {}: unknown observable `{}`; allowed: {OBSERVABLES}",
-                Shown(text),
-                Shown(name)
-            )
-        })?;
-        if out.contains(&o) {
-            bail!("--observables {}: {} is given twice", Shown(text), o.name());
-        }
-        out.push(o);
-    }
-    Ok(out)
+    Ok(options::parse_outputs("--observables", &[text])?)
 }
 
 /// The unit of an ASD of a quantity of SI unit `unit`, as a static string for messages.
@@ -63,6 +52,7 @@ pub(crate) fn read_given(
 pub fn parse_readout(items: &[String], budgeted: &[Observable]) -> Result<(Readout, Vec<PathBuf>)> {
     let mut readout = Readout::default();
     let mut files = Vec::new();
+    refuse_repeated_keys("--readout", "observable", items)?;
     for item in items {
         // A value with the extension of an ASD file is a file; anything else must be a number.
         let file = item
@@ -125,6 +115,7 @@ pub fn parse_terms(
 ) -> Result<(Vec<UserTerm>, Vec<PathBuf>)> {
     let mut terms: Vec<UserTerm> = Vec::new();
     let mut files = Vec::new();
+    refuse_repeated_keys("--term", "term name", items)?;
     for item in items {
         let shown = Shown(item);
         let (name, rest) = item.split_once('=').ok_or_else(|| {
@@ -140,9 +131,6 @@ pub fn parse_terms(
                  starting with a letter",
                 Shown(name)
             );
-        }
-        if terms.iter().any(|t| t.name == name) {
-            bail!("--term {shown}: a term named `{name}` is given twice");
         }
         let source = source.trim();
         let source = match (Observable::from_name(source), Input::from_name(source)) {

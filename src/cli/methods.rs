@@ -10,7 +10,7 @@ use clap::Args;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::freq;
-use tiltnoise_core::model::{Model, Request};
+use tiltnoise_core::model::{Input, Model, Observable, Request};
 use tiltnoise_core::params::Params;
 
 /// Arguments of `tiltnoise methods`.
@@ -24,6 +24,10 @@ pub struct MethodsArgs {
         allow_hyphen_values = true
     )]
     freq: String,
+    /// Inputs of the matrix, as `tf --input` takes them (names or the groups `tilt`,
+    /// `translation`, `ground`, `forces`). Default: tilt.
+    #[arg(long = "input", value_name = "NAME[,NAME...]")]
+    inputs: Vec<String>,
     /// Output format on the terminal.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -60,6 +64,7 @@ struct MethodsJson<'a> {
 pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> Result<()> {
     let MethodsArgs {
         freq: spec,
+        inputs,
         format,
         save,
         figure,
@@ -79,7 +84,11 @@ pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> 
     let out = &mut run.out;
     let model = Model::new(params)?;
     let grid = freq::parse_spec(spec)?;
-    let request = Request::all_tilt();
+    let request = Request {
+        outputs: Observable::ALL.to_vec(),
+        inputs: super::tf::parse_inputs(&inputs)?,
+    };
+    let matrix = matrix_label(&request);
     let band = (grid[0], grid[grid.len() - 1]);
     let auto = choose(
         &model,
@@ -117,7 +126,7 @@ pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> 
         Format::Table => {
             writeln!(
                 out,
-                "7x3 tilt matrix on {spec} Hz ({} points; accuracy checked > 1 % from every mode)",
+                "{matrix} on {spec} Hz ({} points; accuracy checked > 1 % from every mode)",
                 grid.len()
             )?;
             writeln!(
@@ -172,7 +181,7 @@ pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> 
                 tiltnoise_plot::methods_figure::methods_figure(
                     &points,
                     DEFAULT_REL_TOL,
-                    &format!("Speed against accuracy, 7x3 tilt matrix, {spec} Hz"),
+                    &format!("Speed against accuracy, {matrix}, {spec} Hz"),
                     &view,
                     format,
                 )
@@ -180,4 +189,21 @@ pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> 
         }
         Ok(())
     })
+}
+
+/// `7x3 tilt matrix`, `7x6 ground matrix`, or the inputs named: what the table measures.
+fn matrix_label(request: &Request) -> String {
+    let size = format!("{}x{}", request.outputs.len(), request.inputs.len());
+    let groups = [
+        ("tilt", Input::all_tilts()),
+        ("translation", Input::all_translations()),
+        ("ground", Input::all_ground()),
+    ];
+    match groups.iter().find(|(_, inputs)| *inputs == request.inputs) {
+        Some((name, _)) => format!("{size} {name} matrix"),
+        None => {
+            let names: Vec<&str> = request.inputs.iter().map(|i| i.name()).collect();
+            format!("{size} matrix from {}", names.join(", "))
+        }
+    }
 }

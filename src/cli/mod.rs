@@ -30,6 +30,7 @@ use std::path::{Path, PathBuf};
 use tiltnoise_core::model::Model;
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
+use tiltnoise_core::repeats::refuse_repeated_keys;
 use tiltnoise_io::Staging;
 
 /// Tilt-noise budgets for double torsion pendulums (the 8-DoF PETER model of
@@ -121,6 +122,7 @@ impl ParamArgs {
             Some(path) => Params::from_file(path)?,
             None => Params::table_i(),
         };
+        refuse_repeated_keys("--set", "parameter key", &self.set)?;
         for assignment in &self.set {
             params = params.with_override(assignment)?;
         }

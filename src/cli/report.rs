@@ -4,7 +4,7 @@
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fmt::Write;
-use tiltnoise_core::model::{Model, Observable, TiltAxis};
+use tiltnoise_core::model::{Model, Observable, TiltAxis, TranslationAxis};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::tf::{self, Input, Method, Request};
 
@@ -156,6 +156,52 @@ pub fn static_limits(model: &Model) -> String {
             entry(o, t),
             label,
             expected
+        );
+    }
+    s
+}
+
+/// The response per unit floor acceleration as f -> 0 for each translation (its real part),
+/// next to the equivalence principle's values: x_t acts as the tilt eta_t = a_x / g, y_t as
+/// theta_t = -a_y / g, z_t as a change of g (each fibre stretched by the extra weight it
+/// carries).
+pub fn translation_limits(model: &Model) -> String {
+    let limit = tiltnoise_core::model::translation::acceleration_limit(model);
+    let observe = |o: Observable, a: TranslationAxis| limit[(o.index(), a.index())].re;
+    let p = model.params();
+    let g = p.environment.g_m_per_s2;
+    let lever = model.derived().lever_m;
+    let (m_a, m_b) = (p.mass.m_a_kg, p.mass.m_b_kg);
+    let hooke = -((m_a + m_b) / p.bouncing.kappa_a_n_per_m + m_b / p.bouncing.kappa_b_n_per_m);
+    let mut s = String::from(
+        "floor translation per unit floor acceleration a = -w^2 u (f -> 0; equivalence principle):\n",
+    );
+    for (o, a, expected, label) in [
+        (
+            Observable::X,
+            TranslationAxis::XT,
+            -lever / g,
+            "X/eta_t / g",
+        ),
+        (
+            Observable::Y,
+            TranslationAxis::YT,
+            -lever / g,
+            "-Y/theta_t / g",
+        ),
+        (
+            Observable::Z,
+            TranslationAxis::ZT,
+            hooke,
+            "-((m_a+m_b)/kappa_a + m_b/kappa_b)",
+        ),
+    ] {
+        let _ = writeln!(
+            s,
+            "  {}/{} / (-w^2) = {:+.6e} s^2   ({label} = {expected:+.6e} s^2)",
+            o.name(),
+            a.name(),
+            observe(o, a),
         );
     }
     s

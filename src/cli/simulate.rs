@@ -6,22 +6,25 @@
 use super::figure_args::FigureArgs;
 use super::output::save_image;
 use super::Run;
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{bail, Context, Result};
 use clap::Args;
 use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use tiltnoise_core::error::{Num, Shown};
+use tiltnoise_core::error::Num;
 use tiltnoise_core::limits::{check_memory, planned_bytes, STREAMED_WELCH_BYTES_PER_SAMPLE};
-use tiltnoise_core::model::{Coord, Model, Observable};
+use tiltnoise_core::model::{Model, Observable};
 use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::noise::Readout;
+use tiltnoise_core::options;
+use tiltnoise_core::options::Spelling;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::simulate::resonance::check_resonances;
 use tiltnoise_core::simulate::stream::{
     check_streamed_samples, FreeMotion, MinMaxEnvelope, SimChunk,
 };
 use tiltnoise_core::simulate::{
-    aliased_frequency_hz, default_sim_nperseg, equal_energy_init, kick_x, InitialState,
+    self, aliased_frequency_hz, default_sim_nperseg, parse_coordinates, Excitation, InitialState,
     ModalPropagator, SimConfig, DEFAULT_MODE_ENERGY_J,
 };
 use tiltnoise_core::spectral::{Psd, WelchAccumulator, WelchConfig};
@@ -33,9 +36,6 @@ use tiltnoise_plot::simulate_figure::{
 };
 
 mod driven;
-
-/// Default readout: the paper's 9 nm/sqrt(Hz) on X (the angles are noiseless unless given).
-const DEFAULT_X_READOUT_ASD_M: f64 = 9e-9;
 
 /// Runs with at least this many samples get a progress bar on a terminal (about 2 s of work).
 const WORTH_A_BAR: usize = 1 << 23;
@@ -164,123 +164,34 @@ pub(crate) struct SimulateArgs {
     figure: FigureArgs,
 }
 
+/// `--readout OBS=ASD` items over the default (the paper's 9 nm/sqrt(Hz) on X; 0 removes
+/// one), each observable once, in observable order.
 fn parse_readout(items: &[String]) -> Result<Vec<(Observable, f64)>> {
-    let mut readout = vec![(Observable::X, DEFAULT_X_READOUT_ASD_M)];
-    for item in items {
-        let (o, asd) = super::args::parse_readout_item(item)?;
-        readout.retain(|(x, _)| *x != o);
-        if asd > 0.0 {
-            readout.push((o, asd));
-        }
-    }
+    let items = items
+        .iter()
+        .map(|item| super::args::parse_readout_item(item))
+        .collect::<Result<Vec<_>>>()?;
+    let mut readout = options::apply_readout("--readout", Readout::default(), &items, None)?.asd;
     readout.sort_by_key(|(o, _)| o.index());
     Ok(readout)
 }
 
-/// Parses `COORD=VALUE,...` lists into `out` (SI units).
-fn parse_coords(option: &str, items: &[String], out: &mut [f64; 8]) -> Result<()> {
-    let names: Vec<&str> = Coord::ALL.iter().map(|c| c.name()).collect();
-    let mut given = [false; 8];
-    for item in items {
-        for entry in item.split(',').map(str::trim).filter(|e| !e.is_empty()) {
-            let shown = Shown(entry);
-            let (name, value) = entry.split_once('=').ok_or_else(|| {
-                anyhow!("{option} {shown}: expected COORD=VALUE, e.g. phi_b=0.01")
-            })?;
-            let c = Coord::ALL
-                .into_iter()
-                .find(|c| c.name() == name.trim())
-                .ok_or_else(|| {
-                    anyhow!(
-                        "{option} {shown}: unknown coordinate `{}`; allowed: {}",
-                        Shown(name.trim()),
-                        names.join(", ")
-                    )
-                })?;
-            let unit = if option == "--init" {
-                c.unit().to_string()
-            } else {
-                format!("{}/s", c.unit())
-            };
-            let v: f64 = value.trim().parse().map_err(|_| {
-                anyhow!(
-                    "{option} {shown}: `{}` is not a number",
-                    Shown(value.trim())
-                )
-            })?;
-            if !v.is_finite() {
-                bail!("{option} {shown}: {v} {unit} is not allowed: must be finite");
-            }
-            if given[c.index()] {
-                bail!("{option} {shown}: coordinate `{}` is given twice", c.name());
-            }
-            given[c.index()] = true;
-            out[c.index()] = v;
-        }
-    }
-    Ok(())
-}
-
-/// The run's initial state and a description of where it came from.
+/// The run's initial state and a description of where it came from: the kick, the given
+/// coordinates and rates, or equal energy in every mode.
 fn initial_state(model: &Model, args: &SimulateArgs) -> Result<(InitialState, String)> {
-    if let Some(x) = args.kick_x {
-        if !(x.is_finite() && x != 0.0) {
-            bail!("--kick-x {x}: the displacement (m) must be finite and non-zero");
+    let excitation = if let Some(x_m) = args.kick_x {
+        Excitation::KickX { x_m }
+    } else if !args.init.is_empty() || !args.init_rate.is_empty() {
+        let (mut q, mut qdot) = ([0.0; 8], [0.0; 8]);
+        parse_coordinates("--init", &args.init, false, &mut q)?;
+        parse_coordinates("--init-rate", &args.init_rate, true, &mut qdot)?;
+        Excitation::Given { q, qdot }
+    } else {
+        Excitation::EqualEnergy {
+            energy_j: args.mode_energy,
         }
-        let init = kick_x(model, x);
-        if init.q.iter().any(|v| !v.is_finite()) {
-            bail!(
-                "--kick-x {x}: X does not respond statically to a force on the test mass along \
-                 x for these parameters, so the kick is undefined"
-            );
-        }
-        if let Err(e) = tiltnoise_core::simulate::check_initial_state(&init) {
-            bail!(
-                "--kick-x {} m: the static deflection it starts from is outside the linear \
-                 model ({e})",
-                tiltnoise_core::error::Num(x)
-            );
-        }
-        return Ok((
-            init,
-            format!("kick: static X displacement of {x:e} m released from rest"),
-        ));
-    }
-    if !args.init.is_empty() || !args.init_rate.is_empty() {
-        let mut init = InitialState {
-            q: [0.0; 8],
-            qdot: [0.0; 8],
-        };
-        parse_coords("--init", &args.init, &mut init.q)?;
-        parse_coords("--init-rate", &args.init_rate, &mut init.qdot)?;
-        if init.q.iter().chain(&init.qdot).all(|&v| v == 0.0) {
-            bail!("--init/--init-rate: every coordinate and rate is 0: nothing moves");
-        }
-        let mut text = String::from("given:");
-        for c in Coord::ALL {
-            let (q, v) = (init.q[c.index()], init.qdot[c.index()]);
-            if q != 0.0 || v != 0.0 {
-                let _ = write!(
-                    text,
-                    " {}={q:e} {}, rate {v:e} {}/s;",
-                    c.name(),
-                    c.unit(),
-                    c.unit()
-                );
-            }
-        }
-        return Ok((init, text.trim_end_matches(';').to_string()));
-    }
-    let e = args.mode_energy;
-    if !(e.is_finite() && e > 0.0) {
-        bail!("--mode-energy {e}: the energy per mode (J) must be finite and > 0");
-    }
-    Ok((
-        equal_energy_init(model, e),
-        format!(
-            "equal energy {e:e} J in each of the 8 modes, phases 0.7 + 1.3·k rad for mode k = 0..7"
-        ),
-    ))
+    };
+    Ok(simulate::initial_state(model, &excitation, Spelling::Flag)?)
 }
 
 /// Runs `tiltnoise simulate`.

@@ -17,7 +17,9 @@ use std::path::{Path, PathBuf};
 use tiltnoise_core::error::{Num, OutputError, Shown};
 use tiltnoise_core::model::{Input, Observable};
 use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::options;
 use tiltnoise_core::params::Params;
+use tiltnoise_core::repeats::{refuse_repeated_keys, refuse_repeats};
 use tiltnoise_core::subtract::{
     subtract, MeasuredRecord, Method, NoiseLevel, StartTime, Status, SubtractConfig,
     SubtractResult, WitnessNoise, WitnessRecord,
@@ -165,6 +167,13 @@ fn parse_band(option: &str, text: &str) -> Result<(f64, f64)> {
     Ok((a, b))
 }
 
+/// `--fit KEY,...`: the parameter keys, each once.
+fn fit_keys(specs: &[String]) -> Result<Vec<String>> {
+    let keys = options::split_names("--fit", specs)?;
+    refuse_repeats("--fit", "parameter key", &keys, |k| k.to_string())?;
+    Ok(keys.into_iter().map(str::to_string).collect())
+}
+
 /// `--colocated-ratio INPUT=R`, each input once.
 fn parse_colocated_ratio(items: &[String]) -> Result<Vec<(Input, f64)>> {
     let mut out: Vec<(Input, f64)> = Vec::new();
@@ -254,23 +263,15 @@ fn select_observables(
             .collect::<Vec<_>>()
             .join(", ")
     };
-    let mut wanted: Vec<Observable> = Vec::new();
-    for name in names.iter().map(|n| n.trim()) {
-        let o = Observable::from_name(name).ok_or_else(|| {
-            anyhow!(
-                "--observables: unknown observable `{}`; allowed: X, Y, Z, theta, eta, phi, phi_a",
-                Shown(name)
-            )
-        })?;
-        if !channels.iter().any(|c| c.0 == o) {
+    let wanted = options::parse_outputs("--observables", names)?;
+    for o in &wanted {
+        if !channels.iter().any(|c| c.0 == *o) {
             bail!(
-                "--observables {name}: --measured {} has no channel {name}; it has {}",
+                "--observables {0}: --measured {1} has no channel {0}; it has {2}",
+                o.name(),
                 path.display(),
                 available()
             );
-        }
-        if !wanted.contains(&o) {
-            wanted.push(o);
         }
     }
     Ok(channels
@@ -307,16 +308,16 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
              (a three-cornered hat needs no noise ratio)"
         );
     }
-    let mut readout: Vec<(Observable, f64)> = Vec::new();
-    for item in &args.readout {
-        let (o, asd) = parse_readout_item(item)?;
-        readout.retain(|(x, _)| *x != o);
-        readout.push((o, asd));
-    }
+    refuse_repeated_keys("--readout", "observable", &args.readout)?;
+    let readout = args
+        .readout
+        .iter()
+        .map(|item| parse_readout_item(item))
+        .collect::<Result<Vec<_>>>()?;
     let cfg = SubtractConfig {
         segment_len: args.nperseg,
         holdout_fraction: args.holdout,
-        keys: args.fit.iter().map(|k| k.trim().to_string()).collect(),
+        keys: fit_keys(&args.fit)?,
         fit_band_hz: args
             .band
             .as_deref()

@@ -2,13 +2,15 @@
 //! observables, on a frequency grid, with the same outputs (CSV, HDF5, figures) and methods for
 //! every kind of input.
 //!
-//! Inputs are named as in files: the tilt angles `theta_t`, `eta_t`, `phi_t` (rad) and the twelve
-//! components `F_a.x` .. `M_b.z` of the forces (N, applied at the centres of mass) and torques
-//! (N m, about the centres of mass) on the crossbar (`a`) and the test mass (`b`), inertial axes
-//! (Appendix A of the paper, zeroth order). Observables: `X`, `Y`, `Z` (m), `theta`, `eta`, `phi`,
-//! `phi_a` (rad). Entries are complex responses per unit input: m/rad, rad/rad, m/N, rad/(N m), ...
+//! Inputs are named as in files: the tilt angles `theta_t`, `eta_t`, `phi_t` (rad), the floor's
+//! translations `x_t`, `y_t`, `z_t` (m, along the lab axes: the crossbar arm along y), and the
+//! twelve components `F_a.x` .. `M_b.z` of the forces (N, applied at the centres of mass) and
+//! torques (N m, about the centres of mass) on the crossbar (`a`) and the test mass (`b`),
+//! inertial axes (Appendix A of the paper, zeroth order). Observables: `X`, `Y`, `Z` (m), `theta`,
+//! `eta`, `phi`, `phi_a` (rad). Entries are complex responses per unit input: m/rad, rad/rad,
+//! m/m, rad/m, m/N, rad/(N m), ...
 
-use super::args::MethodArg;
+use super::args::{MethodArg, PerArg};
 use super::figure_args::FigureArgs;
 use super::output::save_tf;
 use super::Run;
@@ -17,6 +19,7 @@ use clap::Args;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::freq;
+use tiltnoise_core::ground::GroundQuantity;
 use tiltnoise_core::limits::{MAX_GRID_POINTS, MAX_STREAMED_GRID_POINTS};
 use tiltnoise_core::model::{Model, Observable};
 use tiltnoise_core::modes::NormalModes;
@@ -42,18 +45,26 @@ pub struct TfArgs {
     #[arg(long, value_name = "FILE")]
     freq_file: Option<PathBuf>,
     /// Inputs (columns), comma-separated and/or repeated: tilt angles theta_t, eta_t, phi_t
-    /// (rad); force components F_a.x, F_a.y, F_a.z, F_b.x, F_b.y, F_b.z (N) and torque components
-    /// M_a.x .. M_b.z (N m) on the crossbar (a) and the test mass (b); the groups `tilt` (the
-    /// three tilt angles) and `forces` (all twelve components). Default: tilt.
+    /// (rad); floor translations x_t, y_t, z_t (m; the crossbar arm along y); force components
+    /// F_a.x, F_a.y, F_a.z, F_b.x, F_b.y, F_b.z (N) and torque components M_a.x .. M_b.z (N m)
+    /// on the crossbar (a) and the test mass (b); the groups `tilt` (the three tilt angles),
+    /// `translation` (the three translations), `ground` (tilt and translation) and `forces`
+    /// (all twelve components). Default: tilt.
     #[arg(long = "input", value_name = "NAME[,NAME...]")]
     inputs: Vec<String>,
+    /// Express the transfer functions from the floor's motion (tilt and translation inputs) per
+    /// unit of its displacement (rad, m), velocity (rad/s, m/s) or acceleration (rad/s^2,
+    /// m/s^2): the response per unit displacement times 1/(i w) or -1/w^2. Force and torque
+    /// inputs stay per N and N m. Velocity and acceleration need frequencies above 0 Hz.
+    #[arg(long, value_enum, default_value_t = PerArg::Displacement)]
+    per: PerArg,
     /// Observables (rows), comma-separated and/or repeated: X, Y, Z (m), theta, eta, phi, phi_a
     /// (rad). Default: all seven.
     #[arg(long = "output", value_name = "NAME[,NAME...]")]
     outputs: Vec<String>,
     /// Output file, format from the extension: .h5 (all numbers), .csv, .png/.svg (|H| per
-    /// observable, one panel per kind of input: tilt, forces, torques; tilt alone is the paper's
-    /// Figure 5). Repeatable. Without --save the CSV goes to stdout.
+    /// observable, one panel per kind of input: tilt, translation, forces, torques; tilt alone
+    /// is the paper's Figure 5). Repeatable. Without --save the CSV goes to stdout.
     #[arg(long, value_name = "PATH")]
     save: Vec<PathBuf>,
     /// Evaluation method.
@@ -170,12 +181,28 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
             Ok(tiltnoise_io::OutputKind::Png | tiltnoise_io::OutputKind::Svg)
         )
     });
+    let per = args.per.quantity();
     let model = Model::new(params)?;
     let grid = match (&args.freq, &args.freq_file) {
         (Some(spec), _) => Grid::Log(freq::parse_log_spec(spec, MAX_STREAMED_GRID_POINTS)?),
         (None, Some(path)) => Grid::Points(read_freq_file(path)?),
         (None, None) => Grid::Points(freq::default_grid(&model)),
     };
+    if let (Grid::Points(freqs), Some(path)) = (&grid, &args.freq_file) {
+        let ground = request.inputs.iter().any(|i| i.is_ground());
+        if let Some(k) = freqs.iter().position(|&f| per.to_displacement(f).is_none()) {
+            if ground {
+                bail!(
+                    "--per {q}: frequency {} of {} is 0 Hz, where a transfer function per unit \
+                     floor {q} has no value (a {q} carries no displacement at DC); use \
+                     frequencies above 0 Hz",
+                    k + 1,
+                    path.display(),
+                    q = per.name(),
+                );
+            }
+        }
+    }
     if let (Some(path), Grid::Log(g)) = (figure_path, &grid) {
         if g.len() > MAX_GRID_POINTS {
             bail!(
@@ -221,7 +248,9 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
         return stream_tf(plan.as_ref(), &grid, block_freqs, &args, &model, &meta, run);
     }
     let freqs = grid.block(0, grid.len());
-    let tf = tf::evaluate(plan.as_ref(), &freqs).context("evaluating the transfer functions")?;
+    let tf = tf::evaluate(plan.as_ref(), &freqs)
+        .and_then(|tf| per_unit(tf, per))
+        .context("evaluating the transfer functions")?;
     write_report(&mut run.out, &model, &modes, &request)?;
     run.write_outputs(false, || {
         for path in &args.save {
@@ -229,6 +258,17 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
         }
         Ok(())
     })
+}
+
+/// `tf` with the floor's motion per unit `per` (as it is when `per` is the displacement).
+fn per_unit(
+    tf: tf::TransferMatrix,
+    per: GroundQuantity,
+) -> Result<tf::TransferMatrix, tiltnoise_core::error::TfError> {
+    match per {
+        GroundQuantity::Displacement => Ok(tf),
+        _ => tf.per_ground_quantity(per),
+    }
 }
 
 /// Frequencies per block of a streamed grid: 16384 points of the largest request (7 x 15
@@ -280,7 +320,8 @@ impl Grid {
     }
 }
 
-/// The modes table and, for tilt inputs, the static limits (printed when files are saved).
+/// The modes table and, for tilt inputs, the static limits, for translations their limits per
+/// unit acceleration (printed when files are saved).
 fn write_report(
     out: &mut super::stdout::Out,
     model: &Model,
@@ -291,6 +332,14 @@ fn write_report(
     if request.inputs.iter().any(|i| matches!(i, Input::Tilt(_))) {
         writeln!(out)?;
         write!(out, "{}", super::report::static_limits(model))?;
+    }
+    if request
+        .inputs
+        .iter()
+        .any(|i| matches!(i, Input::Translation(_)))
+    {
+        writeln!(out)?;
+        write!(out, "{}", super::report::translation_limits(model))?;
     }
     Ok(())
 }
@@ -331,7 +380,9 @@ fn stream_tf(
     let mut start = 0;
     while start < n {
         let freqs = grid.block(start, block_freqs);
-        let block = tf::evaluate(plan, &freqs).context("evaluating the transfer functions")?;
+        let block = tf::evaluate(plan, &freqs)
+            .and_then(|tf| per_unit(tf, args.per.quantity()))
+            .context("evaluating the transfer functions")?;
         for w in &mut hdf5 {
             w.append(&block)?;
         }
@@ -341,11 +392,7 @@ fn stream_tf(
         if args.save.is_empty() {
             text.clear();
             if start == 0 {
-                text.push_str(&tiltnoise_io::tf_csv_header(
-                    &block.outputs,
-                    &block.inputs,
-                    meta,
-                ));
+                text.push_str(&tiltnoise_io::tf_csv_header(&block, meta));
             }
             tiltnoise_io::push_tf_csv_rows(&mut text, &block);
             write!(run.out, "{text}")?;

@@ -240,7 +240,7 @@ fn bad_open_budget_requests_exit_2_and_write_nothing() {
     let cases: Vec<(Vec<String>, Vec<String>)> = vec![
         (
             vec!["--observables".into(), "X,Q".into()],
-            vec!["--observables".into(), "unknown observable `Q`".into()],
+            vec!["--observables".into(), "unknown observable \"Q\"".into()],
         ),
         (
             vec!["--observables".into(), "X,X".into()],
@@ -306,7 +306,7 @@ fn bad_open_budget_requests_exit_2_and_write_nothing() {
                 "--term".into(),
                 format!("a=X:{g}"),
             ],
-            vec!["`a` is given twice".into()],
+            vec!["--term: a is given twice".into()],
         ),
         (
             vec!["--term".into(), "a=phi".into()],

@@ -30,6 +30,30 @@ pub fn shared_tilt_data(test: &str, rel: &str) -> Option<PathBuf> {
     None
 }
 
+/// The numbers of a CSV that `tiltnoise tf` writes: the header, the frequencies, and per
+/// frequency the complex entries `(re, im)` in header order.
+pub fn parse_tf_csv(text: &str) -> (Vec<String>, Vec<f64>, Vec<Vec<num_complex::Complex64>>) {
+    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
+    let header: Vec<String> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let (mut freqs, mut rows) = (Vec::new(), Vec::new());
+    for line in lines {
+        let v: Vec<f64> = line.split(',').map(|s| s.parse().unwrap()).collect();
+        freqs.push(v[0]);
+        rows.push(
+            v[1..]
+                .chunks_exact(2)
+                .map(|c| num_complex::Complex64::new(c[0], c[1]))
+                .collect(),
+        );
+    }
+    (header, freqs, rows)
+}
+
 /// Runs the `tiltnoise` binary with `args`.
 ///
 /// Tests run in parallel threads of one process: a child spawned while another thread holds an

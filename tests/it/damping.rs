@@ -52,7 +52,7 @@ fn viscous() -> Params {
 }
 
 fn request() -> Request {
-    let mut inputs = Input::all_tilts();
+    let mut inputs = Input::all_ground();
     for name in ["F_b.x", "M_b.z", "F_b.z", "M_a.z"] {
         inputs.push(Input::Force(ForceInput::from_name(name).unwrap()));
     }
@@ -73,7 +73,7 @@ fn grid(model: &Model) -> Vec<f64> {
 }
 
 /// Direct, block and split against the reference on every entry of the request. LU methods (tilt
-/// inputs): `LU_GAMMA kappa` with `kappa` the entry's condition number in the paper's coordinates,
+/// and floor-translation inputs): `LU_GAMMA kappa` with `kappa` the entry's condition number in the paper's coordinates,
 /// as in `crates/tiltnoise-core/tests/it/stability.rs`. Force inputs only for split: in relative
 /// angles the direct and block LU lose relative accuracy on force entries that are differences of
 /// O(1) coordinates (phi/F_b.x above the swing modes, documented in
@@ -100,7 +100,10 @@ fn check_against_reference(params: &Params, label: &str) {
         let req = if accurate {
             request()
         } else {
-            Request::all_tilt()
+            Request {
+                outputs: Observable::ALL.to_vec(),
+                inputs: Input::all_ground(),
+            }
         };
         let tf = plan(&model, &req, method).unwrap();
         for &f in &grid(&model) {

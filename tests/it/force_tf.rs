@@ -13,7 +13,7 @@
 use crate::common;
 use crate::tolerances::{CSV_ROUND_TRIP, DD_REF_FACTOR, POLE_EXCLUSION, TARGET_REL};
 
-use common::{assert_fails_without_output, tiltnoise};
+use common::{assert_fails_without_output, parse_tf_csv, tiltnoise};
 use num_complex::Complex64;
 use std::path::Path;
 use tiltnoise_core::model::{ForceInput, Model, Observable};
@@ -28,29 +28,6 @@ fn params_damped() -> Params {
         .and_then(|p| p.with_override("loss.torsion_b_rad=3e-4"))
         .and_then(|p| p.with_override("loss.bouncing_b_rad=1e-3"))
         .unwrap()
-}
-
-/// Parses the CSV that `tf` prints: header, then rows `f, (re, im) per entry`.
-fn parse_csv(text: &str) -> (Vec<String>, Vec<f64>, Vec<Vec<Complex64>>) {
-    let mut lines = text.lines().filter(|l| !l.starts_with('#'));
-    let header: Vec<String> = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_string)
-        .collect();
-    let (mut freqs, mut rows) = (Vec::new(), Vec::new());
-    for line in lines {
-        let v: Vec<f64> = line.split(',').map(|s| s.parse().unwrap()).collect();
-        freqs.push(v[0]);
-        rows.push(
-            v[1..]
-                .chunks_exact(2)
-                .map(|c| Complex64::new(c[0], c[1]))
-                .collect(),
-        );
-    }
-    (header, freqs, rows)
 }
 
 /// True when `f` is within [`POLE_EXCLUSION`] of a normal mode of `model`.
@@ -95,7 +72,7 @@ fn cli_force_and_torque_columns_match_the_reference() {
             "1e-4:60:30",
         ]);
         assert!(out.status.success(), "{}", common::stderr(&out));
-        let (header, freqs, rows) = parse_csv(&String::from_utf8(out.stdout).unwrap());
+        let (header, freqs, rows) = parse_tf_csv(&String::from_utf8(out.stdout).unwrap());
         // Columns: every observable per input, row-major, in the order given.
         assert_eq!(header[1], "X.F_b.x.re");
         assert_eq!(header[2 * inputs.len() + 1], "Y.F_b.x.re");
@@ -166,7 +143,7 @@ fn cli_writes_hdf5_csv_and_figures_for_force_inputs() {
     assert_eq!(inputs, ["F_b.x", "M_b.z"]);
     let csv = std::fs::read_to_string(p("f.csv")).unwrap();
     let csv_rows: Vec<&str> = csv.lines().filter(|l| !l.starts_with('#')).collect();
-    let (_, freqs, rows) = parse_csv(&csv_rows.join("\n"));
+    let (_, freqs, rows) = parse_tf_csv(&csv_rows.join("\n"));
     assert_eq!(freqs.len(), 200);
     let model = Model::new(&Params::table_i()).unwrap();
     let req = request(
@@ -209,7 +186,7 @@ fn torque_on_the_test_mass_near_torsion_agrees_with_the_two_dof_model() {
     assert!(out.status.success(), "{}", common::stderr(&out));
     let explain = common::stderr(&out);
     assert!(explain.contains("picked `torsion2`"), "{explain}");
-    let (_, freqs, rows) = parse_csv(&String::from_utf8(out.stdout).unwrap());
+    let (_, freqs, rows) = parse_tf_csv(&String::from_utf8(out.stdout).unwrap());
     let params = Params::table_i();
     let model = Model::new(&params).unwrap();
     let modes = NormalModes::new(&model);

@@ -1138,22 +1138,33 @@ fn spectra_csv_errors_name_row_and_column() {
         (
             "freq_hz,theta_t\n-1,1\n1,1\n",
             "negf",
-            &["line 2 (row 0)", "-1", "> 0"],
+            &["line 2 (row 0)", "-1", "from 1e-9 to 1e6 Hz"],
         ),
         (
             "freq_hz,theta_t\n0,1\n1,1\n",
             "zerof",
-            &["line 2 (row 0)", "frequency 0.0 Hz", "> 0"],
+            &["line 2 (row 0)", "frequency 0.0 Hz", "from 1e-9 to 1e6 Hz"],
         ),
         (
             "freq_hz,theta_t,eta_t\n1,1,1\n2,1,-1e-9\n",
             "negasd",
-            &["line 3 (row 1)", "`eta_t`", "-1e-9", "rad/sqrt(Hz)", ">= 0"],
+            &[
+                "line 3 (row 1)",
+                "`eta_t`",
+                "-1e-9",
+                "rad/sqrt(Hz)",
+                "0 or a value from",
+            ],
         ),
         (
             "freq_hz,theta_t\n1,1\n2,nan\n",
             "nanasd",
-            &["line 3 (row 1)", "`theta_t`", "NaN", "finite"],
+            &[
+                "line 3 (row 1)",
+                "`theta_t`",
+                "NaN",
+                "0 or a value from 1e-40",
+            ],
         ),
         (
             "freq_hz,theta_t\n1,1\n",
@@ -1311,7 +1322,11 @@ fn spectra_hdf5_errors() {
     );
     let e = spectra_err(&p, &ReadOptions::default());
     assert!(matches!(e, InputError::Asd { .. }));
-    err_msg(e, &p, &["/asd[1, 1]", "`eta_t`", "-2", ">= 0"]);
+    err_msg(
+        e,
+        &p,
+        &["/asd[1, 1]", "`eta_t`", "-2", "0 or a value from 1e-40"],
+    );
 
     let p = dir.path().join("freq.h5");
     write_asd_h5(&p, &[0.1, 0.1], &["theta_t"], &[vec![1.0], vec![1.0]]);
@@ -1475,7 +1490,7 @@ fn interpolation_zeros_coherence_and_band_restriction() {
 
 /// Finite values whose spectrum overflows: an ASD too large to square (CSV) or of `f64::MAX`
 /// (HDF5) is refused by the ASD bound, and a rate spectrum at a tiny frequency, whose division
-/// by `(2 pi f)^2` overflows, by the CSD check, naming the entry and frequency.
+/// by `(2 pi f)^2` would overflow, by the frequency bound, naming the line.
 #[test]
 fn spectra_that_overflow_are_refused() {
     let corpus = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz_corpus");
@@ -1487,7 +1502,7 @@ fn spectra_that_overflow_are_refused() {
         err_msg(
             spectra_err(&path, &ReadOptions::default()),
             &path,
-            &["ASD", "<= 1e150"],
+            &["ASD", "0 or a value from 1e-40 to 1e40 rad/sqrt(Hz)"],
         );
     }
     let dir = tmp();
@@ -1500,7 +1515,11 @@ fn spectra_that_overflow_are_refused() {
     err_msg(
         spectra_err(&rate, &opts),
         &rate,
-        &["tilt cross-spectral density S(theta_t, theta_t) at 1e-160 Hz overflows f64"],
+        &[
+            "line 2 (row 0)",
+            "frequency 1e-160 Hz",
+            "from 1e-9 to 1e6 Hz",
+        ],
     );
 }
 
@@ -1529,9 +1548,35 @@ fn absurdly_large_asds_are_refused() {
     let measured = dir.path().join("measured.csv");
     std::fs::write(&measured, "freq_hz,X\n1e-3,1e-8\n2e-3,1e200\n").unwrap();
     let e = tiltnoise_io::input::read_measured(&measured).unwrap_err();
-    err_msg(e, &measured, &["line 3", "column `X`", "1e200", "<= 1e150"]);
+    err_msg(
+        e,
+        &measured,
+        &[
+            "line 3",
+            "column `X`",
+            "1e200",
+            "from 1e-40 to 1e40 m/sqrt(Hz)",
+        ],
+    );
     let tilt = dir.path().join("tilt.csv");
     std::fs::write(&tilt, "freq_hz,theta_t\n1e-3,1e-8\n2e-3,2e150\n").unwrap();
     let e = spectra_err(&tilt, &ReadOptions::default());
-    err_msg(e, &tilt, &["column `theta_t`", "2e150", "<= 1e150"]);
+    err_msg(
+        e,
+        &tilt,
+        &["column `theta_t`", "2e150", "from 1e-40 to 1e40"],
+    );
+    // Nonzero ASDs whose PSD would underflow are refused too; zero stays.
+    std::fs::write(&tilt, "freq_hz,theta_t\n1e-3,0\n2e-3,1e-200\n").unwrap();
+    let e = spectra_err(&tilt, &ReadOptions::default());
+    err_msg(
+        e,
+        &tilt,
+        &[
+            "line 3",
+            "column `theta_t`",
+            "1e-200",
+            "0 or a value from 1e-40",
+        ],
+    );
 }

@@ -182,7 +182,10 @@ fn bad_input_exits_2_names_the_option_and_writes_nothing() {
         (vec!["--init", "phi_b"], vec!["--init phi_b", "COORD=VALUE"]),
         (vec!["--kick-x", "nan"], vec!["--kick-x NaN", "finite"]),
         (vec!["--mode-energy", "-1"], vec!["--mode-energy -1", "> 0"]),
-        (vec!["--readout", "X=-1"], vec!["--readout X=-1", ">= 0"]),
+        (
+            vec!["--readout", "X=-1"],
+            vec!["--readout X=-1", "0 or a value from 1e-40"],
+        ),
         (vec!["--readout", "W=1"], vec!["unknown observable `W`"]),
         (
             vec!["--set", "loss.torsion_b_rad=1e-3"],

@@ -238,6 +238,19 @@ pub enum TfError {
     /// A grid whose result does not fit into the memory available ([`crate::tf::evaluate`]).
     #[error(transparent)]
     TooLarge(#[from] LimitError),
+    /// A transfer function per unit velocity or acceleration of the floor asked for where it has
+    /// no value from the one per unit displacement (0 Hz, see [`crate::ground`]).
+    #[error(
+        "a transfer function per unit floor {quantity} has no value at {} Hz (a {quantity} \
+         carries no displacement there): use frequencies above 0 Hz",
+        Num(*.freq_hz)
+    )]
+    NoGroundFactor {
+        /// `velocity` or `acceleration`.
+        quantity: &'static str,
+        /// The frequency.
+        freq_hz: f64,
+    },
     /// The planner found no method that meets the requested tolerance, or cannot plan the
     /// request ([`crate::tf::plan_auto`]).
     #[error("{message}")]

@@ -2,8 +2,8 @@
 //!
 //! The 8-degree-of-freedom linear model of the double torsion pendulum PETER (De Marchi et al.,
 //! Phys. Rev. D 87, 122006, 2013): mass and stiffness matrices, normal modes, generalized forces
-//! and the transfer functions from floor tilt and from forces and torques to the test-mass
-//! observables; spectral estimation, typed noise terms and budgets, thermal noise, Monte Carlo,
+//! and the transfer functions from the floor's tilt and translation and from forces and torques
+//! to the test-mass observables; spectral estimation, typed noise terms and budgets, thermal noise, Monte Carlo,
 //! fit and simulation.
 //!
 //! Data flow is one way: [`params`] -> [`model`] -> [`modes`], [`tf`] -> [`spectral`],
@@ -13,8 +13,10 @@
 //!
 //! Conventions, stated at every boundary: SI units (the unit is part of every parameter key),
 //! one-sided spectra (PSD in unit^2/Hz, ASD its square root), complex amplitudes for
-//! `e^{+i w t}` time dependence, and the tilt sign of [`model::tilt`] (in which
-//! `X -> -eta_t (Z + Z_b + h_c)` as f -> 0).
+//! `e^{+i w t}` time dependence, the tilt sign of [`model::tilt`] (in which
+//! `X -> -eta_t (Z + Z_b + h_c)` as f -> 0), and the floor translation of [`model::translation`]
+//! (the floor's displacement along the lab axes, the crossbar arm along y; per unit floor
+//! acceleration it acts as the tilt `eta_t = a_x / g`, `theta_t = -a_y / g` as f -> 0).
 //!
 //! Normal modes, and transfer functions named by observable and input (the planner picks the
 //! cheapest method within 1e-9 of the double-double reference):
@@ -52,6 +54,7 @@ pub mod dd;
 pub mod error;
 pub mod fit;
 pub mod freq;
+pub mod ground;
 pub mod input;
 pub mod limits;
 pub mod mc;
@@ -63,6 +66,7 @@ mod num_text;
 pub mod options;
 pub mod params;
 pub mod reference;
+pub mod repeats;
 pub mod rng;
 pub mod simulate;
 pub mod spectral;

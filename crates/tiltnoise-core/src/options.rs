@@ -5,9 +5,10 @@
 //! ([`Spelling`]), then the value given and what is allowed.
 
 use crate::error::{Num, Shown};
-use crate::limits::LimitError;
+use crate::limits::{LimitError, ASDS};
 use crate::model::{ForceInput, Input, Observable};
 use crate::noise::Readout;
+use crate::repeats::{refuse_repeats, Repeated};
 
 /// How a front end spells its options in messages.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -65,16 +66,9 @@ pub enum OptionError {
         /// The name given.
         name: String,
     },
-    /// A name given twice (also through a group).
-    #[error("{option}: {name} is given twice; name each {what} once")]
-    Repeated {
-        /// The option.
-        option: String,
-        /// The name.
-        name: &'static str,
-        /// `input` or `observable`.
-        what: &'static str,
-    },
+    /// A key or name given twice (also through a group).
+    #[error(transparent)]
+    Repeated(#[from] Repeated),
     /// A readout item that is not `OBS=ASD`.
     #[error("{option} {}: expected OBS=ASD, e.g. X=9e-9", Shown(.item))]
     ReadoutSyntax {
@@ -103,8 +97,14 @@ pub enum OptionError {
         /// The value's text.
         value: String,
     },
-    /// A readout ASD that is negative or not finite.
-    #[error("{option} {}: ASD {asd} {unit}/sqrt(Hz) is not allowed: must be finite and >= 0", Shown(.item))]
+    /// A readout ASD that is negative, not finite, or outside [`ASDS`] (its PSD would overflow
+    /// or underflow).
+    #[error(
+        "{option} {}: ASD {} {unit}/sqrt(Hz) is not allowed: must be {} (see docs/limits.md)",
+        Shown(.item),
+        Num(*.asd),
+        ASDS.allowed(&format!("{unit}/sqrt(Hz)"))
+    )]
     ReadoutAsd {
         /// The option.
         option: String,
@@ -136,9 +136,12 @@ pub enum OptionError {
 
 /// Every input name, for messages.
 pub fn input_names() -> String {
-    let mut names: Vec<&str> = Input::all_tilts().into_iter().map(Input::name).collect();
+    let mut names: Vec<&str> = Input::all_ground().into_iter().map(Input::name).collect();
     names.extend(ForceInput::ALL.iter().map(|f| f.name()));
-    format!("{}, or the groups `tilt` and `forces`", names.join(", "))
+    format!(
+        "{}, or the groups `tilt`, `translation`, `ground` and `forces`",
+        names.join(", ")
+    )
 }
 
 /// Every observable name, for messages.
@@ -170,38 +173,29 @@ pub fn split_names<'a, S: AsRef<str>>(
 }
 
 /// The inputs named by `specs` ([`split_names`]): tilt angles (`theta_t`, `eta_t`, `phi_t`),
-/// force and torque components (`F_a.x` .. `M_b.z`) and the groups `tilt` and `forces`, in
-/// the order given, each once; no name means the three tilt angles.
+/// floor translations (`x_t`, `y_t`, `z_t`), force and torque components (`F_a.x` .. `M_b.z`)
+/// and the groups `tilt`, `translation`, `ground` (tilt and translation) and `forces`, in the
+/// order given, each once; no name means the three tilt angles.
 pub fn parse_inputs<S: AsRef<str>>(option: &str, specs: &[S]) -> Result<Vec<Input>, OptionError> {
     if specs.is_empty() {
         return Ok(Input::all_tilts());
     }
     let mut inputs: Vec<Input> = Vec::new();
     for name in split_names(option, specs)? {
-        let group: Vec<Input> = match name {
-            "tilt" => Input::all_tilts(),
-            "forces" => ForceInput::ALL.into_iter().map(Input::Force).collect(),
-            _ => match Input::from_name(name) {
-                Some(i) => vec![i],
-                None => {
-                    return Err(OptionError::UnknownInput {
-                        option: option.to_string(),
-                        name: name.to_string(),
-                    })
-                }
-            },
-        };
-        for i in group {
-            if inputs.contains(&i) {
-                return Err(OptionError::Repeated {
+        match name {
+            "tilt" => inputs.extend(Input::all_tilts()),
+            "translation" => inputs.extend(Input::all_translations()),
+            "ground" => inputs.extend(Input::all_ground()),
+            "forces" => inputs.extend(ForceInput::ALL.into_iter().map(Input::Force)),
+            _ => inputs.push(
+                Input::from_name(name).ok_or_else(|| OptionError::UnknownInput {
                     option: option.to_string(),
-                    name: i.name(),
-                    what: "input",
-                });
-            }
-            inputs.push(i);
+                    name: name.to_string(),
+                })?,
+            ),
         }
     }
+    refuse_repeats(option, "input", &inputs, |i| i.name().to_string())?;
     Ok(inputs)
 }
 
@@ -214,21 +208,16 @@ pub fn parse_outputs<S: AsRef<str>>(
     if specs.is_empty() {
         return Ok(Observable::ALL.to_vec());
     }
-    let mut outputs = Vec::new();
-    for name in split_names(option, specs)? {
-        let o = Observable::from_name(name).ok_or_else(|| OptionError::UnknownObservable {
-            option: option.to_string(),
-            name: name.to_string(),
-        })?;
-        if outputs.contains(&o) {
-            return Err(OptionError::Repeated {
+    let outputs = split_names(option, specs)?
+        .into_iter()
+        .map(|name| {
+            Observable::from_name(name).ok_or_else(|| OptionError::UnknownObservable {
                 option: option.to_string(),
-                name: o.name(),
-                what: "observable",
-            });
-        }
-        outputs.push(o);
-    }
+                name: name.to_string(),
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    refuse_repeats(option, "observable", &outputs, |o| o.name().to_string())?;
     Ok(outputs)
 }
 
@@ -273,7 +262,7 @@ fn check_readout_asd(
     o: Observable,
     asd: f64,
 ) -> Result<(Observable, f64), OptionError> {
-    if !(asd.is_finite() && asd >= 0.0) {
+    if !ASDS.admits(asd) {
         return Err(OptionError::ReadoutAsd {
             option: option.to_string(),
             item: item.to_string(),
@@ -284,15 +273,17 @@ fn check_readout_asd(
     Ok((o, asd))
 }
 
-/// `readout` with the items applied in order: a value replaces the observable's readout (the
-/// default is the paper's 9e-9 m/sqrt(Hz) on X), 0 removes it. With `budgeted`, an
-/// observable outside it is refused.
+/// `readout` with the items applied: a value replaces the observable's readout (the default is
+/// the paper's 9e-9 m/sqrt(Hz) on X), 0 removes it. An observable given twice is refused; with
+/// `budgeted`, so is an observable outside it.
 pub fn apply_readout(
     option: &str,
     mut readout: Readout,
     items: &[(Observable, f64)],
     budgeted: Option<&[Observable]>,
 ) -> Result<Readout, OptionError> {
+    let observables: Vec<Observable> = items.iter().map(|(o, _)| *o).collect();
+    refuse_repeats(option, "observable", &observables, |o| o.name().to_string())?;
     for &(o, asd) in items {
         if let Some(budgeted) = budgeted {
             if !budgeted.contains(&o) {
@@ -347,6 +338,15 @@ mod tests {
         );
         assert_eq!(parse_inputs("--input", &["forces"]).unwrap().len(), 12);
         assert_eq!(parse_inputs("--input", &["tilt,forces"]).unwrap().len(), 15);
+        assert_eq!(
+            parse_inputs("--input", &["translation"]).unwrap(),
+            Input::all_translations()
+        );
+        let ground = parse_inputs("--input", &["ground"]).unwrap();
+        let names: Vec<&str> = ground.iter().map(|i| i.name()).collect();
+        assert_eq!(names, ["theta_t", "eta_t", "phi_t", "x_t", "y_t", "z_t"]);
+        let e = parse_inputs("--input", &["ground,y_t"]).unwrap_err();
+        assert!(e.to_string().contains("y_t is given twice"), "{e}");
     }
 
     #[test]
@@ -411,7 +411,8 @@ mod tests {
             ("X=abc", "--readout X=abc: `abc` is not a number"),
             (
                 "X=-1",
-                "--readout X=-1: ASD -1 m/sqrt(Hz) is not allowed: must be finite and >= 0",
+                "--readout X=-1: ASD -1 m/sqrt(Hz) is not allowed: must be 0 or a value from \
+                 1e-40 to 1e40 m/sqrt(Hz) (see docs/limits.md)",
             ),
         ];
         for (item, want) in cases {
@@ -426,7 +427,8 @@ mod tests {
             readout_item("readout", "phi", f64::NAN)
                 .unwrap_err()
                 .to_string(),
-            "readout phi=NaN: ASD NaN rad/sqrt(Hz) is not allowed: must be finite and >= 0"
+            "readout phi=NaN: ASD NaN rad/sqrt(Hz) is not allowed: must be 0 or a value from \
+             1e-40 to 1e40 rad/sqrt(Hz) (see docs/limits.md)"
         );
     }
 
@@ -459,5 +461,16 @@ mod tests {
             None,
         );
         assert_eq!(r.unwrap().asd.len(), 2);
+        let e = apply_readout(
+            "--readout",
+            Readout::default(),
+            &[(Observable::X, 1e-9), (Observable::X, 2e-9)],
+            None,
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "--readout: X is given twice; name each observable once"
+        );
     }
 }

@@ -5,6 +5,7 @@
 use crate::atomic::{probe_directory, NAME_MAX};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::OutputError;
+use tiltnoise_core::input::split_hdf5_address;
 
 /// Checks every output path of a run against the rules below and against the files the run
 /// reads (`inputs`: the option that names each, such as `--tilt`, and its path); the
@@ -16,8 +17,9 @@ use tiltnoise_core::error::OutputError;
 ///   is created there and removed at once).
 /// * No two outputs are the same file, and no output is an input of the run. Files are
 ///   compared by identity: device and inode for files that exist (following symbolic links),
-///   else the canonical directory and the file name, so `./out.h5` and `out.h5`, or a
-///   symbolic link and its target, are the same file.
+///   else the canonical directory and the file name, so `./out.h5` and `out.h5`, a symbolic
+///   link and its target, or two hard links, are the same file. An input given as an HDF5
+///   address (`tilt.h5:/group/dataset`, [`split_hdf5_address`]) is the file it addresses.
 ///
 /// # Errors
 ///
@@ -29,7 +31,7 @@ pub fn check_outputs(outputs: &[&Path], inputs: &[(&str, &Path)]) -> Result<(), 
     };
     let inputs: Vec<(&str, &Path, Identity)> = inputs
         .iter()
-        .map(|&(option, path)| (option, path, Identity::of(path)))
+        .map(|&(option, path)| (option, path, Identity::of(&split_hdf5_address(path).0)))
         .collect();
     let mut checked: Vec<(&Path, Identity)> = Vec::with_capacity(outputs.len());
     let mut probed: Vec<PathBuf> = Vec::new();
@@ -211,5 +213,32 @@ mod tests {
         }
         let other = d.join("other.h5");
         assert!(check_outputs(&[&other], &[("--tilt", &input)]).is_ok());
+    }
+
+    #[test]
+    fn an_hdf5_address_is_the_file_it_addresses() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let file = d.join("gw.h5");
+        std::fs::write(&file, "x").unwrap();
+        let address = d.join("gw.h5:/tilt/theta");
+        let e = refusal(&[&file], &[("--tilt", &address)]);
+        assert!(
+            e.contains("--tilt") && e.contains("replace an input"),
+            "{e}"
+        );
+        let roundabout = d.join("sub/../gw.h5");
+        std::fs::create_dir(d.join("sub")).unwrap();
+        assert!(check_outputs(&[&roundabout], &[("--tilt", &address)]).is_err());
+        #[cfg(unix)]
+        {
+            std::os::unix::fs::symlink(&file, d.join("link.h5")).unwrap();
+            let through_link = d.join("link.h5:/theta");
+            assert!(check_outputs(&[&file], &[("--tilt", &through_link)]).is_err());
+            std::fs::hard_link(&file, d.join("hard.h5")).unwrap();
+            assert!(check_outputs(&[&d.join("hard.h5")], &[("--tilt", &address)]).is_err());
+        }
+        let other = d.join("other.h5");
+        assert!(check_outputs(&[&other], &[("--tilt", &address)]).is_ok());
     }
 }

@@ -2,13 +2,13 @@
 
 use crate::atomic::write_atomic;
 use crate::csv_layout::{csv_head, CsvPreamble};
-use crate::tf_hdf5::{SIGN_CONVENTION, TIME_DEPENDENCE};
+use crate::tf_hdf5::{has_translation, SIGN_CONVENTION, TIME_DEPENDENCE, TRANSLATION_CONVENTION};
 use crate::RunMeta;
 use std::io::{BufWriter, Write as _};
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
-use tiltnoise_core::model::Observable;
-use tiltnoise_core::tf::{Input, TransferMatrix};
+use tiltnoise_core::ground::GroundQuantity;
+use tiltnoise_core::tf::TransferMatrix;
 
 /// Writes `tf` as CSV, atomically (see [`super::write_atomic`]).
 ///
@@ -37,7 +37,7 @@ pub fn write_tf_csv(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> Result<
 pub fn tf_csv_string(tf: &TransferMatrix, meta: &RunMeta) -> String {
     let (nf, no, ni) = (tf.freqs_hz.len(), tf.outputs.len(), tf.inputs.len());
     let mut s = String::with_capacity((nf + 1) * (1 + 2 * no * ni) * 24);
-    s.push_str(&tf_csv_header(&tf.outputs, &tf.inputs, meta));
+    s.push_str(&tf_csv_header(tf, meta));
     push_tf_csv_rows(&mut s, tf);
     s
 }
@@ -48,37 +48,52 @@ pub const SCHEMA_TF_CSV: &str = "tiltnoise.transfer_functions_csv";
 /// Value of the `# schema_version:` line. Bumped on any change that can break a reader.
 pub const SCHEMA_VERSION_TF_CSV: u32 = 2;
 
-/// The `#` lines and the header line of [`tf_csv_string`] (each with its newline) for these
-/// outputs and inputs.
-pub fn tf_csv_header(outputs: &[Observable], inputs: &[Input], meta: &RunMeta) -> String {
+/// The `#` lines and the header line of [`tf_csv_string`] (each with its newline) for the
+/// outputs, inputs and units of `tf` (a whole matrix or its first block).
+pub fn tf_csv_header(tf: &TransferMatrix, meta: &RunMeta) -> String {
     let mut columns = Vec::new();
-    for o in outputs {
-        for i in inputs {
-            let unit = format!("{}/{}", o.unit(), parenthesized(i.unit()));
+    for (oi, o) in tf.outputs.iter().enumerate() {
+        for (ii, i) in tf.inputs.iter().enumerate() {
+            let unit = tf.unit(oi, ii);
             let (o, i) = (o.name(), i.name());
             columns.push((format!("{o}.{i}.re"), unit.clone()));
             columns.push((format!("{o}.{i}.im"), unit));
         }
     }
+    let mut notes = vec![
+        format!("H(f) per unit input, time dependence {TIME_DEPENDENCE}"),
+        format!("tilt sign convention: {SIGN_CONVENTION}"),
+    ];
+    if has_translation(&tf.inputs) {
+        notes.push(format!("floor translation: {TRANSLATION_CONVENTION}"));
+    }
+    if let Some(per) = ground_quantity_note(tf) {
+        notes.push(per);
+    }
     let preamble = CsvPreamble {
         schema: SCHEMA_TF_CSV,
         schema_version: SCHEMA_VERSION_TF_CSV,
         meta,
-        notes: vec![
-            format!("H(f) per unit input, time dependence {TIME_DEPENDENCE}"),
-            format!("tilt sign convention: {SIGN_CONVENTION}"),
-        ],
+        notes,
     };
     csv_head(&preamble, &columns)
 }
 
-/// `N m` -> `(N m)`: a compound unit as a divisor.
-fn parenthesized(unit: &str) -> String {
-    if unit.contains(' ') || unit.contains('/') {
-        format!("({unit})")
-    } else {
-        unit.to_string()
-    }
+/// What the floor's motion is per unit of, when not its displacement: the CSV note and the
+/// HDF5 attribute `ground_quantity`.
+pub(crate) fn ground_quantity_note(tf: &TransferMatrix) -> Option<String> {
+    let q = tf.ground_quantity();
+    (q != GroundQuantity::Displacement).then(|| {
+        format!(
+            "floor motion (tilt and translation inputs) per unit {}: the displacement's H \
+             times {}",
+            q.name(),
+            match q {
+                GroundQuantity::Velocity => "1/(i w)",
+                _ => "-1/w^2",
+            }
+        )
+    })
 }
 
 /// Appends the data lines of [`tf_csv_string`] for every frequency of `tf` to `s`: a grid

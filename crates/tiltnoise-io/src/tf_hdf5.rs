@@ -18,6 +18,20 @@ pub const SCHEMA_VERSION_TF: i64 = 2;
 pub const SIGN_CONVENTION: &str = "tilt t = small right-handed rotation taking the floor frame \
      to the inertial frame; X -> -eta_t (Z+Z_b+h_c), Y -> +theta_t (Z+Z_b+h_c) as f -> 0";
 
+/// Value of the root attribute `translation_convention`, written when the matrix has a floor
+/// translation input (see [`tiltnoise_core::model::translation`]).
+pub const TRANSLATION_CONVENTION: &str = "x_t, y_t, z_t = displacement of the floor, the \
+     suspension point and the housing together along the lab axes (crossbar arm along y, z up), \
+     m; per unit floor acceleration a = -w^2 u: X/x_t -> X/eta_t / g, Y/y_t -> -Y/theta_t / g \
+     as f -> 0 (equivalence principle)";
+
+/// True when `inputs` has a floor translation, whose convention the files then state.
+pub(crate) fn has_translation(inputs: &[tiltnoise_core::tf::Input]) -> bool {
+    inputs
+        .iter()
+        .any(|i| matches!(i, tiltnoise_core::tf::Input::Translation(_)))
+}
+
 /// Value of the root attribute `time_dependence`: values are complex amplitudes of
 /// `exp(+i w t)`.
 pub const TIME_DEPENDENCE: &str = "exp(+i w t)";
@@ -26,7 +40,8 @@ pub const TIME_DEPENDENCE: &str = "exp(+i w t)";
 /// atomically (see [`super::write_atomic`]).
 ///
 /// Layout: root attributes `schema`, `schema_version`, `tool_version`, `created_by`, `method`,
-/// `parameters_toml`, `sign_convention`, `time_dependence`; datasets `/frequency_hz`,
+/// `parameters_toml`, `sign_convention`, `time_dependence` (and `translation_convention` with a
+/// floor-translation input); datasets `/frequency_hz`,
 /// `/transfer` (complex, `[n_freq, n_outputs, n_inputs]`), `/outputs`, `/inputs`,
 /// `/output_units`, `/input_units`, and `/modes/{index,frequency_hz}` when `meta.modes` is not
 /// empty. Every item is described in `docs/schemas.md`.
@@ -81,6 +96,12 @@ pub(crate) fn write_root(
     str_attr(file, "parameters_toml", &meta.params_toml)?;
     str_attr(file, "sign_convention", SIGN_CONVENTION)?;
     str_attr(file, "time_dependence", TIME_DEPENDENCE)?;
+    if has_translation(&tf.inputs) {
+        str_attr(file, "translation_convention", TRANSLATION_CONVENTION)?;
+    }
+    if let Some(per) = crate::tf_csv::ground_quantity_note(tf) {
+        str_attr(file, "ground_quantity", &per)?;
+    }
     Ok(())
 }
 
@@ -113,7 +134,7 @@ pub(crate) fn write_labels(file: &hdf5::File, tf: &TransferMatrix) -> hdf5::Resu
     dataset(
         file,
         "input_units",
-        &strings(tf.inputs.iter().map(|i| i.unit()))?,
+        &strings((0..tf.inputs.len()).map(|i| tf.input_unit(i)))?,
     )?;
     Ok(())
 }

@@ -194,7 +194,7 @@ impl TfCsvWriter {
     ///
     /// [`OutputError::Write`] naming the target.
     pub fn append(&mut self, block: &TransferMatrix) -> Result<(), OutputError> {
-        let header = tf_csv_header(&block.outputs, &block.inputs, &self.meta);
+        let header = tf_csv_header(block, &self.meta);
         self.text.clear();
         match &self.header {
             None => self.text.push_str(&header),

@@ -1,7 +1,7 @@
-//! Display names shared by the figures: observables and tilt axes with Greek letters and
-//! Unicode subscripts, and panel titles.
+//! Display names shared by the figures: observables, tilt and translation axes with Greek
+//! letters and Unicode subscripts, and panel titles.
 
-use tiltnoise_core::model::{Observable, TiltAxis};
+use tiltnoise_core::model::{Observable, TiltAxis, TranslationAxis};
 
 /// Display name of an observable (Greek letters, Unicode subscripts).
 pub fn observable_symbol(o: Observable) -> &'static str {
@@ -36,6 +36,15 @@ pub fn tilt_symbol(a: TiltAxis) -> &'static str {
         TiltAxis::ThetaT => "θₜ",
         TiltAxis::EtaT => "ηₜ",
         TiltAxis::PhiT => "φₜ",
+    }
+}
+
+/// Display name of a floor-translation axis: xₜ, yₜ or zₜ.
+pub fn translation_symbol(a: TranslationAxis) -> &'static str {
+    match a {
+        TranslationAxis::XT => "xₜ",
+        TranslationAxis::YT => "yₜ",
+        TranslationAxis::ZT => "zₜ",
     }
 }
 

@@ -1,15 +1,16 @@
 //! The paper's Figure 5: moduli of the transfer functions from the floor tilt angles
 //! (θₜ solid, ηₜ dashed, φₜ dotted) to the soft-DoF observables X, φ and φₐ; and the same
-//! layout for force and torque inputs (one panel per observable and kind of input, so each panel
-//! has one unit: m/N, rad/(N m), ...).
+//! layout for the floor's translations and for force and torque inputs (one panel per observable
+//! and kind of input, so each panel has one unit: m/m, m/N, rad/(N m), ...).
 
 use super::chart::{Dash, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
 // Re-exported: `plot::tf_figure::observable_symbol` is a public path.
 use super::chart::{LegendPlacement, YScale};
 pub use super::labels::observable_symbol;
-use super::labels::{observable_title, tilt_symbol};
+use super::labels::{observable_title, tilt_symbol, translation_symbol};
 use super::{render, DrawError, ImageFormat, View};
-use tiltnoise_core::model::{ForceInput, Input, Observable, TiltAxis};
+use tiltnoise_core::ground::GroundQuantity;
+use tiltnoise_core::model::{ForceInput, Input, Observable, TiltAxis, TranslationAxis};
 use tiltnoise_core::tf::TransferMatrix;
 
 /// Options of [`tf_figure_with`].
@@ -62,11 +63,24 @@ pub fn tilt_symbol_style(t: TiltAxis) -> (&'static str, TraceStyle) {
     (tilt_symbol(t), style)
 }
 
+/// Display name and line style of a floor-translation axis: xₜ solid, yₜ dashed, zₜ dotted, in
+/// colours of their own (the tilt's are taken).
+pub fn translation_symbol_style(t: TranslationAxis) -> (&'static str, TraceStyle) {
+    let style = match t {
+        TranslationAxis::XT => TraceStyle::new(PALETTE[3], Dash::Solid, 2),
+        TranslationAxis::YT => TraceStyle::new(PALETTE[4], Dash::Dashed, 2),
+        TranslationAxis::ZT => TraceStyle::new(PALETTE[5], Dash::Dotted, 3),
+    };
+    (translation_symbol(t), style)
+}
+
 /// The kinds of input a panel groups: one panel per observable and kind, since the units differ.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum InputKind {
     /// Floor tilt angles (rad).
     Tilt,
+    /// Floor translations (m).
+    Translation,
     /// Force components (N).
     Force,
     /// Torque components (N m).
@@ -74,21 +88,46 @@ enum InputKind {
 }
 
 impl InputKind {
+    /// Every kind, in panel order.
+    const ALL: [InputKind; 4] = [
+        InputKind::Tilt,
+        InputKind::Translation,
+        InputKind::Force,
+        InputKind::Torque,
+    ];
+
     fn of(input: Input) -> InputKind {
         match input {
             Input::Tilt(_) => InputKind::Tilt,
+            Input::Translation(_) => InputKind::Translation,
             Input::Force(f) if f.unit() == "N" => InputKind::Force,
             Input::Force(_) => InputKind::Torque,
         }
     }
 
-    /// `(y-axis symbol of the input, unit of the response per unit input, title suffix)`.
-    fn labels(self, o: Observable) -> (&'static str, String, &'static str) {
+    /// `(y-axis symbol of the input, unit of the response per unit input, title suffix)`, the
+    /// floor's motion per unit `per` (its displacement, velocity or acceleration).
+    fn labels(self, o: Observable, per: GroundQuantity) -> (&'static str, String, &'static str) {
+        let floor = |unit: &str| match per.unit(unit) {
+            u if u.contains('/') => format!("{}/({u})", o.unit()),
+            u => format!("{}/{u}", o.unit()),
+        };
         match self {
-            InputKind::Tilt => ("tilt", format!("{}/rad", o.unit()), ""),
+            InputKind::Tilt => ("tilt", floor("rad"), ""),
+            InputKind::Translation => ("u", floor("m"), ", per floor translation"),
             InputKind::Force => ("F", format!("{}/N", o.unit()), ", per force"),
             InputKind::Torque => ("M", format!("{}/(N m)", o.unit()), ", per torque"),
         }
+    }
+}
+
+/// What a tilt (`radian`) or translation (`metre`) column is per, for the caption.
+fn per_unit_text(per: GroundQuantity, unit: &str) -> String {
+    let symbol = if unit == "radian" { "rad" } else { "m" };
+    match per {
+        GroundQuantity::Displacement => unit.to_string(),
+        GroundQuantity::Velocity => format!("{symbol}/s"),
+        GroundQuantity::Acceleration => format!("{symbol}/s²"),
     }
 }
 
@@ -113,7 +152,7 @@ pub fn force_symbol_style(f: ForceInput) -> (String, TraceStyle) {
 /// The default pixel size of the figure for `inputs` under `options` (observables `None`:
 /// counted as the paper's three): two columns, rows of about 320 px, at least 1200 x 1000.
 pub fn default_size(options: &TfFigureOptions, inputs: &[Input]) -> (u32, u32) {
-    let kinds = [InputKind::Tilt, InputKind::Force, InputKind::Torque]
+    let kinds = InputKind::ALL
         .into_iter()
         .filter(|&k| inputs.iter().any(|&i| InputKind::of(i) == k))
         .count();
@@ -136,7 +175,7 @@ pub fn build_tf_figure(
     tf: &TransferMatrix,
     options: &TfFigureOptions,
 ) -> Result<LogLogFigure, String> {
-    let kinds: Vec<InputKind> = [InputKind::Tilt, InputKind::Force, InputKind::Torque]
+    let kinds: Vec<InputKind> = InputKind::ALL
         .into_iter()
         .filter(|&k| tf.inputs.iter().any(|&i| InputKind::of(i) == k))
         .collect();
@@ -161,7 +200,7 @@ pub fn build_tf_figure(
             ));
         };
         for &kind in &kinds {
-            let (input_symbol, unit, suffix) = kind.labels(o);
+            let (input_symbol, unit, suffix) = kind.labels(o, tf.ground_quantity());
             let mut panel = Panel::new(
                 format!("{}{suffix}", observable_title(o)),
                 ("frequency", "Hz"),
@@ -197,6 +236,10 @@ pub fn build_tf_figure(
                         let (name, style) = tilt_symbol_style(t);
                         (name.to_string(), style)
                     }
+                    Input::Translation(t) => {
+                        let (name, style) = translation_symbol_style(t);
+                        (name.to_string(), style)
+                    }
                     Input::Force(f) => force_symbol_style(f),
                 };
                 let identically_zero =
@@ -226,11 +269,18 @@ pub fn build_tf_figure(
         }
     }
     let has_tilt = kinds.contains(&InputKind::Tilt);
-    let has_forces = kinds.len() > usize::from(has_tilt);
-    let what = match (has_tilt, has_forces) {
-        (true, false) => "Floor tilt",
-        (false, _) => "Forces and torques",
-        (true, true) => "Floor tilt, forces and torques",
+    let has_translation = kinds.contains(&InputKind::Translation);
+    let has_forces = kinds.contains(&InputKind::Force) || kinds.contains(&InputKind::Torque);
+    let floor = match (has_tilt, has_translation) {
+        (true, false) => Some("Floor tilt"),
+        (false, true) => Some("Floor translation"),
+        (true, true) => Some("Floor tilt and translation"),
+        (false, false) => None,
+    };
+    let what = match (floor, has_forces) {
+        (Some(floor), false) => floor.to_string(),
+        (None, _) => "Forces and torques".to_string(),
+        (Some(floor), true) => format!("{floor}, forces and torques"),
     };
     let shown = if options.phase {
         "|H(f)| and phase"
@@ -244,9 +294,11 @@ pub fn build_tf_figure(
     let mut caption = Vec::new();
     if has_tilt {
         caption.extend([
-            "Tilt lines: θₜ solid, ηₜ dashed, φₜ dotted. |H| is the modulus of the complex \
-             response per radian of floor tilt."
-                .to_string(),
+            format!(
+                "Tilt lines: θₜ solid, ηₜ dashed, φₜ dotted. |H| is the modulus of the complex \
+                 response per {} of floor tilt.",
+                per_unit_text(tf.ground_quantity(), "radian")
+            ),
             "Sign convention: tilt t = small rotation taking the floor frame to the inertial \
              frame (the floor turns by −t); observables are read in the enclosure frame."
                 .to_string(),
@@ -254,6 +306,32 @@ pub fn build_tf_figure(
              other entries shown tend to 0 (φ/ηₜ and φₐ/ηₜ as f⁴)."
                 .to_string(),
         ]);
+    }
+    if has_translation {
+        caption.extend([
+            format!(
+                "Translation lines: xₜ solid, yₜ dashed, zₜ dotted. |H| is the modulus of the \
+                 response per {} of floor translation (the floor, the suspension point and the \
+                 housing move together; the crossbar arm lies along y).",
+                per_unit_text(tf.ground_quantity(), "metre")
+            ),
+            "Equivalence principle, f → 0: per unit floor acceleration a = −ω² u, xₜ acts as the \
+             tilt ηₜ = aₓ/g and yₜ as θₜ = −a_y/g; zₜ as a change of g (the fibres' stretch). \
+             Every response per metre falls at least as f² at low frequency (φ/xₜ and φₐ/xₜ \
+             as f⁴)."
+                .to_string(),
+        ]);
+    }
+    if (has_tilt || has_translation) && tf.ground_quantity() != GroundQuantity::Displacement {
+        caption.push(format!(
+            "Per unit {} of the floor's motion: the response per unit displacement divided by \
+             {}.",
+            tf.ground_quantity().name(),
+            match tf.ground_quantity() {
+                GroundQuantity::Velocity => "iω",
+                _ => "−ω²",
+            }
+        ));
     }
     if has_forces {
         caption.push(

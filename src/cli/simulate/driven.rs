@@ -9,9 +9,11 @@ use crate::cli::Run;
 use anyhow::{anyhow, bail, Result};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::{Num, Shown};
-use tiltnoise_core::model::{Model, Observable, TiltAxis};
+use tiltnoise_core::limits::GAINS;
+use tiltnoise_core::model::{Input, Model, Observable, TiltAxis};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
+use tiltnoise_core::repeats::{list_entries, refuse_repeated_keys};
 use tiltnoise_core::simulate::aliased_frequency_hz;
 use tiltnoise_core::simulate::default_sim_nperseg as default_nperseg;
 use tiltnoise_core::simulate::driven::{
@@ -25,10 +27,9 @@ use tiltnoise_plot::simulate_figure::{asd_figure, ModeMark, SimAsdData, ASD_SIZE
 /// `--drive-gain AXIS=GAIN,...` for the axes of the record (others 1).
 fn parse_gains(items: &[String], axes: &[TiltAxis]) -> Result<Vec<f64>> {
     let mut gains = vec![1.0; axes.len()];
-    for entry in items.iter().flat_map(|i| i.split(',')).map(str::trim) {
-        if entry.is_empty() {
-            continue;
-        }
+    let entries = list_entries(items);
+    refuse_repeated_keys("--drive-gain", "axis", &entries)?;
+    for entry in entries {
         let shown = Shown(entry);
         let (name, value) = entry
             .split_once('=')
@@ -47,8 +48,13 @@ fn parse_gains(items: &[String], axes: &[TiltAxis]) -> Result<Vec<f64>> {
             .trim()
             .parse()
             .map_err(|_| anyhow!("--drive-gain {shown}: `{}` is not a number", Shown(value)))?;
-        if !g.is_finite() {
-            bail!("--drive-gain {shown}: the gain must be finite");
+        if !GAINS.admits(g) {
+            bail!(
+                "--drive-gain {shown}: the gain {} is not allowed: must be {} (see \
+                 docs/limits.md)",
+                Num(g),
+                GAINS.allowed("")
+            );
         }
         gains[i] = g;
     }
@@ -97,9 +103,10 @@ pub(super) fn run(
         );
     }
     let readout = parse_readout(&args.readout)?;
+    let inputs: Vec<Input> = series.axes.iter().map(|&a| Input::Tilt(a)).collect();
     let drive = drive_from_record(
         1.0 / fs,
-        &series.axes,
+        &inputs,
         &series.data,
         m,
         &gains,

@@ -3,17 +3,18 @@
 //! `Display` impl can panic too) and checks what a successful read promises. A reader's error
 //! is a correct answer; a panic is the finding.
 //!
-//! Always checked: frequency grids and files finite, parameters that read back unchanged.
-//! Checked with `TILTNOISE_FUZZ_STRICT` set (promises that finite but extreme inputs still
-//! break, see `docs/robustness.md`): tilt and measured values finite after conversion,
-//! sample rates finite and > 0, sigmas of measured modes > 0, streamed chunks bit-identical
-//! to the in-memory read.
+//! Always checked: frequency grids and files finite, parameters that read back unchanged, and
+//! the finiteness policy (`tiltnoise_core::limits::magnitude`): every sample of a series read
+//! within `SAMPLES` and its sample rate within `SAMPLE_RATES`, spectra finite with increasing
+//! frequencies, measured ASDs within `ASDS`. Checked with `TILTNOISE_FUZZ_STRICT` set: sigmas
+//! of measured modes > 0, streamed chunks bit-identical to the in-memory read.
 //!
 //! Self-contained (std, `tiltnoise-core`, `tiltnoise-io`), so that libFuzzer targets for
 //! nightly can compile this file as it is (`docs/robustness.md`).
 
 use std::path::Path;
 use tiltnoise_core::freq::parse_spec;
+use tiltnoise_core::limits::{Magnitudes, ASDS, SAMPLES, SAMPLE_RATES};
 use tiltnoise_core::params::Params;
 use tiltnoise_io::input::{
     read_asd_column, read_measured, read_measured_input, read_tilt, read_tilt_series,
@@ -175,12 +176,16 @@ fn assert_increasing(what: &str, freqs: &[f64]) {
     }
 }
 
-fn check_series(s: &TiltSeries) {
-    if !strict() {
-        return;
+/// Every value of `values` within `allowed` (the readers' finiteness policy).
+fn assert_admitted(what: &str, values: &[f64], allowed: &Magnitudes) {
+    if let Some((i, v)) = allowed.first_refused(values) {
+        panic!("a successful read returned {what}[{i}] = {v}, outside {allowed:?}");
     }
+}
+
+fn check_series(s: &TiltSeries) {
     assert!(
-        s.sample_rate_hz.is_finite() && s.sample_rate_hz > 0.0,
+        SAMPLE_RATES.admits(s.sample_rate_hz),
         "sample rate {}",
         s.sample_rate_hz
     );
@@ -190,14 +195,11 @@ fn check_series(s: &TiltSeries) {
             ch.len() >= 2 && ch.len() == s.data[0].len(),
             "channel lengths"
         );
-        assert_finite(&format!("series {axis:?}"), ch.iter().copied());
+        assert_admitted(&format!("series {axis:?}"), ch, &SAMPLES);
     }
 }
 
 fn check_spectra(s: &TiltSpectra) {
-    if !strict() {
-        return;
-    }
     assert_increasing("frequency", &s.freqs_hz);
     let n = s.axes.len();
     assert_eq!(s.csd.len(), s.freqs_hz.len() * n * n, "CSD size");
@@ -212,25 +214,22 @@ fn check_tilt(input: &TiltInput) {
 }
 
 fn check_measured(m: &MeasuredInput) {
-    if !strict() {
-        return;
-    }
     match m {
         MeasuredInput::Spectra(s) => {
             assert_increasing("measured frequency", &s.freqs_hz);
             for (o, asd) in &s.asd {
                 assert_eq!(asd.len(), s.freqs_hz.len(), "{o:?}: one ASD per frequency");
-                assert_finite(&format!("measured ASD {o:?}"), asd.iter().copied());
+                assert_admitted(&format!("measured ASD {o:?}"), asd, &ASDS);
             }
         }
         MeasuredInput::Series(s) => {
-            assert!(s.sample_rate_hz.is_finite() && s.sample_rate_hz > 0.0);
+            assert!(SAMPLE_RATES.admits(s.sample_rate_hz));
             for (o, x) in &s.channels {
                 assert!(
                     x.len() >= 2 && x.len() == s.channels[0].1.len(),
                     "{o:?}: lengths"
                 );
-                assert_finite(&format!("measured series {o:?}"), x.iter().copied());
+                assert_admitted(&format!("measured series {o:?}"), x, &SAMPLES);
             }
         }
     }

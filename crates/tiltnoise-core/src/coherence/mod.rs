@@ -37,7 +37,7 @@ pub use compare::{fit_agreement, with_error, Agreement};
 
 use crate::align::{align, AlignError, Alignment, RecordClock};
 use crate::budget::default_segment_len;
-use crate::error::TfError;
+use crate::error::{Num, TfError};
 use crate::model::{Input, Model, Observable, Request, TiltAxis};
 use crate::spectral::confidence::{
     bin_correlation, coherence_interval, coherence_threshold, equivalent_averages, tf_radius,
@@ -269,11 +269,6 @@ pub fn coherence_from_series(
             .iter()
             .map(|(_, x)| &x[alignment.start_b..alignment.start_b + n]),
     );
-    let mut spectra = csd_matrix(&channels, fs, &cfg)?;
-    if opts.tilt_quantity == crate::input::Quantity::Rate {
-        let rates: Vec<usize> = (0..tilt.channels.len()).collect();
-        crate::input::rate::rate_channels_to_angle(&mut spectra, &rates);
-    }
     let names: Vec<String> = tilt
         .channels
         .iter()
@@ -285,6 +280,25 @@ pub fn coherence_from_series(
                 .map(|(o, _)| format!("{} of {}", o.name(), measured.name)),
         )
         .collect();
+    // A constant channel has no power above DC; its Welch estimate would be rounding noise.
+    for (x, name) in channels.iter().zip(&names) {
+        if let Some(&first) = x.first().filter(|&&v| x.iter().all(|&w| w == v)) {
+            let what = match first == 0.0 {
+                true => "zero at every sample".to_string(),
+                false => format!("constant ({})", Num(first)),
+            };
+            return Err(CoherenceError::Config(format!(
+                "{name} is {what} over the common stretch: it has no power above DC to \
+                 analyse; leave it out"
+            )));
+        }
+    }
+    let mut spectra = csd_matrix(&channels, fs, &cfg)?;
+    if opts.tilt_quantity == crate::input::Quantity::Rate {
+        let rates: Vec<usize> = (0..tilt.channels.len()).collect();
+        crate::input::rate::rate_channels_to_angle(&mut spectra, &rates);
+    }
+
     for (c, name) in names.iter().enumerate() {
         let psd = spectra.psd(c);
         if psd.iter().any(|p| !p.is_finite()) {

@@ -1,6 +1,6 @@
 //! The model's matrices in double-double, written from the paper's formulas (Appendix A,
-//! eqs. (def_I) and (EM), the zeroth-order generalized forces, section II.D and section IV.B)
-//! and the parameter values. Deliberately shares nothing with `crate::model` (the `f64` model) but the
+//! eqs. (def_I) and (EM), the zeroth-order generalized forces, section II.D and section IV.B),
+//! the apparent forces of the floor's translation, and the parameter values. Deliberately shares nothing with `crate::model` (the `f64` model) but the
 //! coordinate order, which is fixed by the paper and restated here.
 
 use super::complex::CDd;
@@ -59,6 +59,9 @@ pub struct Matrices {
     pub g0: [[Dd; 3]; 8],
     /// Tilt forcing, part multiplying w^2 (G2).
     pub g2: [[Dd; 3]; 8],
+    /// Floor-translation forcing per unit `w^2` displacement (columns x_t, y_t, z_t); its
+    /// frequency-independent part is zero.
+    pub translation_g2: [[Dd; 3]; 8],
     /// Observation matrix C (rows X, Y, Z, theta, eta, phi, phi_a).
     pub observation: [[Dd; 8]; 7],
 }
@@ -73,6 +76,19 @@ fn cross(a: [Dd; 3], b: [Dd; 3]) -> [Dd; 3] {
         a[2] * b[0] - a[0] * b[2],
         a[0] * b[1] - a[1] * b[0],
     ]
+}
+
+/// `B loads`: the generalized forces of 12 force and torque components (zero terms skipped).
+fn generalized_forces(force: &[[Dd; 12]; 8], loads: &[Dd]) -> [Dd; 8] {
+    std::array::from_fn(|r| {
+        let mut q = Dd::ZERO;
+        for (c, &load) in loads.iter().enumerate() {
+            if !force[r][c].is_zero() && !load.is_zero() {
+                q += force[r][c] * load;
+            }
+        }
+        q
+    })
 }
 
 pub fn build(p: &Params) -> Matrices {
@@ -257,17 +273,29 @@ pub fn build(p: &Params) -> Matrices {
             apparent_torque(inertia_b),
         ];
         let loads: Vec<Dd> = [fa, fb, ma, mb].concat();
-        for r in 0..8 {
-            let mut q = Dd::ZERO;
-            for (c, &load) in loads.iter().enumerate() {
-                if !force[r][c].is_zero() && !load.is_zero() {
-                    q += force[r][c] * load;
-                }
-            }
-            // Q per unit t''; a harmonic tilt has t'' = -w^2 t, so G2 = -Q.
+        // Q per unit t''; a harmonic tilt has t'' = -w^2 t, so G2 = -Q.
+        for (r, q) in generalized_forces(&force, &loads).into_iter().enumerate() {
             g2[r][axis] = -q;
         }
     }
+
+    // Floor translation: the frame accelerates by u'' without turning, so each body feels
+    // -m u'' at its centre of mass and no torque. Q per unit u''; u'' = -w^2 u, so G2 = -Q.
+    let mut translation_g2 = [[Dd::ZERO; 3]; 8];
+    for axis in 0..3 {
+        let mut loads = [Dd::ZERO; 12];
+        loads[axis] = -m_a;
+        loads[3 + axis] = -m_b;
+        for (r, q) in generalized_forces(&force, &loads).into_iter().enumerate() {
+            translation_g2[r][axis] = -q;
+        }
+    }
+    // Section II.A places the crossbar's centre of mass so that the pendulum balances on the
+    // upper fibre, m_a y_a = m_b d: a uniform field along x exerts no torque about the fibre
+    // (phi_a), one along z none about x (theta_a). y_a = d m_b / m_a in double-double leaves a
+    // few DD_EPS of m_b d there; the balance is exact by definition.
+    translation_g2[PA][0] = Dd::ZERO;
+    translation_g2[TA][2] = Dd::ZERO;
 
     // Observation rows (section II.D).
     let lever = z + z_b + h_c;
@@ -297,6 +325,7 @@ pub fn build(p: &Params) -> Matrices {
         force,
         g0,
         g2,
+        translation_g2,
         observation,
     }
 }

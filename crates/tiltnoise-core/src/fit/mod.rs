@@ -35,6 +35,7 @@ pub use measured::{Measured, MeasuredMode, SigmaSource};
 
 use crate::error::{ParamError, Shown};
 use crate::params::Params;
+use crate::repeats::{refuse_repeats, Repeated};
 use nalgebra::{DMatrix, DVector};
 
 /// Default free parameters: for each mode, or pair of nearly degenerate modes, the parameter
@@ -246,15 +247,9 @@ pub enum FitError {
         /// The keys that can be free.
         allowed: String,
     },
-    /// The same key twice.
-    #[error(
-        "fit: parameter `{}` is listed twice in --free; give each key once",
-        Shown(.key)
-    )]
-    DuplicateKey {
-        /// The key.
-        key: String,
-    },
+    /// The same key twice in the free parameters.
+    #[error(transparent)]
+    Repeated(#[from] Repeated),
     /// A box width that is not a positive finite number.
     #[error("fit: --bound-sigmas {value} is not allowed: must be finite and > 0")]
     BoundSigmas {
@@ -464,6 +459,7 @@ fn check_config(
     if config.free.is_empty() {
         return Err(FitError::NoFree);
     }
+    refuse_repeats("--free", "parameter key", &config.free, String::clone)?;
     let fields = params.fields();
     let rel_sigma = |key: &str| {
         crate::mc::uncertainties(params)
@@ -486,9 +482,6 @@ fn check_config(
                 key: key.clone(),
                 allowed: allowed.clone(),
             })?;
-        if out.iter().any(|f| &f.key == key) {
-            return Err(FitError::DuplicateKey { key: key.clone() });
-        }
         let sigma = rel_sigma(key) * field.value.abs();
         if sigma <= 0.0 {
             return Err(FitError::ExactKey {

@@ -5,7 +5,7 @@
 //! index, the unit where there is one, and what is allowed. Sample indices are 0-based (the
 //! sample index in the series); CSV line numbers are 1-based (as shown by an editor).
 
-use crate::error::Shown;
+use crate::error::{Num, Shown};
 use std::path::{Path, PathBuf};
 
 /// Formats an optional CSV line number as ` (line N)`.
@@ -179,6 +179,52 @@ pub enum InputError {
         unit: &'static str,
         /// 1-based CSV line, when the input is CSV.
         line: Option<usize>,
+    },
+
+    /// A finite sample outside the magnitudes every spectrum and fit derived from it stays
+    /// finite and normal for ([`SAMPLES`](crate::limits::SAMPLES)), in the channel's unit after
+    /// the file's unit and any scale factor.
+    #[error(
+        "input file {path}: channel `{}` sample index {index}{} is {} {unit} (with the file's \
+         unit and any scale factor applied); allowed: {} (beyond them the spectra and fits \
+         derived from the samples overflow or underflow f64: check the units and the scale \
+         factor; see docs/limits.md)",
+        Shown(.channel),
+        at_line(.line),
+        Num(*.value),
+        crate::limits::SAMPLES.allowed(.unit)
+    )]
+    OutOfRange {
+        /// The file.
+        path: PathBuf,
+        /// The source channel (dataset or column name).
+        channel: String,
+        /// 0-based sample index.
+        index: usize,
+        /// The value, in `unit`.
+        value: f64,
+        /// Unit of the channel.
+        unit: &'static str,
+        /// 1-based CSV line, when the input is CSV.
+        line: Option<usize>,
+    },
+
+    /// A sample rate (from an attribute, a header, or the spacing of a time column) outside
+    /// [`SAMPLE_RATES`](crate::limits::SAMPLE_RATES).
+    #[error(
+        "input file {path}: {source_of} gives a sample rate of {} Hz; allowed: {} (the \
+         spectra of the record would leave the range of f64; see docs/limits.md)",
+        Num(*.rate_hz),
+        crate::limits::SAMPLE_RATES.allowed("Hz")
+    )]
+    SampleRate {
+        /// The file.
+        path: PathBuf,
+        /// Where the rate comes from, e.g. `attribute sample_rate_hz of /`, `column time_s
+        /// (dt = 1e-300 s)`.
+        source_of: String,
+        /// The rate (Hz).
+        rate_hz: f64,
     },
 
     /// A run of non-finite samples touching the start or the end of a channel, which linear
@@ -466,13 +512,15 @@ pub enum InputError {
         value: f64,
     },
 
-    /// A negative, non-finite or absurdly large amplitude spectral density (above
-    /// [`MAX_ASD`](crate::limits::MAX_ASD)).
+    /// A negative or non-finite amplitude (or power) spectral density, or one outside
+    /// [`ASDS`](crate::limits::ASDS) ([`PSDS`](crate::limits::PSDS)): its PSD, and what is
+    /// derived from it, would overflow or underflow.
     #[error(
-        "input file {path}: {location}, column `{}`: ASD {value:?} {unit} is not allowed: must \
-         be finite, >= 0 and <= {:e}",
+        "input file {path}: {location}, column `{}`: {} {value:?} {unit} is not allowed: must \
+         be {} (see docs/limits.md)",
         Shown(.column),
-        crate::limits::MAX_ASD
+        if *.power { "PSD" } else { "ASD" },
+        if *.power { crate::limits::PSDS } else { crate::limits::ASDS }.allowed(.unit)
     )]
     Asd {
         /// The file.
@@ -485,6 +533,8 @@ pub enum InputError {
         value: f64,
         /// Unit of the value.
         unit: &'static str,
+        /// Whether the value is a PSD (else an ASD).
+        power: bool,
     },
 
     /// A cross-spectral density matrix that is not Hermitian positive semidefinite within
@@ -567,6 +617,24 @@ pub fn require_two(
         });
     }
     Ok(())
+}
+
+/// The sample rate `rate_hz` of `path`, if it is within
+/// [`SAMPLE_RATES`](crate::limits::SAMPLE_RATES); else [`InputError::SampleRate`] saying where
+/// it comes from (`source_of`, built only then).
+pub fn check_sample_rate(
+    path: &Path,
+    source_of: impl FnOnce() -> String,
+    rate_hz: f64,
+) -> Result<f64, InputError> {
+    if crate::limits::SAMPLE_RATES.admits(rate_hz) {
+        return Ok(rate_hz);
+    }
+    Err(InputError::SampleRate {
+        path: path.to_path_buf(),
+        source_of: source_of(),
+        rate_hz,
+    })
 }
 
 #[cfg(test)]

@@ -7,8 +7,9 @@
 //!
 //! **Tilt sign.** The crate's tilt `t = (theta_t, eta_t, phi_t)` (rad) is the small
 //! right-handed rotation taking the **floor** frame to the **inertial** frame: the floor itself
-//! rotates by `-t` (see [`crate::model::tilt`]). Lab axes: `x`, `y` horizontal (`x` along the
-//! crossbar arm, `y` along the other), `z` up. Every value returned by this module is `t` in
+//! rotates by `-t` (see [`crate::model::tilt`]). Lab axes: `x`, `y` horizontal (the crossbar
+//! arm along `y`, the test mass at `(0, -d, .)`; `x` perpendicular to the arm, the test mass's
+//! X), `z` up. Every value returned by this module is `t` in
 //! this convention: a series in rad (angle) or rad/s (its rate), spectra as one-sided PSD/CSD
 //! of the angle in rad²/Hz.
 //!
@@ -63,11 +64,11 @@ mod source;
 mod spectra;
 
 pub use axis_map::{resolve, AxisMap, AxisMapEntry, MapOrigin, Mapped, Resolved, Sign};
-pub use error::{require_two, InputError};
-pub use scale::{check_scales, scale_for, scale_note, ChannelScale};
+pub use error::{check_sample_rate, require_two, InputError};
+pub use scale::{check_scales, parse_scales, scale_for, scale_note, ChannelScale};
 pub use series::{gap_note, process_channel, ChannelCtx, Gap, GapScanner, TiltSeries};
 pub use source::SeriesSource;
-pub use spectra::{assemble, check_csd_finite, TiltSpectra, CSD_RTOL};
+pub use spectra::{assemble, check_csd_finite, frequency_refusal, TiltSpectra, CSD_RTOL};
 
 use crate::error::Shown;
 use std::fmt;

@@ -4,6 +4,7 @@
 
 use super::error::InputError;
 use crate::error::{shown_list, Shown};
+use crate::repeats::{refuse_repeated_keys, refuse_repeats};
 use std::fmt;
 use std::path::Path;
 use std::str::FromStr;
@@ -58,6 +59,20 @@ impl fmt::Display for ChannelScale {
     }
 }
 
+/// The `CHANNEL=FACTOR` items of the option `option` (`--scale`, `scale`), each channel once.
+///
+/// # Errors
+///
+/// The message (without the option) of the first item that does not parse, or of a channel
+/// given twice.
+pub fn parse_scales<S: AsRef<str>>(option: &str, items: &[S]) -> Result<Vec<ChannelScale>, String> {
+    refuse_repeated_keys(option, "channel", items).map_err(|e| e.to_string())?;
+    items
+        .iter()
+        .map(|s| s.as_ref().parse().map_err(|e| format!("{option}: {e}")))
+        .collect()
+}
+
 /// The factor given for `channel`, if any.
 pub fn scale_for(scales: &[ChannelScale], channel: &str) -> Option<f64> {
     scales
@@ -74,14 +89,15 @@ pub fn check_scales(
     available: &[String],
     kind: &'static str,
 ) -> Result<(), InputError> {
-    for (i, s) in scales.iter().enumerate() {
-        if scales[..i].iter().any(|p| p.channel == s.channel) {
-            return Err(InputError::Scale {
-                path: path.to_path_buf(),
-                channel: s.channel.clone(),
-                message: "is given a scale twice; allowed: once".to_string(),
-            });
+    let channels: Vec<&str> = scales.iter().map(|s| s.channel.as_str()).collect();
+    refuse_repeats("scale", "channel", &channels, |c| c.to_string()).map_err(|e| {
+        InputError::Scale {
+            path: path.to_path_buf(),
+            channel: e.name,
+            message: "is given a scale twice; allowed: once".to_string(),
         }
+    })?;
+    for s in scales {
         if !available.contains(&s.channel) {
             return Err(InputError::Scale {
                 path: path.to_path_buf(),

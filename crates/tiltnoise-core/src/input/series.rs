@@ -5,6 +5,7 @@
 
 use super::error::InputError;
 use super::{GapPolicy, Provenance, Quantity};
+use crate::limits::SAMPLES;
 use crate::model::TiltAxis;
 use std::path::Path;
 
@@ -87,10 +88,17 @@ pub struct Gap {
 }
 
 impl Gap {
-    /// The bridged value at index `k` (`before < k < after`).
+    /// The bridged value at index `k` (`before < k < after`). Between two allowed samples
+    /// ([`SAMPLES`]) it is allowed too: where a bridge between samples of opposite signs
+    /// crosses zero, a value smaller than [`SAMPLES`]' smallest magnitude is 0.
     pub fn value(&self, k: usize) -> f64 {
         let frac = (k - self.before) as f64 / (self.after - self.before) as f64;
-        self.a + (self.b - self.a) * frac
+        let v = self.a + (self.b - self.a) * frac;
+        if v.abs() < SAMPLES.smallest {
+            0.0
+        } else {
+            v
+        }
     }
 
     /// The gap containing `k` in a sorted, disjoint list.
@@ -109,6 +117,27 @@ pub struct ChannelCtx<'a> {
 }
 
 impl ChannelCtx<'_> {
+    /// Refuses a finite sample outside [`SAMPLES`] (NaN and infinities are gaps, for the gap
+    /// policy to decide): [`InputError::OutOfRange`] naming the file, channel, index and value.
+    pub fn check_sample(
+        &self,
+        index: usize,
+        value: f64,
+        line: Option<usize>,
+    ) -> Result<(), InputError> {
+        if !value.is_finite() || SAMPLES.admits(value) {
+            return Ok(());
+        }
+        Err(InputError::OutOfRange {
+            path: self.path.to_path_buf(),
+            channel: self.channel.to_string(),
+            index,
+            value,
+            unit: self.unit,
+            line,
+        })
+    }
+
     pub fn non_finite(&self, index: usize, value: f64, line: Option<usize>) -> InputError {
         InputError::NonFinite {
             path: self.path.to_path_buf(),
@@ -133,8 +162,10 @@ impl ChannelCtx<'_> {
     }
 }
 
-/// Streams over one (signed) channel in order, in blocks of any size: validates finiteness
-/// under [`GapPolicy::Reject`] and records interior gaps under [`GapPolicy::Interpolate`].
+/// Streams over one (signed, scaled) channel in order, in blocks of any size: refuses a finite
+/// sample outside [`SAMPLES`] under either policy, validates finiteness under
+/// [`GapPolicy::Reject`] and records interior gaps under [`GapPolicy::Interpolate`] (a bridge
+/// between two allowed samples stays within their magnitudes).
 #[derive(Debug)]
 pub struct GapScanner {
     policy: GapPolicy,
@@ -163,6 +194,7 @@ impl GapScanner {
             let k = self.pos;
             self.pos += 1;
             if v.is_finite() {
+                ctx.check_sample(k, v, None)?;
                 if let Some(start) = self.gap_start.take() {
                     let Some((before, a)) = self.last_finite else {
                         return Err(ctx.edge_gap("leading", start, k - 1, self.len));
@@ -220,8 +252,9 @@ pub fn fill_gaps(
     Ok(())
 }
 
-/// In-memory processing of a whole signed channel (angle or rate alike): non-finite samples
-/// refused or bridged, as `policy` says. Returns the number of bridged samples.
+/// In-memory processing of a whole signed channel (angle or rate alike): samples outside
+/// [`SAMPLES`] refused, non-finite samples refused or bridged, as `policy` says. Returns the
+/// number of bridged samples.
 pub fn process_channel(
     data: &mut [f64],
     policy: GapPolicy,
@@ -261,5 +294,36 @@ mod tests {
         let e = process_channel(&mut trail, GapPolicy::Interpolate, &ctx).unwrap_err();
         assert!(e.to_string().contains("trailing"), "{e}");
         assert!(e.to_string().contains("2..=2"), "{e}");
+    }
+
+    #[test]
+    fn samples_outside_their_magnitudes_are_refused_under_either_policy() {
+        let ctx = ChannelCtx {
+            path: Path::new("x.csv"),
+            channel: "c",
+            unit: "rad",
+        };
+        for policy in [GapPolicy::Reject, GapPolicy::Interpolate] {
+            for bad in [1e308, -1e41, 1e-310, -2e-41] {
+                let mut d = vec![0.0, 1e-9, bad, 0.0];
+                let e = process_channel(&mut d, policy, &ctx).unwrap_err();
+                assert!(matches!(e, InputError::OutOfRange { index: 2, .. }), "{e}");
+                let text = e.to_string();
+                assert!(
+                    text.contains("channel `c` sample index 2")
+                        && text.contains(&crate::error::Num(bad).to_string())
+                        && text.contains("from 1e-40 to 1e40 rad"),
+                    "{text}"
+                );
+            }
+            // Exact zeros are structural and stay.
+            let mut zeros = vec![0.0; 8];
+            assert_eq!(process_channel(&mut zeros, policy, &ctx).unwrap(), 0);
+        }
+        // A bridge across zero between the smallest samples stays within the magnitudes.
+        let mut d = vec![1e-40, f64::NAN, f64::NAN, f64::NAN, -1e-40];
+        process_channel(&mut d, GapPolicy::Interpolate, &ctx).unwrap();
+        assert_eq!(d, [1e-40, 0.0, 0.0, 0.0, -1e-40]);
+        assert!(d.iter().all(|&v| SAMPLES.admits(v)));
     }
 }

@@ -1,6 +1,7 @@
 //! [`TiltSpectra`]: one-sided tilt cross-spectral densities and their log-log interpolation.
 
 use super::Provenance;
+use crate::limits::SPECTRUM_FREQUENCIES;
 use crate::model::TiltAxis;
 use num_complex::Complex64;
 
@@ -152,6 +153,24 @@ impl TiltSpectra {
             provenance,
         };
         (grid, out)
+    }
+}
+
+/// What is wrong with the frequency `f_hz` of a spectrum read from a file, coming after
+/// `previous` (if any): outside [`SPECTRUM_FREQUENCIES`] or not greater than `previous`. The
+/// text is what is allowed, for [`super::InputError::Frequency`]; `None` if `f_hz` is allowed.
+pub fn frequency_refusal(f_hz: f64, previous: Option<f64>) -> Option<String> {
+    if !SPECTRUM_FREQUENCIES.admits(f_hz) {
+        return Some(format!(
+            "{} (a rate spectrum is divided by (2 pi f)^2; see docs/limits.md)",
+            SPECTRUM_FREQUENCIES.allowed("Hz")
+        ));
+    }
+    match previous {
+        Some(p) if f_hz <= p => Some(format!(
+            "strictly increasing: greater than the previous {p:?} Hz"
+        )),
+        _ => None,
     }
 }
 

@@ -148,6 +148,45 @@ impl TiltAxis {
     }
 }
 
+/// Floor translation: the displacement of the floor as a rigid body along the lab axes (m),
+/// and with it of the pivot about which tilt is defined, the upper suspension point and the
+/// sensor housing. Lab axes as the model's: the crossbar arm lies along y (the test mass at
+/// `(0, -d, .)`), x is perpendicular to it (the test mass's X), z is up. See
+/// [`crate::model::translation`] for the forcing and its low-frequency equivalence with tilt.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum TranslationAxis {
+    /// Displacement along x, perpendicular to the crossbar arm (m).
+    XT,
+    /// Displacement along y, along the crossbar arm (m).
+    YT,
+    /// Displacement along z, up (m).
+    ZT,
+}
+
+impl TranslationAxis {
+    /// All translation inputs in the crate's index order.
+    pub const ALL: [TranslationAxis; 3] = [
+        TranslationAxis::XT,
+        TranslationAxis::YT,
+        TranslationAxis::ZT,
+    ];
+
+    /// Index into 3-vectors (the lab axis: 0 for x, 1 for y, 2 for z).
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// ASCII name as used in files and on the command line.
+    pub fn name(self) -> &'static str {
+        ["x_t", "y_t", "z_t"][self.index()]
+    }
+
+    /// SI unit of the input.
+    pub fn unit(self) -> &'static str {
+        "m"
+    }
+}
+
 /// The 12 components of the external forces F_a, F_b (N, at the centres of mass) and torques
 /// M_a, M_b (N m, about the centres of mass), inertial axes, in the order of [`ForceInput::ALL`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -204,10 +243,10 @@ impl ForceInput {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Block {
     /// {theta_a, delta_a, theta_b, delta_b}: swinging along y and bouncing. Seen by Y, Z, theta;
-    /// driven by theta_t.
+    /// driven by theta_t and the floor translations y_t, z_t.
     SwingYBounce,
     /// {eta_a, phi_a, eta_b, phi_b}: swinging along x and torsion. Seen by X, eta, phi, phi_a;
-    /// driven by eta_t and phi_t.
+    /// driven by eta_t, phi_t and the floor translation x_t.
     SwingXTorsion,
 }
 

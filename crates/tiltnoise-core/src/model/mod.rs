@@ -1,14 +1,15 @@
 //! The linearized 8-DoF model of the double torsion pendulum (paper, Appendix A): mass and
-//! stiffness matrices, the zeroth-order generalized-force matrix, the tilt forcing and the
-//! observation matrix. Pure numerics: depends on `params` and `nalgebra`, never on I/O.
+//! stiffness matrices, the zeroth-order generalized-force matrix, the forcing by the floor's tilt
+//! and translation, and the observation matrix. Pure numerics: depends on `params` and `nalgebra`, never on I/O.
 
 mod coords;
 pub mod damping;
 mod matrices;
 mod request;
 pub mod tilt;
+pub mod translation;
 
-pub use coords::{Block, Coord, ForceInput, Observable, TiltAxis};
+pub use coords::{Block, Coord, ForceInput, Observable, TiltAxis, TranslationAxis};
 pub use damping::{DampingKind, DissipativeElement};
 pub use request::{Input, Request};
 
@@ -25,6 +26,8 @@ pub type CMat8 = SMatrix<Complex64, 8, 8>;
 pub type ForceMatrix = SMatrix<f64, 8, 12>;
 /// Generalized forces per unit tilt angle (8 x 3).
 pub type TiltMatrix = SMatrix<f64, 8, 3>;
+/// Generalized forces per unit floor displacement and `w^2` (8 x 3).
+pub type TranslationMatrix = SMatrix<f64, 8, 3>;
 /// Observables per unit coordinate (7 x 8).
 pub type ObservationMatrix = SMatrix<f64, 7, 8>;
 /// A generalized-coordinate vector.
@@ -110,6 +113,7 @@ pub struct Model {
     dissipation: Vec<DissipativeElement>,
     force: ForceMatrix,
     tilt: tilt::TiltForcing,
+    translation: translation::TranslationForcing,
     observation: ObservationMatrix,
 }
 
@@ -136,6 +140,7 @@ impl Model {
         check_stable(&mass, &(stiffness_gravity + stiffness_elastic))?;
         let force = matrices::force_matrix(params, &derived);
         let tilt = tilt::TiltForcing::new(params, &derived, &force, &stiffness_gravity);
+        let translation = translation::TranslationForcing::new(params, &force);
         let observation = matrices::observation(params);
         let finite = |m: &[f64]| m.iter().all(|x| x.is_finite());
         if !(finite(mass.as_slice())
@@ -146,11 +151,13 @@ impl Model {
             && finite(force.as_slice())
             && finite(tilt.g0.as_slice())
             && finite(tilt.g2.as_slice())
+            && finite(translation.g2.as_slice())
             && finite(observation.as_slice()))
         {
             return Err(ParamError::NotFinite {
-                detail: "an entry of M, K, C, the force, tilt or observation matrix overflows \
-                         f64; the parameter values are far outside a laboratory pendulum's"
+                detail: "an entry of M, K, C, the force, tilt, translation or observation matrix \
+                         overflows f64; the parameter values are far outside a laboratory \
+                         pendulum's"
                     .into(),
             });
         }
@@ -165,6 +172,7 @@ impl Model {
             dissipation,
             force,
             tilt,
+            translation,
             observation,
         })
     }
@@ -260,6 +268,11 @@ impl Model {
     /// Tilt forcing `G(w) = G0 + w^2 G2`; see [`tilt`] for the sign convention.
     pub fn tilt_forcing(&self) -> &tilt::TiltForcing {
         &self.tilt
+    }
+
+    /// Floor-translation forcing `G(w) = w^2 G2`; see [`translation`] for the convention.
+    pub fn translation_forcing(&self) -> &translation::TranslationForcing {
+        &self.translation
     }
 
     /// Observation matrix C: observables (X, Y, Z in m; theta, eta, phi, phi_a in rad) from q.

@@ -1,14 +1,16 @@
-//! What a transfer function is asked for: its inputs (tilt angles, forces, torques) and its
-//! outputs (observables). Plain data of the model layer, shared by every evaluator (the
+//! What a transfer function is asked for: its inputs (floor tilt and translation, forces,
+//! torques) and its outputs (observables). Plain data of the model layer, shared by every evaluator (the
 //! transfer-function methods and the double-double reference).
 
-use super::{ForceInput, Observable, TiltAxis};
+use super::{ForceInput, Observable, TiltAxis, TranslationAxis};
 
 /// An input of a transfer function.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Input {
     /// A floor tilt angle (rad).
     Tilt(TiltAxis),
+    /// A floor translation (m).
+    Translation(TranslationAxis),
     /// A force (N) or torque (N m) component on one of the bodies.
     Force(ForceInput),
 }
@@ -19,10 +21,31 @@ impl Input {
         TiltAxis::ALL.into_iter().map(Input::Tilt).collect()
     }
 
-    /// Name used in files and on the command line (`theta_t`, `F_b.x`, ...).
+    /// Every floor translation, in order x_t, y_t, z_t.
+    pub fn all_translations() -> Vec<Input> {
+        TranslationAxis::ALL
+            .into_iter()
+            .map(Input::Translation)
+            .collect()
+    }
+
+    /// The floor's six motions: the tilt angles, then the translations.
+    pub fn all_ground() -> Vec<Input> {
+        let mut all = Input::all_tilts();
+        all.extend(Input::all_translations());
+        all
+    }
+
+    /// True for the floor's motions (tilt and translation), false for forces and torques.
+    pub fn is_ground(self) -> bool {
+        !matches!(self, Input::Force(_))
+    }
+
+    /// Name used in files and on the command line (`theta_t`, `x_t`, `F_b.x`, ...).
     pub fn name(self) -> &'static str {
         match self {
             Input::Tilt(t) => t.name(),
+            Input::Translation(t) => t.name(),
             Input::Force(f) => f.name(),
         }
     }
@@ -31,6 +54,7 @@ impl Input {
     pub fn unit(self) -> &'static str {
         match self {
             Input::Tilt(t) => t.unit(),
+            Input::Translation(t) => t.unit(),
             Input::Force(f) => f.unit(),
         }
     }
@@ -41,6 +65,12 @@ impl Input {
             .into_iter()
             .find(|t| t.name() == name)
             .map(Input::Tilt)
+            .or_else(|| {
+                TranslationAxis::ALL
+                    .into_iter()
+                    .find(|t| t.name() == name)
+                    .map(Input::Translation)
+            })
             .or_else(|| ForceInput::from_name(name).map(Input::Force))
     }
 }

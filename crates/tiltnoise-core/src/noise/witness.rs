@@ -44,11 +44,13 @@ impl WitnessNoise {
     pub fn check(&self, what: &str) -> Result<(), String> {
         let name = self.input.name();
         if let NoiseLevel::White(asd) = self.level {
-            if !(asd.is_finite() && asd >= 0.0) {
+            if !crate::limits::ASDS.admits(asd) {
                 return Err(format!(
-                    "{what} {name}: the ASD {asd:e} {}/sqrt(Hz) is not allowed: must be finite \
-                     and >= 0",
-                    self.input.unit()
+                    "{what} {name}: the ASD {} {}/sqrt(Hz) is not allowed: must be {} (see \
+                     docs/limits.md)",
+                    crate::error::Num(asd),
+                    self.input.unit(),
+                    crate::limits::ASDS.allowed(&format!("{}/sqrt(Hz)", self.input.unit()))
                 ));
             }
         }

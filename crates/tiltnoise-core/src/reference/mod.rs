@@ -3,8 +3,8 @@
 //! # What it is for
 //!
 //! The oracle of the accuracy tests and of the methods table: it evaluates
-//! `H(w) = C (K_c - w^2 M)^-1 (G0 + w^2 G2)` (or a column of the force matrix instead of the
-//! tilt forcing) to about 30 significant digits, so that the error of every `f64` method
+//! `H(w) = C (K_c - w^2 M)^-1 (G0 + w^2 G2)` (the tilt forcing, the translation forcing with
+//! `G0 = 0`, or a column of the force matrix) to about 30 significant digits, so that the error of every `f64` method
 //! ([`crate::tf::Method`]) can be measured rather than estimated. It costs about 8 us per
 //! frequency for the 7 x 3 tilt matrix, 2 to 3 times the `f64` direct method; no production
 //! path uses it.
@@ -17,10 +17,12 @@
 //! loss factors `1 + i phi`, each fibre's diluted swing loss on its share of the gravity
 //! stiffness), the viscous damping matrix `C` (the dynamic stiffness is then
 //! `K_c + i w C - w^2 M`, with `w` the double-double square root of `w^2`), the zeroth-order
-//! force matrix, the tilt forcing `G0 + w^2 G2` (the
-//! crate's sign convention, see [`crate::model::tilt`]; `G2` from the apparent forces and torques
-//! `F_i = -m_i (r_s'' + w' x r_gi0)`, `M_i = -I_i w'` themselves) and the observation matrix are
-//! all rebuilt here from the [`Params`] values in double-double arithmetic. Shared with the rest
+//! force matrix, the tilt forcing `G0 + w^2 G2` (the crate's sign convention, see
+//! [`crate::model::tilt`]; `G2` from the apparent forces and torques
+//! `F_i = -m_i (r_s'' + w' x r_gi0)`, `M_i = -I_i w'` themselves), the floor translation's
+//! forcing `w^2 G2` (from the apparent forces `F_i = -m_i u''` themselves, see
+//! [`crate::model::translation`]) and the observation matrix are all rebuilt here from the
+//! [`Params`] values in double-double arithmetic. Shared with the rest
 //! of the crate are only the parameter struct, the index order of coordinates, observables and
 //! inputs (the paper's, restated here) and the error types. The tilt forcing is used as defined,
 //! `G0 + w^2 G2`: not the rotation-plus-translation split that some `f64` methods use, so that a
@@ -119,6 +121,7 @@ struct Formulation {
     system: System,
     g0: [[Dd; 3]; N],
     g2: [[Dd; 3]; N],
+    translation_g2: [[Dd; 3]; N],
     force: [[Dd; 12]; N],
     observation: [[Dd; N]; 7],
 }
@@ -160,6 +163,7 @@ impl Formulation {
             },
             g0: m.g0,
             g2: m.g2,
+            translation_g2: m.translation_g2,
             force: m.force,
             observation: m.observation,
         }
@@ -178,6 +182,7 @@ impl Formulation {
             },
             g0: to_abs_rows(&m.g0),
             g2: to_abs_rows(&m.g2),
+            translation_g2: to_abs_rows(&m.translation_g2),
             force: to_abs_rows(&m.force),
             observation: to_abs_cols(&m.observation),
         }
@@ -194,6 +199,14 @@ impl Formulation {
                     g0 + g2 * w2
                 }
             }
+            Input::Translation(axis) => {
+                let g2 = self.translation_g2[r][axis.index()];
+                if g2.is_zero() || w2.is_zero() {
+                    Dd::ZERO
+                } else {
+                    g2 * w2
+                }
+            }
             Input::Force(f) => self.force[r][f.index()],
         }
     }
@@ -204,6 +217,7 @@ impl Formulation {
             Input::Tilt(axis) => {
                 self.g0[r][axis.index()].hi.abs() + w2 * self.g2[r][axis.index()].hi.abs()
             }
+            Input::Translation(axis) => w2 * self.translation_g2[r][axis.index()].hi.abs(),
             Input::Force(f) => self.force[r][f.index()].hi.abs(),
         }
     }
@@ -348,6 +362,12 @@ impl ReferenceModel {
     /// Tilt forcing per unit `w^2` angle, `G2` (8x3).
     pub fn tilt_g2(&self) -> &[[Dd; 3]; 8] {
         &self.m.g2
+    }
+
+    /// Floor-translation forcing per unit `w^2` displacement, `G2` (8x3, columns x_t, y_t,
+    /// z_t); the frequency-independent part is zero.
+    pub fn translation_g2(&self) -> &[[Dd; 3]; 8] {
+        &self.m.translation_g2
     }
 
     /// Observation matrix C (7x8, rows in the order of [`Observable::ALL`]).

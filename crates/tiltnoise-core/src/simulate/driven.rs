@@ -1,11 +1,13 @@
-//! The undamped model driven by floor tilt, propagated exactly in the normal-mode basis for a
-//! piecewise-linear tilt at a fine step, sampled every `keep_every` steps: a record of the
-//! observables made from a known tilt series, for example to test `subtract`.
+//! The undamped model driven by the floor's motion (tilt and translation), propagated exactly in
+//! the normal-mode basis for a piecewise-linear drive at a fine step, sampled every `keep_every`
+//! steps: a record of the observables made from a known tilt or translation series, for example
+//! to test `subtract`.
 //!
 //! # Method
 //!
-//! The tilt enters as `M q'' + K q = G0 u - G2 u''` (the frequency-domain forcing
-//! `(G0 + w^2 G2) u` of [`crate::model::tilt`]). The substitution `q = p - M^-1 G2 u` removes
+//! A ground input enters as `M q'' + K q = G0 u - G2 u''` (the frequency-domain forcing
+//! `(G0 + w^2 G2) u` of [`crate::model::tilt`]; for a translation `G0 = 0` and `G2` the apparent
+//! forces of [`crate::model::translation`]). The substitution `q = p - M^-1 G2 u` removes
 //! the second derivative: `M p'' + K p = B0 u` with `B0 = G0 + K M^-1 G2`, the split of the
 //! state-space method ([`crate::tf::StateSpace`]). In the mass-normalized modes `V` of
 //! [`NormalModes`], `p = V a` and `a_k'' + w_k^2 a_k = b_k(t)` with `b = V^T B0 u`.
@@ -25,11 +27,17 @@
 //! `h = 0.1 s`. [`drive_from_record`] therefore interpolates a coarse record to a finer step
 //! first (band-limited, [`bandlimited_upsample`]).
 //!
+//! A translation's response vanishes as `w^2` at low frequency while `p` and `M^-1 G2 u` are
+//! each of the order of `u`: the sum loses the factor `(f / f_1)^2` of relative accuracy below
+//! the lowest mode `f_1` of the block (the ratio `eps (f_1 / f)^2`, 1e-10 at 0.1 mHz for Table
+//! I's swing-x+torsion block). A drive's constant offset or linear trend excites nothing (no
+//! acceleration) and comes out as zero to rounding.
+//!
 //! Only the undamped model is supported, like [`super::simulate`].
 
 use super::{InitialState, SimError, Simulation};
 use crate::limits::{check_memory, planned_bytes};
-use crate::model::{Model, Observable, TiltAxis};
+use crate::model::{Input, Model, Observable};
 use crate::modes::NormalModes;
 use crate::rng::Rng;
 use num_complex::Complex64;
@@ -38,14 +46,17 @@ use realfft::RealFftPlanner;
 /// Largest factor by which [`drive_from_record`] refines the step.
 pub const MAX_OVERSAMPLE: usize = 1000;
 
-/// Floor tilt at a fine step: the pendulum's drive, crate sign convention (rad).
+/// The floor's motion at a fine step: the pendulum's drive, tilt in the crate's sign convention
+/// (rad) and translation along the lab axes (m).
 #[derive(Debug, Clone, PartialEq)]
-pub struct TiltDrive {
+pub struct GroundDrive {
     /// Step between samples (s).
     pub step_s: f64,
-    /// The axes driven, in canonical order, at least one.
-    pub axes: Vec<TiltAxis>,
-    /// One series per axis, all of the same length (>= 2), tilt angle (rad).
+    /// The ground inputs driven ([`Input::Tilt`], [`Input::Translation`]), each once, at least
+    /// one.
+    pub inputs: Vec<Input>,
+    /// One series per input, all of the same length (>= 2): tilt angle (rad) or displacement
+    /// (m).
     pub samples: Vec<Vec<f64>>,
 }
 
@@ -71,7 +82,7 @@ pub struct DrivenConfig {
 /// [`SimError::InvalidReadout`], [`SimError::NonOscillatoryMode`], [`SimError::TooLarge`].
 pub fn simulate_driven(
     model: &Model,
-    drive: &TiltDrive,
+    drive: &GroundDrive,
     cfg: &DrivenConfig,
 ) -> Result<Simulation, SimError> {
     if !model.is_undamped() {
@@ -110,9 +121,9 @@ pub fn simulate_driven(
     let dyn_ = Dynamics::new(model)?;
     let (omega, modes) = (dyn_.omega, &dyn_.modes);
     let c = model.observation();
-    let axes: Vec<usize> = drive.axes.iter().map(|a| a.index()).collect();
-    let modal_in: Vec<[f64; 8]> = axes.iter().map(|&a| dyn_.modal_in[a]).collect();
-    let feed: Vec<[f64; 8]> = axes.iter().map(|&a| dyn_.feed[a]).collect();
+    let columns: Vec<usize> = drive.inputs.iter().map(|&i| ground_column(i)).collect();
+    let modal_in: Vec<[f64; 8]> = columns.iter().map(|&a| dyn_.modal_in[a]).collect();
+    let feed: Vec<[f64; 8]> = columns.iter().map(|&a| dyn_.feed[a]).collect();
     let shapes: [[f64; 8]; 8] =
         std::array::from_fn(|k| std::array::from_fn(|i| modes.modes[k].shape[i]));
 
@@ -192,15 +203,24 @@ pub fn simulate_driven(
     })
 }
 
-/// The modes and the tilt forcing in the form the stepping uses.
+/// The column of a ground input in [`Dynamics`]: tilt axes 0..3, translations 3..6.
+fn ground_column(input: Input) -> usize {
+    match input {
+        Input::Tilt(a) => a.index(),
+        Input::Translation(a) => 3 + a.index(),
+        Input::Force(_) => unreachable!("check_drive admits ground inputs only"),
+    }
+}
+
+/// The modes and the ground forcing in the form the stepping uses.
 struct Dynamics {
     modes: NormalModes,
     /// `w_k` (rad/s).
     omega: [f64; 8],
-    /// Per tilt axis (crate order): modal forcing `V^T B0 e_axis`.
-    modal_in: [[f64; 8]; 3],
-    /// Per tilt axis: the feed-through `-M^-1 G2 e_axis` of `q`.
-    feed: [[f64; 8]; 3],
+    /// Per ground column ([`ground_column`]): modal forcing `V^T B0 e_axis`.
+    modal_in: [[f64; 8]; 6],
+    /// Per ground column: the feed-through `-M^-1 G2 e_axis` of `q`.
+    feed: [[f64; 8]; 6],
 }
 
 impl Dynamics {
@@ -217,16 +237,19 @@ impl Dynamics {
             omega[k] = mode.omega_sq.sqrt();
         }
         let forcing = model.tilt_forcing();
-        let m_inv_g2 = model
-            .mass()
-            .lu()
-            .solve(&forcing.g2)
-            .expect("the mass matrix is positive definite");
-        let b0 = forcing.g0 + model.stiffness() * m_inv_g2;
-        let modal_in = std::array::from_fn(|a| {
-            std::array::from_fn(|k| modes.modes[k].shape.dot(&b0.column(a)))
+        let lu = model.mass().lu();
+        let m_inv = |g2| lu.solve(g2).expect("the mass matrix is positive definite");
+        let (tilt, translation) = (m_inv(&forcing.g2), m_inv(&model.translation_forcing().g2));
+        // B0 = G0 + K M^-1 G2; a translation has G0 = 0.
+        let b0 = [
+            forcing.g0 + model.stiffness() * tilt,
+            model.stiffness() * translation,
+        ];
+        let m_inv_g2 = [tilt, translation];
+        let modal_in = std::array::from_fn(|c| {
+            std::array::from_fn(|k| modes.modes[k].shape.dot(&b0[c / 3].column(c % 3)))
         });
-        let feed = std::array::from_fn(|a| std::array::from_fn(|i| -m_inv_g2[(i, a)]));
+        let feed = std::array::from_fn(|c| std::array::from_fn(|i| -m_inv_g2[c / 3][(i, c % 3)]));
         Ok(Dynamics {
             modes,
             omega,
@@ -243,14 +266,14 @@ impl Dynamics {
 /// # Errors
 ///
 /// As [`simulate_driven`].
-pub fn quasi_static_start(model: &Model, drive: &TiltDrive) -> Result<InitialState, SimError> {
+pub fn quasi_static_start(model: &Model, drive: &GroundDrive) -> Result<InitialState, SimError> {
     check_drive(drive)?;
     let d = Dynamics::new(model)?;
     let h = drive.step_s;
     let (mut q, mut qdot) = ([0.0; 8], [0.0; 8]);
-    for (axis, series) in drive.axes.iter().zip(&drive.samples) {
+    for (&input, series) in drive.inputs.iter().zip(&drive.samples) {
         let (u, du) = (series[0], (series[1] - series[0]) / h);
-        let a = axis.index();
+        let a = ground_column(input);
         for k in 0..8 {
             let w2 = d.omega[k] * d.omega[k];
             for i in 0..8 {
@@ -266,37 +289,50 @@ pub fn quasi_static_start(model: &Model, drive: &TiltDrive) -> Result<InitialSta
     Ok(InitialState { q, qdot })
 }
 
-fn check_drive(drive: &TiltDrive) -> Result<(), SimError> {
+fn check_drive(drive: &GroundDrive) -> Result<(), SimError> {
     let bad = |message: String| Err(SimError::InvalidDrive { message });
-    if drive.axes.is_empty() || drive.axes.len() != drive.samples.len() {
+    if drive.inputs.is_empty() || drive.inputs.len() != drive.samples.len() {
         return bad(format!(
-            "{} axes and {} series: one series per axis, at least one",
-            drive.axes.len(),
+            "{} inputs and {} series: one series per input, at least one",
+            drive.inputs.len(),
             drive.samples.len()
         ));
+    }
+    for (k, input) in drive.inputs.iter().enumerate() {
+        if !input.is_ground() {
+            return bad(format!(
+                "{} is not a motion of the floor: a drive is tilt (theta_t, eta_t, phi_t) or \
+                 translation (x_t, y_t, z_t)",
+                input.name()
+            ));
+        }
+        if drive.inputs[..k].contains(input) {
+            return bad(format!("{} is driven twice", input.name()));
+        }
     }
     let n = drive.samples[0].len();
     if n < 2 {
         return bad(format!("{n} sample(s): at least 2 are needed"));
     }
-    for (axis, series) in drive.axes.iter().zip(&drive.samples) {
+    for (input, series) in drive.inputs.iter().zip(&drive.samples) {
         if series.len() != n {
             return bad(format!(
                 "{} has {} samples and {} has {n}",
-                axis.name(),
+                input.name(),
                 series.len(),
-                drive.axes[0].name()
+                drive.inputs[0].name()
             ));
         }
         if let Some((i, v)) = series.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return bad(format!("{} sample {i} = {v} is not finite", axis.name()));
+            return bad(format!("{} sample {i} = {v} is not finite", input.name()));
         }
     }
     Ok(())
 }
 
-/// A record of sampling step `dt_s` turned into the drive of [`simulate_driven`]: interpolated
-/// to `dt_s / oversample` by [`bandlimited_upsample`], scaled by `gains[axis]` and delayed by
+/// A record of sampling step `dt_s` (one series per ground input of `inputs`) turned into the
+/// drive of [`simulate_driven`]: interpolated
+/// to `dt_s / oversample` by [`bandlimited_upsample`], scaled by `gains[input]` and delayed by
 /// `delay_steps` fine steps (`drive(t) = gain record(t - delay)`; before the record's first
 /// sample or after its last the end value is held).
 ///
@@ -307,12 +343,12 @@ fn check_drive(drive: &TiltDrive) -> Result<(), SimError> {
 /// the fine drive does not fit into memory.
 pub fn drive_from_record(
     dt_s: f64,
-    axes: &[TiltAxis],
+    inputs: &[Input],
     record: &[Vec<f64>],
     oversample: usize,
     gains: &[f64],
     delay_steps: i64,
-) -> Result<TiltDrive, SimError> {
+) -> Result<GroundDrive, SimError> {
     if !(1..=MAX_OVERSAMPLE).contains(&oversample) {
         return Err(SimError::InvalidDrive {
             message: format!("oversampling factor {oversample}: must be 1 ..= {MAX_OVERSAMPLE}"),
@@ -323,16 +359,16 @@ pub fn drive_from_record(
             message: format!("gain {g} is not finite"),
         });
     }
-    check_drive(&TiltDrive {
+    check_drive(&GroundDrive {
         step_s: dt_s,
-        axes: axes.to_vec(),
+        inputs: inputs.to_vec(),
         samples: record.to_vec(),
     })?;
     let n = record[0].len();
     let n_fine = (n - 1) * oversample + 1;
     check_memory(
-        || format!("a tilt drive of {n_fine} steps on {} axes", axes.len()),
-        planned_bytes(n * oversample * (axes.len() + 2), 16),
+        || format!("a drive of {n_fine} steps on {} inputs", inputs.len()),
+        planned_bytes(n * oversample * (inputs.len() + 2), 16),
     )?;
     let samples = record
         .iter()
@@ -344,9 +380,9 @@ pub fn drive_from_record(
                 .collect()
         })
         .collect();
-    Ok(TiltDrive {
+    Ok(GroundDrive {
         step_s: dt_s / oversample as f64,
-        axes: axes.to_vec(),
+        inputs: inputs.to_vec(),
         samples,
     })
 }
@@ -428,6 +464,135 @@ mod tests {
         }
     }
 
+    /// The rounding scale of the quasi-static response of observable `o` per unit of ground
+    /// column `a`: the modal sum's terms `|C v_k| |v_k^T B0| / w_k^2`, each with the
+    /// eigensolver's relative error `8 eps w_max^2 / w_k^2` (Weyl / Davis-Kahan with the gap
+    /// bounded by `w_k^2`) plus `64 eps` of rounding, and `64 eps` on the feed-through; in
+    /// units of eps.
+    fn static_rounding_scale(model: &Model, d: &Dynamics, o: Observable, a: usize) -> f64 {
+        let c = model.observation();
+        let w2_max = d.omega.iter().fold(0.0f64, |m, w| m.max(w * w));
+        let modal: f64 = (0..8)
+            .map(|k| {
+                let cv: f64 = (0..8)
+                    .map(|i| c[(o.index(), i)] * d.modes.modes[k].shape[i])
+                    .sum();
+                let w2 = d.omega[k].powi(2);
+                (cv * d.modal_in[a][k] / w2).abs() * (64.0 + 8.0 * w2_max / w2)
+            })
+            .sum();
+        let feed: f64 = (0..8)
+            .map(|i| (c[(o.index(), i)] * d.feed[a][i]).abs())
+            .sum();
+        modal + 64.0 * feed
+    }
+
+    fn record_all(keep_every: usize) -> DrivenConfig {
+        DrivenConfig {
+            keep_every,
+            readout_asd: Vec::new(),
+            seed: 0,
+        }
+    }
+
+    /// A floor moving at constant velocity is not accelerated: from the quasi-static start the
+    /// exact response is 0 at every step (the modal part and the feed-through `-M^-1 G2 u`
+    /// cancel), for each translation. What the cancellation leaves is within the accuracy
+    /// target of every transfer function times the size of the cancelling terms,
+    /// `||c||_1 ||M^-1 G2||_inf |u|`.
+    #[test]
+    fn a_floor_at_constant_velocity_excites_nothing() {
+        use crate::model::TranslationAxis;
+        use crate::params::Params;
+        let model = Model::new(&Params::table_i()).unwrap();
+        let d = Dynamics::new(&model).unwrap();
+        let n = 2000;
+        for axis in TranslationAxis::ALL {
+            let input = Input::Translation(axis);
+            let drive = GroundDrive {
+                step_s: 0.5,
+                inputs: vec![input],
+                samples: vec![(0..n).map(|j| 1e-6 + 3e-9 * j as f64).collect()],
+            };
+            let sim = simulate_driven(&model, &drive, &record_all(1)).unwrap();
+            let feed = &d.feed[ground_column(input)];
+            let feed_size = feed.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for o in Observable::ALL {
+                let c_size: f64 = model.observation().row(o.index()).abs().sum();
+                for (j, &u) in drive.samples[0].iter().enumerate() {
+                    let got = sim.observable(o)[j];
+                    let tol = crate::tf::DEFAULT_REL_TOL * c_size * feed_size * u.abs();
+                    assert!(
+                        got.abs() <= tol,
+                        "{}/{} at step {j}: {got:e} (tol {tol:e})",
+                        o.name(),
+                        axis.name()
+                    );
+                }
+            }
+        }
+    }
+
+    /// A tilt about y is a rigid rotation of the pendulum with the floor plus a translation of
+    /// the suspension point by `-h eta_t` along x (`G2[:, eta_t] + M e_eta_a = -h G2[:, x_t]`,
+    /// `model::translation`), and the rigid rotation's forcing `(K_gravity e_eta_a, -M e_eta_a)`
+    /// moves `q` by exactly `e_eta_a eta_t`. So for any drive `s(t)`, the response to
+    /// `eta_t = s` is `C e_eta_a s - h` times the response to `x_t = s`, sample by sample,
+    /// likewise `theta_t` and `+h y_t`. Here `s` is a few tones from 0.2 mHz to 3 Hz over
+    /// 4000 s, across the torsion, swing and bounce modes; agreement within the accuracy target
+    /// of every transfer function, relative to the largest response.
+    #[test]
+    fn tilt_is_a_rotation_plus_the_translation_of_the_suspension_point() {
+        use crate::model::{Coord, TiltAxis, TranslationAxis};
+        use crate::params::Params;
+        let model = Model::new(&Params::table_i()).unwrap();
+        let h = model.params().length.h_m;
+        let step = 0.05;
+        let n = 80_000;
+        let s: Vec<f64> = (0..n)
+            .map(|j| {
+                let t = j as f64 * step;
+                [(2e-4, 1.0), (1.1e-3, 0.3), (0.37, 0.02), (3.0, 0.003)]
+                    .iter()
+                    .map(|&(f, a)| a * 1e-6 * (std::f64::consts::TAU * f * t + f).sin())
+                    .sum()
+            })
+            .collect();
+        let run = |input: Input| {
+            let drive = GroundDrive {
+                step_s: step,
+                inputs: vec![input],
+                samples: vec![s.clone()],
+            };
+            simulate_driven(&model, &drive, &record_all(10)).unwrap()
+        };
+        let c = model.observation();
+        for (tilt, axis, sign, coord) in [
+            (TiltAxis::EtaT, TranslationAxis::XT, -1.0, Coord::EtaA),
+            (TiltAxis::ThetaT, TranslationAxis::YT, 1.0, Coord::ThetaA),
+        ] {
+            let (by_tilt, by_translation) = (run(Input::Tilt(tilt)), run(Input::Translation(axis)));
+            for o in Observable::ALL {
+                let rigid = c[(o.index(), coord.index())];
+                let (a, b) = (by_tilt.observable(o), by_translation.observable(o));
+                let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let mut worst = 0.0f64;
+                for (j, (&x, &y)) in a.iter().zip(b).enumerate() {
+                    let want = rigid * s[10 * j] + sign * h * y;
+                    worst = worst.max((x - want).abs());
+                }
+                assert!(
+                    worst <= crate::tf::DEFAULT_REL_TOL * scale,
+                    "{}/{} against the rigid rotation and {}: max |diff| {worst:e}, largest \
+                     response {scale:e}",
+                    o.name(),
+                    tilt.name(),
+                    axis.name()
+                );
+            }
+        }
+    }
+
     /// A tilt linear in time has `u'' = 0`: from the quasi-static start the exact response is
     /// the static one, `X = H_X,eta(0) u` and `Y = H_Y,theta(0) u`, at every step, however
     /// large `w_k h` (the 0.5 s step is beyond explicit integrators' limit for the bouncing
@@ -437,14 +602,14 @@ mod tests {
     /// bounded by `w_k^2`), plus `64 eps` of rounding on every term and the feed-through.
     #[test]
     fn a_ramp_gives_the_static_response_exactly() {
-        use crate::model::{Input, Request};
+        use crate::model::{Request, TiltAxis};
         use crate::params::Params;
         use crate::tf::{plan, Method};
         let model = Model::new(&Params::table_i()).unwrap();
         let n = 2000;
-        let drive = TiltDrive {
+        let drive = GroundDrive {
             step_s: 0.5,
-            axes: vec![TiltAxis::ThetaT, TiltAxis::EtaT],
+            inputs: vec![Input::Tilt(TiltAxis::ThetaT), Input::Tilt(TiltAxis::EtaT)],
             samples: vec![
                 (0..n).map(|j| 1e-6 + 3e-9 * j as f64).collect(),
                 (0..n).map(|j| -2e-6 + 5e-9 * j as f64).collect(),
@@ -469,23 +634,7 @@ mod tests {
             .eval(0.0)
             .unwrap();
         let d = Dynamics::new(&model).unwrap();
-        let c = model.observation();
-        let w2_max = d.omega.iter().fold(0.0f64, |m, w| m.max(w * w));
-        let magnitude = |o: Observable, a: usize| -> f64 {
-            let modal: f64 = (0..8)
-                .map(|k| {
-                    let cv: f64 = (0..8)
-                        .map(|i| c[(o.index(), i)] * d.modes.modes[k].shape[i])
-                        .sum();
-                    let w2 = d.omega[k].powi(2);
-                    (cv * d.modal_in[a][k] / w2).abs() * (64.0 + 8.0 * w2_max / w2)
-                })
-                .sum();
-            let feed: f64 = (0..8)
-                .map(|i| (c[(o.index(), i)] * d.feed[a][i]).abs())
-                .sum();
-            modal + 64.0 * feed
-        };
+        let magnitude = |o: Observable, a: usize| static_rounding_scale(&model, &d, o, a);
         for (j, i) in (0..n).step_by(7).enumerate() {
             let (ut, ue) = (drive.samples[0][i], drive.samples[1][i]);
             for (row, o) in [Observable::X, Observable::Y].into_iter().enumerate() {

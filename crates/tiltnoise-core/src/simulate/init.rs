@@ -8,8 +8,10 @@ use super::{
     check_initial_state, check_samples, equal_energy_init, kick_x, InitialState, Simulation,
 };
 use crate::error::{Num, Shown};
+use crate::limits::MIN_SAMPLE;
 use crate::model::{Coord, Model, Observable};
 use crate::options::{OptionError, Spelling};
+use crate::repeats::{list_entries, refuse_repeated_keys};
 use std::fmt::Write as _;
 
 /// The smallest Welch segment of a simulation's ASDs (samples).
@@ -39,15 +41,14 @@ pub enum Excitation {
 }
 
 /// Sets coordinate `name` of `out` to `value` (SI units; `rate`: a velocity) for the option
-/// `option`, whose item `item` is shown in messages; refuses an unknown name, a value that is
-/// not finite and a coordinate already set (`given`).
+/// `option`, whose item `item` is shown in messages; refuses an unknown name and a value that
+/// is not finite.
 pub fn set_coordinate(
     option: &str,
     item: &str,
     name: &str,
     value: f64,
     rate: bool,
-    given: &mut [bool; 8],
     out: &mut [f64; 8],
 ) -> Result<(), OptionError> {
     let shown = Shown(item);
@@ -61,13 +62,6 @@ pub fn set_coordinate(
             "{option} {shown}: {value} {unit} is not allowed: must be finite"
         )));
     }
-    if given[c.index()] {
-        return Err(OptionError::Conflict(format!(
-            "{option} {shown}: coordinate `{}` is given twice",
-            c.name()
-        )));
-    }
-    given[c.index()] = true;
     out[c.index()] = value;
     Ok(())
 }
@@ -96,36 +90,69 @@ pub fn parse_coordinates<S: AsRef<str>>(
     rate: bool,
     out: &mut [f64; 8],
 ) -> Result<(), OptionError> {
-    let mut given = [false; 8];
-    for item in items {
-        for entry in item
-            .as_ref()
-            .split(',')
-            .map(str::trim)
-            .filter(|e| !e.is_empty())
-        {
-            let shown = Shown(entry);
-            let (name, value) = entry.split_once('=').ok_or_else(|| {
-                OptionError::Conflict(format!(
-                    "{option} {shown}: expected COORD=VALUE, e.g. phi_b=0.01"
-                ))
-            })?;
-            // The name is checked first, as it comes first in the item.
-            coordinate(option, entry, name.trim())?;
-            let v: f64 = value.trim().parse().map_err(|_| {
-                OptionError::Conflict(format!(
-                    "{option} {shown}: `{}` is not a number",
-                    Shown(value.trim())
-                ))
-            })?;
-            set_coordinate(option, entry, name.trim(), v, rate, &mut given, out)?;
-        }
+    let entries = list_entries(items);
+    refuse_repeated_keys(option, "coordinate", &entries)?;
+    for entry in entries {
+        let shown = Shown(entry);
+        let (name, value) = entry.split_once('=').ok_or_else(|| {
+            OptionError::Conflict(format!(
+                "{option} {shown}: expected COORD=VALUE, e.g. phi_b=0.01"
+            ))
+        })?;
+        // The name is checked first, as it comes first in the item.
+        coordinate(option, entry, name.trim())?;
+        let v: f64 = value.trim().parse().map_err(|_| {
+            OptionError::Conflict(format!(
+                "{option} {shown}: `{}` is not a number",
+                Shown(value.trim())
+            ))
+        })?;
+        set_coordinate(option, entry, name.trim(), v, rate, out)?;
     }
     Ok(())
 }
 
 /// The initial state of `excitation` on `model` and a description of where it came from.
+/// Every coordinate and rate is 0 or at least [`MIN_SAMPLE`] in magnitude: a smaller one
+/// would give observables whose spectra underflow (the error names the option and value).
 pub fn initial_state(
+    model: &Model,
+    excitation: &Excitation,
+    spelling: Spelling,
+) -> Result<(InitialState, String), OptionError> {
+    let (init, text) = excitation_state(model, excitation, spelling)?;
+    let option = match *excitation {
+        Excitation::KickX { x_m } => spelling.example("kick_x", &Num(x_m).to_string()),
+        Excitation::EqualEnergy { energy_j } => {
+            spelling.example("mode_energy", &Num(energy_j).to_string())
+        }
+        Excitation::Given { .. } => format!(
+            "{}/{}",
+            spelling.option("init"),
+            spelling.option("init_rate")
+        ),
+    };
+    for c in Coord::ALL {
+        for (what, value, unit) in [
+            ("value", init.q[c.index()], c.unit().to_string()),
+            ("rate", init.qdot[c.index()], format!("{}/s", c.unit())),
+        ] {
+            if value != 0.0 && value.abs() < MIN_SAMPLE {
+                return Err(OptionError::Conflict(format!(
+                    "{option}: the initial {what} of {} would be {} {unit}, nonzero and \
+                     smaller than {MIN_SAMPLE:e} in magnitude: the spectra of the motion would \
+                     underflow f64 (see docs/limits.md)",
+                    c.name(),
+                    Num(value)
+                )));
+            }
+        }
+    }
+    Ok((init, text))
+}
+
+/// [`initial_state`] before the check of the smallest magnitudes.
+fn excitation_state(
     model: &Model,
     excitation: &Excitation,
     spelling: Spelling,
@@ -323,7 +350,7 @@ mod tests {
             ("phi_c=1", "--init phi_c=1: unknown coordinate `phi_c`; allowed: theta_a, eta_a, phi_a, delta_a, theta_b, eta_b, phi_b, delta_b"),
             ("phi_b=x", "--init phi_b=x: `x` is not a number"),
             ("phi_b=inf", "--init phi_b=inf: inf rad is not allowed: must be finite"),
-            ("phi_b=1,phi_b=2", "--init phi_b=2: coordinate `phi_b` is given twice"),
+            ("phi_b=1,phi_b=2", "--init: phi_b is given twice; name each coordinate once"),
         ];
         for (item, want) in cases {
             let e = parse_coordinates("--init", &[item], false, &mut q).unwrap_err();

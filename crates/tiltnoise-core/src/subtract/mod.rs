@@ -36,6 +36,7 @@ pub mod align;
 pub mod bands;
 pub mod colocated;
 pub mod estimate;
+mod input_checks;
 mod parameters;
 pub mod predict;
 mod problem;
@@ -234,6 +235,9 @@ pub enum SubtractError {
     /// An option outside its allowed range.
     #[error("{0}")]
     Config(String),
+    /// A record the estimation cannot use: a non-finite sample or spectrum, a dead channel.
+    #[error("{0}")]
+    Record(String),
     /// A band with no bin.
     #[error(
         "the {what} band {} .. {} Hz holds no bin of the Welch grid {} .. {} Hz; allowed: a band \
@@ -391,9 +395,12 @@ pub fn subtract(
         .map(|(_, x)| &x[alignment.measured_first..alignment.measured_first + n])
         .collect();
     let outputs: Vec<Observable> = measured.channels.iter().map(|c| c.0).collect();
+    let channel_names = input_checks::channel_names(inputs, &outputs);
+    input_checks::check_channels(&channel_names, &w, &y)?;
     let welch_cfg = WelchConfig::new(segment_len);
     let train: Vec<&[f64]> = w.iter().chain(&y).map(|x| &x[..n_train]).collect();
     let training_spectra = csd_matrix(&train, fs, &welch_cfg)?;
+    input_checks::check_spectra(&training_spectra, &channel_names, "training")?;
     let n_eff_train = equivalent_averages(&welch_cfg, training_spectra.n_segments);
     let adjacent = stats::bin_variance_factor(segment_len, 1);
     let witness_spectra = WitnessSpectra::new(&training_spectra, n_in, n_eff_train, adjacent);
@@ -574,6 +581,7 @@ pub fn subtract(
 
     let held: Vec<&[f64]> = w.iter().chain(&y).map(|x| &x[n_train..]).collect();
     let held_spectra = csd_matrix(&held, fs, &welch_cfg)?;
+    input_checks::check_spectra(&held_spectra, &channel_names, "held-out")?;
     let n_eff_held = equivalent_averages(&welch_cfg, held_spectra.n_segments);
     let psds = |series: &[(Observable, Vec<f64>)]| -> Result<Vec<Vec<f64>>, SubtractError> {
         series

@@ -132,7 +132,8 @@ pub struct Direct {
 }
 
 /// The `8 x inputs` forcing matrices `(G0, G2)` of a request: tilt columns from
-/// [`Model::tilt_forcing`], force columns (frequency independent) from [`Model::force_matrix`].
+/// [`Model::tilt_forcing`], translation columns (`G0 = 0`) from [`Model::translation_forcing`],
+/// force columns (frequency independent) from [`Model::force_matrix`].
 pub(super) fn forcing_columns(model: &Model, inputs: &[Input]) -> (DMatrix<f64>, DMatrix<f64>) {
     let mut forcing0 = DMatrix::zeros(8, inputs.len());
     let mut forcing2 = DMatrix::zeros(8, inputs.len());
@@ -142,6 +143,9 @@ pub(super) fn forcing_columns(model: &Model, inputs: &[Input]) -> (DMatrix<f64>,
             Input::Tilt(axis) => {
                 forcing0.set_column(col, &tilt.g0.column(axis.index()));
                 forcing2.set_column(col, &tilt.g2.column(axis.index()));
+            }
+            Input::Translation(axis) => {
+                forcing2.set_column(col, &model.translation_forcing().g2.column(axis.index()));
             }
             Input::Force(f) => {
                 forcing0.set_column(col, &model.force_matrix().column(f.index()));

@@ -14,6 +14,8 @@
 //! (direct, block, split, modal, torsion2) use the dense layout, two planes per entry.
 
 use super::{Input, Method};
+use crate::error::TfError;
+use crate::ground::GroundQuantity;
 use crate::model::Observable;
 use num_complex::Complex64;
 
@@ -116,6 +118,9 @@ pub struct TransferMatrix {
     pub inputs: Vec<Input>,
     /// The method that produced the values.
     pub method: Method,
+    /// What the floor's motion (tilt and translation columns) is per unit of: displacement
+    /// unless converted by [`TransferMatrix::per_ground_quantity`].
+    ground_quantity: GroundQuantity,
     layout: Layout,
     /// `layout.n_planes()` planes of `n_stored_freqs()` values, one after the other.
     data: Vec<f64>,
@@ -157,6 +162,7 @@ impl TransferMatrix {
             outputs,
             inputs,
             method,
+            ground_quantity: GroundQuantity::Displacement,
             layout: Layout::dense(n),
             data,
         }
@@ -177,6 +183,7 @@ impl TransferMatrix {
             outputs,
             inputs,
             method,
+            ground_quantity: GroundQuantity::Displacement,
             layout,
             data,
         }
@@ -239,14 +246,76 @@ impl TransferMatrix {
         out
     }
 
-    /// Unit of entry (o, i): output unit per input unit.
+    /// Unit of entry (o, i): output unit per input unit ([`TransferMatrix::input_unit`]).
     pub fn unit(&self, o: usize, i: usize) -> String {
-        let input = self.inputs[i].unit();
-        if input.contains(' ') {
+        let input = self.input_unit(i);
+        if input.contains(' ') || input.contains('/') {
             format!("{}/({input})", self.outputs[o].unit())
         } else {
             format!("{}/{input}", self.outputs[o].unit())
         }
+    }
+
+    /// Unit of input `i` as the values are per: the input's own (rad, m, N, N m), or for the
+    /// floor's motion that of [`TransferMatrix::ground_quantity`] (rad/s^2, m/s, ...).
+    pub fn input_unit(&self, i: usize) -> String {
+        let input = self.inputs[i];
+        match input.is_ground() {
+            true => self.ground_quantity.unit(input.unit()),
+            false => input.unit().to_string(),
+        }
+    }
+
+    /// What the floor's motion (the tilt and translation columns) is per unit of.
+    pub fn ground_quantity(&self) -> GroundQuantity {
+        self.ground_quantity
+    }
+
+    /// The same transfer functions with the floor's motion (the tilt and translation columns)
+    /// per unit `quantity` instead of per unit displacement: each such value times
+    /// [`GroundQuantity::to_displacement`] at its frequency (per unit floor acceleration
+    /// `H / (-w^2)`); force and torque columns unchanged. Dense layout.
+    ///
+    /// # Errors
+    ///
+    /// [`TfError::NoGroundFactor`] at the first frequency where the factor does not exist
+    /// (0 Hz for velocity and acceleration) when the matrix has a tilt or translation column.
+    ///
+    /// # Panics
+    ///
+    /// If the matrix is not per unit displacement (converted already).
+    pub fn per_ground_quantity(&self, quantity: GroundQuantity) -> Result<TransferMatrix, TfError> {
+        assert_eq!(
+            self.ground_quantity,
+            GroundQuantity::Displacement,
+            "converts transfer functions per unit displacement"
+        );
+        let (no, ni) = (self.outputs.len(), self.inputs.len());
+        let ground: Vec<bool> = self.inputs.iter().map(|i| i.is_ground()).collect();
+        let mut values = self.dense_values();
+        if no > 0 && ground.iter().any(|&g| g) {
+            for (k, point) in values.chunks_exact_mut(no * ni).enumerate() {
+                let f = self.freqs_hz[k];
+                let c = quantity.to_displacement(f).ok_or(TfError::NoGroundFactor {
+                    quantity: quantity.name(),
+                    freq_hz: f,
+                })?;
+                for (e, h) in point.iter_mut().enumerate() {
+                    if ground[e % ni] {
+                        *h *= c;
+                    }
+                }
+            }
+        }
+        let mut m = TransferMatrix::from_dense(
+            self.freqs_hz[..self.n_stored_freqs()].to_vec(),
+            self.outputs.clone(),
+            self.inputs.clone(),
+            self.method,
+            &values,
+        );
+        m.ground_quantity = quantity;
+        Ok(m)
     }
 
     /// Position of an observable among the rows.
@@ -329,6 +398,45 @@ mod tests {
             assert_eq!(rows.get(1, 0, 1), m.get(1, 1, 1));
             assert_eq!(rows.get(0, 0, 0), Complex64::new(0.0, 0.0));
         }
+    }
+
+    /// Per unit floor acceleration the ground columns are divided by `-w^2`, the force columns
+    /// are untouched, and the units say so; at 0 Hz there is no such value.
+    #[test]
+    fn ground_columns_per_unit_acceleration() {
+        use crate::model::{ForceInput, TranslationAxis};
+        let inputs = vec![
+            Input::Translation(TranslationAxis::XT),
+            Input::Force(ForceInput::ALL[0]),
+        ];
+        let values = [Complex64::new(2.0, 1.0), Complex64::new(3.0, -1.0)];
+        let m = TransferMatrix::from_dense(
+            vec![0.5],
+            vec![Observable::X],
+            inputs.clone(),
+            Method::Direct,
+            &values,
+        );
+        let a = m.per_ground_quantity(GroundQuantity::Acceleration).unwrap();
+        let w2 = crate::units::angular(0.5).powi(2);
+        assert_eq!(a.get(0, 0, 0), values[0] * (-1.0 / w2));
+        assert_eq!(a.get(0, 0, 1), values[1]);
+        assert_eq!(
+            (a.unit(0, 0), a.unit(0, 1)),
+            ("m/(m/s^2)".into(), "m/N".into())
+        );
+        assert_eq!(m.unit(0, 0), "m/m");
+        let at_dc = TransferMatrix::from_dense(
+            vec![0.0],
+            vec![Observable::X],
+            inputs,
+            Method::Direct,
+            &values,
+        );
+        assert!(matches!(
+            at_dc.per_ground_quantity(GroundQuantity::Velocity),
+            Err(TfError::NoGroundFactor { .. })
+        ));
     }
 
     #[test]

@@ -8,7 +8,8 @@
 //! H(s) = c^T D(s)^-1 g(s) = N(s) / P(s),   P = det D,   N = -det [[D, g], [c^T, 0]],
 //! ```
 //!
-//! with `g = G0 + s G2` (tilt) or a column of the force matrix. Both determinants are expanded
+//! with `g = G0 + s G2` (tilt; `G0 = 0` for the floor's translation, so its entries have at
+//! least one factor `s`) or a column of the force matrix. Both determinants are expanded
 //! at plan time as polynomials in `s` (Laplace expansion of matrices of polynomials of degree
 //! <= 1) in double-double, from the paper's matrices in double-double ([`crate::dd::matrices`]). Alongside each coefficient the sum
 //! of the magnitudes of its terms is kept; a coefficient below `ZERO_REL` times that sum is a
@@ -460,6 +461,10 @@ impl PoleZero {
                 Input::Tilt(t) => (
                     to_abs_rows(std::array::from_fn(|r| m.g0[r][t.index()])),
                     to_abs_rows(std::array::from_fn(|r| m.g2[r][t.index()])),
+                ),
+                Input::Translation(t) => (
+                    [Dd::ZERO; 8],
+                    to_abs_rows(std::array::from_fn(|r| m.translation_g2[r][t.index()])),
                 ),
                 Input::Force(f) => (
                     to_abs_rows(std::array::from_fn(|r| m.force[r][f.index()])),

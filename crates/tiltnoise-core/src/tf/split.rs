@@ -52,6 +52,17 @@
 //! cancels there: `D^-1 K_c -> 1`), the second at high frequency (the first cancels there for
 //! eta/phi_t, which falls as f^-2: `w^2 D^-1 M -> -1`).
 //!
+//! # The floor's translation (x_t, y_t, z_t)
+//!
+//! `G0 = 0` and `G2` is the apparent force of the floor's acceleration on both centres of mass
+//! ([`crate::model::translation`]), with exact zeros where the balanced crossbar cancels it, so
+//! nothing needs splitting off: the low form is `H = w^2 C D^-1 G2` and the high form the
+//! mass-line split above, `H = -C M^-1 G2 + C D^-1 K_c M^-1 G2` (with `K_c + i w C` under viscous
+//! damping), both in absolute angles. The x_t column is the eta_t column's translation forcing
+//! per `-h` (`R[:, eta_t] = -h G2[:, x_t]`), so phi/x_t falls as `f^4` at low frequency and as
+//! `f^-2` at high frequency exactly as phi/eta_t does, and keeps its relative accuracy the same
+//! way: `(T^-T G2)_psi = 0` exactly.
+//!
 //! # Where the forms switch
 //!
 //! Both forms are exact; they differ in rounding. The low form loses relative accuracy only on
@@ -97,7 +108,7 @@
 use super::direct::{omega_sq, with_viscous, EquilibratedLu};
 use super::{Input, Method, Request, TransferFunction};
 use crate::error::TfError;
-use crate::model::{Block, Coord, ForceInput, Model, TiltAxis};
+use crate::model::{Block, Coord, ForceInput, Model, TiltAxis, TranslationAxis};
 use crate::modes::NormalModes;
 use nalgebra::{Matrix4, RowVector4, Scalar, Vector4};
 use num_complex::Complex64;
@@ -243,12 +254,16 @@ impl AbsoluteBlock {
         let local = |c: Coord| idx.iter().position(|&i| i == c.index());
         let force_q =
             |f: ForceInput| Vector4::from_fn(|r, _| model.force_matrix()[(idx[r], f.index())]);
+        let translation_q = |a: TranslationAxis| {
+            Vector4::from_fn(|r, _| model.translation_forcing().g2[(idx[r], a.index())])
+        };
         let inputs: Vec<(usize, Input)> = request
             .inputs
             .iter()
             .enumerate()
             .filter(|&(_, &input)| match input {
                 Input::Tilt(axis) => local(tilt_coord(axis)).is_some(),
+                Input::Translation(a) => translation_q(a).iter().any(|&v| v != 0.0),
                 Input::Force(f) => force_q(f).iter().any(|&v| v != 0.0),
             })
             .map(|(col, &input)| (col, input))
@@ -303,6 +318,28 @@ impl AbsoluteBlock {
                             false,
                         );
                         (form.clone(), form)
+                    }
+                    Input::Translation(a) => {
+                        let g = t.force(&translation_q(a));
+                        let y0 = mass
+                            .lu()
+                            .solve(&g)
+                            .expect("M is positive definite (checked by Model::new)");
+                        let high_offset = outputs.iter().map(|(_, c)| -c.dot(&y0.transpose()));
+                        let c_y0 = match &damping {
+                            Some(c) => c * y0,
+                            None => Vector4::zeros(),
+                        };
+                        (
+                            Form::new(vec![0.0; outputs.len()], g.map(Complex64::from), 1.0, true),
+                            Form::new(
+                                high_offset.collect(),
+                                stiffness * y0.map(Complex64::from),
+                                1.0,
+                                false,
+                            )
+                            .with_damping(Vector4::zeros(), c_y0),
+                        )
                     }
                     Input::Tilt(axis @ (TiltAxis::ThetaT | TiltAxis::EtaT)) => {
                         let a = local(tilt_coord(axis)).expect("filtered above");

@@ -17,7 +17,8 @@
 //! the upper fibre and is represented exactly: `G(w) = -w^2 M e_phi_a` with this model's own `M`
 //! (the phi rows of the full model's `G2`). Tilt about a horizontal axis (theta_t, eta_t) acts
 //! through the swing coordinates, which this model does not have, and is refused at plan time,
-//! as are forces without a torsion component and the outputs Y, Z, theta, eta.
+//! as are the floor's translations (their apparent forces exert no torque on the balanced
+//! crossbar), forces without a torsion component and the outputs Y, Z, theta, eta.
 //!
 //! Its transfer functions differ from the 8-DoF model's by the neglected mass coupling of the
 //! torsion angles to the swing (`I_a4` on eta_a, `-m_b d Z_b` on eta_b): every neglected term
@@ -83,6 +84,15 @@ impl Torsion2 {
                      swing angles (eta_a, eta_b for eta_t; theta_a, theta_b for theta_t) by the \
                      gravity correction and the suspension point's acceleration; use `split` or \
                      `direct`"
+                        .into(),
+                )),
+                Input::Translation(axis) => Err(unsupported(
+                    format!("input {}", axis.name()),
+                    "a floor translation turns neither fibre: its apparent forces act at the \
+                     centres of mass, and the crossbar is balanced on the upper fibre \
+                     (m_a y_a = m_b d), so it drives the 8-DoF model only through the swing and \
+                     bounce coordinates (and their mass coupling to torsion), which the 2-DoF \
+                     torsional model does not have; use `split` or `polezero`"
                         .into(),
                 )),
                 Input::Force(f) => {

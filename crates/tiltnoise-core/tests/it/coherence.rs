@@ -539,7 +539,11 @@ fn records_that_cannot_be_analysed_are_refused_with_their_names() {
     let mut dead = tilt.clone();
     dead.channels[1].1 = &flat;
     let e = run(&dead, &measured);
-    assert!(e.contains("eta_t of --tilt synthetic has no power"), "{e}");
+    assert!(
+        e.contains("eta_t of --tilt synthetic is constant (2.5) over the common stretch")
+            && e.contains("no power above DC"),
+        "{e}"
+    );
     let mut nan = s.measured[0].clone();
     nan[99] = f64::NAN;
     let mut bad = measured.clone();

@@ -8,6 +8,10 @@
 //! * M  from T = 1/2 sum m |J q'|^2 + 1/2 w.I.w, with J = dr_g/dq and [w]x = A^T dA/dq_h;
 //! * B  (zeroth-order generalized forces, eq. qh) = [J_a^T, J_b^T, W_a^T, W_b^T] (inertial axes);
 //! * G0 by tilting the direction of gravity, G2 from the apparent forces of section IV.B;
+//! * the floor translation's G2 from the kinetic energy in the inertial frame, where a centre of
+//!   mass moves at `u' + J q'`: the cross term `sum m (J q') . u'` of T puts
+//!   `-sum m J^T u'' = w^2 (sum m J^T) u` on the right of Lagrange's equations, so
+//!   `G2[h][k] = d^2 T / dq'_h du'_k`;
 //! * C  from the cube-centre position and the attitudes of A_b and A_a.
 //!
 //! Each hyper-dual component also carries the sum of the absolute values of the terms added into
@@ -17,7 +21,7 @@
 use crate::tolerances::ENERGY_C_TOL;
 use nalgebra::{Matrix4, SMatrix, Vector4};
 use std::ops::{Add, Mul, Neg, Sub};
-use tiltnoise_core::model::{Coord, ForceInput, Model, Observable, TiltAxis};
+use tiltnoise_core::model::{Coord, ForceInput, Model, Observable, TiltAxis, TranslationAxis};
 use tiltnoise_core::params::Params;
 
 // ------------------------------------------------------------------------------------------------
@@ -329,6 +333,8 @@ struct Reference {
     b: [[Hd; 12]; 8],
     g0: [[Hd; 3]; 8],
     g2: [[Hd; 3]; 8],
+    /// Floor translation: generalized force per unit `w^2 u`.
+    translation_g2: [[Hd; 3]; 8],
     c: [[Hd; 8]; 7],
 }
 
@@ -406,6 +412,20 @@ impl Reference {
             }
         }
 
+        // Floor translation: T = 1/2 sum m |u' + J q'|^2 with u' seeded on e2 and q'_h on e1;
+        // the mixed part is d^2 T / dq'_h du'_k.
+        let half = Hd::cst(0.5);
+        let translation_g2 = std::array::from_fn(|h| {
+            std::array::from_fn(|k| {
+                let q_dot = seeds::<8>(Some(h), None);
+                let u_dot = seeds::<3>(None, Some(k));
+                let velocity =
+                    |jac: &[V3; 8]| (0..8).fold(u_dot, |v, i| add3(v, scale(q_dot[i], jac[i])));
+                let (v_a, v_b) = (velocity(&j_a), velocity(&j_b));
+                (half * (ph.m_a * dot(v_a, v_a) + ph.m_b * dot(v_b, v_b))).part(3)
+            })
+        });
+
         // Observables: X, Y, Z of the cube centre, TM attitude, crossbar torsion.
         let c = std::array::from_fn(|r| {
             std::array::from_fn(|h| match r {
@@ -422,6 +442,7 @@ impl Reference {
             b,
             g0,
             g2,
+            translation_g2,
             c,
         }
     }
@@ -554,6 +575,17 @@ fn crosscheck(set: &str, p: &Params) {
         ),
         ("G0", compare(set, "G0", names, tilts, &tilt.g0, &r.g0)),
         ("G2", compare(set, "G2", names, tilts, &tilt.g2, &r.g2)),
+        (
+            "G2_u",
+            compare(
+                set,
+                "G2_u",
+                names,
+                TranslationAxis::ALL.map(TranslationAxis::name),
+                &model.translation_forcing().g2,
+                &r.translation_g2,
+            ),
+        ),
         (
             "C",
             compare(set, "C", observables, names, model.observation(), &r.c),

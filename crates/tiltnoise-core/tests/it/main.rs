@@ -27,4 +27,5 @@ mod subtract;
 mod subtract_pulls;
 mod synthetic;
 mod tilt_tf;
+mod translation_tf;
 mod welch_scipy;

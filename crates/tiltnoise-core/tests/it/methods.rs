@@ -5,7 +5,8 @@
 //!
 //! * Test models: Table I undamped; Table I with loss angles 1e-3 on both torsions and both
 //!   bouncings.
-//! * Entry points: the 7x3 tilt matrix; the 7 observables from 8 force/torque components.
+//! * Entry points: the 7x3 tilt matrix; the 7 observables from 8 force/torque components; the
+//!   7x3 floor-translation matrix.
 //! * Grid: 1e-5 .. 100 Hz, 40 points per decade, plus points 1 % and 5 % above and below every
 //!   mode.
 //!
@@ -116,6 +117,13 @@ fn entry_points() -> Vec<(&'static str, Request)> {
                 inputs: forces.iter().map(|n| force(n)).collect(),
             },
         ),
+        (
+            "translation",
+            Request {
+                outputs: Observable::ALL.to_vec(),
+                inputs: Input::all_translations(),
+            },
+        ),
     ]
 }
 
@@ -218,10 +226,11 @@ fn poles_and_zeros(case: &Case, request: &Request) -> Vec<Vec<f64>> {
 fn zones(entry_point: &str) -> &'static [Vec<f64>] {
     static TILT: OnceLock<Vec<Vec<f64>>> = OnceLock::new();
     static FORCES: OnceLock<Vec<Vec<f64>>> = OnceLock::new();
-    let cell = if entry_point == "tilt" {
-        &TILT
-    } else {
-        &FORCES
+    static TRANSLATION: OnceLock<Vec<Vec<f64>>> = OnceLock::new();
+    let cell = match entry_point {
+        "tilt" => &TILT,
+        "forces" => &FORCES,
+        _ => &TRANSLATION,
     };
     let request = entry_points()
         .into_iter()
@@ -243,7 +252,30 @@ fn in_zone(f: f64, special: &[f64]) -> bool {
 fn forcing(model: &Model, input: Input, w2: f64) -> SVector<f64, 8> {
     match input {
         Input::Tilt(t) => model.tilt_forcing().at(w2.sqrt()).column(t.index()).into(),
+        Input::Translation(t) => model
+            .translation_forcing()
+            .at(w2.sqrt())
+            .column(t.index())
+            .into(),
         Input::Force(f) => model.force_matrix().column(f.index()).into(),
+    }
+}
+
+/// `(G0, G2)` of an input, its forcing being `G0 + w^2 G2`.
+fn forcing_parts(model: &Model, input: Input) -> (SVector<f64, 8>, SVector<f64, 8>) {
+    match input {
+        Input::Tilt(t) => (
+            model.tilt_forcing().g0.column(t.index()).into(),
+            model.tilt_forcing().g2.column(t.index()).into(),
+        ),
+        Input::Translation(t) => (
+            SVector::zeros(),
+            model.translation_forcing().g2.column(t.index()).into(),
+        ),
+        Input::Force(f) => (
+            model.force_matrix().column(f.index()).into(),
+            SVector::zeros(),
+        ),
     }
 }
 
@@ -322,19 +354,12 @@ fn statespace_bound(case: &Case, request: &Request, freq_hz: f64) -> Vec<f64> {
     let mut abs_s = lu.l().map(|z| z.norm()) * lu.u().map(|z| z.norm());
     lu.p().inv_permute_rows(&mut abs_s);
     let abs_sinv = s_inv.map(|z| z.norm());
-    let tilt = m.tilt_forcing();
     let c_obs = m.observation();
     let mut out = Vec::new();
     for o in &request.outputs {
         let row = c_obs.row(o.index()).abs();
         for &i in &request.inputs {
-            let (g0, g2): (SVector<f64, 8>, SVector<f64, 8>) = match i {
-                Input::Tilt(t) => (
-                    tilt.g0.column(t.index()).into(),
-                    tilt.g2.column(t.index()).into(),
-                ),
-                Input::Force(f) => (m.force_matrix().column(f.index()).into(), SVector::zeros()),
-            };
+            let (g0, g2) = forcing_parts(m, i);
             let y = m_inv * g2;
             let dy = g * (abs_minv * (abs_m * y.abs() + g2.abs()));
             let b0 = g0.map(Complex64::from) + k * y.map(Complex64::from);
@@ -402,16 +427,7 @@ fn dual_norm(case: &Case, x: &SVector<f64, 8>) -> f64 {
 /// eigenvalue error times `|term_k| / |mu_k - w^2|`, with `||.||*` the `M^-1` norm.
 fn modal_bound(case: &Case, o: Observable, input: Input, w2: f64) -> f64 {
     let modes = &case.modes.modes;
-    let (g0, g2) = match input {
-        Input::Tilt(t) => (
-            case.model.tilt_forcing().g0.column(t.index()).into(),
-            case.model.tilt_forcing().g2.column(t.index()).into(),
-        ),
-        Input::Force(f) => (
-            case.model.force_matrix().column(f.index()).into(),
-            SVector::<f64, 8>::zeros(),
-        ),
-    };
+    let (g0, g2) = forcing_parts(&case.model, input);
     let g_size = dual_norm(case, &g0) + w2 * dual_norm(case, &g2);
     let c_size = dual_norm(case, &case.model.observation().row(o.index()).transpose());
     (0..modes.len())

@@ -3,7 +3,8 @@
 //! * Accuracy: the accuracy target, 1e-9 relative on every structurally nonzero entry, on a dense
 //!   log grid 1e-5 .. 100 Hz (2000 points plus points just outside every exclusion zone),
 //!   excluding 1 % in frequency around the entry's own poles and zeros (taken from the undamped
-//!   model's factors); undamped, damped (loss 1e-3 on torsions and bouncings), and m_a = 1.3 kg.
+//!   model's factors); undamped, damped (loss 1e-3 on torsions and bouncings), and m_a = 1.3 kg;
+//!   the tilt, force and floor-translation matrices.
 //!   The grid is evaluated in one batch (`tf::evaluate`, the path `auto` takes);
 //!   `tests/it/polezero_batch.rs` checks that it equals the point-by-point path bit for bit.
 //! * Structure: the zeros at s = 0 and the degree drops found by the plan match the physics.
@@ -56,6 +57,13 @@ fn force_request() -> Request {
             .iter()
             .map(|n| Input::Force(ForceInput::from_name(n).unwrap()))
             .collect(),
+    }
+}
+
+fn translation_request() -> Request {
+    Request {
+        outputs: Observable::ALL.to_vec(),
+        inputs: Input::all_translations(),
     }
 }
 
@@ -178,6 +186,70 @@ fn force_entries_meet_the_target() {
             "polezero forces, {name}: max rel err {err:.2e} ({entry} at {f:.4e} Hz), {n} values"
         );
         assert!(err <= TARGET_REL, "{name}: {err:e} at {entry}, {f} Hz");
+    }
+}
+
+#[test]
+fn translation_entries_meet_the_target() {
+    let request = translation_request();
+    for (name, params, zone_params) in cases() {
+        let (err, entry, f, n) = accuracy(&params, &zone_params, &request);
+        println!(
+            "polezero translation, {name}: max rel err {err:.2e} ({entry} at {f:.4e} Hz), {n} \
+             values"
+        );
+        assert!(err <= TARGET_REL, "{name}: {err:e} at {entry}, {f} Hz");
+    }
+}
+
+/// The floor's translation: `G0 = 0`, so every entry has a factor `s`, and a second one where
+/// no static response reaches the observable (the balanced crossbar: no torsion from x_t, no
+/// swing from z_t). theta/z_t has a third: the gravity stiffness is diagonal in absolute angles,
+/// and the bounce drives the test mass's absolute tilt only through the crossbar's swing, itself
+/// a second-order response (the mass coupling `m_b d` of theta_a and delta_b). At high frequency the mass line `-C M^-1 G2` is finite except where it vanishes:
+/// the test mass's rotation about z has no mass-line response to a force at its centre
+/// (phi/x_t); a vertical translation of both bodies is the elongation delta_a alone, which
+/// neither Y nor theta reads (Y/z_t, theta/z_t); and under y_t the elongations, which move the
+/// centres of mass only vertically, hold both at their height, so the cube's Z (its centre's
+/// height, to first order) does not move on the mass line (Z/y_t). Those fall as f^-2.
+#[test]
+fn translation_structure_matches_the_physics() {
+    use tiltnoise_core::model::TranslationAxis;
+    let request = translation_request();
+    for (name, params, _) in cases() {
+        let fs = PoleZero::factors(&params, &request);
+        // X, eta, phi, phi_a from x_t; Y, Z, theta from y_t and from z_t.
+        assert_eq!(fs.len(), 10, "{name}");
+        for f in &fs {
+            let o = request.outputs[f.output];
+            let Input::Translation(t) = request.inputs[f.input] else {
+                unreachable!()
+            };
+            let power = match (o, t) {
+                (Observable::Phi | Observable::PhiA, TranslationAxis::XT)
+                | (Observable::Y, TranslationAxis::ZT) => 2,
+                (Observable::Theta, TranslationAxis::ZT) => 3,
+                _ => 1,
+            };
+            let falls = matches!(
+                (o, t),
+                (Observable::Phi, TranslationAxis::XT)
+                    | (Observable::Z, TranslationAxis::YT)
+                    | (Observable::Y | Observable::Theta, TranslationAxis::ZT)
+            );
+            let high = f.power as i32 + f.zeros.len() as i32 - 4;
+            println!(
+                "{name}: {}/{}: p = {}, {} zeros, s^{high} at high f, cancelled {:?}",
+                o.name(),
+                t.name(),
+                f.power,
+                f.zeros.len(),
+                f.cancelled
+            );
+            let label = format!("{name}: {}/{}", o.name(), t.name());
+            assert_eq!(f.power, power, "{label}");
+            assert_eq!(high, if falls { -1 } else { 0 }, "{label}");
+        }
     }
 }
 

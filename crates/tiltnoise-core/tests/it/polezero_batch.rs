@@ -5,7 +5,7 @@
 //! * Batch = per point, bit for bit, on grids with f = 0, points at 1e-9 and 1e-6 relative from
 //!   every pole and zero, points up to 1e5 Hz, every grid length up to three chunks (short
 //!   last chunks) and every offset; also on two and three threads ([`eval_grid_threads`]).
-//!   Undamped, damped, tilt and force requests. The same values in the plan's compact layout
+//!   Undamped, damped, tilt, force and floor-translation requests. The same values in the plan's compact layout
 //!   ([`evaluate`], [`evaluate_into`] on 1 to 3 threads, into a reused matrix), whose stored
 //!   entries are exactly those the plan has factors for.
 //! * The batch values against `gain s^p prod(z_j - s) / prod(lambda_k - s)` in double-double
@@ -54,7 +54,24 @@ fn cases() -> Vec<(&'static str, Params, Request)> {
         ("Table I, loss 1e-3, tilt", damped(), Request::all_tilt()),
         ("Table I, forces", Params::table_i(), force_request()),
         ("Table I, loss 1e-3, forces", damped(), force_request()),
+        (
+            "Table I, translation",
+            Params::table_i(),
+            translation_request(),
+        ),
+        (
+            "Table I, loss 1e-3, translation",
+            damped(),
+            translation_request(),
+        ),
     ]
+}
+
+fn translation_request() -> Request {
+    Request {
+        outputs: Observable::ALL.to_vec(),
+        inputs: Input::all_translations(),
+    }
 }
 
 fn hz(s: f64) -> f64 {
@@ -74,7 +91,7 @@ fn hard_grid() -> Vec<f64> {
         .map(|k| 1e-6 * 1e11_f64.powf(k as f64 / n as f64))
         .collect();
     f.push(0.0);
-    for r in [Request::all_tilt(), force_request()] {
+    for r in [Request::all_tilt(), force_request(), translation_request()] {
         for e in PoleZero::factors(&Params::table_i(), &r) {
             for z in e.poles.iter().chain(&e.zeros) {
                 let f0 = hz(z.abs_f64());

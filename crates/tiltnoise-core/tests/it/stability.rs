@@ -182,7 +182,7 @@ fn modal_rcond(case: &Case, w2: f64) -> f64 {
 fn tilt_of(input: Input) -> TiltAxis {
     match input {
         Input::Tilt(t) => t,
-        Input::Force(_) => unreachable!("tilt requests only"),
+        Input::Translation(_) | Input::Force(_) => unreachable!("tilt requests only"),
     }
 }
 

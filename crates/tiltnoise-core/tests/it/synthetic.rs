@@ -11,10 +11,10 @@
 
 use num_complex::Complex64;
 use realfft::RealFftPlanner;
-use tiltnoise_core::model::{Model, Observable, TiltAxis};
+use tiltnoise_core::model::{Input, Model, Observable, TiltAxis};
 use tiltnoise_core::params::Params;
 use tiltnoise_core::rng::Rng;
-use tiltnoise_core::simulate::driven::{simulate_driven, DrivenConfig, TiltDrive};
+use tiltnoise_core::simulate::driven::{simulate_driven, DrivenConfig, GroundDrive};
 
 /// What to make.
 #[derive(Debug, Clone)]
@@ -141,9 +141,9 @@ pub fn make(spec: &Spec) -> Record {
         inv.process(&mut spec_c, &mut x).unwrap();
         fine.push(x.iter().map(|v| v / n_fine as f64).collect::<Vec<f64>>());
     }
-    let drive = TiltDrive {
+    let drive = GroundDrive {
         step_s: 1.0 / fs_fine,
-        axes: axes.clone(),
+        inputs: axes.iter().map(|&a| Input::Tilt(a)).collect(),
         samples: fine
             .iter()
             .zip(spec.gains)

@@ -12,9 +12,10 @@
 
 use super::csv::{parse_field, CsvFile};
 use super::h5::{self, h5err};
-use super::{InputError, InputFormat};
+use super::{frequency_refusal, InputError, InputFormat};
 use std::path::Path;
 use tiltnoise_core::error::Shown;
+use tiltnoise_core::limits::ASDS;
 
 /// Frequencies (Hz) and one-sided ASD of the column read, and the column's name.
 #[derive(Debug, Clone, PartialEq)]
@@ -185,13 +186,12 @@ fn check_frequency(
     f: f64,
     location: impl FnOnce() -> String,
 ) -> Result<(), InputError> {
-    let previous = before.last().copied().unwrap_or(0.0);
-    if !(f.is_finite() && f > previous) {
+    if let Some(allowed) = frequency_refusal(f, before.last().copied()) {
         return Err(InputError::Frequency {
             path: path.to_path_buf(),
             location: location(),
             value: f,
-            allowed: format!("finite, > 0 and greater than the previous {previous} Hz"),
+            allowed,
         });
     }
     Ok(())
@@ -204,13 +204,14 @@ fn check_asd(
     unit: &'static str,
     location: impl FnOnce() -> String,
 ) -> Result<(), InputError> {
-    if !(value.is_finite() && value >= 0.0) {
+    if !ASDS.admits(value) {
         return Err(InputError::Asd {
             path: path.to_path_buf(),
             location: location(),
             column: column.to_string(),
             value,
             unit,
+            power: false,
         });
     }
     Ok(())

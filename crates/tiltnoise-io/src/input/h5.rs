@@ -1,7 +1,7 @@
 //! HDF5 helpers: opening, layout detection, typed attribute reading with precise errors.
 
 use super::meta::{is_iso8601, ISO8601_ALLOWED};
-use super::InputError;
+use super::{check_sample_rate, InputError};
 use super::{resolve, MapOrigin, Resolved};
 use super::{
     AxisMap, InputKind, ReadOptions, ACCEPTED_LAYOUTS, INPUT_SCHEMA_VERSION, SCHEMA_TILT_SERIES,
@@ -258,7 +258,9 @@ pub(crate) fn sample_rate_hz(path: &Path, file: &hdf5::File) -> Result<f64, Inpu
             attribute: "sample_rate_hz",
             expected: RATE_ALLOWED,
         }),
-        Some(AttrValue::Num(v)) if v.is_finite() && v > 0.0 => Ok(v),
+        Some(AttrValue::Num(v)) if v.is_finite() && v > 0.0 => {
+            check_sample_rate(path, || "attribute sample_rate_hz of /".to_string(), v)
+        }
         Some(other) => Err(InputError::BadAttribute {
             path: path.to_path_buf(),
             object: "/".to_string(),

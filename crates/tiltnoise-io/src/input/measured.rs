@@ -3,8 +3,9 @@
 //!
 //! * **Spectrum, CSV**: header `freq_hz` then any of `X`, `Y`, `Z`, `theta`, `eta`, `phi`,
 //!   `phi_a`; values are one-sided ASDs (m/sqrt(Hz) for X, Y, Z; rad/sqrt(Hz) for the angles).
-//!   Frequencies strictly increasing and > 0; ASDs finite, >= 0 and at most
-//!   [`MAX_ASD`](tiltnoise_core::limits::MAX_ASD) ([`read_measured`]).
+//!   Frequencies strictly increasing within
+//!   [`SPECTRUM_FREQUENCIES`](tiltnoise_core::limits::SPECTRUM_FREQUENCIES); ASDs within
+//!   [`ASDS`](tiltnoise_core::limits::ASDS) ([`read_measured`]).
 //! * **Time series, HDF5** (`.h5`, `.hdf5`): the layout `tiltnoise simulate` writes, root
 //!   attribute `schema = tiltnoise.observable_series` (optional), root attribute
 //!   `sample_rate_hz`, one 1-D float dataset per observable named as above, optional `units`
@@ -18,11 +19,11 @@
 
 use super::csv::{decimal_resolution, parse_field, CsvFile, Prelude};
 use super::h5::{self, h5err, AttrValue};
-use super::InputError;
-use super::InputFormat;
+use super::{check_sample_rate, frequency_refusal, ChannelCtx, InputError, InputFormat};
 use std::path::Path;
 use tiltnoise_core::budget::{add_measured, series_psds, BudgetError, MeasuredPsds};
-use tiltnoise_core::error::Shown;
+use tiltnoise_core::error::{Num, Shown};
+use tiltnoise_core::limits::{ASDS, SAMPLES};
 use tiltnoise_core::model::Observable;
 use tiltnoise_core::noise::BudgetReport;
 
@@ -201,8 +202,8 @@ fn read_series_hdf5(path: &Path) -> Result<MeasuredSeries, InputError> {
     Ok(series)
 }
 
-/// Common checks: at least one channel, equal lengths >= 2, finite samples. `lines` maps a
-/// sample index to its CSV line.
+/// Common checks: at least one channel, equal lengths >= 2, finite samples within
+/// [`SAMPLES`](tiltnoise_core::limits::SAMPLES). `lines` maps a sample index to its CSV line.
 fn finish_series(
     path: &Path,
     sample_rate_hz: f64,
@@ -230,15 +231,19 @@ fn finish_series(
                 len_b: data.len(),
             });
         }
-        if let Some((index, &value)) = data.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(InputError::NonFinite {
-                path: path.to_path_buf(),
-                channel: o.name().to_string(),
-                index,
-                value,
-                unit: o.unit(),
-                line: lines.map(|l| l[index]),
-            });
+        let ctx = ChannelCtx {
+            path,
+            channel: o.name(),
+            unit: o.unit(),
+        };
+        if let Some((index, &value)) = data
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !v.is_finite() || !SAMPLES.admits(**v))
+        {
+            let line = lines.map(|l| l[index]);
+            ctx.check_sample(index, value, line)?;
+            return Err(ctx.non_finite(index, value, line));
         }
     }
     super::require_two(path, &format!("channel {}", o0.name()), n, "samples")?;
@@ -341,9 +346,14 @@ fn read_series_csv(
             });
         }
     }
+    let rate = check_sample_rate(
+        path,
+        || format!("column time_s (dt = {} s)", Num(dt)),
+        1.0 / dt,
+    )?;
     finish_series(
         path,
-        1.0 / dt,
+        rate,
         observables.into_iter().zip(data).collect(),
         Some(&lines),
     )
@@ -411,19 +421,18 @@ fn read_spectra_csv(
             )),
         };
         let f = number(0)?;
-        let previous = freqs.last().copied().unwrap_or(0.0);
-        if !(f.is_finite() && f > previous) {
+        if let Some(allowed) = frequency_refusal(f, freqs.last().copied()) {
             return Err(InputError::Frequency {
                 path: path.to_path_buf(),
                 location: format!("line {line}, column {}", prelude.header[0]),
                 value: f,
-                allowed: format!("finite, > 0 and greater than the previous {previous} Hz"),
+                allowed,
             });
         }
         freqs.push(f);
         for (c, (o, column)) in observables.iter().zip(asd.iter_mut()).enumerate() {
             let v = number(c + 1)?;
-            if !(v.is_finite() && (0.0..=tiltnoise_core::limits::MAX_ASD).contains(&v)) {
+            if !ASDS.admits(v) {
                 return Err(InputError::Asd {
                     path: path.to_path_buf(),
                     location: format!("line {line}"),
@@ -434,6 +443,7 @@ fn read_spectra_csv(
                     } else {
                         "rad/sqrt(Hz)"
                     },
+                    power: false,
                 });
             }
             column.push(v);

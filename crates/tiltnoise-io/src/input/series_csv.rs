@@ -2,9 +2,10 @@
 
 use super::csv::{self, decimal_resolution, parse_field, CsvFile, Prelude};
 use super::meta::{series_unit, SERIES_UNITS};
+use super::{check_sample_rate, require_two, InputError};
 use super::{gap_note, process_channel, ChannelCtx, TiltSeries};
-use super::{require_two, InputError};
 use super::{GapPolicy, InputFormat, InputKind, Provenance, ReadOptions};
+use tiltnoise_core::error::Num;
 
 /// Reads the records of a CSV series whose prelude has been read (`prelude.header[0]` is
 /// `time_s`).
@@ -82,14 +83,25 @@ pub(crate) fn read(
                     line: Some(line),
                 });
             }
-            out.push(m.sign.factor() * (factor * raw));
+            let value = m.sign.factor() * (factor * raw);
+            let ctx = ChannelCtx {
+                path: &path,
+                channel: &m.source,
+                unit,
+            };
+            ctx.check_sample(index, value, Some(line))?;
+            out.push(value);
         }
         Ok(())
     })?;
 
     require_two(&path, "column time_s", times.len(), "samples")?;
     let dt = check_uniform(&path, &times, &resolution, &lines)?;
-    let sample_rate_hz = 1.0 / dt;
+    let sample_rate_hz = check_sample_rate(
+        &path,
+        || format!("column time_s (dt = {} s)", Num(dt)),
+        1.0 / dt,
+    )?;
     notes.push(format!(
         "sample rate {sample_rate_hz} Hz from column time_s (dt = {dt} s, uniform within the \
          printed precision)"

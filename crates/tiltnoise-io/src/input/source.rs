@@ -4,10 +4,11 @@
 use super::h5::{self, h5err, AttrValue};
 use super::meta::{decide_quantity, series_factors, series_unit, Declared, SERIES_UNITS};
 use super::Mapped;
+use super::{check_sample_rate, require_two, InputError};
 use super::{gap_note, ChannelCtx, Gap, GapScanner, TiltSeries};
-use super::{require_two, InputError};
 use super::{GapPolicy, InputFormat, InputKind, Provenance, Quantity, ReadOptions, SeriesSource};
 use std::path::{Path, PathBuf};
+use tiltnoise_core::error::Num;
 use tiltnoise_core::limits::{check_count, MAX_STREAMED_SAMPLES};
 use tiltnoise_core::model::TiltAxis;
 
@@ -297,6 +298,7 @@ impl TiltSeriesSource {
         for (i, x) in v.iter_mut().enumerate() {
             let y = s * (f * *x);
             if y.is_finite() {
+                ctx.check_sample(start + i, y, None)?;
                 *x = y;
             } else {
                 let k = start + i;
@@ -479,6 +481,11 @@ fn gwpy_rate(
         }
     }
     let (name, dx, x0) = first.expect("at least one mapped channel");
+    let rate = check_sample_rate(
+        path,
+        || format!("attribute dx = {} s of {name}", Num(dx)),
+        1.0 / dx,
+    )?;
     notes.push(format!(
         "sample rate {} Hz from attribute dx = {dx} s of {name} (gwpy TimeSeries layout){}",
         1.0 / dx,
@@ -486,5 +493,5 @@ fn gwpy_rate(
             "; x0 = {x} s (GPS time in gwpy's convention)"
         ))
     ));
-    Ok(1.0 / dx)
+    Ok(rate)
 }

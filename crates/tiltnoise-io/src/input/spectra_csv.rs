@@ -4,9 +4,10 @@
 use super::csv::{self, parse_field, CsvFile, Prelude};
 use super::meta::{asd_unit, ASD_UNITS};
 use super::{assemble, check_csd_finite, TiltSpectra};
-use super::{require_two, InputError};
+use super::{frequency_refusal, require_two, InputError};
 use super::{InputFormat, InputKind, Provenance, ReadOptions};
 use num_complex::Complex64;
+use tiltnoise_core::limits::ASDS;
 
 /// Reads the records of a CSV spectrum whose prelude has been read (`prelude.header[0]` is
 /// `freq_hz`).
@@ -46,23 +47,13 @@ pub(crate) fn read(
                 })
             }
         };
-        if !(f.is_finite() && f > 0.0) {
+        if let Some(allowed) = frequency_refusal(f, freqs.last().copied()) {
             return Err(InputError::Frequency {
                 path: path.clone(),
                 location: location(),
                 value: f,
-                allowed: "finite and > 0".to_string(),
+                allowed,
             });
-        }
-        if let Some(&prev) = freqs.last() {
-            if f <= prev {
-                return Err(InputError::Frequency {
-                    path: path.clone(),
-                    location: location(),
-                    value: f,
-                    allowed: format!("strictly increasing: greater than the previous {prev:?} Hz"),
-                });
-            }
         }
         freqs.push(f);
         for m in &resolved.channels {
@@ -80,13 +71,14 @@ pub(crate) fn read(
                     })
                 }
             };
-            if !(v.is_finite() && (0.0..=tiltnoise_core::limits::MAX_ASD).contains(&v)) {
+            if !ASDS.admits(v) {
                 return Err(InputError::Asd {
                     path: path.clone(),
                     location: format!("line {line} (row {row})"),
                     column: m.source.clone(),
                     value: v,
                     unit,
+                    power: false,
                 });
             }
             asd[m.index].push(v);

@@ -8,9 +8,10 @@
 use super::h5::{self, h5err, AttrValue};
 use super::meta::{asd_unit, csd_unit, decide_quantity, Declared, ASD_UNITS, CSD_UNITS};
 use super::{assemble, check_csd_finite, require_two, InputError, TiltSpectra};
-use super::{InputFormat, InputKind, Provenance, ReadOptions};
+use super::{frequency_refusal, InputFormat, InputKind, Provenance, ReadOptions};
 use num_complex::Complex64;
 use std::path::Path;
+use tiltnoise_core::limits::{ASDS, PSDS};
 
 /// Whether the values of a dataset are amplitude or power spectral densities.
 #[derive(Clone, Copy, PartialEq)]
@@ -168,17 +169,16 @@ pub(crate) fn read(
         } else {
             CSD_UNITS
         };
-        if let Some((k, &bad)) = v
-            .iter()
-            .enumerate()
-            .find(|(_, x)| !(x.is_finite() && **x >= 0.0))
-        {
+        let power = this == Density::Power;
+        let allowed = if power { PSDS } else { ASDS };
+        if let Some((k, bad)) = allowed.first_refused(&v) {
             return Err(InputError::Asd {
                 path: path.to_path_buf(),
                 location: format!("{name}[{k}]"),
                 column: m.source.clone(),
                 value: bad,
                 unit: unit_text,
+                power,
             });
         }
         values.push(v);
@@ -194,6 +194,19 @@ pub(crate) fn read(
         ));
     }
     let freqs: Vec<f64> = keep.iter().map(|&k| x0 + k as f64 * dx).collect();
+    for (i, &f) in freqs.iter().enumerate() {
+        if let Some(allowed) = frequency_refusal(f, i.checked_sub(1).map(|p| freqs[p])) {
+            return Err(InputError::Frequency {
+                path: path.to_path_buf(),
+                location: format!(
+                    "bin {} of dataset {first} (x0 = {x0} Hz, dx = {dx} Hz)",
+                    keep[i]
+                ),
+                value: f,
+                allowed,
+            });
+        }
+    }
     require_two(
         path,
         &format!("dataset {first}"),

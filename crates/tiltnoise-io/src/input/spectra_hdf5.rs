@@ -4,10 +4,11 @@
 use super::h5::{self, h5err, AttrValue};
 use super::meta::{asd_unit, csd_unit, decide_quantity, Declared, Unit, ASD_UNITS, CSD_UNITS};
 use super::{assemble, check_csd_finite, TiltSpectra, CSD_RTOL};
-use super::{require_two, InputError};
+use super::{frequency_refusal, require_two, InputError};
 use super::{InputFormat, InputKind, Provenance, Quantity, ReadOptions, ACCEPTED_LAYOUTS};
 use num_complex::Complex64;
 use std::path::Path;
+use tiltnoise_core::limits::{ASDS, PSDS};
 
 const AXES_ALLOWED: &str = "a 1-D array of strings naming the axes of the last dimension(s) of \
      /asd or /csd, e.g. [\"theta_t\", \"eta_t\"]";
@@ -57,14 +58,8 @@ pub(crate) fn read(
             value: f,
             allowed,
         };
-        if !(f.is_finite() && f > 0.0) {
-            return Err(err("finite and > 0".to_string()));
-        }
-        if k > 0 && f <= freqs[k - 1] {
-            return Err(err(format!(
-                "strictly increasing: greater than the previous {:?} Hz",
-                freqs[k - 1]
-            )));
+        if let Some(allowed) = frequency_refusal(f, k.checked_sub(1).map(|p| freqs[p])) {
+            return Err(err(allowed));
         }
     }
     require_two(path, "dataset /frequency_hz", freqs.len(), "frequencies")?;
@@ -290,13 +285,14 @@ fn read_asd(
     for k in 0..nf {
         for a in 0..m {
             let v = asd[k * m + a];
-            if !(v.is_finite() && (0.0..=tiltnoise_core::limits::MAX_ASD).contains(&v)) {
+            if !ASDS.admits(v) {
                 return Err(InputError::Asd {
                     path: path.to_path_buf(),
                     location: format!("/asd[{k}, {a}] at {} Hz", freqs[k]),
                     column: names[a].clone(),
                     value: v,
                     unit,
+                    power: false,
                 });
             }
             src[(k * m + a) * m + a] = Complex64::new(v * v, 0.0);
@@ -346,6 +342,14 @@ fn read_csd(
                         j,
                         format!("entry {s} is not finite"),
                         "finite values".to_string(),
+                    ));
+                }
+                if !PSDS.admits(s.norm()) {
+                    return Err(err(
+                        i,
+                        j,
+                        format!("entry {s} has the magnitude {:e}", s.norm()),
+                        format!("{} (see docs/limits.md)", PSDS.allowed("")),
                     ));
                 }
             }

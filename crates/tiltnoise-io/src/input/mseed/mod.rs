@@ -15,10 +15,10 @@ mod record;
 mod steim;
 
 use super::meta::{decide_quantity, Declared};
+use super::{check_sample_rate, Provenance, Quantity, ReadOptions};
 use super::{check_scales, gap_note, process_channel, require_two, scale_for, scale_note};
 use super::{resolve, ChannelCtx, InputError, MapOrigin, TiltSeries};
 use super::{AxisMap, AxisMapEntry, ChannelScale, GapPolicy, InputFormat, InputKind};
-use super::{Provenance, Quantity, ReadOptions};
 use channels::{Channel, Placed};
 use std::io::Read;
 use std::path::Path;
@@ -210,6 +210,11 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
     for m in &resolved.channels {
         let recs = groups[m.index].take().unwrap_or_default();
         let ch = channels::merge(&m.source, recs).map_err(|(at, msg)| fault(path, at, msg))?;
+        check_sample_rate(
+            path,
+            || format!("the records of channel {}", ch.id),
+            ch.sample_rate_hz,
+        )?;
         let what = || format!("input file {}, channel {}", path.display(), m.source);
         check_memory(
             what,

@@ -9,16 +9,25 @@
 //! simulation, a day of tilt data, 10 000 Monte Carlo draws, the 2000-point default grid)
 //! stay far below it and within the 256 MB the long runs target. Where the honest bound is the
 //! machine rather than a fixed number, [`check_memory`] refuses a planned allocation of more
-//! than half of `MemAvailable` in `/proc/meminfo` (Linux; elsewhere only the fixed limits
-//! apply): the other half is for the rest of the machine and for the copies the per-item
-//! estimates leave out.
+//! than half of the memory available: `MemAvailable` in `/proc/meminfo`, or less when the
+//! process's address space is limited (`ulimit -v`, `RLIMIT_AS`: the limit less what is mapped
+//! already) (Linux; elsewhere only the fixed limits apply). The other half is for the rest of
+//! the machine and for the copies the per-item estimates leave out.
 //!
 //! Text inputs are read through [`BoundedReader`], which stops at the file's byte limit plus
 //! one and at [`MAX_LINE_BYTES`] within a line, so a device (`/dev/zero`, `/dev/urandom`), a
 //! pipe or a huge file costs at most its limit in time and memory. Regular files larger than
 //! their limit are refused from their metadata without being read ([`check_file_len`]).
 //!
-//! Depends on `error` (number formatting) only; reads no file except `/proc/meminfo`.
+//! The magnitudes a value may have where it enters (samples, spectra, sample rates,
+//! frequencies, factors) are in [`magnitude`], re-exported here: one place for every limit.
+//!
+//! Depends on `error` (number formatting) only; reads no file except `/proc/meminfo`,
+//! `/proc/self/limits` and `/proc/self/status`.
+
+pub mod magnitude;
+
+pub use magnitude::*;
 
 use crate::num_text::Num;
 use std::fmt;
@@ -98,11 +107,6 @@ pub const MAX_STREAMED_SAMPLES: usize = 1 << 32;
 /// Bytes planned per sample and channel of an input held in memory: the 8-byte value and its
 /// copy while it is processed.
 pub const SERIES_BYTES_PER_SAMPLE: u64 = 16;
-
-/// Largest amplitude spectral density read from a file (in its unit per sqrt(Hz)): its square,
-/// the PSD, and sums of up to 10^8 such PSDs (band means, totals) stay finite in f64. No
-/// physical tilt, displacement or angle comes anywhere near it.
-pub const MAX_ASD: f64 = 1e150;
 
 /// Highest frequency (Hz) of any grid (`--freq`, a frequency file, an array from Python): a
 /// million times the highest mode of the pendulum (about 10 Hz). Far above it the dynamic
@@ -244,9 +248,18 @@ pub fn planned_bytes(count: usize, bytes_each: u64) -> u64 {
     (count as u64).saturating_mul(bytes_each)
 }
 
+/// Allocations up to this size are not checked against the machine: every machine the tool
+/// runs on has them, and reading `/proc` costs tens of microseconds, more than a small
+/// computation (a Python `transfer` of a few points) takes.
+pub const UNCHECKED_BYTES: u64 = 64 << 20;
+
 /// Refuses an allocation of `needed` bytes larger than half of the memory available now
-/// ([`available_memory_bytes`]); without that information (not Linux) it accepts.
+/// ([`available_memory_bytes`]); without that information (not Linux), or for at most
+/// [`UNCHECKED_BYTES`], it accepts.
 pub fn check_memory(what: impl FnOnce() -> String, needed: u64) -> Result<(), LimitError> {
+    if needed <= UNCHECKED_BYTES {
+        return Ok(());
+    }
     check_memory_against(what, needed, available_memory_bytes())
 }
 
@@ -266,11 +279,43 @@ pub fn check_memory_against(
     }
 }
 
-/// `MemAvailable` of `/proc/meminfo` in bytes (the kernel's estimate of what can be allocated
-/// without swapping), or `None` when it cannot be read (not Linux).
+/// The memory this process can allocate, in bytes: `MemAvailable` of `/proc/meminfo` (the
+/// kernel's estimate of what can be allocated without swapping), or the address space left
+/// under the process's limit (`ulimit -v`) if that is less; `None` when neither can be read
+/// (not Linux).
 pub fn available_memory_bytes() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
-    parse_mem_available(&text)
+    let read = |path: &str| std::fs::read_to_string(path).ok();
+    let machine = read("/proc/meminfo").and_then(|t| parse_mem_available(&t));
+    let headroom = read("/proc/self/limits")
+        .and_then(|t| parse_address_space_limit(&t))
+        .and_then(|limit| {
+            let mapped = read("/proc/self/status").and_then(|t| parse_vm_size(&t))?;
+            Some(limit.saturating_sub(mapped))
+        });
+    match (machine, headroom) {
+        (Some(m), Some(h)) => Some(m.min(h)),
+        (m, h) => m.or(h),
+    }
+}
+
+/// The soft limit of the line `Max address space` of `/proc/self/limits` text, in bytes;
+/// `None` when it is `unlimited` or absent.
+pub fn parse_address_space_limit(limits: &str) -> Option<u64> {
+    let line = limits
+        .lines()
+        .find_map(|l| l.strip_prefix("Max address space"))?;
+    line.split_whitespace().next()?.parse().ok()
+}
+
+/// `VmSize` of `/proc/self/status` text (the address space mapped), in bytes.
+pub fn parse_vm_size(status: &str) -> Option<u64> {
+    let line = status.lines().find_map(|l| l.strip_prefix("VmSize:"))?;
+    let mut parts = line.split_whitespace();
+    let value: u64 = parts.next()?.parse().ok()?;
+    match parts.next() {
+        Some("kB") => value.checked_mul(1024),
+        _ => None,
+    }
 }
 
 /// The `MemAvailable:` line of `/proc/meminfo` text (`MemAvailable:   20486532 kB`), in bytes.
@@ -503,6 +548,18 @@ mod tests {
         assert_eq!(parse_mem_available(text), Some(20486532 * 1024));
         assert_eq!(parse_mem_available("MemTotal: 1 kB\n"), None);
         assert_eq!(parse_mem_available("MemAvailable: x kB\n"), None);
+        let limits = "Limit                     Soft Limit           Hard Limit           Units\n\
+                      Max cpu time              unlimited            unlimited            seconds\n\
+                      Max address space         4294967296           unlimited            bytes\n";
+        assert_eq!(parse_address_space_limit(limits), Some(4 << 30));
+        let unlimited =
+            "Max address space         unlimited            unlimited            bytes\n";
+        assert_eq!(parse_address_space_limit(unlimited), None);
+        assert_eq!(
+            parse_vm_size("Name:\tx\nVmSize:\t  10248 kB\n"),
+            Some(10248 * 1024)
+        );
+        assert_eq!(parse_vm_size("VmPeak: 1 kB\n"), None);
         if cfg!(target_os = "linux") {
             assert!(available_memory_bytes().is_some_and(|b| b > 0));
         }
