@@ -19,6 +19,7 @@ mod simulate;
 mod stdout;
 mod subtract;
 mod tf;
+mod witness_noise;
 
 pub use stdout::{is_closed_pipe, note, Out};
 
