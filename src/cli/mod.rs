@@ -20,6 +20,7 @@ mod stdout;
 mod subtract;
 mod tf;
 mod visibility;
+mod witness_noise;
 
 pub use stdout::{is_closed_pipe, note, Out};
 

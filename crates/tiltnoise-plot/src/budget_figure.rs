@@ -122,6 +122,10 @@ fn term_style(component: &Component, readout: Option<ReadoutLabel>) -> (String, 
     };
     match kind {
         TermKind::Tilt => ("tilt".to_string(), style(TILT_COLOR, Dash::Solid, 2)),
+        TermKind::WitnessNoise => (
+            "tiltmeter noise in the tilt term (not in the total)".to_string(),
+            style(TILT_COLOR, Dash::Dotted, 2),
+        ),
         TermKind::Readout => {
             let label = match readout {
                 Some(ReadoutLabel::White(asd, o)) => format!("readout, {}", si_asd(asd, o.unit())),
@@ -184,6 +188,7 @@ fn draw_rank(component: &Component) -> u8 {
             TermKind::Residual => 2,
             TermKind::Tilt => 3,
             TermKind::TiltAxis(_) => 4,
+            TermKind::WitnessNoise => 4,
             TermKind::Readout => 5,
             TermKind::Thermal => 6,
             TermKind::ThermalElement(_) => 7,

@@ -23,8 +23,9 @@ use crate::input::{InputError, Quantity, SeriesSource, TiltSpectra};
 use crate::limits::{check_memory, planned_bytes, LimitError};
 use crate::model::{Model, Observable, TiltAxis};
 use crate::noise::{
-    add_equivalent_response, add_thermal, add_user_terms, check_user_terms, tilt_budget, Budget,
-    BudgetReport, Readout, SegmentBand, SpectralSource, TermKind, TiltCsd, UserTerm, UserTermError,
+    add_equivalent_response, add_thermal, add_user_terms, add_witness_noise, check_user_terms,
+    check_witness_noise, tilt_budget, Budget, BudgetReport, Readout, SegmentBand, SpectralSource,
+    TermKind, TiltCsd, UserTerm, UserTermError, WitnessNoise, WitnessNoiseError,
 };
 use crate::spectral::{Averaging, SpectralError, WelchAccumulator, WelchConfig};
 use crate::tf::{self, Input, Request, TransferMatrix};
@@ -58,6 +59,9 @@ pub enum BudgetError {
     /// A user term or a coloured readout that does not fit the budget.
     #[error(transparent)]
     User(#[from] UserTermError),
+    /// A witness noise that does not fit the budget.
+    #[error(transparent)]
+    Witness(#[from] WitnessNoiseError),
     /// Options that contradict each other or the input.
     #[error("{0}")]
     Config(String),
@@ -85,6 +89,9 @@ pub struct BudgetOptions {
     pub readout: Readout,
     /// User-named terms (ASDs of observables, or input noises through the model).
     pub user_terms: Vec<UserTerm>,
+    /// The tiltmeter's own noise per tilt axis: shown through the model as `witness_noise`,
+    /// not in the total.
+    pub witness_noise: Vec<WitnessNoise>,
     /// Model grid for spectra input (Hz); time series use the Welch grid.
     pub spectra_grid_hz: Vec<f64>,
     /// Frequencies to read the budget at ([`crate::noise::SummaryAt`]).
@@ -104,6 +111,7 @@ impl Default for BudgetOptions {
             percentiles: (10.0, 90.0),
             readout: Readout::default(),
             user_terms: Vec::new(),
+            witness_noise: Vec::new(),
             spectra_grid_hz: Vec::new(),
             summary: SummaryRequest::default(),
             cancel: Cancel::never(),
@@ -310,6 +318,7 @@ pub fn budget_from_series(
     let segment_bands = band_per_observable(&opts.outputs, &segment_tilt, opts.percentiles);
     add_damping_terms(model, &mut budget)?;
     add_user_terms(&mut budget, model, &opts.user_terms)?;
+    add_witness_noise(&mut budget, model, &opts.witness_noise)?;
     check_budget_finite(&budget)?;
     let report = BudgetReport {
         budget,
@@ -340,7 +349,7 @@ pub fn budget_from_series(
         cfg,
         n_segments: spectra.n_segments,
     };
-    with_summary(model, report, &tilt, &opts.summary, &opts.user_terms)
+    with_summary(model, report, &tilt, opts)
 }
 
 /// `report` with its summary ([`summary::summarize`]), and a note for every frequency left out.
@@ -348,10 +357,9 @@ fn with_summary(
     model: &Model,
     mut report: BudgetReport,
     tilt: &summary::TiltData<'_>,
-    req: &SummaryRequest,
-    user_terms: &[UserTerm],
+    opts: &BudgetOptions,
 ) -> Result<BudgetReport, BudgetError> {
-    let (summary, notes) = summary::summarize(model, &report, tilt, req, user_terms)?;
+    let (summary, notes) = summary::summarize(model, &report, tilt, opts)?;
     report.summary = summary;
     report.notes.extend(notes);
     Ok(report)
@@ -364,6 +372,8 @@ fn check_given_spectra(opts: &BudgetOptions, lo: f64, hi: f64) -> Result<(), Bud
         .check_covers(lo, hi)
         .map_err(|e| BudgetError::User(UserTermError::Coverage(e)))?;
     check_user_terms(&opts.user_terms, &opts.outputs, lo, hi)?;
+    check_witness_noise(&opts.witness_noise, lo, hi)
+        .map_err(|e| BudgetError::Witness(WitnessNoiseError::Coverage(e)))?;
     Ok(())
 }
 
@@ -449,6 +459,7 @@ pub fn budget_from_spectra(
     );
     add_damping_terms(model, &mut budget)?;
     add_user_terms(&mut budget, model, &opts.user_terms)?;
+    add_witness_noise(&mut budget, model, &opts.witness_noise)?;
     check_budget_finite(&budget)?;
     let report = BudgetReport {
         budget,
@@ -463,13 +474,7 @@ pub fn budget_from_spectra(
         notes,
         summary: Vec::new(),
     };
-    with_summary(
-        model,
-        report,
-        &summary::TiltData::Spectra(spectra),
-        &opts.summary,
-        &opts.user_terms,
-    )
+    with_summary(model, report, &summary::TiltData::Spectra(spectra), opts)
 }
 
 /// Refuses tilt cross-spectra that overflowed `f64` (samples far beyond any tilt angle or rate,

@@ -12,8 +12,8 @@ use super::{tilt_tf, BudgetError};
 use crate::input::TiltSpectra;
 use crate::model::{Model, Observable};
 use crate::noise::{
-    add_thermal, add_user_terms, tilt_budget, BandMean, BudgetReport, Evaluation, ObservableAt,
-    SummaryAt, TermAt, TermGroup, TiltCsd, UserTerm,
+    add_thermal, add_user_terms, add_witness_noise, tilt_budget, BandMean, BudgetReport,
+    Evaluation, ObservableAt, SummaryAt, TermAt, TermGroup, TermKind, TiltCsd,
 };
 use crate::spectral::{band_dof, WelchConfig};
 use num_complex::Complex64;
@@ -154,9 +154,9 @@ pub(super) fn summarize(
     model: &Model,
     report: &BudgetReport,
     tilt: &TiltData<'_>,
-    req: &SummaryRequest,
-    user_terms: &[UserTerm],
+    opts: &super::BudgetOptions,
 ) -> Result<(Vec<SummaryAt>, Vec<String>), BudgetError> {
+    let req = &opts.summary;
     req.validate()?;
     let outputs: Vec<Observable> = report
         .budget
@@ -209,7 +209,8 @@ pub(super) fn summarize(
                 &crate::thermal::thermal_noise(model, &outputs, &at_f)?,
             );
         }
-        add_user_terms(&mut point, model, user_terms)?;
+        add_user_terms(&mut point, model, &opts.user_terms)?;
+        add_witness_noise(&mut point, model, &opts.witness_noise)?;
         let observables = report
             .budget
             .observables
@@ -225,7 +226,10 @@ pub(super) fn summarize(
                     .map(|t| TermAt {
                         kind: t.kind.clone(),
                         psd: t.psd[0],
-                        evaluation: if t.kind.group() == TermGroup::Tilt {
+                        // The witness noise is a given spectrum through the model: exact at f.
+                        evaluation: if t.kind.group() == TermGroup::Tilt
+                            && t.kind != TermKind::WitnessNoise
+                        {
                             tilt_evaluation.clone()
                         } else {
                             Evaluation::Exact

@@ -13,6 +13,11 @@ pub enum TermKind {
     /// One tilt axis alone, `|H_oi|^2 S_ii`: a diagnostic breakdown of [`TermKind::Tilt`] (it
     /// does not add up to it when the axes are correlated); not part of the total.
     TiltAxis(TiltAxis),
+    /// The witness instruments' own noise through the model, `sum_i |H_oi|^2 S_nn,i`: the
+    /// part of [`TermKind::Tilt`] that is the tiltmeter's noise, not the floor's motion (the
+    /// tilt term, computed from the witness record, already contains it); not part of the
+    /// total.
+    WitnessNoise,
     /// Readout (sensing) noise of the observable.
     Readout,
     /// Thermal noise of every dissipative element together (fluctuation-dissipation theorem).
@@ -34,7 +39,7 @@ pub enum TermKind {
 /// The groups a budget's terms are drawn and stored in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum TermGroup {
-    /// [`TermKind::Tilt`] and its per-axis breakdown.
+    /// [`TermKind::Tilt`], its per-axis breakdown and the witness noise in it.
     Tilt,
     /// [`TermKind::Readout`].
     Readout,
@@ -47,13 +52,15 @@ pub enum TermGroup {
 }
 
 impl TermKind {
-    /// The key of the term in the budget files (`tilt`, `tilt.eta_t`, `readout`, `thermal`,
-    /// `thermal.torsion_b`, `user`, `user.<name>`, `measured`, `residual`); see
+    /// The key of the term in the budget files (`tilt`, `tilt.eta_t`, `witness_noise`,
+    /// `readout`, `thermal`, `thermal.torsion_b`, `user`, `user.<name>`, `measured`,
+    /// `residual`); see
     /// `docs/schemas.md`.
     pub fn name(&self) -> String {
         match self {
             TermKind::Tilt => "tilt".into(),
             TermKind::TiltAxis(a) => format!("tilt.{}", a.name()),
+            TermKind::WitnessNoise => "witness_noise".into(),
             TermKind::Readout => "readout".into(),
             TermKind::Thermal => "thermal".into(),
             TermKind::ThermalElement(e) => format!("thermal.{e}"),
@@ -68,6 +75,7 @@ impl TermKind {
     pub fn from_name(name: &str) -> Option<TermKind> {
         Some(match name {
             "tilt" => TermKind::Tilt,
+            "witness_noise" => TermKind::WitnessNoise,
             "readout" => TermKind::Readout,
             "thermal" => TermKind::Thermal,
             "user" => TermKind::User,
@@ -110,7 +118,7 @@ impl TermKind {
     /// The group of the term.
     pub fn group(&self) -> TermGroup {
         match self {
-            TermKind::Tilt | TermKind::TiltAxis(_) => TermGroup::Tilt,
+            TermKind::Tilt | TermKind::TiltAxis(_) | TermKind::WitnessNoise => TermGroup::Tilt,
             TermKind::Readout => TermGroup::Readout,
             TermKind::Thermal | TermKind::ThermalElement(_) => TermGroup::Thermal,
             TermKind::User | TermKind::UserNamed(_) => TermGroup::User,
@@ -181,6 +189,7 @@ mod tests {
         let kinds = [
             TermKind::Tilt,
             TermKind::TiltAxis(TiltAxis::EtaT),
+            TermKind::WitnessNoise,
             TermKind::Readout,
             TermKind::Thermal,
             TermKind::ThermalElement("swing_a_viscous".into()),
@@ -205,6 +214,7 @@ mod tests {
         assert!(TermKind::Thermal.in_total() && TermKind::User.in_total());
         assert!(!TermKind::UserNamed("actuation".into()).in_total());
         assert!(!TermKind::TiltAxis(TiltAxis::ThetaT).in_total());
+        assert!(!TermKind::WitnessNoise.in_total());
         assert!(!TermKind::ThermalElement("torsion_b".into()).in_total());
         assert!(!TermKind::Measured.in_total() && !TermKind::Residual.in_total());
     }
