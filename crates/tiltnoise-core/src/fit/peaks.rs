@@ -20,7 +20,7 @@
 //!   golden-section search on the direct sum within one padded bin.
 //! * **Amplitudes.** Each channel's complex amplitudes of all the peaks at once: the windowed
 //!   transforms at the peak frequencies are a linear combination of the sinusoids' amplitudes
-//!   through the window's transform, solved exactly ([`joint_amplitudes`]), so that a mode's
+//!   through the window's transform, solved exactly (`joint_amplitudes`), so that a mode's
 //!   amplitude carries no leakage from a strong neighbour (a Hann side lobe 39 bins out is a
 //!   few 1e-6 of it, which is the whole signal of a weakly visible mode).
 //! * **Ratios.** For each unit group present (X, Y, Z in m; theta, eta, phi, phi_a in rad) the
