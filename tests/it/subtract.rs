@@ -419,6 +419,7 @@ fn noisy_witness_end_to_end() {
     let other = Record {
         axes: rec.axes.clone(),
         tilt: rec.colocated[0].clone(),
+        translation: Vec::new(),
         colocated: Vec::new(),
         measured: Vec::new(),
     };
@@ -635,6 +636,7 @@ fn bad_input_is_refused_without_output() {
     let mut bad = Record {
         axes: rec.axes.clone(),
         tilt: rec.tilt.clone(),
+        translation: Vec::new(),
         colocated: Vec::new(),
         measured: rec.measured.clone(),
     };
