@@ -711,11 +711,19 @@ fn bad_input_is_refused_without_output() {
             vec!["--witness-noise eta_t=2e-9", "given twice"],
         ),
         (
+            vec![p("m.h5"), "--witness-noise".into(), "F_b.x=1e-9".into()],
+            vec![
+                "--witness-noise F_b.x=1e-9",
+                "not a floor input",
+                "theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)",
+            ],
+        ),
+        (
             vec![p("m.h5"), "--witness-noise".into(), "x_t=1e-9".into()],
             vec![
-                "--witness-noise x_t=1e-9",
-                "not a floor input",
-                "theta_t, eta_t, phi_t",
+                "--witness-noise x_t",
+                "the witness record has no input x_t",
+                "theta_t, eta_t",
             ],
         ),
         (
