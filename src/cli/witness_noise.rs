@@ -5,11 +5,12 @@
 //! `:0.1` for 10 %). `--tilt-noise` is the same option under its former name.
 
 use super::budget_terms::read_given;
-use anyhow::{anyhow, bail, Result};
+use anyhow::{anyhow, Result};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::Input;
 use tiltnoise_core::noise::{NoiseLevel, WitnessNoise};
+use tiltnoise_core::repeats::refuse_repeated_keys;
 use tiltnoise_io::input::InputFormat;
 
 /// The model inputs a witness can record.
@@ -24,6 +25,7 @@ pub fn is_floor_input(input: Input) -> bool {
 pub fn parse_witness_noise(items: &[String]) -> Result<(Vec<WitnessNoise>, Vec<PathBuf>)> {
     let mut out: Vec<WitnessNoise> = Vec::new();
     let mut files = Vec::new();
+    refuse_repeated_keys("--witness-noise", "input", items)?;
     for item in items {
         let shown = Shown(item);
         let (name, value) = item.split_once('=').ok_or_else(|| {
@@ -41,12 +43,6 @@ pub fn parse_witness_noise(items: &[String]) -> Result<(Vec<WitnessNoise>, Vec<P
                     Shown(name)
                 )
             })?;
-        if out.iter().any(|x| x.input == input) {
-            bail!(
-                "--witness-noise {shown}: {} is given twice; give each input once",
-                input.name()
-            );
-        }
         let (level, rel) = match value.rsplit_once(':') {
             Some((head, tail)) if !head.trim().is_empty() && tail.trim().parse::<f64>().is_ok() => {
                 (head.trim(), tail.trim().parse::<f64>().expect("checked"))

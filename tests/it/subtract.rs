@@ -698,7 +698,11 @@ fn bad_input_is_refused_without_output() {
         ),
         (
             vec![p("m.h5"), "--tilt-noise".into(), "eta_t=-1".into()],
-            vec!["--witness-noise", "eta_t=-1", "finite and >= 0"],
+            vec![
+                "--witness-noise",
+                "eta_t=-1",
+                "must be 0 or a value from 1e-40 to 1e40",
+            ],
         ),
         (
             vec![
@@ -708,7 +712,7 @@ fn bad_input_is_refused_without_output() {
                 "--witness-noise".into(),
                 "eta_t=2e-9".into(),
             ],
-            vec!["--witness-noise eta_t=2e-9", "given twice"],
+            vec!["--witness-noise: eta_t is given twice; name each input once"],
         ),
         (
             vec![p("m.h5"), "--witness-noise".into(), "F_b.x=1e-9".into()],
