@@ -336,3 +336,16 @@ fn tf_takes_one_frequency_and_explains_a_point_next_to_a_mode() {
     let out = tiltnoise(&[&near[..], &["--method", "polezero"]].concat());
     assert!(out.status.success(), "{}", stderr(&out));
 }
+
+/// A segment duration shorter than the Welch segment says how short the Welch segment must be.
+#[test]
+fn a_segment_shorter_than_the_welch_segment_names_nperseg() {
+    let lab = concat!(env!("CARGO_MANIFEST_DIR"), "/tilt_data/lab_tilt_24h.h5");
+    assert_fails(
+        &["budget", "--tilt", lab, "--segment-duration", "3600"],
+        &[
+            "segment duration 3600 s",
+            "(nperseg) to at most 3600 samples",
+        ],
+    );
+}

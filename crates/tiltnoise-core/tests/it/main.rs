@@ -26,6 +26,7 @@ mod scenes;
 mod simulate;
 mod stability;
 mod subtract;
+mod subtract_ground;
 mod subtract_pulls;
 mod synthetic;
 mod tilt_tf;
