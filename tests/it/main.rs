@@ -46,3 +46,4 @@ mod streaming;
 mod subtract;
 mod thermal;
 mod translation_cli;
+mod visibility_cli;
