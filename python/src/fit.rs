@@ -6,7 +6,9 @@ use crate::params::PyParams;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
-use tiltnoise_core::fit::{self, FitConfig, FitError, FitResult, Measured, SigmaSource};
+use tiltnoise_core::fit::{
+    self, FitConfig, FitError, FitResult, Measured, SigmaSource, Visibilities,
+};
 use tiltnoise_core::params::Params;
 use tiltnoise_core::repeats::refuse_repeats;
 
@@ -21,16 +23,44 @@ fn measured(path: Option<PathBuf>) -> PyResult<Measured> {
     }
 }
 
+/// The measured visibilities: a CSV file (`mode,observable,reference,ratio[,sigma]`), or none.
+fn visibilities(path: Option<PathBuf>) -> PyResult<Visibilities> {
+    match path {
+        None => Ok(Visibilities::none()),
+        Some(p) => tiltnoise_io::read_visibilities(&p).map_err(|e| match e {
+            FitError::Visibility { .. } => InputFileError::new_err(e.to_string()),
+            other => value_error(other.to_string()),
+        }),
+    }
+}
+
+/// What `Model.fit` measures against: the frequency file, or Table II's measured column; with
+/// visibilities and no frequency file, no frequency at all (Table II belongs to the paper's
+/// pendulum, not to the one whose record gave the visibilities), as on the command line.
+pub struct FitInputs {
+    /// `measured=`: the frequency file.
+    pub measured: Option<PathBuf>,
+    /// `visibility=`: the visibility file.
+    pub visibility: Option<PathBuf>,
+}
+
 /// Runs the fit of `params` (`Model.fit`).
 pub fn run(
     py: Python<'_>,
     params: &Params,
     free: Option<Vec<String>>,
-    measured_path: Option<PathBuf>,
+    inputs: FitInputs,
     bound_sigmas: f64,
     prior: bool,
 ) -> PyResult<Fit> {
-    let measured = measured(measured_path)?;
+    let measured = match (&inputs.measured, &inputs.visibility) {
+        (None, Some(_)) => Measured {
+            modes: Vec::new(),
+            origin: "no frequency file".into(),
+        },
+        _ => measured(inputs.measured)?,
+    };
+    let visibilities = visibilities(inputs.visibility)?;
     if let Some(keys) = &free {
         refuse_repeats("free", "parameter key", keys, String::clone)
             .map_err(|e| value_error(e.to_string()))?;
@@ -42,7 +72,7 @@ pub fn run(
         ..FitConfig::default()
     };
     let result = py
-        .detach(|| fit::fit(params, &measured, &config))
+        .detach(|| fit::fit_with_visibilities(params, &measured, &visibilities, &config))
         .map_err(|e| value_error(e.to_string()))?;
     Ok(Fit {
         result,
@@ -71,13 +101,15 @@ impl Fit {
 
     /// Per free parameter: ``key``, ``unit``, ``nominal``, ``fitted``, ``prior_sigma``,
     /// ``fitted_sigma`` (``None`` on a bound), ``at_bound`` (``"lower"``, ``"upper"`` or
-    /// ``None``), ``data_sigma_rel``, ``poorly_constrained``.
+    /// ``None``), ``data_sigma_rel``, ``poorly_constrained``, ``start`` (where the fit began:
+    /// away from the symmetric point for an asymmetry offset).
     #[getter]
     fn parameters<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
         self.result
             .params
             .iter()
-            .map(|p| {
+            .zip(&self.result.start)
+            .map(|(p, &start)| {
                 let d = PyDict::new(py);
                 d.set_item("key", &p.key)?;
                 d.set_item("unit", &p.unit)?;
@@ -88,6 +120,7 @@ impl Fit {
                 d.set_item("at_bound", p.at_bound.map(|b| b.name()))?;
                 d.set_item("data_sigma_rel", p.data_sigma_rel)?;
                 d.set_item("poorly_constrained", p.poorly_constrained)?;
+                d.set_item("start", start)?;
                 Ok(d)
             })
             .collect()
@@ -117,6 +150,37 @@ impl Fit {
                 d.set_item("fitted_hz", m.fitted_hz)?;
                 d.set_item("residual_hz", m.residual_hz())?;
                 d.set_item("residual_sigmas", m.residual_sigmas())?;
+                Ok(d)
+            })
+            .collect()
+    }
+
+    /// Per measured visibility (the command line's ``visibilities``): ``mode``,
+    /// ``observable``, ``reference``, ``measured`` (the signed ratio), ``sigma``,
+    /// ``sigma_source``, ``nominal`` and ``fitted`` (the model's ratio; NaN where the reference
+    /// does not see the mode), ``residual_sigmas``.
+    #[getter]
+    fn visibilities<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        self.result
+            .visibilities
+            .iter()
+            .map(|v| {
+                let d = PyDict::new(py);
+                d.set_item("mode", v.measured.mode)?;
+                d.set_item("observable", v.measured.observable.name())?;
+                d.set_item("reference", v.measured.reference.name())?;
+                d.set_item("measured", v.measured.ratio)?;
+                d.set_item("sigma", v.measured.sigma)?;
+                d.set_item(
+                    "sigma_source",
+                    match v.measured.sigma_source {
+                        SigmaSource::File => "file",
+                        SigmaSource::Digits => "digits",
+                    },
+                )?;
+                d.set_item("nominal", v.nominal)?;
+                d.set_item("fitted", v.fitted)?;
+                d.set_item("residual_sigmas", v.residual_sigmas())?;
                 Ok(d)
             })
             .collect()

@@ -558,8 +558,11 @@ impl PyModel {
     /// command line's eight) to measured mode frequencies, each within ``bound_sigmas`` of its
     /// error bar, optionally with the Gaussian prior (the command line's ``tiltnoise fit``;
     /// ``docs/fit.md``). ``measured``: a CSV file ``mode,frequency_hz[,sigma_hz]`` (any subset
-    /// of the modes); default Table II's measured column. Returns a :class:`Fit`.
-    #[pyo3(signature = (free=None, measured=None, bound_sigmas=1.0, prior=false))]
+    /// of the modes); default Table II's measured column, or none when ``visibility`` is given.
+    /// ``visibility``: a CSV file ``mode,observable,reference,ratio[,sigma]`` of measured mode
+    /// visibilities (the command line's ``fit --visibility``), fitted together with the
+    /// frequencies. Returns a :class:`Fit`.
+    #[pyo3(signature = (free=None, measured=None, bound_sigmas=1.0, prior=false, visibility=None))]
     fn fit(
         &self,
         py: Python<'_>,
@@ -567,8 +570,13 @@ impl PyModel {
         measured: Option<std::path::PathBuf>,
         bound_sigmas: f64,
         prior: bool,
+        visibility: Option<std::path::PathBuf>,
     ) -> PyResult<crate::fit::Fit> {
-        crate::fit::run(py, self.model.params(), free, measured, bound_sigmas, prior)
+        let inputs = crate::fit::FitInputs {
+            measured,
+            visibility,
+        };
+        crate::fit::run(py, self.model.params(), free, inputs, bound_sigmas, prior)
     }
 
     /// Free motion of the undamped model (the command line's ``tiltnoise simulate``): exact

@@ -1,6 +1,6 @@
 """The same mistake gives the same message from Python as from the command line: both call the
 library's checks, which name the option as each front end spells it (`--input` / `inputs`,
-`--segment-duration 3600` / `segment_duration=3600`). Each case runs the command line, maps its
+`--segment-duration 14400` / `segment_duration=14400`). Each case runs the command line, maps its
 option names to the keywords, and compares the whole message."""
 
 import numpy as np
@@ -70,7 +70,8 @@ def test_model_messages_equal_the_command_lines(model, cli_error, cli_args, call
         (["--tilt", LAB_TILT, "--readout", "q=1e-9"], dict(readout={"q": 1e-9}),
          [("--readout", "readout")]),
         (["--tilt", LAB_TILT, "--percentiles", "10,90"], dict(percentiles=(10, 90)),
-         [("--segment-duration 3600", "segment_duration=3600"),
+         [("--segment-duration 14400", "segment_duration=14400"),
+          ("--nperseg 4096", "nperseg=4096"),
           ("--segment-duration", "segment_duration"), ("--percentiles", "percentiles")]),
         (["--tilt", SPECTRA, "--overlap", "0.25"], dict(overlap=0.25),
          [("--overlap", "overlap"), ("--freq", "freq")]),

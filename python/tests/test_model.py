@@ -212,6 +212,30 @@ def test_fit_equals_the_command_lines(model, cli):
     assert got.params.to_toml() == expected["fitted_params_toml"]
 
 
+def test_fit_to_visibilities_equals_the_command_lines(cli, tmp_path):
+    # nu_6 seen in Y and Z (forbidden by the mirror plane of the symmetric pendulum) and nu_2 in
+    # Y: a test-mass offset along x explains them; its prior error bar 1 mm.
+    params = tmp_path / "p.toml"
+    params.write_text(cli("params")
+                      + '\n[uncertainty]\n"asymmetry.tm_com_x_m" = { sigma = 1e-3 }\n')
+    vis = tmp_path / "vis.csv"
+    vis.write_text("mode,observable,reference,ratio,sigma\n"
+                   "6,Y,X,1.2e-3,1e-4\n6,Z,X,-7.5e-4,1e-4\n2,Y,X,1.6,0.1\n")
+    args = ("fit", "--visibility", str(vis), "--free", "asymmetry.tm_com_x_m",
+            "--bound-sigmas", "3", "--format", "json")
+    expected = json.loads(cli("--params", str(params), *args))
+    got = tiltnoise.Model(tiltnoise.Params.from_toml(params)).fit(
+        free=["asymmetry.tm_com_x_m"], visibility=vis, bound_sigmas=3.0)
+    assert got.parameters == expected["parameters"]
+    assert got.visibilities == expected["visibilities"]
+    assert got.modes == expected["modes"] == []
+    assert got.chi2 == expected["chi2"] and got.dof == expected["dof"]
+    assert got.measured_origin == expected["measured_origin"]
+    # The offset is found, on the side the signs of the ratios say.
+    offset = next(p for p in got.parameters if p["key"] == "asymmetry.tm_com_x_m")
+    assert offset["fitted"] != 0.0
+
+
 def test_fit_errors(model, tmp_path):
     with pytest.raises(ValueError, match="unknown parameter key `length.hh`"):
         model.fit(free=["length.hh"])
@@ -219,6 +243,10 @@ def test_fit_errors(model, tmp_path):
     bad.write_text("mode,frequency_hz\n9,1.0\n")
     with pytest.raises(tiltnoise.InputFileError, match="modes.csv"):
         model.fit(measured=bad)
+    vis = tmp_path / "vis.csv"
+    vis.write_text("mode,observable,reference,ratio\n6,Y,Q,1e-3\n")
+    with pytest.raises(tiltnoise.InputFileError, match="vis.csv"):
+        model.fit(visibility=vis)
 
 
 def test_repeated_calls_on_other_grids_give_a_new_models_values():

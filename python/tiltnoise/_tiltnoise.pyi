@@ -83,6 +83,8 @@ class Fit:
     def parameters(self) -> list[dict[str, Any]]: ...
     @property
     def modes(self) -> list[dict[str, Any]]: ...
+    @property
+    def visibilities(self) -> list[dict[str, Any]]: ...
     chi2: float
     chi2_nominal: float
     prior_term: float
@@ -168,6 +170,7 @@ class Model:
         measured: Optional[_Path] = None,
         bound_sigmas: float = 1.0,
         prior: bool = False,
+        visibility: Optional[_Path] = None,
     ) -> Fit: ...
     def simulate(
         self,

@@ -244,11 +244,11 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     );
     run.check_outputs(&saves, &inputs)?;
     let model = Model::new(params)?;
-    if args.percentiles.is_some() && args.segment_duration.is_none() {
-        bail!(
-            "--percentiles applies to the per-segment band and needs --segment-duration \
-             (e.g. --segment-duration 14400 with --nperseg 4096: each segment holds a Welch segment)"
-        );
+    if args.percentiles.is_some() {
+        tiltnoise_core::budget::option_checks::require_segments_for_percentiles(
+            tiltnoise_core::options::Spelling::Flag,
+            args.segment_duration.is_some(),
+        )?;
     }
     let opts = BudgetOptions {
         welch_segment_len: args.nperseg,

@@ -63,10 +63,12 @@ pub fn require_segments_for_percentiles(
         return Ok(());
     }
     Err(OptionError::Conflict(format!(
-        "{} applies to the per-segment band and needs {} (e.g. {})",
+        "{} applies to the per-segment band and needs {} (e.g. {} with {} at 1 Hz: each \
+         segment holds a Welch segment)",
         spelling.option("percentiles"),
         spelling.option("segment_duration"),
-        spelling.example("segment_duration", "3600")
+        spelling.example("segment_duration", "14400"),
+        spelling.example("nperseg", "4096")
     )))
 }
 
@@ -128,7 +130,8 @@ mod tests {
                 .unwrap_err()
                 .to_string(),
             "percentiles applies to the per-segment band and needs segment_duration (e.g. \
-             segment_duration=3600)"
+             segment_duration=14400 with nperseg=4096 at 1 Hz: each segment holds a Welch \
+             segment)"
         );
         assert!(require_segments_for_percentiles(Spelling::Flag, true).is_ok());
         assert_eq!(
