@@ -61,11 +61,13 @@ pub(crate) fn read(
     let resolved = h5::resolve_axes(
         path,
         available,
+        &vec![None; available.len()],
         "dataset",
         opts,
         file_map.as_ref(),
         &mut notes,
     )?;
+    super::refuse_translation_spectra(path, &resolved)?;
     const X0: &str = "the first frequency in Hz (gwpy's x0): finite, the same for every axis";
     const DX: &str = "the frequency spacing in Hz (gwpy's dx): finite and > 0, the same for \
                       every axis";
@@ -149,7 +151,6 @@ pub(crate) fn read(
                     channel: m.source.clone(),
                     unit: u.clone(),
                     quantity: unit.quantity,
-                    factor: unit.factor,
                 });
                 d
             }
@@ -231,7 +232,7 @@ pub(crate) fn read(
             Complex64::new(0.0, 0.0)
         }
     });
-    let axes: Vec<_> = resolved.channels.iter().map(|c| c.axis).collect();
+    let axes: Vec<_> = resolved.channels.iter().filter_map(|c| c.tilt_axis()).collect();
     check_csd_finite(path, &freqs, &axes, &csd)?;
     Ok(TiltSpectra {
         freqs_hz: freqs,

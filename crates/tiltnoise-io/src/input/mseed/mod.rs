@@ -3,21 +3,23 @@
 //! one channel per SEED code `NET.STA.LOC.CHA`, chosen with the axis map (full codes or bare
 //! channel codes such as `LJE`; by default the rotation channels `?JE`, `?JN`, `?JZ`).
 //!
-//! miniSEED stores no units. The quantity comes from the options, else from the instrument
-//! code (second letter of the channel code): `J` (rotation sensor) is a rate (rad/s), `A`
-//! (tiltmeter) an angle (rad). Integer samples (INT16, INT32, Steim-1, Steim-2) are digitizer
-//! counts and need a scale factor per channel ([`super::ChannelScale`]); floating-point
-//! samples (FLOAT32, FLOAT64) are taken to be in rad or rad/s already, which the provenance
-//! says. See `docs/input_formats.md`.
+//! miniSEED stores no units. A channel's unit comes from the options (`ReadOptions::units`),
+//! else, for a tilt channel, from the options' quantity or the instrument code (second letter
+//! of the channel code): `J` (rotation sensor) is a rate (rad/s), `A` (tiltmeter) an angle
+//! (rad). Seismometer and accelerometer channels (`H`, `L`, `N`, `P`) are translations and
+//! need their unit from the options. Integer samples (INT16, INT32, Steim-1, Steim-2) are
+//! digitizer counts and need a scale factor per channel ([`super::ChannelScale`]);
+//! floating-point samples (FLOAT32, FLOAT64) are taken to be in their unit already, which the
+//! provenance says. See `docs/input_formats.md`.
 
 mod channels;
 mod record;
 mod steim;
 
-use super::meta::{decide_quantity, Declared};
+use super::series_units::{self, check_unstated_data, into_series, units_note, Stated};
 use super::{check_sample_rate, Provenance, Quantity, ReadOptions};
-use super::{check_scales, gap_note, process_channel, require_two, scale_for, scale_note};
-use super::{resolve, ChannelCtx, InputError, MapOrigin, TiltSeries};
+use super::{check_scales, gap_note, process_channel, require_two, scale_for};
+use super::{resolve, ChannelCtx, ChannelUnit, InputError, MapOrigin, TiltSeries};
 use super::{AxisMap, AxisMapEntry, ChannelScale, GapPolicy, InputFormat, InputKind};
 use channels::{Channel, Placed};
 use std::io::Read;
@@ -165,6 +167,31 @@ fn full_scales(
     Ok(out)
 }
 
+/// The units given in the options, with channel codes replaced by full SEED codes.
+fn full_units(
+    path: &Path,
+    units: &[ChannelUnit],
+    ids: &[String],
+) -> Result<Vec<ChannelUnit>, InputError> {
+    units
+        .iter()
+        .map(|u| {
+            Ok(ChannelUnit {
+                channel: full_code(path, &u.channel, ids)?.unwrap_or_else(|| u.channel.clone()),
+                ..u.clone()
+            })
+        })
+        .collect()
+}
+
+/// Channel names of the options (sensor declarations) as full SEED codes.
+fn full_names(path: &Path, names: &[String], ids: &[String]) -> Result<Vec<String>, InputError> {
+    names
+        .iter()
+        .map(|n| Ok(full_code(path, n, ids)?.unwrap_or_else(|| n.clone())))
+        .collect()
+}
+
 /// The quantity an instrument code says: `J` rotation sensor -> rate, `A` tiltmeter -> angle.
 fn code_quantity(id: &str) -> Option<(Quantity, &'static str)> {
     let cha = id.rsplit('.').next().unwrap_or("");
@@ -173,6 +200,15 @@ fn code_quantity(id: &str) -> Option<(Quantity, &'static str)> {
         Some(b'A') => Some((Quantity::Angle, "instrument code A: tiltmeter, rad")),
         _ => None,
     }
+}
+
+/// The unit an instrument code implies, as an assumption the options may replace.
+fn code_unit(id: &str) -> Option<Stated> {
+    let (quantity, why) = code_quantity(id)?;
+    Some(Stated {
+        assumed: true,
+        ..Stated::in_file(quantity.unit(), why.to_string())
+    })
 }
 
 /// Reads a miniSEED 2 file as a tilt time series.
@@ -190,7 +226,18 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
         Some(m) => MapOrigin::Options(m),
         None => MapOrigin::Default,
     };
-    let resolved = resolve(path, &ids, origin, "channel")?;
+    let given = full_units(path, &opts.units, &ids)?;
+    let mut unit_notes = Vec::new();
+    let stated = series_units::merge_given(
+        path,
+        &ids,
+        ids.iter().map(|id| code_unit(id)).collect(),
+        &given,
+        "channel",
+        &mut unit_notes,
+    )?;
+    let motions = series_units::motions(path, &ids, &stated)?;
+    let resolved = resolve(path, &ids, &motions, origin, "channel")?;
     let scales = full_scales(path, &opts.scale, &ids)?;
     let mut notes = vec![format!(
         "miniSEED 2: {} records, channels {}{}",
@@ -203,6 +250,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
         }
     )];
     notes.extend(resolved.notes.iter().cloned());
+    notes.extend(unit_notes);
 
     // Merge the mapped channels only: a file of many channels costs the memory of three.
     let mut groups: Vec<Option<Vec<Placed>>> = groups.into_iter().map(|(_, v)| Some(v)).collect();
@@ -296,47 +344,50 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
     }
     notes.push(format!("sample rate {rate} Hz from the records"));
 
-    // Quantity: the options, else the instrument codes.
-    let mut declared = Vec::new();
-    for ch in &chans {
-        match code_quantity(&ch.id) {
-            Some((q, why)) => {
-                notes.push(format!(
-                    "channel {}: {why} (miniSEED stores no units)",
-                    ch.id
-                ));
-                declared.push(Declared {
-                    channel: ch.id.clone(),
-                    unit: q.unit().to_string(),
-                    quantity: Some(q),
-                    factor: 1.0,
-                })
-            }
-            None if opts.quantity.is_none() => {
+    // Units: the options', else (tilt channels) the options' quantity or the instrument code.
+    for (m, ch) in resolved.channels.iter().zip(&chans) {
+        match &stated[m.index] {
+            Some(s) if s.assumed => notes.push(format!(
+                "channel {}: {} (miniSEED stores no units)",
+                ch.id, s.origin
+            )),
+            Some(_) => {}
+            None if opts.quantity.is_none() && m.tilt_axis().is_some() => {
                 return Err(fault(
                     path,
                     None,
                     format!(
                         "channel {}: miniSEED stores no units and the instrument code (second \
                          letter of the channel code) is neither J (rotation sensor, rad/s) nor A \
-                         (tiltmeter, rad); allowed: give the quantity explicitly (angle or rate)",
-                        ch.id
+                         (tiltmeter, rad); allowed: give its unit (units {}=rad/s) or the \
+                         quantity explicitly (angle or rate)",
+                        ch.id, ch.id
                     ),
                 ))
             }
             None => {}
         }
     }
-    let quantity = decide_quantity(path, opts.quantity, &declared, &[], &mut notes)?;
-    let unit = quantity.unit();
+    let sensor_opts = ReadOptions {
+        scale: scales.clone(),
+        corrected: full_names(path, &opts.corrected, &ids)?,
+        pendulum: full_names(path, &opts.pendulum, &ids)?,
+        ..opts.clone()
+    };
+    let plan = series_units::plan(path, &resolved, &stated, &sensor_opts, &mut notes)?;
 
     let mut data = Vec::new();
-    for ((m, ch), &k) in resolved.channels.iter().zip(&chans).zip(&spans) {
-        let factor = match (scale_for(&scales, &ch.id), ch.counts) {
-            (Some(f), _) => {
-                notes.push(scale_note(&ch.id, f, "given explicitly"));
-                f
-            }
+    for (((m, ch), &k), planned) in resolved
+        .channels
+        .iter()
+        .zip(&chans)
+        .zip(&spans)
+        .zip(&plan.channels)
+    {
+        let unit = planned.unit();
+        let factor = planned.factor;
+        match (scale_for(&scales, &ch.id), ch.counts) {
+            (Some(_), _) => {}
             (None, true) => {
                 return Err(InputError::Scale {
                     path: path.to_path_buf(),
@@ -355,9 +406,8 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
                     ch.id,
                     ch.encodings.join(", ")
                 ));
-                1.0
             }
-        };
+        }
         if opts.gaps == GapPolicy::Reject {
             if let Some(&(a, b)) = ch.gaps.iter().find(|&&(a, b)| b > k && a < k + len) {
                 return Err(fault(
@@ -402,22 +452,20 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
         if bridged > 0 {
             notes.push(gap_note(&m.source, bridged));
         }
+        check_unstated_data(path, &m.source, planned, &v, rate)?;
         data.push(v);
     }
-    Ok(TiltSeries {
-        sample_rate_hz: rate,
-        axes: resolved.channels.iter().map(|m| m.axis).collect(),
-        data,
-        provenance: Provenance {
-            path: path.to_path_buf(),
-            format: InputFormat::Miniseed,
-            kind: InputKind::Series,
-            quantity,
-            axis_map: resolved.map.to_string(),
-            start_time: Some(chans[0].time(spans[0])),
-            notes,
-        },
-    })
+    notes.push(units_note(&plan));
+    let provenance = Provenance {
+        path: path.to_path_buf(),
+        format: InputFormat::Miniseed,
+        kind: InputKind::Series,
+        quantity: plan.quantity,
+        axis_map: resolved.map.to_string(),
+        start_time: Some(chans[0].time(spans[0])),
+        notes,
+    };
+    Ok(into_series(&plan, data, rate, provenance))
 }
 
 #[cfg(test)]
