@@ -1,10 +1,15 @@
-//! The budget job: a tilt input (time series or spectra) -> tilt cross-spectra -> transfer
-//! functions on the same grid -> the noise budget of the chosen observables (tilt, readout,
-//! thermal, user-named terms), whole record and per segment, and read at chosen frequencies.
+//! The budget job: a record of the floor's motion (a time series of tilt and translation
+//! channels, or tilt spectra) -> the cross-spectra of the model's inputs -> transfer functions
+//! on the same grid -> the noise budget of the chosen observables (tilt, translation and
+//! ground, readout, thermal, user-named terms), whole record and per segment, and read at
+//! chosen frequencies.
 //!
 //! Time series are streamed in chunks through Welch accumulators, so a month of 10 Hz data is
 //! processed in bounded memory: one whole-record accumulator, one for the current segment, and
-//! the `tilt` PSD of every finished segment (stored as `f32`, enough for percentile bands).
+//! the PSD of the term that adds to the total (`tilt`, `translation` or `ground`) of every
+//! finished segment (stored as `f32`, enough for percentile bands). The channels' cross-spectra
+//! are carried to the inputs' by [`GroundMap`]: bin by bin, in each channel's own quantity, with
+//! inertial sensors corrected.
 //! Progress is reported through a callback; the library never draws to the terminal.
 //! Conventions: one-sided spectra, PSD in unit^2/Hz (see [`crate::noise`]).
 
@@ -17,16 +22,17 @@ pub use measured::{add_measured, series_psds, MeasuredPsds};
 pub use summary::{SummaryRequest, DEFAULT_BAND_FRACTION, DEFAULT_SUMMARY_FREQS_HZ};
 
 use crate::error::TfError;
-use crate::input::rate::angle_csd_above_dc;
-use crate::input::{InputError, Quantity, SeriesSource, TiltSpectra};
+use crate::ground::GroundQuantity;
+use crate::input::{GroundMap, InputError, SeriesSource, TiltSpectra};
 use crate::limits::{check_memory, planned_bytes, LimitError};
-use crate::model::{Model, Observable, TiltAxis};
+use crate::model::{Input, Model, Observable};
 use crate::noise::{
-    add_equivalent_response, add_thermal, add_user_terms, check_user_terms, tilt_budget, Budget,
-    BudgetReport, Readout, SegmentBand, SpectralSource, TermKind, TiltCsd, UserTerm, UserTermError,
+    add_equivalent_response, add_thermal, add_user_terms, check_user_terms, ground_budget, Budget,
+    BudgetReport, GroundCsd, Readout, SegmentBand, SpectralSource, TermKind, UserTerm,
+    UserTermError,
 };
 use crate::spectral::{Averaging, SpectralError, WelchAccumulator, WelchConfig};
-use crate::tf::{self, Input, Request, TransferMatrix};
+use crate::tf::{self, Request, TransferMatrix};
 
 /// Samples per channel read from the input at a time: 2^18 samples x 3 channels x 8 bytes
 /// = 6 MiB, large enough to amortize HDF5 calls, small against the 256 MB memory goal.
@@ -110,15 +116,17 @@ pub fn default_segment_len(n_samples: usize) -> usize {
     DEFAULT_WELCH_SEGMENT.min(1 << quarter.ilog2())
 }
 
-fn tilt_tf(
+/// The transfer functions from the floor's `inputs` (per unit displacement: rad, m) to
+/// `outputs` on `grid`, by the planner's method.
+fn ground_tf(
     model: &Model,
     outputs: &[Observable],
-    axes: &[TiltAxis],
+    inputs: &[Input],
     grid: &[f64],
 ) -> Result<TransferMatrix, TfError> {
     let request = Request {
         outputs: outputs.to_vec(),
-        inputs: axes.iter().map(|&a| Input::Tilt(a)).collect(),
+        inputs: inputs.to_vec(),
     };
     let (plan, _) = tf::plan_auto(model, &tf::Scene::over_grid(request, grid))?;
     tf::evaluate(plan.as_ref(), grid)
@@ -142,8 +150,21 @@ pub const RATE_BUDGET_NOTE: &str = "tilt rate: the Welch cross-spectra of the ra
      (rad^2/s^2/Hz) divided by (2 pi f)^2 at every bin f > 0, exact up to Nyquist (no time \
      integration); the DC bin carries no angle information and is excluded";
 
-/// Budget from a time series of tilt angle or rate ([`SeriesSource::quantity`]; a rate's
-/// spectra become the angle's by [`crate::input::rate`], the DC bin is dropped for both).
+/// The term of the floor's motion that adds to the total of a budget of `inputs`: `ground` for
+/// tilt and translation together, else `tilt` or `translation`.
+fn total_ground_term(inputs: &[Input]) -> TermKind {
+    let tilt = inputs.iter().any(|i| matches!(i, Input::Tilt(_)));
+    let translation = inputs.iter().any(|i| matches!(i, Input::Translation(_)));
+    match (tilt, translation) {
+        (true, true) => TermKind::Ground,
+        (false, true) => TermKind::Translation,
+        _ => TermKind::Tilt,
+    }
+}
+
+/// Budget from a time series of the floor's motion ([`SeriesSource::channels`]: tilt angles or
+/// rates, translations as displacement, velocity or acceleration; their spectra become the
+/// inputs' by [`GroundMap`], with inertial sensors corrected, and the DC bin is dropped).
 /// `progress(done, total)` is called with samples processed.
 pub fn budget_from_series(
     model: &Model,
@@ -154,8 +175,11 @@ pub fn budget_from_series(
     opts.summary.validate()?;
     let fs = series.sample_rate_hz();
     let n = series.len();
-    let axes = series.axes().to_vec();
-    let quantity = series.quantity();
+    let channels = series.channels();
+    let map = GroundMap::new(&channels, model.params().environment.g_m_per_s2)
+        .map_err(BudgetError::Config)?;
+    let inputs = map.inputs();
+    let segment_term = total_ground_term(&inputs);
     let seg_len = opts
         .welch_segment_len
         .unwrap_or_else(|| default_segment_len(n));
@@ -201,7 +225,7 @@ pub fn budget_from_series(
             Some(s as usize)
         }
     };
-    let n_ax = axes.len();
+    let n_ax = channels.len();
     check_kept_memory(&cfg, n, n_ax, segment_samples, opts.outputs.len())?;
     let mut whole = WelchAccumulator::new(n_ax, fs, &cfg)?;
     let mut current: Option<WelchAccumulator> = None;
@@ -230,22 +254,23 @@ pub fn budget_from_series(
                 if in_segment == seg {
                     let spectra = current.take().expect("segment in progress").finish()?;
                     in_segment = 0;
-                    let (grid, csd) = angle_csd_above_dc(&spectra, quantity);
+                    let (grid, csd) = map.apply(&spectra);
                     if tf_cache.is_none() {
-                        tf_cache = Some(tilt_tf(model, &opts.outputs, &axes, &grid)?);
+                        tf_cache = Some(ground_tf(model, &opts.outputs, &inputs, &grid)?);
                     }
                     let tf = tf_cache.as_ref().expect("computed above");
-                    // Reduce each finished segment to its tilt PSDs at once (bounded memory).
-                    let b = tilt_budget(
+                    // Reduce each finished segment to the PSDs of its total ground term at
+                    // once (bounded memory).
+                    let b = ground_budget(
                         tf,
-                        &TiltCsd {
-                            axes: &axes,
+                        &GroundCsd {
+                            inputs: &inputs,
                             csd: &csd,
                         },
                         &Readout::none(),
                     );
                     for (o, ob) in b.observables.iter().enumerate() {
-                        let psd = &ob.term(&TermKind::Tilt).expect("tilt term").psd;
+                        let psd = &ob.term(&segment_term).expect("the total's ground term").psd;
                         segment_tilt[o].push(psd.iter().map(|&p| p as f32).collect());
                     }
                 }
@@ -255,24 +280,29 @@ pub fn budget_from_series(
         progress(start as u64, n as u64);
     }
     let spectra = whole.finish()?;
-    let (grid, csd) = angle_csd_above_dc(&spectra, quantity);
+    let (grid, csd) = map.apply(&spectra);
     let tf = match tf_cache {
         Some(tf) => tf,
-        None => tilt_tf(model, &opts.outputs, &axes, &grid)?,
+        None => ground_tf(model, &opts.outputs, &inputs, &grid)?,
     };
-    check_csd_finite(&csd, &axes, quantity)?;
-    let mut budget = tilt_budget(
+    check_csd_finite(&csd, &channels)?;
+    let mut budget = ground_budget(
         &tf,
-        &TiltCsd {
-            axes: &axes,
+        &GroundCsd {
+            inputs: &inputs,
             csd: &csd,
         },
         &opts.readout,
     );
     let mut notes = Vec::new();
-    if quantity == Quantity::Rate {
+    if channels
+        .iter()
+        .any(|c| matches!(c.input, Input::Tilt(_)) && c.quantity == GroundQuantity::Velocity)
+    {
         notes.push(RATE_BUDGET_NOTE.to_string());
     }
+    notes.extend(map.notes().iter().cloned());
+    notes.extend(map.spectra_notes());
     if in_segment > 0 {
         notes.push(format!(
             "the last {in_segment} samples ({:.0} s) do not fill a segment and are left out of \
@@ -280,7 +310,12 @@ pub fn budget_from_series(
             in_segment as f64 / fs
         ));
     }
-    let segment_bands = band_per_observable(&opts.outputs, &segment_tilt, opts.percentiles);
+    let segment_bands = band_per_observable(
+        &segment_term,
+        &opts.outputs,
+        &segment_tilt,
+        opts.percentiles,
+    );
     add_damping_terms(model, &mut budget)?;
     add_user_terms(&mut budget, model, &opts.user_terms)?;
     check_budget_finite(&budget)?;
@@ -301,7 +336,7 @@ pub fn budget_from_series(
             n_welch_segments: spectra.n_segments,
             n_samples: n,
         },
-        axes,
+        inputs,
         readout: opts.readout.clone(),
         user_terms: opts.user_terms.clone(),
         notes,
@@ -372,6 +407,7 @@ fn check_kept_memory(
 }
 
 fn band_per_observable(
+    term: &TermKind,
     outputs: &[Observable],
     per_segment: &[Vec<Vec<f32>>],
     (lo, hi): (f64, f64),
@@ -380,7 +416,7 @@ fn band_per_observable(
         .iter()
         .zip(per_segment)
         .filter(|(_, segs)| !segs.is_empty())
-        .map(|(&o, segs)| (o, SegmentBand::new(segs, lo, hi)))
+        .map(|(&o, segs)| (o, SegmentBand::new(term.clone(), segs, lo, hi)))
         .collect()
 }
 
@@ -411,11 +447,12 @@ pub fn budget_from_spectra(
         }
     }
     check_given_spectra(opts, grid[0], grid[grid.len() - 1])?;
-    let tf = tilt_tf(model, &opts.outputs, &on_grid.axes, &grid)?;
-    let mut budget: Budget = tilt_budget(
+    let inputs: Vec<Input> = on_grid.axes.iter().map(|&a| Input::Tilt(a)).collect();
+    let tf = ground_tf(model, &opts.outputs, &inputs, &grid)?;
+    let mut budget: Budget = ground_budget(
         &tf,
-        &TiltCsd {
-            axes: &on_grid.axes,
+        &GroundCsd {
+            inputs: &inputs,
             csd: &on_grid.csd,
         },
         &opts.readout,
@@ -430,7 +467,7 @@ pub fn budget_from_spectra(
         source: SpectralSource::Spectra {
             data_band_hz: spectra.band_hz(),
         },
-        axes: on_grid.axes.clone(),
+        inputs,
         readout: opts.readout.clone(),
         user_terms: opts.user_terms.clone(),
         notes,
@@ -445,25 +482,24 @@ pub fn budget_from_spectra(
     )
 }
 
-/// Refuses tilt cross-spectra that overflowed `f64` (samples far beyond any tilt angle or rate,
-/// e.g. 1e200 rad, square to infinity), naming the axis.
+/// Refuses cross-spectra of the inputs that overflowed `f64` (samples far beyond any tilt or
+/// floor motion, e.g. 1e200 rad, square to infinity), naming the input.
 fn check_csd_finite(
     csd: &[num_complex::Complex64],
-    axes: &[TiltAxis],
-    quantity: Quantity,
+    channels: &[crate::input::GroundChannel],
 ) -> Result<(), BudgetError> {
-    let n = axes.len();
+    let n = channels.len();
     if let Some(j) = csd
         .iter()
         .position(|z| !(z.re.is_finite() && z.im.is_finite()))
     {
-        let axis = axes[(j % (n * n)) / n];
+        let c = channels[(j % (n * n)) / n];
         return Err(BudgetError::NotFinite(format!(
-            "the tilt power spectrum of {} overflows f64: its samples are far too large to be \
-             tilt {}s in {} (check the file's units and --quantity)",
-            axis.name(),
-            quantity.name(),
-            quantity.unit()
+            "the power spectrum of {} overflows f64: its samples are far too large to be a \
+             {} of the floor in {} (check the file's units)",
+            c.input.name(),
+            c.quantity.name(),
+            c.unit()
         )));
     }
     Ok(())
