@@ -305,7 +305,11 @@ fn describe_arrays(
             return Err(value_error(format!(
                 "units: {:?} is not an input of tilt; it has {}",
                 u.channel,
-                inputs.iter().map(|i| i.name()).collect::<Vec<_>>().join(", ")
+                inputs
+                    .iter()
+                    .map(|i| i.name())
+                    .collect::<Vec<_>>()
+                    .join(", ")
             )));
         }
     }
@@ -422,7 +426,10 @@ fn check_unstated_array(name: &str, quantity: Quantity, data: &[f64], fs: f64) -
         return Ok(());
     }
     let likely = tiltnoise_core::input::likely_units(rms, quantity, fs);
-    let first = likely.first().cloned().unwrap_or_else(|| "nrad".to_string());
+    let first = likely
+        .first()
+        .cloned()
+        .unwrap_or_else(|| "nrad".to_string());
     Err(value_error(format!(
         "tilt[{name:?}] has no unit and is read in {}, but its detrended RMS is {} {}, above \
          the {} {} no laboratory floor reaches; its values are likely in {}: give its unit, \

@@ -368,7 +368,16 @@ fn romy_layout_fixture_reads_with_mapping_and_rate() {
     let rate = opts(None, Some(Quantity::Rate), GapPolicy::Reject);
     let e = series_err(&p, &rate);
     assert!(matches!(e, InputError::ChannelUnit { .. }), "{e}");
-    err_msg(e, &p, &["channel `LHE`", "feeds x_t", "has no unit", "--units LHE=m/s^2"]);
+    err_msg(
+        e,
+        &p,
+        &[
+            "channel `LHE`",
+            "feeds x_t",
+            "has no unit",
+            "--units LHE=m/s^2",
+        ],
+    );
     let units = ["LHE", "LHN", "LHZ"].map(|c| format!("{c}=m/s^2").parse().unwrap());
     let s2 = series(
         &p,
@@ -385,7 +394,10 @@ fn romy_layout_fixture_reads_with_mapping_and_rate() {
     assert_eq!(bits(&s2.data[0]), bits(&s.data[0]));
     assert_eq!(bits(&s2.data[1]), bits(&s.data[1]));
     let x = &s2.translations[0];
-    assert_eq!((x.axis, x.quantity), (TranslationAxis::XT, GroundQuantity::Acceleration));
+    assert_eq!(
+        (x.axis, x.quantity),
+        (TranslationAxis::XT, GroundQuantity::Acceleration)
+    );
     assert_eq!(x.data[..2], [2e-8, -2e-8]);
 }
 

@@ -109,7 +109,11 @@ fn asd_columns(report: &BudgetReport) -> Vec<(String, String, Vec<f64>)> {
         let unit = asd_unit(o.unit());
         let o = o.name();
         let term = band.term.name();
-        columns.push((format!("{o}.{term}.median"), unit.clone(), sqrt(&band.median)));
+        columns.push((
+            format!("{o}.{term}.median"),
+            unit.clone(),
+            sqrt(&band.median),
+        ));
         let lower = format!("{o}.{term}.p{}", format_f64(band.lower_pct));
         columns.push((lower, unit.clone(), sqrt(&band.lower)));
         let upper = format!("{o}.{term}.p{}", format_f64(band.upper_pct));

@@ -10,8 +10,8 @@ use crate::cli::Run;
 use anyhow::{anyhow, bail, Result};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::{Num, Shown};
-use tiltnoise_core::limits::GAINS;
 use tiltnoise_core::input::GroundMap;
+use tiltnoise_core::limits::GAINS;
 use tiltnoise_core::model::{Input, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
@@ -43,7 +43,11 @@ fn parse_gains(items: &[String], inputs: &[Input]) -> Result<Vec<f64>> {
                 anyhow!(
                     "--drive-gain {shown}: the record has no input `{}`; it has {}",
                     Shown(name.trim()),
-                    inputs.iter().map(|a| a.name()).collect::<Vec<_>>().join(", ")
+                    inputs
+                        .iter()
+                        .map(|a| a.name())
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 )
             })?;
         let g: f64 = value

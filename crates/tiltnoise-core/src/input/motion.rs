@@ -293,6 +293,13 @@ impl GroundMap {
                     block[a * n + c.target] += add;
                 }
             }
+            // A corrected channel's PSD is a difference of nearly equal terms where the sensor
+            // read mostly the other motion: rounding may leave it at -eps times those terms,
+            // which is no power. Clip it (a NaN stays NaN for the finiteness check).
+            for c in &self.corrections {
+                let s = &mut block[c.target * n + c.target];
+                *s = Complex64::new(if s.re < 0.0 { 0.0 } else { s.re }, 0.0);
+            }
         }
         (freqs_hz, csd)
     }

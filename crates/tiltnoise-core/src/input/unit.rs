@@ -435,7 +435,11 @@ mod tests {
         let mut line: Vec<f64> = (0..100).map(|k| 2.0 + 0.5 * k as f64).collect();
         line[17] = f64::NAN;
         line[40] = f64::INFINITY;
-        assert!(DetrendedRms::of(&line) < 1e-12, "{}", DetrendedRms::of(&line));
+        assert!(
+            DetrendedRms::of(&line) < 1e-12,
+            "{}",
+            DetrendedRms::of(&line)
+        );
     }
 
     #[test]

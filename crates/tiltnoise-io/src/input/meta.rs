@@ -11,8 +11,6 @@ pub(crate) const ASD_UNITS: &str = "rad/sqrt(Hz) (angle) or rad/s/sqrt(Hz) (rate
 /// Accepted unit strings of CSD datasets, for messages.
 pub(crate) const CSD_UNITS: &str = "rad^2/Hz (angle) or rad^2/s^2/Hz (rate)";
 
-
-
 /// What the unit string of a spectrum says: its quantity (the spectra are read in SI).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct SpectrumUnit {

@@ -56,7 +56,12 @@ pub(crate) fn read(
         times.push(t);
         resolution.push(decimal_resolution(fields[0]));
         lines.push(line);
-        for ((m, out), p) in resolved.channels.iter().zip(data.iter_mut()).zip(&plan.channels) {
+        for ((m, out), p) in resolved
+            .channels
+            .iter()
+            .zip(data.iter_mut())
+            .zip(&plan.channels)
+        {
             let (factor, unit) = (p.factor, p.unit());
             let text = fields[m.index + 1];
             let raw = match parse_field(text) {
@@ -110,7 +115,12 @@ pub(crate) fn read(
         notes.push(format!("time_s starts at {} s", times[0]));
     }
 
-    for ((m, ch), p) in resolved.channels.iter().zip(data.iter_mut()).zip(&plan.channels) {
+    for ((m, ch), p) in resolved
+        .channels
+        .iter()
+        .zip(data.iter_mut())
+        .zip(&plan.channels)
+    {
         let ctx = ChannelCtx {
             path: &path,
             channel: &m.source,

@@ -6,7 +6,7 @@
 //! whose unit nobody states is checked against [`unstated_rms_bound`]).
 
 use super::meta::{decide_quantity, Declared};
-use super::{check_sensors, channel_motions, motion_of, scale_for, scale_note};
+use super::{channel_motions, check_sensors, motion_of, scale_for, scale_note};
 use super::{ChannelUnit, GroundChannel, InputError, Motion, ParsedUnit, Quantity, ReadOptions};
 use super::{Resolved, Sensors, TranslationChannel, Unit};
 use std::path::Path;
@@ -97,7 +97,10 @@ pub(crate) fn merge_given(
         };
         from_file[i] = Some(match from_file[i].take() {
             None => mine,
-            Some(s) if s.counts => Stated { counts: true, ..mine },
+            Some(s) if s.counts => Stated {
+                counts: true,
+                ..mine
+            },
             Some(s) if s.assumed => {
                 if s.unit() != Some(g.unit) {
                     notes.push(format!(
@@ -310,7 +313,11 @@ pub(crate) fn plan(
 fn sensors(path: &Path, resolved: &Resolved, opts: &ReadOptions) -> Result<Sensors, InputError> {
     let mut sensors = Sensors::default();
     for (names, motion, what) in [
-        (&opts.pendulum, Motion::Rotation, "read by a pendulum tiltmeter"),
+        (
+            &opts.pendulum,
+            Motion::Rotation,
+            "read by a pendulum tiltmeter",
+        ),
         (&opts.corrected, Motion::Translation, "corrected"),
     ] {
         for name in names {
@@ -321,7 +328,11 @@ fn sensors(path: &Path, resolved: &Resolved, opts: &ReadOptions) -> Result<Senso
                 message,
             };
             let Some(m) = m else {
-                let mapped: Vec<&str> = resolved.channels.iter().map(|m| m.source.as_str()).collect();
+                let mapped: Vec<&str> = resolved
+                    .channels
+                    .iter()
+                    .map(|m| m.source.as_str())
+                    .collect();
                 return Err(refuse(format!(
                     "is declared {what}, but is not a channel the record reads; allowed: one of \
                      {}",
@@ -391,7 +402,13 @@ pub(crate) fn check_unstated_data(
     if !planned.unstated {
         return Ok(());
     }
-    check_unstated(path, channel, planned, DetrendedRms::of(data), sample_rate_hz)
+    check_unstated(
+        path,
+        channel,
+        planned,
+        DetrendedRms::of(data),
+        sample_rate_hz,
+    )
 }
 
 /// The units of the record's channels for the provenance: `theta_t: rad/s, x_t: m/s^2`.
@@ -401,7 +418,10 @@ pub(crate) fn units_note(plan: &Plan) -> String {
         .iter()
         .map(|p| format!("{}: {}", p.channel.input.name(), p.unit()))
         .collect();
-    format!("channel units (after any prefix and scale): {}", items.join(", "))
+    format!(
+        "channel units (after any prefix and scale): {}",
+        items.join(", ")
+    )
 }
 
 /// The series of the planned channels' `data` (one per planned channel, in SI, signed): tilt

@@ -232,7 +232,11 @@ pub(crate) fn read(
             Complex64::new(0.0, 0.0)
         }
     });
-    let axes: Vec<_> = resolved.channels.iter().filter_map(|c| c.tilt_axis()).collect();
+    let axes: Vec<_> = resolved
+        .channels
+        .iter()
+        .filter_map(|c| c.tilt_axis())
+        .collect();
     check_csd_finite(path, &freqs, &axes, &csd)?;
     Ok(TiltSpectra {
         freqs_hz: freqs,

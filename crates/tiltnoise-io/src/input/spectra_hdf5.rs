@@ -2,7 +2,9 @@
 //! `[n, n_axes]` or `/csd` `[n, n_axes, n_axes]` (complex), root attribute `axes`.
 
 use super::h5::{self, h5err, AttrValue};
-use super::meta::{asd_unit, csd_unit, decide_quantity, Declared, SpectrumUnit, ASD_UNITS, CSD_UNITS};
+use super::meta::{
+    asd_unit, csd_unit, decide_quantity, Declared, SpectrumUnit, ASD_UNITS, CSD_UNITS,
+};
 use super::{assemble, check_csd_finite, TiltSpectra, CSD_RTOL};
 use super::{frequency_refusal, require_two, InputError};
 use super::{InputFormat, InputKind, Provenance, Quantity, ReadOptions, ACCEPTED_LAYOUTS};
@@ -158,7 +160,11 @@ pub(crate) fn read(
     let csd = assemble(&freqs, &resolved.channels, quantity, |k, a, b| {
         src[(k * m + a) * m + b]
     });
-    let axes: Vec<_> = resolved.channels.iter().filter_map(|c| c.tilt_axis()).collect();
+    let axes: Vec<_> = resolved
+        .channels
+        .iter()
+        .filter_map(|c| c.tilt_axis())
+        .collect();
     check_csd_finite(path, &freqs, &axes, &csd)?;
     Ok(TiltSpectra {
         freqs_hz: freqs,
