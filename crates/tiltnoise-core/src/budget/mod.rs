@@ -31,7 +31,7 @@ use crate::noise::{
     BudgetReport, GroundCsd, Readout, SegmentBand, SpectralSource, TermKind, UserTerm,
     UserTermError,
 };
-use crate::spectral::{Averaging, SpectralError, WelchAccumulator, WelchConfig};
+use crate::spectral::{Averaging, CrossSpectra, SpectralError, WelchAccumulator, WelchConfig};
 use crate::tf::{self, Request, TransferMatrix};
 
 /// Samples per channel read from the input at a time: 2^18 samples x 3 channels x 8 bytes
@@ -228,7 +228,15 @@ pub fn budget_from_series(
     let n_ax = channels.len();
     check_kept_memory(&cfg, n, n_ax, segment_samples, opts.outputs.len())?;
     let mut whole = WelchAccumulator::new(n_ax, fs, &cfg)?;
+    // One accumulator and one matrix buffer for every segment, emptied and reused: a month of
+    // hourly segments of six channels would otherwise map and clear 5 MB twice an hour.
     let mut current: Option<WelchAccumulator> = None;
+    let mut segment_spectra = CrossSpectra {
+        freqs_hz: Vec::new(),
+        n_channels: n_ax,
+        data: Vec::new(),
+        n_segments: 0,
+    };
     let mut in_segment = 0usize;
     let mut tf_cache: Option<TransferMatrix> = None;
     let mut segment_tilt: Vec<Vec<Vec<f32>>> = vec![Vec::new(); opts.outputs.len()];
@@ -252,11 +260,13 @@ pub fn budget_from_series(
                 in_segment += take;
                 offset += take;
                 if in_segment == seg {
-                    let spectra = current.take().expect("segment in progress").finish()?;
+                    acc.finish_into(&mut segment_spectra)?;
                     in_segment = 0;
-                    let (grid, csd) = map.apply(&spectra);
+                    map.apply_in_place(&mut segment_spectra);
+                    let nn = n_ax * n_ax;
+                    let (grid, csd) = (&segment_spectra.freqs_hz[1..], &segment_spectra.data[nn..]);
                     if tf_cache.is_none() {
-                        tf_cache = Some(ground_tf(model, &opts.outputs, &inputs, &grid)?);
+                        tf_cache = Some(ground_tf(model, &opts.outputs, &inputs, grid)?);
                     }
                     let tf = tf_cache.as_ref().expect("computed above");
                     // Reduce each finished segment to the PSDs of its total ground term at
@@ -265,7 +275,7 @@ pub fn budget_from_series(
                         tf,
                         &GroundCsd {
                             inputs: &inputs,
-                            csd: &csd,
+                            csd,
                         },
                         &Readout::none(),
                     );

@@ -242,29 +242,40 @@ impl GroundMap {
     /// channels, on the bins `f > 0`: `(freqs_hz, csd)` with `csd[((k - 1) n + i) n + j]`
     /// (rad^2/Hz, rad m/Hz, m^2/Hz). The DC bin is dropped for every channel.
     pub fn apply(&self, spectra: &CrossSpectra) -> (Vec<f64>, Vec<Complex64>) {
+        let nn = spectra.n_channels * spectra.n_channels;
+        let mut inputs = spectra.clone();
+        self.apply_in_place(&mut inputs);
+        (inputs.freqs_hz.split_off(1), inputs.data.split_off(nn))
+    }
+
+    /// [`GroundMap::apply`] in place: every bin `f > 0` of `spectra` becomes the inputs'; the
+    /// DC bin, which carries no displacement of a rate, is left as it was and must be skipped
+    /// (`&spectra.data[n * n..]`, `&spectra.freqs_hz[1..]`).
+    pub fn apply_in_place(&self, spectra: &mut CrossSpectra) {
         let n = spectra.n_channels;
         assert_eq!(
             n,
             self.channels.len(),
             "one spectrum per channel of the map"
         );
-        let nn = n * n;
-        let freqs_hz = spectra.freqs_hz[1..].to_vec();
-        let mut csd = spectra.data[nn..].to_vec();
         if self.is_identity() {
-            return (freqs_hz, csd);
+            return;
         }
+        let nn = n * n;
         let parts: Vec<(Complex64, i32)> = self
             .channels
             .iter()
             .map(|c| factor_parts(c.quantity))
             .collect();
         let one = Complex64::new(1.0, 0.0);
-        for (block, &f) in csd.chunks_exact_mut(nn).zip(&freqs_hz) {
+        let freqs = &spectra.freqs_hz[1..];
+        for (block, &f) in spectra.data[nn..].chunks_exact_mut(nn).zip(freqs) {
             let w2 = angle_psd_divisor(Quantity::Rate, f).expect("Welch bins above DC have f > 0");
             let w = crate::units::angular(f);
+            // The matrix is Hermitian and stays so: the upper triangle is scaled and the lower
+            // one is its conjugate (bitwise what scaling it would give).
             for i in 0..n {
-                for j in 0..n {
+                for j in i..n {
                     let (pi, ki) = parts[i];
                     let (pj, kj) = parts[j];
                     let s = &mut block[i * n + j];
@@ -278,6 +289,9 @@ impl GroundMap {
                         2 => *s /= w2,
                         3 => *s /= w2 * w,
                         _ => *s /= w2 * w2,
+                    }
+                    if j > i {
+                        block[j * n + i] = block[i * n + j].conj();
                     }
                 }
             }
@@ -301,7 +315,6 @@ impl GroundMap {
                 *s = Complex64::new(if s.re < 0.0 { 0.0 } else { s.re }, 0.0);
             }
         }
-        (freqs_hz, csd)
     }
 
     /// The channels' series turned into the inputs' displacements (rad, m), one per channel,

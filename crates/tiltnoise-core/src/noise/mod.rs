@@ -221,7 +221,8 @@ impl Readout {
 
 /// Cross-spectral matrices of the floor's inputs (tilt angles in rad, translations in m) on a
 /// frequency grid: `csd[(k * n + i) * n + j] = S_ij(f_k)`, one-sided, `S_ij = <conj(U_i) U_j>`
-/// (rad^2/Hz, rad m/Hz, m^2/Hz).
+/// (rad^2/Hz, rad m/Hz, m^2/Hz). Each matrix is Hermitian, as every estimate of one is: the
+/// budget reads its diagonal and upper triangle.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GroundCsd<'a> {
     /// Input order of the matrix: tilt axes and translations, each once.
@@ -257,9 +258,16 @@ fn propagate(
     }
     let (mut all, mut rotations, mut translations) = (0.0, 0.0, 0.0);
     let mut per_input = [0.0; 6];
+    // S is Hermitian: each pair (i, j), i < j, adds 2 Re(conj(H_oi) S_ij H_oj) with (j, i).
     for i in 0..n {
-        for j in 0..n {
-            let term = (h[i].conj() * s[i * n + j] * h[j]).re;
+        per_input[i] = h[i].norm_sqr() * s[i * n + i].re;
+        let row = h[i].conj();
+        for j in i..n {
+            let term = if j == i {
+                per_input[i]
+            } else {
+                2.0 * (row * s[i * n + j] * h[j]).re
+            };
             all += term;
             match (is_rotation[i], is_rotation[j]) {
                 (true, true) => rotations += term,
@@ -267,7 +275,6 @@ fn propagate(
                 _ => {}
             }
         }
-        per_input[i] = h[i].norm_sqr() * s[i * n + i].re;
     }
     // A positive semi-definite S gives sums >= 0; rounding can leave -eps * scale. A NaN (from
     // an overflow) stays NaN for the budget's finiteness check: `f64::max` would make it 0.
