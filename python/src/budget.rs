@@ -19,7 +19,7 @@ use tiltnoise_core::freq;
 use tiltnoise_core::ground::GroundQuantity;
 use tiltnoise_core::input::{
     check_sensors, ground_index, ground_inputs, motion_of, parse_scales, parse_units,
-    process_channel, unstated_rms_bound, ChannelCtx, DetrendedRms, GapPolicy, GroundChannel,
+    process_channel, unstated_excess, ChannelCtx, DetrendedRms, GapPolicy, GroundChannel,
     InputError, InputMeta, Motion, Quantity, Sensors, SeriesSource,
 };
 use tiltnoise_core::model::{Input, Model, Observable};
@@ -420,13 +420,11 @@ fn describe_arrays(
 /// Refuses a tilt array whose unit is not given and whose detrended RMS exceeds what a
 /// laboratory floor reaches, naming the likely unit.
 fn check_unstated_array(name: &str, quantity: Quantity, data: &[f64], fs: f64) -> PyResult<()> {
-    let rms = DetrendedRms::of(data);
-    let bound = unstated_rms_bound(quantity, fs);
-    if !(rms > bound) {
+    let Some(excess) = unstated_excess(DetrendedRms::of(data), quantity, fs) else {
         return Ok(());
-    }
-    let likely = tiltnoise_core::input::likely_units(rms, quantity, fs);
-    let first = likely
+    };
+    let first = excess
+        .likely
         .first()
         .cloned()
         .unwrap_or_else(|| "nrad".to_string());
@@ -435,14 +433,14 @@ fn check_unstated_array(name: &str, quantity: Quantity, data: &[f64], fs: f64) -
          the {} {} no laboratory floor reaches; its values are likely in {}: give its unit, \
          e.g. units={{\"{name}\": \"{first}\"}}",
         quantity.unit(),
-        Num(rms),
+        Num(excess.rms),
         quantity.unit(),
-        Num(bound),
+        Num(excess.bound),
         quantity.unit(),
-        if likely.is_empty() {
+        if excess.likely.is_empty() {
             "a smaller unit".to_string()
         } else {
-            likely.join(" or ")
+            excess.likely.join(" or ")
         }
     )))
 }

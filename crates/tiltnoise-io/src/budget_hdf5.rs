@@ -112,8 +112,8 @@ fn write_file(
             .map(|i| i.name())
             .collect()
     };
-    strs_attr(&file, "tilt_axes", &named(false))?;
-    strs_attr(&file, "translation_axes", &named(true))?;
+    strs_attr(&file, "tilt_axes", named(false))?;
+    strs_attr(&file, "translation_axes", named(true))?;
     let observables: Vec<&str> = report
         .budget
         .observables

@@ -78,9 +78,9 @@ pub use series::{
 pub use source::SeriesSource;
 pub use spectra::{assemble, check_csd_finite, frequency_refusal, TiltSpectra, CSD_RTOL};
 pub use unit::{
-    likely_units, normalize_unit, parse_unit, parse_units, si_unit, unstated_rms_bound,
-    ChannelUnit, DetrendedRms, Motion, ParsedUnit, Unit, PHYSICAL_UNITS, UNITS_ALLOWED,
-    UNSTATED_ANGLE_RMS_MAX_RAD,
+    likely_units, normalize_unit, parse_unit, parse_units, si_unit, unstated_excess,
+    unstated_rms_bound, ChannelUnit, DetrendedRms, Motion, ParsedUnit, Unit, UnstatedExcess,
+    PHYSICAL_UNITS, UNITS_ALLOWED, UNSTATED_ANGLE_RMS_MAX_RAD,
 };
 
 use crate::error::Shown;

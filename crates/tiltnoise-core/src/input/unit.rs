@@ -275,6 +275,35 @@ pub fn unstated_rms_bound(quantity: Quantity, sample_rate_hz: f64) -> f64 {
     }
 }
 
+/// What is wrong with a series whose unit nobody states and whose detrended RMS exceeds
+/// [`unstated_rms_bound`]: the numbers each front end's message names.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UnstatedExcess {
+    /// The detrended RMS, read in the SI unit of the quantity.
+    pub rms: f64,
+    /// The bound it exceeds.
+    pub bound: f64,
+    /// The likely units, most likely first ([`likely_units`]); empty when even nrad is too
+    /// large.
+    pub likely: Vec<String>,
+}
+
+/// The excess of a series of `quantity` sampled at `sample_rate_hz` whose detrended RMS is
+/// `rms` and whose unit nobody states, or `None` when it is within [`unstated_rms_bound`] (a
+/// NaN RMS, of a series without finite samples, exceeds nothing).
+pub fn unstated_excess(
+    rms: f64,
+    quantity: Quantity,
+    sample_rate_hz: f64,
+) -> Option<UnstatedExcess> {
+    let bound = unstated_rms_bound(quantity, sample_rate_hz);
+    (rms.partial_cmp(&bound) == Some(std::cmp::Ordering::Greater)).then(|| UnstatedExcess {
+        rms,
+        bound,
+        likely: likely_units(rms, quantity, sample_rate_hz),
+    })
+}
+
 /// The prefixed units (`urad`, `nrad`, or their rates) that would bring a detrended RMS of
 /// `rms` (read as SI) under [`unstated_rms_bound`], most likely first: what the message of a
 /// refused series suggests.
@@ -453,5 +482,10 @@ mod tests {
             likely_units(50.0, Quantity::Rate, 1.0),
             ["urad/s", "nrad/s"]
         );
+        assert_eq!(unstated_excess(1e-2, Quantity::Angle, 10.0), None);
+        assert_eq!(unstated_excess(f64::NAN, Quantity::Angle, 10.0), None);
+        let e = unstated_excess(3.0, Quantity::Angle, 10.0).unwrap();
+        assert_eq!((e.rms, e.bound), (3.0, 1e-2));
+        assert_eq!(e.likely, ["urad", "nrad"]);
     }
 }

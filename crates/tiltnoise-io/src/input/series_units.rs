@@ -3,7 +3,7 @@
 //! give (`ReadOptions::units`), what each unit says the channel measures (so that the default
 //! axis map tells rotation from translation), and, once the channels are mapped, the plan of
 //! each: its quantity, the factor into SI, and whether its unit was stated at all (a series
-//! whose unit nobody states is checked against [`unstated_rms_bound`]).
+//! whose unit nobody states is checked against [`tiltnoise_core::input::unstated_rms_bound`]).
 
 use super::meta::{decide_quantity, Declared};
 use super::{channel_motions, check_sensors, motion_of, scale_for, scale_note};
@@ -12,7 +12,7 @@ use super::{Resolved, Sensors, TranslationChannel, Unit};
 use std::path::Path;
 use tiltnoise_core::error::{shown_list, Shown};
 use tiltnoise_core::ground::GroundQuantity;
-use tiltnoise_core::input::{likely_units, unstated_rms_bound, DetrendedRms, UNITS_ALLOWED};
+use tiltnoise_core::input::{unstated_excess, DetrendedRms, UNITS_ALLOWED};
 use tiltnoise_core::model::Input;
 
 /// A channel's unit as stated, and where.
@@ -151,7 +151,7 @@ pub(crate) struct Planned {
     /// Multiplies the values as stored into SI (unit prefix times scale), before the sign.
     pub factor: f64,
     /// Nobody states its unit (a tilt channel taken in rad or rad/s): checked against
-    /// [`unstated_rms_bound`] once read.
+    /// [`tiltnoise_core::input::unstated_rms_bound`] once read.
     pub unstated: bool,
 }
 
@@ -359,7 +359,7 @@ fn sensors(path: &Path, resolved: &Resolved, opts: &ReadOptions) -> Result<Senso
 }
 
 /// Refuses a channel whose unit nobody states (`planned.unstated`) and whose detrended RMS
-/// (`rms`, in the SI unit it is taken in) exceeds [`unstated_rms_bound`] at `sample_rate_hz`:
+/// (`rms`, in the SI unit it is taken in) exceeds [`tiltnoise_core::input::unstated_rms_bound`] at `sample_rate_hz`:
 /// its values are most likely in urad or nrad.
 pub(crate) fn check_unstated(
     path: &Path,
@@ -372,21 +372,22 @@ pub(crate) fn check_unstated(
         GroundQuantity::Displacement => Quantity::Angle,
         _ => Quantity::Rate,
     };
-    let bound = unstated_rms_bound(quantity, sample_rate_hz);
-    if !planned.unstated || !(rms > bound) {
+    if !planned.unstated {
         return Ok(());
     }
-    let likely = likely_units(rms, quantity, sample_rate_hz);
+    let Some(excess) = unstated_excess(rms, quantity, sample_rate_hz) else {
+        return Ok(());
+    };
     Err(InputError::UnstatedUnit {
         path: path.to_path_buf(),
         channel: channel.to_string(),
         rms,
         quantity,
-        bound,
-        likely: if likely.is_empty() {
+        bound: excess.bound,
+        likely: if excess.likely.is_empty() {
             format!("a unit smaller than n{}", quantity.unit())
         } else {
-            likely.join(" or ")
+            excess.likely.join(" or ")
         },
     })
 }
