@@ -1,6 +1,7 @@
 //! The `tiltnoise` binary: parse, run, map errors to exit code 2 with a one-line message.
 
 mod cli;
+mod interrupt;
 
 use clap::error::ErrorKind;
 use clap::{CommandFactory, FromArgMatches};
@@ -11,9 +12,9 @@ use tiltnoise_core::error::shown_within;
 const MAX_ERROR_CHARS: usize = 2000;
 
 fn main() -> ExitCode {
-    // First, before any thread exists: SIGINT and SIGTERM remove the temporary files of the
+    // First: SIGINT, SIGTERM and SIGHUP cancel the run, remove the temporary files of the
     // outputs being written, print one line and end the process with exit code 2.
-    tiltnoise_io::remove_temporaries_on_interrupt();
+    let cancel = interrupt::install();
     // `--version` names the HDF5 library linked in (bundled, static).
     let version = format!(
         "{} (HDF5 {}, static)",
@@ -28,8 +29,9 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => return clap_exit(&e),
     };
-    match cli::run(cli) {
+    match cli::run(cli, cancel.clone()) {
         Ok(()) => ExitCode::SUCCESS,
+        Err(_) if cancel.is_cancelled() => interrupt::wait_for_the_handler(),
         // The reader of standard output has gone (`tiltnoise tf | head -1`): nothing to say.
         Err(e) if cli::is_closed_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => fail(&format!("{e:#}")),

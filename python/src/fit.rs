@@ -39,6 +39,7 @@ pub fn run(
         free: free.unwrap_or_else(|| FitConfig::default().free),
         bound_sigmas,
         prior,
+        ..FitConfig::default()
     };
     let result = py
         .detach(|| fit::fit(params, &measured, &config))

@@ -33,6 +33,7 @@ pub fn frequencies(arg: &Bound<'_, PyAny>, size: Size) -> PyResult<Vec<f64>> {
 
 /// [`frequencies`] into `freqs` (cleared first, its allocation kept), and their
 /// [`auto_band`] (found while a contiguous float64 array is copied, in the same pass).
+#[allow(unsafe_code, reason = "a NumPy array's values read in place")]
 fn frequencies_into(
     arg: &Bound<'_, PyAny>,
     size: Size,
@@ -70,6 +71,7 @@ pub fn auto_band(freqs: &[f64]) -> (f64, f64) {
 }
 
 /// `src` copied into `dst` (emptied first), and its [`auto_band`], in one pass.
+#[allow(unsafe_code, reason = "calls the AVX build after detecting AVX")]
 fn copy_with_band(src: &[f64], dst: &mut Vec<f64>) -> (f64, f64) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx") {
@@ -80,8 +82,16 @@ fn copy_with_band(src: &[f64], dst: &mut Vec<f64>) -> (f64, f64) {
 }
 
 /// [`copy_with_band_lanes`] compiled for AVX: four lanes per instruction instead of two.
+///
+/// # Safety
+///
+/// The running CPU must support AVX (`is_x86_feature_detected!("avx")`).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx")]
+#[allow(
+    unsafe_code,
+    reason = "target_feature functions are unsafe before Rust 1.86"
+)]
 unsafe fn copy_with_band_avx(src: &[f64], dst: &mut Vec<f64>) -> (f64, f64) {
     copy_with_band_lanes(src, dst)
 }

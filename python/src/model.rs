@@ -357,6 +357,7 @@ impl PyModel {
     /// negative or not finite, or one on an undamped resonance.
     #[pyo3(signature = (freq_hz, inputs=None, outputs=None, method="auto", rel_tol=1e-9, threads=None, out=None))]
     #[allow(clippy::too_many_arguments)]
+    #[allow(unsafe_code, reason = "a new NumPy array filled in place")]
     fn transfer<'py>(
         &self,
         py: Python<'py>,

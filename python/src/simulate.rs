@@ -121,6 +121,7 @@ pub fn run(
         duration_s: args.duration,
         readout_asd: readout.clone(),
         seed: args.seed,
+        ..SimConfig::default()
     };
     let wcfg = WelchConfig::new(nperseg);
     let (sim, asd, check, modes) = py.detach(|| -> PyResult<_> {

@@ -5,6 +5,7 @@ use super::args::{AverageArg, ChannelArgs, Format};
 use super::budget_terms::{parse_observables, parse_readout, parse_terms};
 use super::figure_args::FigureArgs;
 use super::output::save_budget;
+use super::witness_noise::parse_witness_noise;
 use super::Run;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
@@ -84,6 +85,11 @@ pub struct BudgetArgs {
     /// Added in quadrature to the total as `user.NAME`.
     #[arg(long, value_name = "NAME=SOURCE:FILE", allow_hyphen_values = true)]
     pub term: Vec<String>,
+    /// Own noise of the tiltmeter that recorded a tilt axis, `AXIS=ASD|FILE[:REL]` (repeatable;
+    /// as for `subtract`): shown through the model as `witness_noise` beside the tilt term,
+    /// which already contains it; not added to the total.
+    #[arg(long, value_name = "AXIS=ASD|FILE[:REL]", allow_hyphen_values = true)]
+    pub witness_noise: Vec<String>,
     /// Model grid for spectra input, FLO:N:FHI (default 1e-4:2000:30 plus resonance points);
     /// restricted to the band the data cover.
     #[arg(long, value_name = "FLO:N:FHI", allow_hyphen_values = true)]
@@ -238,11 +244,17 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     };
     let (readout, readout_files) = parse_readout(&args.readout, &outputs)?;
     let (user_terms, term_files) = parse_terms(&args.term, &outputs)?;
+    let (witness_noise, witness_files) = parse_witness_noise(&args.witness_noise)?;
     let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
     let mut inputs = vec![("--tilt", args.tilt.as_path())];
     inputs.extend(args.measured.as_deref().map(|p| ("--measured", p)));
     inputs.extend(readout_files.iter().map(|p| ("--readout", p.as_path())));
     inputs.extend(term_files.iter().map(|p| ("--term", p.as_path())));
+    inputs.extend(
+        witness_files
+            .iter()
+            .map(|p| ("--witness-noise", p.as_path())),
+    );
     run.check_outputs(&saves, &inputs)?;
     let model = Model::new(params)?;
     if args.percentiles.is_some() && args.segment_duration.is_none() {
@@ -266,11 +278,13 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
         outputs,
         readout,
         user_terms,
+        witness_noise,
         spectra_grid_hz: match &args.freq {
             Some(spec) => freq::parse_spec(spec)?,
             None => freq::default_grid(&model),
         },
         summary: summary_request(&args)?,
+        cancel: run.cancel.clone(),
     };
     let ropts = read_options(&args)?;
     let path = &args.tilt;
@@ -307,6 +321,22 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
         }
     };
     let mut report = report.with_context(|| format!("budget of {}", path.display()))?;
+    for x in &opts.witness_noise {
+        if !report.inputs.contains(&x.input) {
+            bail!(
+                "--witness-noise {}: the record {} has no input {}; it has {}",
+                x.input.name(),
+                path.display(),
+                x.input.name(),
+                report
+                    .inputs
+                    .iter()
+                    .map(|a| a.name())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+        }
+    }
     if let Some(measured) = &args.measured {
         add_measured_file(&mut report, measured)?;
     }

@@ -34,7 +34,12 @@ fn asd_unit(unit: &str) -> &'static str {
 
 /// Reads the ASD of `quantity` (SI unit `unit`) from `path` for the option `option` (e.g.
 /// `--readout phi=r.csv`), which names it in messages.
-fn read_given(option: &str, path: &Path, quantity: &str, unit: &str) -> Result<GivenAsd> {
+pub(crate) fn read_given(
+    option: &str,
+    path: &Path,
+    quantity: &str,
+    unit: &str,
+) -> Result<GivenAsd> {
     let column =
         read_asd_column(path, quantity, asd_unit(unit)).with_context(|| option.to_string())?;
     let origin = format!("{option} (column {})", column.column);

@@ -20,7 +20,8 @@ use tiltnoise_core::model::{Model, Observable, TiltAxis};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
 use tiltnoise_io::input::{
-    read_measured_input, read_start_time, read_tilt_series, MeasuredInput, Quantity,
+    parse_start_time, read_measured_input, read_start_time, read_tilt_series, MeasuredInput,
+    Quantity,
 };
 use tiltnoise_io::{CoherenceInputs, InputMeta, OutputKind, RunMeta};
 
@@ -149,6 +150,7 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
         confidence: args.confidence.unwrap_or(0.95),
         fit_band_hz: args.fit_band.as_deref().map(parse_fit_band).transpose()?,
         tilt_quantity: Quantity::Angle,
+        cancel: run.cancel.clone(),
     };
     let model = Model::new(params)?;
     let ropts = tilt_read_options(
@@ -176,7 +178,11 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
     let tilt_record = Record {
         name: &tilt_name,
         sample_rate_hz: tilt.sample_rate_hz,
-        start_time: tilt.provenance.start_time.as_deref(),
+        start_time: tilt
+            .provenance
+            .start_time
+            .as_deref()
+            .and_then(parse_start_time),
         channels: tilt
             .axes
             .iter()
@@ -187,7 +193,7 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
     let measured_record = Record {
         name: &measured_name,
         sample_rate_hz: measured.sample_rate_hz,
-        start_time: measured_start.as_deref(),
+        start_time: measured_start.as_deref().and_then(parse_start_time),
         channels: select_outputs(&args, &measured.channels)?,
     };
     let report = coherence_from_series(&model, &tilt_record, &measured_record, &opts)?;

@@ -73,6 +73,7 @@ pub(crate) fn run_fit(params: &Params, args: FitArgs, run: &mut Run) -> Result<(
             .unwrap_or_else(|| FitConfig::default().free),
         bound_sigmas: args.bound_sigmas,
         prior: args.prior,
+        cancel: run.cancel.clone(),
     };
     let result = fit::fit(params, &measured, &config)?;
     let json = fit_json(&result, &measured.origin);

@@ -74,6 +74,7 @@ pub(crate) fn run_mc(params: &Params, opts: McOptions, run: &mut Run) -> Result<
         samples: opts.samples,
         seed: opts.seed,
         threads: opts.threads,
+        cancel: run.cancel.clone(),
         ..McConfig::default_for(params)
     };
     let bar = (std::io::stderr().is_terminal() && opts.samples >= 10_000)

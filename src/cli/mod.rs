@@ -19,6 +19,7 @@ mod simulate;
 mod stdout;
 mod subtract;
 mod tf;
+mod witness_noise;
 
 pub use stdout::{is_closed_pipe, note, Out};
 
@@ -26,6 +27,7 @@ use anyhow::Result;
 use args::Format;
 use clap::{Args, Parser, Subcommand};
 use std::path::{Path, PathBuf};
+use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::model::Model;
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
@@ -135,6 +137,8 @@ pub(crate) struct Run {
     /// Standard output.
     pub(crate) out: Out,
     params_file: Option<PathBuf>,
+    /// Set by the interrupt handler; the computations poll it.
+    pub(crate) cancel: Cancel,
 }
 
 impl Run {
@@ -174,10 +178,11 @@ impl Run {
 
 /// Runs the parsed command line. Everything printed is flushed before it returns; when the
 /// command fails, what it printed before is still flushed (its failure is not reported).
-pub fn run(cli: Cli) -> Result<()> {
+pub fn run(cli: Cli, cancel: Cancel) -> Result<()> {
     let mut run = Run {
         out: Out::stdout(),
         params_file: cli.params.params.clone(),
+        cancel,
     };
     let result = run_command(cli, &mut run);
     let flushed = run.out.flush();

@@ -305,6 +305,7 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
         duration_s: args.duration,
         readout_asd: readout.clone(),
         seed: args.seed,
+        cancel: run.cancel.clone(),
     };
     let mut motion = FreeMotion::new(&model, &init, &cfg, args.with_coordinates)?;
     let dt_s = motion.dt_s();
@@ -358,7 +359,10 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
         b
     });
     let mut chunk = SimChunk::default();
-    while motion.next_chunk(chunk_samples, &mut chunk) {
+    while {
+        cfg.cancel.check()?;
+        motion.next_chunk(chunk_samples, &mut chunk)
+    } {
         for w in &mut writers {
             w.append(&chunk)?;
         }

@@ -7,24 +7,26 @@
 use super::args::{parse_readout_item, Format};
 use super::figure_args::FigureArgs;
 use super::output::save_image;
+use super::witness_noise::{is_floor_input, parse_witness_noise};
 use super::Run;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 use tiltnoise_core::error::{Num, OutputError, Shown};
-use tiltnoise_core::limits::ASDS;
-use tiltnoise_core::model::{Observable, TiltAxis};
+use tiltnoise_core::model::{Input, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::options;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::repeats::{refuse_repeated_keys, refuse_repeats};
 use tiltnoise_core::subtract::{
-    subtract, MeasuredRecord, StartTime, Status, SubtractConfig, SubtractResult, TiltRecord,
+    subtract, MeasuredRecord, Method, NoiseLevel, StartTime, Status, SubtractConfig,
+    SubtractResult, WitnessNoise, WitnessRecord,
 };
 use tiltnoise_io::input::{
-    iso8601_to_unix, read_measured_input, read_tilt, unix_to_iso8601, MeasuredInput, ReadOptions,
+    parse_start_time, read_measured_input, read_tilt, utc_text, MeasuredInput, ReadOptions,
     TiltInput,
 };
 use tiltnoise_io::{write_atomic, write_subtract_hdf5, InputMeta, RunMeta, SubtractMeta};
@@ -86,10 +88,28 @@ pub(crate) struct SubtractArgs {
     /// Largest delay between the records to search (s); default 5 % of a Welch segment.
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     max_delay: Option<f64>,
-    /// White noise of the tilt record AXIS=ASD in rad/sqrt(Hz) (repeatable): removes the
-    /// bias its noise puts on the fitted gains (errors in variables).
-    #[arg(long, value_name = "AXIS=ASD", allow_hyphen_values = true)]
-    tilt_noise: Vec<String>,
+    /// Own noise of the witness instrument of a floor input, `INPUT=ASD|FILE[:REL]`
+    /// (repeatable): the ASD in the input's unit/sqrt(Hz), white or an ASD file (as for
+    /// --readout), REL its relative uncertainty (1 sigma, e.g. :0.1). The fit then models the
+    /// witness noise (no errors-in-variables bias) and the prediction is weighted down where
+    /// the witness records mostly its own noise. Also accepted as --tilt-noise.
+    #[arg(
+        long,
+        alias = "tilt-noise",
+        value_name = "INPUT=ASD|FILE[:REL]",
+        allow_hyphen_values = true
+    )]
+    witness_noise: Vec<String>,
+    /// A record of a second (or, repeated, a third) instrument beside the witness, recording
+    /// the same inputs, read as --tilt (same --axes, --quantity, --gaps, --scale): the
+    /// witness's noise is then estimated from them (two: a huddle test; three: a
+    /// three-cornered hat) for every input they record.
+    #[arg(long, value_name = "FILE")]
+    colocated: Vec<PathBuf>,
+    /// Huddle test: the co-located instrument's noise ASD over the witness's, INPUT=R
+    /// (repeatable; default 1, equal noise).
+    #[arg(long, value_name = "INPUT=R", allow_hyphen_values = true)]
+    colocated_ratio: Vec<String>,
     /// White readout of a measured observable OBS=ASD in unit/sqrt(Hz) (repeatable): drawn,
     /// and the cleaned residual is compared with it.
     #[arg(long, value_name = "OBS=ASD", allow_hyphen_values = true)]
@@ -155,36 +175,40 @@ fn fit_keys(specs: &[String]) -> Result<Vec<String>> {
     Ok(keys.into_iter().map(str::to_string).collect())
 }
 
-fn parse_tilt_noise(items: &[String]) -> Result<Vec<(TiltAxis, f64)>> {
-    let mut out: Vec<(TiltAxis, f64)> = Vec::new();
-    refuse_repeated_keys("--tilt-noise", "axis", items)?;
+/// `--colocated-ratio INPUT=R`, each input once.
+fn parse_colocated_ratio(items: &[String]) -> Result<Vec<(Input, f64)>> {
+    let mut out: Vec<(Input, f64)> = Vec::new();
     for item in items {
         let shown = Shown(item);
-        let (name, value) = item
-            .split_once('=')
-            .ok_or_else(|| anyhow!("--tilt-noise {shown}: expected AXIS=ASD, e.g. eta_t=1e-9"))?;
-        let axis = TiltAxis::ALL
-            .into_iter()
-            .find(|a| a.name() == name.trim())
+        let (name, value) = item.split_once('=').ok_or_else(|| {
+            anyhow!("--colocated-ratio {shown}: expected INPUT=R, e.g. eta_t=1.5")
+        })?;
+        let input = Input::from_name(name.trim())
+            .filter(|&i| is_floor_input(i))
             .ok_or_else(|| {
                 anyhow!(
-                    "--tilt-noise {shown}: unknown axis `{}`; allowed: theta_t, eta_t, phi_t",
+                    "--colocated-ratio {shown}: `{}` is not a floor input of the model",
                     Shown(name)
                 )
             })?;
-        let asd: f64 = value
-            .trim()
-            .parse()
-            .map_err(|_| anyhow!("--tilt-noise {shown}: `{}` is not a number", Shown(value)))?;
-        if !ASDS.admits(asd) {
+        let r: f64 = value.trim().parse().map_err(|_| {
+            anyhow!(
+                "--colocated-ratio {shown}: `{}` is not a number",
+                Shown(value)
+            )
+        })?;
+        if !(r.is_finite() && r > 0.0) {
             bail!(
-                "--tilt-noise {shown}: ASD {} rad/sqrt(Hz) is not allowed: must be {} (see \
-                 docs/limits.md)",
-                Num(asd),
-                ASDS.allowed("rad/sqrt(Hz)")
+                "--colocated-ratio {shown}: the ratio {r} is not allowed: must be finite and > 0"
             );
         }
-        out.push((axis, asd));
+        if out.iter().any(|x| x.0 == input) {
+            bail!(
+                "--colocated-ratio {shown}: {} is given twice; give each input once",
+                input.name()
+            );
+        }
+        out.push((input, r));
     }
     Ok(out)
 }
@@ -202,8 +226,14 @@ fn start_of(path: &Path, what: &str, start: &Option<String>) -> Result<Option<St
     start
         .as_deref()
         .map(|s| {
-            iso8601_to_unix(s)
-                .map(|(unix_s, frac_s)| StartTime { unix_s, frac_s })
+            parse_start_time(s)
+                .map(|t| {
+                    let ns = t.as_nanosecond();
+                    StartTime {
+                        unix_s: ns.div_euclid(1_000_000_000) as i64,
+                        frac_s: ns.rem_euclid(1_000_000_000) as f64 * 1e-9,
+                    }
+                })
                 .ok_or_else(|| {
                     anyhow!(
                         "{what} {}: start time `{}` is not an ISO 8601 date-time",
@@ -265,10 +295,26 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
     // A figure of two rows of panels at 100 dpi, for the early check of `--dpi`.
     let view = args.figure.view_for((1800, 1360))?;
     let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
-    run.check_outputs(
-        &saves,
-        &[("--tilt", &args.tilt), ("--measured", &args.measured)],
-    )?;
+    let (witness_noise, noise_files) = parse_witness_noise(&args.witness_noise)?;
+    let mut inputs: Vec<(&str, &Path)> =
+        vec![("--tilt", &args.tilt), ("--measured", &args.measured)];
+    inputs.extend(noise_files.iter().map(|p| ("--witness-noise", p.as_path())));
+    inputs.extend(args.colocated.iter().map(|p| ("--colocated", p.as_path())));
+    run.check_outputs(&saves, &inputs)?;
+    if args.colocated.len() > 2 {
+        bail!(
+            "--colocated is given {} times: give one record (a huddle test with the witness) or \
+             two (a three-cornered hat)",
+            args.colocated.len()
+        );
+    }
+    let colocated_noise_ratio = parse_colocated_ratio(&args.colocated_ratio)?;
+    if !colocated_noise_ratio.is_empty() && args.colocated.len() != 1 {
+        bail!(
+            "--colocated-ratio applies to a huddle test: give exactly one --colocated record \
+             (a three-cornered hat needs no noise ratio)"
+        );
+    }
     refuse_repeated_keys("--readout", "observable", &args.readout)?;
     let readout = args
         .readout
@@ -285,17 +331,27 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
             .map(|b| parse_band("--band", b))
             .transpose()?,
         max_delay_s: args.max_delay,
-        witness_noise_asd: parse_tilt_noise(&args.tilt_noise)?,
+        witness_noise,
+        colocated_noise_ratio,
         readout_asd: readout,
         report_band_hz: parse_band("--report-band", &args.report_band)?,
     };
-    let series = match read_tilt(&args.tilt, &read_options(&args)?)? {
-        TiltInput::Series(s) => s.into_angle(),
-        TiltInput::Spectra(_) => bail!(
-            "--tilt {}: holds spectra; subtract needs a time series of the tilt (angle or rate)",
-            args.tilt.display()
-        ),
+    let read_series = |option: &str, path: &Path| -> Result<_> {
+        match read_tilt(path, &read_options(&args)?)? {
+            TiltInput::Series(s) => Ok(s.into_angle()),
+            TiltInput::Spectra(_) => bail!(
+                "{option} {}: holds spectra; subtract needs a time series of the tilt (angle or \
+                 rate)",
+                path.display()
+            ),
+        }
     };
+    let series = read_series("--tilt", &args.tilt)?;
+    let colocated_series = args
+        .colocated
+        .iter()
+        .map(|p| read_series("--colocated", p))
+        .collect::<Result<Vec<_>>>()?;
     let measured = match read_measured_input(&args.measured)? {
         MeasuredInput::Series(m) => m,
         MeasuredInput::Spectra(_) => bail!(
@@ -314,14 +370,36 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
             args.measured.display()
         )
     };
+    let inputs_of = |axes: &[tiltnoise_core::model::TiltAxis]| -> Vec<Input> {
+        axes.iter().map(|&a| Input::Tilt(a)).collect()
+    };
+    let witness_inputs = inputs_of(&series.axes);
+    let colocated_inputs: Vec<Vec<Input>> = colocated_series
+        .iter()
+        .map(|s| inputs_of(&s.axes))
+        .collect();
+    let colocated = colocated_series
+        .iter()
+        .zip(&args.colocated)
+        .zip(&colocated_inputs)
+        .map(|((s, path), inputs)| {
+            Ok(WitnessRecord {
+                fs_hz: s.sample_rate_hz,
+                inputs,
+                data: &s.data,
+                start: start_of(path, "--colocated", &s.provenance.start_time)?,
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
     let result = subtract(
         params,
-        &TiltRecord {
+        &WitnessRecord {
             fs_hz: series.sample_rate_hz,
-            axes: &series.axes,
+            inputs: &witness_inputs,
             data: &series.data,
             start: tilt_start,
         },
+        &colocated,
         &MeasuredRecord {
             fs_hz: measured.sample_rate_hz,
             channels: &channels,
@@ -331,11 +409,14 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
     )
     .with_context(context)?;
     check_finite(&result).with_context(context)?;
-    let overlap_start = measured_start.map(|s| {
-        let t = s.frac_s + result.alignment.measured_first as f64 / result.alignment.fs_hz;
-        let whole = t.floor();
-        unix_to_iso8601(s.unix_s + whole as i64, t - whole)
-    });
+    let skipped =
+        Duration::from_secs_f64(result.alignment.measured_first as f64 / result.alignment.fs_hz);
+    let overlap_start = measured
+        .start_time
+        .as_deref()
+        .and_then(parse_start_time)
+        .and_then(|t| t.checked_add(skipped).ok())
+        .map(utc_text);
     let input = InputMeta::from(&series.provenance);
     for note in &series.provenance.notes {
         match args.format {
@@ -343,7 +424,7 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
             Format::Table => writeln!(run.out, "input: {note}")?,
         }
     }
-    let json = report_json(&result, &args, &overlap_start);
+    let json = report_json(&result, &args, &cfg.witness_noise, &overlap_start);
     match args.format {
         Format::Json => writeln!(run.out, "{}", serde_json::to_string_pretty(&json)?)?,
         Format::Table => write!(run.out, "{}", report_table(&result))?,
@@ -436,12 +517,49 @@ fn finite(v: f64) -> Option<f64> {
 #[derive(Serialize)]
 struct ReportJson {
     alignment: AlignmentJson,
+    bands: Vec<BandCheckJson>,
     estimates: Vec<EstimateJson>,
     fit: FitJson,
     measured: String,
     notes: Vec<String>,
     residuals: Vec<ResidualJson>,
     tilt: String,
+    witness_noise: Vec<NoiseJson>,
+}
+
+#[derive(Serialize)]
+struct BandCheckJson {
+    bands: Vec<BandJson>,
+    left_raw: bool,
+    observable: &'static str,
+    unit: String,
+    variance_ratio: f64,
+}
+
+#[derive(Serialize)]
+struct BandJson {
+    band_hz: [f64; 2],
+    bins: usize,
+    cleaned_asd: f64,
+    expected_asd: f64,
+    left_raw: bool,
+    limit: f64,
+    ratio: f64,
+    raw_asd: f64,
+    sigma: f64,
+    witness_limited_asd: f64,
+}
+
+#[derive(Serialize)]
+struct NoiseJson {
+    asd: Option<f64>,
+    file: Option<String>,
+    fitted_scale: f64,
+    input: &'static str,
+    method: &'static str,
+    rel: f64,
+    relative_gains: Vec<f64>,
+    unit: String,
 }
 
 #[derive(Serialize)]
@@ -464,6 +582,7 @@ struct EstimateJson {
     lower: f64,
     name: String,
     nominal: f64,
+    prior_sigma: Option<f64>,
     scale: f64,
     sigma: Option<f64>,
     status: &'static str,
@@ -477,6 +596,7 @@ struct FitJson {
     band_hz: [f64; 2],
     bins: std::collections::BTreeMap<&'static str, usize>,
     chi2: f64,
+    coherent_top_hz: Option<f64>,
     dof: usize,
     fitted: Vec<String>,
     iterations: usize,
@@ -502,11 +622,84 @@ struct ResidualJson {
     readout_asd: Option<f64>,
     unit: String,
     wiener_asd: f64,
+    wiener_corrected_asd: f64,
+    wiener_training_excess: f64,
+    witness_limited_asd: f64,
 }
 
-fn report_json(r: &SubtractResult, args: &SubtractArgs, start: &Option<String>) -> ReportJson {
+/// The upper edge of a band as reported: the last band reaches the Nyquist frequency.
+fn band_top(hi: f64, fs_hz: f64) -> f64 {
+    hi.min(fs_hz / 2.0)
+}
+
+fn report_json(
+    r: &SubtractResult,
+    args: &SubtractArgs,
+    noise: &[WitnessNoise],
+    start: &Option<String>,
+) -> ReportJson {
     let a = &r.alignment;
+    let fs = a.fs_hz;
     ReportJson {
+        bands: r
+            .bands
+            .iter()
+            .map(|(o, c)| BandCheckJson {
+                bands: c
+                    .bands
+                    .iter()
+                    .map(|b| BandJson {
+                        band_hz: [b.lo_hz, band_top(b.hi_hz, fs)],
+                        bins: b.bins,
+                        cleaned_asd: b.cleaned_psd.sqrt(),
+                        expected_asd: b.expected_psd.sqrt(),
+                        left_raw: b.left_raw,
+                        limit: b.limit,
+                        ratio: b.ratio,
+                        raw_asd: b.raw_psd.sqrt(),
+                        sigma: b.sigma,
+                        witness_limited_asd: b.witness_limited_psd.sqrt(),
+                    })
+                    .collect(),
+                left_raw: c.left_raw,
+                observable: o.name(),
+                unit: format!("{}/sqrt(Hz)", o.unit()),
+                variance_ratio: c.variance_ratio,
+            })
+            .collect(),
+        witness_noise: noise
+            .iter()
+            .map(|x| (x, None))
+            .chain(r.colocated.iter().map(|e| (&e.noise, Some(&e.method))))
+            .map(|(x, method)| {
+                let a = r
+                    .witness_noise_psd
+                    .iter()
+                    .position(|(i, _)| *i == x.input)
+                    .expect("every stated noise belongs to a witness input");
+                let (asd, file) = match &x.level {
+                    NoiseLevel::White(v) => (Some(*v), None),
+                    NoiseLevel::Curve(c) => (None, Some(c.origin().to_string())),
+                };
+                let (method, relative_gains) = match method {
+                    None => ("given", Vec::new()),
+                    Some(Method::Huddle { relative_gain, .. }) => ("huddle", vec![*relative_gain]),
+                    Some(Method::ThreeCorneredHat { relative_gains }) => {
+                        ("three-cornered hat", relative_gains.to_vec())
+                    }
+                };
+                NoiseJson {
+                    asd,
+                    file,
+                    fitted_scale: r.fit.noise_factors[a].sqrt(),
+                    input: x.input.name(),
+                    method,
+                    rel: x.rel,
+                    relative_gains,
+                    unit: format!("{}/sqrt(Hz)", x.input.unit()),
+                }
+            })
+            .collect(),
         alignment: AlignmentJson {
             fraction_s: a.fraction_s,
             holdout_samples: r.n_holdout,
@@ -528,6 +721,7 @@ fn report_json(r: &SubtractResult, args: &SubtractArgs, start: &Option<String>) 
                 lower: e.bounds.0,
                 name: e.name.clone(),
                 nominal: e.nominal,
+                prior_sigma: e.prior_sigma,
                 scale: e.scale,
                 sigma: finite(e.sigma),
                 status: e.status.name(),
@@ -540,6 +734,7 @@ fn report_json(r: &SubtractResult, args: &SubtractArgs, start: &Option<String>) 
             band_hz: [r.fit.band_hz.0, r.fit.band_hz.1],
             bins: r.fit.bins.iter().map(|(o, n)| (o.name(), *n)).collect(),
             chi2: r.fit.chi2,
+            coherent_top_hz: r.fit.coherent_top_hz,
             dof: r.fit.dof,
             fitted: r.fit.fitted.clone(),
             iterations: r.fit.iterations,
@@ -547,17 +742,10 @@ fn report_json(r: &SubtractResult, args: &SubtractArgs, start: &Option<String>) 
             sigma_factor: r.fit.sigma_factor,
             stop: r.fit.stop.describe(),
             witness_bias: r
-                .fit
-                .estimates
+                .witness_noise_psd
                 .iter()
-                .filter_map(|e| e.name.strip_prefix("gain."))
-                .zip(&r.fit.witness_bias)
-                .filter_map(|(axis, b)| {
-                    TiltAxis::ALL
-                        .into_iter()
-                        .find(|a| a.name() == axis)
-                        .map(|a| (a.name(), *b))
-                })
+                .map(|(i, _)| i.name())
+                .zip(r.fit.witness_bias.iter().copied())
                 .collect(),
         },
         measured: args.measured.display().to_string(),
@@ -582,6 +770,9 @@ fn report_json(r: &SubtractResult, args: &SubtractArgs, start: &Option<String>) 
                     readout_asd: s.readout_asd,
                     unit: format!("{}/sqrt(Hz)", s.observable.unit()),
                     wiener_asd: b.wiener_asd,
+                    wiener_corrected_asd: b.wiener_corrected_asd,
+                    wiener_training_excess: s.wiener_training_excess,
+                    witness_limited_asd: b.witness_limited_asd,
                 }
             })
             .collect(),
@@ -630,6 +821,28 @@ fn report_table(r: &SubtractResult) -> String {
         f.chi2 / f.dof as f64,
         f.sigma_factor
     );
+    for e in &r.colocated {
+        let how = match &e.method {
+            Method::Huddle {
+                relative_gain,
+                noise_ratio,
+            } => format!(
+                "huddle test with one co-located record (its gain relative to the witness {relative_gain:.4}, \
+                 its noise {noise_ratio} times the witness's)"
+            ),
+            Method::ThreeCorneredHat { relative_gains } => format!(
+                "three-cornered hat with two co-located records (gains relative to the witness \
+                 {:.4}, {:.4})",
+                relative_gains[0], relative_gains[1]
+            ),
+        };
+        let _ = writeln!(
+            s,
+            "witness noise of {}: estimated by a {how}, +/- {:.1} % (ASD)",
+            e.noise.input.name(),
+            100.0 * e.noise.rel
+        );
+    }
     let _ = writeln!(s);
     let _ = writeln!(
         s,
@@ -638,8 +851,16 @@ fn report_table(r: &SubtractResult) -> String {
     );
     for e in &f.estimates {
         let status = match e.status {
-            Status::Fitted => "fitted".to_string(),
+            Status::Fitted => match e.prior_sigma {
+                Some(p) => format!("fitted, with its prior +/- {}", Num(p)),
+                None => "fitted".to_string(),
+            },
             Status::AtBound => format!("on the box [{}, {}]", Num(e.bounds.0), Num(e.bounds.1)),
+            Status::NotConstrained if e.prior_sigma.is_some() => format!(
+                "not constrained by the data alone: estimated with its prior {} +/- {}",
+                Num(e.nominal),
+                Num(e.scale)
+            ),
             Status::NotConstrained => format!(
                 "not constrained: held at nominal (the data would give +/- {}; scale {})",
                 if e.sigma.is_finite() {
@@ -650,8 +871,8 @@ fn report_table(r: &SubtractResult) -> String {
                 Num(e.scale)
             ),
         };
-        let est = match e.status {
-            Status::NotConstrained => format!("{}", e.value),
+        let est = match (e.status, e.prior_sigma) {
+            (Status::NotConstrained, None) => format!("{}", e.value),
             _ => with_sigma(e.value, e.sigma),
         };
         let _ = writeln!(
@@ -672,8 +893,9 @@ fn report_table(r: &SubtractResult) -> String {
         let b = &res.band;
         let _ = writeln!(
             s,
-            "  {:<6} {} .. {} Hz ({} bins, +/- {:.1} %): measured {:.3e}, predicted tilt {:.3e}, \
-             cleaned {:.3e}, Wiener {:.3e}, coherence limit {:.3e}",
+            "  {:<6} {} .. {} Hz ({} bins, +/- {:.1} %): measured {:.3e}, predicted {:.3e}, \
+             cleaned {:.3e}, witness-noise limit {:.3e}, Wiener {:.3e} ({:.3e} without its \
+             training noise), coherence limit {:.3e}",
             res.observable.name(),
             Num(b.band_hz.0),
             Num(b.band_hz.1),
@@ -682,7 +904,9 @@ fn report_table(r: &SubtractResult) -> String {
             b.measured_asd,
             b.predicted_asd,
             b.cleaned_asd,
+            b.witness_limited_asd,
             b.wiener_asd,
+            b.wiener_corrected_asd,
             b.expected_asd
         );
         if let Some((ratio, sigma)) = b.cleaned_to_readout {
@@ -697,6 +921,55 @@ fn report_table(r: &SubtractResult) -> String {
                 s,
                 "         cleaned / coherence limit = {:.4} +/- {:.4} (no --readout given)",
                 b.cleaned_to_expected.0, b.cleaned_to_expected.1
+            );
+        }
+    }
+    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
+        "the cleaned record against the raw one over the whole overlap, per 1/3-decade band \
+         (band means as ASD; limit: 1 + z sigma of the ratio, z corrected for the number of \
+         bands):"
+    );
+    for (o, check) in &r.bands {
+        let _ = writeln!(
+            s,
+            "  {:<6} variance cleaned/raw {:.4}{}",
+            o.name(),
+            check.variance_ratio,
+            if check.left_raw {
+                " (left raw entirely)"
+            } else {
+                ""
+            }
+        );
+        let _ = writeln!(
+            s,
+            "         {:>9} .. {:<9} {:>5}  {:>10} {:>10} {:>10} {:>10}  {:>10}  {:>6}",
+            "f_lo/Hz",
+            "f_hi/Hz",
+            "bins",
+            "raw",
+            "expected",
+            "cleaned",
+            "witness",
+            "cleaned/raw",
+            "limit"
+        );
+        for b in &check.bands {
+            let _ = writeln!(
+                s,
+                "         {:>9.3e} .. {:<9.3e} {:>5}  {:>10.3e} {:>10.3e} {:>10.3e} {:>10.3e}  {:>11.4} {:>6.3}{}",
+                b.lo_hz,
+                band_top(b.hi_hz, a.fs_hz),
+                b.bins,
+                b.raw_psd.sqrt(),
+                b.expected_psd.sqrt(),
+                b.cleaned_psd.sqrt(),
+                b.witness_limited_psd.sqrt(),
+                b.ratio,
+                b.limit,
+                if b.left_raw { "  left raw" } else { "" }
             );
         }
     }
@@ -722,8 +995,10 @@ fn figure_data(r: &SubtractResult) -> SubtractFigureData {
         .fit
         .estimates
         .iter()
-        .map(|e| match e.status {
-            Status::NotConstrained => format!("{} not constrained (held at {})", e.name, e.nominal),
+        .map(|e| match (e.status, e.prior_sigma) {
+            (Status::NotConstrained, None) => {
+                format!("{} not constrained (held at {})", e.name, e.nominal)
+            }
             _ => format!(
                 "{} = {}",
                 e.name,
@@ -759,16 +1034,31 @@ fn figure_data(r: &SubtractResult) -> SubtractFigureData {
             }
         ));
     }
+    let excess = r
+        .residuals
+        .first()
+        .map_or(f64::NAN, |s| s.wiener_training_excess);
+    let witness = if r
+        .witness_noise_psd
+        .iter()
+        .any(|(_, m)| m.iter().any(|&v| v > 0.0))
+    {
+        " Witness-noise limit: what the witness's own noise keeps any filter of it from \
+         removing, through the fitted model."
+    } else {
+        ""
+    };
     caption.push(format!(
         "Held-out stretch: the last {} of {} samples at {} Hz; Welch {} samples, Hann, 50 % \
-         overlap. Wiener residual: multiple-input filter trained on the first {} samples. \
-         Coherence limit: (1 − γ²) of the measured PSD, the least any linear filter of the tilt \
-         record can leave.",
+         overlap. Wiener residual: multiple-input filter trained on the first {} samples (its \
+         training noise adds about {:.1} % to its PSD). Coherence limit: (1 − γ²) of the \
+         measured PSD, the least any linear filter of the witness record can leave.{witness}",
         r.n_holdout,
         r.alignment.len,
         Num(r.alignment.fs_hz),
         r.segment_len,
-        r.n_train
+        r.n_train,
+        100.0 * excess
     ));
     SubtractFigureData {
         panels: r
@@ -782,6 +1072,19 @@ fn figure_data(r: &SubtractResult) -> SubtractFigureData {
                 cleaned: asd(&s.cleaned_psd),
                 wiener: asd(&s.wiener_psd),
                 expected: asd(&s.expected_psd),
+                witness_limited: asd(&s.witness_limited_psd),
+                left_raw: r
+                    .bands
+                    .iter()
+                    .find(|(o, _)| *o == s.observable)
+                    .map(|(_, c)| {
+                        c.bands
+                            .iter()
+                            .filter(|b| b.left_raw || c.left_raw)
+                            .map(|b| (b.lo_hz, band_top(b.hi_hz, r.alignment.fs_hz)))
+                            .collect()
+                    })
+                    .unwrap_or_default(),
                 readout: s.readout_asd,
             })
             .collect(),

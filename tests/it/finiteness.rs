@@ -315,7 +315,7 @@ fn commands_refuse_bad_samples_before_printing_and_name_dead_channels() {
             "eta_t=1e300",
         ],
         &[
-            "--tilt-noise eta_t=1e300",
+            "--witness-noise eta_t: the ASD 1e300",
             "0 or a value from 1e-40 to 1e40 rad/sqrt(Hz)",
         ],
     );

@@ -34,6 +34,10 @@ mod miniseed_input;
 mod noise_models;
 mod option_repeats;
 mod output_conventions;
+#[allow(
+    unsafe_code,
+    reason = "signals and resource limits of child processes (libc)"
+)]
 mod process;
 mod romy_budget;
 mod simulate_cli;

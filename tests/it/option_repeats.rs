@@ -132,7 +132,7 @@ fn a_key_or_name_given_twice_is_refused_in_every_command() {
                 &["--tilt-noise", "eta_t=1e-9", "--tilt-noise", "eta_t=2e-9"],
             ]
             .concat(),
-            "--tilt-noise: eta_t is given twice; name each axis once",
+            "--witness-noise: eta_t is given twice; name each input once",
         ),
         (
             [

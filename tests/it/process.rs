@@ -1,7 +1,7 @@
 //! The process around the computation: a standard output that is closed or full, error
 //! messages that stay one short line whatever the user or a file holds, command-line errors,
 //! output paths checked before anything is computed and written all or none, and interrupts
-//! during a write. Every failure is one line on standard error with exit code 2, never a panic,
+//! during a computation or a write. Every failure is one line on standard error with exit code 2, never a panic,
 //! and leaves no file behind.
 
 use crate::common;
@@ -544,6 +544,54 @@ fn interrupt_during_write(args: &[&str], target: &str, signal: libc::c_int, name
         listing(dir.path()),
         Vec::<std::path::PathBuf>::new(),
         "{args:?} left files after {name}"
+    );
+}
+
+/// Runs `args` (a long computation that saves its outputs only at the end) in an empty
+/// directory, sends `signal` while it computes, and checks the end as
+/// [`interrupt_during_write`] does.
+fn interrupt_while_computing(args: &[&str], signal: libc::c_int, name: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let mut child = command(args, dir.path())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Past the start-up (parsing, checking the outputs), well before the end.
+    std::thread::sleep(Duration::from_millis(500));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "{args:?} ended before it was interrupted: not a long computation"
+    );
+    // SAFETY: kill only sends a signal to the child's process id, which is alive (it has not
+    // been waited for and was running just now).
+    assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, signal) }, 0);
+    let status = wait_bounded(&mut child, Duration::from_secs(60));
+    let err = child_stderr(&mut child);
+    assert_eq!(status.code(), Some(2), "{args:?}: {err}");
+    assert_one_line(name, &err);
+    assert!(
+        err.starts_with(&format!("tiltnoise: error: interrupted by {name}")),
+        "{err}"
+    );
+    assert_eq!(
+        listing(dir.path()),
+        Vec::<std::path::PathBuf>::new(),
+        "{args:?} left files after {name}"
+    );
+}
+
+#[test]
+fn an_interrupt_during_a_long_computation_ends_it_without_output() {
+    interrupt_while_computing(
+        &["mc", "--samples", "10000000", "--save", "mc.h5"],
+        libc::SIGINT,
+        "SIGINT",
+    );
+    interrupt_while_computing(
+        &["simulate", "--duration", "3e6", "--save", "sim.h5"],
+        libc::SIGTERM,
+        "SIGTERM",
     );
 }
 

@@ -72,6 +72,7 @@ fn a_simulation_written_in_chunks_is_the_one_shot_record() {
         duration_s: 3000.3,
         readout_asd: vec![(Observable::X, 9e-9), (Observable::Theta, 1e-9)],
         seed: 3,
+        ..SimConfig::default()
     };
     let init = equal_energy_init(&model, DEFAULT_MODE_ENERGY_J);
     let sim = simulate(&model, &init, &cfg).unwrap();

@@ -208,6 +208,9 @@ pub enum FreqError {
 /// An evaluation of a transfer function that has no meaningful result.
 #[derive(Debug, thiserror::Error)]
 pub enum TfError {
+    /// Cancelled through the caller's token ([`crate::cancel`]).
+    #[error(transparent)]
+    Cancelled(#[from] crate::cancel::Cancelled),
     /// The dynamic stiffness `K(1 + i phi) - w^2 M` is singular to working precision: the
     /// frequency sits on an undamped resonance.
     #[error(

@@ -48,6 +48,7 @@
 //! ```
 pub mod align;
 pub mod budget;
+pub mod cancel;
 pub mod coherence;
 pub mod csv_text;
 pub mod dd;

@@ -25,6 +25,7 @@
 //!
 //! Pure numerics: depends on `params` and `model` only; no I/O.
 
+use crate::cancel::{Cancel, Cancelled};
 use crate::error::ParamError;
 use crate::limits::{
     check_count, check_memory, planned_bytes, LimitError, MAX_MC_DRAWS, MAX_THREADS,
@@ -60,6 +61,8 @@ pub struct McConfig {
     pub threads: usize,
     /// Parameters to draw; the others are exact.
     pub uncertainties: Vec<Uncertainty>,
+    /// Polled by every worker between blocks of draws.
+    pub cancel: Cancel,
 }
 
 impl McConfig {
@@ -70,6 +73,7 @@ impl McConfig {
             seed: 1,
             threads: 0,
             uncertainties: uncertainties(params),
+            cancel: Cancel::never(),
         }
     }
 }
@@ -107,6 +111,9 @@ pub enum McError {
     /// More draws or threads than allowed, or than fit into memory.
     #[error("Monte Carlo: {0}")]
     TooLarge(#[from] LimitError),
+    /// Cancelled through [`McConfig::cancel`].
+    #[error(transparent)]
+    Cancelled(#[from] Cancelled),
     /// Every draw was rejected.
     #[error(
         "Monte Carlo: all {samples} draws were rejected as non-physical; reduce the error bars"
@@ -177,12 +184,18 @@ pub fn run(
     std::thread::scope(|scope| {
         for (t, slot) in draws.chunks_mut(chunk).enumerate() {
             let (plan, done) = (&plan, &done);
+            let cancel = &cfg.cancel;
             scope.spawn(move || {
+                // Draws between progress reports and cancellation checks (well under a
+                // millisecond of work).
                 const REPORT_EVERY: usize = 256;
                 let first = t * chunk;
                 for (j, out) in slot.iter_mut().enumerate() {
                     *out = plan.draw(first + j);
                     if (j + 1) % REPORT_EVERY == 0 {
+                        if cancel.is_cancelled() {
+                            return;
+                        }
                         progress(done.fetch_add(REPORT_EVERY, Ordering::Relaxed) + REPORT_EVERY);
                     }
                 }
@@ -193,6 +206,7 @@ pub fn run(
             });
         }
     });
+    cfg.cancel.check()?;
     let (sample_index, freqs_hz): (Vec<usize>, Vec<[f64; 8]>) = draws
         .into_iter()
         .enumerate()

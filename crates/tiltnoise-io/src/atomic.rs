@@ -8,8 +8,8 @@
 //!   [`write_atomic`] leaves each finished temporary file in place, and [`Staging::commit`]
 //!   renames them all at the end; if the run fails before, dropping the `Staging` removes them,
 //!   so either every output of the run appears or none does.
-//! * [`remove_temporaries_on_interrupt`]: SIGINT, SIGTERM and SIGHUP remove the temporary files that
-//!   exist at that moment before the process ends.
+//! * [`remove_temporaries_for_exit`]: removes the temporary files that exist at that moment,
+//!   for an interrupt handler that then ends the process (signals are the command line's).
 
 use std::cell::RefCell;
 use std::ffi::OsString;
@@ -23,7 +23,7 @@ use tiltnoise_core::error::OutputError;
 /// The longest file name most file systems accept (bytes).
 pub(crate) const NAME_MAX: usize = 255;
 
-/// Temporary files that exist right now, for the interrupt handler.
+/// Temporary files that exist right now, for [`remove_temporaries_for_exit`].
 static LIVE_TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
 thread_local! {
@@ -336,75 +336,21 @@ impl Drop for Staging {
     }
 }
 
-/// Removes the temporary files of [`write_atomic`] that exist when the process receives SIGINT,
-/// SIGTERM or SIGHUP (unless SIGHUP is ignored, as under `nohup`), prints one line naming the signal, and ends the process with exit code 2. Call
-/// it once, early in `main`, before any thread is started: it blocks these signals in the
-/// calling thread (so in every thread started later) and waits for them in a thread of its
-/// own. Does nothing on platforms without POSIX signals.
-pub fn remove_temporaries_on_interrupt() {
-    #[cfg(unix)]
-    unix::install();
-}
-
-#[cfg(unix)]
-mod unix {
-    use super::LIVE_TEMPORARIES;
-
-    pub(super) fn install() {
-        use std::io::Write as _;
-        // SAFETY: `set` is initialised by sigemptyset before use; pthread_sigmask and sigwait
-        // only read it. Blocking the signals here makes every thread started later
-        // inherit the mask, so the signals are delivered only to `sigwait` below.
-        unsafe {
-            let mut set: libc::sigset_t = std::mem::zeroed();
-            libc::sigemptyset(&mut set);
-            libc::sigaddset(&mut set, libc::SIGINT);
-            libc::sigaddset(&mut set, libc::SIGTERM);
-            // A hangup (the terminal closed) ends the run as well, unless it is ignored, as
-            // under `nohup`: then the run goes on.
-            let mut hup: libc::sigaction = std::mem::zeroed();
-            if libc::sigaction(libc::SIGHUP, std::ptr::null(), &mut hup) == 0
-                && hup.sa_sigaction != libc::SIG_IGN
-            {
-                libc::sigaddset(&mut set, libc::SIGHUP);
-            }
-            if libc::pthread_sigmask(libc::SIG_BLOCK, &set, std::ptr::null_mut()) != 0 {
-                return;
-            }
-            let set_addr = set;
-            std::thread::spawn(move || {
-                let set = set_addr;
-                let mut sig: libc::c_int = 0;
-                // SAFETY: as above; `sig` is a valid out-pointer.
-                if libc::sigwait(&set, &mut sig) != 0 {
-                    return;
-                }
-                // Waits for a writer that holds the lock for a moment; nothing else does.
-                let live = LIVE_TEMPORARIES
-                    .lock()
-                    .unwrap_or_else(std::sync::PoisonError::into_inner);
-                for p in live.iter() {
-                    let _ = std::fs::remove_file(p);
-                }
-                let removed = live.len();
-                let name = match sig {
-                    libc::SIGINT => "SIGINT",
-                    libc::SIGHUP => "SIGHUP",
-                    _ => "SIGTERM",
-                };
-                // Not eprintln!: a panic on a closed standard error would end this thread
-                // before the process, leaving both signals blocked for good.
-                let _ = writeln!(
-                    std::io::stderr(),
-                    "tiltnoise: error: interrupted by {name}; {removed} temporary file(s) \
-                     removed, no output written"
-                );
-                // SAFETY: _exit ends the process at once, without running atexit handlers
-                // (the HDF5 library's would race with a write in progress on another thread).
-                libc::_exit(2);
-            });
-        }
+/// Removes every temporary file of [`write_atomic`], [`AtomicFile`] and [`Staging`] that exists
+/// now and returns how many there were, for a process about to end at once (the command
+/// line's interrupt handler). The registry stays locked afterwards, so that no temporary file
+/// can appear any more: a writer that tries to create one waits for the process to end.
+/// Safe to call from any thread: a writer holds the lock only for a moment.
+pub fn remove_temporaries_for_exit() -> usize {
+    let live = LIVE_TEMPORARIES
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    for p in live.iter() {
+        let _ = std::fs::remove_file(p);
     }
+    let removed = live.len();
+    std::mem::forget(live);
+    removed
 }
 
 #[cfg(test)]

@@ -37,7 +37,7 @@ mod tf_hdf5;
 mod tf_stream;
 
 pub use asd_csv::{write_asd_csv, SCHEMA_OBSERVABLE_ASD_CSV, SCHEMA_VERSION_OBSERVABLE_ASD_CSV};
-pub use atomic::{remove_temporaries_on_interrupt, write_atomic, AtomicFile, Staging};
+pub use atomic::{remove_temporaries_for_exit, write_atomic, AtomicFile, Staging};
 pub use budget_csv::{
     budget_csv_string, write_budget_csv, SCHEMA_BUDGET_CSV, SCHEMA_VERSION_BUDGET_CSV,
 };

@@ -2,8 +2,10 @@
 //! `tiltnoise budget --measured` reads (schema `tiltnoise.observable_series`: root attribute
 //! `sample_rate_hz`, one 1-D float64 dataset per observable with a `units` attribute, optional
 //! `start_time`), holding the cleaned series; everything else in groups, which series readers
-//! ignore: the predicted tilt parts (`/predicted_tilt`), the estimates (`/estimates`), the
-//! held-out residual spectra (`/residuals/<observable>`), the alignment and the provenance.
+//! ignore: the predicted floor parts (`/predicted_tilt`), the estimates (`/estimates`), the
+//! held-out residual spectra (`/residuals/<observable>`), the check of the cleaned record per
+//! band (`/bands/<observable>`), the witness noise as used (`/witness_noise`), the alignment
+//! and the provenance.
 //! Documented in `docs/subtract.md`.
 
 use super::h5util::{dataset, scalar_attr, str_attr, strs_attr, unit_dataset, units_dataset};
@@ -12,7 +14,7 @@ use super::{InputMeta, RunMeta, SPECTRAL_CONVENTION};
 use crate::atomic::write_atomic;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
-use tiltnoise_core::subtract::SubtractResult;
+use tiltnoise_core::subtract::{Method, SubtractResult};
 
 /// Provenance of a subtraction run.
 #[derive(Debug, Clone, PartialEq)]
@@ -147,6 +149,17 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
         &nums(|x| x.bounds.1),
         e.iter().map(|x| x.unit.as_str()),
     )?;
+    units_dataset(
+        &g,
+        "prior_sigma",
+        &nums(|x| x.prior_sigma.unwrap_or(f64::NAN)),
+        e.iter().map(|x| x.unit.as_str()),
+    )?;
+    scalar_attr(
+        &g,
+        "coherent_top_hz",
+        stored(f.coherent_top_hz.unwrap_or(f64::NAN)),
+    )?;
     scalar_attr(&g, "chi2", f.chi2)?;
     scalar_attr(&g, "dof", f.dof as u64)?;
     scalar_attr(&g, "sigma_factor", f.sigma_factor)?;
@@ -178,6 +191,7 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
     str_attr(&g, "stretch", "held-out (the end of the overlap)")?;
     scalar_attr(&g, "segment_len", r.segment_len as u64)?;
     scalar_attr(&g, "effective_averages", r.n_eff.1)?;
+    let asd = |psd: &[f64]| -> Vec<f64> { psd.iter().map(|p| p.max(0.0).sqrt()).collect() };
     for s in &r.residuals {
         let o = s.observable;
         let h = g.create_group(o.name())?;
@@ -190,10 +204,23 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
             ("cleaned_asd", &s.cleaned_psd),
             ("wiener_asd", &s.wiener_psd),
             ("expected_asd", &s.expected_psd),
+            ("witness_limited_asd", &s.witness_limited_psd),
         ] {
-            let asd: Vec<f64> = psd.iter().map(|p| p.max(0.0).sqrt()).collect();
-            unit_dataset(&h, name, &asd, &unit)?;
+            unit_dataset(&h, name, &asd(psd), &unit)?;
         }
+        for ((input, _), psd) in r.witness_noise_psd.iter().zip(&s.witness_limited_by_input) {
+            unit_dataset(
+                &h,
+                &format!("witness_limited_{}_asd", input.name()),
+                &asd(psd),
+                &unit,
+            )?;
+        }
+        scalar_attr(
+            &h,
+            "wiener_training_excess",
+            stored(s.wiener_training_excess),
+        )?;
         scalar_attr(&h, "readout_asd", stored(s.readout_asd.unwrap_or(f64::NAN)))?;
         let b = &s.band;
         unit_dataset(&h, "band_hz", &[b.band_hz.0, b.band_hz.1], "Hz")?;
@@ -203,6 +230,8 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
             ("band_predicted_asd", b.predicted_asd),
             ("band_cleaned_asd", b.cleaned_asd),
             ("band_wiener_asd", b.wiener_asd),
+            ("band_wiener_corrected_asd", b.wiener_corrected_asd),
+            ("band_witness_limited_asd", b.witness_limited_asd),
             ("band_expected_asd", b.expected_asd),
             ("band_psd_rel_sigma", b.psd_rel_sigma),
             ("band_cleaned_to_expected", b.cleaned_to_expected.0),
@@ -218,6 +247,91 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
         ] {
             scalar_attr(&h, name, stored(v))?;
         }
+    }
+
+    let g = file.create_group("bands")?;
+    str_attr(
+        &g,
+        "description",
+        "the cleaned record against the raw one over the whole overlap, per 1/3-decade band \
+         (band means of Welch PSDs as ASDs); a band left raw had its prediction masked out",
+    )?;
+    let fs = a.fs_hz;
+    for (o, check) in &r.bands {
+        let h = g.create_group(o.name())?;
+        let unit = format!("{}/sqrt(Hz)", o.unit());
+        let b = &check.bands;
+        let col = |get: fn(&tiltnoise_core::subtract::Band) -> f64| -> Vec<f64> {
+            b.iter().map(get).collect()
+        };
+        unit_dataset(&h, "band_lo_hz", &col(|x| x.lo_hz), "Hz")?;
+        unit_dataset(
+            &h,
+            "band_hi_hz",
+            &b.iter().map(|x| x.hi_hz.min(fs / 2.0)).collect::<Vec<_>>(),
+            "Hz",
+        )?;
+        unit_dataset(
+            &h,
+            "bins",
+            &b.iter().map(|x| x.bins as u64).collect::<Vec<_>>(),
+            "1",
+        )?;
+        for (name, get) in [
+            (
+                "raw_asd",
+                (|x| x.raw_psd) as fn(&tiltnoise_core::subtract::Band) -> f64,
+            ),
+            ("expected_asd", |x| x.expected_psd),
+            ("cleaned_asd", |x| x.cleaned_psd),
+            ("witness_limited_asd", |x| x.witness_limited_psd),
+        ] {
+            unit_dataset(&h, name, &asd(&col(get)), &unit)?;
+        }
+        unit_dataset(&h, "ratio", &col(|x| x.ratio), "1")?;
+        unit_dataset(&h, "sigma", &col(|x| x.sigma), "1")?;
+        unit_dataset(&h, "limit", &col(|x| x.limit), "1")?;
+        unit_dataset(
+            &h,
+            "left_raw",
+            &b.iter().map(|x| u8::from(x.left_raw)).collect::<Vec<_>>(),
+            "1",
+        )?;
+        scalar_attr(&h, "variance_ratio", check.variance_ratio)?;
+        scalar_attr(&h, "left_raw", u8::from(check.left_raw))?;
+    }
+
+    let g = file.create_group("witness_noise")?;
+    str_attr(
+        &g,
+        "description",
+        "the witness noise as used, after any fitted scale: one-sided ASD per input on the \
+         Welch grid (0 where none was stated)",
+    )?;
+    if let Some(first) = r.residuals.first() {
+        unit_dataset(&g, "frequency_hz", &first.freqs_hz, "Hz")?;
+    }
+    for (a, (input, psd)) in r.witness_noise_psd.iter().enumerate() {
+        let ds = unit_dataset(
+            &g,
+            input.name(),
+            &asd(psd),
+            &format!("{}/sqrt(Hz)", input.unit()),
+        )?;
+        scalar_attr(&ds, "fitted_scale", r.fit.noise_factors[a].sqrt())?;
+        let estimated = r.colocated.iter().find(|e| e.noise.input == *input);
+        let (method, gains): (&str, Vec<f64>) = match estimated.map(|e| &e.method) {
+            Some(Method::Huddle { relative_gain, .. }) => ("huddle", vec![*relative_gain]),
+            Some(Method::ThreeCorneredHat { relative_gains }) => {
+                ("three-cornered hat", relative_gains.to_vec())
+            }
+            None if psd.iter().any(|&v| v > 0.0) => ("given", Vec::new()),
+            None => ("none", Vec::new()),
+        };
+        str_attr(&ds, "method", method)?;
+        ds.new_attr_builder()
+            .with_data(&ndarray::ArrayView1::from(&gains))
+            .create("relative_gains")?;
     }
 
     let g = file.create_group("alignment")?;
@@ -247,5 +361,6 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
 }
 
 /// The estimator, in one line, for the file.
-const ESTIMATOR: &str = "errors-in-variables-corrected weighted least squares on Welch cross \
-     spectra: r = s_wy - (S_ww - S_mm) G(theta), whitened by S_ww S_ee / n_eff (docs/subtract.md)";
+const ESTIMATOR: &str = "instrumental-variable least squares on Welch cross spectra: \
+     r = s_wy - (S_ww - S_mm) G(theta), whitened by its covariance and pseudo-covariance, \
+     instruments from the smoothed witness spectrum (docs/subtract.md)";

@@ -157,6 +157,10 @@ fn term_style(component: &Component, readout: Option<ReadoutLabel>) -> (String, 
                 style(color, Dash::Dashed, 2),
             )
         }
+        TermKind::WitnessNoise => (
+            "tiltmeter noise in the tilt term (not in the total)".to_string(),
+            style(TILT_COLOR, Dash::Dotted, 2),
+        ),
         TermKind::Readout => {
             let label = match readout {
                 Some(ReadoutLabel::White(asd, o)) => format!("readout, {}", si_asd(asd, o.unit())),
@@ -221,6 +225,7 @@ fn draw_rank(component: &Component) -> u8 {
             TermKind::Tilt => 4,
             TermKind::Translation => 5,
             TermKind::TiltAxis(_) => 6,
+            TermKind::WitnessNoise => 6,
             TermKind::TranslationAxis(_) => 7,
             TermKind::Readout => 8,
             TermKind::Thermal => 9,

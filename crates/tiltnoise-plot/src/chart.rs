@@ -635,33 +635,14 @@ fn draw_log_panel<DB: DrawingBackend>(
     let plot_h = (h - m_top - m_bottom - x_label_area).max(10.0);
 
     let y_ticks = match linear_ticks {
-        Some(labelled) => Ticks {
-            major: labelled.iter().map(|t| t.0).collect(),
-            minor: Vec::new(),
-            step: 1,
-            anchor: 0,
-            labels: labelled,
-            unit: None,
-        },
+        Some(labelled) => labelled_ticks(labelled),
         None => decade_ticks(yr.0, yr.1, plot_h, 2.5 * tick_h),
     };
-    let mut y_label_w: f64 = 0.0;
-    for v in &y_ticks.major {
-        y_label_w =
-            y_label_w.max(body.estimate_text_size(&y_ticks.label(*v), &tick_style)?.0 as f64);
-    }
+    let y_label_w = widest_label(&body, &y_ticks, &tick_style)?;
     let y_label_area = (y_label_w + 2.0 * TICK as f64 + 8.0 + axis_h + 2.0).ceil();
 
     // Curves in data space, clipped to the frame; bands as polygons.
-    let lines: Vec<(Vec<(f64, f64)>, TraceStyle)> = panel
-        .traces
-        .iter()
-        .flat_map(|t| {
-            clip_loglog(&t.points, xr, yr)
-                .into_iter()
-                .map(|l| (l, t.style))
-        })
-        .collect();
+    let lines = clipped_traces(panel, xr, yr);
     let band_outline = panel.band.as_ref().and_then(|b| band_outline(b, xr, yr));
 
     let legend = match panel.legend {
@@ -672,20 +653,13 @@ fn draw_log_panel<DB: DrawingBackend>(
         width: (w - m_left - y_label_area - m_right).max(10.0),
         height: plot_h,
     };
-    let outside = match (&legend, panel.legend) {
-        (None, _) => false,
-        (Some(_), LegendPlacement::OutsideRight) => true,
-        (Some(lb), LegendPlacement::Auto) => {
-            let obstacles = Obstacles::new(&lines, &band_outline, &inside_rect, xr, yr);
-            let (_, cost) = lb.best_inside(&inside_rect, &obstacles);
-            cost > AUTO_INSIDE_MAX_COST
-        }
-        _ => false,
-    };
-    let outside_w = match (&legend, outside) {
-        (Some(lb), true) => lb.width as f64 + 12.0,
-        _ => 0.0,
-    };
+    let outside_w = outside_legend_width(
+        legend.as_ref(),
+        panel.legend,
+        || Obstacles::new(&lines, &band_outline, &inside_rect, xr, yr),
+        &inside_rect,
+    );
+    let outside = outside_w > 0.0;
     let rect = PlotRect {
         width: (inside_rect.width - outside_w).max(10.0),
         ..inside_rect
@@ -738,28 +712,14 @@ fn draw_log_panel<DB: DrawingBackend>(
         .y_label_formatter(&y_fmt)
         .draw()?;
 
-    if let Some(band) = &panel.band {
-        let fill = band.color.mix(band.opacity.clamp(0.0, 1.0)).filled();
-        if let Some((upper, lower)) = &band_outline {
-            // Both edges reduced to the pixel grid, as the curves are.
-            let (upper, lower) = (
-                decimate(upper, &rect, xr, yr),
-                decimate(lower, &rect, xr, yr),
-            );
-            let poly: Vec<_> = upper.iter().chain(lower.iter().rev()).copied().collect();
-            chart.draw_series(std::iter::once(Polygon::new(poly, fill)))?;
-        }
-    }
-    for (line, style) in &lines {
-        let line = decimate(line, &rect, xr, yr);
-        if RASTER.with(|r| r.get()) {
-            for run in split_at_reversals(&line, &rect, xr, yr) {
-                draw_polyline(&mut chart, run, *style)?;
-            }
-        } else {
-            draw_polyline(&mut chart, line, *style)?;
-        }
-    }
+    let data = PanelData {
+        lines: &lines,
+        band: panel.band.as_ref().zip(band_outline.as_ref()),
+        rect: &rect,
+        xr,
+        yr,
+    };
+    draw_data(&mut chart, &data)?;
 
     // Close the frame: plotters draws only the left and bottom axes.
     let plot = chart.plotting_area();
@@ -772,19 +732,128 @@ fn draw_log_panel<DB: DrawingBackend>(
         BLACK.stroke_width(1),
     ))?;
 
-    if let Some(lb) = legend {
-        if outside {
+    match legend {
+        Some(lb) if outside => {
             let (bx, by) = body.get_base_pixel();
-            let pos = (px.end - bx + 12, py.start - by);
-            lb.draw(&body, pos)?;
-        } else {
+            lb.draw(&body, (px.end - bx + 12, py.start - by))
+        }
+        Some(lb) => {
             let actual = PlotRect {
                 width: fw as f64,
                 height: fh as f64,
             };
             let obstacles = Obstacles::new(&lines, &band_outline, &actual, xr, yr);
-            let (pos, _) = lb.best_inside(&actual, &obstacles);
-            lb.draw(&frame, pos)?;
+            lb.draw(&frame, lb.best_inside(&actual, &obstacles).0)
+        }
+        None => Ok(()),
+    }
+}
+
+/// The width the legend takes to the right of the frame (pixels), 0 when it goes inside or
+/// there is none: outside always when asked, never when hidden or inside, and with
+/// [`LegendPlacement::Auto`] when the best place inside hides too much of the `obstacles`
+/// ([`AUTO_INSIDE_MAX_COST`]).
+fn outside_legend_width(
+    legend: Option<&LegendBox>,
+    placement: LegendPlacement,
+    obstacles: impl FnOnce() -> Obstacles,
+    inside: &PlotRect,
+) -> f64 {
+    let outside = legend.is_some_and(|lb| match placement {
+        LegendPlacement::OutsideRight => true,
+        LegendPlacement::Auto => lb.best_inside(inside, &obstacles()).1 > AUTO_INSIDE_MAX_COST,
+        _ => false,
+    });
+    match legend {
+        Some(lb) if outside => lb.width as f64 + 12.0,
+        _ => 0.0,
+    }
+}
+
+/// The width (pixels) of the widest major tick label of `ticks`.
+fn widest_label<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    ticks: &Ticks,
+    style: &TextStyle,
+) -> Result<f64, DrawError> {
+    let mut widest: f64 = 0.0;
+    for v in &ticks.major {
+        widest = widest.max(area.estimate_text_size(&ticks.label(*v), style)?.0 as f64);
+    }
+    Ok(widest)
+}
+
+/// The panel's curves clipped to the frame `xr` x `yr` (log-log), each piece with its style.
+fn clipped_traces(
+    panel: &Panel,
+    xr: (f64, f64),
+    yr: (f64, f64),
+) -> Vec<(Vec<(f64, f64)>, TraceStyle)> {
+    panel
+        .traces
+        .iter()
+        .flat_map(|t| {
+            clip_loglog(&t.points, xr, yr)
+                .into_iter()
+                .map(|l| (l, t.style))
+        })
+        .collect()
+}
+
+/// Ticks at given positions of a log axis, with their labels (a panel mapped from linear).
+fn labelled_ticks(labelled: Vec<(f64, String)>) -> Ticks {
+    Ticks {
+        major: labelled.iter().map(|t| t.0).collect(),
+        minor: Vec::new(),
+        step: 1,
+        anchor: 0,
+        labels: labelled,
+        unit: None,
+    }
+}
+
+/// A band's upper and lower edge, in data space.
+type Outline = (Vec<(f64, f64)>, Vec<(f64, f64)>);
+
+/// What a log-log panel draws inside its frame, in data space.
+struct PanelData<'a> {
+    /// Curves clipped to the frame, with their styles.
+    lines: &'a [(Vec<(f64, f64)>, TraceStyle)],
+    /// The band and its outline (upper edge, lower edge), if there is one.
+    band: Option<(&'a Band, &'a Outline)>,
+    /// The frame in pixels.
+    rect: &'a PlotRect,
+    xr: (f64, f64),
+    yr: (f64, f64),
+}
+
+/// The band, then the curves, each reduced to the pixel grid.
+fn draw_data<DB: DrawingBackend, X, Y>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<X, Y>>,
+    d: &PanelData<'_>,
+) -> Result<(), DrawError>
+where
+    X: plotters::coord::ranged1d::Ranged<ValueType = f64>,
+    Y: plotters::coord::ranged1d::Ranged<ValueType = f64>,
+{
+    if let Some((band, (upper, lower))) = d.band {
+        let fill = band.color.mix(band.opacity.clamp(0.0, 1.0)).filled();
+        // Both edges reduced to the pixel grid, as the curves are.
+        let (upper, lower) = (
+            decimate(upper, d.rect, d.xr, d.yr),
+            decimate(lower, d.rect, d.xr, d.yr),
+        );
+        let poly: Vec<_> = upper.iter().chain(lower.iter().rev()).copied().collect();
+        chart.draw_series(std::iter::once(Polygon::new(poly, fill)))?;
+    }
+    for (line, style) in d.lines {
+        let line = decimate(line, d.rect, d.xr, d.yr);
+        if RASTER.with(|r| r.get()) {
+            for run in split_at_reversals(&line, d.rect, d.xr, d.yr) {
+                draw_polyline(chart, run, *style)?;
+            }
+        } else {
+            draw_polyline(chart, line, *style)?;
         }
     }
     Ok(())
@@ -1074,11 +1143,7 @@ fn clip_segment(
 /// bottom), NaN points dropped: `(upper, lower)`, both by increasing x. `None` if either has
 /// fewer than two points.
 #[allow(clippy::type_complexity)]
-fn band_outline(
-    band: &Band,
-    (x0, x1): (f64, f64),
-    (y0, y1): (f64, f64),
-) -> Option<(Vec<(f64, f64)>, Vec<(f64, f64)>)> {
+fn band_outline(band: &Band, (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> Option<Outline> {
     let clamp = |&(x, y): &(f64, f64)| -> Option<(f64, f64)> {
         if x.is_nan() || y.is_nan() || x <= 0.0 {
             return None;

@@ -21,6 +21,8 @@
 //! plotters' glyph spacing. In SVG output text stays text (`<text font-family="sans-serif">`),
 //! so the viewer's sans-serif font is used there.
 
+#![forbid(unsafe_code)]
+
 pub mod budget_figure;
 pub mod chart;
 pub mod coherence_figure;

@@ -1,11 +1,12 @@
 //! The figure of `tiltnoise subtract`: per measured observable, on the held-out stretch, the
-//! one-sided ASDs of the measured record, of its predicted tilt part, of the model-cleaned
-//! residual, of the Wiener filter's residual and of the residual the coherence allows, with
-//! the readout level and the report band marked; the estimates in the caption.
+//! one-sided ASDs of the measured record, of its predicted floor part, of the model-cleaned
+//! residual, of the Wiener filter's residual, of the residual the coherence allows and of the
+//! residual the witness's own noise leaves, with the readout level, the report band and the
+//! bands left raw marked; the estimates in the caption.
 //!
 //! Plain data in ([`SubtractFigureData`]), a [`LogLogFigure`] out; drawn by [`subtract_figure`].
 
-use super::chart::{Dash, LegendPlacement, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
+use super::chart::{Band, Dash, LegendPlacement, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
 use super::labels::{observable_symbol, observable_title, si_asd};
 use super::{render, DrawError, ImageFormat, View};
 use plotters::style::RGBColor;
@@ -29,6 +30,11 @@ pub struct ObservablePanel {
     pub wiener: Vec<f64>,
     /// Residual the coherence allows.
     pub expected: Vec<f64>,
+    /// Residual the witness's own noise leaves through the fitted model (all zero without a
+    /// stated witness noise: not drawn).
+    pub witness_limited: Vec<f64>,
+    /// Bands left raw (Hz): the prediction did not lower the record there.
+    pub left_raw: Vec<(f64, f64)>,
     /// White readout, if known.
     pub readout: Option<f64>,
 }
@@ -49,6 +55,7 @@ const PREDICTED: RGBColor = PALETTE[1];
 const CLEANED: RGBColor = PALETTE[0];
 const WIENER: RGBColor = PALETTE[4];
 const EXPECTED: RGBColor = PALETTE[2];
+const WITNESS: RGBColor = PALETTE[5];
 const READOUT: RGBColor = PALETTE[3];
 const BAND: RGBColor = RGBColor(150, 150, 150);
 
@@ -64,6 +71,7 @@ pub fn build_subtract_figure(data: &SubtractFigureData) -> Result<LogLogFigure, 
             ("cleaned", &p.cleaned),
             ("wiener", &p.wiener),
             ("expected", &p.expected),
+            ("witness-limited", &p.witness_limited),
         ] {
             if v.len() != n || n < 3 {
                 return Err(format!(
@@ -118,6 +126,13 @@ pub fn build_subtract_figure(data: &SubtractFigureData) -> Result<LogLogFigure, 
             pts(&p.expected),
             TraceStyle::new(EXPECTED, Dash::Dashed, 2),
         ));
+        if p.witness_limited.iter().skip(1).any(|&v| v > 0.0) {
+            panel.traces.push(Trace::new(
+                "witness-noise limit (model)",
+                pts(&p.witness_limited),
+                TraceStyle::new(WITNESS, Dash::Dotted, 2),
+            ));
+        }
         let x = panel.resolved_x_range();
         if let Some(r) = p.readout.filter(|r| *r > 0.0) {
             panel.traces.push(Trace::new(
@@ -129,6 +144,19 @@ pub fn build_subtract_figure(data: &SubtractFigureData) -> Result<LogLogFigure, 
         panel.max_decades = Some(6.0);
         let y = panel.resolved_y_range();
         panel.y_range = Some(y);
+        if !p.left_raw.is_empty() {
+            let mut upper = Vec::new();
+            for &(lo, hi) in &p.left_raw {
+                let (lo, hi) = (lo.max(x.0), hi.min(x.1));
+                upper.extend([(lo, 0.0), (lo, y.1), (hi, y.1), (hi, 0.0)]);
+            }
+            panel.band = Some(Band::new(
+                "left raw (the prediction did not lower the record)",
+                vec![(x.0, 0.0), (x.1, 0.0)],
+                upper,
+                BAND,
+            ));
+        }
         panel.traces.insert(
             0,
             Trace::new(

@@ -222,6 +222,8 @@ fn subtract_figure_png_and_svg() {
         cleaned: curve(0.0, 0.0),
         wiener: curve(1e-10, 0.0),
         expected: curve(0.0, 0.0),
+        witness_limited: curve(3e-10, 0.5),
+        left_raw: vec![(0.2, 0.3)],
         readout: Some(1e-9),
     };
     let data = SubtractFigureData {
@@ -249,6 +251,8 @@ fn subtract_figure_png_and_svg() {
         "coherence limit",
         "readout 1 nm/√Hz",
         "readout 1 nrad/√Hz",
+        "witness-noise limit (model)",
+        "left raw",
         "gain.eta_t",
     ] {
         assert!(svg.contains(text), "{text} missing from the SVG");

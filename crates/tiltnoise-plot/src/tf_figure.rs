@@ -200,68 +200,7 @@ pub fn build_tf_figure(
             ));
         };
         for &kind in &kinds {
-            let (input_symbol, unit, suffix) = kind.labels(o, tf.ground_quantity());
-            let mut panel = Panel::new(
-                format!("{}{suffix}", observable_title(o)),
-                ("frequency", "Hz"),
-                (
-                    &format!("|{} / {input_symbol}|", observable_symbol(o)),
-                    &unit,
-                ),
-            );
-            // Undamped peaks reach 1e6 while phi/eta_t falls as f^4 to 1e-10 at 0.1 mHz and
-            // force responses as f^-4 to 1e-14 at 30 Hz: the automatic range clips the peaks,
-            // and up to 24 decades keep those tails visible.
-            panel.max_decades = Some(24.0);
-            let mut phase = Panel::new(
-                format!("{}{suffix}: phase", observable_symbol(o)),
-                ("frequency", "Hz"),
-                (
-                    &format!("arg({} / {input_symbol})", observable_symbol(o)),
-                    "deg",
-                ),
-            );
-            phase.y_scale = YScale::Linear {
-                tick_step: Some(90.0),
-            };
-            // A little beyond ±180 so a phase of 180 (an undamped sign) is not on the frame.
-            phase.y_range = Some((-200.0, 200.0));
-            phase.legend = LegendPlacement::Hidden;
-            for (ii, &input) in tf.inputs.iter().enumerate() {
-                if InputKind::of(input) != kind {
-                    continue;
-                }
-                let (name, style) = match input {
-                    Input::Tilt(t) => {
-                        let (name, style) = tilt_symbol_style(t);
-                        (name.to_string(), style)
-                    }
-                    Input::Translation(t) => {
-                        let (name, style) = translation_symbol_style(t);
-                        (name.to_string(), style)
-                    }
-                    Input::Force(f) => force_symbol_style(f),
-                };
-                let identically_zero =
-                    (0..tf.freqs_hz.len()).all(|k| tf.get(k, oi, ii).norm() == 0.0);
-                if identically_zero {
-                    panel.notes.push(format!("{name}: identically 0"));
-                    phase.notes.push(format!("{name}: identically 0"));
-                    continue;
-                }
-                let points = tf
-                    .freqs_hz
-                    .iter()
-                    .enumerate()
-                    .map(|(k, &f)| (f, tf.get(k, oi, ii).norm()))
-                    .collect();
-                panel.traces.push(Trace::new(name.clone(), points, style));
-                let degrees = phase_points(
-                    &tf.freqs_hz,
-                    (0..tf.freqs_hz.len()).map(|k| tf.get(k, oi, ii).arg().to_degrees()),
-                );
-                phase.traces.push(Trace::new(name, degrees, style));
-            }
+            let (panel, phase) = magnitude_and_phase(tf, o, oi, kind);
             panels.push(panel);
             if options.phase {
                 panels.push(phase);
@@ -291,6 +230,104 @@ pub fn build_tf_figure(
     if let Some(note) = &options.note {
         title.push_str(&format!(" ({note})"));
     }
+    let caption = caption(
+        tf,
+        options,
+        (has_tilt, has_translation, has_forces),
+        &observables,
+    );
+    Ok(LogLogFigure {
+        size: size_for_panels(panels.len()),
+        title: Some(title),
+        panels,
+        columns: 2,
+        caption,
+        // With phase panels, one legend below the grid: beside each magnitude panel it would
+        // take half its width.
+        shared_legend: options.phase,
+    })
+}
+
+/// The magnitude panel of observable `o` (output `oi` of `tf`) against the inputs of `kind`,
+/// and its phase panel.
+fn magnitude_and_phase(
+    tf: &TransferMatrix,
+    o: Observable,
+    oi: usize,
+    kind: InputKind,
+) -> (Panel, Panel) {
+    let (input_symbol, unit, suffix) = kind.labels(o, tf.ground_quantity());
+    let mut panel = Panel::new(
+        format!("{}{suffix}", observable_title(o)),
+        ("frequency", "Hz"),
+        (
+            &format!("|{} / {input_symbol}|", observable_symbol(o)),
+            &unit,
+        ),
+    );
+    // Undamped peaks reach 1e6 while phi/eta_t falls as f^4 to 1e-10 at 0.1 mHz and
+    // force responses as f^-4 to 1e-14 at 30 Hz: the automatic range clips the peaks,
+    // and up to 24 decades keep those tails visible.
+    panel.max_decades = Some(24.0);
+    let mut phase = Panel::new(
+        format!("{}{suffix}: phase", observable_symbol(o)),
+        ("frequency", "Hz"),
+        (
+            &format!("arg({} / {input_symbol})", observable_symbol(o)),
+            "deg",
+        ),
+    );
+    phase.y_scale = YScale::Linear {
+        tick_step: Some(90.0),
+    };
+    // A little beyond ±180 so a phase of 180 (an undamped sign) is not on the frame.
+    phase.y_range = Some((-200.0, 200.0));
+    phase.legend = LegendPlacement::Hidden;
+    for (ii, &input) in tf.inputs.iter().enumerate() {
+        if InputKind::of(input) != kind {
+            continue;
+        }
+        let (name, style) = match input {
+            Input::Tilt(t) => {
+                let (name, style) = tilt_symbol_style(t);
+                (name.to_string(), style)
+            }
+            Input::Translation(t) => {
+                let (name, style) = translation_symbol_style(t);
+                (name.to_string(), style)
+            }
+            Input::Force(f) => force_symbol_style(f),
+        };
+        let identically_zero = (0..tf.freqs_hz.len()).all(|k| tf.get(k, oi, ii).norm() == 0.0);
+        if identically_zero {
+            panel.notes.push(format!("{name}: identically 0"));
+            phase.notes.push(format!("{name}: identically 0"));
+            continue;
+        }
+        let points = tf
+            .freqs_hz
+            .iter()
+            .enumerate()
+            .map(|(k, &f)| (f, tf.get(k, oi, ii).norm()))
+            .collect();
+        panel.traces.push(Trace::new(name.clone(), points, style));
+        let degrees = phase_points(
+            &tf.freqs_hz,
+            (0..tf.freqs_hz.len()).map(|k| tf.get(k, oi, ii).arg().to_degrees()),
+        );
+        phase.traces.push(Trace::new(name, degrees, style));
+    }
+    (panel, phase)
+}
+
+/// The lines under the figure: the conventions of the inputs present (tilt, translation, forces),
+/// the grid, the phase's convention, the outputs not drawn.
+fn caption(
+    tf: &TransferMatrix,
+    options: &TfFigureOptions,
+    (has_tilt, has_translation, has_forces): (bool, bool, bool),
+    observables: &[Observable],
+) -> Vec<String> {
     let mut caption = Vec::new();
     if has_tilt {
         caption.extend([
@@ -373,16 +410,7 @@ pub fn build_tf_figure(
             omitted.join(", ")
         ));
     }
-    Ok(LogLogFigure {
-        size: size_for_panels(panels.len()),
-        title: Some(title),
-        panels,
-        columns: 2,
-        caption,
-        // With phase panels, one legend below the grid: beside each magnitude panel it would
-        // take half its width.
-        shared_legend: options.phase,
-    })
+    caption
 }
 
 /// Largest phase step (degrees) drawn as a line between neighbouring frequencies: a larger

@@ -131,6 +131,7 @@ pub(super) fn run(
             keep_every: m,
             readout_asd: readout.clone(),
             seed: args.seed,
+            cancel: tiltnoise_core::cancel::Cancel::never(),
         },
     )?;
     let n = sim.len();

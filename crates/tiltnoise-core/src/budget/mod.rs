@@ -21,15 +21,16 @@ pub use crate::noise::loglog_at;
 pub use measured::{add_measured, series_psds, MeasuredPsds};
 pub use summary::{SummaryRequest, DEFAULT_BAND_FRACTION, DEFAULT_SUMMARY_FREQS_HZ};
 
+use crate::cancel::{Cancel, Cancelled};
 use crate::error::TfError;
 use crate::ground::GroundQuantity;
 use crate::input::{GroundMap, InputError, SeriesSource, TiltSpectra};
 use crate::limits::{check_memory, planned_bytes, LimitError};
 use crate::model::{Input, Model, Observable};
 use crate::noise::{
-    add_equivalent_response, add_thermal, add_user_terms, check_user_terms, ground_budget, Budget,
-    BudgetReport, GroundCsd, Readout, SegmentBand, SpectralSource, TermKind, UserTerm,
-    UserTermError,
+    add_equivalent_response, add_thermal, add_user_terms, add_witness_noise, check_user_terms,
+    check_witness_noise, ground_budget, Budget, BudgetReport, GroundCsd, Readout, SegmentBand,
+    SpectralSource, TermKind, UserTerm, UserTermError, WitnessNoise, WitnessNoiseError,
 };
 use crate::spectral::{Averaging, CrossSpectra, SpectralError, WelchAccumulator, WelchConfig};
 use crate::tf::{self, Request, TransferMatrix};
@@ -45,6 +46,9 @@ pub const DEFAULT_WELCH_SEGMENT: usize = 1 << 14;
 /// Failures of a budget run.
 #[derive(Debug, thiserror::Error)]
 pub enum BudgetError {
+    /// Cancelled through [`BudgetOptions::cancel`].
+    #[error(transparent)]
+    Cancelled(#[from] Cancelled),
     /// Reading the tilt input failed.
     #[error(transparent)]
     Input(#[from] InputError),
@@ -60,6 +64,9 @@ pub enum BudgetError {
     /// A user term or a coloured readout that does not fit the budget.
     #[error(transparent)]
     User(#[from] UserTermError),
+    /// A witness noise that does not fit the budget.
+    #[error(transparent)]
+    Witness(#[from] WitnessNoiseError),
     /// Options that contradict each other or the input.
     #[error("{0}")]
     Config(String),
@@ -87,10 +94,15 @@ pub struct BudgetOptions {
     pub readout: Readout,
     /// User-named terms (ASDs of observables, or input noises through the model).
     pub user_terms: Vec<UserTerm>,
+    /// The tiltmeter's own noise per tilt axis: shown through the model as `witness_noise`,
+    /// not in the total.
+    pub witness_noise: Vec<WitnessNoise>,
     /// Model grid for spectra input (Hz); time series use the Welch grid.
     pub spectra_grid_hz: Vec<f64>,
     /// Frequencies to read the budget at ([`crate::noise::SummaryAt`]).
     pub summary: SummaryRequest,
+    /// Polled before each chunk of a series ([`CHUNK_SAMPLES`]).
+    pub cancel: Cancel,
 }
 
 impl Default for BudgetOptions {
@@ -104,8 +116,10 @@ impl Default for BudgetOptions {
             percentiles: (10.0, 90.0),
             readout: Readout::default(),
             user_terms: Vec::new(),
+            witness_noise: Vec::new(),
             spectra_grid_hz: Vec::new(),
             summary: SummaryRequest::default(),
+            cancel: Cancel::never(),
         }
     }
 }
@@ -162,24 +176,9 @@ fn total_ground_term(inputs: &[Input]) -> TermKind {
     }
 }
 
-/// Budget from a time series of the floor's motion ([`SeriesSource::channels`]: tilt angles or
-/// rates, translations as displacement, velocity or acceleration; their spectra become the
-/// inputs' by [`GroundMap`], with inertial sensors corrected, and the DC bin is dropped).
-/// `progress(done, total)` is called with samples processed.
-pub fn budget_from_series(
-    model: &Model,
-    series: &mut dyn SeriesSource,
-    opts: &BudgetOptions,
-    progress: &mut dyn FnMut(u64, u64),
-) -> Result<BudgetReport, BudgetError> {
-    opts.summary.validate()?;
-    let fs = series.sample_rate_hz();
-    let n = series.len();
-    let channels = series.channels();
-    let map = GroundMap::new(&channels, model.params().environment.g_m_per_s2)
-        .map_err(BudgetError::Config)?;
-    let inputs = map.inputs();
-    let segment_term = total_ground_term(&inputs);
+/// The Welch settings of a series of `n` samples: the options' segment (or the default for
+/// `n`) and overlap, checked against the record.
+fn welch_config(opts: &BudgetOptions, n: usize) -> Result<WelchConfig, BudgetError> {
     let seg_len = opts
         .welch_segment_len
         .unwrap_or_else(|| default_segment_len(n));
@@ -195,14 +194,18 @@ pub fn budget_from_series(
         .with_averaging(opts.averaging);
     cfg.validate()?;
     cfg.check_series_len(n)?;
-    // The Welch grid's band, known before the record is read: refuse given spectra that do not
-    // cover it now rather than after a long pass.
-    check_given_spectra(
-        opts,
-        fs / seg_len as f64,
-        (seg_len / 2) as f64 * fs / seg_len as f64,
-    )?;
-    let segment_samples = match opts.segment_duration_s {
+    Ok(cfg)
+}
+
+/// Samples per segment of the percentile band, if asked for: at least one Welch segment of
+/// `seg_len`, at most the record of `n` samples at `fs` Hz.
+fn segment_samples(
+    opts: &BudgetOptions,
+    fs: f64,
+    n: usize,
+    seg_len: usize,
+) -> Result<Option<usize>, BudgetError> {
+    Ok(match opts.segment_duration_s {
         None => None,
         Some(d) => {
             let s = (d * fs).round();
@@ -224,7 +227,37 @@ pub fn budget_from_series(
             }
             Some(s as usize)
         }
-    };
+    })
+}
+
+/// Budget from a time series of the floor's motion ([`SeriesSource::channels`]: tilt angles or
+/// rates, translations as displacement, velocity or acceleration; their spectra become the
+/// inputs' by [`GroundMap`], with inertial sensors corrected, and the DC bin is dropped).
+/// `progress(done, total)` is called with samples processed.
+pub fn budget_from_series(
+    model: &Model,
+    series: &mut dyn SeriesSource,
+    opts: &BudgetOptions,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<BudgetReport, BudgetError> {
+    opts.summary.validate()?;
+    let fs = series.sample_rate_hz();
+    let n = series.len();
+    let channels = series.channels();
+    let map = GroundMap::new(&channels, model.params().environment.g_m_per_s2)
+        .map_err(BudgetError::Config)?;
+    let inputs = map.inputs();
+    let segment_term = total_ground_term(&inputs);
+    let cfg = welch_config(opts, n)?;
+    let seg_len = cfg.segment_len;
+    // The Welch grid's band, known before the record is read: refuse given spectra that do not
+    // cover it now rather than after a long pass.
+    check_given_spectra(
+        opts,
+        fs / seg_len as f64,
+        (seg_len / 2) as f64 * fs / seg_len as f64,
+    )?;
+    let segment_samples = segment_samples(opts, fs, n, seg_len)?;
     let n_ax = channels.len();
     check_kept_memory(&cfg, n, n_ax, segment_samples, opts.outputs.len())?;
     let mut whole = WelchAccumulator::new(n_ax, fs, &cfg)?;
@@ -244,6 +277,7 @@ pub fn budget_from_series(
     let mut start = 0;
     while start < n {
         let len = CHUNK_SAMPLES.min(n - start);
+        opts.cancel.check()?;
         let chunk = series.read_chunk(start, len)?;
         let views: Vec<&[f64]> = chunk.iter().map(Vec::as_slice).collect();
         whole.push(&views)?;
@@ -328,6 +362,7 @@ pub fn budget_from_series(
     );
     add_damping_terms(model, &mut budget)?;
     add_user_terms(&mut budget, model, &opts.user_terms)?;
+    add_witness_noise(&mut budget, model, &opts.witness_noise)?;
     check_budget_finite(&budget)?;
     let report = BudgetReport {
         budget,
@@ -358,7 +393,7 @@ pub fn budget_from_series(
         cfg,
         n_segments: spectra.n_segments,
     };
-    with_summary(model, report, &tilt, &opts.summary, &opts.user_terms)
+    with_summary(model, report, &tilt, opts)
 }
 
 /// `report` with its summary ([`summary::summarize`]), and a note for every frequency left out.
@@ -366,10 +401,9 @@ fn with_summary(
     model: &Model,
     mut report: BudgetReport,
     tilt: &summary::TiltData<'_>,
-    req: &SummaryRequest,
-    user_terms: &[UserTerm],
+    opts: &BudgetOptions,
 ) -> Result<BudgetReport, BudgetError> {
-    let (summary, notes) = summary::summarize(model, &report, tilt, req, user_terms)?;
+    let (summary, notes) = summary::summarize(model, &report, tilt, opts)?;
     report.summary = summary;
     report.notes.extend(notes);
     Ok(report)
@@ -382,6 +416,8 @@ fn check_given_spectra(opts: &BudgetOptions, lo: f64, hi: f64) -> Result<(), Bud
         .check_covers(lo, hi)
         .map_err(|e| BudgetError::User(UserTermError::Coverage(e)))?;
     check_user_terms(&opts.user_terms, &opts.outputs, lo, hi)?;
+    check_witness_noise(&opts.witness_noise, lo, hi)
+        .map_err(|e| BudgetError::Witness(WitnessNoiseError::Coverage(e)))?;
     Ok(())
 }
 
@@ -469,6 +505,7 @@ pub fn budget_from_spectra(
     );
     add_damping_terms(model, &mut budget)?;
     add_user_terms(&mut budget, model, &opts.user_terms)?;
+    add_witness_noise(&mut budget, model, &opts.witness_noise)?;
     check_budget_finite(&budget)?;
     let report = BudgetReport {
         budget,
@@ -483,13 +520,7 @@ pub fn budget_from_spectra(
         notes,
         summary: Vec::new(),
     };
-    with_summary(
-        model,
-        report,
-        &summary::TiltData::Spectra(spectra),
-        &opts.summary,
-        &opts.user_terms,
-    )
+    with_summary(model, report, &summary::TiltData::Spectra(spectra), opts)
 }
 
 /// Refuses cross-spectra of the inputs that overflowed `f64` (samples far beyond any tilt or

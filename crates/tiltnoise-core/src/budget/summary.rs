@@ -12,8 +12,8 @@ use super::{ground_tf, BudgetError};
 use crate::input::TiltSpectra;
 use crate::model::{Model, Observable};
 use crate::noise::{
-    add_thermal, add_user_terms, ground_budget, BandMean, BudgetReport, Evaluation, GroundCsd,
-    ObservableAt, SummaryAt, TermAt, UserTerm,
+    add_thermal, add_user_terms, add_witness_noise, ground_budget, BandMean, BudgetReport,
+    Evaluation, GroundCsd, ObservableAt, SummaryAt, TermAt,
 };
 use crate::spectral::{band_dof, WelchConfig};
 use num_complex::Complex64;
@@ -154,9 +154,9 @@ pub(super) fn summarize(
     model: &Model,
     report: &BudgetReport,
     tilt: &TiltData<'_>,
-    req: &SummaryRequest,
-    user_terms: &[UserTerm],
+    opts: &super::BudgetOptions,
 ) -> Result<(Vec<SummaryAt>, Vec<String>), BudgetError> {
+    let req = &opts.summary;
     req.validate()?;
     let outputs: Vec<Observable> = report
         .budget
@@ -209,7 +209,8 @@ pub(super) fn summarize(
                 &crate::thermal::thermal_noise(model, &outputs, &at_f)?,
             );
         }
-        add_user_terms(&mut point, model, user_terms)?;
+        add_user_terms(&mut point, model, &opts.user_terms)?;
+        add_witness_noise(&mut point, model, &opts.witness_noise)?;
         let observables = report
             .budget
             .observables
@@ -225,6 +226,7 @@ pub(super) fn summarize(
                     .map(|t| TermAt {
                         kind: t.kind.clone(),
                         psd: t.psd[0],
+                        // The witness noise is a given spectrum through the model: exact at f.
                         evaluation: if t.kind.is_ground_motion() {
                             tilt_evaluation.clone()
                         } else {

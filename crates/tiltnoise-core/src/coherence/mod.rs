@@ -43,7 +43,9 @@ use crate::spectral::confidence::{
     bin_correlation, coherence_interval, coherence_threshold, equivalent_averages, tf_radius,
     tf_sigma,
 };
-use crate::spectral::{coherence, csd_matrix, multiple_input, SpectralError, WelchConfig};
+use crate::spectral::{
+    coherence, csd_matrix_cancellable, multiple_input, SpectralError, WelchConfig,
+};
 use crate::tf::{self, Scene};
 use num_complex::Complex64;
 use resolution::{kernel, smoothed, RESOLUTION_FRACTION};
@@ -56,8 +58,8 @@ pub struct Record<'a, C> {
     pub name: &'a str,
     /// Sample rate (Hz).
     pub sample_rate_hz: f64,
-    /// ISO 8601 time of sample 0, if the file states one.
-    pub start_time: Option<&'a str>,
+    /// The instant of sample 0, if the file states one.
+    pub start_time: Option<jiff::Timestamp>,
     /// `(label, samples)`: tilt axes (rad, the crate's sign convention) or observables (m, rad).
     pub channels: Vec<(C, &'a [f64])>,
 }
@@ -93,6 +95,8 @@ pub struct CoherenceOptions {
     /// turned into the angle's bin by bin ([`crate::input::rate::rate_channels_to_angle`]), so
     /// the measured transfer functions are from the angle, as the model's.
     pub tilt_quantity: crate::input::Quantity,
+    /// Polled before each Welch segment.
+    pub cancel: crate::cancel::Cancel,
 }
 
 impl Default for CoherenceOptions {
@@ -103,6 +107,7 @@ impl Default for CoherenceOptions {
             confidence: 0.95,
             fit_band_hz: None,
             tilt_quantity: crate::input::Quantity::Angle,
+            cancel: crate::cancel::Cancel::never(),
         }
     }
 }
@@ -293,7 +298,7 @@ pub fn coherence_from_series(
             )));
         }
     }
-    let mut spectra = csd_matrix(&channels, fs, &cfg)?;
+    let mut spectra = csd_matrix_cancellable(&channels, fs, &cfg, &opts.cancel)?;
     if opts.tilt_quantity == crate::input::Quantity::Rate {
         let rates: Vec<usize> = (0..tilt.channels.len()).collect();
         crate::input::rate::rate_channels_to_angle(&mut spectra, &rates);

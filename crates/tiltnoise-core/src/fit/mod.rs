@@ -33,6 +33,7 @@ pub mod measured;
 
 pub use measured::{Measured, MeasuredMode, SigmaSource};
 
+use crate::cancel::{Cancel, Cancelled};
 use crate::error::{ParamError, Shown};
 use crate::params::Params;
 use crate::repeats::{refuse_repeats, Repeated};
@@ -75,6 +76,8 @@ pub struct FitConfig {
     pub bound_sigmas: f64,
     /// Add the Gaussian prior `sum ((p - p0) / sigma_p)^2` to the objective.
     pub prior: bool,
+    /// Polled before each evaluation of the model's frequencies and Jacobian.
+    pub cancel: Cancel,
 }
 
 impl Default for FitConfig {
@@ -83,6 +86,7 @@ impl Default for FitConfig {
             free: DEFAULT_FREE.iter().map(|k| k.to_string()).collect(),
             bound_sigmas: 1.0,
             prior: false,
+            cancel: Cancel::never(),
         }
     }
 }
@@ -199,6 +203,9 @@ pub struct FitResult {
 /// A fit that cannot be run.
 #[derive(Debug, thiserror::Error)]
 pub enum FitError {
+    /// Cancelled through [`FitConfig::cancel`].
+    #[error(transparent)]
+    Cancelled(#[from] Cancelled),
     /// A malformed measured-frequency file.
     #[error("measured frequencies {origin}: {message}")]
     Measured {
@@ -310,7 +317,10 @@ pub fn fit(
             })
     };
     // Data rows, then (with the prior) one row u_j per parameter.
+    // Once cancelled every evaluation fails, which the minimizer takes as rejected steps
+    // until its damping runs out (a few dozen cheap rounds); the check after it returns.
     let residuals = |u: &DVector<f64>| -> Result<Evaluation, FitError> {
+        config.cancel.check()?;
         let (freqs, dfdp) = jacobian::frequencies_and_jacobian(&at(u)?, &keys)?;
         let rows = m + if config.prior { free.len() } else { 0 };
         let mut r = DVector::zeros(rows);
@@ -336,6 +346,7 @@ pub fn fit(
         max_iterations: MAX_ITERATIONS,
     };
     let out = lm::minimize(u0, n, &opts, |u| residuals(u).map(|(r, j, _)| (r, j)))?;
+    config.cancel.check()?;
     let fitted_params = at(&out.u)?;
     let (_, _, fitted_freqs) = residuals(&out.u)?;
 

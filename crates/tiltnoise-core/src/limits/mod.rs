@@ -99,8 +99,8 @@ pub const MAX_STREAMED_SIM_SAMPLES: usize = MAX_SERIES_SAMPLES;
 pub const MAX_SERIES_SAMPLES: usize = 1 << 25;
 
 /// Most samples per channel of an HDF5 tilt series the budget streams (in chunks, in bounded
-/// memory, so the bound is time): at about 10^7 samples per second (measured), 2^32 samples
-/// take several minutes to half an hour. They are 13 years at 10 Hz; the limit stops a file of
+/// memory, so the bound is time): at the streaming throughput of `scripts/bench/README.md`
+/// (`stream_budget.py`), 2^32 samples take several minutes to half an hour. They are 13 years at 10 Hz; the limit stops a file of
 /// a few KiB whose metadata claims 10^12 samples.
 pub const MAX_STREAMED_SAMPLES: usize = 1 << 32;
 

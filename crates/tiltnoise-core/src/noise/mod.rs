@@ -30,6 +30,7 @@ mod segments;
 mod summary;
 mod term;
 mod user;
+mod witness;
 
 pub use equivalent::{add_equivalent_response, equivalent_input, Calibration};
 pub use given::{loglog_at, GivenAsd, GivenAsdError};
@@ -37,6 +38,10 @@ pub use segments::{percentile, SegmentBand};
 pub use summary::{BandMean, Evaluation, ObservableAt, SummaryAt, TermAt};
 pub use term::{is_term_name, Component, TermGroup, TermKind};
 pub use user::{add_user_terms, check_user_terms, UserSource, UserTerm, UserTermError};
+pub use witness::{
+    add_witness_noise, check_witness_noise, NoiseLevel, WitnessNoise, WitnessNoiseError,
+    MAX_NOISE_REL,
+};
 
 use crate::input::{motion_of, Motion};
 use crate::model::Observable;

@@ -24,6 +24,11 @@ pub enum TermKind {
     /// [`TermKind::Tilt`] and [`TermKind::Translation`] are its breakdown (never added in
     /// quadrature: tilt and floor acceleration are correlated, and act alike at low frequency).
     Ground,
+    /// The witness instruments' own noise through the model, `sum_i |H_oi|^2 S_nn,i`: the
+    /// part of [`TermKind::Tilt`] that is the tiltmeter's noise, not the floor's motion (the
+    /// tilt term, computed from the witness record, already contains it); not part of the
+    /// total.
+    WitnessNoise,
     /// Readout (sensing) noise of the observable.
     Readout,
     /// Thermal noise of every dissipative element together (fluctuation-dissipation theorem).
@@ -45,7 +50,7 @@ pub enum TermKind {
 /// The groups a budget's terms are drawn and stored in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum TermGroup {
-    /// [`TermKind::Tilt`] and its per-axis breakdown.
+    /// [`TermKind::Tilt`], its per-axis breakdown and the witness noise in it.
     Tilt,
     /// [`TermKind::Translation`] and its per-axis breakdown.
     Translation,
@@ -63,8 +68,8 @@ pub enum TermGroup {
 
 impl TermKind {
     /// The key of the term in the budget files (`tilt`, `tilt.eta_t`, `translation`,
-    /// `translation.x_t`, `ground`, `readout`, `thermal`, `thermal.torsion_b`, `user`,
-    /// `user.<name>`, `measured`, `residual`); see `docs/schemas.md`.
+    /// `translation.x_t`, `ground`, `witness_noise`, `readout`, `thermal`, `thermal.torsion_b`,
+    /// `user`, `user.<name>`, `measured`, `residual`); see `docs/schemas.md`.
     pub fn name(&self) -> String {
         match self {
             TermKind::Tilt => "tilt".into(),
@@ -72,6 +77,7 @@ impl TermKind {
             TermKind::Translation => "translation".into(),
             TermKind::TranslationAxis(t) => format!("translation.{}", t.name()),
             TermKind::Ground => "ground".into(),
+            TermKind::WitnessNoise => "witness_noise".into(),
             TermKind::Readout => "readout".into(),
             TermKind::Thermal => "thermal".into(),
             TermKind::ThermalElement(e) => format!("thermal.{e}"),
@@ -88,6 +94,7 @@ impl TermKind {
             "tilt" => TermKind::Tilt,
             "translation" => TermKind::Translation,
             "ground" => TermKind::Ground,
+            "witness_noise" => TermKind::WitnessNoise,
             "readout" => TermKind::Readout,
             "thermal" => TermKind::Thermal,
             "user" => TermKind::User,
@@ -133,12 +140,14 @@ impl TermKind {
     }
 
     /// Whether the term is one of the floor's motion: tilt, translation or ground, or one axis
-    /// of them (the terms estimated from the record, read at a frequency as band means).
+    /// of them (the terms estimated from the record, read at a frequency as band means; not
+    /// the witness noise, a given spectrum).
     pub fn is_ground_motion(&self) -> bool {
-        matches!(
-            self.group(),
-            TermGroup::Tilt | TermGroup::Translation | TermGroup::Ground
-        )
+        *self != TermKind::WitnessNoise
+            && matches!(
+                self.group(),
+                TermGroup::Tilt | TermGroup::Translation | TermGroup::Ground
+            )
     }
 
     /// Whether the term is a noise the model predicts (everything but measured and residual):
@@ -150,7 +159,7 @@ impl TermKind {
     /// The group of the term.
     pub fn group(&self) -> TermGroup {
         match self {
-            TermKind::Tilt | TermKind::TiltAxis(_) => TermGroup::Tilt,
+            TermKind::Tilt | TermKind::TiltAxis(_) | TermKind::WitnessNoise => TermGroup::Tilt,
             TermKind::Translation | TermKind::TranslationAxis(_) => TermGroup::Translation,
             TermKind::Ground => TermGroup::Ground,
             TermKind::Readout => TermGroup::Readout,
@@ -228,6 +237,7 @@ mod tests {
             TermKind::Translation,
             TermKind::TranslationAxis(TranslationAxis::ZT),
             TermKind::Ground,
+            TermKind::WitnessNoise,
             TermKind::Readout,
             TermKind::Thermal,
             TermKind::ThermalElement("swing_a_viscous".into()),
@@ -254,6 +264,7 @@ mod tests {
             assert!(adds(TermKind::Readout) && adds(TermKind::Thermal) && adds(TermKind::User));
             assert!(!adds(TermKind::UserNamed("actuation".into())));
             assert!(!adds(TermKind::TiltAxis(TiltAxis::ThetaT)));
+            assert!(!adds(TermKind::WitnessNoise));
             assert!(!adds(TermKind::TranslationAxis(TranslationAxis::XT)));
             assert!(!adds(TermKind::ThermalElement("torsion_b".into())));
             assert!(!adds(TermKind::Measured) && !adds(TermKind::Residual));

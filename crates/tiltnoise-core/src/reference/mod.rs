@@ -4,10 +4,10 @@
 //!
 //! The oracle of the accuracy tests and of the methods table: it evaluates
 //! `H(w) = C (K_c - w^2 M)^-1 (G0 + w^2 G2)` (the tilt forcing, the translation forcing with
-//! `G0 = 0`, or a column of the force matrix) to about 30 significant digits, so that the error of every `f64` method
-//! ([`crate::tf::Method`]) can be measured rather than estimated. It costs about 8 us per
-//! frequency for the 7 x 3 tilt matrix, 2 to 3 times the `f64` direct method; no production
-//! path uses it.
+//! `G0 = 0`, or a column of the force matrix) to about 30 significant digits, so that the error
+//! of every `f64` method ([`crate::tf::Method`]) can be measured rather than estimated. It is
+//! slower than the `f64` direct method (`tiltnoise methods` times both); no production path
+//! uses it.
 //!
 //! # Independence
 //!

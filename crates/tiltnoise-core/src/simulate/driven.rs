@@ -36,6 +36,7 @@
 //! Only the undamped model is supported, like [`super::simulate`].
 
 use super::{InitialState, SimError, Simulation};
+use crate::cancel::Cancel;
 use crate::limits::{check_memory, planned_bytes};
 use crate::model::{Input, Model, Observable};
 use crate::modes::NormalModes;
@@ -70,6 +71,8 @@ pub struct DrivenConfig {
     pub readout_asd: Vec<(Observable, f64)>,
     /// Seed of the readout noise (stream 0, as [`super::simulate`]).
     pub seed: u64,
+    /// Polled every [`super::PROGRESS_STRIDE`] steps.
+    pub cancel: Cancel,
 }
 
 /// Exact response of the undamped model to `drive` (see the module docs), recorded every
@@ -168,6 +171,9 @@ pub fn simulate_driven(
     };
     record(0, &a, &mut q_out, &mut obs);
     for j in 0..n_fine - 1 {
+        if j % super::PROGRESS_STRIDE == 0 {
+            cfg.cancel.check()?;
+        }
         if j > 0 {
             b_now = b_next;
             b_next = forcing_at(j + 1);
@@ -492,6 +498,7 @@ mod tests {
             keep_every,
             readout_asd: Vec::new(),
             seed: 0,
+            cancel: Cancel::never(),
         }
     }
 
@@ -622,6 +629,7 @@ mod tests {
                 keep_every: 7,
                 readout_asd: Vec::new(),
                 seed: 0,
+                cancel: Cancel::never(),
             },
         )
         .unwrap();

@@ -40,6 +40,7 @@
 //!
 //! Pure numerics: depends on `model`, `modes` and (for [`resonance`]) `spectral` only.
 
+use crate::cancel::{Cancel, Cancelled};
 use crate::error::Num;
 use crate::limits::{
     check_count, check_memory, planned_bytes, LimitError, MAX_SIM_SAMPLES, SIM_BYTES_PER_SAMPLE,
@@ -92,6 +93,9 @@ pub struct SimConfig {
     pub readout_asd: Vec<(Observable, f64)>,
     /// Seed of the noise generator.
     pub seed: u64,
+    /// Polled between chunks of [`PROGRESS_STRIDE`] samples by [`simulate_with_progress`]; a
+    /// caller of [`stream::FreeMotion`] polls it between the chunks it asks for.
+    pub cancel: Cancel,
 }
 
 impl Default for SimConfig {
@@ -102,6 +106,7 @@ impl Default for SimConfig {
             duration_s: 43_200.0,
             readout_asd: vec![(Observable::X, 9e-9)],
             seed: 0,
+            cancel: Cancel::never(),
         }
     }
 }
@@ -162,6 +167,9 @@ impl Simulation {
 /// Why a simulation was refused. Every variant names the value and what is allowed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SimError {
+    /// Cancelled through the configuration's token ([`crate::cancel`]).
+    #[error(transparent)]
+    Cancelled(#[from] Cancelled),
     /// An initial coordinate or rate outside the linear model's range, or not finite.
     #[error(
         "initial {what} of {coordinate} = {} {unit} is not allowed: must be finite and at most \
@@ -442,7 +450,10 @@ pub fn simulate_with_progress(
     let mut q = Vec::with_capacity(n);
     let mut obs: Vec<Vec<f64>> = (0..7).map(|_| Vec::with_capacity(n)).collect();
     let mut chunk = SimChunk::default();
-    while motion.next_chunk(PROGRESS_STRIDE, &mut chunk) {
+    while {
+        cfg.cancel.check()?;
+        motion.next_chunk(PROGRESS_STRIDE, &mut chunk)
+    } {
         q.extend_from_slice(&chunk.q);
         for (all, part) in obs.iter_mut().zip(&chunk.observables) {
             all.extend_from_slice(part);

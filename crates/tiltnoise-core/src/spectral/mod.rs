@@ -75,12 +75,17 @@ mod window;
 pub use config::{Averaging, Detrend, WelchConfig};
 pub use cross::{coherence, multiple_input, MultipleInput, INPUT_RCOND_MIN};
 pub use dof::band_dof;
-pub use welch::{csd, csd_matrix, welch, CrossSpectra, Csd, Psd, WelchAccumulator};
+pub use welch::{
+    csd, csd_matrix, csd_matrix_cancellable, welch, CrossSpectra, Csd, Psd, WelchAccumulator,
+};
 pub use window::hann_periodic;
 
 /// Invalid Welch parameters or input series. Every variant names the offending lengths.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SpectralError {
+    /// The computation was cancelled ([`crate::cancel`]).
+    #[error(transparent)]
+    Cancelled(#[from] crate::cancel::Cancelled),
     /// `segment_len` is below 2 samples.
     #[error("Welch segment length of {segment_len} samples is too short: must be at least 2")]
     SegmentTooShort {

@@ -8,6 +8,7 @@ use realfft::{RealFftPlanner, RealToComplex};
 use super::stats::{median_bias, median_in_place, pairwise_sum};
 use super::window::hann_periodic;
 use super::{Averaging, Detrend, SpectralError, WelchConfig};
+use crate::cancel::Cancel;
 use crate::limits::check_memory;
 
 /// One-sided power spectral density of one series.
@@ -121,6 +122,8 @@ pub struct WelchAccumulator {
     stored: Vec<Complex64>,
     n_segments: usize,
     n_samples: usize,
+    /// Polled before each segment.
+    cancel: Cancel,
 }
 
 impl std::fmt::Debug for WelchAccumulator {
@@ -173,7 +176,15 @@ impl WelchAccumulator {
             stored: Vec::new(),
             n_segments: 0,
             n_samples: 0,
+            cancel: Cancel::never(),
         })
+    }
+
+    /// The accumulator polling `cancel` before each segment: a push after the token is set
+    /// returns [`SpectralError::Cancelled`].
+    pub fn with_cancel(mut self, cancel: Cancel) -> Self {
+        self.cancel = cancel;
+        self
     }
 
     /// Number of channels.
@@ -259,6 +270,7 @@ impl WelchAccumulator {
             self.filled += take;
             pos += take;
             if self.filled == len {
+                self.cancel.check()?;
                 self.process_segment()?;
             }
         }
@@ -448,6 +460,18 @@ pub fn csd_matrix(
     fs_hz: f64,
     cfg: &WelchConfig,
 ) -> Result<CrossSpectra, SpectralError> {
+    csd_matrix_cancellable(channels, fs_hz, cfg, &Cancel::never())
+}
+
+/// [`csd_matrix`] polling `cancel` before each segment.
+///
+/// Errors: those of [`csd_matrix`], and [`SpectralError::Cancelled`] once `cancel` is set.
+pub fn csd_matrix_cancellable(
+    channels: &[&[f64]],
+    fs_hz: f64,
+    cfg: &WelchConfig,
+    cancel: &Cancel,
+) -> Result<CrossSpectra, SpectralError> {
     if channels.is_empty() {
         return Err(SpectralError::NoChannels);
     }
@@ -463,7 +487,7 @@ pub fn csd_matrix(
         },
         cfg.kept_bytes(n, channels.len()),
     )?;
-    let mut acc = WelchAccumulator::new(channels.len(), fs_hz, cfg)?;
+    let mut acc = WelchAccumulator::new(channels.len(), fs_hz, cfg)?.with_cancel(cancel.clone());
     acc.reserve_segments(n_segments);
     acc.push(channels)?;
     acc.finish()

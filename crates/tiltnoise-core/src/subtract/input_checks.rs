@@ -6,13 +6,14 @@
 
 use super::SubtractError;
 use crate::error::Num;
-use crate::model::{Observable, TiltAxis};
+use crate::model::{Input, Observable};
 use crate::spectral::CrossSpectra;
 
-/// The names of the tilt axes and then of the measured observables, for messages:
+/// The names of the witness's inputs and then of the measured observables, for messages:
 /// `eta_t of the tilt record`, `X of the measured record`.
-pub(super) fn channel_names(axes: &[TiltAxis], outputs: &[Observable]) -> Vec<String> {
-    axes.iter()
+pub(super) fn channel_names(inputs: &[Input], outputs: &[Observable]) -> Vec<String> {
+    inputs
+        .iter()
         .map(|a| format!("{} of the tilt record", a.name()))
         .chain(
             outputs
@@ -99,7 +100,10 @@ mod tests {
 
     #[test]
     fn dead_and_non_finite_channels_are_named() {
-        let names = channel_names(&[TiltAxis::EtaT], &[Observable::X, Observable::Phi]);
+        let names = channel_names(
+            &[Input::Tilt(crate::model::TiltAxis::EtaT)],
+            &[Observable::X, Observable::Phi],
+        );
         assert_eq!(names[1], "X of the measured record");
         let noise: Vec<f64> = (0..256).map(|k| ((k * 37 % 101) as f64).sin()).collect();
         let zero = vec![0.0; 256];

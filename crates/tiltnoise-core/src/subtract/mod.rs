@@ -1,8 +1,9 @@
-//! Tilt subtraction: how much of a measured record of the observables is floor tilt, how well
-//! the model's coupling matches the data, and what is left once it is removed.
+//! Tilt subtraction: how much of a measured record of the observables is floor motion, how
+//! well the model's coupling matches the data, and what is left once it is removed.
 //!
-//! Inputs: a tilt record (the witness: angle series in the crate's sign convention, one per
-//! axis) and a measured record of some observables (m, rad), each with its sample rate and,
+//! Inputs: a witness record (series of the model's floor inputs, such as the tilt angles in
+//! the crate's sign convention, one per input), optionally the witness's own noise per input,
+//! and a measured record of some observables (m, rad), each with its sample rate and,
 //! optionally, the ISO 8601 time of its first sample. The pipeline ([`subtract`]):
 //!
 //! 1. **Alignment** ([`align()`]): by start times to the nearest sample (the fraction of a sample
@@ -11,14 +12,17 @@
 //!    resampled.
 //! 2. **Split**: the first part of the overlap trains (fit, Wiener filter), the last
 //!    `holdout_fraction` of it validates.
-//! 3. **Fit** ([`estimate`]): a gain per tilt axis (the tiltmeter's calibration), a delay (the
-//!    clocks' offset) and any chosen model parameters, by errors-in-variables-corrected
-//!    weighted least squares on the Welch cross spectra, with uncertainties; parameters the data
-//!    cannot constrain are held at their nominal values and reported as such.
-//! 4. **Prediction** ([`predict`]): the tilt part of each observable in the time domain
-//!    through the fitted model (exact frequency-domain filtering of the whole overlap), and the
-//!    cleaned record `measured - predicted`.
-//! 5. **Residuals** ([`residuals`]): on the held-out stretch, the cleaned residual against
+//! 3. **Fit** ([`estimate`]): a gain per witness input (the instrument's calibration), a delay
+//!    (the clocks' offset), any chosen model parameters and the scales of uncertain witness
+//!    noise levels, by weighted least squares on the Welch cross spectra given the witness
+//!    noise, with uncertainties; parameters the data cannot constrain are held at their
+//!    nominal values and reported as such.
+//! 4. **Prediction** ([`predict`]): the floor part of each observable in the time domain
+//!    through the fitted model, weighted per bin by what the witness knows of the floor motion
+//!    given its noise ([`weighting`]), and the cleaned record `measured - predicted`.
+//! 5. **Check** ([`bands`]): per 1/3-decade band, the cleaned record against the raw one and
+//!    against the residual the model expects; a band where it is worse is left raw.
+//! 6. **Residuals** ([`residuals`]): on the held-out stretch, the cleaned residual against
 //!    the readout, against the residual the coherence allows, and against a data-driven
 //!    multiple-input Wiener filter trained on the training stretch.
 //!
@@ -29,21 +33,34 @@
 //! `simulate` (nothing else; no I/O).
 
 pub mod align;
+pub mod bands;
+pub mod colocated;
 pub mod estimate;
 mod input_checks;
+mod parameters;
 pub mod predict;
+mod problem;
 pub mod residuals;
 pub mod stats;
+pub mod weighting;
 
+pub use crate::noise::{NoiseLevel, WitnessNoise};
 pub use align::{align, Alignment, StartTime};
+pub use bands::{Band, BandCheck};
+pub use colocated::{ColocatedEstimate, Method};
 pub use estimate::{Estimate, FitReport, FitRequest, Status};
+pub use parameters::{FREE_ENVIRONMENT_KEY, FREE_SECTIONS};
 pub use predict::{Coupling, Prediction};
 pub use residuals::{BandSummary, ResidualSpectra};
 
 use crate::error::{Num, TfError};
-use crate::model::{Model, Observable, TiltAxis};
+use crate::model::{Input, Model, Observable};
 use crate::params::Params;
+use crate::spectral::confidence::equivalent_averages;
 use crate::spectral::{csd_matrix, welch, SpectralError, WelchConfig};
+use nalgebra::DVector;
+use num_complex::Complex64;
+use weighting::{prediction_margin, weighting as weigh, WitnessSpectra};
 
 /// Default held-out fraction of the overlap.
 pub const DEFAULT_HOLDOUT_FRACTION: f64 = 0.25;
@@ -70,14 +87,15 @@ pub const DEFAULT_MAX_DELAY_FRACTION: f64 = 0.05;
 /// Largest delay allowed, as a fraction of the segment.
 pub const MAX_DELAY_FRACTION: f64 = 0.1;
 
-/// The tilt record: angle series (rad), crate sign convention.
+/// The witness record: one series per model input of the floor (tilt angles in rad, in the
+/// crate's sign convention), each in the input's unit.
 #[derive(Debug, Clone, Copy)]
-pub struct TiltRecord<'a> {
+pub struct WitnessRecord<'a> {
     /// Sample rate (Hz).
     pub fs_hz: f64,
-    /// Axes, canonical order.
-    pub axes: &'a [TiltAxis],
-    /// One series per axis, equal lengths.
+    /// The inputs, each once.
+    pub inputs: &'a [Input],
+    /// One series per input, equal lengths.
     pub data: &'a [Vec<f64>],
     /// Time of the first sample, if known.
     pub start: Option<StartTime>,
@@ -107,8 +125,12 @@ pub struct SubtractConfig {
     pub fit_band_hz: Option<(f64, f64)>,
     /// Largest delay magnitude (s); `None`: [`DEFAULT_MAX_DELAY_FRACTION`] of a segment.
     pub max_delay_s: Option<f64>,
-    /// White noise of the tilt record per axis: one-sided ASD (rad/sqrt(Hz)).
-    pub witness_noise_asd: Vec<(TiltAxis, f64)>,
+    /// The witnesses' own noise per input (none: taken as noiseless, unless co-located records
+    /// estimate it).
+    pub witness_noise: Vec<WitnessNoise>,
+    /// The ratio `r` of a co-located instrument's noise ASD to the witness's, per input, for
+    /// a huddle (two instruments); 1 (equal noise) when not stated.
+    pub colocated_noise_ratio: Vec<(Input, f64)>,
     /// White readout of the measured observables: one-sided ASD (unit/sqrt(Hz)).
     pub readout_asd: Vec<(Observable, f64)>,
     /// Band of the residual summaries (Hz).
@@ -123,7 +145,8 @@ impl Default for SubtractConfig {
             keys: Vec::new(),
             fit_band_hz: None,
             max_delay_s: None,
-            witness_noise_asd: Vec::new(),
+            witness_noise: Vec::new(),
+            colocated_noise_ratio: Vec::new(),
             readout_asd: Vec::new(),
             report_band_hz: DEFAULT_REPORT_BAND_HZ,
         }
@@ -147,10 +170,17 @@ pub struct SubtractResult {
     pub fit: FitReport,
     /// Largest delay allowed (s).
     pub max_delay_s: f64,
-    /// Predicted tilt part per observable over the overlap.
+    /// The witnesses' noise as used (after any fitted scale), per input: the PSD on the Welch
+    /// grid (unit^2/Hz).
+    pub witness_noise_psd: Vec<(Input, Vec<f64>)>,
+    /// The noise levels estimated from co-located records.
+    pub colocated: Vec<ColocatedEstimate>,
+    /// Predicted floor part per observable over the overlap, as subtracted.
     pub prediction: Prediction,
     /// Measured minus predicted, per observable, over the overlap.
     pub cleaned: Vec<(Observable, Vec<f64>)>,
+    /// The check of the cleaned record against the raw one, per observable.
+    pub bands: Vec<(Observable, BandCheck)>,
     /// Residual spectra and band summaries on the held-out stretch.
     pub residuals: Vec<ResidualSpectra>,
     /// Notes for the provenance.
@@ -225,14 +255,22 @@ pub enum SubtractError {
     /// No usable bin in the fit band.
     #[error(
         "no bin of the fit band {} .. {} Hz is usable (every one is near a resonance of the \
-         model, or the tilt record has no power above its own noise there); choose another \
-         band with --band",
+         model, or the witness records no floor motion above its own noise there); choose \
+         another band with --band",
         Num(.band_hz.0), Num(.band_hz.1)
     )]
     NoFitBins {
         /// The band (Hz).
         band_hz: (f64, f64),
     },
+    /// The witness is coherent with no observable.
+    #[error(
+        "the witness record is not coherent with any measured observable at any frequency (its \
+         multiple coherence is what noise alone gives): it cannot be subtracted; check that the \
+         records overlap in time, their axis maps and sign conventions, or give a fit band with \
+         --band"
+    )]
+    NotCoherent,
     /// A key that is not a parameter.
     #[error("--fit: unknown parameter key `{}`; allowed: {allowed}", crate::error::Shown(.key))]
     UnknownKey {
@@ -285,21 +323,23 @@ fn pow2_floor(n: usize) -> usize {
 /// # Errors
 ///
 /// Every refusal of [`SubtractError`]: records that do not overlap or do not share a rate,
-/// an overlap too short for the Welch segment, options out of range, bad fit keys.
+/// an overlap too short for the Welch segment, options out of range, bad fit keys, witness
+/// noise spectra that do not cover the Welch band.
 pub fn subtract(
     params: &Params,
-    tilt: &TiltRecord,
+    witness: &WitnessRecord,
+    colocated: &[WitnessRecord],
     measured: &MeasuredRecord,
     cfg: &SubtractConfig,
 ) -> Result<SubtractResult, SubtractError> {
-    let n_w = tilt.data.first().map_or(0, Vec::len);
+    let n_w = witness.data.first().map_or(0, Vec::len);
     let n_m = measured.channels.first().map_or(0, |c| c.1.len());
     let alignment = align(
-        (tilt.fs_hz, n_w, tilt.start),
+        (witness.fs_hz, n_w, witness.start),
         (measured.fs_hz, n_m, measured.start),
     )?;
     let fs = alignment.fs_hz;
-    check_config(tilt, measured, cfg)?;
+    check_config(witness, measured, cfg)?;
     let n = alignment.len;
     let n_hold = (n as f64 * cfg.holdout_fraction).round() as usize;
     let n_train = n - n_hold;
@@ -342,7 +382,9 @@ pub fn subtract(
         }
         None => DEFAULT_MAX_DELAY_FRACTION * segment_s,
     };
-    let w: Vec<&[f64]> = tilt
+    let inputs = witness.inputs;
+    let n_in = inputs.len();
+    let w: Vec<&[f64]> = witness
         .data
         .iter()
         .map(|x| &x[alignment.witness_first..alignment.witness_first + n])
@@ -353,81 +395,194 @@ pub fn subtract(
         .map(|(_, x)| &x[alignment.measured_first..alignment.measured_first + n])
         .collect();
     let outputs: Vec<Observable> = measured.channels.iter().map(|c| c.0).collect();
-    let channel_names = input_checks::channel_names(tilt.axes, &outputs);
+    let channel_names = input_checks::channel_names(inputs, &outputs);
     input_checks::check_channels(&channel_names, &w, &y)?;
     let welch_cfg = WelchConfig::new(segment_len);
-    let step = segment_len - welch_cfg.overlap;
     let train: Vec<&[f64]> = w.iter().chain(&y).map(|x| &x[..n_train]).collect();
     let training_spectra = csd_matrix(&train, fs, &welch_cfg)?;
     input_checks::check_spectra(&training_spectra, &channel_names, "training")?;
-    let n_eff_train = stats::effective_averages(segment_len, step, training_spectra.n_segments);
-    let witness_noise_psd: Vec<f64> = tilt
-        .axes
+    let n_eff_train = equivalent_averages(&welch_cfg, training_spectra.n_segments);
+    let adjacent = stats::bin_variance_factor(segment_len, 1);
+    let witness_spectra = WitnessSpectra::new(&training_spectra, n_in, n_eff_train, adjacent);
+    let freqs = &training_spectra.freqs_hz;
+    let colocated =
+        colocated::estimate_all(witness, colocated, &cfg.colocated_noise_ratio, segment_len)?;
+    let mut noise = cfg.witness_noise.clone();
+    for e in &colocated {
+        if noise.iter().any(|x| x.input == e.noise.input) {
+            return Err(SubtractError::Config(format!(
+                "--witness-noise {}: the noise of {} is also estimated from the co-located \
+                 records; give one or the other",
+                e.noise.input.name(),
+                e.noise.input.name()
+            )));
+        }
+        noise.push(e.noise.clone());
+    }
+    let noise_psd = noise_on_grid(inputs, &noise, freqs)?;
+    let noise_rel: Vec<f64> = inputs
         .iter()
-        .map(|a| {
-            cfg.witness_noise_asd
-                .iter()
-                .find(|(x, _)| x == a)
-                .map_or(0.0, |(_, asd)| asd * asd)
-        })
+        .map(|i| noise.iter().find(|x| x.input == *i).map_or(0.0, |x| x.rel))
         .collect();
     let fit = estimate::fit(
         params,
-        tilt.axes,
+        inputs,
         &outputs,
         &estimate::Training {
             spectra: &training_spectra,
+            witness: &witness_spectra,
             fs_hz: fs,
             segment_len,
             n_eff: n_eff_train,
-            n_segments: training_spectra.n_segments,
         },
         alignment.fraction_s,
         &FitRequest {
             keys: cfg.keys.clone(),
             band_hz: cfg.fit_band_hz,
             max_delay_s,
-            witness_noise_psd,
+            noise_psd: noise_psd.clone(),
+            noise_rel,
         },
     )?;
-    let gains: Vec<f64> = tilt
-        .axes
+    let noise_psd: Vec<Vec<f64>> = noise_psd
         .iter()
-        .map(|a| {
-            fit.estimates
-                .iter()
-                .find(|e| e.name == format!("gain.{}", a.name()))
-                .map_or(1.0, |e| e.value)
-        })
+        .zip(&fit.noise_factors)
+        .map(|(m, k)| m.iter().map(|v| v * k).collect())
         .collect();
-    let delay_s = fit
-        .estimates
-        .iter()
-        .find(|e| e.name == "delay_s")
-        .map_or(0.0, |e| e.value);
+    let noise_at = |k: usize| -> Vec<f64> { noise_psd.iter().map(|m| m[k]).collect() };
+    let coupling = Coupling {
+        gains: inputs
+            .iter()
+            .map(|i| {
+                fit.estimates
+                    .iter()
+                    .find(|e| e.name == format!("gain.{}", i.name()))
+                    .map_or(1.0, |e| e.value)
+            })
+            .collect(),
+        delay_s: fit
+            .estimates
+            .iter()
+            .find(|e| e.name == "delay_s")
+            .map_or(0.0, |e| e.value)
+            - alignment.fraction_s,
+    };
     let fitted_model = Model::new(&fit.params).map_err(|e| SubtractError::Params(e.to_string()))?;
-    let prediction = predict::predict(
-        &fitted_model,
-        fs,
-        tilt.axes,
-        &w,
+    let weights = predict::Weights {
+        freqs_hz: freqs[1..].to_vec(),
+        at: (1..freqs.len())
+            .map(|k| {
+                let margin = prediction_margin(witness_spectra.dof[k]);
+                weigh(&witness_spectra.smoothed[k], &noise_at(k), margin).at
+            })
+            .collect(),
+    };
+    let predictor =
+        predict::predictor(&fitted_model, fs, inputs, &w, &outputs, &coupling, &weights)?;
+    let model_spectra = model_spectra(
+        &fit.params,
+        inputs,
         &outputs,
-        &Coupling {
-            gains,
-            delay_s: delay_s - alignment.fraction_s,
-        },
+        &coupling,
+        &witness_spectra,
+        &noise_at,
     )?;
-    let cleaned: Vec<(Observable, Vec<f64>)> = prediction
-        .series
-        .iter()
-        .zip(&y)
-        .map(|((o, p), m)| (*o, m.iter().zip(p).map(|(a, b)| a - b).collect()))
+
+    // The cleaned record against the raw one, band by band, before it is written; the
+    // residual expected of it is the coherence limit of the whole overlap.
+    let whole: Vec<&[f64]> = w.iter().chain(&y).copied().collect();
+    let whole_spectra = csd_matrix(&whole, fs, &welch_cfg)?;
+    let n_segments_whole = whole_spectra.n_segments;
+    let n_eff_whole = equivalent_averages(&welch_cfg, n_segments_whole);
+    let raw_psd: Vec<Vec<f64>> = (0..outputs.len())
+        .map(|o| whole_spectra.psd(n_in + o))
         .collect();
+    let coherence_limit: Vec<Vec<f64>> = (0..outputs.len())
+        .map(|o| residuals::coherence_limit(&whole_spectra, n_in, n_in + o, n_eff_whole))
+        .collect();
+    let mut left: Vec<Vec<(f64, f64)>> = vec![Vec::new(); outputs.len()];
+    let mut whole_left = vec![false; outputs.len()];
+    let (prediction, cleaned, bands) = loop {
+        let mask = |o: usize, f: f64| {
+            if whole_left[o] {
+                0.0
+            } else {
+                bands::mask(&left[o], f)
+            }
+        };
+        let mut prediction = predictor.series(&mask);
+        for (o, (_, p)) in prediction.series.iter_mut().enumerate() {
+            if whole_left[o] {
+                p.iter_mut().for_each(|v| *v = 0.0);
+            }
+        }
+        let cleaned: Vec<(Observable, Vec<f64>)> = prediction
+            .series
+            .iter()
+            .zip(&y)
+            .map(|((o, p), m)| (*o, m.iter().zip(p).map(|(a, b)| a - b).collect()))
+            .collect();
+        let mut new_left: Vec<(usize, (f64, f64))> = Vec::new();
+        let mut new_whole: Vec<usize> = Vec::new();
+        let mut checks = Vec::with_capacity(outputs.len());
+        for (o, (obs, c)) in cleaned.iter().enumerate() {
+            let cleaned_psd = welch(c, fs, &welch_cfg)?.psd;
+            let ms = &model_spectra[o];
+            let expected: Vec<f64> = (0..freqs.len())
+                .map(|k| {
+                    let c = ms.guard[k] * mask(o, freqs[k]);
+                    raw_psd[o][k] - c * (2.0 - c) * (raw_psd[o][k] - coherence_limit[o][k])
+                })
+                .collect();
+            let judged = bands::judge(
+                freqs,
+                &bands::BinSpectra {
+                    raw: &raw_psd[o],
+                    cleaned: &cleaned_psd,
+                    expected: &expected,
+                    witness_limited: &ms.witness_limited,
+                },
+                &welch_cfg,
+                n_segments_whole,
+                &left[o],
+            );
+            let variance_ratio = variance(c) / variance(y[o]);
+            if !whole_left[o] {
+                let worse: Vec<(usize, (f64, f64))> = judged
+                    .iter()
+                    .filter(|b| b.ratio > 1.0 && !b.left_raw)
+                    .map(|b| (o, (b.lo_hz, b.hi_hz)))
+                    .collect();
+                if worse.is_empty() && variance_ratio > 1.0 {
+                    new_whole.push(o);
+                }
+                new_left.extend(worse);
+            }
+            checks.push((
+                *obs,
+                BandCheck {
+                    bands: judged,
+                    variance_ratio,
+                    left_raw: whole_left[o],
+                },
+            ));
+        }
+        let changed = !(new_left.is_empty() && new_whole.is_empty());
+        for (o, band) in new_left {
+            left[o].push(band);
+        }
+        for o in new_whole {
+            whole_left[o] = true;
+        }
+        if !changed {
+            break (prediction, cleaned, checks);
+        }
+    };
 
     let held: Vec<&[f64]> = w.iter().chain(&y).map(|x| &x[n_train..]).collect();
     let held_spectra = csd_matrix(&held, fs, &welch_cfg)?;
     input_checks::check_spectra(&held_spectra, &channel_names, "held-out")?;
-    let n_eff_held = stats::effective_averages(segment_len, step, held_spectra.n_segments);
+    let n_eff_held = equivalent_averages(&welch_cfg, held_spectra.n_segments);
     let psds = |series: &[(Observable, Vec<f64>)]| -> Result<Vec<Vec<f64>>, SubtractError> {
         series
             .iter()
@@ -436,7 +591,7 @@ pub fn subtract(
     };
     let predicted_psd = psds(&prediction.series)?;
     let cleaned_psd = psds(&cleaned)?;
-    let wiener = residuals::Wiener::train(&training_spectra, tilt.axes.len(), outputs.len());
+    let wiener = residuals::Wiener::train(&training_spectra, n_in, outputs.len(), n_eff_train);
     let report_band = cfg.report_band_hz;
     let grid = &held_spectra.freqs_hz;
     if grid
@@ -457,8 +612,8 @@ pub fn subtract(
             predicted_psd: &predicted_psd,
             cleaned_psd: &cleaned_psd,
             n_eff: n_eff_held,
-            n_segments: held_spectra.n_segments,
-            bin_variance_factor: stats::bin_variance_factor(segment_len, 1),
+            bin_variance_factor: adjacent,
+            witness_limited: &model_spectra,
         },
         &outputs,
         &cfg.readout_asd,
@@ -468,14 +623,33 @@ pub fn subtract(
     notes.extend(fit.notes.iter().cloned());
     for (o, bands) in &prediction.guarded {
         if !bands.is_empty() {
-            let list: Vec<String> = bands
-                .iter()
-                .map(|(a, b)| format!("{} .. {} Hz", Num(*a), Num(*b)))
-                .collect();
             notes.push(format!(
                 "{}: not predicted near the model's undamped resonances ({})",
                 o.name(),
-                list.join(", ")
+                band_list(bands)
+            ));
+        }
+    }
+    for (o, check) in &bands {
+        if check.left_raw {
+            notes.push(format!(
+                "{}: left raw entirely: the prediction would have raised the record's variance \
+                 (by a factor {:.3}); check the witness, its noise level and the model",
+                o.name(),
+                check.variance_ratio
+            ));
+            continue;
+        }
+        let worse: Vec<&Band> = check.bands.iter().filter(|b| b.left_raw).collect();
+        if !worse.is_empty() {
+            let edges: Vec<(f64, f64)> = worse
+                .iter()
+                .map(|b| (b.lo_hz, b.hi_hz.min(fs / 2.0)))
+                .collect();
+            notes.push(format!(
+                "{}: left raw in {} (the prediction did not lower the record there)",
+                o.name(),
+                band_list(&edges)
             ));
         }
     }
@@ -498,15 +672,130 @@ pub fn subtract(
         n_eff: (n_eff_train, n_eff_held),
         fit,
         max_delay_s,
+        witness_noise_psd: inputs.iter().copied().zip(noise_psd.clone()).collect(),
+        colocated,
         prediction,
         cleaned,
+        bands,
         residuals,
         notes,
     })
 }
 
+/// `a .. b Hz, ...`.
+fn band_list(bands: &[(f64, f64)]) -> String {
+    bands
+        .iter()
+        .map(|(a, b)| format!("{} .. {} Hz", Num(*a), Num(*b)))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Variance about the mean.
+fn variance(x: &[f64]) -> f64 {
+    let n = x.len() as f64;
+    let mean = x.iter().sum::<f64>() / n;
+    x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n
+}
+
+/// The witnesses' noise PSDs `[input][Welch bin]` (DC: that of bin 1); zeros for an input
+/// without a stated noise.
+fn noise_on_grid(
+    inputs: &[Input],
+    noise: &[WitnessNoise],
+    freqs: &[f64],
+) -> Result<Vec<Vec<f64>>, SubtractError> {
+    inputs
+        .iter()
+        .map(|i| match noise.iter().find(|x| x.input == *i) {
+            None => Ok(vec![0.0; freqs.len()]),
+            Some(x) => {
+                let mut psd = x.psd_on(&freqs[1..]).map_err(SubtractError::Config)?;
+                psd.insert(0, psd[0]);
+                Ok(psd)
+            }
+        })
+        .collect()
+}
+
+/// What the model says of one observable on the Welch grid.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelSpectra {
+    /// The prediction's guard factor near the resonances ([`predict`]), per bin.
+    pub guard: Vec<f64>,
+    /// PSD of the witness-limited residual `G^H R G` (unit^2/Hz), the tilt PSD taken as zero
+    /// where it is not significantly above the witness noise.
+    pub witness_limited: Vec<f64>,
+    /// Per input, the scalar witness-limited residual `|G_a|^2 S_tt S_mm / S_ww` of that
+    /// input alone.
+    pub witness_limited_by_input: Vec<Vec<f64>>,
+}
+
+/// [`ModelSpectra`] of every output with the fitted coupling.
+fn model_spectra(
+    fitted: &Params,
+    inputs: &[Input],
+    outputs: &[Observable],
+    coupling: &Coupling,
+    witness: &WitnessSpectra,
+    noise_at: &dyn Fn(usize) -> Vec<f64>,
+) -> Result<Vec<ModelSpectra>, SubtractError> {
+    let n_in = inputs.len();
+    let freqs = &witness.freqs_hz;
+    let grid = &freqs[1..];
+    let request = crate::model::Request {
+        outputs: outputs.to_vec(),
+        inputs: inputs.to_vec(),
+    };
+    let at = |scale: f64| -> Result<Vec<Complex64>, SubtractError> {
+        let f: Vec<f64> = grid.iter().map(|f| f * scale).collect();
+        problem::transfer(fitted, &request, &f)
+    };
+    let h = at(1.0)?;
+    let h_up = at(1.0 + predict::FREQ_ERROR_REL)?;
+    let h_down = at(1.0 - predict::FREQ_ERROR_REL)?;
+    let block = outputs.len() * n_in;
+    Ok((0..outputs.len())
+        .map(|o| {
+            let mut ms = ModelSpectra {
+                guard: vec![0.0; freqs.len()],
+                witness_limited: vec![0.0; freqs.len()],
+                witness_limited_by_input: vec![vec![0.0; freqs.len()]; n_in],
+            };
+            for (g, &f) in grid.iter().enumerate() {
+                let k = g + 1;
+                let rows = g * block + o * n_in..g * block + (o + 1) * n_in;
+                ms.guard[k] = predict::guard_factor(predict::sensitivity(
+                    &h[rows.clone()],
+                    &h_up[rows.clone()],
+                    &h_down[rows.clone()],
+                ));
+                let phase =
+                    Complex64::from_polar(1.0, -std::f64::consts::TAU * f * coupling.delay_s);
+                let gv =
+                    DVector::from_fn(n_in, |a, _| h[rows.start + a] * coupling.gains[a] * phase);
+                let sbar = &witness.smoothed[k];
+                let noise = noise_at(k);
+                let margin = prediction_margin(witness.dof[k]);
+                let wgt = weigh(sbar, &noise, margin);
+                ms.witness_limited[k] = (gv.adjoint() * &wgt.limit * &gv)[(0, 0)].re.max(0.0);
+                for a in 0..n_in {
+                    let s = sbar[(a, a)].re;
+                    let tt = (s - margin * noise[a]).max(0.0);
+                    ms.witness_limited_by_input[a][k] = if s > 0.0 {
+                        gv[a].norm_sqr() * tt * noise[a] / s
+                    } else {
+                        0.0
+                    };
+                }
+            }
+            ms
+        })
+        .collect())
+}
+
 fn check_config(
-    tilt: &TiltRecord,
+    witness: &WitnessRecord,
     measured: &MeasuredRecord,
     cfg: &SubtractConfig,
 ) -> Result<(), SubtractError> {
@@ -518,22 +807,40 @@ fn check_config(
             Num(f)
         )));
     }
-    for (axis, asd) in &cfg.witness_noise_asd {
-        if !tilt.axes.contains(axis) {
+    for (i, input) in witness.inputs.iter().enumerate() {
+        if !matches!(input, Input::Tilt(_)) {
             return Err(SubtractError::Config(format!(
-                "--tilt-noise {}: the tilt record has no axis {}; it has {}",
-                axis.name(),
-                axis.name(),
-                names(tilt.axes.iter().map(|a| a.name()))
+                "the witness record's channel {} is not a motion of the floor; a witness records \
+                 floor inputs of the model (theta_t, eta_t, phi_t)",
+                input.name()
             )));
         }
-        if !(asd.is_finite() && *asd >= 0.0) {
+        if witness.inputs[..i].contains(input) {
             return Err(SubtractError::Config(format!(
-                "--tilt-noise {}={}: the ASD (rad/sqrt(Hz)) must be finite and >= 0",
-                axis.name(),
-                Num(*asd)
+                "the witness record has input {} twice; give each input once",
+                input.name()
             )));
         }
+    }
+    for (input, r) in &cfg.colocated_noise_ratio {
+        if !(r.is_finite() && *r > 0.0) {
+            return Err(SubtractError::Config(format!(
+                "--colocated-ratio {}={}: the ratio of noise ASDs must be finite and > 0",
+                input.name(),
+                Num(*r)
+            )));
+        }
+    }
+    for x in &cfg.witness_noise {
+        if !witness.inputs.contains(&x.input) {
+            return Err(SubtractError::Config(format!(
+                "--witness-noise {}: the witness record has no input {}; it has {}",
+                x.input.name(),
+                x.input.name(),
+                names(witness.inputs.iter().map(|a| a.name()))
+            )));
+        }
+        x.check("--witness-noise").map_err(SubtractError::Config)?;
     }
     for (o, asd) in &cfg.readout_asd {
         if !measured.channels.iter().any(|c| c.0 == *o) {

@@ -10,15 +10,8 @@
 //! a large allocation with `madvise(MADV_HUGEPAGE)` before anything touches it (the default
 //! THP policy of many distributions is `madvise`: huge pages only where asked for). NumPy does
 //! the same for its large arrays. Elsewhere, or when the advice is refused, the buffer is an
-//! ordinary zeroed vector: the advice changes speed only, never values.
-//!
-//! Measured on the 2-core EPYC VM of `scripts/bench/README.md` (`benches/methods.rs`, Table
-//! I's 7x3 tilt matrix, with and without the advice, alternating runs): `tf::evaluate` at 1e6
-//! points (an 88 MB result, mapped afresh by the allocator at every call) 17.1 to 18.6 ns per
-//! point with the advice, 50.5 to 50.8 without (fresh 4 KiB pages cost about 2.6 us each to
-//! fault in here); at 1e5 points (8.8 MB) 8.8 against 8.9: glibc keeps a freed block of that
-//! size for the next call, so no page is new; the dense complex output (34 MB) into a reused
-//! buffer 11.7 to 12.0 against 12.5 to 12.9 (fewer TLB misses).
+//! ordinary zeroed vector: the advice changes speed only, never values. What it gains is
+//! measured by `benches/methods.rs` (figures in `scripts/bench/README.md`, "Huge pages").
 
 use num_complex::Complex64;
 
@@ -43,6 +36,10 @@ pub fn zeroed_f64(len: usize) -> Vec<f64> {
 }
 
 /// [`zeroed_f64`] for complex values: `len` zeros, huge pages advised when large.
+#[allow(
+    unsafe_code,
+    reason = "reinterprets a zeroed f64 allocation as Complex64"
+)]
 pub fn zeroed_complex(len: usize) -> Vec<Complex64> {
     let mut v = std::mem::ManuallyDrop::new(zeroed_f64(2 * len));
     if v.capacity() != v.len() {
@@ -60,6 +57,7 @@ pub fn zeroed_complex(len: usize) -> Vec<Complex64> {
 /// `madvise(MADV_HUGEPAGE)` on the whole 2 MiB pages inside `[ptr, ptr + bytes)`; a refusal
 /// (no THP in this kernel, policy `never`) is ignored: the pages stay ordinary.
 #[cfg(target_os = "linux")]
+#[allow(unsafe_code, reason = "madvise has no safe wrapper")]
 fn advise_huge_pages(ptr: usize, bytes: usize) {
     let start = ptr.next_multiple_of(HUGE_PAGE_BYTES);
     let end = (ptr + bytes) / HUGE_PAGE_BYTES * HUGE_PAGE_BYTES;

@@ -4,6 +4,7 @@
 
 use super::buffer::zeroed_f64;
 use super::{Request, TransferFunction, TransferMatrix};
+use crate::cancel::Cancel;
 use crate::error::TfError;
 use crate::limits::{check_memory, planned_bytes, GRID_BYTES_PER_ENTRY};
 use num_complex::Complex64;
@@ -34,10 +35,12 @@ type Slot<'f, J> = Mutex<Option<(&'f [f64], J)>>;
 /// threads (`std::thread::scope`; one of them the calling thread) that take the parts in grid
 /// order, each the next one not yet taken: a thread that starts late or runs slower (a core
 /// that was idle, or shared with other work) takes fewer. The error of the first failing part
-/// in grid order; no part after it is started once it is known.
+/// in grid order; no part after it is started once it is known. `cancel` is polled before each
+/// part is taken ([`MAX_PART_POINTS`] bounds the work between two polls).
 fn on_threads<'f, J: Send>(
     jobs: impl Iterator<Item = (&'f [f64], J)>,
     threads: usize,
+    cancel: &Cancel,
     eval: &EvalPart<'_, J>,
 ) -> Result<(), TfError> {
     let jobs: Vec<Slot<'_, J>> = jobs.map(|j| Mutex::new(Some(j))).collect();
@@ -47,6 +50,9 @@ fn on_threads<'f, J: Send>(
         let k = next.fetch_add(1, Ordering::Relaxed);
         let Some(slot) = jobs.get(k) else { break };
         if lock(&first_error).as_ref().is_some_and(|(bad, _)| *bad < k) {
+            break;
+        }
+        if cancel.is_cancelled() {
             break;
         }
         let (f, o) = lock(slot).take().expect("each part is taken once");
@@ -64,6 +70,7 @@ fn on_threads<'f, J: Send>(
         }
         work();
     });
+    cancel.check()?;
     first_error
         .into_inner()
         .unwrap_or_else(PoisonError::into_inner)
@@ -110,26 +117,32 @@ pub const STREAM_MIN_BYTES: usize = 8 << 20;
 
 /// Grid points per part handed to a thread: `threads` (0 means 1) each take about
 /// [`PARTS_PER_THREAD`] parts of at least [`MIN_PART_POINTS`] points (one part per thread if
-/// that leaves fewer), at least one point each.
+/// that leaves fewer), at least one point each, at most [`MAX_PART_POINTS`].
 fn part_len(n_freqs: usize, threads: usize) -> usize {
     let threads = threads.max(1);
     if threads == 1 {
-        return n_freqs.max(1);
+        return n_freqs.clamp(1, MAX_PART_POINTS);
     }
     let even = n_freqs.div_ceil(threads);
     n_freqs
         .div_ceil(threads * PARTS_PER_THREAD)
         .max(MIN_PART_POINTS)
         .min(even)
-        .max(1)
+        .clamp(1, MAX_PART_POINTS)
 }
+
+/// Largest part of a grid: bounds the work between two polls of the cancellation token
+/// (`benches/cancel.rs` measures what it takes to stop), while the start of a part stays
+/// negligible against it.
+const MAX_PART_POINTS: usize = 1 << 14;
 
 /// Parts per thread of a grid evaluated on several threads: enough that a thread which
 /// starts late or runs slower hands its share to the others.
 const PARTS_PER_THREAD: usize = 8;
 
 /// Smallest part of a grid handed to a thread: a part costs a few microseconds to start
-/// (a chunk buffer, the dispatch), small against 2048 points of about 10 ns each.
+/// (a chunk buffer, the dispatch), small against the work of 2048 points even with the
+/// cheapest method (`benches/methods.rs`).
 const MIN_PART_POINTS: usize = 2048;
 
 /// [`TransferFunction::eval_grid_into`] (dense `[freq][output][input]` complex values) with
@@ -151,6 +164,23 @@ pub fn eval_grid_threads(
     threads: usize,
     destination: Destination,
 ) -> Result<(), TfError> {
+    eval_grid_threads_cancellable(tf, freqs_hz, out, threads, destination, &Cancel::never())
+}
+
+/// [`eval_grid_threads`] polling `cancel` between the parts of the grid:
+/// [`TfError::Cancelled`] once it is set, the output then holding unspecified values.
+///
+/// # Panics
+///
+/// If `out` has the wrong length.
+pub fn eval_grid_threads_cancellable(
+    tf: &dyn TransferFunction,
+    freqs_hz: &[f64],
+    out: &mut [Complex64],
+    threads: usize,
+    destination: Destination,
+    cancel: &Cancel,
+) -> Result<(), TfError> {
     let block = check_grid_len(tf.request(), freqs_hz, out);
     if block == 0 || freqs_hz.is_empty() {
         return tf.eval_grid_into_dest(freqs_hz, out, destination);
@@ -163,7 +193,7 @@ pub fn eval_grid_threads(
     let part = part_len(freqs_hz.len(), threads);
     let jobs = freqs_hz.chunks(part).zip(out.chunks_mut(part * block));
     // `eval_grid_into` checks that every value is finite (while it is in cache).
-    on_threads(jobs, threads, &|f, o| {
+    on_threads(jobs, threads, cancel, &|f, o| {
         tf.eval_grid_into_dest(f, o, destination)
     })
 }
@@ -208,6 +238,18 @@ pub fn evaluate_into(
     threads: usize,
     out: &mut TransferMatrix,
 ) -> Result<(), TfError> {
+    evaluate_into_cancellable(tf, freqs_hz, threads, out, &Cancel::never())
+}
+
+/// [`evaluate_into`] polling `cancel` between the parts of the grid: [`TfError::Cancelled`]
+/// once it is set, `out` then holding unspecified values.
+pub fn evaluate_into_cancellable(
+    tf: &dyn TransferFunction,
+    freqs_hz: &[f64],
+    threads: usize,
+    out: &mut TransferMatrix,
+    cancel: &Cancel,
+) -> Result<(), TfError> {
     let r = tf.request();
     out.freqs_hz.clear();
     out.freqs_hz.extend_from_slice(freqs_hz);
@@ -239,7 +281,7 @@ pub fn evaluate_into(
         }
     }
     let jobs = freqs_hz.chunks(part).zip(parts);
-    on_threads(jobs, threads, &|f, mut p: Vec<&mut [f64]>| {
+    on_threads(jobs, threads, cancel, &|f, mut p: Vec<&mut [f64]>| {
         // Blocks small enough that their values are still in cache when they are checked.
         let mut start = 0;
         while start < f.len() {
@@ -301,12 +343,15 @@ mod tests {
     use crate::tf::{plan, Method};
 
     /// Parts cover the grid: one per thread on one thread or a short grid, else about
-    /// `PARTS_PER_THREAD` per thread of at least `MIN_PART_POINTS`.
+    /// `PARTS_PER_THREAD` per thread of at least `MIN_PART_POINTS`; never more than
+    /// `MAX_PART_POINTS` (the work between two polls of the cancellation token).
     #[test]
     fn parts_cover_the_grid() {
         assert_eq!(part_len(0, 2), 1);
         assert_eq!(part_len(10, 0), 10);
-        assert_eq!(part_len(100_000, 1), 100_000);
+        assert_eq!(part_len(16_000, 1), 16_000);
+        assert_eq!(part_len(100_000, 1), MAX_PART_POINTS);
+        assert_eq!(part_len(100_000_000, 2), MAX_PART_POINTS);
         assert_eq!(part_len(3000, 2), 1500);
         assert_eq!(
             part_len(100_000, 2),

@@ -42,6 +42,12 @@ mod grid;
 mod matrix;
 mod modal;
 pub mod planner;
+#[allow(unsafe_code, reason = "the AVX kernel")]
+#[allow(
+    clippy::undocumented_unsafe_blocks,
+    reason = "the intrinsics of polezero/lanes.rs share one SAFETY argument, on its AVX type; \
+              each block gets its own with the type that proves the CPU feature"
+)]
 mod polezero;
 mod split;
 mod statespace;
@@ -56,7 +62,10 @@ pub use block::BlockReduced;
 pub use buffer::{zeroed_complex, zeroed_f64};
 pub use direct::{Direct, SINGULAR_RCOND};
 pub(crate) use grid::check_grid_len;
-pub use grid::{eval_grid_threads, evaluate, evaluate_into, Destination, STREAM_MIN_BYTES};
+pub use grid::{
+    eval_grid_threads, eval_grid_threads_cancellable, evaluate, evaluate_into,
+    evaluate_into_cancellable, Destination, STREAM_MIN_BYTES,
+};
 pub use matrix::{Layout, TransferMatrix};
 pub use modal::Modal;
 pub use planner::{

@@ -147,9 +147,10 @@ impl NoChoice {
     }
 }
 
-/// Candidates in order of model size, then cost per point (pole-zero ~30-90 ns, block and
-/// split ~1 us, modal ~0.3 us on the full model, direct ~3 us). The state-space method is not
-/// one: slower than direct (~6 us) and never more accurate, it is there for comparison.
+/// Candidates in order of model size, then cost per point as `tiltnoise methods` measures it
+/// (pole-zero cheapest, then modal, block and split, direct last; figures in
+/// `scripts/bench/README.md`). The state-space method is not one: slower than direct and
+/// never more accurate, it is there for comparison.
 const CANDIDATES: [(Method, usize); 6] = [
     (Method::Torsion2, 2),
     (Method::PoleZero, 4),

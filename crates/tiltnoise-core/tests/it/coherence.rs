@@ -395,7 +395,7 @@ fn records<'a>(
         Record {
             name: "--tilt synthetic",
             sample_rate_hz: 1.0,
-            start_time: starts.0,
+            start_time: starts.0.map(|t| t.parse().unwrap()),
             channels: vec![
                 (TiltAxis::ThetaT, &s.tilt[0][..]),
                 (TiltAxis::EtaT, &s.tilt[1][..]),
@@ -404,7 +404,7 @@ fn records<'a>(
         Record {
             name: "--measured synthetic",
             sample_rate_hz: 1.0,
-            start_time: starts.1,
+            start_time: starts.1.map(|t| t.parse().unwrap()),
             channels: vec![
                 (Observable::X, &s.measured[0][skip..]),
                 (Observable::Phi, &s.measured[1][skip..]),

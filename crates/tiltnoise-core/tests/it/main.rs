@@ -10,6 +10,7 @@ mod common;
 mod tolerances;
 
 mod budget_summary;
+mod cancel;
 mod coherence;
 mod energy_crosscheck;
 mod freq_grid;
@@ -24,6 +25,7 @@ mod scenes;
 mod simulate;
 mod stability;
 mod subtract;
+mod subtract_pulls;
 mod synthetic;
 mod tilt_tf;
 mod translation_tf;

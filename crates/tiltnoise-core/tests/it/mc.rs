@@ -29,6 +29,7 @@ fn cfg(samples: usize, seed: u64, threads: usize, uncertainties: Vec<Uncertainty
         seed,
         threads,
         uncertainties,
+        cancel: tiltnoise_core::cancel::Cancel::never(),
     }
 }
 

@@ -711,6 +711,7 @@ fn noisy_config() -> SimConfig {
             (Observable::PhiA, 3e-10),
         ],
         seed: 11,
+        ..SimConfig::default()
     }
 }
 

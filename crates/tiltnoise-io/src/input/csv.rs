@@ -442,7 +442,7 @@ pub(crate) fn interpret_spectra(
     let mapped: Vec<String> = resolved.channels.iter().map(|m| m.source.clone()).collect();
     let (declared, undeclared) = declared_units(path, prelude, &mapped, classify, allowed)?;
     let quantity = decide_quantity(path, opts.quantity, &declared, &undeclared, &mut notes)?;
-    let start_time = start_time(path, prelude)?;
+    let start_time = start_time(path, prelude, &mut notes)?;
     if let Some(d) = prelude.meta("description") {
         notes.push(format!("description: {}", Shown(&d.value)));
     }
@@ -572,7 +572,7 @@ pub(crate) fn interpret_series(
     notes.extend(unit_notes);
     super::check_scales(path, &opts.scale, columns, "column")?;
     let plan = series_units::plan(path, &resolved, &stated, opts, &mut notes)?;
-    let start_time = start_time(path, prelude)?;
+    let start_time = start_time(path, prelude, &mut notes)?;
     if let Some(d) = prelude.meta("description") {
         notes.push(format!("description: {}", Shown(&d.value)));
     }
@@ -584,21 +584,24 @@ pub(crate) fn interpret_series(
     })
 }
 
-/// The `# start_time:` value, validated.
-pub(crate) fn start_time(path: &Path, prelude: &Prelude) -> Result<Option<String>, InputError> {
-    let Some(m) = prelude.meta("start_time") else {
-        return Ok(None);
-    };
-    if !super::meta::is_iso8601(&m.value) {
-        return Err(InputError::BadAttribute {
-            path: path.to_path_buf(),
-            object: format!("line {}", m.line),
-            attribute: "# start_time:",
-            value: format!("`{}`", m.value),
-            allowed: super::meta::ISO8601_ALLOWED,
-        });
-    }
-    Ok(Some(m.value.clone()))
+/// The `# start_time:` value, validated; a note when it has no zone designator.
+pub(crate) fn start_time(
+    path: &Path,
+    prelude: &Prelude,
+    notes: &mut Vec<String>,
+) -> Result<Option<String>, InputError> {
+    prelude
+        .meta("start_time")
+        .map(|m| {
+            super::start_time::checked(
+                path,
+                format!("line {}", m.line),
+                "# start_time:",
+                m.value.clone(),
+                notes,
+            )
+        })
+        .transpose()
 }
 
 #[cfg(test)]

@@ -1,6 +1,6 @@
 //! HDF5 helpers: opening, layout detection, typed attribute reading with precise errors.
 
-use super::meta::{is_iso8601, ISO8601_ALLOWED};
+use super::start_time::{self, ISO8601_ALLOWED};
 use super::{check_sample_rate, InputError};
 use super::{resolve, MapOrigin, Resolved};
 use super::{
@@ -431,18 +431,9 @@ pub(crate) fn start_and_description(
     file: &hdf5::File,
     notes: &mut Vec<String>,
 ) -> Result<Option<String>, InputError> {
-    let start = str_attr(path, file, "/", "start_time", ISO8601_ALLOWED)?;
-    if let Some(s) = &start {
-        if !is_iso8601(s) {
-            return Err(InputError::BadAttribute {
-                path: path.to_path_buf(),
-                object: "/".to_string(),
-                attribute: "start_time",
-                value: format!("`{s}`"),
-                allowed: ISO8601_ALLOWED,
-            });
-        }
-    }
+    let start = str_attr(path, file, "/", "start_time", ISO8601_ALLOWED)?
+        .map(|s| start_time::checked(path, "/".to_string(), "start_time", s, notes))
+        .transpose()?;
     if let Some(d) = str_attr(path, file, "/", "description", "a string")? {
         notes.push(format!("description: {d}"));
     }

@@ -67,7 +67,7 @@ pub fn read_measured_input(path: &Path) -> Result<MeasuredInput, InputError> {
         InputFormat::Csv => {
             let (file, prelude) = CsvFile::open(path)?;
             if prelude.header.first().map(String::as_str) == Some("time_s") {
-                let start_time = super::csv::start_time(path, &prelude)?;
+                let start_time = super::csv::start_time(path, &prelude, &mut Vec::new())?;
                 let mut series = read_series_csv(path, file, &prelude.header, prelude.header_line)?;
                 series.start_time = start_time;
                 Ok(MeasuredInput::Series(series))
@@ -140,18 +140,15 @@ fn read_series_hdf5(path: &Path) -> Result<MeasuredSeries, InputError> {
         }
     }
     let sample_rate_hz = h5::sample_rate_hz(path, &file)?;
-    let start_time = h5::str_attr(path, &file, "/", "start_time", super::meta::ISO8601_ALLOWED)?;
-    if let Some(s) = &start_time {
-        if !super::meta::is_iso8601(s) {
-            return Err(InputError::BadAttribute {
-                path: path.to_path_buf(),
-                object: "/".to_string(),
-                attribute: "start_time",
-                value: format!("`{}`", Shown(s)),
-                allowed: super::meta::ISO8601_ALLOWED,
-            });
-        }
-    }
+    let start_time = h5::str_attr(
+        path,
+        &file,
+        "/",
+        "start_time",
+        super::start_time::ISO8601_ALLOWED,
+    )?
+    .map(|s| super::start_time::checked(path, "/".to_string(), "start_time", s, &mut Vec::new()))
+    .transpose()?;
     let mut channels: Vec<(Observable, Vec<f64>)> = Vec::new();
     let names = h5::root_datasets(path, &file)?;
     let n_observables = names

@@ -14,7 +14,8 @@
 //!   results bit-identical to [`read_tilt_series`]; it is a
 //!   [`tiltnoise_core::input::SeriesSource`] for the budget job.
 //! * [`read_measured`], [`read_measured_input`]: measured ASDs or series of the observables.
-//! * [`read_start_time`]: the start time a series file of either kind states.
+//! * [`read_start_time`]: the start time a series file of either kind states;
+//!   [`parse_start_time`] the instant it names, [`utc_text`] the text of an instant.
 //! * [`read_asd_column`]: the ASD of one quantity (a coloured readout, a user-named term).
 
 mod asd_file;
@@ -36,9 +37,8 @@ pub use measured::{
     add_measured_file, read_measured, read_measured_input, MeasuredInput, MeasuredSeries,
     MeasuredSpectra, SCHEMA_OBSERVABLE_SERIES,
 };
-pub use meta::{iso8601_to_unix, unix_to_iso8601};
 pub use source::TiltSeriesSource;
-pub use start_time::read_start_time;
+pub use start_time::{parse_start_time, read_start_time, utc_text};
 pub use tiltnoise_core::input::*;
 
 use std::path::Path;

@@ -8,7 +8,7 @@
 use super::h5::{self, h5err, AttrValue};
 use super::meta::{asd_unit, csd_unit, decide_quantity, Declared, ASD_UNITS, CSD_UNITS};
 use super::{assemble, check_csd_finite, require_two, InputError, TiltSpectra};
-use super::{frequency_refusal, InputFormat, InputKind, Provenance, ReadOptions};
+use super::{frequency_refusal, InputFormat, InputKind, Mapped, Provenance, ReadOptions};
 use num_complex::Complex64;
 use std::path::Path;
 use tiltnoise_core::limits::{ASDS, PSDS};
@@ -68,9 +68,6 @@ pub(crate) fn read(
         &mut notes,
     )?;
     super::refuse_translation_spectra(path, &resolved)?;
-    const X0: &str = "the first frequency in Hz (gwpy's x0): finite, the same for every axis";
-    const DX: &str = "the frequency spacing in Hz (gwpy's dx): finite and > 0, the same for \
-                      every axis";
     let mut grid: Option<(String, f64, f64, usize)> = None;
     let mut values: Vec<Vec<f64>> = Vec::new();
     let mut declared = Vec::new();
@@ -94,17 +91,7 @@ pub(crate) fn read(
         h5::check_storage(path, &ds, &name)?;
         let len = ds.shape()[0];
         h5::check_whole_read(path, &name, len, resolved.channels.len(), "frequencies")?;
-        let x0 = num_attr(path, &ds, &object, "x0", X0)?;
-        let dx = num_attr(path, &ds, &object, "dx", DX)?;
-        if dx <= 0.0 {
-            return Err(InputError::BadAttribute {
-                path: path.to_path_buf(),
-                object,
-                attribute: "dx",
-                value: format!("{dx}"),
-                allowed: DX,
-            });
-        }
+        let (x0, dx) = first_and_spacing(path, &ds, &object)?;
         match &grid {
             None => grid = Some((name.clone(), x0, dx, len)),
             Some((a, x0_a, dx_a, len_a)) => {
@@ -122,39 +109,7 @@ pub(crate) fn read(
                 }
             }
         }
-        let unit = match h5::attr(path, &ds, &object, "unit")? {
-            None => None,
-            Some(AttrValue::Str(u)) => Some(u),
-            Some(other) => Some(other.describe()),
-        };
-        let this = match &unit {
-            None => {
-                undeclared.push(m.source.clone());
-                Density::Amplitude
-            }
-            Some(u) => {
-                let (d, unit) = match (asd_unit(u), csd_unit(u)) {
-                    (Some(unit), _) => (Density::Amplitude, unit),
-                    (None, Some(unit)) => (Density::Power, unit),
-                    (None, None) => {
-                        return Err(InputError::Units {
-                            path: path.to_path_buf(),
-                            location: format!("attribute `unit` of {object}"),
-                            value: u.clone(),
-                            allowed: "an ASD in rad/sqrt(Hz) or rad/s/sqrt(Hz) (gwpy: \
-                                      `rad / Hz(1/2)`), or a PSD in rad^2/Hz or rad^2/s^2/Hz \
-                                      (gwpy: `rad2 / Hz`)",
-                        })
-                    }
-                };
-                declared.push(Declared {
-                    channel: m.source.clone(),
-                    unit: u.clone(),
-                    quantity: unit.quantity,
-                });
-                d
-            }
-        };
+        let (unit, this) = unit_and_density(path, &ds, &object, m, &mut declared, &mut undeclared)?;
         if density.is_some_and(|d| d != this) {
             return Err(InputError::Units {
                 path: path.to_path_buf(),
@@ -164,56 +119,12 @@ pub(crate) fn read(
             });
         }
         density = Some(this);
-        let v = ds.read_raw::<f64>().map_err(h5err(path, object.clone()))?;
-        let unit_text = if this == Density::Amplitude {
-            ASD_UNITS
-        } else {
-            CSD_UNITS
-        };
-        let power = this == Density::Power;
-        let allowed = if power { PSDS } else { ASDS };
-        if let Some((k, bad)) = allowed.first_refused(&v) {
-            return Err(InputError::Asd {
-                path: path.to_path_buf(),
-                location: format!("{name}[{k}]"),
-                column: m.source.clone(),
-                value: bad,
-                unit: unit_text,
-                power,
-            });
-        }
+        let v = checked_values(path, &ds, &object, &name, m, this)?;
         values.push(v);
     }
     let quantity = decide_quantity(path, opts.quantity, &declared, &undeclared, &mut notes)?;
     let (first, x0, dx, len) = grid.expect("resolve maps at least one channel");
-    // f_k = x0 + k dx; bins at f <= 0 are dropped.
-    let keep: Vec<usize> = (0..len).filter(|&k| x0 + k as f64 * dx > 0.0).collect();
-    if keep.len() < len {
-        notes.push(format!(
-            "{} bins at f <= 0 Hz dropped (a spectrum at DC has no tilt information here)",
-            len - keep.len()
-        ));
-    }
-    let freqs: Vec<f64> = keep.iter().map(|&k| x0 + k as f64 * dx).collect();
-    for (i, &f) in freqs.iter().enumerate() {
-        if let Some(allowed) = frequency_refusal(f, i.checked_sub(1).map(|p| freqs[p])) {
-            return Err(InputError::Frequency {
-                path: path.to_path_buf(),
-                location: format!(
-                    "bin {} of dataset {first} (x0 = {x0} Hz, dx = {dx} Hz)",
-                    keep[i]
-                ),
-                value: f,
-                allowed,
-            });
-        }
-    }
-    require_two(
-        path,
-        &format!("dataset {first}"),
-        freqs.len(),
-        "frequencies",
-    )?;
+    let (keep, freqs) = positive_frequencies(path, &first, (x0, dx, len), &mut notes)?;
     notes.push("gwpy spectra: axes taken as uncorrelated (off-diagonal CSD = 0)".to_string());
     let power = density == Some(Density::Power);
     // values[i] belongs to resolved.channels[i]; `assemble` indexes by source index.
@@ -252,4 +163,145 @@ pub(crate) fn read(
             notes,
         },
     })
+}
+
+/// What `x0` and `dx` must be, for messages.
+const X0: &str = "the first frequency in Hz (gwpy's x0): finite, the same for every axis";
+const DX: &str = "the frequency spacing in Hz (gwpy's dx): finite and > 0, the same for every \
+                  axis";
+
+/// The first frequency and the spacing (Hz) of a FrequencySeries dataset.
+fn first_and_spacing(
+    path: &Path,
+    ds: &hdf5::Dataset,
+    object: &str,
+) -> Result<(f64, f64), InputError> {
+    let x0 = num_attr(path, ds, object, "x0", X0)?;
+    let dx = num_attr(path, ds, object, "dx", DX)?;
+    if dx <= 0.0 {
+        return Err(InputError::BadAttribute {
+            path: path.to_path_buf(),
+            object: object.to_string(),
+            attribute: "dx",
+            value: format!("{dx}"),
+            allowed: DX,
+        });
+    }
+    Ok((x0, dx))
+}
+
+/// The `unit` attribute of the dataset of `m`, if any, and the density it says (an ASD when
+/// there is none); the unit goes to `declared`, or the channel to `undeclared`.
+fn unit_and_density(
+    path: &Path,
+    ds: &hdf5::Dataset,
+    object: &str,
+    m: &Mapped,
+    declared: &mut Vec<Declared>,
+    undeclared: &mut Vec<String>,
+) -> Result<(Option<String>, Density), InputError> {
+    let unit = match h5::attr(path, ds, object, "unit")? {
+        None => None,
+        Some(AttrValue::Str(u)) => Some(u),
+        Some(other) => Some(other.describe()),
+    };
+    let density = match &unit {
+        None => {
+            undeclared.push(m.source.clone());
+            Density::Amplitude
+        }
+        Some(u) => {
+            let (d, unit) = match (asd_unit(u), csd_unit(u)) {
+                (Some(unit), _) => (Density::Amplitude, unit),
+                (None, Some(unit)) => (Density::Power, unit),
+                (None, None) => {
+                    return Err(InputError::Units {
+                        path: path.to_path_buf(),
+                        location: format!("attribute `unit` of {object}"),
+                        value: u.clone(),
+                        allowed: "an ASD in rad/sqrt(Hz) or rad/s/sqrt(Hz) (gwpy: \
+                      `rad / Hz(1/2)`), or a PSD in rad^2/Hz or rad^2/s^2/Hz \
+                      (gwpy: `rad2 / Hz`)",
+                    })
+                }
+            };
+            declared.push(Declared {
+                channel: m.source.clone(),
+                unit: u.clone(),
+                quantity: unit.quantity,
+            });
+            d
+        }
+    };
+    Ok((unit, density))
+}
+
+/// The values of the dataset of `m`, each within what an ASD or a PSD (`density`) allows.
+fn checked_values(
+    path: &Path,
+    ds: &hdf5::Dataset,
+    object: &str,
+    name: &str,
+    m: &Mapped,
+    density: Density,
+) -> Result<Vec<f64>, InputError> {
+    let v = ds
+        .read_raw::<f64>()
+        .map_err(h5err(path, object.to_string()))?;
+    let unit_text = if density == Density::Amplitude {
+        ASD_UNITS
+    } else {
+        CSD_UNITS
+    };
+    let power = density == Density::Power;
+    let allowed = if power { PSDS } else { ASDS };
+    if let Some((k, bad)) = allowed.first_refused(&v) {
+        return Err(InputError::Asd {
+            path: path.to_path_buf(),
+            location: format!("{name}[{k}]"),
+            column: m.source.clone(),
+            value: bad,
+            unit: unit_text,
+            power,
+        });
+    }
+    Ok(v)
+}
+
+/// The bins above 0 Hz of the grid `x0 + k dx`, `k < len` (their indices and frequencies),
+/// checked as frequencies; a note when bins at or below 0 Hz are dropped.
+fn positive_frequencies(
+    path: &Path,
+    first: &str,
+    (x0, dx, len): (f64, f64, usize),
+    notes: &mut Vec<String>,
+) -> Result<(Vec<usize>, Vec<f64>), InputError> {
+    let keep: Vec<usize> = (0..len).filter(|&k| x0 + k as f64 * dx > 0.0).collect();
+    if keep.len() < len {
+        notes.push(format!(
+            "{} bins at f <= 0 Hz dropped (a spectrum at DC has no tilt information here)",
+            len - keep.len()
+        ));
+    }
+    let freqs: Vec<f64> = keep.iter().map(|&k| x0 + k as f64 * dx).collect();
+    for (i, &f) in freqs.iter().enumerate() {
+        if let Some(allowed) = frequency_refusal(f, i.checked_sub(1).map(|p| freqs[p])) {
+            return Err(InputError::Frequency {
+                path: path.to_path_buf(),
+                location: format!(
+                    "bin {} of dataset {first} (x0 = {x0} Hz, dx = {dx} Hz)",
+                    keep[i]
+                ),
+                value: f,
+                allowed,
+            });
+        }
+    }
+    require_two(
+        path,
+        &format!("dataset {first}"),
+        freqs.len(),
+        "frequencies",
+    )?;
+    Ok((keep, freqs))
 }

@@ -26,7 +26,6 @@ pub(crate) fn read(
     let datasets = h5::root_datasets(path, file)?;
     let has = |n: &str| datasets.iter().any(|d| d == n);
 
-    // Frequencies.
     if !has("frequency_hz") {
         return Err(InputError::MissingDataset {
             path: path.to_path_buf(),
@@ -35,37 +34,7 @@ pub(crate) fn read(
                 .to_string(),
         });
     }
-    let fds = file
-        .dataset("frequency_hz")
-        .map_err(h5err(path, "dataset /frequency_hz"))?;
-    let (float, dtype) = h5::is_float(&fds).map_err(h5err(path, "dataset /frequency_hz"))?;
-    if fds.ndim() != 1 || !float {
-        return Err(InputError::BadDataset {
-            path: path.to_path_buf(),
-            dataset: "/frequency_hz".to_string(),
-            found: format!("type {dtype} and shape {:?}", fds.shape()),
-            allowed: "a 1-D float64 dataset (Hz)".to_string(),
-        });
-    }
-    h5::check_storage(path, &fds, "/frequency_hz")?;
-    // The values: one CSD matrix of up to 3 x 3 complex (2 x 9 `f64`) per frequency.
-    h5::check_whole_read(path, "/frequency_hz", fds.size(), 19, "frequencies")?;
-    let freqs: Vec<f64> = fds
-        .read_raw::<f64>()
-        .map_err(h5err(path, "dataset /frequency_hz"))?;
-    for (k, &f) in freqs.iter().enumerate() {
-        let err = |allowed: String| InputError::Frequency {
-            path: path.to_path_buf(),
-            location: format!("/frequency_hz[{k}]"),
-            value: f,
-            allowed,
-        };
-        if let Some(allowed) = frequency_refusal(f, k.checked_sub(1).map(|p| freqs[p])) {
-            return Err(err(allowed));
-        }
-    }
-    require_two(path, "dataset /frequency_hz", freqs.len(), "frequencies")?;
-
+    let freqs = frequencies(path, file)?;
     match (has("asd"), has("csd")) {
         (true, true) => {
             return Err(InputError::UnknownLayout {
@@ -87,41 +56,7 @@ pub(crate) fn read(
         _ => {}
     }
 
-    // Axis names.
-    let names = match h5::attr(path, file, "/", "axes")? {
-        None => {
-            return Err(InputError::MissingAttribute {
-                path: path.to_path_buf(),
-                object: "/".to_string(),
-                attribute: "axes",
-                expected: AXES_ALLOWED,
-            })
-        }
-        Some(AttrValue::Str(s)) => vec![s],
-        Some(AttrValue::StrList(v)) => v,
-        Some(other) => {
-            return Err(InputError::BadAttribute {
-                path: path.to_path_buf(),
-                object: "/".to_string(),
-                attribute: "axes",
-                value: other.describe(),
-                allowed: AXES_ALLOWED,
-            })
-        }
-    };
-    if let Some((i, n)) = names
-        .iter()
-        .enumerate()
-        .find(|(i, n)| names[..*i].contains(n))
-    {
-        return Err(InputError::BadAttribute {
-            path: path.to_path_buf(),
-            object: "/".to_string(),
-            attribute: "axes",
-            value: format!("{names:?} (`{n}` repeated at position {i})"),
-            allowed: "unique axis names",
-        });
-    }
+    let names = axis_names(path, file)?;
     let m = names.len();
 
     // Spectral values: src[(k * m + a) * m + b], source axis order.
@@ -180,6 +115,81 @@ pub(crate) fn read(
             notes,
         },
     })
+}
+
+/// `/frequency_hz`: 1-D float, each frequency allowed, strictly increasing, at least two.
+fn frequencies(path: &Path, file: &hdf5::File) -> Result<Vec<f64>, InputError> {
+    let fds = file
+        .dataset("frequency_hz")
+        .map_err(h5err(path, "dataset /frequency_hz"))?;
+    let (float, dtype) = h5::is_float(&fds).map_err(h5err(path, "dataset /frequency_hz"))?;
+    if fds.ndim() != 1 || !float {
+        return Err(InputError::BadDataset {
+            path: path.to_path_buf(),
+            dataset: "/frequency_hz".to_string(),
+            found: format!("type {dtype} and shape {:?}", fds.shape()),
+            allowed: "a 1-D float64 dataset (Hz)".to_string(),
+        });
+    }
+    h5::check_storage(path, &fds, "/frequency_hz")?;
+    // The values: one CSD matrix of up to 3 x 3 complex (2 x 9 `f64`) per frequency.
+    h5::check_whole_read(path, "/frequency_hz", fds.size(), 19, "frequencies")?;
+    let freqs: Vec<f64> = fds
+        .read_raw::<f64>()
+        .map_err(h5err(path, "dataset /frequency_hz"))?;
+    for (k, &f) in freqs.iter().enumerate() {
+        let err = |allowed: String| InputError::Frequency {
+            path: path.to_path_buf(),
+            location: format!("/frequency_hz[{k}]"),
+            value: f,
+            allowed,
+        };
+        if let Some(allowed) = frequency_refusal(f, k.checked_sub(1).map(|p| freqs[p])) {
+            return Err(err(allowed));
+        }
+    }
+    require_two(path, "dataset /frequency_hz", freqs.len(), "frequencies")?;
+
+    Ok(freqs)
+}
+
+/// The root attribute `axes`: the source axis names, each once.
+fn axis_names(path: &Path, file: &hdf5::File) -> Result<Vec<String>, InputError> {
+    let names = match h5::attr(path, file, "/", "axes")? {
+        None => {
+            return Err(InputError::MissingAttribute {
+                path: path.to_path_buf(),
+                object: "/".to_string(),
+                attribute: "axes",
+                expected: AXES_ALLOWED,
+            })
+        }
+        Some(AttrValue::Str(s)) => vec![s],
+        Some(AttrValue::StrList(v)) => v,
+        Some(other) => {
+            return Err(InputError::BadAttribute {
+                path: path.to_path_buf(),
+                object: "/".to_string(),
+                attribute: "axes",
+                value: other.describe(),
+                allowed: AXES_ALLOWED,
+            })
+        }
+    };
+    if let Some((i, n)) = names
+        .iter()
+        .enumerate()
+        .find(|(i, n)| names[..*i].contains(n))
+    {
+        return Err(InputError::BadAttribute {
+            path: path.to_path_buf(),
+            object: "/".to_string(),
+            attribute: "axes",
+            value: format!("{names:?} (`{n}` repeated at position {i})"),
+            allowed: "unique axis names",
+        });
+    }
+    Ok(names)
 }
 
 type Values = (Vec<Complex64>, Option<Declared>);

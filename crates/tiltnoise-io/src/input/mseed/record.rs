@@ -6,6 +6,7 @@
 
 pub(crate) use super::steim::WordOrder;
 use super::steim::{self, Steim};
+use jiff::{civil, tz::Offset, Timestamp};
 
 /// Length of the fixed header section.
 const FIXED_HEADER: usize = 48;
@@ -89,14 +90,18 @@ fn plausible(year: u16, day: u16) -> bool {
     (1900..=2100).contains(&year) && (1..=366).contains(&day)
 }
 
-/// Days from 1970-01-01 to `year`-01-01 (proleptic Gregorian).
-fn days_to_year(year: i64) -> i64 {
-    let y = year - 1;
-    365 * (year - 1970) + (y / 4 - y / 100 + y / 400) - (1969 / 4 - 1969 / 100 + 1969 / 400)
-}
-
-fn is_leap(year: i64) -> bool {
-    (year % 4 == 0 && year % 100 != 0) || year % 400 == 0
+/// Seconds from 1970-01-01T00:00:00 UTC to the start of day `day` (1-based) of `year`;
+/// `None` for a day the year does not have.
+fn start_of_day_s(year: i16, day: i16) -> Option<i64> {
+    let date = civil::Date::new(year, 1, 1)
+        .and_then(|d| d.with().day_of_year(day).build())
+        .ok()?;
+    Some(
+        Offset::UTC
+            .to_timestamp(date.to_datetime(civil::Time::midnight()))
+            .ok()?
+            .as_second(),
+    )
 }
 
 /// The nominal sample rate of the header's factor and multiplier (SEED manual, fixed header
@@ -135,7 +140,9 @@ pub(crate) fn is_v3(b: &[u8]) -> bool {
 
 /// Decodes the record at the start of `b` (which holds the rest of the file). Returns the
 /// record; its length says where the next one starts.
-pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
+/// The byte order of the fixed header at the start of `b`, after checking that it looks like a
+/// miniSEED 2 data record at all.
+fn header_order(b: &[u8]) -> Result<WordOrder, String> {
     if is_v3(b) {
         return Err(
             "this is a miniSEED 3 record; allowed: miniSEED 2 (SEED 2.4 data records \
@@ -165,23 +172,27 @@ pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
             b[6]
         ));
     }
-    let order = if plausible(u16_at(b, 20, WordOrder::Big), u16_at(b, 22, WordOrder::Big)) {
-        WordOrder::Big
+    if plausible(u16_at(b, 20, WordOrder::Big), u16_at(b, 22, WordOrder::Big)) {
+        Ok(WordOrder::Big)
     } else if plausible(
         u16_at(b, 20, WordOrder::Little),
         u16_at(b, 22, WordOrder::Little),
     ) {
-        WordOrder::Little
+        Ok(WordOrder::Little)
     } else {
-        return Err(format!(
+        Err(format!(
             "start year {} / day {} (big-endian; little-endian {} / {}) is not plausible in \
              either byte order; allowed: year 1900..=2100, day 1..=366",
             u16_at(b, 20, WordOrder::Big),
             u16_at(b, 22, WordOrder::Big),
             u16_at(b, 20, WordOrder::Little),
             u16_at(b, 22, WordOrder::Little)
-        ));
-    };
+        ))
+    }
+}
+
+pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
+    let order = header_order(b)?;
     let station = code(&b[8..13], "station")?;
     let location = code(&b[13..15], "location")?;
     let channel = code(&b[15..18], "channel")?;
@@ -198,9 +209,12 @@ pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
              allowed: hour <= 23, minute <= 59, second <= 60, 0.0001 s units <= 9999"
         ));
     }
-    if day == 366 && !is_leap(i64::from(year)) {
-        return Err(format!("start day 366 of {year}, which is not a leap year"));
-    }
+    // `plausible` bounds the year and day, so only day 366 of a common year is refused here.
+    let Some(day_start_s) = start_of_day_s(year as i16, day as i16) else {
+        return Err(format!(
+            "start day {day} of {year}, which is not a leap year"
+        ));
+    };
     let n = usize::from(u16_at(b, 30, order));
     let factor = u16_at(b, 32, order) as i16;
     let multiplier = u16_at(b, 34, order) as i16;
@@ -209,59 +223,13 @@ pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
     let data_offset = usize::from(u16_at(b, 44, order));
     let first_blockette = usize::from(u16_at(b, 46, order));
 
-    // The blockette chain: offsets strictly increasing (no cycle), each inside the bytes there
-    // are; blockette 1000 gives the record length, which bounds them again below.
-    let mut b1000: Option<(u8, u8, u8)> = None;
-    let mut usec: i8 = 0;
-    let mut has_b1001 = false;
-    let mut b100_rate: Option<f32> = None;
-    let mut end_of_blockettes = FIXED_HEADER;
-    let mut at = first_blockette;
-    let mut count = 0;
-    while at != 0 {
-        count += 1;
-        if count > MAX_BLOCKETTES {
-            return Err(format!(
-                "more than {MAX_BLOCKETTES} blockettes; the chain is damaged"
-            ));
-        }
-        if at < end_of_blockettes || at + 4 > b.len() {
-            return Err(format!(
-                "blockette at byte {at} of the record is outside the record or overlaps the \
-                 header or the previous blockette"
-            ));
-        }
-        let kind = u16_at(b, at, order);
-        let next = usize::from(u16_at(b, at + 2, order));
-        let size = match kind {
-            1000 => 8,
-            1001 => 8,
-            100 => 12,
-            _ => 4,
-        };
-        if at + size > b.len() {
-            return Err(format!(
-                "blockette {kind} at byte {at} runs past the end of the file"
-            ));
-        }
-        match kind {
-            1000 => b1000 = Some((b[at + 4], b[at + 5], b[at + 6])),
-            1001 => {
-                usec = b[at + 5] as i8;
-                has_b1001 = true;
-            }
-            100 => b100_rate = Some(f32::from_bits(u32_at(b, at + 4, order))),
-            _ => {}
-        }
-        end_of_blockettes = at + size;
-        if next != 0 && next <= at {
-            return Err(format!(
-                "blockette {kind} at byte {at} points back to byte {next}; allowed: the next \
-                 blockette further on, or 0 for the last"
-            ));
-        }
-        at = next;
-    }
+    let Blockettes {
+        b1000,
+        usec,
+        has_b1001,
+        b100_rate,
+        end: end_of_blockettes,
+    } = blockettes(b, first_blockette, order)?;
     let Some((encoding_code, word_order, len_exp)) = b1000 else {
         return Err(
             "no blockette 1000 (data only SEED blockette); allowed: miniSEED 2 \
@@ -330,9 +298,9 @@ pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
         ));
     }
 
-    let days = days_to_year(i64::from(year)) + i64::from(day) - 1;
+    // Second 60 (a leap second) runs on into the next minute, as in libmseed.
     let mut start_ns =
-        ((days * 24 + i64::from(hour)) * 60 + i64::from(minute)) * 60 + i64::from(second);
+        day_start_s + (i64::from(hour) * 60 + i64::from(minute)) * 60 + i64::from(second);
     start_ns = start_ns * NS_PER_S + i64::from(fract) * 100_000 + i64::from(usec) * 1000;
     // Bit 1 of the activity flags: the time correction is already applied.
     if activity & 0x02 == 0 {
@@ -346,6 +314,83 @@ pub(crate) fn decode(b: &[u8]) -> Result<Record, String> {
         encoding,
         samples,
         len,
+    })
+}
+
+/// What the blockette chain of a record says.
+struct Blockettes {
+    /// Blockette 1000: encoding, word order, record length exponent.
+    b1000: Option<(u8, u8, u8)>,
+    /// Blockette 1001: microseconds to add to the start time.
+    usec: i8,
+    has_b1001: bool,
+    /// Blockette 100: the actual sample rate.
+    b100_rate: Option<f32>,
+    /// Where the last blockette ends.
+    end: usize,
+}
+
+/// Walks the blockette chain from byte `first`: offsets strictly increasing (no cycle), each
+/// inside the bytes there are; blockette 1000 gives the record length, which bounds them again
+/// in [`decode`].
+fn blockettes(b: &[u8], first: usize, order: WordOrder) -> Result<Blockettes, String> {
+    let mut b1000: Option<(u8, u8, u8)> = None;
+    let mut usec: i8 = 0;
+    let mut has_b1001 = false;
+    let mut b100_rate: Option<f32> = None;
+    let mut end_of_blockettes = FIXED_HEADER;
+    let mut at = first;
+    let mut count = 0;
+    while at != 0 {
+        count += 1;
+        if count > MAX_BLOCKETTES {
+            return Err(format!(
+                "more than {MAX_BLOCKETTES} blockettes; the chain is damaged"
+            ));
+        }
+        if at < end_of_blockettes || at + 4 > b.len() {
+            return Err(format!(
+                "blockette at byte {at} of the record is outside the record or overlaps the \
+                 header or the previous blockette"
+            ));
+        }
+        let kind = u16_at(b, at, order);
+        let next = usize::from(u16_at(b, at + 2, order));
+        let size = match kind {
+            1000 => 8,
+            1001 => 8,
+            100 => 12,
+            _ => 4,
+        };
+        if at + size > b.len() {
+            return Err(format!(
+                "blockette {kind} at byte {at} runs past the end of the file"
+            ));
+        }
+        match kind {
+            1000 => b1000 = Some((b[at + 4], b[at + 5], b[at + 6])),
+            1001 => {
+                usec = b[at + 5] as i8;
+                has_b1001 = true;
+            }
+            100 => b100_rate = Some(f32::from_bits(u32_at(b, at + 4, order))),
+            _ => {}
+        }
+        end_of_blockettes = at + size;
+        if next != 0 && next <= at {
+            return Err(format!(
+                "blockette {kind} at byte {at} points back to byte {next}; allowed: the next \
+                 blockette further on, or 0 for the last"
+            ));
+        }
+        at = next;
+    }
+    Ok(Blockettes {
+        b1000,
+        usec,
+        has_b1001,
+        b100_rate,
+        end: end_of_blockettes,
     })
 }
 
@@ -407,26 +452,9 @@ fn decode_samples(
 
 /// ISO 8601 UTC text of `ns` since 1970 (`YYYY-MM-DDThh:mm:ss.ffffffZ`, microseconds).
 pub(crate) fn iso8601(ns: i64) -> String {
-    let secs = ns.div_euclid(NS_PER_S);
-    let micros = ns.rem_euclid(NS_PER_S) / 1000;
-    let days = secs.div_euclid(86_400);
-    let sod = secs.rem_euclid(86_400);
-    // Civil date from days since 1970-01-01 (Howard Hinnant's algorithm).
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = doy - (153 * mp + 2) / 5 + 1;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 };
-    let y = yoe + era * 400 + i64::from(m <= 2);
-    format!(
-        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}.{micros:06}Z",
-        sod / 3600,
-        sod % 3600 / 60,
-        sod % 60
-    )
+    // Every i64 of nanoseconds (years 1677..2262) is a valid instant.
+    let instant = Timestamp::from_nanosecond(i128::from(ns)).expect("within jiff's range");
+    super::super::start_time::utc_text_micros(instant)
 }
 
 #[cfg(test)]
@@ -435,14 +463,17 @@ mod tests {
 
     #[test]
     fn times() {
-        assert_eq!(days_to_year(1970), 0);
-        assert_eq!(days_to_year(2018), 17532);
+        assert_eq!(start_of_day_s(1970, 1), Some(0));
+        // Python: datetime(2018, 1, 1, tzinfo=timezone.utc).timestamp()
+        assert_eq!(start_of_day_s(2018, 1), Some(1_514_764_800));
+        assert_eq!(start_of_day_s(2000, 366), Some(978_220_800));
+        assert_eq!(start_of_day_s(2100, 366), None);
         // 2018-01-23T09:31:42 = day 23 of 2018.
-        let ns = ((days_to_year(2018) + 22) * 86_400 + 9 * 3600 + 31 * 60 + 42) * NS_PER_S;
+        let ns = (start_of_day_s(2018, 23).unwrap() + 9 * 3600 + 31 * 60 + 42) * NS_PER_S;
         assert_eq!(iso8601(ns), "2018-01-23T09:31:42.000000Z");
         assert_eq!(iso8601(-1000), "1969-12-31T23:59:59.999999Z");
         assert_eq!(
-            iso8601((days_to_year(2000) + 59) * 86_400 * NS_PER_S),
+            iso8601(start_of_day_s(2000, 60).unwrap() * NS_PER_S),
             "2000-02-29T00:00:00.000000Z"
         );
     }

@@ -1,0 +1,79 @@
+//! `--witness-noise INPUT=ASD|FILE[:REL]` (`subtract`, `budget`): the own noise of the
+//! instrument that records a floor input of the model, as a one-sided ASD in the input's unit
+//! per sqrt(Hz): white (a number) or a spectrum (a `.csv`, `.h5` or `.hdf5` ASD file, read as
+//! for `--readout`), and optionally its relative uncertainty REL (1 sigma of the ASD, e.g.
+//! `:0.1` for 10 %). `--tilt-noise` is the same option under its former name.
+
+use super::budget_terms::read_given;
+use anyhow::{anyhow, Result};
+use std::path::{Path, PathBuf};
+use tiltnoise_core::error::Shown;
+use tiltnoise_core::model::Input;
+use tiltnoise_core::noise::{NoiseLevel, WitnessNoise};
+use tiltnoise_core::repeats::refuse_repeated_keys;
+use tiltnoise_io::input::InputFormat;
+
+/// The model inputs a witness can record.
+const FLOOR_INPUTS: &str = "theta_t, eta_t, phi_t";
+
+/// Whether `input` is a motion of the floor (what a witness records).
+pub fn is_floor_input(input: Input) -> bool {
+    matches!(input, Input::Tilt(_))
+}
+
+/// Parses every `--witness-noise` item, each input once; returns the levels and the files read.
+pub fn parse_witness_noise(items: &[String]) -> Result<(Vec<WitnessNoise>, Vec<PathBuf>)> {
+    let mut out: Vec<WitnessNoise> = Vec::new();
+    let mut files = Vec::new();
+    refuse_repeated_keys("--witness-noise", "input", items)?;
+    for item in items {
+        let shown = Shown(item);
+        let (name, value) = item.split_once('=').ok_or_else(|| {
+            anyhow!(
+                "--witness-noise {shown}: expected INPUT=ASD|FILE[:REL], e.g. eta_t=6e-8 or \
+                 eta_t=noise.csv:0.1"
+            )
+        })?;
+        let input = Input::from_name(name.trim())
+            .filter(|&i| is_floor_input(i))
+            .ok_or_else(|| {
+                anyhow!(
+                    "--witness-noise {shown}: `{}` is not a floor input of the model; allowed: \
+                     {FLOOR_INPUTS}",
+                    Shown(name)
+                )
+            })?;
+        let (level, rel) = match value.rsplit_once(':') {
+            Some((head, tail)) if !head.trim().is_empty() && tail.trim().parse::<f64>().is_ok() => {
+                (head.trim(), tail.trim().parse::<f64>().expect("checked"))
+            }
+            _ => (value.trim(), 0.0),
+        };
+        let level = if InputFormat::from_path(Path::new(level)).is_ok() {
+            let path = PathBuf::from(level);
+            let given = read_given(
+                &format!("--witness-noise {shown}"),
+                &path,
+                input.name(),
+                input.unit(),
+            )?;
+            files.push(path);
+            NoiseLevel::Curve(given)
+        } else {
+            NoiseLevel::White(level.parse().map_err(|_| {
+                anyhow!(
+                    "--witness-noise {shown}: `{}` is neither a number (the ASD in {}/sqrt(Hz)) \
+                     nor an ASD file (.csv, .h5, .hdf5)",
+                    Shown(level),
+                    input.unit()
+                )
+            })?)
+        };
+        let noise = WitnessNoise { input, level, rel };
+        noise
+            .check("--witness-noise")
+            .map_err(|e| anyhow!("{e} (in {shown})"))?;
+        out.push(noise);
+    }
+    Ok((out, files))
+}
