@@ -16,10 +16,11 @@ mod channels;
 mod record;
 mod steim;
 
-use super::series_units::{self, check_unstated_data, into_series, units_note, Stated};
+use super::series_units::{self, check_unstated_data, into_series, units_note, Planned, Stated};
+use super::TiltSeries;
 use super::{check_sample_rate, Provenance, Quantity, ReadOptions};
 use super::{check_scales, gap_note, process_channel, require_two, scale_for};
-use super::{resolve, ChannelCtx, ChannelUnit, InputError, MapOrigin, TiltSeries};
+use super::{resolve, ChannelCtx, ChannelUnit, InputError, MapOrigin, Mapped, Resolved};
 use super::{AxisMap, AxisMapEntry, ChannelScale, GapPolicy, InputFormat, InputKind};
 use channels::{Channel, Placed};
 use std::io::Read;
@@ -252,8 +253,53 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
     notes.extend(resolved.notes.iter().cloned());
     notes.extend(unit_notes);
 
-    // Merge the mapped channels only: a file of many channels costs the memory of three.
-    let mut groups: Vec<Option<Vec<Placed>>> = groups.into_iter().map(|(_, v)| Some(v)).collect();
+    let groups: Vec<Option<Vec<Placed>>> = groups.into_iter().map(|(_, v)| Some(v)).collect();
+    let chans = merge_mapped(path, groups, &resolved)?;
+    let span = common_span(path, &chans, &mut notes)?;
+    check_tilt_units(path, &resolved, &chans, &stated, opts.quantity, &mut notes)?;
+    let sensor_opts = ReadOptions {
+        scale: scales.clone(),
+        corrected: full_names(path, &opts.corrected, &ids)?,
+        pendulum: full_names(path, &opts.pendulum, &ids)?,
+        ..opts.clone()
+    };
+    let plan = series_units::plan(path, &resolved, &stated, &sensor_opts, &mut notes)?;
+    let mut data = Vec::new();
+    for (((m, ch), &k), planned) in resolved
+        .channels
+        .iter()
+        .zip(&chans)
+        .zip(&span.starts)
+        .zip(&plan.channels)
+    {
+        let part = ChannelPart {
+            start: k,
+            len: span.len,
+        };
+        let v = channel_samples(path, m, ch, part, planned, &scales, opts, &mut notes)?;
+        check_unstated_data(path, &m.source, planned, &v, span.rate)?;
+        data.push(v);
+    }
+    notes.push(units_note(&plan));
+    let provenance = Provenance {
+        path: path.to_path_buf(),
+        format: InputFormat::Miniseed,
+        kind: InputKind::Series,
+        quantity: plan.quantity,
+        axis_map: resolved.map.to_string(),
+        start_time: Some(chans[0].time(span.starts[0])),
+        notes,
+    };
+    Ok(into_series(&plan, data, span.rate, provenance))
+}
+
+/// Merges the records of the mapped channels only (a file of many channels costs the memory of
+/// three), each checked for its sample rate and the memory its samples take.
+fn merge_mapped(
+    path: &Path,
+    mut groups: Vec<Option<Vec<Placed>>>,
+    resolved: &Resolved,
+) -> Result<Vec<Channel>, InputError> {
     let mut chans: Vec<Channel> = Vec::new();
     for m in &resolved.channels {
         let recs = groups[m.index].take().unwrap_or_default();
@@ -270,8 +316,26 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
         )?;
         chans.push(ch);
     }
+    Ok(chans)
+}
 
-    // One rate, one grid, the common span.
+/// The stretch every mapped channel covers, on one time grid.
+struct Span {
+    /// The common sample rate (Hz).
+    rate: f64,
+    /// Per channel, its first sample in the span.
+    starts: Vec<usize>,
+    /// Samples in the span.
+    len: usize,
+}
+
+/// One rate, one grid, the common span of `chans` (at least two samples), with a note when
+/// it trims a channel.
+fn common_span(
+    path: &Path,
+    chans: &[Channel],
+    notes: &mut Vec<String>,
+) -> Result<Span, InputError> {
     let first = &chans[0];
     let rate = first.sample_rate_hz;
     for ch in &chans[1..] {
@@ -288,15 +352,15 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
         }
     }
     let start_ns = chans.iter().map(|c| c.start_ns).max().unwrap_or(0);
-    let mut spans = Vec::new();
-    for ch in &chans {
+    let tolerance = chans
+        .iter()
+        .map(|c| c.time_resolution_ns)
+        .max()
+        .unwrap_or(0) as f64;
+    let mut starts = Vec::new();
+    for ch in chans {
         let offset = (start_ns - ch.start_ns) as f64 / ch.period_ns();
         let k = offset.round();
-        let tolerance = chans
-            .iter()
-            .map(|c| c.time_resolution_ns)
-            .max()
-            .unwrap_or(0) as f64;
         if (offset - k).abs() * ch.period_ns() > tolerance {
             return Err(fault(
                 path,
@@ -311,11 +375,11 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
                 ),
             ));
         }
-        spans.push(k as usize);
+        starts.push(k as usize);
     }
     let len = chans
         .iter()
-        .zip(&spans)
+        .zip(&starts)
         .map(|(c, &k)| c.data.len().saturating_sub(k))
         .min()
         .unwrap_or(0);
@@ -327,7 +391,7 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
     )?;
     let trimmed = chans
         .iter()
-        .zip(&spans)
+        .zip(&starts)
         .any(|(c, &k)| k > 0 || c.data.len() != k + len);
     if trimmed {
         let ranges: Vec<String> = chans
@@ -338,21 +402,32 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
             "channels cover different spans ({}); read over their common span {} to {} \
              ({len} samples)",
             ranges.join(", "),
-            chans[0].time(spans[0]),
-            chans[0].time(spans[0] + len - 1)
+            chans[0].time(starts[0]),
+            chans[0].time(starts[0] + len - 1)
         ));
     }
     notes.push(format!("sample rate {rate} Hz from the records"));
+    Ok(Span { rate, starts, len })
+}
 
-    // Units: the options', else (tilt channels) the options' quantity or the instrument code.
-    for (m, ch) in resolved.channels.iter().zip(&chans) {
+/// Notes the units the instrument codes imply (miniSEED stores none), and refuses a tilt
+/// channel whose unit nothing gives: neither the options, nor the quantity, nor its code.
+fn check_tilt_units(
+    path: &Path,
+    resolved: &Resolved,
+    chans: &[Channel],
+    stated: &[Option<Stated>],
+    quantity: Option<Quantity>,
+    notes: &mut Vec<String>,
+) -> Result<(), InputError> {
+    for (m, ch) in resolved.channels.iter().zip(chans) {
         match &stated[m.index] {
             Some(s) if s.assumed => notes.push(format!(
                 "channel {}: {} (miniSEED stores no units)",
                 ch.id, s.origin
             )),
             Some(_) => {}
-            None if opts.quantity.is_none() && m.tilt_axis().is_some() => {
+            None if quantity.is_none() && m.tilt_axis().is_some() => {
                 return Err(fault(
                     path,
                     None,
@@ -368,104 +443,99 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
             None => {}
         }
     }
-    let sensor_opts = ReadOptions {
-        scale: scales.clone(),
-        corrected: full_names(path, &opts.corrected, &ids)?,
-        pendulum: full_names(path, &opts.pendulum, &ids)?,
-        ..opts.clone()
-    };
-    let plan = series_units::plan(path, &resolved, &stated, &sensor_opts, &mut notes)?;
+    Ok(())
+}
 
-    let mut data = Vec::new();
-    for (((m, ch), &k), planned) in resolved
-        .channels
-        .iter()
-        .zip(&chans)
-        .zip(&spans)
-        .zip(&plan.channels)
-    {
-        let unit = planned.unit();
-        let factor = planned.factor;
-        match (scale_for(&scales, &ch.id), ch.counts) {
-            (Some(_), _) => {}
-            (None, true) => {
-                return Err(InputError::Scale {
-                    path: path.to_path_buf(),
-                    channel: ch.id.clone(),
-                    message: format!(
-                        "holds digitizer counts ({}); allowed: give a scale CHANNEL=FACTOR \
-                         with the {unit} per count of the instrument's response",
-                        ch.encodings.join(", ")
-                    ),
-                })
-            }
-            (None, false) => {
-                notes.push(format!(
-                    "channel {}: {} samples taken to be in {unit} already (miniSEED stores no \
-                     units); give a scale if they are not",
-                    ch.id,
+/// Samples `start .. start + len` of a channel.
+#[derive(Clone, Copy)]
+struct ChannelPart {
+    start: usize,
+    len: usize,
+}
+
+/// The samples of channel `ch` (mapped by `m`, planned as `planned`) in `part`, scaled into
+/// its unit, signed by the map and with gaps handled by the gap policy; notes for each
+/// assumption.
+#[allow(clippy::too_many_arguments)]
+fn channel_samples(
+    path: &Path,
+    m: &Mapped,
+    ch: &Channel,
+    part: ChannelPart,
+    planned: &Planned,
+    scales: &[ChannelScale],
+    opts: &ReadOptions,
+    notes: &mut Vec<String>,
+) -> Result<Vec<f64>, InputError> {
+    let (k, len) = (part.start, part.len);
+    let unit = planned.unit();
+    match (scale_for(scales, &ch.id), ch.counts) {
+        (Some(_), _) => {}
+        (None, true) => {
+            return Err(InputError::Scale {
+                path: path.to_path_buf(),
+                channel: ch.id.clone(),
+                message: format!(
+                    "holds digitizer counts ({}); allowed: give a scale CHANNEL=FACTOR with the \
+                     {unit} per count of the instrument's response",
                     ch.encodings.join(", ")
-                ));
-            }
+                ),
+            })
         }
-        if opts.gaps == GapPolicy::Reject {
-            if let Some(&(a, b)) = ch.gaps.iter().find(|&&(a, b)| b > k && a < k + len) {
-                return Err(fault(
-                    path,
-                    None,
-                    format!(
-                        "channel {}: no records for {} samples from {} to {} (sample indices \
-                         {}..={} of the series); allowed: no gaps, or gap interpolation to \
-                         bridge interior gaps linearly",
-                        ch.id,
-                        b - a,
-                        ch.time(a),
-                        ch.time(b - 1),
-                        a.max(k) - k,
-                        b.min(k + len) - 1 - k
-                    ),
-                ));
-            }
-        }
-        if !ch.gaps.is_empty() || ch.overlapping > 0 {
+        (None, false) => {
             notes.push(format!(
-                "channel {}: {} records, {} gaps ({} samples, filled with NaN before the gap \
-                 policy), {} samples in identical overlaps kept once",
+                "channel {}: {} samples taken to be in {unit} already (miniSEED stores no \
+                 units); give a scale if they are not",
                 ch.id,
-                ch.records,
-                ch.gaps.len(),
-                ch.gaps.iter().map(|(a, b)| b - a).sum::<usize>(),
-                ch.overlapping
+                ch.encodings.join(", ")
             ));
         }
-        let s = m.sign.factor();
-        let mut v: Vec<f64> = ch.data[k..k + len]
-            .iter()
-            .map(|x| s * (factor * x))
-            .collect();
-        let ctx = ChannelCtx {
-            path,
-            channel: &m.source,
-            unit,
-        };
-        let bridged = process_channel(&mut v, opts.gaps, &ctx)?;
-        if bridged > 0 {
-            notes.push(gap_note(&m.source, bridged));
-        }
-        check_unstated_data(path, &m.source, planned, &v, rate)?;
-        data.push(v);
     }
-    notes.push(units_note(&plan));
-    let provenance = Provenance {
-        path: path.to_path_buf(),
-        format: InputFormat::Miniseed,
-        kind: InputKind::Series,
-        quantity: plan.quantity,
-        axis_map: resolved.map.to_string(),
-        start_time: Some(chans[0].time(spans[0])),
-        notes,
+    if opts.gaps == GapPolicy::Reject {
+        if let Some(&(a, b)) = ch.gaps.iter().find(|&&(a, b)| b > k && a < k + len) {
+            return Err(fault(
+                path,
+                None,
+                format!(
+                    "channel {}: no records for {} samples from {} to {} (sample indices \
+                     {}..={} of the series); allowed: no gaps, or gap interpolation to bridge \
+                     interior gaps linearly",
+                    ch.id,
+                    b - a,
+                    ch.time(a),
+                    ch.time(b - 1),
+                    a.max(k) - k,
+                    b.min(k + len) - 1 - k
+                ),
+            ));
+        }
+    }
+    if !ch.gaps.is_empty() || ch.overlapping > 0 {
+        notes.push(format!(
+            "channel {}: {} records, {} gaps ({} samples, filled with NaN before the gap \
+             policy), {} samples in identical overlaps kept once",
+            ch.id,
+            ch.records,
+            ch.gaps.len(),
+            ch.gaps.iter().map(|(a, b)| b - a).sum::<usize>(),
+            ch.overlapping
+        ));
+    }
+    let (s, factor) = (m.sign.factor(), planned.factor);
+    let mut v: Vec<f64> = ch.data[k..k + len]
+        .iter()
+        .map(|x| s * (factor * x))
+        .collect();
+    let ctx = ChannelCtx {
+        path,
+        channel: &m.source,
+        unit,
     };
-    Ok(into_series(&plan, data, rate, provenance))
+    let bridged = process_channel(&mut v, opts.gaps, &ctx)?;
+    if bridged > 0 {
+        notes.push(gap_note(&m.source, bridged));
+    }
+    Ok(v)
 }
 
 #[cfg(test)]
