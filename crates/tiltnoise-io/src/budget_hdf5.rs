@@ -50,6 +50,16 @@ pub fn write_budget_hdf5(
     })
 }
 
+/// The names of the report's floor inputs: its translations, or its tilt axes.
+fn input_names(report: &BudgetReport, translation: bool) -> Vec<&'static str> {
+    report
+        .inputs
+        .iter()
+        .filter(|i| matches!(i, tiltnoise_core::model::Input::Translation(_)) == translation)
+        .map(|i| i.name())
+        .collect()
+}
+
 fn write_file(
     path: &Path,
     report: &BudgetReport,
@@ -104,16 +114,8 @@ fn write_file(
                 .create("data_band_hz")?;
         }
     }
-    let named = |translation: bool| -> Vec<&str> {
-        report
-            .inputs
-            .iter()
-            .filter(|i| matches!(i, tiltnoise_core::model::Input::Translation(_)) == translation)
-            .map(|i| i.name())
-            .collect()
-    };
-    strs_attr(&file, "tilt_axes", named(false))?;
-    strs_attr(&file, "translation_axes", named(true))?;
+    strs_attr(&file, "tilt_axes", input_names(report, false))?;
+    strs_attr(&file, "translation_axes", input_names(report, true))?;
     let observables: Vec<&str> = report
         .budget
         .observables

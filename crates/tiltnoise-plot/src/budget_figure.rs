@@ -561,6 +561,26 @@ fn pretty(v: f64) -> String {
 
 /// Caption paragraphs: input, spectral estimate, segments, readout, conventions, notes.
 /// With `many_panels` (more than four) the conventions are said in one short paragraph.
+/// What the caption calls the floor's motion of `report` (`Tilt`, `Translation`, `Floor
+/// motion`), and the symbols of its inputs.
+fn floor_inputs(report: &BudgetReport) -> (String, String) {
+    let symbols: Vec<&str> = report
+        .inputs
+        .iter()
+        .filter_map(|i| match i {
+            Input::Tilt(a) => Some(tilt_symbol(*a)),
+            Input::Translation(t) => Some(translation_symbol(*t)),
+            Input::Force(_) => None,
+        })
+        .collect();
+    let mut name = floor_name(report).to_string();
+    name[..1].make_ascii_uppercase();
+    if name == "Ground" {
+        name = "Floor motion".to_string();
+    }
+    (name, symbols.join(", "))
+}
+
 fn caption(report: &BudgetReport, input: Option<&InputMeta>, many_panels: bool) -> Vec<String> {
     let mut out = Vec::new();
     if let Some(i) = input {
@@ -578,25 +598,7 @@ fn caption(report: &BudgetReport, input: Option<&InputMeta>, many_panels: bool) 
         s.push('.');
         out.push(s);
     }
-    let axes: Vec<&str> = report
-        .inputs
-        .iter()
-        .filter_map(|i| match i {
-            Input::Tilt(a) => Some(tilt_symbol(*a)),
-            Input::Translation(t) => Some(translation_symbol(*t)),
-            Input::Force(_) => None,
-        })
-        .collect();
-    let axes = axes.join(", ");
-    let floor = {
-        let mut name = floor_name(report).to_string();
-        name[..1].make_ascii_uppercase();
-        if name == "Ground" {
-            "Floor motion".to_string()
-        } else {
-            name
-        }
-    };
+    let (floor, axes) = floor_inputs(report);
     out.push(match &report.source {
         SpectralSource::Welch {
             sample_rate_hz,

@@ -296,26 +296,14 @@ pub fn budget_from_series(
                 if in_segment == seg {
                     acc.finish_into(&mut segment_spectra)?;
                     in_segment = 0;
-                    map.apply_in_place(&mut segment_spectra);
-                    let nn = n_ax * n_ax;
-                    let (grid, csd) = (&segment_spectra.freqs_hz[1..], &segment_spectra.data[nn..]);
                     if tf_cache.is_none() {
+                        let grid = &segment_spectra.freqs_hz[1..];
                         tf_cache = Some(ground_tf(model, &opts.outputs, &inputs, grid)?);
                     }
                     let tf = tf_cache.as_ref().expect("computed above");
-                    // Reduce each finished segment to the PSDs of its total ground term at
-                    // once (bounded memory).
-                    let b = ground_budget(
-                        tf,
-                        &GroundCsd {
-                            inputs: &inputs,
-                            csd,
-                        },
-                        &Readout::none(),
-                    );
-                    for (o, ob) in b.observables.iter().enumerate() {
-                        let psd = &ob.term(&segment_term).expect("the total's ground term").psd;
-                        segment_tilt[o].push(psd.iter().map(|&p| p as f32).collect());
+                    let psds = segment_psds(&map, tf, &mut segment_spectra, &segment_term);
+                    for (kept, psd) in segment_tilt.iter_mut().zip(psds) {
+                        kept.push(psd);
                     }
                 }
             }
@@ -394,6 +382,35 @@ pub fn budget_from_series(
         n_segments: spectra.n_segments,
     };
     with_summary(model, report, &tilt, opts)
+}
+
+/// The PSDs (f32, enough for percentile bands) of the term `term` of the floor's motion of
+/// every output of `tf`, from the channels' cross-spectra of one segment, which become the
+/// inputs' in place: a finished segment reduced at once, so that memory stays bounded.
+fn segment_psds(
+    map: &GroundMap,
+    tf: &TransferMatrix,
+    spectra: &mut CrossSpectra,
+    term: &TermKind,
+) -> Vec<Vec<f32>> {
+    map.apply_in_place(spectra);
+    let nn = spectra.n_channels * spectra.n_channels;
+    let inputs = map.inputs();
+    let b = ground_budget(
+        tf,
+        &GroundCsd {
+            inputs: &inputs,
+            csd: &spectra.data[nn..],
+        },
+        &Readout::none(),
+    );
+    b.observables
+        .iter()
+        .map(|ob| {
+            let psd = &ob.term(term).expect("the total's ground term").psd;
+            psd.iter().map(|&p| p as f32).collect()
+        })
+        .collect()
 }
 
 /// `report` with its summary ([`summary::summarize`]), and a note for every frequency left out.
