@@ -37,10 +37,16 @@
 //! else from the file's metadata (HDF5 attribute `units` on each channel dataset: `rad` or
 //! `rad/s`; CSV: a `# units:` line), else it **defaults to angle** and the provenance says so.
 //! A rate is **kept as a rate** in a time series ([`TiltSeries::quantity`],
-//! [`SeriesSource::quantity`]) and converted to angle where spectra are formed: its one-sided
+//! [`SeriesSource::channels`]) and converted to angle where spectra are formed: its one-sided
 //! CSD divided by `(2 pi f)²` at every `f > 0`, exactly up to Nyquist; the DC bin carries no
 //! angle information and is excluded ([`rate`]). Spectra of a rate are divided by `(2 pi f)²`
 //! as they are read.
+//!
+//! **Translation.** A channel whose unit is one of length, velocity or acceleration ([`Unit`],
+//! [`ChannelUnit`] for files that state none) is the floor's translation `x_t`, `y_t`, `z_t`
+//! ([`TranslationChannel`]); inertial sensors sense tilt too, and [`GroundMap`] carries every
+//! channel's spectra to the inputs' displacements with that corrected ([`motion`]). A tilt
+//! channel whose unit nobody states is bounded ([`unstated_rms_bound`]).
 //!
 //! **Gaps.** NaN or infinite samples are refused ([`InputError::NonFinite`], naming channel
 //! and sample index) unless [`GapPolicy::Interpolate`] is selected: then each interior run of
