@@ -63,7 +63,8 @@ pub struct BudgetArgs {
     /// Welch averaging: mean (default), or median (with scipy's bias correction).
     #[arg(long, value_enum)]
     pub average: Option<AverageArg>,
-    /// Split the record into segments of this many seconds (e.g. 3600) for a percentile band.
+    /// Split the record into segments of this many seconds for a percentile band; each must
+    /// hold one Welch segment (--nperseg samples), e.g. 14400 with --nperseg 4096 at 1 Hz.
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     pub segment_duration: Option<f64>,
     /// Percentiles of the band across segments, LOWER,UPPER (default 10,90; with
@@ -260,7 +261,7 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     if args.percentiles.is_some() && args.segment_duration.is_none() {
         bail!(
             "--percentiles applies to the per-segment band and needs --segment-duration \
-             (e.g. --segment-duration 3600)"
+             (e.g. --segment-duration 14400 with --nperseg 4096: each segment holds a Welch segment)"
         );
     }
     let opts = BudgetOptions {

@@ -32,11 +32,11 @@ use tiltnoise_io::{read_freq_file, RunMeta};
 /// Arguments of `tiltnoise tf`.
 #[derive(Debug, Args)]
 pub struct TfArgs {
-    /// Log-spaced grid FLO:N:FHI (Hz:count:Hz), e.g. 1e-4:2000:30. Default: 0.1 mHz to 30 Hz,
-    /// 2000 points, plus points around every resonance.
+    /// Log-spaced grid FLO:N:FHI (Hz:count:Hz), e.g. 1e-4:2000:30, or one frequency F (Hz).
+    /// Default: 0.1 mHz to 30 Hz, 2000 points, plus points around every resonance.
     #[arg(
         long,
-        value_name = "FLO:N:FHI",
+        value_name = "FLO:N:FHI|F",
         conflicts_with = "freq_file",
         allow_hyphen_values = true
     )]
@@ -232,6 +232,9 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
                 }
                 Err(refusal @ NoChoice::Tolerance { .. }) => {
                     bail!("{refusal}; run with --explain for every candidate")
+                }
+                Err(refusal @ NoChoice::NearMode { .. }) => {
+                    bail!("{refusal} (--method polezero, or another --freq)")
                 }
                 Err(refusal) => return Err(refusal.into()),
             };

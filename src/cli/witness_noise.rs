@@ -14,11 +14,11 @@ use tiltnoise_core::repeats::refuse_repeated_keys;
 use tiltnoise_io::input::InputFormat;
 
 /// The model inputs a witness can record.
-const FLOOR_INPUTS: &str = "theta_t, eta_t, phi_t";
+const FLOOR_INPUTS: &str = "theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)";
 
-/// Whether `input` is a motion of the floor (what a witness records).
+/// Whether `input` is a motion of the floor (what a witness records): a tilt or a translation.
 pub fn is_floor_input(input: Input) -> bool {
-    matches!(input, Input::Tilt(_))
+    input.is_ground()
 }
 
 /// Parses every `--witness-noise` item, each input once; returns the levels and the files read.

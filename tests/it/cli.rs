@@ -218,3 +218,48 @@ fn mc_json_reports_every_mode_and_refuses_zero_samples() {
     }
     assert_fails(&["mc", "--samples", "0"], &["samples = 0"]);
 }
+
+/// `--freq F` is the grid of the one frequency F; a request next to a mode that the planner
+/// cannot verify names the mode and the two ways out, and the first of them works.
+#[test]
+fn tf_takes_one_frequency_and_explains_a_point_next_to_a_mode() {
+    let out = tiltnoise(&["tf", "--freq", "1e-3", "--input", "eta_t", "--output", "X"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (_, freqs, values) = common::parse_tf_csv(&String::from_utf8_lossy(&out.stdout));
+    assert_eq!(freqs, vec![1e-3]);
+    // X -> -eta_t (Z + Z_b + h_c) as f -> 0: negative and finite at 1 mHz.
+    assert!(values[0][0].re.is_finite() && values[0][0].re < 0.0);
+
+    let near = ["tf", "--freq", "0.415", "--input", "eta_t", "--output", "X"];
+    assert_fails(
+        &near,
+        &[
+            "0.415 Hz lies within 1 % of the normal mode at ",
+            "--method polezero",
+            "another --freq",
+        ],
+    );
+    let err = stderr(&tiltnoise(&near));
+    let mode_hz: f64 = err
+        .split("normal mode at ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|x| x.parse().ok())
+        .unwrap_or_else(|| panic!("no mode frequency in: {err}"));
+    assert!(((mode_hz - 0.415) / mode_hz).abs() < 0.01, "{err}");
+    let out = tiltnoise(&[&near[..], &["--method", "polezero"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+/// A segment duration shorter than the Welch segment says how short the Welch segment must be.
+#[test]
+fn a_segment_shorter_than_the_welch_segment_names_nperseg() {
+    let lab = concat!(env!("CARGO_MANIFEST_DIR"), "/tilt_data/lab_tilt_24h.h5");
+    assert_fails(
+        &["budget", "--tilt", lab, "--segment-duration", "3600"],
+        &[
+            "segment duration 3600 s",
+            "(nperseg) to at most 3600 samples",
+        ],
+    );
+}

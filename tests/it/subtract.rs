@@ -419,6 +419,7 @@ fn noisy_witness_end_to_end() {
     let other = Record {
         axes: rec.axes.clone(),
         tilt: rec.colocated[0].clone(),
+        translation: Vec::new(),
         colocated: Vec::new(),
         measured: Vec::new(),
     };
@@ -635,6 +636,7 @@ fn bad_input_is_refused_without_output() {
     let mut bad = Record {
         axes: rec.axes.clone(),
         tilt: rec.tilt.clone(),
+        translation: Vec::new(),
         colocated: Vec::new(),
         measured: rec.measured.clone(),
     };
@@ -713,11 +715,19 @@ fn bad_input_is_refused_without_output() {
             vec!["--witness-noise: eta_t is given twice; name each input once"],
         ),
         (
+            vec![p("m.h5"), "--witness-noise".into(), "F_b.x=1e-9".into()],
+            vec![
+                "--witness-noise F_b.x=1e-9",
+                "not a floor input",
+                "theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)",
+            ],
+        ),
+        (
             vec![p("m.h5"), "--witness-noise".into(), "x_t=1e-9".into()],
             vec![
-                "--witness-noise x_t=1e-9",
-                "not a floor input",
-                "theta_t, eta_t, phi_t",
+                "--witness-noise x_t",
+                "the witness record has no input x_t",
+                "theta_t, eta_t",
             ],
         ),
         (

@@ -131,8 +131,8 @@ pub fn check_frequencies(freqs_hz: &[f64], origin: &str) -> Result<(), FreqError
     }
 }
 
-/// Parses `FLO:N:FHI` (Hz, count, Hz), e.g. `1e-4:2000:30`; N is at most
-/// [`MAX_GRID_POINTS`].
+/// Parses `FLO:N:FHI` (Hz, count, Hz), e.g. `1e-4:2000:30`, or a single frequency `F` (Hz);
+/// N is at most [`MAX_GRID_POINTS`].
 pub fn parse_spec(spec: &str) -> Result<Vec<f64>, FreqError> {
     let grid = parse_log_spec(spec, MAX_GRID_POINTS)?;
     Ok(grid.block(0, grid.len()))
@@ -147,8 +147,15 @@ pub fn parse_log_spec(spec: &str, limit: usize) -> Result<LogGrid, FreqError> {
         message: message.into(),
     };
     let parts: Vec<&str> = spec.split(':').map(str::trim).collect();
-    let [lo, n_text, hi] = parts[..] else {
-        return Err(err("expected FLO:N:FHI, e.g. 1e-4:2000:30 (Hz:count:Hz)"));
+    let (lo, n_text, hi) = match parts[..] {
+        [lo, n_text, hi] => (lo, n_text, hi),
+        // One frequency: the grid of one point.
+        [f] if f.parse::<f64>().is_ok() => (f, "1", f),
+        _ => {
+            return Err(err(
+                "expected FLO:N:FHI, e.g. 1e-4:2000:30 (Hz:count:Hz), or one frequency F (Hz)",
+            ))
+        }
     };
     let lo: f64 = lo.parse().map_err(|_| err("FLO is not a number"))?;
     let hi: f64 = hi.parse().map_err(|_| err("FHI is not a number"))?;

@@ -212,9 +212,11 @@ fn segment_samples(
             if !(d.is_finite() && s >= seg_len as f64) {
                 return Err(BudgetError::Config(format!(
                     "segment duration {} s is not allowed: must hold at least one Welch segment \
-                     ({seg_len} samples = {} s at {fs} Hz)",
+                     ({seg_len} samples = {} s at {fs} Hz); shorten the Welch segment (nperseg) \
+                     to at most {} samples, or lengthen the segment duration",
                     crate::error::Num(d),
-                    seg_len as f64 / fs
+                    seg_len as f64 / fs,
+                    if s.is_finite() { s.max(0.0) } else { 0.0 }
                 )));
             }
             if s > n as f64 {

@@ -808,10 +808,10 @@ fn check_config(
         )));
     }
     for (i, input) in witness.inputs.iter().enumerate() {
-        if !matches!(input, Input::Tilt(_)) {
+        if !input.is_ground() {
             return Err(SubtractError::Config(format!(
                 "the witness record's channel {} is not a motion of the floor; a witness records \
-                 floor inputs of the model (theta_t, eta_t, phi_t)",
+                 floor inputs of the model (theta_t, eta_t, phi_t, x_t, y_t, z_t)",
                 input.name()
             )));
         }

@@ -9,7 +9,9 @@
 //! 1. the line through each channel's first and last sample is removed, so that the periodic
 //!    extension the DFT assumes has no jump; its response is added back exactly: a tilt linear
 //!    in time has `u'' = 0`, so the response is the static one, `H(0) (a + b (t - tau))`
-//!    (for a damped model the real part of `H(0)`, exact to first order in the loss angles);
+//!    (for a damped model the real part of `H(0)`, exact to first order in the loss angles),
+//!    weighted as the lowest DFT bin is (the line holds the record's longest periods) and left
+//!    out with the lowest band;
 //! 2. the rest is transformed, multiplied bin by bin by `F_o(f_k) = A(f_k) G_o(f_k)`, with
 //!    `G_oa = g_a H_oa(f_k) exp(-i 2 pi f_k tau)` (`e^{+iwt}` convention: a delay is
 //!    `exp(-i w tau)`; [`crate::tf::Method::Split`], full relative accuracy on every entry)
@@ -149,7 +151,7 @@ pub fn guard_factor(s: f64) -> f64 {
 
 impl Predictor {
     /// The prediction of every observable, each bin's spectrum multiplied by `mask(output
-    /// index, frequency)` (1: predicted; 0: left out).
+    /// index, frequency)` (1: predicted; 0: left out), the line part by the mask at 0 Hz.
     pub fn series(&self, mask: &dyn Fn(usize, f64) -> f64) -> Prediction {
         let mut planner = RealFftPlanner::<f64>::new();
         let inv = planner.plan_fft_inverse(self.n);
@@ -168,8 +170,9 @@ impl Predictor {
                 inv.process(&mut spec, &mut y)
                     .expect("buffers sized by the plan");
                 let n = self.n as f64;
+                let line_mask = mask(o, 0.0);
                 for (v, l) in y.iter_mut().zip(&self.line[o]) {
-                    *v = *v / n + l;
+                    *v = *v / n + line_mask * l;
                 }
                 (self.outputs[o], y)
             })
@@ -280,18 +283,28 @@ pub fn predictor(
             spec[n_bins - 1].im = 0.0;
         }
     }
+    // The line holds the record's longest periods: it is weighted as the lowest bin is,
+    // `F_b = sum_a A_ba G_a(0)`, so that a witness that records only its own noise there (a
+    // noise rising at low frequency) adds none of it.
+    let at_lowest = weights.at(df);
     let shift = coupling.delay_s * fs_hz;
     let line = (0..n_out)
         .map(|o| {
+            let f_line: Vec<f64> = (0..n_in)
+                .map(|b| {
+                    (0..n_in)
+                        .map(|a| at_lowest[(b, a)] * h0[o * n_in + a].re * coupling.gains[a])
+                        .sum::<Complex64>()
+                        .re
+                })
+                .collect();
             (0..n)
                 .map(|i| {
                     let t = i as f64 - shift;
                     lines
                         .iter()
-                        .enumerate()
-                        .map(|(a, &(c0, c1))| {
-                            h0[o * n_in + a].re * coupling.gains[a] * (c0 + c1 * t)
-                        })
+                        .zip(&f_line)
+                        .map(|(&(c0, c1), f)| f * (c0 + c1 * t))
                         .sum()
                 })
                 .collect()

@@ -82,9 +82,18 @@ pub struct Choice {
 /// every candidate's verdict.
 #[derive(Debug, Clone, PartialEq)]
 pub enum NoChoice {
-    /// The band cannot be verified: empty, not positive, not finite, or within
-    /// [`POLE_EXCLUSION`] of a mode everywhere.
+    /// The band cannot be verified: empty, not positive or not finite.
     Band(String),
+    /// Every point of the band lies within [`POLE_EXCLUSION`] of a normal mode, where no
+    /// method can be checked against the reference (the undamped response is infinite on the
+    /// mode, and within that distance the mode frequency's own uncertainty decides the value):
+    /// the caller chooses a method, or frequencies away from the mode.
+    NearMode {
+        /// The band asked for (Hz).
+        band_hz: (f64, f64),
+        /// The frequency of the nearest normal mode (Hz).
+        mode_hz: f64,
+    },
     /// Every candidate was tried and none meets the tolerance.
     Tolerance {
         /// The scene.
@@ -98,6 +107,28 @@ impl std::fmt::Display for NoChoice {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let (scene, verdicts) = match self {
             NoChoice::Band(why) => return f.write_str(why),
+            NoChoice::NearMode { band_hz, mode_hz } => {
+                let at = if band_hz.0 == band_hz.1 {
+                    format!("{} Hz lies", Num(band_hz.0))
+                } else {
+                    format!(
+                        "every frequency of {} .. {} Hz lies",
+                        Num(band_hz.0),
+                        Num(band_hz.1)
+                    )
+                };
+                return write!(
+                    f,
+                    "{at} within {} % of the normal mode at {:.5e} Hz, where the automatic choice \
+                     cannot check any method against the reference (on an undamped mode the \
+                     response is infinite); choose the method yourself (pole-zero stays \
+                     accurate next to a mode), or ask for frequencies at least {} % away from \
+                     the mode",
+                    100.0 * POLE_EXCLUSION,
+                    mode_hz,
+                    100.0 * POLE_EXCLUSION
+                );
+            }
             NoChoice::Tolerance { scene, verdicts } => (scene, verdicts),
         };
         let (lo, hi) = scene.band_hz;
@@ -138,6 +169,7 @@ impl NoChoice {
     pub fn explain(&self) -> String {
         match self {
             NoChoice::Band(why) => why.clone(),
+            NoChoice::NearMode { .. } => self.to_string(),
             NoChoice::Tolerance { scene, verdicts } => format!(
                 "{}\n{}\nnone meets the tolerance",
                 explain_scene(scene),
@@ -214,11 +246,20 @@ pub fn choose(model: &Model, scene: &Scene) -> Result<Choice, NoChoice> {
     }
     let grid = verification_grid(model, scene.band_hz);
     if grid.is_empty() {
-        return Err(NoChoice::Band(format!(
-            "scene band {} .. {} Hz lies within {POLE_EXCLUSION} of a mode: nothing to verify",
-            Num(lo),
-            Num(hi)
-        )));
+        let middle = (lo * hi).sqrt();
+        let mode_hz = NormalModes::new(model)
+            .frequencies_hz()
+            .into_iter()
+            .min_by(|a, b| {
+                ((a - middle) / a)
+                    .abs()
+                    .total_cmp(&((b - middle) / b).abs())
+            })
+            .unwrap_or(middle);
+        return Err(NoChoice::NearMode {
+            band_hz: (lo, hi),
+            mode_hz,
+        });
     }
     let reference = ReferenceModel::new(model.params());
     let mut verdicts = Vec::new();

@@ -25,6 +25,7 @@ mod scenes;
 mod simulate;
 mod stability;
 mod subtract;
+mod subtract_ground;
 mod subtract_pulls;
 mod synthetic;
 mod tilt_tf;
