@@ -22,6 +22,15 @@
 //! * `polezero_evaluate/1t`: `tf::evaluate` itself, which also allocates its result (fresh
 //!   pages: 8.8 MB at 1e5 points) and copies the grid.
 //!
+//! Group `polezero_as_built_7x3_tilt`: the pole-zero method on the symmetric Table I and, side
+//! by side in the same run, on two pendulums as built whose offsets along x couple the blocks
+//! (the 8x8 system: 21 entries of 8 factors over 8 poles, against 11 entries over two 4x4
+//! blocks): the crossbar's centre of mass 1 mm off along x, and the test mass's (some entries
+//! with conjugate pairs of complex zeros, still real arithmetic). `<model>/matrix` is
+//! `tf::evaluate_into` into the plan's own layout (what `auto` hands the user), `<model>/batch`
+//! `eval_grid_into` into the dense complex matrix; one thread. The cost ratio coupled /
+//! symmetric per point is read from one run.
+//!
 //! Group `polezero_ground`: the pole-zero method on the 7x3 tilt matrix and on the 7x6 ground
 //! matrix (tilt and the floor's translation x_t, y_t, z_t), side by side in one run:
 //! `tilt_7x3/batch`, `ground_7x6/batch` (`eval_grid_into`, the dense complex matrix) and
@@ -184,6 +193,52 @@ fn methods(c: &mut Criterion) {
     g.finish();
 }
 
+fn as_built(c: &mut Criterion) {
+    let request = Request::all_tilt();
+    let block = request.outputs.len() * request.inputs.len();
+    let n = n_points();
+    let grid = log_grid(F_LO_HZ, F_HI_HZ, n).expect("valid grid");
+    let mut out = tf::zeroed_complex(block * n);
+    let mut g = c.benchmark_group("polezero_as_built_7x3_tilt");
+    g.sample_size(10)
+        .sampling_mode(SamplingMode::Flat)
+        .warm_up_time(Duration::from_millis(300))
+        .measurement_time(Duration::from_secs(1))
+        .throughput(Throughput::Elements(n as u64));
+    let set = |key: &str| {
+        Params::table_i()
+            .with_override(&format!("asymmetry.{key}=1e-3"))
+            .expect("a 1 mm offset is valid")
+    };
+    for (name, params) in [
+        ("symmetric", Params::table_i()),
+        ("crossbar_x_1mm", set("crossbar_com_x_m")),
+        ("tm_x_1mm", set("tm_com_x_m")),
+    ] {
+        let model = Model::new(&params).expect("valid parameters");
+        let plan = tf::plan(&model, &request, Method::PoleZero).expect("pole-zero plans 7x3 tilt");
+        let plan = plan.as_ref();
+        let mut m = tf::evaluate(plan, &grid).expect("no singular frequency");
+        eprintln!(
+            "polezero_as_built: {name}: {} planes of the compact layout per point",
+            plan.layout().n_planes()
+        );
+        g.bench_function(format!("{name}/matrix"), |b| {
+            b.iter(|| {
+                tf::evaluate_into(plan, black_box(&grid), 1, black_box(&mut m))
+                    .expect("no singular frequency on the grid")
+            })
+        });
+        g.bench_function(format!("{name}/batch"), |b| {
+            b.iter(|| {
+                plan.eval_grid_into(black_box(&grid), black_box(&mut out))
+                    .expect("no singular frequency on the grid")
+            })
+        });
+    }
+    g.finish();
+}
+
 /// The pole-zero method's cost per point with the six ground inputs against the three tilt
 /// inputs (module docs).
 fn polezero_ground(c: &mut Criterion) {
@@ -224,5 +279,5 @@ fn polezero_ground(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, methods, polezero_ground);
+criterion_group!(benches, methods, as_built, polezero_ground);
 criterion_main!(benches);

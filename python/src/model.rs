@@ -304,7 +304,17 @@ impl PyModel {
                 omega_sq_rad2_per_s2: m.omega_sq,
                 quality_factor: m.quality_factor,
                 loss_angle_rad: m.loss_angle,
-                block: m.block.name(),
+                block: m.block_name(),
+                overlap: m.overlap,
+                ratio: Observable::ALL
+                    .iter()
+                    .map(|o| (o.name(), modes.ratio[k][o.index()]))
+                    .collect(),
+                seen_above_ratio: modes
+                    .observables_above_ratio(k)
+                    .iter()
+                    .map(|o| o.name())
+                    .collect(),
                 dominant_coordinates: m
                     .dominant_coords(DOMINANT_SHARE)
                     .into_iter()
@@ -462,9 +472,10 @@ impl PyModel {
     /// Keys: ``M`` (8x8 mass matrix), ``K`` (8x8 undamped stiffness), ``K_imag`` (8x8
     /// structural damping, ``Im K_c``), ``D`` (8x8 viscous damping), ``G0``, ``G2`` (8x3 tilt
     /// forcing), ``G2_translation`` (8x3 floor-translation forcing per unit ``w^2``),
-    /// ``F`` (8x12 force/torque forcing), ``C`` (7x8 observation matrix), and the labels
-    /// ``coordinates``, ``observables``, ``tilt_inputs``, ``translation_inputs``,
-    /// ``force_inputs``.
+    /// ``F`` (8x12 force/torque forcing), ``C`` (7x8 observation matrix), ``q0`` (the rest
+    /// configuration the model is linear about: 0 for the symmetric pendulum, the tilted
+    /// equilibrium of the pendulum as built), and the labels ``coordinates``, ``observables``,
+    /// ``tilt_inputs``, ``translation_inputs``, ``force_inputs``.
     fn matrices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let m = &self.model;
         let d = PyDict::new(py);
@@ -477,6 +488,7 @@ impl PyModel {
         d.set_item("G2_translation", matrix(py, &m.translation_forcing().g2))?;
         d.set_item("F", matrix(py, m.force_matrix()))?;
         d.set_item("C", matrix(py, m.observation()))?;
+        d.set_item("q0", m.rest_configuration().as_slice().to_vec())?;
         let names = |v: Vec<&'static str>| PyList::new(py, v);
         d.set_item(
             "coordinates",
@@ -611,7 +623,8 @@ impl PyModel {
 /// One normal mode (see :meth:`Model.modes`).
 #[pyclass(module = "tiltnoise", frozen, get_all)]
 pub struct Mode {
-    /// 1-based, in order of increasing frequency (the paper's nu_1 ... nu_8).
+    /// The label k of nu_k: the rank in frequency (the paper's nu_1 ... nu_8) for the
+    /// symmetric pendulum, the symmetric mode it overlaps most for the pendulum as built.
     index: usize,
     /// Frequency (Hz), refined to the last bit in double-double.
     frequency_hz: f64,
@@ -621,8 +634,14 @@ pub struct Mode {
     quality_factor: f64,
     /// Modal loss angle 1/Q (rad).
     loss_angle_rad: f64,
-    /// The decoupled block of the model the mode lives in.
+    /// The decoupled block of the model the mode lives in, or ``coupled``.
     block: &'static str,
+    /// Mass-metric overlap with the symmetric pendulum's mode nu_index (1 when symmetric).
+    overlap: f64,
+    /// Amplitude in each observable over the largest of its unit group in this mode.
+    ratio: HashMap<&'static str, f64>,
+    /// Observables whose ``ratio`` reaches 1e-4.
+    seen_above_ratio: Vec<&'static str>,
     /// ``(coordinate, share)`` of the coordinates with at least 5 % of the kinetic energy.
     dominant_coordinates: Vec<(&'static str, f64)>,
     /// Share of the modal kinetic energy per coordinate (sums to 1).

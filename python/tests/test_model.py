@@ -256,3 +256,23 @@ def test_threads_sharing_models_get_their_own_grids():
     for t in threads:
         t.join()
     assert wrong == []
+
+
+def test_the_pendulum_as_built_equals_the_command_line(cli):
+    """An [asymmetry] offset through Params: the rest configuration, the mode labels, overlaps
+    and amplitude ratios are the command line's (the test mass's centre of mass 1 mm off along
+    x tilts it by atan(1 mm / (Z_b + delta_b)) and lights nu_6 in Z)."""
+    p = tiltnoise.Params().set("asymmetry.tm_com_x_m", 1e-3)
+    model = tiltnoise.Model(p)
+    expected = json.loads(cli("--set", "asymmetry.tm_com_x_m=1e-3", "modes", "--format", "json"))
+    q0 = model.matrices()["q0"]
+    coords = model.matrices()["coordinates"]
+    assert [q0[coords.index(c)] for c in coords] == [
+        expected["rest_configuration"][c] for c in coords
+    ]
+    assert q0[coords.index("eta_b")] == pytest.approx(1.3157887e-3, rel=1e-7)
+    for m, e in zip(model.modes(), expected["modes"]):
+        assert (m.index, m.block, m.overlap) == (e["index"], e["block"], e["overlap"])
+        assert m.ratio == e["ratio"] and m.seen_above_ratio == e["seen_above_ratio"]
+    nu6 = next(m for m in model.modes() if m.index == 6)
+    assert nu6.block == "coupled" and "Z" in nu6.seen_above_ratio

@@ -55,6 +55,9 @@ class Mode:
     quality_factor: float
     loss_angle_rad: float
     block: str
+    overlap: float
+    ratio: dict[str, float]
+    seen_above_ratio: list[str]
     dominant_coordinates: list[Tuple[str, float]]
     energy_share: dict[str, float]
     seen_by: list[str]

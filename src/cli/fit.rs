@@ -1,6 +1,7 @@
 //! `tiltnoise fit`: the command line of the constrained least-squares fit of parameters to
-//! measured mode frequencies ([`tiltnoise_core::fit`]): argument parsing, the table and JSON reports and
-//! the `--save` writers (.json, .h5; written atomically, checked before the fit runs).
+//! measured mode frequencies and visibilities ([`tiltnoise_core::fit`]): argument parsing, the
+//! table and JSON reports and the `--save` writers (.json, .h5; written atomically, checked
+//! before the fit runs).
 
 use super::Run;
 use anyhow::Result;
@@ -9,17 +10,23 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::OutputError;
-use tiltnoise_core::fit::{self, Bound, FitConfig, FitResult, Measured, SigmaSource};
+use tiltnoise_core::fit::{self, Bound, FitConfig, FitResult, Measured, SigmaSource, Visibilities};
 use tiltnoise_core::params::Params;
-use tiltnoise_io::{read_measured_modes, write_atomic, write_fit_hdf5};
+use tiltnoise_io::{read_measured_modes, read_visibilities, write_atomic, write_fit_hdf5};
 
 /// Arguments of `tiltnoise fit`.
 #[derive(Debug, Args)]
 pub(crate) struct FitArgs {
     /// Measured frequencies: CSV `mode,frequency_hz[,sigma_hz]` (any subset of modes 1..8; see
-    /// docs/fit.md). Default: the measured column of Table II.
+    /// docs/fit.md). Default: the measured column of Table II, or none with --visibility.
     #[arg(long, value_name = "FILE")]
     measured: Option<PathBuf>,
+    /// Measured mode visibilities, fitted together with the frequencies: CSV
+    /// `mode,observable,reference,ratio[,sigma]`, the signed ratio of mode nu_k's component in
+    /// an observable to its component in a reference observable (docs/fit.md; `tiltnoise
+    /// visibility` measures them from a free-motion record).
+    #[arg(long, value_name = "FILE")]
+    visibility: Option<PathBuf>,
     /// Free parameters, comma-separated dotted keys (default: k_a, k_b, kappa_a, kappa_b, Z,
     /// I^a_22, Z_b, d; see docs/fit.md).
     #[arg(long, value_name = "KEY,KEY,...", value_delimiter = ',')]
@@ -59,11 +66,26 @@ pub(crate) fn run_fit(params: &Params, args: FitArgs, run: &mut Run) -> Result<(
         .measured
         .iter()
         .map(|p| ("--measured", p.as_path()))
+        .chain(
+            args.visibility
+                .iter()
+                .map(|p| ("--visibility", p.as_path())),
+        )
         .collect();
     run.check_outputs(&saves, &inputs)?;
-    let measured = match &args.measured {
-        Some(path) => read_measured_modes(path)?,
-        None => Measured::table_ii(),
+    // Visibilities without a frequency file are fitted alone: Table II's frequencies belong to
+    // the paper's pendulum, not to the one whose record gave the visibilities.
+    let measured = match (&args.measured, &args.visibility) {
+        (Some(path), _) => read_measured_modes(path)?,
+        (None, None) => Measured::table_ii(),
+        (None, Some(_)) => Measured {
+            modes: Vec::new(),
+            origin: "no frequency file".into(),
+        },
+    };
+    let visibilities = match &args.visibility {
+        Some(path) => read_visibilities(path)?,
+        None => Visibilities::none(),
     };
     let config = FitConfig {
         free: args
@@ -75,7 +97,7 @@ pub(crate) fn run_fit(params: &Params, args: FitArgs, run: &mut Run) -> Result<(
         prior: args.prior,
         cancel: run.cancel.clone(),
     };
-    let result = fit::fit(params, &measured, &config)?;
+    let result = fit::fit_with_visibilities(params, &measured, &visibilities, &config)?;
     let json = fit_json(&result, &measured.origin);
     match args.format {
         FitFormat::Json => writeln!(run.out, "{}", serde_json::to_string_pretty(&json)?)?,
@@ -117,6 +139,13 @@ fn save_kind(path: &Path) -> Result<SaveKind, OutputError> {
     }
 }
 
+fn sigma_source(s: SigmaSource) -> &'static str {
+    match s {
+        SigmaSource::File => "file",
+        SigmaSource::Digits => "digits",
+    }
+}
+
 fn bound_name(b: Option<Bound>) -> &'static str {
     b.map_or("", Bound::name)
 }
@@ -128,6 +157,7 @@ fn fit_json<'a>(r: &'a FitResult, origin: &'a str) -> FitJson<'a> {
         bound_sigmas: r.config.bound_sigmas,
         chi2: r.chi2,
         chi2_nominal: r.chi2_nominal,
+        correlation: &r.correlation,
         dof: r.dof,
         evaluations: r.evaluations,
         fitted_params_toml: r.fitted_params.to_toml(),
@@ -144,16 +174,14 @@ fn fit_json<'a>(r: &'a FitResult, origin: &'a str) -> FitJson<'a> {
                 residual_hz: m.residual_hz(),
                 residual_sigmas: m.residual_sigmas(),
                 sigma_hz: m.measured.sigma_hz,
-                sigma_source: match m.measured.sigma_source {
-                    SigmaSource::File => "file",
-                    SigmaSource::Digits => "digits",
-                },
+                sigma_source: sigma_source(m.measured.sigma_source),
             })
             .collect(),
         parameters: r
             .params
             .iter()
-            .map(|p| ParamJson {
+            .zip(&r.start)
+            .map(|(p, &start)| ParamJson {
                 at_bound: p.at_bound.map(Bound::name),
                 data_sigma_rel: p.data_sigma_rel,
                 fitted: p.fitted,
@@ -162,6 +190,7 @@ fn fit_json<'a>(r: &'a FitResult, origin: &'a str) -> FitJson<'a> {
                 nominal: p.nominal,
                 poorly_constrained: p.poorly_constrained,
                 prior_sigma: p.prior_sigma,
+                start,
                 unit: &p.unit,
             })
             .collect(),
@@ -170,6 +199,21 @@ fn fit_json<'a>(r: &'a FitResult, origin: &'a str) -> FitJson<'a> {
         projected_gradient: r.projected_gradient,
         singular_values: &r.singular_values,
         stop: r.stop.describe(),
+        visibilities: r
+            .visibilities
+            .iter()
+            .map(|v| VisibilityJson {
+                fitted: v.fitted,
+                measured: v.measured.ratio,
+                mode: v.measured.mode,
+                nominal: v.nominal,
+                observable: v.measured.observable.name(),
+                reference: v.measured.reference.name(),
+                residual_sigmas: v.residual_sigmas(),
+                sigma: v.measured.sigma,
+                sigma_source: sigma_source(v.measured.sigma_source),
+            })
+            .collect(),
         weak_directions: r
             .weak_directions
             .iter()
@@ -189,6 +233,8 @@ struct FitJson<'a> {
     bound_sigmas: f64,
     chi2: f64,
     chi2_nominal: f64,
+    /// Correlation matrix of the parameters (their order); null on a bound.
+    correlation: &'a [Vec<f64>],
     dof: usize,
     evaluations: usize,
     fitted_params_toml: String,
@@ -201,7 +247,21 @@ struct FitJson<'a> {
     projected_gradient: f64,
     singular_values: &'a [f64],
     stop: &'static str,
+    visibilities: Vec<VisibilityJson>,
     weak_directions: Vec<WeakJson<'a>>,
+}
+
+#[derive(Serialize)]
+struct VisibilityJson {
+    fitted: f64,
+    measured: f64,
+    mode: usize,
+    nominal: f64,
+    observable: &'static str,
+    reference: &'static str,
+    residual_sigmas: f64,
+    sigma: f64,
+    sigma_source: &'static str,
 }
 
 #[derive(Serialize)]
@@ -226,6 +286,7 @@ struct ParamJson<'a> {
     nominal: f64,
     poorly_constrained: bool,
     prior_sigma: f64,
+    start: f64,
     unit: &'a str,
 }
 
@@ -245,16 +306,24 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
     };
     let _ = writeln!(
         s,
-        "Fit of {} parameters to {} measured modes ({origin}); {box_kind} |p - p0| <= {} sigma_p",
+        "Fit of {} parameters to {} measured modes ({origin}){}; {box_kind} |p - p0| <= {} \
+         sigma_p",
         r.params.len(),
         r.modes.len(),
+        match r.visibilities.len() {
+            0 => String::new(),
+            n => format!(" and {n} visibilities"),
+        },
         r.config.bound_sigmas
     );
     let _ = writeln!(
         s,
-        "chi^2: nominal {:.4e} -> fitted {:.4e}, dof {}; {} iterations, stop: {} (projected \
+        "chi^2: nominal {} -> fitted {:.4e}, dof {}; {} iterations, stop: {} (projected \
          gradient {:.1e})",
-        r.chi2_nominal,
+        match r.chi2_nominal.is_finite() {
+            true => format!("{:.4e}", r.chi2_nominal),
+            false => "undefined (a visibility's reference does not see its mode there)".into(),
+        },
         r.chi2,
         r.dof,
         r.iterations,
@@ -285,11 +354,13 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
         );
     }
     let _ = writeln!(s);
-    let _ = writeln!(
-        s,
-        "{:<5} {:>13} {:>11} {:>13} {:>13} {:>12} {:>10}",
-        "mode", "measured Hz", "sigma Hz", "nominal Hz", "fitted Hz", "resid Hz", "resid/sig"
-    );
+    if !r.modes.is_empty() {
+        let _ = writeln!(
+            s,
+            "{:<5} {:>13} {:>11} {:>13} {:>13} {:>12} {:>10}",
+            "mode", "measured Hz", "sigma Hz", "nominal Hz", "fitted Hz", "resid Hz", "resid/sig"
+        );
+    }
     for m in &r.modes {
         let _ = writeln!(
             s,
@@ -301,6 +372,64 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
             m.fitted_hz,
             m.residual_hz(),
             m.residual_sigmas()
+        );
+    }
+    if !r.visibilities.is_empty() {
+        let _ = writeln!(s);
+        let _ = writeln!(
+            s,
+            "{:<5} {:<13} {:>13} {:>11} {:>13} {:>13} {:>10}",
+            "mode", "ratio", "measured", "sigma", "nominal", "fitted", "resid/sig"
+        );
+        for v in &r.visibilities {
+            let _ = writeln!(
+                s,
+                "nu_{:<2} {:<13} {:>13.5e} {:>11.2e} {:>13.5e} {:>13.5e} {:>10.2}",
+                v.measured.mode,
+                format!(
+                    "{}/{}",
+                    v.measured.observable.name(),
+                    v.measured.reference.name()
+                ),
+                v.measured.ratio,
+                v.measured.sigma,
+                v.nominal,
+                v.fitted,
+                v.residual_sigmas()
+            );
+        }
+    }
+    if r.params.len() > 1 {
+        let _ = writeln!(s);
+        let _ = writeln!(s, "correlations (linearized covariance; - on a bound):");
+        for (i, p) in r.params.iter().enumerate() {
+            let row: Vec<String> = r.correlation[i]
+                .iter()
+                .map(|c| match c.is_finite() {
+                    true => format!("{c:>7.3}"),
+                    false => format!("{:>7}", "-"),
+                })
+                .collect();
+            let _ = writeln!(s, "{:<26} {}", p.key, row.join(" "));
+        }
+    }
+    if r.start
+        .iter()
+        .zip(&r.params)
+        .any(|(s0, p)| *s0 != p.nominal)
+    {
+        let start: Vec<String> = r
+            .params
+            .iter()
+            .zip(&r.start)
+            .filter(|(p, s0)| **s0 != p.nominal)
+            .map(|(p, s0)| format!("{} = {s0:e}", p.key))
+            .collect();
+        let _ = writeln!(s);
+        let _ = writeln!(
+            s,
+            "start: away from the symmetric point, the best of the starts was {}",
+            start.join(", ")
         );
     }
     let _ = writeln!(s);

@@ -133,10 +133,28 @@ fn caption(result: &McResult, cfg: &McConfig) -> String {
         .iter()
         .map(|(s, shape, names)| format!("{} % {shape} on {}", s * 100.0, names.join(", ")))
         .collect();
+    // The [asymmetry] offsets have absolute errors, in their own unit.
+    let offsets: Vec<String> = cfg
+        .uncertainties
+        .iter()
+        .filter(|u| u.abs_sigma > 0.0)
+        .map(|u| {
+            let name = u.key.split_once('.').map_or(u.key.as_str(), |(_, n)| n);
+            format!("{:e} {} on {name}", u.abs_sigma, u.distribution.name())
+        })
+        .collect();
+    let absolute = if offsets.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; absolute errors (1 std, in the key's unit): {}",
+            offsets.join("; ")
+        )
+    };
     format!(
         "Black dashed: nominal parameters; orange: mean; shaded: mean ± 1 std. {} draws, {} \
-         rejected as non-physical, seed {}. Relative errors (1 std): {}; all other parameters \
-         exact.",
+         rejected as non-physical, seed {}. Relative errors (1 std): {}{absolute}; all other \
+         parameters exact.",
         result.samples,
         result.rejected,
         cfg.seed,

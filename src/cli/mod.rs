@@ -19,6 +19,7 @@ mod simulate;
 mod stdout;
 mod subtract;
 mod tf;
+mod visibility;
 mod witness_noise;
 
 pub use stdout::{is_closed_pipe, note, Out};
@@ -90,6 +91,9 @@ enum Command {
     /// Constrained least-squares fit of chosen parameters, within their error bars, to measured
     /// mode frequencies (default: Table II's measured column).
     Fit(fit::FitArgs),
+    /// Mode visibilities measured from a free-motion record (the signed ratio of each mode's
+    /// peaks in two channels, with its error), as the CSV `fit --visibility` reads.
+    Visibility(visibility::VisibilityArgs),
     /// Monte Carlo of the normal modes over the parameter uncertainties (default: Gaussian,
     /// 2.5 % on masses, lengths, inertias; 10 % on torsion and bouncing constants; g, h exact).
     Mc {
@@ -201,8 +205,8 @@ fn run_command(cli: Cli, run: &mut Run) -> Result<()> {
             let model = Model::new(&params)?;
             let modes = NormalModes::new(&model);
             match format {
-                Format::Table => write!(run.out, "{}", report::modes_table(&modes))?,
-                Format::Json => writeln!(run.out, "{}", report::modes_json(&modes))?,
+                Format::Table => write!(run.out, "{}", report::modes_report(&model, &modes))?,
+                Format::Json => writeln!(run.out, "{}", report::modes_json(&model, &modes))?,
             }
             Ok(())
         }
@@ -211,6 +215,7 @@ fn run_command(cli: Cli, run: &mut Run) -> Result<()> {
         Command::Coherence(args) => coherence::run_coherence(&params, args, run),
         Command::Simulate(args) => simulate::run_simulate(&params, args, run),
         Command::Fit(args) => fit::run_fit(&params, args, run),
+        Command::Visibility(args) => visibility::run_visibility(&params, args, run),
         Command::Subtract(args) => subtract::run_subtract(&params, args, run),
         Command::Methods(args) => methods::run_methods(&params, args, run),
         Command::Mc {

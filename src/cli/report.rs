@@ -4,8 +4,8 @@
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fmt::Write;
-use tiltnoise_core::model::{Model, Observable, TiltAxis, TranslationAxis};
-use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::model::{Coord, Model, Observable, TiltAxis, TranslationAxis};
+use tiltnoise_core::modes::{NormalModes, RATIO_THRESHOLD};
 use tiltnoise_core::tf::{self, Input, Method, Request};
 
 /// Share of modal kinetic energy above which a coordinate is listed as dominant.
@@ -47,10 +47,68 @@ pub fn modes_table(modes: &NormalModes) -> String {
             m.index,
             format_hz(m.frequency_hz),
             format_q(m.quality_factor),
-            m.block.name(),
+            m.block_name(),
             dominant,
             seen
         );
+    }
+    s
+}
+
+/// The `modes` command's report: the modes table; the rest configuration of a pendulum as
+/// built; every mode's amplitude ratios (each observable over the largest of its unit group in
+/// that mode) with the observables above [`RATIO_THRESHOLD`], and for a pendulum as built the
+/// overlap with the symmetric mode that labels it.
+pub fn modes_report(model: &Model, modes: &NormalModes) -> String {
+    let mut s = modes_table(modes);
+    let as_built = !model.is_symmetric();
+    if as_built {
+        let rest = model.rest_configuration();
+        let _ = writeln!(
+            s,
+            "\nrest configuration (equilibrium of the exact potential; test-mass angles \
+             relative to the crossbar):"
+        );
+        let list: Vec<String> = Coord::ALL
+            .iter()
+            .map(|c| format!("{} {:+.6e} {}", c.name(), rest[c.index()], c.unit()))
+            .collect();
+        let _ = writeln!(s, "  {}", list[..4].join(", "));
+        let _ = writeln!(s, "  {}", list[4..].join(", "));
+    }
+    let _ = writeln!(
+        s,
+        "\namplitude ratios: each observable over the largest of its unit group (X, Y, Z in m; \
+         theta, eta, phi, phi_a in rad) in the same mode; seen above {RATIO_THRESHOLD:e}:"
+    );
+    let _ = write!(s, "{:<5}", "mode");
+    if as_built {
+        let _ = write!(s, " {:>9}", "overlap");
+    }
+    for o in Observable::ALL {
+        let _ = write!(s, " {:>10}", o.name());
+    }
+    let _ = writeln!(s, "  seen above");
+    for (k, m) in modes.modes.iter().enumerate() {
+        let _ = write!(s, "nu_{:<2}", m.index);
+        if as_built {
+            let _ = write!(s, " {:>9.6}", m.overlap);
+        }
+        for o in Observable::ALL {
+            let r = modes.ratio[k][o.index()];
+            // An exact zero (the other block of a decoupled model) reads as one.
+            let _ = if r == 0.0 {
+                write!(s, " {:>10}", "0")
+            } else {
+                write!(s, " {r:>+10.3e}")
+            };
+        }
+        let seen: Vec<&str> = modes
+            .observables_above_ratio(k)
+            .iter()
+            .map(|o| o.name())
+            .collect();
+        let _ = writeln!(s, "  {}", seen.join(" "));
     }
     s
 }
@@ -68,14 +126,15 @@ pub fn format_q(q: f64) -> String {
     }
 }
 
-/// `{"modes": [{"index": 1, "frequency_hz": ..., ...}, ...]}`.
-pub fn modes_json(modes: &NormalModes) -> String {
+/// `{"modes": [{"index": 1, "frequency_hz": ..., ...}, ...], "ratio_threshold": ...,
+/// "rest_configuration": {...}}`.
+pub fn modes_json(model: &Model, modes: &NormalModes) -> String {
     let list = modes
         .modes
         .iter()
         .enumerate()
         .map(|(k, m)| ModeJson {
-            block: m.block.name(),
+            block: m.block_name(),
             dominant_coordinates: m
                 .dominant_coords(DOMINANT_SHARE)
                 .into_iter()
@@ -92,7 +151,17 @@ pub fn modes_json(modes: &NormalModes) -> String {
                 .map(|o| (o.name(), m.observable_amplitude[o.index()]))
                 .collect(),
             omega_sq_rad2_per_s2: m.omega_sq,
+            overlap: m.overlap,
             quality_factor: m.quality_factor.is_finite().then_some(m.quality_factor),
+            ratio: Observable::ALL
+                .iter()
+                .map(|o| (o.name(), modes.ratio[k][o.index()]))
+                .collect(),
+            seen_above_ratio: modes
+                .observables_above_ratio(k)
+                .iter()
+                .map(|o| o.name())
+                .collect(),
             seen_by: modes
                 .observables_seeing(k)
                 .iter()
@@ -101,7 +170,16 @@ pub fn modes_json(modes: &NormalModes) -> String {
             undamped: !m.quality_factor.is_finite(),
         })
         .collect();
-    serde_json::to_string_pretty(&ModesJson { modes: list }).expect("JSON of plain data")
+    let rest = model.rest_configuration();
+    serde_json::to_string_pretty(&ModesJson {
+        modes: list,
+        ratio_threshold: RATIO_THRESHOLD,
+        rest_configuration: Coord::ALL
+            .iter()
+            .map(|c| (c.name(), rest[c.index()]))
+            .collect(),
+    })
+    .expect("JSON of plain data")
 }
 
 // The JSON reports list the keys of every object in alphabetical order (as they always have):
@@ -110,6 +188,10 @@ pub fn modes_json(modes: &NormalModes) -> String {
 #[derive(Serialize)]
 struct ModesJson {
     modes: Vec<ModeJson>,
+    /// [`RATIO_THRESHOLD`]: `seen_above_ratio` lists the observables whose ratio reaches it.
+    ratio_threshold: f64,
+    /// The rest configuration `q0` (rad, m): all 0 for the symmetric pendulum.
+    rest_configuration: BTreeMap<&'static str, f64>,
 }
 
 #[derive(Serialize)]
@@ -121,8 +203,13 @@ struct ModeJson {
     loss_angle_rad: f64,
     observable_amplitude: BTreeMap<&'static str, f64>,
     omega_sq_rad2_per_s2: f64,
+    /// Overlap with the symmetric pendulum's mode of the same label (1 when symmetric).
+    overlap: f64,
     /// `null` when undamped (JSON has no infinity; numbers are never strings).
     quality_factor: Option<f64>,
+    /// Amplitude over the largest of the observable's unit group, in this mode.
+    ratio: BTreeMap<&'static str, f64>,
+    seen_above_ratio: Vec<&'static str>,
     seen_by: Vec<&'static str>,
     /// No loss reaches the mode: Q is infinite, `quality_factor` is null.
     undamped: bool,
@@ -224,8 +311,9 @@ mod tests {
 
     #[test]
     fn modes_json_lists_keys_alphabetically() {
-        let modes = NormalModes::new(&Model::new(&Params::table_i()).unwrap());
-        let value = assert_keys_sorted(&modes_json(&modes));
+        let model = Model::new(&Params::table_i()).unwrap();
+        let modes = NormalModes::new(&model);
+        let value = assert_keys_sorted(&modes_json(&model, &modes));
         assert!(value["modes"][0]["quality_factor"].is_null());
         assert_eq!(value["modes"][0]["undamped"], true);
     }

@@ -67,6 +67,92 @@ fn bad_parameter_input_is_refused() {
         &["--set", "mass.m_b_kg=nan", "modes"],
         &["mass.m_b_kg", "NaN"],
     );
+    // An offset that would move a centre of mass out of its body: the key, the value, the
+    // bound and what it is a fraction of.
+    assert_fails(
+        &["--set", "asymmetry.tm_com_x_m=0.08", "modes"],
+        &[
+            "asymmetry.tm_com_x_m",
+            "0.08 m",
+            "7.6000e-2 m",
+            "10 % of Z_b",
+        ],
+    );
+    assert_fails(
+        &["--set", "asymmetry.sensor_rot_z_rad=inf", "modes"],
+        &["asymmetry.sensor_rot_z_rad", "inf"],
+    );
+    // A relative error of an offset whose nominal value is 0 means nothing.
+    let p = dir.path().join("sigma.toml");
+    let text = String::from_utf8(tiltnoise(&["params"]).stdout).unwrap()
+        + "\n[uncertainty]\n\"asymmetry.crossbar_com_x_m\" = { rel_sigma = 0.1 }\n";
+    std::fs::write(&p, text).unwrap();
+    assert_fails(
+        &["--params", p.to_str().unwrap(), "modes"],
+        &[
+            "sigma.toml",
+            "asymmetry.crossbar_com_x_m",
+            "allowed fields: sigma",
+        ],
+    );
+}
+
+/// The pendulum as built on the command line: the rest configuration, mode labels with their
+/// overlaps and the amplitude ratios, in JSON as in the library, and `auto` picks the pole-zero
+/// method for the coupled system (block and split refuse it).
+#[test]
+fn modes_and_tf_of_the_pendulum_as_built() {
+    let set = ["--set", "asymmetry.crossbar_com_x_m=1e-3"];
+    let out = tiltnoise(&[&set[..], &["modes", "--format", "json"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let params = tiltnoise_core::params::Params::table_i()
+        .with_override("asymmetry.crossbar_com_x_m=1e-3")
+        .unwrap();
+    let model = tiltnoise_core::model::Model::new(&params).unwrap();
+    let lib = tiltnoise_core::modes::NormalModes::new(&model);
+    assert_eq!(
+        v["rest_configuration"]["eta_a"].as_f64().unwrap(),
+        model.rest_configuration()[1]
+    );
+    for (k, (j, m)) in v["modes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(&lib.modes)
+        .enumerate()
+    {
+        assert_eq!(j["index"].as_u64().unwrap() as usize, m.index);
+        assert_eq!(j["block"], "coupled");
+        assert_eq!(j["overlap"].as_f64().unwrap(), m.overlap);
+        assert_eq!(j["ratio"]["Y"].as_f64().unwrap(), lib.ratio[k][1]);
+    }
+    let table = String::from_utf8(tiltnoise(&[&set[..], &["modes"]].concat()).stdout).unwrap();
+    assert!(
+        table.contains("rest configuration") && table.contains("overlap"),
+        "{table}"
+    );
+
+    let out = tiltnoise(&[&set[..], &["tf", "--freq", "1e-3:20:10", "--explain"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), stderr(&out));
+    assert!(text.contains("picked `polezero`"), "{text}");
+    assert_fails(
+        &[
+            &set[..],
+            &["tf", "--freq", "1e-3:20:10", "--method", "block"],
+        ]
+        .concat(),
+        &["block", "coupled model", "polezero"],
+    );
+    assert_fails(
+        &[
+            &set[..],
+            &["tf", "--freq", "1e-3:20:10", "--method", "split"],
+        ]
+        .concat(),
+        &["split", "pendulum as built"],
+    );
 }
 
 #[test]

@@ -287,7 +287,8 @@ fn refusals_name_the_problem() {
     match fit(&p, &three, &config(&four)) {
         Err(FitError::TooManyFree {
             free: 4,
-            measured: 3,
+            modes: 3,
+            visibilities: 0,
         }) => {}
         other => panic!("{other:?}"),
     }

@@ -47,3 +47,4 @@ mod streaming;
 mod subtract;
 mod thermal;
 mod translation_cli;
+mod visibility_cli;

@@ -123,6 +123,33 @@ pub enum ParamError {
         /// What is allowed, e.g. `finite and > 0`.
         allowed: &'static str,
     },
+    /// An offset of the `[asymmetry]` section too large for the body it moves in.
+    #[error(
+        "parameter `{key}` = {} {unit} is not allowed: |value| must be < {limit:.4e} {unit} \
+         ({reason})",
+        Num(*.value)
+    )]
+    OffsetTooLarge {
+        /// Dotted key, e.g. `asymmetry.tm_com_x_m`.
+        key: &'static str,
+        /// The value given.
+        value: f64,
+        /// Its unit, `m` or `rad`.
+        unit: &'static str,
+        /// The bound of `|value|`, in the key's unit.
+        limit: f64,
+        /// What the bound is a fraction of.
+        reason: &'static str,
+    },
+    /// The exact potential of an asymmetric pendulum has no stable rest configuration near
+    /// the drawing's (Newton on its gradient diverges or ends on a saddle).
+    #[error("no stable equilibrium with the [asymmetry] offsets {keys}: {detail}")]
+    NoEquilibrium {
+        /// The nonzero asymmetry keys with their values.
+        keys: String,
+        /// What failed.
+        detail: String,
+    },
     /// A tensor or matrix assembled from several parameters is not positive definite.
     #[error("{what} is not positive definite (from parameters {keys}): {detail}")]
     NotPositiveDefinite {

@@ -55,6 +55,7 @@ pub mod dd;
 pub mod error;
 pub mod fit;
 pub mod freq;
+pub mod geometry;
 pub mod ground;
 pub mod input;
 pub mod limits;

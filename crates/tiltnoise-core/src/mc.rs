@@ -2,8 +2,9 @@
 //! eight mode frequencies of every draw are collected, giving the mean and standard deviation per
 //! mode (the "calculated" column of Table II, whose error bars are the paper's Monte Carlo spread).
 //!
-//! * Each listed parameter is drawn as `p (1 + rel_sigma z)`, with `z` a standard Gaussian or a
-//!   uniform variate on `[-sqrt(3), sqrt(3)]` (same standard deviation); the others are exact.
+//! * Each listed parameter is drawn as `p (1 + rel_sigma z)` (an `[asymmetry]` offset as
+//!   `p + sigma z`, its error being absolute), with `z` a standard Gaussian or a uniform variate
+//!   on `[-sqrt(3), sqrt(3)]` (same standard deviation); the others are exact.
 //! * Every draw is validated with [`Params::validate`] and [`Model::new`] (mass matrix positive
 //!   definite) and must give eight non-negative eigenvalues; a draw that fails is *rejected* and
 //!   counted, not redrawn.
@@ -13,17 +14,18 @@
 //!   `rel_sigma` must be below [`MAX_REL_SIGMA`] = 0.25 for a Gaussian (4 sigma must not reach
 //!   zero) and below 1/sqrt(3) for a uniform draw (its range `+/- sqrt(3) sigma` must not).
 //! * Only parameters that enter the undamped modes are drawn (masses, inertias, torsion and
-//!   bouncing constants, lengths, g); an error on any other (loss angles, damping, temperature)
-//!   is accepted and has no effect.
+//!   bouncing constants, lengths, g, the `[asymmetry]` offsets); an error on any other (loss
+//!   angles, damping, temperature, the readout rotation) is accepted and has no effect.
 //! * At most [`MAX_MC_DRAWS`] draws on at most [`MAX_THREADS`] threads, and no more draws than
 //!   fit into the memory available ([`check_size`]).
 //! * Reproducible: sample `i` has its own random stream derived from `(seed, i)`, so the result
 //!   is bit-identical for a given seed whatever the number of threads.
-//! * Per draw only the eigenvalues are computed, per decoupled 4x4 block (Cholesky reduction and
-//!   symmetric eigenvalues, exactly as [`crate::modes::NormalModes`] does), and the eight
-//!   frequencies are sorted (mode identity by rank, as in Table II).
+//! * Per draw only the eigenvalues are computed, per decoupled 4x4 block or of the coupled 8x8
+//!   problem (Cholesky reduction and symmetric eigenvalues, exactly as
+//!   [`crate::modes::NormalModes`] does), and the eight frequencies are sorted (mode identity by
+//!   rank, as in Table II).
 //!
-//! Pure numerics: depends on `params` and `model` only; no I/O.
+//! Pure numerics: depends on `params`, `model` and `modes` (the reduction of the pencil); no I/O.
 
 use crate::cancel::{Cancel, Cancelled};
 use crate::error::ParamError;
@@ -32,6 +34,7 @@ use crate::limits::{
     MC_BYTES_PER_DRAW,
 };
 use crate::model::{Block, Model};
+use crate::modes::reduced_pencil;
 use crate::params::uncertainty::{check, UncertaintyError};
 use crate::params::Params;
 use crate::rng::Rng;
@@ -124,28 +127,31 @@ pub enum McError {
     },
 }
 
-/// The eight undamped mode frequencies (Hz) of a model, sorted ascending, or `None` if a block's
-/// mass matrix is not positive definite or an eigenvalue is negative or not finite. Same
-/// arithmetic as [`crate::modes::NormalModes::new`] (eigenvalues only).
+/// The eight undamped mode frequencies (Hz) of a model, sorted ascending, or `None` if a mass
+/// matrix is not positive definite or an eigenvalue is negative or not finite. Same arithmetic
+/// as [`crate::modes::NormalModes::new`] (eigenvalues only): per block when the model is
+/// decoupled, of the full 8x8 pencil otherwise.
 pub fn mode_frequencies_hz(model: &Model) -> Option<[f64; 8]> {
     let mass = model.mass();
     let stiffness = model.stiffness();
-    let mut out = [0.0; 8];
-    for (b, block) in Block::ALL.into_iter().enumerate() {
-        let mb = Model::block_of(mass, block);
-        let kb = Model::block_of(&stiffness, block);
-        let l = mb.cholesky()?.l();
-        let l_inv = l.try_inverse()?;
-        let a = l_inv * kb * l_inv.transpose();
-        let a = (a + a.transpose()) * 0.5;
-        let eig = a.symmetric_eigenvalues();
-        for k in 0..4 {
-            let w2 = eig[k];
-            if !(w2.is_finite() && w2 >= 0.0) {
-                return None;
-            }
-            out[4 * b + k] = w2.sqrt() / std::f64::consts::TAU;
+    let mut w2: Vec<f64> = Vec::with_capacity(8);
+    if model.decoupled() {
+        for block in Block::ALL {
+            let mb = Model::block_of(mass, block);
+            let kb = Model::block_of(&stiffness, block);
+            let (_, a) = reduced_pencil(&mb, &kb)?;
+            w2.extend(a.symmetric_eigenvalues().iter());
         }
+    } else {
+        let (_, a) = reduced_pencil(mass, &stiffness)?;
+        w2.extend(a.symmetric_eigenvalues().iter());
+    }
+    let mut out = [0.0; 8];
+    for (f, &w2) in out.iter_mut().zip(&w2) {
+        if !(w2.is_finite() && w2 >= 0.0) {
+            return None;
+        }
+        *f = w2.sqrt() / std::f64::consts::TAU;
     }
     out.sort_by(f64::total_cmp);
     Some(out)
@@ -253,7 +259,8 @@ fn mean_and_std(x: &[[f64; 8]]) -> ([f64; 8], [f64; 8]) {
 /// Which parameter, with what error: accessors of the drawn parameters.
 struct Plan {
     nominal: Params,
-    draws: Vec<(FieldMut, f64, Distribution)>,
+    /// Each drawn parameter with its relative and absolute standard deviations (one is 0).
+    draws: Vec<(FieldMut, f64, f64, Distribution)>,
     seed: u64,
 }
 
@@ -269,8 +276,15 @@ impl Plan {
         let draws = cfg
             .uncertainties
             .iter()
-            .filter(|u| u.rel_sigma > 0.0)
-            .filter_map(|u| Some((modal_field(&u.key)?, u.rel_sigma, u.distribution)))
+            .filter(|u| !u.is_exact())
+            .filter_map(|u| {
+                Some((
+                    modal_field(&u.key)?,
+                    u.rel_sigma,
+                    u.abs_sigma,
+                    u.distribution,
+                ))
+            })
             .collect();
         // The error model is not needed per draw: clone and validate the values only.
         let nominal = Params {
@@ -288,12 +302,17 @@ impl Plan {
     fn draw(&self, index: usize) -> Option<[f64; 8]> {
         let mut rng = Rng::stream(self.seed, index as u64);
         let mut p = self.nominal.clone();
-        for &(field, rel_sigma, dist) in &self.draws {
+        for &(field, rel_sigma, abs_sigma, dist) in &self.draws {
             let z = match dist {
                 Distribution::Gaussian => rng.gaussian(),
                 Distribution::Uniform => 3f64.sqrt() * (2.0 * rng.uniform() - 1.0),
             };
-            *field(&mut p) *= 1.0 + rel_sigma * z;
+            let value = field(&mut p);
+            if abs_sigma > 0.0 {
+                *value += abs_sigma * z;
+            } else {
+                *value *= 1.0 + rel_sigma * z;
+            }
         }
         p.validate().ok()?;
         let model = Model::new(&p).ok()?;
@@ -328,6 +347,12 @@ fn modal_field(key: &str) -> Option<FieldMut> {
         "length.z_b_m" => |p| &mut p.length.z_b_m,
         "length.h_m" => |p| &mut p.length.h_m,
         "environment.g_m_per_s2" => |p| &mut p.environment.g_m_per_s2,
+        "asymmetry.crossbar_com_x_m" => |p| &mut p.asymmetry.crossbar_com_x_m,
+        "asymmetry.crossbar_com_y_m" => |p| &mut p.asymmetry.crossbar_com_y_m,
+        "asymmetry.tm_com_x_m" => |p| &mut p.asymmetry.tm_com_x_m,
+        "asymmetry.tm_com_y_m" => |p| &mut p.asymmetry.tm_com_y_m,
+        "asymmetry.lower_attachment_x_m" => |p| &mut p.asymmetry.lower_attachment_x_m,
+        "asymmetry.lower_attachment_y_m" => |p| &mut p.asymmetry.lower_attachment_y_m,
         _ => return None,
     };
     Some(f)
@@ -358,13 +383,10 @@ mod tests {
             assert_eq!(changed, [f.key]);
         }
         // Every parameter with a non-zero default error enters the modes.
-        for u in default_uncertainties(&p)
-            .iter()
-            .filter(|u| u.rel_sigma > 0.0)
-        {
+        for u in default_uncertainties(&p).iter().filter(|u| !u.is_exact()) {
             assert!(modal_field(&u.key).is_some(), "{}", u.key);
         }
-        assert_eq!(drawn, 20);
+        assert_eq!(drawn, 26);
     }
 
     #[test]
@@ -393,6 +415,7 @@ mod tests {
         let p = Params::table_i();
         let base = mode_frequencies_hz(&Model::new(&p).unwrap()).unwrap();
         for f in p.fields().iter().filter(|f| modal_field(f.key).is_none()) {
+            // (A readout rotation changes what the observables read, never the modes.)
             let v = if f.value == 0.0 { 1e-3 } else { f.value * 1.5 };
             let q = p.with_override(&format!("{}={v:?}", f.key)).unwrap();
             let other = mode_frequencies_hz(&Model::new(&q).unwrap()).unwrap();

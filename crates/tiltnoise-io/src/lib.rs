@@ -53,7 +53,7 @@ pub use coherence_hdf5::{
 pub use fit_hdf5::{write_fit_hdf5, SCHEMA_FIT, SCHEMA_VERSION_FIT};
 pub use freq_file::read_freq_file;
 pub use mc_hdf5::{write_mc_hdf5, REJECTED_DRAWS, SCHEMA_MC, SCHEMA_VERSION_MC};
-pub use measured_modes::read_measured_modes;
+pub use measured_modes::{read_measured_modes, read_visibilities};
 pub use output_paths::check_outputs;
 pub use series_hdf5::{
     write_observable_series_hdf5, SeriesAsd, SimulationMeta, SCHEMA_OBSERVABLE_SERIES,

@@ -93,6 +93,13 @@ fn write_file(
     let sigma: Vec<f64> = cfg.uncertainties.iter().map(|u| u.rel_sigma).collect();
     let d = dataset(&group, "rel_sigma", &sigma)?;
     str_attr(&d, "unit", "1 (relative standard deviation)")?;
+    let sigma: Vec<f64> = cfg.uncertainties.iter().map(|u| u.abs_sigma).collect();
+    let d = dataset(&group, "abs_sigma", &sigma)?;
+    str_attr(
+        &d,
+        "unit",
+        "the key's unit (absolute standard deviation of an [asymmetry] offset)",
+    )?;
     let dists = strings(cfg.uncertainties.iter().map(|u| u.distribution.name()))?;
     dataset(&group, "distribution", &dists)?;
     file.close()

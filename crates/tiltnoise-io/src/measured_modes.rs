@@ -1,8 +1,9 @@
-//! Measured mode-frequency files (`tiltnoise fit --measured`), in the format that
-//! [`tiltnoise_core::fit::Measured::parse`] validates.
+//! Measured mode-frequency and visibility files (`tiltnoise fit --measured`, `--visibility`), in
+//! the formats that [`tiltnoise_core::fit::Measured::parse`] and
+//! [`tiltnoise_core::fit::Visibilities::parse`] validate.
 
 use std::path::Path;
-use tiltnoise_core::fit::{FitError, Measured};
+use tiltnoise_core::fit::{FitError, Measured, Visibilities};
 use tiltnoise_core::limits::{read_text_file, TextFileError, MAX_SETTINGS_FILE_BYTES};
 
 /// Reads and validates a measured-frequency file; its path names it in messages.
@@ -29,4 +30,27 @@ pub fn read_measured_modes(path: &Path) -> Result<Measured, FitError> {
         TextFileError::TooLarge(e) => FitError::TooLarge(e),
     })?;
     Measured::parse(&text, &origin)
+}
+
+/// Reads and validates a visibility file (`tiltnoise fit --visibility`), in the format that
+/// [`Visibilities::parse`] validates; its path names it in messages.
+///
+/// # Errors
+///
+/// [`FitError::Visibility`] naming the file (and line) when it cannot be read or is malformed;
+/// [`FitError::TooLarge`] as [`read_measured_modes`].
+pub fn read_visibilities(path: &Path) -> Result<Visibilities, FitError> {
+    let origin = path.display().to_string();
+    let name = format!("visibilities {origin}");
+    let text =
+        read_text_file(path, MAX_SETTINGS_FILE_BYTES, &name, "a visibility file").map_err(|e| {
+            match e {
+                TextFileError::Io(e) => FitError::Visibility {
+                    origin: origin.clone(),
+                    message: e.to_string(),
+                },
+                TextFileError::TooLarge(e) => FitError::TooLarge(e),
+            }
+        })?;
+    Visibilities::parse(&text, &origin)
 }

@@ -78,6 +78,45 @@ fn cross(a: [Dd; 3], b: [Dd; 3]) -> [Dd; 3] {
     ]
 }
 
+/// The rounding scale of each datum of [`Matrices`]: the sum of the magnitudes of the terms
+/// computed into it (its rounding is a few [`super::DD_EPS`] of this), where that differs from
+/// the datum's own magnitude.
+#[derive(Debug, Clone)]
+pub struct Scales {
+    /// Of [`Matrices::mass`].
+    pub mass: [[f64; 8]; 8],
+    /// Of [`Matrices::stiffness`] (real and imaginary parts together).
+    pub stiffness: [[f64; 8]; 8],
+    /// Of [`Matrices::force`].
+    pub force: [[f64; 12]; 8],
+    /// Of [`Matrices::g0`].
+    pub g0: [[f64; 3]; 8],
+    /// Of [`Matrices::g2`].
+    pub g2: [[f64; 3]; 8],
+    /// Of [`Matrices::translation_g2`].
+    pub translation_g2: [[f64; 3]; 8],
+    /// Of [`Matrices::observation`].
+    pub observation: [[f64; 8]; 7],
+}
+
+impl Scales {
+    /// Each datum's own magnitude as its scale (the closed forms).
+    pub fn own(m: &Matrices) -> Scales {
+        let abs = |x: &Dd| x.to_f64().abs();
+        Scales {
+            mass: m.mass.map(|r| r.map(|x| abs(&x))),
+            stiffness: m
+                .stiffness
+                .map(|r| r.map(|z| z.re.to_f64().abs() + z.im.to_f64().abs())),
+            force: m.force.map(|r| r.map(|x| abs(&x))),
+            g0: m.g0.map(|r| r.map(|x| abs(&x))),
+            g2: m.g2.map(|r| r.map(|x| abs(&x))),
+            translation_g2: m.translation_g2.map(|r| r.map(|x| abs(&x))),
+            observation: m.observation.map(|r| r.map(|x| abs(&x))),
+        }
+    }
+}
+
 /// `B loads`: the generalized forces of 12 force and torque components (zero terms skipped).
 fn generalized_forces(force: &[[Dd; 12]; 8], loads: &[Dd]) -> [Dd; 8] {
     std::array::from_fn(|r| {
@@ -91,6 +130,8 @@ fn generalized_forces(force: &[[Dd; 12]; 8], loads: &[Dd]) -> [Dd; 8] {
     })
 }
 
+/// The closed forms of Appendix A: the symmetric pendulum (the `[asymmetry]` keys are not read;
+/// [`crate::geometry::dd_matrices`] gives the matrices of any parameter set).
 pub fn build(p: &Params) -> Matrices {
     let (m_a, m_b) = (dd(p.mass.m_a_kg), dd(p.mass.m_b_kg));
     let i = &p.inertia;

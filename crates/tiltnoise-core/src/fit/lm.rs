@@ -20,6 +20,10 @@ use nalgebra::{DMatrix, DVector};
 /// below the rounding of `u` for any `A_ii` and `g` met in practice.
 pub const LAMBDA_MAX: f64 = 1e16;
 
+/// The damping's starting value, relative to `diag(A)` (Marquardt's classic 1e-3: nearly a
+/// Gauss-Newton step).
+pub const INITIAL_LAMBDA: f64 = 1e-3;
+
 /// Relative rounding error of the cost `|r|^2 / 2` of a few residuals (a few eps): cost
 /// differences below it are not a reliable measure of progress.
 pub const COST_ROUNDING: f64 = 8.0 * f64::EPSILON;
@@ -89,8 +93,10 @@ pub fn minimize<E>(
     let (mut r, mut jac) = eval(&u)?;
     let mut evaluations = 1;
     let mut cost = 0.5 * r.norm_squared();
-    let diag_max = (jac.transpose() * &jac).diagonal().max();
-    let mut lambda = 1e-3 * diag_max.max(f64::MIN_POSITIVE);
+    // The damping multiplies diag(A) (Marquardt's scaling), so it is dimensionless: a start
+    // scaled by A's own size would damp a steep problem (large residuals per error bar) so
+    // hard that no step could lower the cost measurably.
+    let mut lambda = INITIAL_LAMBDA;
     let mut iterations = 0;
     let stop = loop {
         let g = jac.transpose() * &r;

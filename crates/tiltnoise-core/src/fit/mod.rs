@@ -1,24 +1,38 @@
 //! Constrained least-squares fit of chosen parameters to measured normal-mode frequencies (the
 //! paper's validation: "a least square fit, constrained within the experimental error bars,
 //! then adjusts the mechanical parameters in order to best match the observed normal mode
-//! frequencies", Table II).
+//! frequencies", Table II), and to measured mode visibilities ([`visibility`]: the signed ratio
+//! of a mode's components in two observables), which is what determines the `[asymmetry]`
+//! offsets of the pendulum as built.
 //!
 //! * **Variables.** Each free parameter `p` is fitted in the scaled variable
 //!   `u = (p - p0) / sigma_p`, with `p0` the nominal value and `sigma_p = rel_sigma |p0|` its
 //!   error bar from [`crate::mc::uncertainties`] (the Monte Carlo's error model, overridable in
-//!   the parameter file). Parameters without an error bar (g, h, loss angles) cannot be free.
+//!   the parameter file), or the absolute `sigma` of an `[asymmetry]` offset, whose nominal value
+//!   is 0 (its box is then absolute too: `|p - p0| <= n sigma`). Parameters without an error
+//!   bar (g, h, loss angles, and the offsets unless the file gives them one) cannot be free.
 //! * **Objective.** `chi^2 = sum_k ((f_k(p) - f_k,meas) / sigma_k)^2` over the measured modes,
-//!   mode identity by rank (sorted frequencies, as in Table II). "Constrained within the error
+//!   mode identity by label (the rank, sorted frequencies, as in Table II, for the symmetric
+//!   pendulum; see [`crate::modes`] for the pendulum as built), plus `sum_i ((rho_i(p) -
+//!   rho_i,meas) / sigma_i)^2` over the measured visibilities `rho_i`. "Constrained within the error
 //!   bars" is read literally: a hard box `|u| <= n` (`n` = [`FitConfig::bound_sigmas`], 1 by
 //!   default). Optionally ([`FitConfig::prior`]) the Gaussian prior `sum u^2` is added, which
 //!   turns the fit into a maximum a-posteriori estimate that also works for parameters the data
 //!   cannot pin down; the box still applies.
 //! * **Solver.** Levenberg-Marquardt with an active set on the box ([`lm`]), analytic Jacobian
-//!   from eigenvalue perturbation theory ([`jacobian`]).
+//!   from eigenvalue and eigenvector perturbation theory ([`jacobian`]).
+//! * **Start.** The nominal parameters, except for the free `[asymmetry]` offsets: at the
+//!   symmetric point a frequency's derivative with an offset along x vanishes (the mirror
+//!   symmetry makes every frequency even in it), so the data cannot tell its sign there and a
+//!   fit to frequencies alone would stay put. Each free offset starts a quarter of its box away
+//!   from 0, on each side ([`START_FRACTION`]); every combination of sides is a start (up to
+//!   [`MAX_SIGN_STARTS`] of them, beyond that all offsets on one side, then on the other), and
+//!   the solution with the least objective is kept.
 //! * **Uncertainties.** Linearized covariance `(J^T J)^-1` of the scaled variables at the
 //!   solution (`J` = weighted Jacobian, with the prior rows when the prior is on), over the free
 //!   parameters *not* on a bound; a parameter on a bound is flagged and has no sigma (the
 //!   linearization does not describe a truncated distribution). Not rescaled by `chi^2 / dof`.
+//!   The correlations are those of that covariance ([`FitResult::correlation`]).
 //! * **Poorly constrained** ("prior-dominated"): a free parameter whose data-only sigma,
 //!   `sqrt((J_d^T J_d)^-1_ii)` in units of its error bar, is >= 1: the measured frequencies
 //!   determine it no better than its error bar did. The singular values `s < 1` of the data
@@ -30,8 +44,11 @@
 pub mod jacobian;
 pub mod lm;
 pub mod measured;
+pub mod peaks;
+pub mod visibility;
 
 pub use measured::{Measured, MeasuredMode, SigmaSource};
+pub use visibility::{MeasuredVisibility, Visibilities};
 
 use crate::cancel::{Cancel, Cancelled};
 use crate::error::{ParamError, Shown};
@@ -61,6 +78,15 @@ pub const DEFAULT_FREE: [&str; 8] = [
 pub const GTOL: f64 = 1e-10;
 /// Iteration limit of the solver.
 pub const MAX_ITERATIONS: usize = 200;
+
+/// Where a free `[asymmetry]` offset starts, as a fraction of its box half-width, on either
+/// side of 0 (module docs): far enough from the symmetric point for the frequencies' derivative
+/// to tell the sides apart, well inside the box.
+pub const START_FRACTION: f64 = 0.25;
+
+/// The most starts made of the combinations of sides of the free offsets (4 offsets); with
+/// more offsets, two starts (every offset on the positive side, every one on the negative).
+pub const MAX_SIGN_STARTS: usize = 16;
 
 /// Singular values of the weighted Jacobian below `s_max * RANK_TOL` count as zero when
 /// inverting `J^T J` (sigma reported infinite): `RANK_TOL` is `eps` times a generous bound on
@@ -121,7 +147,7 @@ pub struct FittedParam {
     pub nominal: f64,
     /// Fitted value.
     pub fitted: f64,
-    /// Error bar sigma_p = rel_sigma |p0| (the prior sigma).
+    /// Error bar sigma_p = rel_sigma |p0|, or the absolute sigma of an offset (the prior sigma).
     pub prior_sigma: f64,
     /// Linearized posterior sigma at the solution; `None` on a bound, infinite if the
     /// parameter lies in the null space of the Jacobian.
@@ -157,6 +183,30 @@ impl ModeFit {
     }
 }
 
+/// One measured visibility at the nominal and the fitted parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VisibilityFit {
+    /// The measurement.
+    pub measured: MeasuredVisibility,
+    /// Model ratio at the nominal parameters (NaN where the model's mode has no component in
+    /// the reference there, e.g. the symmetric pendulum's nu_6 in Y).
+    pub nominal: f64,
+    /// Model ratio at the fitted parameters.
+    pub fitted: f64,
+}
+
+impl VisibilityFit {
+    /// Fitted minus measured.
+    pub fn residual(&self) -> f64 {
+        self.fitted - self.measured.ratio
+    }
+
+    /// Fitted minus measured, in measurement sigmas.
+    pub fn residual_sigmas(&self) -> f64 {
+        self.residual() / self.measured.sigma
+    }
+}
+
 /// A combination of free parameters the data determine poorly.
 #[derive(Debug, Clone, PartialEq)]
 pub struct WeakDirection {
@@ -173,16 +223,25 @@ pub struct FitResult {
     pub params: Vec<FittedParam>,
     /// The measured modes, by rank.
     pub modes: Vec<ModeFit>,
+    /// The measured visibilities, in the order of [`Visibilities::items`] (empty when none).
+    pub visibilities: Vec<VisibilityFit>,
+    /// Correlation matrix of the fitted parameters (order of `params`), from the linearized
+    /// covariance; rows and columns of a parameter on a bound are NaN (no covariance there).
+    pub correlation: Vec<Vec<f64>>,
+    /// The starting point the solution was reached from (parameter values, order of `params`).
+    pub start: Vec<f64>,
     /// The full fitted parameter set.
     pub fitted_params: Params,
-    /// Data chi^2 at the nominal parameters.
+    /// Data chi^2 at the nominal parameters; NaN when a visibility's reference observable does
+    /// not see its mode there (the symmetric pendulum's nu_2 in Y, say).
     pub chi2_nominal: f64,
     /// Data chi^2 at the solution.
     pub chi2: f64,
     /// Prior term `sum u^2` at the solution (0 when the prior is off).
     pub prior_term: f64,
-    /// Degrees of freedom: measured modes minus free parameters (box only), or measured modes
-    /// (with the prior, which adds one pseudo-measurement per parameter).
+    /// Degrees of freedom: measurements (modes and visibilities) minus free parameters (box
+    /// only), or measurements (with the prior, which adds one pseudo-measurement per
+    /// parameter).
     pub dof: usize,
     /// Singular values of the data Jacobian in scaled variables, largest first.
     pub singular_values: Vec<f64>,
@@ -206,6 +265,14 @@ pub enum FitError {
     /// Cancelled through [`FitConfig::cancel`].
     #[error(transparent)]
     Cancelled(#[from] Cancelled),
+    /// A malformed visibility file, or a visibility the model cannot form.
+    #[error("visibilities {origin}: {message}")]
+    Visibility {
+        /// File (and line), or the ratio.
+        origin: String,
+        /// What is wrong and what is allowed.
+        message: String,
+    },
     /// A malformed measured-frequency file.
     #[error("measured frequencies {origin}: {message}")]
     Measured {
@@ -221,16 +288,19 @@ pub enum FitError {
     /// No free parameter.
     #[error("fit: no free parameter; give at least one with --free KEY,...")]
     NoFree,
-    /// More free parameters than measured modes.
+    /// More free parameters than measurements.
     #[error(
-        "fit: {free} free parameters but only {measured} measured modes; at most as many free \
-         parameters as measured modes are allowed (drop some from --free or measure more modes)"
+        "fit: {free} free parameters but only {modes} measured modes and {visibilities} \
+         visibilities; at most as many free parameters as measurements are allowed (drop some \
+         from --free or measure more)"
     )]
     TooManyFree {
         /// Number of free parameters.
         free: usize,
-        /// Number of measured modes.
-        measured: usize,
+        /// Number of measured mode frequencies.
+        modes: usize,
+        /// Number of measured visibilities.
+        visibilities: usize,
     },
     /// A free key that is not a parameter.
     #[error(
@@ -287,8 +357,9 @@ pub enum FitError {
     Params(ParamError),
 }
 
-/// Weighted residuals, their Jacobian in `u` and the eight model frequencies (Hz).
-type Evaluation = (DVector<f64>, DMatrix<f64>, [f64; 8]);
+/// Weighted residuals, their Jacobian in `u`, the eight model frequencies (Hz) and the model's
+/// visibilities.
+type Evaluation = (DVector<f64>, DMatrix<f64>, [f64; 8], Vec<f64>);
 
 /// One free parameter's setup.
 struct Free {
@@ -298,16 +369,54 @@ struct Free {
     sigma: f64,
 }
 
-/// Fits `config.free` of `params` to `measured`.
+/// Fits `config.free` of `params` to the measured frequencies `measured` (see the module docs).
 pub fn fit(
     params: &Params,
     measured: &Measured,
     config: &FitConfig,
 ) -> Result<FitResult, FitError> {
-    let free = check_config(params, measured, config)?;
+    fit_with_visibilities(params, measured, &Visibilities::none(), config)
+}
+
+/// The starting points in scaled variables (module docs): 0 for every parameter but the free
+/// offsets, which start at `+/- START_FRACTION n` in every combination of sides.
+fn starts(free: &[Free], n: f64) -> Vec<DVector<f64>> {
+    let offsets: Vec<usize> = (0..free.len())
+        .filter(|&j| crate::params::uncertainty::is_absolute_key(&free[j].key))
+        .collect();
+    let delta = START_FRACTION * n;
+    let at = |signs: &dyn Fn(usize) -> f64| {
+        let mut u = DVector::zeros(free.len());
+        for (i, &j) in offsets.iter().enumerate() {
+            u[j] = delta * signs(i);
+        }
+        u
+    };
+    if offsets.is_empty() {
+        return vec![DVector::zeros(free.len())];
+    }
+    if 1usize << offsets.len().min(usize::BITS as usize - 1) > MAX_SIGN_STARTS {
+        return vec![at(&|_| 1.0), at(&|_| -1.0)];
+    }
+    (0..1usize << offsets.len())
+        .map(|bits| at(&|i| if bits >> i & 1 == 1 { -1.0 } else { 1.0 }))
+        .collect()
+}
+
+/// Fits `config.free` of `params` to the measured frequencies `measured` and visibilities
+/// `visibilities` together (see the module docs).
+pub fn fit_with_visibilities(
+    params: &Params,
+    measured: &Measured,
+    visibilities: &Visibilities,
+    config: &FitConfig,
+) -> Result<FitResult, FitError> {
+    let vis = &visibilities.items;
+    let free = check_config(params, (measured.modes.len(), vis.len()), config)?;
     let n = config.bound_sigmas;
     let keys: Vec<String> = free.iter().map(|f| f.key.clone()).collect();
     let m = measured.modes.len();
+    let data_rows = m + vis.len();
     let ranks: Vec<usize> = measured.modes.iter().map(|x| x.mode - 1).collect();
     let at = |u: &DVector<f64>| -> Result<Params, FitError> {
         free.iter()
@@ -316,41 +425,74 @@ pub fn fit(
                 jacobian::with_value(&p, &f.key, f.nominal + ui * f.sigma)
             })
     };
-    // Data rows, then (with the prior) one row u_j per parameter.
+    // Frequency rows, visibility rows, then (with the prior) one row u_j per parameter.
     // Once cancelled every evaluation fails, which the minimizer takes as rejected steps
     // until its damping runs out (a few dozen cheap rounds); the check after it returns.
     let residuals = |u: &DVector<f64>| -> Result<Evaluation, FitError> {
         config.cancel.check()?;
-        let (freqs, dfdp) = jacobian::frequencies_and_jacobian(&at(u)?, &keys)?;
-        let rows = m + if config.prior { free.len() } else { 0 };
+        let e = jacobian::evaluate(&at(u)?, &keys, vis)?;
+        let rows = data_rows + if config.prior { free.len() } else { 0 };
         let mut r = DVector::zeros(rows);
         let mut jac = DMatrix::zeros(rows, free.len());
         for (i, (x, &k)) in measured.modes.iter().zip(&ranks).enumerate() {
-            r[i] = (freqs[k] - x.frequency_hz) / x.sigma_hz;
+            r[i] = (e.frequencies_hz[k] - x.frequency_hz) / x.sigma_hz;
             for (j, f) in free.iter().enumerate() {
-                jac[(i, j)] = dfdp[(k, j)] * f.sigma / x.sigma_hz;
+                jac[(i, j)] = e.frequency_jacobian[(k, j)] * f.sigma / x.sigma_hz;
+            }
+        }
+        for (i, v) in vis.iter().enumerate() {
+            r[m + i] = (e.ratios[i] - v.ratio) / v.sigma;
+            for (j, f) in free.iter().enumerate() {
+                jac[(m + i, j)] = e.ratio_jacobian[(i, j)] * f.sigma / v.sigma;
             }
         }
         if config.prior {
             for j in 0..free.len() {
-                r[m + j] = u[j];
-                jac[(m + j, j)] = 1.0;
+                r[data_rows + j] = u[j];
+                jac[(data_rows + j, j)] = 1.0;
             }
         }
-        Ok((r, jac, freqs))
+        Ok((r, jac, e.frequencies_hz, e.ratios))
     };
-    let u0 = DVector::zeros(free.len());
-    let (r0, _, nominal_freqs) = residuals(&u0)?;
+    let nominal = at(&DVector::zeros(free.len()))?;
+    let nominal_model = crate::model::Model::new(&nominal).map_err(FitError::Params)?;
+    let nominal_freqs = jacobian::evaluate(&nominal, &[], &[])?.frequencies_hz;
+    let nominal_ratios = nominal_ratios(&nominal_model, vis);
+    let chi2_nominal = measured
+        .modes
+        .iter()
+        .zip(&ranks)
+        .map(|(x, &k)| ((nominal_freqs[k] - x.frequency_hz) / x.sigma_hz).powi(2))
+        .chain(
+            vis.iter()
+                .zip(&nominal_ratios)
+                .map(|(v, r)| ((r - v.ratio) / v.sigma).powi(2)),
+        )
+        .sum::<f64>();
     let opts = lm::LmOptions {
         gtol: GTOL,
         max_iterations: MAX_ITERATIONS,
     };
-    let out = lm::minimize(u0, n, &opts, |u| residuals(u).map(|(r, j, _)| (r, j)))?;
-    config.cancel.check()?;
+    let mut best: Option<(lm::LmOutcome, DVector<f64>)> = None;
+    let mut evaluations = 0;
+    for u0 in starts(&free, n) {
+        let out = lm::minimize(u0.clone(), n, &opts, |u| {
+            residuals(u).map(|(r, j, _, _)| (r, j))
+        })?;
+        config.cancel.check()?;
+        evaluations += out.evaluations;
+        if best
+            .as_ref()
+            .is_none_or(|(b, _)| out.r.norm_squared() < b.r.norm_squared())
+        {
+            best = Some((out, u0));
+        }
+    }
+    let (out, u_start) = best.expect("at least one start");
     let fitted_params = at(&out.u)?;
-    let (_, _, fitted_freqs) = residuals(&out.u)?;
+    let (_, _, fitted_freqs, fitted_ratios) = residuals(&out.u)?;
 
-    let data_jac = out.jac.rows(0, m).into_owned();
+    let data_jac = out.jac.rows(0, data_rows).into_owned();
     let data_sigma_rel = diag_of_inverse(&data_jac);
     let at_bound: Vec<Option<Bound>> = out
         .u
@@ -362,7 +504,14 @@ pub fn fit(
         })
         .collect();
     let inside: Vec<usize> = (0..free.len()).filter(|&j| at_bound[j].is_none()).collect();
-    let posterior = diag_of_inverse(&out.jac.select_columns(&inside));
+    let covariance = covariance(&out.jac.select_columns(&inside));
+    let mut correlation = vec![vec![f64::NAN; free.len()]; free.len()];
+    for (a, &i) in inside.iter().enumerate() {
+        for (b, &j) in inside.iter().enumerate() {
+            correlation[i][j] =
+                covariance[(a, b)] / (covariance[(a, a)] * covariance[(b, b)]).sqrt();
+        }
+    }
     let params_out = free
         .iter()
         .enumerate()
@@ -375,7 +524,7 @@ pub fn fit(
             fitted_sigma: inside
                 .iter()
                 .position(|&i| i == j)
-                .map(|pos| posterior[pos] * f.sigma),
+                .map(|pos| covariance[(pos, pos)].sqrt() * f.sigma),
             at_bound: at_bound[j],
             data_sigma_rel: data_sigma_rel[j],
             poorly_constrained: data_sigma_rel[j] >= 1.0,
@@ -398,7 +547,7 @@ pub fn fit(
                 .collect(),
         })
         .collect();
-    let chi2 = |r: &DVector<f64>| r.rows(0, m).norm_squared();
+    let chi2 = out.r.rows(0, data_rows).norm_squared();
     Ok(FitResult {
         params: params_out,
         modes: measured
@@ -411,21 +560,78 @@ pub fn fit(
                 fitted_hz: fitted_freqs[k],
             })
             .collect(),
+        visibilities: vis
+            .iter()
+            .zip(nominal_ratios.iter().zip(&fitted_ratios))
+            .map(|(v, (&nominal, &fitted))| VisibilityFit {
+                measured: v.clone(),
+                nominal,
+                fitted,
+            })
+            .collect(),
+        correlation,
+        start: free
+            .iter()
+            .zip(u_start.iter())
+            .map(|(f, &u)| f.nominal + u * f.sigma)
+            .collect(),
         fitted_params,
-        chi2_nominal: chi2(&r0),
-        chi2: chi2(&out.r),
+        chi2_nominal,
+        chi2,
         prior_term: match config.prior {
             true => out.u.norm_squared(),
             false => 0.0,
         },
-        dof: if config.prior { m } else { m - free.len() },
+        dof: if config.prior {
+            data_rows
+        } else {
+            data_rows - free.len()
+        },
         singular_values,
         weak_directions,
         iterations: out.iterations,
-        evaluations: out.evaluations + 2,
+        evaluations: evaluations + 2,
         stop: out.stop,
         projected_gradient: out.projected_gradient,
         config: config.clone(),
+    })
+}
+
+/// The model's visibilities at the nominal parameters, NaN where the reference does not see
+/// the mode (the symmetric pendulum's forbidden channels).
+fn nominal_ratios(model: &crate::model::Model, vis: &[MeasuredVisibility]) -> Vec<f64> {
+    let modes = crate::modes::NormalModes::new_f64(model);
+    vis.iter()
+        .map(|v| {
+            visibility::model_ratio(&modes, model.observation(), v, &[])
+                .map_or(f64::NAN, |(r, _)| r)
+        })
+        .collect()
+}
+
+/// `(J^T J)^-1` through the SVD of `J` (the pseudo-inverse: directions along a numerically zero
+/// singular value, see [`RANK_TOL`], get an infinite variance).
+fn covariance(jac: &DMatrix<f64>) -> DMatrix<f64> {
+    let cols = jac.ncols();
+    if cols == 0 {
+        return DMatrix::zeros(0, 0);
+    }
+    let svd = jac.clone().svd(false, true);
+    let v_t = svd.v_t.expect("requested");
+    let s_max = svd.singular_values.max();
+    DMatrix::from_fn(cols, cols, |a, b| {
+        let mut c = 0.0;
+        for (i, &s) in svd.singular_values.iter().enumerate() {
+            let (va, vb) = (v_t[(i, a)], v_t[(i, b)]);
+            if s <= s_max * RANK_TOL {
+                if va != 0.0 && vb != 0.0 {
+                    return if a == b { f64::INFINITY } else { f64::NAN };
+                }
+                continue;
+            }
+            c += va * vb / (s * s);
+        }
+        c
     })
 }
 
@@ -460,7 +666,7 @@ fn diag_of_inverse(jac: &DMatrix<f64>) -> Vec<f64> {
 /// Checks the configuration against the parameters and the measurements.
 fn check_config(
     params: &Params,
-    measured: &Measured,
+    (modes, visibilities): (usize, usize),
     config: &FitConfig,
 ) -> Result<Vec<Free>, FitError> {
     let n = config.bound_sigmas;
@@ -472,16 +678,16 @@ fn check_config(
     }
     refuse_repeats("--free", "parameter key", &config.free, String::clone)?;
     let fields = params.fields();
-    let rel_sigma = |key: &str| {
+    let sigma_of = |key: &str, value: f64| {
         crate::mc::uncertainties(params)
             .into_iter()
             .find(|u| u.key == key)
-            .map_or(0.0, |u| u.rel_sigma)
+            .map_or(0.0, |u| u.sigma_at(value))
     };
     let allowed: Vec<&str> = fields
         .iter()
+        .filter(|f| sigma_of(f.key, f.value) > 0.0)
         .map(|f| f.key)
-        .filter(|k| rel_sigma(k) > 0.0)
         .collect();
     let allowed = allowed.join(", ");
     let mut out: Vec<Free> = Vec::with_capacity(config.free.len());
@@ -493,7 +699,8 @@ fn check_config(
                 key: key.clone(),
                 allowed: allowed.clone(),
             })?;
-        let sigma = rel_sigma(key) * field.value.abs();
+        let sigma = sigma_of(key, field.value);
+        let absolute = crate::params::uncertainty::is_absolute_key(key);
         if sigma <= 0.0 {
             return Err(FitError::ExactKey {
                 key: key.clone(),
@@ -502,11 +709,12 @@ fn check_config(
         }
         let (lower, upper) = (field.value - n * sigma, field.value + n * sigma);
         // A box edge that changes the sign of the parameter would also make the matrix
-        // derivative step (relative to |p|) vanish; the physical ranges exclude it anyway.
+        // derivative step (relative to |p|) vanish; the physical ranges exclude it anyway. An
+        // offset may take either sign (its step is absolute).
         let edge_error = [lower, upper].into_iter().find_map(|edge| {
             let reason = match jacobian::with_value(params, key, edge) {
                 Err(e) => Some(e.to_string()),
-                Ok(_) if edge.signum() != field.value.signum() || edge == 0.0 => {
+                Ok(_) if !absolute && (edge.signum() != field.value.signum() || edge == 0.0) => {
                     Some("the parameter changes sign".to_string())
                 }
                 Ok(_) => None,
@@ -530,10 +738,11 @@ fn check_config(
             sigma,
         });
     }
-    if out.len() > measured.modes.len() {
+    if out.len() > modes + visibilities {
         return Err(FitError::TooManyFree {
             free: out.len(),
-            measured: measured.modes.len(),
+            modes,
+            visibilities,
         });
     }
     Ok(out)

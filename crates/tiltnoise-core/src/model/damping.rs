@@ -32,6 +32,21 @@
 //!
 //! Viscous elements act on the same directions with the coefficients of
 //! [`crate::params::Viscous`].
+//!
+//! # At a tilted equilibrium
+//!
+//! With the `[asymmetry]` offsets the bodies rest tilted ([`crate::geometry`]) and the gravity
+//! stiffness is no longer exactly the sum above: it gains couplings of the order of the rest
+//! angles. The loss of a fibre's swing is the fibre's bending loss near its clamp, which is set
+//! by the angle through which the fibre's direction turns away from its rest direction, whatever
+//! that rest direction is. So each swing element keeps its weight `phi_swing k_g` (`k_ga`, `k_gb`
+//! from the nominal lengths and tensions: the pendulum's gravity stiffness changes only at second
+//! order in the rest angles, well inside the uncertainty of a dilution factor) and acts on the
+//! two components of that turn: the angular displacement of the body the fibre carries about the
+//! body's own x and y axes (the fibre is its z axis), per unit `q`, from the exact kinematics
+//! ([`crate::geometry::Linearization::swing`]). At the symmetric equilibrium these are exactly
+//! `e_theta_a, e_eta_a` and `u_t, u_e` above. Torsion and bouncing act on the fibres' own
+//! coordinates phi and delta and stay there; viscous swing elements use the same directions.
 
 use super::{Coord, Mat8, Vec8};
 use crate::params::Params;
@@ -95,14 +110,29 @@ pub fn swing_stiffness(p: &Params) -> (f64, f64) {
     )
 }
 
+/// The two swing directions of each fibre (upper, lower): the components, per unit `q`, of
+/// the turn of the fibre's direction away from its rest direction. At the symmetric equilibrium
+/// these are `e_theta_a, e_eta_a` and `e_theta_a + e_theta_b, e_eta_a + e_eta_b`; at a tilted
+/// one they come from the exact kinematics ([`crate::geometry::Linearization::swing`]).
+pub type SwingDirections = [[Vec8; 2]; 2];
+
+/// The swing directions at the symmetric equilibrium.
+pub(super) fn symmetric_swing() -> SwingDirections {
+    use Coord::*;
+    [
+        [unit(&[ThetaA]), unit(&[EtaA])],
+        [unit(&[ThetaA, ThetaB]), unit(&[EtaA, EtaB])],
+    ]
+}
+
 /// Every dissipative element with a nonzero coefficient, structural first, in the order
-/// torsion a, torsion b, bouncing a, bouncing b, swing a, swing b.
-pub(super) fn elements(p: &Params) -> Vec<DissipativeElement> {
+/// torsion a, torsion b, bouncing a, bouncing b, swing a, swing b; the swing elements act on
+/// `swing`.
+pub(super) fn elements(p: &Params, swing: &SwingDirections) -> Vec<DissipativeElement> {
     use Coord::*;
     let (k_ga, k_gb) = swing_stiffness(p);
     let (loss, visc) = (&p.loss, &p.viscous);
-    let swing_a = [unit(&[ThetaA]), unit(&[EtaA])];
-    let swing_b = [unit(&[ThetaA, ThetaB]), unit(&[EtaA, EtaB])];
+    let [swing_a, swing_b] = swing;
     let one = |c: Coord| vec![unit(&[c])];
     let specs: [(&str, f64, f64, Vec<Vec8>); 6] = [
         (

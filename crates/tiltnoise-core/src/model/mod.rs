@@ -1,7 +1,11 @@
 //! The linearized 8-DoF model of the double torsion pendulum (paper, Appendix A): mass and
 //! stiffness matrices, the zeroth-order generalized-force matrix, the forcing by the floor's tilt
-//! and translation, and the observation matrix. Pure numerics: depends on `params` and `nalgebra`, never on I/O.
+//! and translation, and the observation matrix. For the symmetric pendulum these are the
+//! Appendix's closed forms; with `[asymmetry]` offsets, the linearization about the tilted rest
+//! configuration of the pendulum as built ([`crate::geometry`]). Pure numerics: depends on
+//! `params`, `geometry` and `nalgebra`, never on I/O.
 
+mod as_built;
 mod coords;
 pub mod damping;
 mod matrices;
@@ -98,11 +102,22 @@ fn check_stable(mass: &Mat8, stiffness: &Mat8) -> Result<(), ParamError> {
     })
 }
 
+/// True when no entry of `m` couples the two blocks of [`Block`].
+fn block_diagonal(m: &Mat8) -> bool {
+    let [a, b] = Block::ALL.map(|block| block.coords().map(Coord::index));
+    a.iter()
+        .all(|&i| b.iter().all(|&j| m[(i, j)] == 0.0 && m[(j, i)] == 0.0))
+}
+
 /// The linear model built from one validated parameter set. Immutable; cheap to clone.
 #[derive(Debug, Clone)]
 pub struct Model {
     params: Params,
     derived: Derived,
+    /// The rest configuration about which the model is linear.
+    rest: Vec8,
+    /// `M`, `K_c` and the viscous damping are block diagonal in the [`Block`] split.
+    decoupled: bool,
     mass: Mat8,
     stiffness_gravity: Mat8,
     stiffness_elastic: Mat8,
@@ -121,12 +136,27 @@ impl Model {
     /// Builds the model. Fails if the mass matrix is not positive definite (possible for
     /// parameter sets that pass the per-key checks, e.g. a huge negative I^a_23 coupling), if
     /// the equilibrium is not stable (the stiffness is not positive definite, see
-    /// [`ParamError::Unstable`]), or if a matrix entry overflows.
+    /// [`ParamError::Unstable`]), if the pendulum as built has no stable rest configuration
+    /// near the drawing's ([`ParamError::NoEquilibrium`]), or if a matrix entry overflows.
     pub fn new(params: &Params) -> Result<Model, ParamError> {
-        let derived = matrices::derived(params);
-        let mass = matrices::mass(params, &derived);
-        let (stiffness_gravity, stiffness_elastic) = matrices::stiffness(params);
-        let dissipation = damping::elements(params);
+        let linear = if params.asymmetry.is_zero() {
+            as_built::RestLinear::symmetric(params)
+        } else {
+            as_built::RestLinear::as_built(params)?
+        };
+        let as_built::RestLinear {
+            derived,
+            rest,
+            mass,
+            stiffness_gravity,
+            force,
+            tilt,
+            translation,
+            observation,
+            swing,
+        } = linear;
+        let (_, stiffness_elastic) = matrices::stiffness(params);
+        let dissipation = damping::elements(params, &swing);
         let stiffness_imag = damping::total(&dissipation, DampingKind::Structural);
         let damping = damping::total(&dissipation, DampingKind::Viscous);
         if mass.cholesky().is_none() {
@@ -138,10 +168,6 @@ impl Model {
             });
         }
         check_stable(&mass, &(stiffness_gravity + stiffness_elastic))?;
-        let force = matrices::force_matrix(params, &derived);
-        let tilt = tilt::TiltForcing::new(params, &derived, &force, &stiffness_gravity);
-        let translation = translation::TranslationForcing::new(params, &force);
-        let observation = matrices::observation(params);
         let finite = |m: &[f64]| m.iter().all(|x| x.is_finite());
         if !(finite(mass.as_slice())
             && finite(stiffness_gravity.as_slice())
@@ -161,9 +187,14 @@ impl Model {
                     .into(),
             });
         }
+        let decoupled = [mass, stiffness_gravity, stiffness_imag, damping]
+            .iter()
+            .all(block_diagonal);
         Ok(Model {
             params: params.clone(),
             derived,
+            rest,
+            decoupled,
             mass,
             stiffness_gravity,
             stiffness_elastic,
@@ -278,6 +309,29 @@ impl Model {
     /// Observation matrix C: observables (X, Y, Z in m; theta, eta, phi, phi_a in rad) from q.
     pub fn observation(&self) -> &ObservationMatrix {
         &self.observation
+    }
+
+    /// The rest configuration `q0` the model is linearized about (rad, m; coordinate order
+    /// [`Coord::ALL`]): 0 for the symmetric pendulum, the tilted equilibrium found from the
+    /// exact potential when an `[asymmetry]` offset moves a centre of mass
+    /// ([`crate::geometry`]). Angles of body b are relative to body a, as the coordinates.
+    pub fn rest_configuration(&self) -> &Vec8 {
+        &self.rest
+    }
+
+    /// True when `M`, `K_c` and the viscous damping are exactly block diagonal in the split
+    /// of [`Block`], so that the two blocks are independent systems: always for the symmetric
+    /// pendulum, and with any offsets that keep the mirror plane x = 0 (along y only, or a
+    /// readout rotation; the observation matrix may then mix the blocks). An offset along x
+    /// couples them: the coupled 8x8 system.
+    pub fn decoupled(&self) -> bool {
+        self.decoupled
+    }
+
+    /// True when every `[asymmetry]` key is 0: the symmetric pendulum of the paper, whose
+    /// matrices are the closed forms of Appendix A.
+    pub fn is_symmetric(&self) -> bool {
+        self.params.asymmetry.is_zero()
     }
 
     /// Principal 4x4 sub-matrix of an 8x8 matrix on one block's coordinates.

@@ -10,7 +10,9 @@ use crate::error::{shown_within, ParamError, Shown, SHOWN_MAX_CHARS};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+pub mod asymmetry;
 pub mod uncertainty;
+pub use asymmetry::Asymmetry;
 pub use uncertainty::UncertaintyTable;
 
 /// The embedded default parameter file (Table I of the paper), with a unit comment on every line.
@@ -199,6 +201,10 @@ pub struct Params {
     /// Viscous damping coefficients (optional section, default 0).
     #[serde(default)]
     pub viscous: Viscous,
+    /// Assembly asymmetries and readout misalignment (optional section, default 0: the
+    /// symmetric pendulum of the paper).
+    #[serde(default)]
+    pub asymmetry: Asymmetry,
     /// Error bars overriding the defaults (optional section; see [`uncertainty`]).
     #[serde(default, skip_serializing_if = "UncertaintyTable::is_empty")]
     pub uncertainty: UncertaintyTable,
@@ -221,6 +227,9 @@ pub enum Allowed {
     Length,
     /// A length that may be 0: >= 0 and at most [`MAX_LENGTH_M`].
     LengthOrZero,
+    /// An offset of the `[asymmetry]` section: finite, and below a fraction of the body it
+    /// moves in ([`Asymmetry::limits`], checked with the lengths).
+    Offset,
 }
 
 /// The largest length a parameter may have (m). The model describes a laboratory pendulum;
@@ -239,6 +248,7 @@ impl Allowed {
                 Allowed::AtLeastOne => v >= 1.0,
                 Allowed::Length => v > 0.0 && v <= MAX_LENGTH_M,
                 Allowed::LengthOrZero => (0.0..=MAX_LENGTH_M).contains(&v),
+                Allowed::Offset => true,
             }
     }
 
@@ -252,6 +262,9 @@ impl Allowed {
             Allowed::AtLeastOne => "finite and >= 1",
             Allowed::Length => "> 0 and <= 1000 (a laboratory pendulum)",
             Allowed::LengthOrZero => ">= 0 and <= 1000 (a laboratory pendulum)",
+            Allowed::Offset => {
+                "finite, |value| < 10 % of the body's length (0.1 rad for a rotation)"
+            }
         }
     }
 }
@@ -383,7 +396,7 @@ impl Params {
             &self.bouncing,
             &self.length,
         );
-        vec![
+        let mut fields = vec![
             f("mass.m_a_kg", m.m_a_kg, "kg", "m_a", Positive),
             f("mass.m_b_kg", m.m_b_kg, "kg", "m_b", Positive),
             f(
@@ -575,7 +588,28 @@ impl Params {
                 "c_swing,b",
                 NonNegative,
             ),
-        ]
+        ];
+        let symbols = [
+            "crossbar centre of mass, x offset",
+            "crossbar centre of mass, y offset",
+            "test-mass centre of mass, x offset",
+            "test-mass centre of mass, y offset",
+            "lower fibre clamp, x offset",
+            "lower fibre clamp, y offset",
+            "readout axes, rotation about x",
+            "readout axes, rotation about y",
+            "readout axes, rotation about z",
+        ];
+        let l = &self.length;
+        for (limit, symbol) in self
+            .asymmetry
+            .limits(l.d_m, l.z_a_m, l.z_b_m)
+            .into_iter()
+            .zip(symbols)
+        {
+            fields.push(f(limit.key, limit.value, limit.unit, symbol, Offset));
+        }
+        fields
     }
 
     /// Checks every value against its allowed range and both inertia tensors for positive
@@ -604,6 +638,18 @@ impl Params {
                     (i.a22_kg_m2 * i.a33_kg_m2).sqrt()
                 ),
             });
+        }
+        let l = &self.length;
+        for limit in self.asymmetry.limits(l.d_m, l.z_a_m, l.z_b_m) {
+            if limit.value.abs() >= limit.limit {
+                return Err(ParamError::OffsetTooLarge {
+                    key: limit.key,
+                    value: limit.value,
+                    unit: limit.unit,
+                    limit: limit.limit,
+                    reason: limit.reason,
+                });
+            }
         }
         // Already checked when read from TOML; this catches a table built in code. (Skipped
         // when empty: the Monte Carlo validates every draw.)

@@ -5,6 +5,7 @@
 //! [uncertainty]
 //! "mass.m_a_kg" = { rel_sigma = 0.03, distribution = "uniform" }
 //! "length.h_m" = { rel_sigma = 0.0 }          # exact
+//! "asymmetry.tm_com_x_m" = { sigma = 2e-4 }    # absolute: 0.2 mm
 //! ```
 //!
 //! * Keys are the dotted keys of [`Params::fields`]; quoted (`"mass.m_a_kg"`) or bare dotted
@@ -12,6 +13,11 @@
 //! * `rel_sigma` is the relative standard deviation (0.03 = 3 %) of the parameter, relative to
 //!   its own value; 0 makes it exact. `distribution` is `gaussian` (the default) or `uniform`
 //!   (flat on `+/- sqrt(3) rel_sigma`: the same standard deviation).
+//! * The `[asymmetry]` keys, whose nominal value is an offset from the drawing (0 by default),
+//!   take an absolute `sigma` in the key's unit instead ([`is_absolute_key`]); a relative error
+//!   of a nominal 0 would mean nothing. Their default is 0 (exact), so a Monte Carlo draws
+//!   nothing new unless a file sets one; a draw that leaves the key's bound
+//!   ([`crate::params::Asymmetry::limits`]) is rejected as non-physical, as any other.
 //! * Entries override [`default_uncertainties`]: Gaussian, 2.5 % on masses, inertias and lengths
 //!   (except `length.h_m`), 10 % on the torsion and bouncing constants, everything else exact.
 //! * An error bar may not make the parameter non-physical within its range: the relative factor
@@ -91,15 +97,38 @@ impl Distribution {
     }
 }
 
+/// True for the keys whose error is absolute (`sigma` in the key's unit): the `[asymmetry]`
+/// offsets, whose nominal value 0 gives a relative error no meaning.
+pub fn is_absolute_key(key: &str) -> bool {
+    key.starts_with("asymmetry.")
+}
+
 /// The error of one parameter.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Uncertainty {
     /// Dotted parameter key, as in the parameter file (e.g. `mass.m_a_kg`).
     pub key: String,
-    /// Relative standard deviation (0.025 = 2.5 %), relative to the parameter's own value.
+    /// Relative standard deviation (0.025 = 2.5 %), relative to the parameter's own value; 0
+    /// for the keys with an absolute error ([`is_absolute_key`]).
     pub rel_sigma: f64,
+    /// Absolute standard deviation in the key's unit, for the keys of [`is_absolute_key`]; 0
+    /// for every other key.
+    pub abs_sigma: f64,
     /// Distribution shape.
     pub distribution: Distribution,
+}
+
+impl Uncertainty {
+    /// The standard deviation of a parameter of value `value`, in its unit:
+    /// `rel_sigma |value| + abs_sigma` (one of the two is 0).
+    pub fn sigma_at(&self, value: f64) -> f64 {
+        self.rel_sigma * value.abs() + self.abs_sigma
+    }
+
+    /// No error: the parameter is exact.
+    pub fn is_exact(&self) -> bool {
+        self.rel_sigma == 0.0 && self.abs_sigma == 0.0
+    }
 }
 
 /// An error model that cannot be used. Every message names the key, the value and what is
@@ -136,6 +165,17 @@ pub enum UncertaintyError {
         /// The value given.
         rel_sigma: f64,
     },
+    /// An absolute sigma that is negative or not finite.
+    #[error(
+        "[uncertainty]: sigma of `{key}` = {sigma} is not allowed: must be finite and >= 0 \
+         (absolute, in the key's unit)"
+    )]
+    InvalidAbsSigma {
+        /// The parameter.
+        key: String,
+        /// The value given.
+        sigma: f64,
+    },
     /// A relative sigma so large that draws would be non-physical.
     #[error(
         "[uncertainty]: rel_sigma of `{key}` = {rel_sigma} ({percent} %, {dist}) can make the \
@@ -169,7 +209,8 @@ pub enum UncertaintyError {
     /// An entry that is not `{ rel_sigma = ..., distribution = ... }`.
     #[error(
         "[uncertainty]: entry `{key}`: {message}; expected e.g. \
-         `\"{key}\" = {{ rel_sigma = 0.03, distribution = \"gaussian\" }}`",
+         `\"{key}\" = {{ rel_sigma = 0.03, distribution = \"gaussian\" }}` (an [asymmetry] \
+         key takes `sigma`, absolute in its unit)",
         key = Shown(.key)
     )]
     Malformed {
@@ -211,7 +252,8 @@ fn parameter_keys() -> &'static [&'static str] {
 }
 
 /// Checks an error model: every key is one of `keys` and appears once, every `rel_sigma` is
-/// finite, >= 0 and below its distribution's [`Distribution::max_rel_sigma`].
+/// finite, >= 0 and below its distribution's [`Distribution::max_rel_sigma`], every
+/// `abs_sigma` finite and >= 0.
 pub fn check(list: &[Uncertainty], keys: &[&str]) -> Result<(), UncertaintyError> {
     for (i, u) in list.iter().enumerate() {
         if !keys.contains(&u.key.as_str()) {
@@ -222,6 +264,12 @@ pub fn check(list: &[Uncertainty], keys: &[&str]) -> Result<(), UncertaintyError
         }
         if list[..i].iter().any(|v| v.key == u.key) {
             return Err(UncertaintyError::DuplicateKey { key: u.key.clone() });
+        }
+        if !(u.abs_sigma.is_finite() && u.abs_sigma >= 0.0) {
+            return Err(UncertaintyError::InvalidAbsSigma {
+                key: u.key.clone(),
+                sigma: u.abs_sigma,
+            });
         }
         if !(u.rel_sigma.is_finite() && u.rel_sigma >= 0.0) {
             return Err(UncertaintyError::InvalidSigma {
@@ -243,7 +291,8 @@ pub fn check(list: &[Uncertainty], keys: &[&str]) -> Result<(), UncertaintyError
 /// The default error model, one entry per parameter in [`Params::fields`] order: Gaussian, 2.5 %
 /// on every `mass.*`, `inertia.*` (I^a_23 too, relative to its own value) and `length.*` except
 /// `length.h_m`; 10 % on `torsion.*` and `bouncing.*`; `rel_sigma = 0` (exact) for
-/// `length.h_m`, `environment.g_m_per_s2` and `loss.*` (only g of these enters the modes).
+/// `length.h_m`, `environment.g_m_per_s2` and `loss.*` (only g of these enters the modes);
+/// `abs_sigma = 0` (exact) for the `[asymmetry]` keys.
 pub fn default_uncertainties(params: &Params) -> Vec<Uncertainty> {
     params
         .fields()
@@ -259,6 +308,7 @@ pub fn default_uncertainties(params: &Params) -> Vec<Uncertainty> {
             Uncertainty {
                 key: f.key.to_string(),
                 rel_sigma,
+                abs_sigma: 0.0,
                 distribution: Distribution::Gaussian,
             }
         })
@@ -268,7 +318,7 @@ pub fn default_uncertainties(params: &Params) -> Vec<Uncertainty> {
 impl Params {
     /// The effective error model: [`default_uncertainties`] with the entries of the
     /// `[uncertainty]` table replacing the defaults of their keys. One entry per parameter, in
-    /// [`Params::fields`] order; exact parameters have `rel_sigma = 0`.
+    /// [`Params::fields`] order; exact parameters have `rel_sigma = abs_sigma = 0`.
     pub fn effective_uncertainties(&self) -> Vec<Uncertainty> {
         let mut list = default_uncertainties(self);
         for u in &mut list {
@@ -287,17 +337,24 @@ impl Params {
             "\n# Effective error model (defaults of tiltnoise, overridden by [uncertainty] above);\n\
              # rel_sigma is the relative standard deviation, uniform is flat on +/- sqrt(3) sigma:\n",
         );
-        for u in list.iter().filter(|u| u.rel_sigma > 0.0) {
+        if list.iter().any(|u| u.abs_sigma > 0.0) {
+            text.push_str("# (sigma: the absolute standard deviation of an [asymmetry] offset)\n");
+        }
+        for u in list.iter().filter(|u| !u.is_exact()) {
+            let (name, value) = if is_absolute_key(&u.key) {
+                ("sigma", u.abs_sigma)
+            } else {
+                ("rel_sigma", u.rel_sigma)
+            };
             text.push_str(&format!(
-                "#   \"{}\" = {{ rel_sigma = {:?}, distribution = \"{}\" }}\n",
+                "#   \"{}\" = {{ {name} = {value:?}, distribution = \"{}\" }}\n",
                 u.key,
-                u.rel_sigma,
                 u.distribution.name()
             ));
         }
         let exact: Vec<&str> = list
             .iter()
-            .filter(|u| u.rel_sigma == 0.0)
+            .filter(|u| u.is_exact())
             .map(|u| u.key.as_str())
             .collect();
         if exact.is_empty() {
@@ -319,10 +376,13 @@ impl Params {
     }
 }
 
-/// One entry as written in TOML.
+/// One entry as written in TOML: `sigma` for an absolute key, else `rel_sigma`.
 #[derive(Serialize)]
 struct EntryOut {
-    rel_sigma: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rel_sigma: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    sigma: Option<f64>,
     distribution: &'static str,
 }
 
@@ -336,7 +396,8 @@ impl Serialize for UncertaintyTable {
             map.serialize_entry(
                 &u.key,
                 &EntryOut {
-                    rel_sigma: u.rel_sigma,
+                    rel_sigma: (!is_absolute_key(&u.key)).then_some(u.rel_sigma),
+                    sigma: is_absolute_key(&u.key).then_some(u.abs_sigma),
                     distribution: u.distribution.name(),
                 },
             )?;
@@ -355,8 +416,8 @@ impl<'de> Deserialize<'de> for UncertaintyTable {
     }
 }
 
-/// Collects the entries of `table`, whose keys follow `prefix`: a sub-table with `rel_sigma` or
-/// `distribution` is an entry, any other sub-table continues the dotted key (so that the bare
+/// Collects the entries of `table`, whose keys follow `prefix`: a sub-table with `rel_sigma`,
+/// `sigma` or `distribution` is an entry, any other sub-table continues the dotted key (so that the bare
 /// dotted key `mass.m_a_kg = {...}` reads like the quoted `"mass.m_a_kg" = {...}`).
 fn flatten(
     prefix: &str,
@@ -375,25 +436,39 @@ fn flatten(
         let toml::Value::Table(t) = value else {
             return Err(malformed(format!("value {value} is not a table")));
         };
-        if !(t.contains_key("rel_sigma") || t.contains_key("distribution")) {
+        if !["rel_sigma", "sigma", "distribution"]
+            .iter()
+            .any(|f| t.contains_key(*f))
+        {
             flatten(&key, t, out)?;
             continue;
         }
+        // An [asymmetry] key's nominal value is 0: its error is absolute.
+        let (spread, unit) = if is_absolute_key(&key) {
+            ("sigma", " (absolute, in the key's unit)")
+        } else {
+            ("rel_sigma", "")
+        };
         if let Some(field) = t
             .keys()
-            .find(|k| !matches!(k.as_str(), "rel_sigma" | "distribution"))
+            .find(|k| k.as_str() != spread && k.as_str() != "distribution")
         {
             return Err(malformed(format!(
-                "unknown field `{field}`; allowed fields: rel_sigma, distribution"
+                "unknown field `{field}`; allowed fields: {spread}{unit}, distribution"
             )));
         }
-        let rel_sigma = match t.get("rel_sigma") {
+        let value = match t.get(spread) {
             Some(toml::Value::Float(x)) => *x,
             Some(toml::Value::Integer(n)) => *n as f64,
             Some(other) => {
-                return Err(malformed(format!("rel_sigma = {other} is not a number")));
+                return Err(malformed(format!("{spread} = {other} is not a number")));
             }
-            None => return Err(malformed("rel_sigma is missing".to_string())),
+            None => return Err(malformed(format!("{spread} is missing"))),
+        };
+        let (rel_sigma, abs_sigma) = if is_absolute_key(&key) {
+            (0.0, value)
+        } else {
+            (value, 0.0)
         };
         let distribution = match t.get("distribution") {
             None => Distribution::Gaussian,
@@ -413,6 +488,7 @@ fn flatten(
         out.push(Uncertainty {
             key,
             rel_sigma,
+            abs_sigma,
             distribution,
         });
     }
@@ -517,11 +593,57 @@ mod tests {
         .is_ok());
     }
 
+    /// The [asymmetry] keys take an absolute `sigma` (their nominal value is 0), every other
+    /// key a `rel_sigma`; each refuses the other's field, names the key and reads back.
+    #[test]
+    fn asymmetry_keys_take_an_absolute_sigma() {
+        let p = with_table(
+            "\n[uncertainty]\n\"asymmetry.tm_com_x_m\" = { sigma = 2e-4, distribution = \"uniform\" }\n",
+        )
+        .unwrap();
+        let eff = p.effective_uncertainties();
+        let u = eff
+            .iter()
+            .find(|u| u.key == "asymmetry.tm_com_x_m")
+            .unwrap();
+        assert_eq!((u.rel_sigma, u.abs_sigma), (0.0, 2e-4));
+        assert_eq!(u.sigma_at(0.0), 2e-4);
+        assert!(eff
+            .iter()
+            .filter(|u| is_absolute_key(&u.key) && u.key != "asymmetry.tm_com_x_m")
+            .all(|u| u.is_exact()));
+        assert!(p.to_toml().contains("sigma = 0.0002"), "{}", p.to_toml());
+        assert_eq!(
+            Params::from_toml_str(&p.to_toml(), "round trip").unwrap(),
+            p
+        );
+        for (entry, needles) in [
+            (
+                "\"asymmetry.tm_com_x_m\" = { rel_sigma = 0.1 }",
+                &["asymmetry.tm_com_x_m", "rel_sigma", "allowed fields: sigma"][..],
+            ),
+            (
+                "\"mass.m_a_kg\" = { sigma = 0.1 }",
+                &["mass.m_a_kg", "sigma", "allowed fields: rel_sigma"],
+            ),
+            (
+                "\"asymmetry.sensor_rot_z_rad\" = { sigma = -1e-3 }",
+                &["asymmetry.sensor_rot_z_rad", "-0.001", ">= 0"],
+            ),
+        ] {
+            let e = with_table(&format!("\n[uncertainty]\n{entry}\n")).unwrap_err();
+            for n in needles {
+                assert!(e.contains(n), "`{n}` missing in: {e}");
+            }
+        }
+    }
+
     #[test]
     fn check_refuses_duplicates() {
         let u = Uncertainty {
             key: "mass.m_a_kg".into(),
             rel_sigma: 0.01,
+            abs_sigma: 0.0,
             distribution: Distribution::Gaussian,
         };
         let e = check(&[u.clone(), u], parameter_keys()).unwrap_err();

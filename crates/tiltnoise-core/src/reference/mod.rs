@@ -24,7 +24,12 @@
 //! [`crate::model::translation`]) and the observation matrix are all rebuilt here from the
 //! [`Params`] values in double-double arithmetic. Shared with the rest
 //! of the crate are only the parameter struct, the index order of coordinates, observables and
-//! inputs (the paper's, restated here) and the error types. The tilt forcing is used as defined,
+//! inputs (the paper's, restated here) and the error types. For the pendulum as built
+//! ([`crate::params::asymmetry`]) the matrices are the exact kinematics linearized in
+//! double-double ([`crate::geometry::dd_matrices`]), the same computation the `f64` model
+//! rounds: the independent check of those matrices is the energy cross-check's own kinematics
+//! (`tests/it/energy_crosscheck.rs`), and the reference stays the oracle of the methods' solves.
+//! The tilt forcing is used as defined,
 //! `G0 + w^2 G2`: not the rotation-plus-translation split that some `f64` methods use, so that a
 //! mistake in that reformulation cannot be replicated here.
 //!
@@ -55,8 +60,9 @@
 //!   2e7 at 3 Hz, 2e10 at 100 Hz, error 5e-23 there). [`ReferenceModel::entry_condition`] gives
 //!   `kappa` per entry, so a test can always state the reference's own error bar.
 //!
-//! Exact zeros are kept: the model is block diagonal after a permutation, multipliers across the
-//! blocks are exactly zero and are skipped, so entries such as X/theta_t are exactly 0.
+//! Exact zeros are kept: the symmetric pendulum's model is block diagonal after a permutation,
+//! multipliers across the blocks are exactly zero and are skipped, so entries such as X/theta_t
+//! are exactly 0 (an offset along x couples the blocks, and those entries are not zero then).
 //!
 //! ```
 //! use tiltnoise_core::params::Params;
@@ -72,7 +78,7 @@
 
 pub use crate::dd::{CDd, Dd, DD_EPS};
 
-use crate::dd::matrices::{self as build, Matrices};
+use crate::dd::matrices::{self as build, Matrices, Scales};
 use crate::error::{FreqError, TfError};
 use crate::model::Observable;
 use crate::model::{Input, Request};
@@ -124,6 +130,45 @@ struct Formulation {
     translation_g2: [[Dd; 3]; N],
     force: [[Dd; 12]; N],
     observation: [[Dd; N]; 7],
+    /// The rounding scale of each datum, for the condition numbers.
+    scales: Scales,
+}
+
+/// `|a| + |b|`: the scale of a difference of two data.
+fn sum_rows<const C: usize>(v: &[[f64; C]; N]) -> [[f64; C]; N] {
+    let mut out = *v;
+    for (a, b) in ANGLE_PAIRS {
+        for c in 0..C {
+            out[a][c] = v[a][c] + v[b][c];
+        }
+    }
+    out
+}
+
+fn sum_cols<const R: usize>(a: &[[f64; N]; R]) -> [[f64; N]; R] {
+    let mut out = *a;
+    for (row, orig) in out.iter_mut().zip(a) {
+        for (ca, cb) in ANGLE_PAIRS {
+            row[ca] = orig[ca] + orig[cb];
+        }
+    }
+    out
+}
+
+impl Scales {
+    /// The scales after the change to absolute test-mass angles: sums where the data are
+    /// differenced.
+    fn absolute(&self) -> Scales {
+        Scales {
+            mass: sum_rows(&sum_cols(&self.mass)),
+            stiffness: sum_rows(&sum_cols(&self.stiffness)),
+            force: sum_rows(&self.force),
+            g0: sum_rows(&self.g0),
+            g2: sum_rows(&self.g2),
+            translation_g2: sum_rows(&self.translation_g2),
+            observation: sum_cols(&self.observation),
+        }
+    }
 }
 
 /// `T^T v` for the columns of `v` (generalized forces), see [`Formulation::absolute`].
@@ -154,8 +199,9 @@ fn to_abs_cols<T: Copy + std::ops::Sub<Output = T>, const R: usize>(
 
 impl Formulation {
     /// The paper's coordinates q (relative test-mass angles).
-    fn paper(m: &Matrices) -> Formulation {
+    fn paper(m: &Matrices, scales: &Scales) -> Formulation {
         Formulation {
+            scales: scales.clone(),
             system: System {
                 mass: m.mass,
                 stiffness: m.stiffness,
@@ -173,8 +219,9 @@ impl Formulation {
     /// theta_a + theta_b, eta_a + eta_b, phi_a + phi_b, delta_b)`: `T^T M T`, `T^T K_c T`,
     /// `T^T G0`, `T^T G2`, `T^T B` and `C T`, each transformed separately so that structural
     /// cancellations are exact and never meet a `w^2`.
-    fn absolute(m: &Matrices) -> Formulation {
+    fn absolute(m: &Matrices, scales: &Scales) -> Formulation {
         Formulation {
+            scales: scales.absolute(),
             system: System {
                 mass: to_abs_rows(&to_abs_cols(&m.mass)),
                 stiffness: to_abs_rows(&to_abs_cols(&m.stiffness)),
@@ -211,14 +258,13 @@ impl Formulation {
         }
     }
 
-    /// `|forcing|` entry by entry with each datum's own magnitude: `|G0| + w^2 |G2|` or `|B|`.
+    /// `|forcing|` entry by entry with each datum's rounding scale: `|G0| + w^2 |G2|` or `|B|`.
     fn forcing_magnitude(&self, input: Input, r: usize, w2: f64) -> f64 {
+        let s = &self.scales;
         match input {
-            Input::Tilt(axis) => {
-                self.g0[r][axis.index()].hi.abs() + w2 * self.g2[r][axis.index()].hi.abs()
-            }
-            Input::Translation(axis) => w2 * self.translation_g2[r][axis.index()].hi.abs(),
-            Input::Force(f) => self.force[r][f.index()].hi.abs(),
+            Input::Tilt(axis) => s.g0[r][axis.index()] + w2 * s.g2[r][axis.index()],
+            Input::Translation(axis) => w2 * s.translation_g2[r][axis.index()],
+            Input::Force(f) => s.force[r][f.index()],
         }
     }
 
@@ -255,11 +301,12 @@ impl Formulation {
         let sys = &self.system;
         let lu = sys.factor(w2, freq_hz)?;
         let a = sys.dynamic(w2, &[0; N]);
+        let scales = &self.scales;
         let abs_a: [[f64; N]; N] = std::array::from_fn(|r| {
             std::array::from_fn(|c| {
-                sys.stiffness[r][c].abs_f64()
+                scales.stiffness[r][c]
                     + w2f.sqrt() * sys.damping[r][c].hi.abs()
-                    + w2f * sys.mass[r][c].hi.abs()
+                    + w2f * scales.mass[r][c]
             })
         });
         // y = A^-T c = A^-1 c: the dynamic stiffness is (complex) symmetric in both formulations.
@@ -282,7 +329,7 @@ impl Formulation {
                 let mut num = 0.0;
                 for r in 0..N {
                     let y_r = y[r].abs_f64();
-                    num += self.observation[row][r].hi.abs() * x[r].abs_f64()
+                    num += scales.observation[row][r] * x[r].abs_f64()
                         + y_r * self.forcing_magnitude(*input, r, w2f);
                     for k in 0..N {
                         num += y_r * abs_a[r][k] * x[k].abs_f64();
@@ -314,11 +361,17 @@ struct Lu {
 
 impl ReferenceModel {
     /// Builds every matrix in double-double from the parameter values.
+    ///
+    /// # Panics
+    ///
+    /// For parameters with `[asymmetry]` offsets that have no stable rest configuration (those
+    /// [`crate::model::Model::new`] refuses): see [`crate::geometry::dd_matrices`].
     pub fn new(params: &Params) -> ReferenceModel {
-        let m = build::build(params);
+        let (m, scales) = crate::geometry::dd_matrices(params);
+        let scales = scales.unwrap_or_else(|| Scales::own(&m));
         ReferenceModel {
-            absolute: Formulation::absolute(&m),
-            paper: Formulation::paper(&m),
+            absolute: Formulation::absolute(&m, &scales),
+            paper: Formulation::paper(&m, &scales),
             m,
         }
     }
@@ -405,7 +458,10 @@ impl ReferenceModel {
     /// ```
     ///
     /// (`|B|` for a force input): a relative perturbation of at most `eps` of every datum moves
-    /// the entry by at most about `kappa eps` relative, to first order. The reference's data
+    /// the entry by at most about `kappa eps` relative, to first order. For the pendulum as
+    /// built each `|datum|` is its rounding scale instead, the sum of the magnitudes of the terms
+    /// the exact kinematics computed into it ([`build::Scales`]): its rounding is relative to
+    /// that. The reference's data
     /// carry a few [`DD_EPS`] each and its solve is componentwise backward stable, so its error
     /// on an entry is a small multiple of `DD_EPS kappa`. Structural zeros get 0.
     pub fn entry_condition(&self, request: &Request, freq_hz: f64) -> Result<Vec<f64>, TfError> {

@@ -34,6 +34,14 @@
 //! and statespace lose it where the entries are small remainders (theta/z_t falls as f^6 at low
 //! frequency). The 2-DoF model refuses translations: they exert no torque on the balanced
 //! crossbar.
+//!
+//! For the pendulum as built ([`crate::params::asymmetry`]) an offset along x couples the two
+//! blocks into one 8x8 system: [`Method::Block`] refuses it at plan time, [`Method::Split`] and
+//! [`Method::Torsion2`] refuse any offset (their closed forms are the symmetric pendulum's), and
+//! [`Method::PoleZero`] factors the coupled system as a whole (8 poles, up to 8 factors per
+//! entry), with a relative error of 1.1e-12 at most outside 1 % of each entry's poles and zeros
+//! on the test models of `tests/it/methods.rs` (the reference's own error, `DD_EPS` times an
+//! entry's condition from the data's rounding scales, is part of the bound there).
 
 mod block;
 mod buffer;
@@ -263,8 +271,9 @@ pub trait TransferFunction: Send + Sync {
 }
 
 /// Builds the plan for `method` (factorizations and forcing matrices prepared once). Fails
-/// only for a method that cannot represent part of the request ([`Method::Torsion2`]); the
-/// methods of the full model plan every request.
+/// for a method that cannot represent part of the request ([`Method::Torsion2`]), viscous
+/// damping (the methods that solve only `K_c`), or the pendulum as built: `block` refuses the
+/// coupled model (an offset along x), `split` and `torsion2` any `[asymmetry]` key.
 pub fn plan(
     model: &Model,
     request: &Request,
@@ -284,6 +293,13 @@ pub fn plan(
                 .into(),
         });
     }
+    if let Some((item, reason)) = refused_for_geometry(model, method) {
+        return Err(PlanError::Unsupported {
+            method,
+            item: item.into(),
+            reason: reason.into(),
+        });
+    }
     Ok(match method {
         Method::Direct => Box::new(Direct::new(model, request.clone())),
         Method::Block => Box::new(BlockReduced::new(model, request.clone())),
@@ -293,6 +309,32 @@ pub fn plan(
         Method::PoleZero => Box::new(PoleZero::new(model, request.clone())),
         Method::StateSpace => Box::new(StateSpace::new(model, request.clone())),
     })
+}
+
+/// Why `method` cannot serve the pendulum as built ([`crate::params::asymmetry`]), if it
+/// cannot: `(item, reason)`. Direct, pole-zero, modal and state-space work on whatever `M`,
+/// `K_c`, forcing and observation the model has, coupled or not.
+fn refused_for_geometry(model: &Model, method: Method) -> Option<(&'static str, &'static str)> {
+    match method {
+        Method::Block if !model.decoupled() => Some((
+            "the coupled model",
+            "an offset along x (asymmetry.crossbar_com_x_m, tm_com_x_m or \
+             lower_attachment_x_m) couples the swing-y+bounce and swing-x+torsion blocks; \
+             `polezero`, `direct`, `modal` and `statespace` solve the coupled 8x8 system",
+        )),
+        Method::Split if !model.is_symmetric() => Some((
+            "the pendulum as built",
+            "its exact static part and closed-form translation forcing hold for the symmetric \
+             pendulum, whose observables each read one block; with [asymmetry] keys set, \
+             `polezero` (or `direct`) has full accuracy",
+        )),
+        Method::Torsion2 if !model.is_symmetric() => Some((
+            "the pendulum as built",
+            "the 2-DoF torsional model of section IV.C is derived for the symmetric pendulum \
+             read along the lab axes",
+        )),
+        _ => None,
+    }
 }
 
 #[cfg(test)]

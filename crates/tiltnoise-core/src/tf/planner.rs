@@ -263,7 +263,13 @@ pub fn choose(model: &Model, scene: &Scene) -> Result<Choice, NoChoice> {
     }
     let reference = ReferenceModel::new(model.params());
     let mut verdicts = Vec::new();
-    for (method, dofs) in CANDIDATES {
+    for (method, block_dofs) in CANDIDATES {
+        // A block method solves the whole 8x8 system when the blocks are coupled.
+        let dofs = if block_dofs == 4 && !model.decoupled() {
+            8
+        } else {
+            block_dofs
+        };
         let outcome = measured_error(model, &reference, &scene.request, method, &grid);
         let ok = matches!(outcome, Ok(e) if e <= scene.rel_tol);
         verdicts.push(Verdict {

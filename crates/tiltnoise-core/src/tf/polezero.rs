@@ -26,7 +26,7 @@
 //!
 //! the second form with `1 / z_j` rounded once to `f64`, in real arithmetic for undamped blocks
 //! whose zeros are all real, in complex arithmetic otherwise (damped blocks, or complex zeros).
-//! `power + #zeros <= 4`, so every entry is at most four factors `a + b s` (`s` or
+//! `power + #zeros <= 4` in a block, so every entry is at most four factors `a + b s` (`s` or
 //! `1 - s / z`). Every factor is relatively accurate: the relative error of an entry is a few
 //! `eps (1 + sum |z| / |z - s| + sum |lambda| / |lambda - s|)`, about `1e2 eps` at 1 % from a
 //! pole or zero and `~eps` elsewhere, with no cancellation at low or high frequency
@@ -34,6 +34,15 @@
 //! `tests/it/polezero_batch.rs` checks the f64 evaluation against the same product form in
 //! double-double within this bound, from 0 Hz to 1e5 Hz). Entries whose observation row or
 //! forcing column misses a block get nothing from it; entries no block reaches are exactly 0.0.
+//!
+//! The pendulum as built: with an offset along x the two blocks couple into one system of 8
+//! coordinates, factored as a whole the same way (the determinants then have up to 9 rows: each
+//! minor is expanded once). Its zeros go two by two into quadratic factors
+//! `(1 - s / z_1)(1 - s / z_2) = 1 + c1 s + c2 s^2`, whose coefficients are real for a conjugate
+//! pair too, so an undamped coupled system stays in real arithmetic whatever its zeros; a
+//! coefficient of the polynomials is set to zero as a structural cancellation against the sum
+//! of the rounding scales of its terms, which for the pendulum as built carry the data's own
+//! ([`crate::dd::matrices::Scales`]).
 //!
 //! Evaluation (`kernel`): a grid is evaluated eight frequencies at a time in vector lanes, each
 //! block's denominator and its reciprocal once per frequency, each entry a few
@@ -56,12 +65,12 @@ mod kernel;
 mod lanes;
 
 use super::{Destination, Input, Layout, Method, Request, TransferFunction};
-use crate::dd::matrices::{self, Matrices};
+use crate::dd::matrices::{Matrices, Scales};
 use crate::dd::{CDd, Dd, DD_EPS};
 use crate::error::TfError;
 use crate::model::{Block, Coord, Model};
 use crate::params::Params;
-use kernel::{BlockForm, ComplexEntry, Kernel, RealEntry};
+use kernel::{BlockForm, ComplexBlock, ComplexEntry, Kernel, RealBlock, RealEntry};
 use num_complex::Complex64;
 
 /// A coefficient smaller than this times the sum of its terms' magnitudes is a structural
@@ -80,27 +89,132 @@ pub struct PoleZero {
     layout: Layout,
 }
 
-/// An entry ready for its block: position in the output, gain, factors `(a, b)` (the first
-/// `count` of them not padding), `count`.
-type Prepared = (usize, CDd, [(CDd, CDd); 4], usize);
+/// An entry's product form in double-double, ready for a block of `N` coordinates: gain,
+/// `power` of `s`, linear factors `(a, b)` (the first `count` of them not padding) and
+/// quadratic factors `1 + c1 s + c2 s^2` (the first `n_pairs`), see [`RealEntry`].
+struct Prepared<const N: usize> {
+    at: usize,
+    gain: CDd,
+    power: usize,
+    factors: [(CDd, CDd); N],
+    count: usize,
+    pairs: [(Dd, Dd); N],
+    n_pairs: usize,
+}
 
-/// The four factors `(a, b)` (padded with `(1, 0)`), the gain and the number of factors that
-/// are not padding, of one entry, in double-double.
-fn entry_factors(f: &EntryFactors) -> (CDd, [(CDd, CDd); 4], usize) {
+/// The product form of one entry: each zero `z` a linear factor `1 - s / z` with `z` in the
+/// gain, a zero at the origin the factor `s`. With `quadratic` (the coupled system's real
+/// arithmetic) the zeros at the origin are a `power` instead, and the others go two by two into
+/// `(1 - s / z_1)(1 - s / z_2)`: each conjugate pair (exact conjugates: [`symmetrize`] made
+/// them so), then the real zeros sorted by magnitude, the smallest with the largest; a real
+/// zero left over stays linear.
+fn prepare<const N: usize>(f: &EntryFactors, at: usize, quadratic: bool) -> Prepared<N> {
     let one = CDd::real(Dd::ONE);
-    let mut gain = f.gain;
-    let mut factors = [(one, CDd::ZERO); 4];
-    let mut k = 0;
-    for _ in 0..f.power {
-        factors[k] = (CDd::ZERO, one);
-        k += 1;
+    let mut p = Prepared {
+        at,
+        gain: f.gain,
+        power: 0,
+        factors: [(one, CDd::ZERO); N],
+        count: 0,
+        pairs: [(Dd::ZERO, Dd::ZERO); N],
+        n_pairs: 0,
+    };
+    let linear = |p: &mut Prepared<N>, z: CDd| {
+        p.factors[p.count] = (one, -(one / z));
+        p.gain = p.gain * z;
+        p.count += 1;
+    };
+    if !quadratic {
+        for _ in 0..f.power {
+            p.factors[p.count] = (CDd::ZERO, one);
+            p.count += 1;
+        }
+        for &z in &f.zeros {
+            linear(&mut p, z);
+        }
+        return p;
     }
-    for z in &f.zeros {
-        factors[k] = (one, -(one / *z));
-        gain = gain * *z;
-        k += 1;
+    p.power = f.power as usize;
+    let pair = |p: &mut Prepared<N>, a: CDd, b: CDd| {
+        // 1 - s (1/a + 1/b) + s^2 / (a b): real for a conjugate pair or two real zeros.
+        let (wa, wb) = (one / a, one / b);
+        p.pairs[p.n_pairs] = ((-(wa + wb)).re, (wa * wb).re);
+        p.gain = p.gain * a * b;
+        p.n_pairs += 1;
+    };
+    for &z in f.zeros.iter().filter(|z| z.im.hi > 0.0) {
+        pair(&mut p, z, z.conj());
     }
-    (gain, factors, k)
+    let mut real: Vec<CDd> = f.zeros.iter().copied().filter(|z| z.im.is_zero()).collect();
+    real.sort_by(|a, b| a.abs_f64().total_cmp(&b.abs_f64()));
+    while real.len() >= 2 {
+        let (small, large) = (real.remove(0), real.pop().expect("two zeros left"));
+        pair(&mut p, small, large);
+    }
+    if let Some(&z) = real.first() {
+        linear(&mut p, z);
+    }
+    p
+}
+
+/// The kernel's form of one block of `N` coordinates: its poles and entries in real
+/// arithmetic (`Ok`) when the block is undamped and every entry's gain is real and its zeros
+/// real or, in the coupled system (`N = 8`), complex in conjugate pairs; else in complex
+/// arithmetic (`Err`).
+#[allow(clippy::type_complexity, reason = "the two arms of one block's form")]
+fn block_form<const N: usize>(
+    fs: &[&EntryFactors],
+    n_in: usize,
+    position: &dyn Fn(usize) -> (usize, usize),
+) -> Result<([f64; N], Vec<RealEntry<N>>), ([Complex64; N], Vec<ComplexEntry<N>>)> {
+    let poles = &fs[0].poles;
+    let quadratic = N == 8;
+    let real_zeros = |f: &EntryFactors| {
+        f.zeros
+            .iter()
+            .all(|z| z.im.is_zero() || (quadratic && f.zeros.contains(&z.conj())))
+    };
+    let real = poles.iter().all(|p| p.im.is_zero())
+        && fs.iter().all(|f| f.gain.im.is_zero() && real_zeros(f));
+    if real {
+        let entries = fs
+            .iter()
+            .map(|f| {
+                let p = prepare::<N>(f, f.output * n_in + f.input, quadratic);
+                RealEntry {
+                    re: position(p.at).0,
+                    first_re: false,
+                    factors: p.count,
+                    gain: p.gain.re.to_f64(),
+                    a: p.factors.map(|(a, _)| a.re.to_f64()),
+                    b: p.factors.map(|(_, b)| b.re.to_f64()),
+                    power: p.power,
+                    pairs: p.n_pairs,
+                    c1: p.pairs.map(|(c1, _)| c1.to_f64()),
+                    c2: p.pairs.map(|(_, c2)| c2.to_f64()),
+                }
+            })
+            .collect();
+        Ok((std::array::from_fn(|k| poles[k].re.to_f64()), entries))
+    } else {
+        let entries = fs
+            .iter()
+            .map(|f| {
+                let p = prepare::<N>(f, f.output * n_in + f.input, false);
+                ComplexEntry {
+                    re: position(p.at).0,
+                    im: position(p.at).1,
+                    first_re: false,
+                    first_im: false,
+                    factors: p.count,
+                    gain: p.gain.to_c64(),
+                    a: p.factors.map(|(a, _)| a.to_c64()),
+                    b: p.factors.map(|(_, b)| b.to_c64()),
+                }
+            })
+            .collect();
+        Err((std::array::from_fn(|k| poles[k].to_c64()), entries))
+    }
 }
 
 /// One entry's factored form in double-double (exposed for the tests).
@@ -110,8 +224,8 @@ pub struct EntryFactors {
     pub output: usize,
     /// Request column.
     pub input: usize,
-    /// The entry's block.
-    pub block: Block,
+    /// The entry's block; `None` for the coupled 8x8 system of an asymmetric pendulum.
+    pub block: Option<Block>,
     /// `H = gain s^power prod(z_j - s) / prod(lambda_k - s)`.
     pub gain: CDd,
     /// Multiplicity of the zero at `s = 0`.
@@ -122,6 +236,13 @@ pub struct EntryFactors {
     pub poles: Vec<CDd>,
     /// Coefficients of `N` zeroed as structural cancellations: `(power of s, |c| / scale)`.
     pub cancelled: Vec<(usize, f64)>,
+    /// `H = N(s) / P(s)` before factoring: the coefficients of `N` (ascending, after the
+    /// cancellations) and of `P = det(K_c - s M)`, each with the sum of the magnitudes of the
+    /// terms computed into it. A coefficient errs by a few `DD_EPS` of its magnitude (the
+    /// expansion's roundings and the data's own), which bounds the factors' error.
+    pub numerator: Vec<(CDd, f64)>,
+    /// See [`EntryFactors::numerator`].
+    pub denominator: Vec<(CDd, f64)>,
 }
 
 /// A polynomial in `s` (ascending coefficients) with the magnitude sums of its coefficients.
@@ -181,31 +302,120 @@ impl Poly {
     }
 }
 
-/// Determinant of the square matrix of polynomials `a` restricted to `rows` x `cols` (Laplace
-/// expansion along the first row).
-fn det(a: &[Vec<Poly>], rows: &[usize], cols: &[usize]) -> Poly {
-    if rows.len() == 1 {
-        return a[rows[0]][cols[0]].clone();
-    }
-    let mut acc = Poly::zero();
-    let r0 = rows[0];
-    for (k, &c) in cols.iter().enumerate() {
-        let e = &a[r0][c];
-        if e.is_zero() {
+/// Determinant of the leading `n x n` part of the square matrix of polynomials `a`, by Laplace
+/// expansion along the first row, each minor along its own first row, columns in increasing
+/// order. Minors are computed once each (by the set of columns they keep: the rows are the
+/// last ones), which makes the expansion of an 8x8 or 9x9 matrix cost `2^n n` products
+/// instead of `n!`; the arithmetic is that of the plain recursion.
+fn det(a: &[Vec<Poly>], n: usize) -> Poly {
+    let mut minors: Vec<Poly> = vec![Poly::zero(); 1 << n];
+    for mask in 1_usize..1 << n {
+        let size = mask.count_ones() as usize;
+        let row = n - size;
+        let cols = (0..n).filter(|c| mask & (1 << c) != 0);
+        if size == 1 {
+            minors[mask] = a[row][mask.trailing_zeros() as usize].clone();
             continue;
         }
-        let sub_cols: Vec<usize> = cols.iter().copied().filter(|&x| x != c).collect();
-        let minor = det(a, &rows[1..], &sub_cols);
-        acc.add_signed(&e.mul(&minor), k % 2 == 1);
+        let mut acc = Poly::zero();
+        for (k, c) in cols.enumerate() {
+            let e = &a[row][c];
+            if e.is_zero() {
+                continue;
+            }
+            acc.add_signed(&e.mul(&minors[mask & !(1 << c)]), k % 2 == 1);
+        }
+        minors[mask] = acc;
     }
-    acc
+    minors.pop().unwrap_or_else(Poly::zero)
 }
 
 fn lin(c0: CDd, c1: CDd) -> Poly {
+    lin_scaled(c0, c0.abs_f64(), c1, c1.abs_f64())
+}
+
+/// `c0 + c1 s` whose coefficients carry the rounding scales `m0`, `m1`.
+fn lin_scaled(c0: CDd, m0: f64, c1: CDd, m1: f64) -> Poly {
     Poly {
         c: vec![c0, c1],
-        mag: vec![c0.abs_f64(), c1.abs_f64()],
+        mag: vec![m0, m1],
     }
+}
+
+/// The rounding scales of the data of the pendulum as built ([`Scales`]) after the change to
+/// absolute test-mass angles: the scale of a difference is the sum of its terms' scales.
+struct Scaled {
+    mass: [[f64; 8]; 8],
+    stiffness: [[f64; 8]; 8],
+    /// Per request input: the forcing's scales, frequency-independent and per `w^2`.
+    forcing: Vec<([f64; 8], [f64; 8])>,
+    /// Per request output.
+    observation: Vec<[f64; 8]>,
+}
+
+impl Scaled {
+    fn new(scales: Option<&Scales>, request: &Request) -> Option<Scaled> {
+        let s = scales?;
+        let rows = |col: [f64; 8]| {
+            let mut out = col;
+            for (a, b) in PAIRS {
+                out[a] = col[a] + col[b];
+            }
+            out
+        };
+        Some(Scaled {
+            mass: abs_matrix_scale(&s.mass),
+            stiffness: abs_matrix_scale(&s.stiffness),
+            forcing: request
+                .inputs
+                .iter()
+                .map(|input| match input {
+                    Input::Tilt(t) => (
+                        rows(std::array::from_fn(|r| s.g0[r][t.index()])),
+                        rows(std::array::from_fn(|r| s.g2[r][t.index()])),
+                    ),
+                    Input::Translation(t) => (
+                        [0.0; 8],
+                        rows(std::array::from_fn(|r| s.translation_g2[r][t.index()])),
+                    ),
+                    Input::Force(f) => (
+                        rows(std::array::from_fn(|r| s.force[r][f.index()])),
+                        [0.0; 8],
+                    ),
+                })
+                .collect(),
+            observation: request
+                .outputs
+                .iter()
+                .map(|o| {
+                    let row = s.observation[o.index()];
+                    let mut out = row;
+                    for (a, b) in PAIRS {
+                        out[a] = row[a] + row[b];
+                    }
+                    out
+                })
+                .collect(),
+        })
+    }
+}
+
+/// [`abs_matrix`] of the scales: sums where it takes differences.
+fn abs_matrix_scale(m: &[[f64; 8]; 8]) -> [[f64; 8]; 8] {
+    let mut a = *m;
+    for row in a.iter_mut() {
+        let orig = *row;
+        for (ca, cb) in PAIRS {
+            row[ca] = orig[ca] + orig[cb];
+        }
+    }
+    let b = a;
+    for (ra, rb) in PAIRS {
+        for c in 0..8 {
+            a[ra][c] = b[ra][c] + b[rb][c];
+        }
+    }
+    a
 }
 
 /// Evaluates the polynomial and its derivative (ascending coefficients) at `z` in double-double.
@@ -319,13 +529,6 @@ fn symmetrize(z: &mut [CDd]) {
     }
 }
 
-/// The block's matrices in absolute test-mass angles (double-double), block-local indices.
-struct BlockData {
-    mass: [[Dd; 4]; 4],
-    stiffness: [[CDd; 4]; 4],
-    idx: [usize; 4],
-}
-
 /// Pairs (crossbar angle, relative test-mass angle), full indices.
 const PAIRS: [(usize, usize); 3] = [(0, 4), (1, 5), (2, 6)];
 
@@ -357,7 +560,9 @@ impl PoleZero {
         for f in &factors {
             nonzero[f.output * n_in + f.input] = true;
         }
-        let all_real = dense.iter().all(|b| matches!(b, BlockForm::Real(_)));
+        let all_real = dense
+            .iter()
+            .all(|b| matches!(b, BlockForm::Real(_) | BlockForm::Real8(_)));
         let layout = Layout::compact(&nonzero, all_real);
         let compact = Self::blocks(&factors, n_in, &|at| match layout.position(at) {
             // A real layout has only real blocks, which never write the imaginary part.
@@ -379,50 +584,20 @@ impl PoleZero {
         n_in: usize,
         position: &dyn Fn(usize) -> (usize, usize),
     ) -> Vec<BlockForm> {
-        Block::ALL
+        [Some(Block::SwingYBounce), Some(Block::SwingXTorsion), None]
             .into_iter()
             .filter_map(|block| {
                 let fs: Vec<&EntryFactors> = factors.iter().filter(|f| f.block == block).collect();
-                let first = fs.first()?;
-                let real = first.poles.iter().all(|p| p.im.is_zero())
-                    && fs
-                        .iter()
-                        .all(|f| f.gain.im.is_zero() && f.zeros.iter().all(|z| z.im.is_zero()));
-                let prepared: Vec<Prepared> = fs
-                    .iter()
-                    .map(|f| {
-                        let (g, fac, count) = entry_factors(f);
-                        (f.output * n_in + f.input, g, fac, count)
-                    })
-                    .collect();
-                Some(if real {
-                    let entries = prepared
-                        .iter()
-                        .map(|(at, g, fac, count)| RealEntry {
-                            re: position(*at).0,
-                            first_re: false,
-                            factors: *count,
-                            gain: g.re.to_f64(),
-                            a: fac.map(|(a, _)| a.re.to_f64()),
-                            b: fac.map(|(_, b)| b.re.to_f64()),
-                        })
-                        .collect();
-                    BlockForm::real(std::array::from_fn(|k| first.poles[k].re.to_f64()), entries)
-                } else {
-                    let entries = prepared
-                        .iter()
-                        .map(|(at, g, fac, count)| ComplexEntry {
-                            re: position(*at).0,
-                            im: position(*at).1,
-                            first_re: false,
-                            first_im: false,
-                            factors: *count,
-                            gain: g.to_c64(),
-                            a: fac.map(|(a, _)| a.to_c64()),
-                            b: fac.map(|(_, b)| b.to_c64()),
-                        })
-                        .collect();
-                    BlockForm::complex(std::array::from_fn(|k| first.poles[k].to_c64()), entries)
+                fs.first()?;
+                Some(match block {
+                    Some(_) => block_form::<4>(&fs, n_in, position).map_or_else(
+                        |(poles, entries)| BlockForm::Complex(ComplexBlock::new(poles, entries)),
+                        |(poles, entries)| BlockForm::Real(RealBlock::new(poles, entries)),
+                    ),
+                    None => block_form::<8>(&fs, n_in, position).map_or_else(
+                        |(poles, entries)| BlockForm::Complex8(ComplexBlock::new(poles, entries)),
+                        |(poles, entries)| BlockForm::Real8(RealBlock::new(poles, entries)),
+                    ),
                 })
             })
             .collect()
@@ -431,7 +606,7 @@ impl PoleZero {
     /// The factored form in double-double of every entry (and block) of `request` that is not
     /// structurally zero.
     pub fn factors(params: &Params, request: &Request) -> Vec<EntryFactors> {
-        let m: Matrices = matrices::build(params);
+        let (m, scales): (Matrices, Option<Scales>) = crate::geometry::dd_matrices(params);
         let mass = abs_matrix(&m.mass);
         let stiffness = abs_matrix(&m.stiffness);
         // T^T on forcing rows, C T on observation columns.
@@ -472,22 +647,23 @@ impl PoleZero {
                 ),
             })
             .collect();
+        // The rounding scale of each transformed datum: a sum of the scales of the terms
+        // (asymmetric), or its own magnitude (the closed forms).
+        let scale = Scaled::new(scales.as_ref(), request);
         let mut out = Vec::new();
-        for block in Block::ALL {
-            let idx = block.coords().map(Coord::index);
-            let data = BlockData {
-                mass: std::array::from_fn(|r| std::array::from_fn(|c| mass[idx[r]][idx[c]])),
-                stiffness: std::array::from_fn(|r| {
-                    std::array::from_fn(|c| stiffness[idx[r]][idx[c]])
-                }),
-                idx,
-            };
-            let mut a: Vec<Vec<Poly>> = (0..5)
+        for (block, idx) in groups(&m) {
+            let n = idx.len();
+            let mut a: Vec<Vec<Poly>> = (0..=n)
                 .map(|r| {
-                    (0..5)
+                    (0..=n)
                         .map(|c| {
-                            if r < 4 && c < 4 {
-                                lin(data.stiffness[r][c], CDd::real(-data.mass[r][c]))
+                            if r < n && c < n {
+                                let (i, j) = (idx[r], idx[c]);
+                                let (k, m) = (stiffness[i][j], CDd::real(-mass[i][j]));
+                                match &scale {
+                                    Some(sc) => lin_scaled(k, sc.stiffness[i][j], m, sc.mass[i][j]),
+                                    None => lin(k, m),
+                                }
                             } else {
                                 Poly::zero()
                             }
@@ -495,8 +671,7 @@ impl PoleZero {
                         .collect()
                 })
                 .collect();
-            let all: Vec<usize> = (0..4).collect();
-            let p = det(&a, &all, &all);
+            let p = det(&a, n);
             let poles = roots(&p.c);
             let mut poles_sorted = poles;
             poles_sorted.sort_by(|x, y| x.re.hi.total_cmp(&y.re.hi));
@@ -504,47 +679,57 @@ impl PoleZero {
             if undamped_block {
                 symmetrize(&mut poles_sorted);
             }
-            let det_m = p.c[4];
+            let det_m = p.c[n];
             for (o, c_row) in obs.iter().enumerate() {
-                let c_b: [Dd; 4] = std::array::from_fn(|k| c_row[data.idx[k]]);
+                let c_b: Vec<Dd> = idx.iter().map(|&k| c_row[k]).collect();
                 if c_b.iter().all(|x| x.is_zero()) {
                     continue;
                 }
                 for (i, (g0, g2)) in forcing.iter().enumerate() {
-                    let g0b: [Dd; 4] = std::array::from_fn(|k| g0[data.idx[k]]);
-                    let g2b: [Dd; 4] = std::array::from_fn(|k| g2[data.idx[k]]);
+                    let g0b: Vec<Dd> = idx.iter().map(|&k| g0[k]).collect();
+                    let g2b: Vec<Dd> = idx.iter().map(|&k| g2[k]).collect();
                     if g0b.iter().chain(&g2b).all(|x| x.is_zero()) {
                         continue;
                     }
-                    for k in 0..4 {
-                        a[k][4] = lin(CDd::real(g0b[k]), CDd::real(g2b[k]));
-                        a[4][k] = lin(CDd::real(c_b[k]), CDd::ZERO);
+                    for k in 0..n {
+                        let (g0, g2, c) = (CDd::real(g0b[k]), CDd::real(g2b[k]), CDd::real(c_b[k]));
+                        (a[k][n], a[n][k]) = match &scale {
+                            Some(sc) => (
+                                lin_scaled(
+                                    g0,
+                                    sc.forcing[i].0[idx[k]],
+                                    g2,
+                                    sc.forcing[i].1[idx[k]],
+                                ),
+                                lin_scaled(c, sc.observation[o][idx[k]], CDd::ZERO, 0.0),
+                            ),
+                            None => (lin(g0, g2), lin(c, CDd::ZERO)),
+                        };
                     }
-                    let rows: Vec<usize> = (0..5).collect();
-                    let mut n = det(&a, &rows, &rows);
-                    for c in n.c.iter_mut() {
+                    let mut num = det(&a, n + 1);
+                    for c in num.c.iter_mut() {
                         *c = -*c;
                     }
                     let mut cancelled = Vec::new();
-                    for (k, (c, m)) in n.c.iter_mut().zip(&n.mag).enumerate() {
+                    for (k, (c, m)) in num.c.iter_mut().zip(&num.mag).enumerate() {
                         let rel = c.abs_f64() / m;
                         if !c.is_zero() && rel <= ZERO_REL {
                             cancelled.push((k, rel));
                             *c = CDd::ZERO;
                         }
                     }
-                    let Some(top) = n.c.iter().rposition(|c| !c.is_zero()) else {
+                    let Some(top) = num.c.iter().rposition(|c| !c.is_zero()) else {
                         continue;
                     };
-                    let power = n.c.iter().position(|c| !c.is_zero()).unwrap_or(0);
-                    let reduced = &n.c[power..=top];
+                    let power = num.c.iter().position(|c| !c.is_zero()).unwrap_or(0);
+                    let reduced = &num.c[power..=top];
                     let mut zeros = roots(reduced);
                     if reduced.iter().all(|c| c.im.is_zero()) {
                         symmetrize(&mut zeros);
                     }
                     let nz = zeros.len();
                     let sign = if nz % 2 == 1 { -1.0 } else { 1.0 };
-                    let gain = (n.c[top] / det_m).scale(Dd::from_f64(sign));
+                    let gain = (num.c[top] / det_m).scale(Dd::from_f64(sign));
                     out.push(EntryFactors {
                         output: o,
                         input: i,
@@ -554,11 +739,37 @@ impl PoleZero {
                         zeros,
                         poles: poles_sorted.clone(),
                         cancelled,
+                        numerator: num.c.iter().copied().zip(num.mag.iter().copied()).collect(),
+                        denominator: p.c.iter().copied().zip(p.mag.iter().copied()).collect(),
                     });
                 }
             }
         }
         out
+    }
+}
+
+/// The independent systems of `m`: the two blocks of [`Block`] when no entry of `M`, `K_c` or
+/// the viscous damping couples them (the symmetric pendulum, or offsets that keep its mirror
+/// plane), else the whole coupled system (`None`). Full indices of each system's coordinates.
+fn groups(m: &Matrices) -> Vec<(Option<Block>, Vec<usize>)> {
+    let [a, b] = Block::ALL.map(|block| block.coords().map(Coord::index));
+    let coupled = a.iter().any(|&i| {
+        b.iter().any(|&j| {
+            [(i, j), (j, i)].iter().any(|&(r, c)| {
+                !(m.mass[r][c].is_zero()
+                    && m.stiffness[r][c].is_zero()
+                    && m.damping[r][c].is_zero())
+            })
+        })
+    });
+    if coupled {
+        vec![(None, (0..8).collect())]
+    } else {
+        Block::ALL
+            .into_iter()
+            .map(|block| (Some(block), block.coords().map(Coord::index).to_vec()))
+            .collect()
     }
 }
 

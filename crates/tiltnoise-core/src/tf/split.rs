@@ -396,7 +396,7 @@ impl AbsoluteBlock {
         let eigenvalues: Vec<f64> = modes
             .modes
             .iter()
-            .filter(|m| m.block == block)
+            .filter(|m| m.block == Some(block))
             .map(|m| m.omega_sq)
             .collect();
         let lo = eigenvalues.iter().copied().fold(f64::INFINITY, f64::min);

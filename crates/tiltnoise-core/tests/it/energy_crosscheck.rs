@@ -1,10 +1,14 @@
 //! Independent cross-check of the linear model against the energies of section II of the paper.
 //!
-//! The kinematics of section II.A (eq. matriceR, r_g,a and r_g,b) are evaluated on hyper-dual
-//! numbers, which carry exact first and mixed second derivatives, and every matrix of the library
-//! is rebuilt from them, without any of the Appendix A formulas:
+//! The kinematics of section II.A (eq. matriceR, r_g,a and r_g,b), with the [asymmetry]
+//! offsets of the pendulum as built (centres of mass and the lower clamp displaced in their
+//! bodies' axes, the readout axes turned), are evaluated on hyper-dual numbers, which carry
+//! exact first and mixed second derivatives, and every matrix of the library is rebuilt from
+//! them at the library's rest configuration `q0` (0 for the symmetric pendulum), without any of
+//! the Appendix A formulas or the library's kinematics:
 //!
-//! * K  = Hessian of the potential U of section II.D at q = 0;
+//! * grad U = 0 at `q0`: the library's rest configuration is an equilibrium of these energies;
+//! * K  = Hessian of the potential U of section II.D at `q0`;
 //! * M  from T = 1/2 sum m |J q'|^2 + 1/2 w.I.w, with J = dr_g/dq and [w]x = A^T dA/dq_h;
 //! * B  (zeroth-order generalized forces, eq. qh) = [J_a^T, J_b^T, W_a^T, W_b^T] (inertial axes);
 //! * G0 by tilting the direction of gravity, G2 from the apparent forces of section IV.B;
@@ -12,7 +16,12 @@
 //!   mass moves at `u' + J q'`: the cross term `sum m (J q') . u'` of T puts
 //!   `-sum m J^T u'' = w^2 (sum m J^T) u` on the right of Lagrange's equations, so
 //!   `G2[h][k] = d^2 T / dq'_h du'_k`;
-//! * C  from the cube-centre position and the attitudes of A_b and A_a.
+//! * C  from the cube-centre position and the attitudes of A_b and A_a, in the readout's axes.
+//!
+//! K and M are also checked against numerical Hessians of the exact energies at the tilted
+//! rest configuration: central differences of the exact gradient (K) and of the positions and
+//! attitudes (M, through the kinetic energy), with the truncation error measured by halving
+//! the step.
 //!
 //! Each hyper-dual component also carries the sum of the absolute values of the terms added into
 //! it (running error analysis), which gives every entry its own rounding scale, including the
@@ -224,12 +233,20 @@ struct Phys {
     h_c: Hd,
     h: Hd,
     y_a: Hd,
+    /// Offsets of the crossbar's and the test mass's centres of mass and of the lower clamp
+    /// (x, y in the body's axes).
+    crossbar: [Hd; 2],
+    tm: [Hd; 2],
+    clamp: [Hd; 2],
+    /// The readout's components of a lab vector: `R(s) v`.
+    readout: M3,
 }
 
 impl Phys {
     fn new(p: &Params) -> Phys {
         let c = Hd::cst;
         let i = &p.inertia;
+        let a = &p.asymmetry;
         let zero = c(0.0);
         Phys {
             m_a: c(p.mass.m_a_kg),
@@ -258,6 +275,14 @@ impl Phys {
             h: c(p.length.h_m),
             // Section II.A: the whole system's centre of mass is on the upper fibre.
             y_a: c(p.length.d_m * p.mass.m_b_kg / p.mass.m_a_kg),
+            crossbar: [c(a.crossbar_com_x_m), c(a.crossbar_com_y_m)],
+            tm: [c(a.tm_com_x_m), c(a.tm_com_y_m)],
+            clamp: [c(a.lower_attachment_x_m), c(a.lower_attachment_y_m)],
+            readout: rot(
+                c(a.sensor_rot_x_rad),
+                c(a.sensor_rot_y_rad),
+                c(a.sensor_rot_z_rad),
+            ),
         }
     }
 }
@@ -278,13 +303,29 @@ fn kinematics(ph: &Phys, q: &[Hd; 8]) -> Kin {
     let r_b = rot(q[4], q[5], q[6]);
     let a_a = transpose(r_a); // u_i,a = R_a^T e_i: column i of A_a
     let a_b = mat_mul(a_a, transpose(r_b)); // u_i,b = R_a^T R_b^T e_i
-    let (u2a, u3a, u3b) = (column(a_a, 1), column(a_a, 2), column(a_b, 2));
-    let r_ga = add3(scale(-(ph.z + ph.z_a + q[3]), u3a), scale(ph.y_a, u2a));
-    let r_gb = add3(
-        add3(scale(-(ph.z + q[3]), u3a), scale(-ph.d, u2a)),
-        scale(-(ph.z_b + q[7]), u3b),
+    let (u1a, u2a, u3a) = (column(a_a, 0), column(a_a, 1), column(a_a, 2));
+    let (u1b, u2b, u3b) = (column(a_b, 0), column(a_b, 1), column(a_b, 2));
+    // The crossbar's centre of mass: Z_a below the upper fibre's lower end, y_a along the arm,
+    // plus its offset in the crossbar's axes.
+    let r_ga = add3(
+        add3(
+            scale(-(ph.z + ph.z_a + q[3]), u3a),
+            scale(ph.y_a + ph.crossbar[1], u2a),
+        ),
+        scale(ph.crossbar[0], u1a),
     );
-    let r_c = add3(r_gb, scale(-ph.h_c, u3b));
+    // The lower clamp, at the arm's end (0, -d) plus its offset; the test mass hangs from it
+    // along its own axis u_3b, its centre of mass offset in its own axes.
+    let clamp = add3(
+        add3(scale(-(ph.z + q[3]), u3a), scale(ph.clamp[1] - ph.d, u2a)),
+        scale(ph.clamp[0], u1a),
+    );
+    let r_gb = add3(
+        add3(clamp, scale(-(ph.z_b + q[7]), u3b)),
+        add3(scale(ph.tm[0], u1b), scale(ph.tm[1], u2b)),
+    );
+    // The cube centre: on the fibre's axis, h_c below the nominal centre of mass.
+    let r_c = add3(clamp, scale(-(ph.z_b + q[7] + ph.h_c), u3b));
     Kin {
         a_a,
         a_b,
@@ -322,7 +363,12 @@ fn potential(ph: &Phys, q: &[Hd; 8], t: &[Hd; 3]) -> Hd {
 
 /// N hyper-dual zeros, e1 seeded on index `e1`, e2 on `e2`.
 fn seeds<const N: usize>(e1: Option<usize>, e2: Option<usize>) -> [Hd; N] {
-    std::array::from_fn(|k| Hd::var(0.0, e1 == Some(k), e2 == Some(k)))
+    at_seeds(&[0.0; N], e1, e2)
+}
+
+/// The values `x`, e1 seeded on index `e1`, e2 on `e2`.
+fn at_seeds<const N: usize>(x: &[f64; N], e1: Option<usize>, e2: Option<usize>) -> [Hd; N] {
+    std::array::from_fn(|k| Hd::var(x[k], e1 == Some(k), e2 == Some(k)))
 }
 
 /// Every matrix of the linear model, rebuilt from the energies; entries carry magnitudes.
@@ -339,25 +385,27 @@ struct Reference {
 }
 
 impl Reference {
-    fn build(ph: &Phys) -> Reference {
+    /// Every matrix at the configuration `q0`.
+    fn build(ph: &Phys, q0: &[f64; 8]) -> Reference {
         let t0 = seeds::<3>(None, None);
-        let grad = std::array::from_fn(|i| potential(ph, &seeds(Some(i), None), &t0).part(1));
+        let q = |e1, e2| at_seeds(q0, e1, e2);
+        let grad = std::array::from_fn(|i| potential(ph, &q(Some(i), None), &t0).part(1));
         let k = std::array::from_fn(|i| {
-            std::array::from_fn(|j| potential(ph, &seeds(Some(i), Some(j)), &t0).part(3))
+            std::array::from_fn(|j| potential(ph, &q(Some(i), Some(j)), &t0).part(3))
         });
         // Generalized force per unit tilt: Q = -dU/dq, linear part in t.
         let g0 = std::array::from_fn(|i| {
             std::array::from_fn(|j| {
-                -potential(ph, &seeds(Some(i), None), &seeds(None, Some(j))).part(3)
+                -potential(ph, &q(Some(i), None), &seeds(None, Some(j))).part(3)
             })
         });
 
-        // First-order kinematics per unit q'_h at q = 0.
+        // First-order kinematics per unit q'_h at q0.
         let mut j_a = [[Hd::cst(0.0); 3]; 8];
         let mut j_b = j_a;
         let (mut wa_body, mut wb_body, mut wa_in, mut wb_in, mut dr_c) = (j_a, j_a, j_a, j_a, j_a);
         for h in 0..8 {
-            let kin = kinematics(ph, &seeds(Some(h), None));
+            let kin = kinematics(ph, &q(Some(h), None));
             j_a[h] = part3(kin.r_ga, 1);
             j_b[h] = part3(kin.r_gb, 1);
             dr_c[h] = part3(kin.r_c, 1);
@@ -378,7 +426,7 @@ impl Reference {
             })
         });
 
-        // Eq. (qh) at q = 0: Q_h = dr_g/dq_h . F + dpsi/dq_h . M for both bodies.
+        // Eq. (qh) at q0: Q_h = dr_g/dq_h . F + dpsi/dq_h . M for both bodies.
         let b: [[Hd; 12]; 8] = std::array::from_fn(|h| {
             [j_a[h], j_b[h], wa_in[h], wb_in[h]]
                 .concat()
@@ -387,8 +435,14 @@ impl Reference {
         });
 
         // Apparent forces per unit t'' (section IV.B): w' = -t'', r_s'' = w' x (0, 0, h).
-        let kin0 = kinematics(ph, &seeds(None, None));
+        let kin0 = kinematics(ph, &q(None, None));
         let (r_ga0, r_gb0) = (part3(kin0.r_ga, 0), part3(kin0.r_gb, 0));
+        // Inertia tensors in lab axes at q0: A I A^T.
+        let lab = |a: M3, i: M3| {
+            let a = part33(a, 0);
+            mat_mul(mat_mul(a, i), transpose(a))
+        };
+        let (i_a, i_b) = (lab(kin0.a_a, ph.i_a), lab(kin0.a_b, ph.i_b));
         let zero = Hd::cst(0.0);
         let mut g2 = [[zero; 3]; 8];
         for axis in 0..3 {
@@ -399,8 +453,8 @@ impl Reference {
             let inputs = [
                 force(ph.m_a, r_ga0),
                 force(ph.m_b, r_gb0),
-                torque(ph.i_a),
-                torque(ph.i_b),
+                torque(i_a),
+                torque(i_b),
             ]
             .concat();
             for (row, b_row) in g2.iter_mut().zip(&b) {
@@ -426,12 +480,14 @@ impl Reference {
             })
         });
 
-        // Observables: X, Y, Z of the cube centre, TM attitude, crossbar torsion.
+        // Observables: X, Y, Z of the cube centre, TM attitude, crossbar torsion, in the
+        // readout's axes.
+        let readout = |v: V3| mat_vec(ph.readout, v);
         let c = std::array::from_fn(|r| {
             std::array::from_fn(|h| match r {
-                0..=2 => dr_c[h][r],
-                3..=5 => wb_in[h][r - 3],
-                _ => wa_in[h][2],
+                0..=2 => readout(dr_c[h])[r],
+                3..=5 => readout(wb_in[h])[r - 3],
+                _ => readout(wa_in[h])[2],
             })
         });
 
@@ -527,18 +583,31 @@ fn assert_reference_symmetric(set: &str, matrix: &str, a: &[[Hd; 8]; 8]) {
 }
 
 /// Full cross-check of one parameter set; prints the largest discrepancy per matrix.
+/// The library's rest configuration (0 for the symmetric pendulum).
+fn rest_of(model: &Model) -> [f64; 8] {
+    std::array::from_fn(|k| model.rest_configuration()[k])
+}
+
 fn crosscheck(set: &str, p: &Params) {
     let model = Model::new(p).expect("valid parameter set");
     let ph = Phys::new(p);
-    let r = Reference::build(&ph);
+    let q0 = rest_of(&model);
+    let r = Reference::build(&ph, &q0);
     let names = coord_names();
 
-    // Equilibrium: y_a = d m_b / m_a and the pre-tension make q = 0 stationary.
+    // Equilibrium: y_a = d m_b / m_a and the pre-tension make q = 0 stationary; an offset
+    // tilts the bodies to the library's q0. Its f64 rounding (half an ulp of each coordinate;
+    // the library solves in double-double) leaves sum_j |K_ij| u |q0_j| of gradient. (It
+    // moves every matrix entry by about u |q0| of its magnitude, 1e-19 for millimetre offsets:
+    // far below the rounding bound of the comparisons below.)
     for (i, g) in r.grad.iter().enumerate() {
-        let tol = ENERGY_C_TOL * f64::EPSILON * g.m[0];
+        let rounding: f64 = (0..8)
+            .map(|j| r.k[i][j].v[0].abs() * 0.5 * f64::EPSILON * q0[j].abs())
+            .sum();
+        let tol = ENERGY_C_TOL * f64::EPSILON * g.m[0] + rounding;
         assert!(
             g.v[0].abs() <= tol,
-            "[{set}] reference dU/d({}) = {:e} at q = 0 (tol {tol:e}): not an equilibrium",
+            "[{set}] reference dU/d({}) = {:e} at q0 (tol {tol:e}): not an equilibrium",
             names[i],
             g.v[0]
         );
@@ -600,6 +669,150 @@ fn crosscheck(set: &str, p: &Params) {
     }
 }
 
+/// K and M against numerical Hessians of the exact energies at the library's rest
+/// configuration. K: central differences of the exact gradient (the hyper-dual first
+/// derivative) with steps `h` and `h/2`; M: the kinetic energy `T(v)` of a velocity `v`, with
+/// the velocities of the centres of mass and the bodies' angular velocities from central
+/// differences of the positions and attitudes (steps `tau`, `tau/2`), and `M_ij = T(e_i + e_j)
+/// - T(e_i) - T(e_j)` (exact for a quadratic form). Each estimate at the smaller step must be
+/// within twice its truncation error, measured as the change from the larger step (central
+/// differences are O(h^2): the error at h/2 is a third of that change), plus the rounding of
+/// the differences, `ENERGY_C_TOL eps` of the differenced magnitudes over the step.
+fn numerical_hessians(set: &str, p: &Params) {
+    let model = Model::new(p).expect("valid parameter set");
+    let ph = Phys::new(p);
+    let q0 = rest_of(&model);
+    let names = coord_names();
+    let t0 = seeds::<3>(None, None);
+    let shifted = |j: usize, h: f64| {
+        let mut q = q0;
+        q[j] += h;
+        q
+    };
+    let grad = |q: &[f64; 8], i: usize| potential(&ph, &at_seeds(q, Some(i), None), &t0).part(1);
+    let k_at = |h: f64| -> [[(f64, f64); 8]; 8] {
+        std::array::from_fn(|i| {
+            std::array::from_fn(|j| {
+                let (a, b) = (grad(&shifted(j, h), i), grad(&shifted(j, -h), i));
+                ((a.v[0] - b.v[0]) / (2.0 * h), (a.m[0] + b.m[0]) / (2.0 * h))
+            })
+        })
+    };
+    let h = 1e-5;
+    let (coarse, fine) = (k_at(h), k_at(h / 2.0));
+    let stiffness = model.stiffness();
+    let (mut worst, mut resolved) = (0.0_f64, 0);
+    for i in 0..8 {
+        for j in 0..8 {
+            let ((kc, _), (kf, mag)) = (coarse[i][j], fine[i][j]);
+            let tol = 2.0 * (kc - kf).abs() + ENERGY_C_TOL * f64::EPSILON * mag;
+            let diff = (kf - stiffness[(i, j)]).abs();
+            // The entries the differences resolve (tolerance below the entry).
+            if tol < stiffness[(i, j)].abs() {
+                worst = worst.max(diff / stiffness[(i, j)].abs());
+                resolved += 1;
+            }
+            assert!(
+                diff <= tol,
+                "[{set}] numerical K[{}, {}] = {kf:e}, library {:e}, tol {tol:e}",
+                names[i],
+                names[j],
+                stiffness[(i, j)]
+            );
+        }
+    }
+    println!(
+        "[{set}] numerical Hessian of U: max |K_num - K| / |K| = {worst:.1e} over the \
+         {resolved} entries it resolves"
+    );
+
+    // Kinetic energy of the velocity v at q0, and its rounding scale.
+    let kin = |q: &[f64; 8]| kinematics(&ph, &at_seeds(q, None, None));
+    let energy = |v: &[f64; 8], tau: f64| -> (f64, f64) {
+        let step = |sign: f64| -> [f64; 8] { std::array::from_fn(|k| q0[k] + sign * tau * v[k]) };
+        let (p, m, c) = (kin(&step(1.0)), kin(&step(-1.0)), kin(&q0));
+        let velocity = |a: V3, b: V3| -> [f64; 3] {
+            std::array::from_fn(|k| (a[k].v[0] - b[k].v[0]) / (2.0 * tau))
+        };
+        let position_scale = |a: V3| a.iter().map(|x| x.m[0]).fold(0.0, f64::max);
+        let mut t = 0.0;
+        let mut scale = 0.0;
+        for (mass, a, b, r) in [
+            (ph.m_a.v[0], p.r_ga, m.r_ga, c.r_ga),
+            (ph.m_b.v[0], p.r_gb, m.r_gb, c.r_gb),
+        ] {
+            let u = velocity(a, b);
+            let speed_sq: f64 = u.iter().map(|x| x * x).sum();
+            t += 0.5 * mass * speed_sq;
+            // |d(v^2)| <= 2 |v| |dv|, |dv| <= ENERGY_C_TOL eps |r| / tau per component.
+            scale += mass * speed_sq.sqrt() * 3.0 * position_scale(r) / tau;
+        }
+        for (a_p, a_m, a_0, inertia) in
+            [(p.a_a, m.a_a, c.a_a, ph.i_a), (p.a_b, m.a_b, c.a_b, ph.i_b)]
+        {
+            // w' = vee(skew(A^T A')) with A' from the central difference (unit attitude
+            // entries: their differences err by eps / tau).
+            let da: M3 = std::array::from_fn(|r| {
+                std::array::from_fn(|k| Hd::cst((a_p[r][k].v[0] - a_m[r][k].v[0]) / (2.0 * tau)))
+            });
+            let s = mat_mul(transpose(part33(a_0, 0)), da);
+            let w: [f64; 3] = [
+                0.5 * (s[2][1].v[0] - s[1][2].v[0]),
+                0.5 * (s[0][2].v[0] - s[2][0].v[0]),
+                0.5 * (s[1][0].v[0] - s[0][1].v[0]),
+            ];
+            let iw: [f64; 3] =
+                std::array::from_fn(|r| (0..3).map(|k| inertia[r][k].v[0] * w[k]).sum());
+            t += 0.5 * (0..3).map(|k| w[k] * iw[k]).sum::<f64>();
+            let norm_i: f64 = inertia.iter().flatten().map(|x| x.v[0].abs()).sum();
+            scale += norm_i * w.iter().map(|x| x.abs()).sum::<f64>() * 3.0 / tau;
+        }
+        (t, scale)
+    };
+    let unit = |i: usize| -> [f64; 8] { std::array::from_fn(|k| f64::from(u8::from(k == i))) };
+    let m_at = |tau: f64| -> [[(f64, f64); 8]; 8] {
+        std::array::from_fn(|i| {
+            std::array::from_fn(|j| {
+                let (ti, si) = energy(&unit(i), tau);
+                if i == j {
+                    return (2.0 * ti, 2.0 * si);
+                }
+                let both: [f64; 8] = std::array::from_fn(|k| unit(i)[k] + unit(j)[k]);
+                let (tb, sb) = energy(&both, tau);
+                let (tj, sj) = energy(&unit(j), tau);
+                (tb - ti - tj, sb + si + sj)
+            })
+        })
+    };
+    let tau = 1e-5;
+    let (coarse, fine) = (m_at(tau), m_at(tau / 2.0));
+    let mass = model.mass();
+    let (mut worst, mut resolved) = (0.0_f64, 0);
+    for i in 0..8 {
+        for j in 0..8 {
+            let ((mc, _), (mf, scale)) = (coarse[i][j], fine[i][j]);
+            let tol = 2.0 * (mc - mf).abs() + ENERGY_C_TOL * f64::EPSILON * scale;
+            let diff = (mf - mass[(i, j)]).abs();
+            // The entries the differences resolve (tolerance below the entry).
+            if tol < mass[(i, j)].abs() {
+                worst = worst.max(diff / mass[(i, j)].abs());
+                resolved += 1;
+            }
+            assert!(
+                diff <= tol,
+                "[{set}] numerical M[{}, {}] = {mf:e}, library {:e}, tol {tol:e}",
+                names[i],
+                names[j],
+                mass[(i, j)]
+            );
+        }
+    }
+    println!(
+        "[{set}] numerical Hessian of T: max |M_num - M| / |M| = {worst:.1e} over the \
+         {resolved} entries it resolves"
+    );
+}
+
 /// Table I with I^b_22 far from I^b_11, a different I^a_23 (other sign) and a different h.
 fn altered() -> Params {
     [
@@ -639,6 +852,69 @@ fn generic() -> Params {
     .fold(Params::table_i(), |p, s| p.with_override(s).expect(s))
 }
 
+/// Parameter sets of the pendulum as built: every kind of offset, alone and together (with
+/// the generic lengths and inertias too), and a readout rotation.
+fn as_built() -> Vec<(&'static str, Params)> {
+    let set =
+        |base: Params, sets: &[&str]| sets.iter().fold(base, |p, s| p.with_override(s).expect(s));
+    vec![
+        (
+            "crossbar x 1 mm",
+            set(Params::table_i(), &["asymmetry.crossbar_com_x_m=1e-3"]),
+        ),
+        (
+            "test mass x 1 mm, y -0.4 mm",
+            set(
+                Params::table_i(),
+                &["asymmetry.tm_com_x_m=1e-3", "asymmetry.tm_com_y_m=-4e-4"],
+            ),
+        ),
+        (
+            "crossbar y, clamp x and y, readout turned",
+            set(
+                Params::table_i(),
+                &[
+                    "asymmetry.crossbar_com_y_m=-2e-3",
+                    "asymmetry.lower_attachment_x_m=1.5e-3",
+                    "asymmetry.lower_attachment_y_m=7e-4",
+                    "asymmetry.sensor_rot_x_rad=3e-3",
+                    "asymmetry.sensor_rot_y_rad=-1e-3",
+                    "asymmetry.sensor_rot_z_rad=2e-3",
+                ],
+            ),
+        ),
+        (
+            "generic, every offset",
+            set(
+                generic(),
+                &[
+                    "asymmetry.crossbar_com_x_m=-8e-4",
+                    "asymmetry.crossbar_com_y_m=1.2e-3",
+                    "asymmetry.tm_com_x_m=2e-3",
+                    "asymmetry.tm_com_y_m=5e-4",
+                    "asymmetry.lower_attachment_x_m=-3e-4",
+                    "asymmetry.lower_attachment_y_m=9e-4",
+                    "asymmetry.sensor_rot_z_rad=-4e-3",
+                ],
+            ),
+        ),
+    ]
+}
+
+#[test]
+fn as_built_parameters_match_energy_reference() {
+    for (set, p) in as_built() {
+        crosscheck(set, &p);
+    }
+}
+
+#[test]
+fn as_built_matches_numerical_hessians_of_the_energies() {
+    for (set, p) in as_built() {
+        numerical_hessians(set, &p);
+    }
+}
+
 #[test]
 fn table_i_matches_energy_reference() {
     crosscheck("Table I", &Params::table_i());
@@ -663,7 +939,7 @@ fn generic_parameters_match_energy_reference() {
 fn reference_static_tilt_response_has_paper_sign() {
     for p in [Params::table_i(), altered(), generic()] {
         let ph = Phys::new(&p);
-        let r = Reference::build(&ph);
+        let r = Reference::build(&ph, &[0.0; 8]);
         let lever = p.length.z_m + p.length.z_b_m + p.length.h_c_m;
         let y_block = [0, 3, 4, 7]; // theta_a, delta_a, theta_b, delta_b
         let x_block = [1, 2, 5, 6]; // eta_a, phi_a, eta_b, phi_b

@@ -9,6 +9,7 @@ const REPO_ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
 mod common;
 mod tolerances;
 
+mod as_built;
 mod budget_summary;
 mod cancel;
 mod coherence;
@@ -30,4 +31,5 @@ mod subtract_pulls;
 mod synthetic;
 mod tilt_tf;
 mod translation_tf;
+mod visibility_fit;
 mod welch_scipy;

@@ -245,6 +245,7 @@ fn refuses_zero_samples_and_too_large_sigma() {
         let u = vec![Uncertainty {
             key: key.into(),
             rel_sigma: s,
+            abs_sigma: 0.0,
             distribution: Distribution::Gaussian,
         }];
         run(&p, &cfg(10, 1, 1, u), &no_progress)
@@ -280,6 +281,7 @@ fn non_physical_draws_are_rejected_and_counted() {
     let u = vec![Uncertainty {
         key: "inertia.a23_kg_m2".into(),
         rel_sigma: 0.2,
+        abs_sigma: 0.0,
         distribution: Distribution::Gaussian,
     }];
     let r = run_ok(&p, &cfg(2000, 5, 2, u));

@@ -329,6 +329,7 @@ fn spectra_show_exactly_the_modes_of_the_observability_table() {
             let visible = modes.visible[k][o.index()];
             let structural = mode
                 .block
+                .expect("the symmetric pendulum is decoupled")
                 .coords()
                 .iter()
                 .all(|c| model.observation()[(o.index(), c.index())] == 0.0);

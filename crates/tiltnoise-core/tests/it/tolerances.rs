@@ -70,6 +70,14 @@ pub const TARGET_REL: f64 = tf::DEFAULT_REL_TOL;
 /// as `1 / |f - f_pole|`, and at 1 % it is about 100 times its value away from the pole.
 pub const POLE_EXCLUSION: f64 = tf::POLE_EXCLUSION;
 
+/// Rounding of a coefficient of the pole-zero method's polynomials `N(s)`, `P(s)` (Laplace
+/// expansions of a 9x9 matrix of linear polynomials, in double-double) in units of `DD_EPS`
+/// times the coefficient's magnitude (the sum of the magnitudes of its terms): each term is a
+/// product of at most 9 data, each within `CLEAN_DEPTH = 64` of its own scale (the exact
+/// kinematics' depth), and the expansion adds about `3 x 9` roundings along a path:
+/// `64 x 9 + 27 = 603`, rounded up.
+pub const POLYNOMIAL_GAMMA: f64 = 640.0;
+
 /// Allowed error of a double-double reference entry in units of `DD_EPS kappa` (`kappa` the
 /// entry's condition number): the longest chain of double-double operations behind one datum
 /// (about 12) plus the solve's componentwise backward error, rounded up. The measured maximum is

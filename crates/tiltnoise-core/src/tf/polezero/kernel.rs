@@ -42,13 +42,18 @@ use crate::error::TfError;
 use crate::tf::Destination;
 use num_complex::Complex64;
 
-/// One entry of an undamped block: `gain prod_k (a_k + b_k s)` times the block's
-/// `1 / prod(lambda - s)`, added at value `re` (its real part). Factors: `s` for a zero at the origin
-/// (`a = 0, b = 1`), `1 - s / z` for a zero `z` (`a = 1, b = -1 / z`, `z` moved into the
-/// gain); the first `factors` of the four, the others padding (`a = 1, b = 0`), skipped (an
-/// exact 1 for every finite `s`).
+/// One entry of an undamped block: `gain s^power prod_k (a_k + b_k s) prod_j (1 + c1_j s +
+/// c2_j s^2)` times the block's `1 / prod(lambda - s)`, added at value `re` (its real part).
+/// Linear factors: `s` for a zero at the origin (`a = 0, b = 1`), `1 - s / z` for a real zero
+/// `z` (`a = 1, b = -1 / z`, `z` moved into the gain); the first `factors` of the `N` (the
+/// block's size), the others padding (`a = 1, b = 0`), skipped (an exact 1 for every finite
+/// `s`). The coupled system (`N = 8`) takes its zeros at the origin as `power` and the others
+/// two by two, `(1 - s / z_1)(1 - s / z_2)` with both zeros moved into the gain: a conjugate
+/// pair (real coefficients, so real arithmetic) or two real zeros (the smallest with the
+/// largest in magnitude, so that two nearby zeros rarely share a factor); five operations per
+/// two zeros against six; the first `pairs` of `c1`, `c2`, a zero left over as a linear factor.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct RealEntry {
+pub(super) struct RealEntry<const N: usize> {
     /// Position of the real part in a point's `f64` values.
     pub re: usize,
     /// The first block to write `out[re]`: it stores `0.0 + h` (what
@@ -57,13 +62,17 @@ pub(super) struct RealEntry {
     pub first_re: bool,
     pub factors: usize,
     pub gain: f64,
-    pub a: [f64; 4],
-    pub b: [f64; 4],
+    pub a: [f64; N],
+    pub b: [f64; N],
+    pub power: usize,
+    pub pairs: usize,
+    pub c1: [f64; N],
+    pub c2: [f64; N],
 }
 
 /// [`RealEntry`] with complex gain and factors (damped blocks, or complex zeros).
 #[derive(Debug, Clone, Copy)]
-pub(super) struct ComplexEntry {
+pub(super) struct ComplexEntry<const N: usize> {
     /// Positions of the real and imaginary parts in a point's `f64` values.
     pub re: usize,
     pub im: usize,
@@ -73,53 +82,62 @@ pub(super) struct ComplexEntry {
     pub first_im: bool,
     pub factors: usize,
     pub gain: Complex64,
-    pub a: [Complex64; 4],
-    pub b: [Complex64; 4],
+    pub a: [Complex64; N],
+    pub b: [Complex64; N],
 }
 
-/// A block with real poles (undamped) whose entries are all real.
-pub(super) struct RealBlock {
-    poles: [f64; 4],
+/// A block of `N` coordinates (4: one of the two decoupled blocks; 8: the coupled system of an
+/// asymmetric pendulum) with real poles (undamped) whose entries are all real.
+pub(super) struct RealBlock<const N: usize> {
+    poles: [f64; N],
     /// `SINGULAR_RCOND lambda_k`.
-    thresholds: [f64; 4],
-    entries: Vec<RealEntry>,
+    thresholds: [f64; N],
+    entries: Vec<RealEntry<N>>,
 }
 
 /// A block in complex arithmetic.
-pub(super) struct ComplexBlock {
-    poles: [Complex64; 4],
+pub(super) struct ComplexBlock<const N: usize> {
+    poles: [Complex64; N],
     /// `(SINGULAR_RCOND |lambda_k|)^2`.
-    thresholds: [f64; 4],
-    entries: Vec<ComplexEntry>,
+    thresholds: [f64; N],
+    entries: Vec<ComplexEntry<N>>,
+}
+
+impl<const N: usize> RealBlock<N> {
+    /// A block in real arithmetic with eigenvalues `poles` (`s`, rad^2/s^2).
+    pub fn new(poles: [f64; N], entries: Vec<RealEntry<N>>) -> Self {
+        RealBlock {
+            poles,
+            thresholds: poles.map(|l| SINGULAR_RCOND * l),
+            entries,
+        }
+    }
+}
+
+impl<const N: usize> ComplexBlock<N> {
+    /// A block in complex arithmetic with eigenvalues `poles`.
+    pub fn new(poles: [Complex64; N], entries: Vec<ComplexEntry<N>>) -> Self {
+        ComplexBlock {
+            poles,
+            thresholds: poles.map(|l| (SINGULAR_RCOND * l.norm()).powi(2)),
+            entries,
+        }
+    }
 }
 
 /// One block's product forms.
 pub(super) enum BlockForm {
-    /// Undamped, every zero real: real arithmetic.
-    Real(RealBlock),
-    /// Damped (or complex zeros): complex arithmetic.
-    Complex(ComplexBlock),
+    /// A decoupled block, undamped, every zero real: real arithmetic.
+    Real(RealBlock<4>),
+    /// A decoupled block, damped (or complex zeros): complex arithmetic.
+    Complex(ComplexBlock<4>),
+    /// The coupled 8x8 system, real arithmetic.
+    Real8(RealBlock<8>),
+    /// The coupled 8x8 system, complex arithmetic.
+    Complex8(ComplexBlock<8>),
 }
 
 impl BlockForm {
-    /// A block in real arithmetic with eigenvalues `poles` (`s`, rad^2/s^2).
-    pub fn real(poles: [f64; 4], entries: Vec<RealEntry>) -> BlockForm {
-        BlockForm::Real(RealBlock {
-            poles,
-            thresholds: poles.map(|l| SINGULAR_RCOND * l),
-            entries,
-        })
-    }
-
-    /// A block in complex arithmetic with eigenvalues `poles`.
-    pub fn complex(poles: [Complex64; 4], entries: Vec<ComplexEntry>) -> BlockForm {
-        BlockForm::Complex(ComplexBlock {
-            poles,
-            thresholds: poles.map(|l| (SINGULAR_RCOND * l.norm()).powi(2)),
-            entries,
-        })
-    }
-
     /// Adds the block's entries at the chunk's first `n` frequencies (`s` per lane) to `out`
     /// (`n` points of `stride` `f64` values), and `v - v` of each value added to `finite`
     /// (interleaved only); false, with `out` partly written, if the block is singular in
@@ -136,42 +154,79 @@ impl BlockForm {
         match self {
             BlockForm::Real(b) => b.add_chunk::<V, PLANAR>(s, n, stride, out, finite),
             BlockForm::Complex(b) => b.add_chunk::<V, PLANAR>(s, n, stride, out, finite),
+            BlockForm::Real8(b) => b.add_chunk::<V, PLANAR>(s, n, stride, out, finite),
+            BlockForm::Complex8(b) => b.add_chunk::<V, PLANAR>(s, n, stride, out, finite),
+        }
+    }
+
+    /// The smallest relative distance `|lambda_k - s| / |lambda_k|` of `s` to a pole, and
+    /// whether it is below the singularity threshold.
+    fn nearest_pole(&self, s: f64) -> (f64, bool) {
+        match self {
+            BlockForm::Real(b) => b.nearest_pole(s),
+            BlockForm::Complex(b) => b.nearest_pole(s),
+            BlockForm::Real8(b) => b.nearest_pole(s),
+            BlockForm::Complex8(b) => b.nearest_pole(s),
+        }
+    }
+
+    /// Sets the entries' `first_*` flags: `first(at)` is true for the first writer of `at`.
+    fn mark_first(&mut self, first: &mut dyn FnMut(usize) -> bool) {
+        match self {
+            BlockForm::Real(b) => b.mark_first(first),
+            BlockForm::Complex(b) => b.mark_first(first),
+            BlockForm::Real8(b) => b.mark_first(first),
+            BlockForm::Complex8(b) => b.mark_first(first),
         }
     }
 
     fn is_singular(&self, s: f64) -> bool {
-        match self {
-            BlockForm::Real(b) => (0..4).any(|k| b.is_singular(k, b.poles[k] - s)),
-            BlockForm::Complex(b) => (0..4).any(|k| b.is_singular(k, b.poles[k] - s)),
-        }
+        self.nearest_pole(s).1
     }
 
     /// The error at a frequency where [`BlockForm::is_singular`] holds.
     #[cold]
     fn singular(&self, s: f64, freq_hz: f64) -> TfError {
-        let rcond = match self {
-            BlockForm::Real(b) => b
-                .poles
-                .iter()
-                .map(|&l| (l - s).abs() / l)
-                .fold(f64::INFINITY, f64::min),
-            BlockForm::Complex(b) => b
-                .poles
-                .iter()
-                .map(|&l| (l - s).norm() / l.norm())
-                .fold(f64::INFINITY, f64::min),
-        };
-        TfError::Singular { freq_hz, rcond }
+        TfError::Singular {
+            freq_hz,
+            rcond: self.nearest_pole(s).0,
+        }
     }
+}
+
+/// `prod_k d_k` as a balanced tree, `(d_0 d_1)(d_2 d_3)` for `N = 4` (and so on for a power
+/// of two): one fixed order of the same IEEE operations in every lane.
+#[inline(always)]
+fn product<T: Copy, const N: usize>(d: [T; N], mul: impl Fn(T, T) -> T) -> T {
+    let mut acc = d;
+    let mut n = N;
+    while n > 1 {
+        for i in 0..n / 2 {
+            acc[i] = mul(acc[2 * i], acc[2 * i + 1]);
+        }
+        n /= 2;
+    }
+    acc[0]
 }
 
 // The kernels below use plain loops, no iterator adaptors with closures around the lane
 // operations: those could be compiled outside the AVX entry point and lose its instructions.
 
-impl RealBlock {
-    /// `|lambda_k - s| < SINGULAR_RCOND lambda_k`, with `d = lambda_k - s`.
-    fn is_singular(&self, k: usize, d: f64) -> bool {
-        d.abs() < self.thresholds[k]
+impl<const N: usize> RealBlock<N> {
+    fn nearest_pole(&self, s: f64) -> (f64, bool) {
+        let rcond = self
+            .poles
+            .iter()
+            .map(|&l| (l - s).abs() / l)
+            .fold(f64::INFINITY, f64::min);
+        let singular = (0..N).any(|k| (self.poles[k] - s).abs() < self.thresholds[k]);
+        (rcond, singular)
+    }
+
+    fn mark_first(&mut self, first: &mut dyn FnMut(usize) -> bool) {
+        for e in &mut self.entries {
+            e.first_re = first(e.re);
+        }
     }
 
     #[inline(always)]
@@ -183,27 +238,36 @@ impl RealBlock {
         out: &mut [f64],
         finite: &mut V,
     ) -> bool {
-        let p = self.poles;
-        let d = [
-            V::splat(p[0]).sub(s),
-            V::splat(p[1]).sub(s),
-            V::splat(p[2]).sub(s),
-            V::splat(p[3]).sub(s),
-        ];
+        let mut d = [s; N];
         let mut singular = false;
-        for (dk, &t) in d.iter().zip(&self.thresholds) {
+        for ((dk, &p), &t) in d.iter_mut().zip(&self.poles).zip(&self.thresholds) {
+            *dk = V::splat(p).sub(s);
             singular |= dk.abs().any_lt(V::splat(t));
         }
         if singular {
             return false;
         }
-        let inv = V::splat(1.0).div(d[0].mul(d[1]).mul(d[2].mul(d[3])));
+        #[inline(always)]
+        fn mul<V: Lanes>(a: V, b: V) -> V {
+            a.mul(b)
+        }
+        let inv = V::splat(1.0).div(product(d, mul::<V>));
+        let s2 = s.mul(s);
         for e in &self.entries {
             // 1 - s / z: relative error ~ 1.5 eps |z| / |z - s| (the rounding of 1 / z and of
             // the product), as z - s with z rounded to f64.
             let mut h = V::splat(e.gain);
+            for _ in 0..e.power {
+                h = h.mul(s);
+            }
             for k in 0..e.factors {
                 h = h.mul(V::splat(e.a[k]).add(V::splat(e.b[k]).mul(s)));
+            }
+            for k in 0..e.pairs {
+                let q = V::splat(1.0)
+                    .add(V::splat(e.c1[k]).mul(s))
+                    .add(V::splat(e.c2[k]).mul(s2));
+                h = h.mul(q);
             }
             put::<V, PLANAR>(out, e.re, stride, n, e.first_re, h.mul(inv), finite);
         }
@@ -269,10 +333,22 @@ fn cmul<V: Lanes>((ar, ai): (V, V), (br, bi): (V, V)) -> (V, V) {
     (ar.mul(br).sub(ai.mul(bi)), ar.mul(bi).add(ai.mul(br)))
 }
 
-impl ComplexBlock {
-    /// `|lambda_k - s|^2 < (SINGULAR_RCOND |lambda_k|)^2`, with `d = lambda_k - s`.
-    fn is_singular(&self, k: usize, d: Complex64) -> bool {
-        d.norm_sqr() < self.thresholds[k]
+impl<const N: usize> ComplexBlock<N> {
+    fn nearest_pole(&self, s: f64) -> (f64, bool) {
+        let rcond = self
+            .poles
+            .iter()
+            .map(|&l| (l - s).norm() / l.norm())
+            .fold(f64::INFINITY, f64::min);
+        let singular = (0..N).any(|k| (self.poles[k] - s).norm_sqr() < self.thresholds[k]);
+        (rcond, singular)
+    }
+
+    fn mark_first(&mut self, first: &mut dyn FnMut(usize) -> bool) {
+        for e in &mut self.entries {
+            e.first_re = first(e.re);
+            e.first_im = first(e.im);
+        }
     }
 
     #[inline(always)]
@@ -284,22 +360,18 @@ impl ComplexBlock {
         out: &mut [f64],
         finite: &mut V,
     ) -> bool {
-        let p = self.poles;
-        let d = [
-            (V::splat(p[0].re).sub(s), V::splat(p[0].im)),
-            (V::splat(p[1].re).sub(s), V::splat(p[1].im)),
-            (V::splat(p[2].re).sub(s), V::splat(p[2].im)),
-            (V::splat(p[3].re).sub(s), V::splat(p[3].im)),
-        ];
+        let mut d = [(s, s); N];
         let mut singular = false;
-        for (&(re, im), &t) in d.iter().zip(&self.thresholds) {
+        for ((dk, p), &t) in d.iter_mut().zip(&self.poles).zip(&self.thresholds) {
+            let (re, im) = (V::splat(p.re).sub(s), V::splat(p.im));
+            *dk = (re, im);
             singular |= re.mul(re).add(im.mul(im)).any_lt(V::splat(t));
         }
         if singular {
             return false;
         }
         // 1 / den = conj(den) / |den|^2; the conjugation is folded into the last product.
-        let (re, im) = cmul(cmul(d[0], d[1]), cmul(d[2], d[3]));
+        let (re, im) = product(d, cmul::<V>);
         let t = re.mul(re).add(im.mul(im));
         let (inv_re, inv_im_neg) = (re.div(t), im.div(t));
         for e in &self.entries {
@@ -343,19 +415,7 @@ impl Kernel {
             written[at] == 1
         };
         for b in &mut blocks {
-            match b {
-                BlockForm::Real(b) => {
-                    for e in &mut b.entries {
-                        e.first_re = first(e.re);
-                    }
-                }
-                BlockForm::Complex(b) => {
-                    for e in &mut b.entries {
-                        e.first_re = first(e.re);
-                        e.first_im = first(e.im);
-                    }
-                }
-            }
+            b.mark_first(&mut first);
         }
         let summed = (0..stride).filter(|&at| written[at] > 1).collect();
         Kernel {
@@ -664,7 +724,7 @@ mod tests {
     /// short last chunk, as is a contribution that overflows alone.
     #[test]
     fn sums_of_blocks_that_overflow_are_refused() {
-        use super::{BlockForm, Kernel, RealEntry};
+        use super::{BlockForm, Kernel, RealBlock, RealEntry};
         use crate::error::TfError;
         use crate::tf::Destination;
         // 1 / prod(1 - s): each block adds `gain` at 0 Hz, `gain / 14^4` at s = 15.
@@ -676,8 +736,12 @@ mod tests {
                 gain,
                 a: [1.0; 4],
                 b: [0.0; 4],
+                power: 0,
+                pairs: 0,
+                c1: [0.0; 4],
+                c2: [0.0; 4],
             };
-            BlockForm::real([1.0; 4], vec![entry])
+            BlockForm::Real(RealBlock::new([1.0; 4], vec![entry]))
         };
         let two = |gain: f64| Kernel::new(vec![block(gain), block(gain)], 1);
         let f_15 = 15f64.sqrt() / std::f64::consts::TAU;
@@ -705,7 +769,7 @@ mod tests {
     }
 
     /// AVX and portable lanes on the same grid, bit for bit: undamped and damped (real and
-    /// complex blocks), the dense and the compact kernel, interleaved and planar, a grid small
+    /// complex blocks, decoupled 4x4 and coupled 8x8), the dense and the compact kernel, interleaved and planar, a grid small
     /// enough for ordinary stores and one large enough for the non-temporal ones (and the
     /// same with ordinary stores into a fresh buffer), with a short last chunk.
     /// Skipped on a CPU without AVX.
@@ -719,7 +783,11 @@ mod tests {
         for key in ["torsion_a_rad", "bouncing_b_rad"] {
             damped = damped.with_override(&format!("loss.{key}=1e-3")).unwrap();
         }
-        for params in [Params::table_i(), damped] {
+        // The coupled 8x8 system of a pendulum as built (real, with conjugate zero pairs;
+        // and damped, complex).
+        let coupled = |p: &Params| p.with_override("asymmetry.tm_com_x_m=1e-3").unwrap();
+        let (built, built_damped) = (coupled(&Params::table_i()), coupled(&damped));
+        for params in [Params::table_i(), damped, built, built_damped] {
             let pz = PoleZero::new(&Model::new(&params).unwrap(), Request::all_tilt());
             for kernel in [&pz.kernel, &pz.compact] {
                 let stride = kernel.stride;

@@ -1,0 +1,128 @@
+//! `tiltnoise visibility`: mode visibilities measured from a recorded free motion
+//! ([`tiltnoise_core::fit::peaks`]), written as the CSV that `fit --visibility` reads.
+
+use super::Run;
+use anyhow::{bail, Result};
+use clap::Args;
+use std::path::{Path, PathBuf};
+use tiltnoise_core::fit::peaks::{self, RecordVisibilities, MIN_SNR};
+use tiltnoise_core::model::Model;
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::params::Params;
+use tiltnoise_io::input::{read_measured_input, MeasuredInput};
+use tiltnoise_io::write_atomic;
+
+/// Arguments of `tiltnoise visibility`.
+#[derive(Debug, Args)]
+pub(crate) struct VisibilityArgs {
+    /// A free-motion or ring-down record of the observables: HDF5 or CSV time series as
+    /// `budget --measured` reads them (the layout `simulate --save` writes).
+    #[arg(long, value_name = "FILE")]
+    record: PathBuf,
+    /// Output CSV `mode,observable,reference,ratio,sigma` for `fit --visibility`.
+    #[arg(long, value_name = "PATH")]
+    save: Option<PathBuf>,
+}
+
+/// Runs `tiltnoise visibility`.
+pub(crate) fn run_visibility(params: &Params, args: VisibilityArgs, run: &mut Run) -> Result<()> {
+    if let Some(path) = &args.save {
+        if path.extension().and_then(|e| e.to_str()) != Some("csv") {
+            bail!(
+                "--save {}: the visibility file is CSV; give a path ending in .csv",
+                path.display()
+            );
+        }
+    }
+    let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
+    run.check_outputs(&saves, &[("--record", args.record.as_path())])?;
+    let series = match read_measured_input(&args.record)? {
+        MeasuredInput::Series(s) => s,
+        MeasuredInput::Spectra(_) => bail!(
+            "--record {}: holds spectra; the visibilities need the time series (header time_s, \
+             or HDF5)",
+            args.record.display()
+        ),
+    };
+    let model = Model::new(params)?;
+    let modes = NormalModes::new(&model);
+    let expected: [f64; 8] = std::array::from_fn(|k| {
+        modes
+            .modes
+            .iter()
+            .find(|m| m.index == k + 1)
+            .map_or(f64::NAN, |m| m.frequency_hz)
+    });
+    let origin = args.record.display().to_string();
+    let measured = peaks::measure(
+        &series.channels,
+        series.sample_rate_hz,
+        &expected,
+        &origin,
+        &run.cancel,
+    )?;
+    let names: Vec<&str> = series.channels.iter().map(|(o, _)| o.name()).collect();
+    write!(run.out, "{}", table(&measured, &names))?;
+    let Some(path) = &args.save else {
+        return Ok(());
+    };
+    let comment = [
+        format!("mode visibilities measured from {origin} by tiltnoise visibility"),
+        format!(
+            "Hann-windowed peaks of each mode near the model's frequency; reference: the \
+             strongest channel of each unit with SNR >= {MIN_SNR}; sigma: first-order error from \
+             the local noise"
+        ),
+    ];
+    let text = measured.visibilities.to_csv(&comment);
+    run.write_outputs(false, || {
+        write_atomic(path, |tmp| {
+            std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
+        })?;
+        Ok(())
+    })
+}
+
+fn table(m: &RecordVisibilities, channels: &[&str]) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{:<5} {:>13} {:>13}  peak SNR in {}",
+        "mode",
+        "expected Hz",
+        "peak Hz",
+        channels.join(", ")
+    );
+    for p in &m.peaks {
+        let snr: Vec<String> = p.snr.iter().map(|x| format!("{x:.3e}")).collect();
+        let _ = writeln!(
+            s,
+            "nu_{:<2} {:>13.6e} {:>13.6e}  {}",
+            p.mode,
+            p.expected_hz,
+            p.frequency_hz,
+            snr.join(" ")
+        );
+    }
+    for (k, why) in &m.skipped {
+        let _ = writeln!(s, "nu_{k:<2} skipped: {why}");
+    }
+    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
+        "{:<5} {:<13} {:>13} {:>11}",
+        "mode", "ratio", "value", "sigma"
+    );
+    for v in &m.visibilities.items {
+        let _ = writeln!(
+            s,
+            "nu_{:<2} {:<13} {:>13.5e} {:>11.2e}",
+            v.mode,
+            format!("{}/{}", v.observable.name(), v.reference.name()),
+            v.ratio,
+            v.sigma
+        );
+    }
+    s
+}
