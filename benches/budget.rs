@@ -9,7 +9,8 @@
 //!   setup of window and FFT plan, the 12-hour point by the per-segment work);
 //! * `tf`: `tf::plan` + `tf::evaluate` with `Method::Direct`, outputs X, phi, phi_a from the
 //!   three tilt inputs, on the Welch grid without DC (throughput in frequencies);
-//! * `tilt_budget`: `noise::tilt_budget` on that grid (throughput in frequencies);
+//! * `tilt_budget`: `noise::ground_budget` of the three tilt inputs on that grid (throughput in
+//!   frequencies);
 //! * `budget_from_series`: the whole library job on a `TiltSeries` in memory (Welch -> TF ->
 //!   budget), once for the whole record and once split into two half-hour segments (per-segment
 //!   Welch accumulators, tilt PSD and percentile band).
@@ -25,7 +26,7 @@ use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughpu
 use tiltnoise_core::budget::{budget_from_series, BudgetOptions};
 use tiltnoise_core::input::{InputFormat, InputKind, Provenance, Quantity, TiltSeries};
 use tiltnoise_core::model::{Model, Observable, TiltAxis};
-use tiltnoise_core::noise::{tilt_budget, Readout, TiltCsd};
+use tiltnoise_core::noise::{ground_budget, GroundCsd, Readout};
 use tiltnoise_core::params::Params;
 use tiltnoise_core::spectral::{csd_matrix, CrossSpectra, WelchConfig};
 use tiltnoise_core::tf::{self, Input, Method, Request, TransferMatrix};
@@ -68,6 +69,8 @@ fn series(data: Vec<Vec<f64>>) -> TiltSeries {
         sample_rate_hz: FS_HZ,
         axes: TiltAxis::ALL.to_vec(),
         data,
+        translations: Vec::new(),
+        sensors: Default::default(),
         provenance: Provenance {
             path: PathBuf::from("bench:memory"),
             format: InputFormat::Hdf5,
@@ -108,7 +111,7 @@ fn stages(c: &mut Criterion) {
     let grid = spectra.freqs_hz[1..].to_vec();
     let n = spectra.n_channels;
     let tf = transfer(&model, &grid);
-    let axes = TiltAxis::ALL;
+    let inputs = Input::all_tilts();
 
     let mut g = c.benchmark_group("welch");
     g.sample_size(10).warm_up_time(Duration::from_millis(500));
@@ -144,10 +147,10 @@ fn stages(c: &mut Criterion) {
     let readout = Readout::default();
     g.bench_function("3obs_3axes_8192f", |b| {
         b.iter(|| {
-            tilt_budget(
+            ground_budget(
                 black_box(&tf),
-                &TiltCsd {
-                    axes: &axes,
+                &GroundCsd {
+                    inputs: &inputs,
                     csd: black_box(&spectra.data[n * n..]),
                 },
                 &readout,

@@ -16,11 +16,13 @@ use tiltnoise_core::budget::option_checks::{self, InputKind};
 use tiltnoise_core::budget::{budget_from_series, budget_from_spectra, BudgetError, BudgetOptions};
 use tiltnoise_core::error::Num;
 use tiltnoise_core::freq;
+use tiltnoise_core::ground::GroundQuantity;
 use tiltnoise_core::input::{
-    parse_scales, process_channel, ChannelCtx, GapPolicy, InputError, InputMeta, Quantity,
-    SeriesSource,
+    check_sensors, ground_index, ground_inputs, motion_of, parse_scales, parse_units,
+    process_channel, unstated_excess, ChannelCtx, DetrendedRms, GapPolicy, GroundChannel,
+    InputError, InputMeta, Motion, Quantity, Sensors, SeriesSource,
 };
-use tiltnoise_core::model::{Model, Observable, TiltAxis};
+use tiltnoise_core::model::{Input, Model, Observable};
 use tiltnoise_core::noise::equivalent::referred_terms;
 use tiltnoise_core::noise::{BudgetReport, Readout, SpectralSource};
 use tiltnoise_core::options::{self, Spelling};
@@ -31,12 +33,11 @@ use tiltnoise_io::input::{
 };
 use tiltnoise_io::RunMeta;
 
-/// A tilt time series handed over as arrays: angle (rad) or rate (rad/s) per axis in canonical
-/// order.
+/// A record of the floor's motion handed over as arrays: one channel per input, in canonical
+/// order, each in the SI unit of its quantity.
 struct ArraySeries {
     sample_rate_hz: f64,
-    quantity: Quantity,
-    axes: Vec<TiltAxis>,
+    channels: Vec<GroundChannel>,
     data: Vec<Vec<f64>>,
 }
 
@@ -45,16 +46,12 @@ impl SeriesSource for ArraySeries {
         self.sample_rate_hz
     }
 
-    fn quantity(&self) -> Quantity {
-        self.quantity
-    }
-
     fn len(&self) -> usize {
         self.data.first().map_or(0, Vec::len)
     }
 
-    fn axes(&self) -> &[TiltAxis] {
-        &self.axes
+    fn channels(&self) -> Vec<GroundChannel> {
+        self.channels.clone()
     }
 
     fn read_chunk(&mut self, start: usize, len: usize) -> Result<Vec<Vec<f64>>, InputError> {
@@ -164,15 +161,16 @@ impl SeriesOptions {
     }
 }
 
-/// The tilt axis of a name, or a `ValueError` naming what is allowed.
-fn tilt_axis(name: &str) -> PyResult<TiltAxis> {
-    TiltAxis::ALL
+/// The input of the floor of a name, or a `ValueError` naming what is allowed.
+fn ground_input(name: &str) -> PyResult<Input> {
+    ground_inputs()
         .into_iter()
         .find(|a| a.name() == name)
         .ok_or_else(|| {
             value_error(format!(
-                "tilt axis {name:?} is not allowed: must be theta_t, eta_t or phi_t (rad, the \
-                 rotation taking the floor frame to the inertial frame)"
+                "input {name:?} is not allowed: must be a tilt axis theta_t, eta_t or phi_t (the \
+                 rotation taking the floor frame to the inertial frame) or a floor translation \
+                 x_t, y_t or z_t"
             ))
         })
 }
@@ -218,12 +216,12 @@ fn array_error(e: InputError) -> PyErr {
     }
 }
 
-/// `(axis, samples)` from a dict `{axis: array}` or a 2-D array with `axes`, each axis once,
-/// the size of all of them checked before any is copied (views are read in place).
+/// `(input, samples)` from a dict `{input: array}` or a 2-D array with `axes`, each input
+/// once, the size of all of them checked before any is copied (views are read in place).
 fn tilt_channels(
     tilt: &Bound<'_, PyAny>,
     axes: Option<&Bound<'_, PyAny>>,
-) -> PyResult<Vec<(TiltAxis, Vec<f64>)>> {
+) -> PyResult<Vec<(Input, Vec<f64>)>> {
     if let Ok(d) = tilt.cast::<PyDict>() {
         if axes.is_some() {
             return Err(value_error(
@@ -233,10 +231,10 @@ fn tilt_channels(
         }
         let mut given = Vec::new();
         for (k, v) in d.iter() {
-            let name: String = k
-                .extract()
-                .map_err(|_| value_error("tilt: the keys must be tilt axis names (str)"))?;
-            let axis = tilt_axis(&name)?;
+            let name: String = k.extract().map_err(|_| {
+                value_error("tilt: the keys must be input names (str), theta_t .. z_t")
+            })?;
+            let axis = ground_input(&name)?;
             let array = v.cast::<PyUntypedArray>().ok().map(|a| a.len());
             given.push((axis, name, v, array));
         }
@@ -263,9 +261,9 @@ fn tilt_channels(
     };
     let axes = names
         .iter()
-        .map(|n| tilt_axis(n))
+        .map(|n| ground_input(n))
         .collect::<PyResult<Vec<_>>>()?;
-    refuse_repeats("axes", "tilt axis", &axes, |a| a.name().to_string())
+    refuse_repeats("axes", "input", &axes, |a| a.name().to_string())
         .map_err(|e| value_error(e.to_string()))?;
     let rows = arrays::rows("tilt", tilt, SERIES)?;
     if rows.len() != axes.len() {
@@ -278,14 +276,194 @@ fn tilt_channels(
     Ok(axes.into_iter().zip(rows).collect())
 }
 
-/// Noise budget of X, phi and phi_a from a tilt time series given as arrays.
+/// What the arrays of `budget` are: a channel per input, the factor of its unit's prefix,
+/// whether its unit is given, the tilt quantity and the provenance note on the units.
+struct Described {
+    channels: Vec<GroundChannel>,
+    /// `(factor into SI, unit given)` per channel.
+    factors: Vec<(f64, bool)>,
+    quantity: Quantity,
+    units_note: String,
+}
+
+/// Describes the arrays `channels` (canonical order) from `quantity` (tilt without a unit),
+/// `units` (`{input: unit}`), and the inputs declared `corrected` or read by a
+/// `pendulum_tiltmeter`, as the readers do for files.
+fn describe_arrays(
+    channels: &[(Input, Vec<f64>)],
+    quantity: &str,
+    units: std::collections::BTreeMap<String, String>,
+    corrected: Vec<String>,
+    pendulum: Vec<String>,
+) -> PyResult<Described> {
+    let quantity: Quantity = quantity.parse().map_err(value_error)?;
+    let items: Vec<String> = units.iter().map(|(k, u)| format!("{k}={u}")).collect();
+    let units = parse_units("units", &items).map_err(value_error)?;
+    let inputs: Vec<Input> = channels.iter().map(|(i, _)| *i).collect();
+    for u in &units {
+        if !inputs.iter().any(|i| i.name() == u.channel) {
+            return Err(value_error(format!(
+                "units: {:?} is not an input of tilt; it has {}",
+                u.channel,
+                inputs
+                    .iter()
+                    .map(|i| i.name())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )));
+        }
+    }
+    let mut sensors = Sensors::default();
+    for (option, names, motion) in [
+        ("corrected", &corrected, Motion::Translation),
+        ("pendulum_tiltmeter", &pendulum, Motion::Rotation),
+    ] {
+        refuse_repeats(option, "input", names, |n| n.clone())
+            .map_err(|e| value_error(e.to_string()))?;
+        for name in names {
+            let input = ground_input(name)?;
+            if !inputs.contains(&input) || motion_of(input) != motion {
+                return Err(value_error(format!(
+                    "{option}: {name:?} is not allowed: must be one of the {} inputs of tilt ({})",
+                    motion.name(),
+                    inputs
+                        .iter()
+                        .filter(|i| motion_of(**i) == motion)
+                        .map(|i| i.name())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )));
+            }
+            match input {
+                Input::Tilt(a) => sensors.pendulum.push(a),
+                Input::Translation(t) => sensors.corrected.push(t),
+                Input::Force(_) => unreachable!("ground inputs only"),
+            }
+        }
+    }
+    let mut tilt_quantity: Option<(Quantity, &str)> = None;
+    let mut out = Vec::new();
+    let mut factors = Vec::new();
+    for &input in &inputs {
+        let given = units.iter().find(|u| u.channel == input.name());
+        if let Some(u) = given {
+            if u.unit.motion != motion_of(input) {
+                return Err(value_error(format!(
+                    "units: {} is a {} of the floor, and {:?} is a unit of {}",
+                    input.name(),
+                    motion_of(input).name(),
+                    u.text,
+                    u.unit.motion.name()
+                )));
+            }
+        }
+        let ground_quantity = match (input, given) {
+            (Input::Translation(_), None) => {
+                return Err(value_error(format!(
+                    "units: the translation {0} has no unit; allowed: m, m/s, m/s^2 or a \
+                     prefixed form, e.g. units={{\"{0}\": \"m/s^2\"}}",
+                    input.name()
+                )))
+            }
+            (Input::Translation(_), Some(u)) => u.unit.quantity,
+            (_, given) => {
+                let q = given
+                    .and_then(|u| u.unit.tilt_quantity())
+                    .unwrap_or(quantity);
+                match tilt_quantity {
+                    Some((other, name)) if other != q => {
+                        return Err(value_error(format!(
+                            "units: tilt inputs {name} and {} are in different quantities ({} \
+                             and {}); allowed: one quantity for every tilt input",
+                            input.name(),
+                            other.unit(),
+                            q.unit()
+                        )))
+                    }
+                    _ => tilt_quantity = Some((q, input.name())),
+                }
+                match q {
+                    Quantity::Angle => GroundQuantity::Displacement,
+                    Quantity::Rate => GroundQuantity::Velocity,
+                }
+            }
+        };
+        out.push(GroundChannel {
+            input,
+            quantity: ground_quantity,
+            sensing: sensors.sensing(input),
+        });
+        factors.push((given.map_or(1.0, |u| u.unit.factor), given.is_some()));
+    }
+    check_sensors(&out).map_err(|e| value_error(format!("tilt: {e}")))?;
+    let units_note = format!(
+        "units: {}",
+        out.iter()
+            .zip(&factors)
+            .map(|(c, (_, given))| format!(
+                "{} {}{}",
+                c.input.name(),
+                c.unit(),
+                if *given { "" } else { " (assumed)" }
+            ))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    Ok(Described {
+        channels: out,
+        factors,
+        quantity: tilt_quantity.map_or(quantity, |(q, _)| q),
+        units_note,
+    })
+}
+
+/// Refuses a tilt array whose unit is not given and whose detrended RMS exceeds what a
+/// laboratory floor reaches, naming the likely unit.
+fn check_unstated_array(name: &str, quantity: Quantity, data: &[f64], fs: f64) -> PyResult<()> {
+    let Some(excess) = unstated_excess(DetrendedRms::of(data), quantity, fs) else {
+        return Ok(());
+    };
+    let first = excess
+        .likely
+        .first()
+        .cloned()
+        .unwrap_or_else(|| "nrad".to_string());
+    Err(value_error(format!(
+        "tilt[{name:?}] has no unit and is read in {}, but its detrended RMS is {} {}, above \
+         the {} {} no laboratory floor reaches; its values are likely in {}: give its unit, \
+         e.g. units={{\"{name}\": \"{first}\"}}",
+        quantity.unit(),
+        Num(excess.rms),
+        quantity.unit(),
+        Num(excess.bound),
+        quantity.unit(),
+        if excess.likely.is_empty() {
+            "a smaller unit".to_string()
+        } else {
+            excess.likely.join(" or ")
+        }
+    )))
+}
+
+/// Noise budget of X, phi and phi_a from a time series of the floor's motion given as arrays.
 ///
-/// ``tilt``: a dict ``{"theta_t": x, "eta_t": y}`` of 1-D arrays, or a 2-D array whose rows
-/// are the axes named by ``axes``. The axes are the crate's tilt angles ``theta_t``,
-/// ``eta_t``, ``phi_t`` (rad; the rotation taking the floor frame to the inertial frame, so
-/// a floor rotation ``E`` about East gives ``theta_t = -E``); ``quantity="rate"`` for rad/s,
-/// whose cross-spectra are divided by ``(2 pi f)**2`` (exact up to Nyquist, DC excluded), as
-/// for the files. ``fs``: sample rate (Hz). ``gaps``: ``"reject"``
+/// ``tilt``: a dict ``{"theta_t": x, "eta_t": y, "x_t": a}`` of 1-D arrays, or a 2-D array
+/// whose rows are the inputs named by ``axes``. The inputs are the crate's tilt angles
+/// ``theta_t``, ``eta_t``, ``phi_t`` (the rotation taking the floor frame to the inertial
+/// frame, so a floor rotation ``E`` about East gives ``theta_t = -E``) and the floor's
+/// translations ``x_t``, ``y_t``, ``z_t`` along the lab axes. ``units``: a dict ``{input:
+/// unit}``: ``rad``, ``urad``, ``rad/s``, ... for tilt, ``m``, ``m/s``, ``m/s^2`` or a
+/// prefixed form for translations, which need one; tilt inputs without one are in
+/// ``quantity`` (``"angle"``, rad, or ``"rate"``, rad/s), all tilt inputs in one quantity. A
+/// rate's, a velocity's or an acceleration's cross-spectra become the displacement's bin by bin
+/// (exact up to Nyquist, DC excluded), as for the files. With tilt and translation the budget
+/// has ``ground`` (both with their cross-spectra, what adds to the total), ``tilt`` and
+/// ``translation``. Translations are inertial sensors (a seismometer reads ``a_x + g eta_t``),
+/// corrected with the tilt of their axis unless listed in ``corrected``; tilt inputs listed in
+/// ``pendulum_tiltmeter`` read ``eta_t + a_x / g`` and are corrected with the translation.
+/// A tilt input whose unit is not given is refused when its detrended RMS exceeds 1e-2 rad (an
+/// angle; ``pi fs`` times that for a rate), which no laboratory floor reaches: its values are
+/// then likely in urad or nrad. ``fs``: sample rate (Hz). ``gaps``: ``"reject"``
 /// (default) or ``"interpolate"`` non-finite samples.
 ///
 /// The other options are the command line's ``budget`` options: ``nperseg`` (Welch segment,
@@ -298,7 +476,7 @@ fn tilt_channels(
 ///
 /// Returns a :class:`Budget`. Raises ``ValueError`` for options or data that do not fit.
 #[pyfunction]
-#[pyo3(signature = (tilt, fs, *, axes=None, quantity="angle", gaps="reject", params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, readout=None, measured=None))]
+#[pyo3(signature = (tilt, fs, *, axes=None, quantity="angle", units=None, corrected=None, pendulum_tiltmeter=None, gaps="reject", params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, readout=None, measured=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn budget(
     py: Python<'_>,
@@ -306,6 +484,9 @@ pub fn budget(
     fs: f64,
     axes: Option<&Bound<'_, PyAny>>,
     quantity: &str,
+    units: Option<std::collections::BTreeMap<String, String>>,
+    corrected: Option<Vec<String>>,
+    pendulum_tiltmeter: Option<Vec<String>>,
     gaps: &str,
     params: Option<&Bound<'_, PyAny>>,
     nperseg: Option<usize>,
@@ -317,16 +498,22 @@ pub fn budget(
     measured: Option<PathBuf>,
 ) -> PyResult<Budget> {
     let (model, params) = model_of(params)?;
-    let quantity: Quantity = quantity.parse().map_err(value_error)?;
     let gaps: GapPolicy = gaps.parse().map_err(value_error)?;
     check_fs(fs)?;
     let mut channels = tilt_channels(tilt, axes)?;
-    channels.sort_by_key(|(a, _)| a.index());
+    channels.sort_by_key(|(a, _)| ground_index(*a));
     if channels.is_empty() {
         return Err(value_error(
-            "tilt: no axis given; give at least one of theta_t, eta_t, phi_t",
+            "tilt: no input given; give at least one of theta_t, eta_t, phi_t, x_t, y_t, z_t",
         ));
     }
+    let described = describe_arrays(
+        &channels,
+        quantity,
+        units.unwrap_or_default(),
+        corrected.unwrap_or_default(),
+        pendulum_tiltmeter.unwrap_or_default(),
+    )?;
     for w in channels.windows(2) {
         if w[0].1.len() != w[1].1.len() {
             return Err(value_error(format!(
@@ -352,21 +539,30 @@ pub fn budget(
     .apply(&mut opts)?;
     let mut notes = Vec::new();
     let report = py.detach(|| -> PyResult<BudgetReport> {
-        for (axis, data) in channels.iter_mut() {
+        for (((input, data), channel), &(factor, stated)) in channels
+            .iter_mut()
+            .zip(&described.channels)
+            .zip(&described.factors)
+        {
+            if factor != 1.0 {
+                data.iter_mut().for_each(|v| *v *= factor);
+            }
             let ctx = ChannelCtx {
                 path: Path::new("tilt"),
-                channel: axis.name(),
-                unit: quantity.unit(),
+                channel: input.name(),
+                unit: channel.unit(),
             };
             let bridged = process_channel(data, gaps, &ctx).map_err(array_error)?;
             if bridged > 0 {
-                notes.push(tiltnoise_core::input::gap_note(axis.name(), bridged));
+                notes.push(tiltnoise_core::input::gap_note(input.name(), bridged));
+            }
+            if !stated {
+                check_unstated_array(input.name(), described.quantity, data, fs)?;
             }
         }
         let mut source = ArraySeries {
             sample_rate_hz: fs,
-            quantity,
-            axes: channels.iter().map(|(a, _)| *a).collect(),
+            channels: described.channels.clone(),
             data: channels.into_iter().map(|(_, d)| d).collect(),
         };
         let mut report = budget_from_series(&model, &mut source, &opts, &mut |_, _| {}).py()?;
@@ -376,11 +572,12 @@ pub fn budget(
         Ok(report)
     })?;
     let axis_map = report
-        .axes
+        .inputs
         .iter()
         .map(|a| format!("{0}={0}", a.name()))
         .collect::<Vec<_>>()
         .join(",");
+    notes.push(described.units_note);
     let inputs = Inputs::of_params(params.file.as_deref()).with("measured", measured.as_deref());
     Ok(Budget::new(
         &model,
@@ -391,7 +588,7 @@ pub fn budget(
             path: "(arrays)".into(),
             format: "numpy".into(),
             kind: "series".into(),
-            quantity: quantity.name().into(),
+            quantity: described.quantity.name().into(),
             axis_map,
             start_time: None,
             notes,
@@ -404,10 +601,15 @@ pub fn budget(
 /// series (angle or rate) or spectra, as described in
 /// ``docs/input_formats.md``; an HDF5 series is streamed from disk in bounded memory.
 ///
-/// ``axes`` is the axis map (``"theta_t=-E,eta_t=-N"``; default from the file, else that),
-/// ``quantity`` ``"angle"``/``"rate"`` (default from the file, else angle), ``gaps``
-/// ``"reject"``/``"interpolate"``, ``scale`` a dict ``{channel: factor}`` (rad or rad/s per
-/// count, required for channels in counts, applied before the axis map); ``freq`` is the model grid of spectra input (``"FLO:N:FHI"``
+/// ``axes`` is the axis map (``"theta_t=-E,eta_t=-N"`` or ``"theta_t=-LJE,x_t=LHE"``; default
+/// from the file, else that for rotation channels and ``x_t=E``, ``y_t=N``, ``z_t=Z`` for
+/// translation channels), ``quantity`` ``"angle"``/``"rate"`` of the tilt channels (default
+/// from the file, else angle), ``units`` a dict ``{channel: unit}`` for files that do not state
+/// them (``"rad/s"``, ``"m/s^2"``, ...; translation channels need one, and a unit the file
+/// states must agree), ``corrected`` the translation channels whose tilt is removed already,
+/// ``pendulum_tiltmeter`` the tilt channels read by a pendulum tiltmeter (see :func:`budget`),
+/// ``gaps`` ``"reject"``/``"interpolate"``, ``scale`` a dict ``{channel: factor}`` (SI units
+/// per count, required for channels in counts, applied before the axis map); ``freq`` is the model grid of spectra input (``"FLO:N:FHI"``
 /// or an array of Hz; default 1e-4..30 Hz plus points around every resonance). The Welch,
 /// segment, readout and measured options are those of :func:`budget`; series options are
 /// refused for spectra and ``freq`` for a series, as on the command line.
@@ -416,13 +618,16 @@ pub fn budget(
 /// (an ``OSError``) if it is not a valid tilt input (the message names the file, the dataset
 /// or column and what is allowed), ``ValueError`` for options that do not fit.
 #[pyfunction]
-#[pyo3(signature = (path, *, axes=None, quantity=None, gaps=None, params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, readout=None, freq=None, measured=None, scale=None))]
+#[pyo3(signature = (path, *, axes=None, quantity=None, units=None, corrected=None, pendulum_tiltmeter=None, gaps=None, params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, readout=None, freq=None, measured=None, scale=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn budget_from_file(
     py: Python<'_>,
     path: PathBuf,
     axes: Option<&str>,
     quantity: Option<&str>,
+    units: Option<std::collections::BTreeMap<String, String>>,
+    corrected: Option<Vec<String>>,
+    pendulum_tiltmeter: Option<Vec<String>>,
     gaps: Option<&str>,
     params: Option<&Bound<'_, PyAny>>,
     nperseg: Option<usize>,
@@ -450,6 +655,17 @@ pub fn budget_from_file(
         quantity: quantity.map(str::parse).transpose().map_err(value_error)?,
         gaps: gaps.unwrap_or("reject").parse().map_err(value_error)?,
         scale,
+        units: parse_units(
+            "units",
+            &units
+                .unwrap_or_default()
+                .iter()
+                .map(|(c, u)| format!("{c}={u}"))
+                .collect::<Vec<_>>(),
+        )
+        .map_err(value_error)?,
+        corrected: names_once("corrected", corrected.unwrap_or_default())?,
+        pendulum: names_once("pendulum_tiltmeter", pendulum_tiltmeter.unwrap_or_default())?,
     };
     let series_opts = SeriesOptions {
         nperseg,
@@ -532,13 +748,21 @@ pub fn budget_from_file(
     ))
 }
 
+/// `names`, each given once, for the option `option`.
+fn names_once(option: &str, names: Vec<String>) -> PyResult<Vec<String>> {
+    refuse_repeats(option, "channel", &names, |n| n.clone())
+        .map_err(|e| value_error(e.to_string()))?;
+    Ok(names)
+}
+
 /// A noise budget: one-sided spectra of each observable's terms on one frequency grid.
 ///
 /// ``freq_hz`` (Hz); ``terms[observable][term]`` and ``total[observable]`` are ASDs in
 /// ``units[observable]`` (``m/sqrt(Hz)`` for X, ``rad/sqrt(Hz)`` for phi and phi_a); the
-/// names are those of the budget files (``tilt``, ``tilt.eta_t``, ``readout``, ``thermal``,
-/// ``thermal.torsion_b``, ``measured``, ``residual``; ``total`` is the sum in power of
-/// ``tilt``, ``thermal`` and ``readout``). :meth:`psd` gives the PSDs; ``equivalent`` the
+/// names are those of the budget files (``tilt``, ``tilt.eta_t``, ``translation``,
+/// ``translation.x_t``, ``ground``, ``readout``, ``thermal``, ``thermal.torsion_b``,
+/// ``measured``, ``residual``; ``total`` is the sum in power of ``ground`` (or ``tilt`` or
+/// ``translation`` when the record has one kind only), ``thermal`` and ``readout``). :meth:`psd` gives the PSDs; ``equivalent`` the
 /// terms referred to the test mass's acceleration (X) or torque (phi, phi_a) for a damped
 /// model; ``segment_bands`` the per-segment percentile band of the ``tilt`` term.
 #[pyclass(module = "tiltnoise", frozen)]
@@ -730,13 +954,15 @@ impl Budget {
         Ok(d)
     }
 
-    /// With ``segment_duration``: ``{observable: {"median", "lower", "upper" (ASDs of the
-    /// tilt term across segments), "lower_pct", "upper_pct", "n_segments"}}``; else empty.
+    /// With ``segment_duration``: ``{observable: {"term" (``tilt``, ``translation`` or
+    /// ``ground``: the floor's term of the total), "median", "lower", "upper" (its ASDs across
+    /// segments), "lower_pct", "upper_pct", "n_segments"}}``; else empty.
     #[getter]
     fn segment_bands<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
         for (o, band) in &self.report.segment_bands {
             let b = PyDict::new(py);
+            b.set_item("term", band.term.name())?;
             b.set_item("median", asd(py, &band.median))?;
             b.set_item("lower", asd(py, &band.lower))?;
             b.set_item("upper", asd(py, &band.upper))?;
@@ -788,7 +1014,18 @@ impl Budget {
     /// The tilt axes that entered the budget.
     #[getter]
     fn axes(&self) -> Vec<&'static str> {
-        self.report.axes.iter().map(|a| a.name()).collect()
+        self.report
+            .inputs
+            .iter()
+            .filter(|i| matches!(i, Input::Tilt(_)))
+            .map(|a| a.name())
+            .collect()
+    }
+
+    /// The inputs of the floor's motion that entered the budget: tilt axes, then translations.
+    #[getter]
+    fn inputs(&self) -> Vec<&'static str> {
+        self.report.inputs.iter().map(|a| a.name()).collect()
     }
 
     /// ``{observable: white readout ASD}`` used (unit/sqrt(Hz)).

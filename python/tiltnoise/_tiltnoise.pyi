@@ -211,6 +211,8 @@ class Budget:
     @property
     def axes(self) -> list[str]: ...
     @property
+    def inputs(self) -> list[str]: ...
+    @property
     def readout(self) -> dict[str, float]: ...
     @property
     def notes(self) -> list[str]: ...
@@ -249,6 +251,9 @@ def budget(
     *,
     axes: Optional[_Names] = None,
     quantity: Literal["angle", "rate"] = "angle",
+    units: Optional[Mapping[str, str]] = None,
+    corrected: Optional[Sequence[str]] = None,
+    pendulum_tiltmeter: Optional[Sequence[str]] = None,
     gaps: Literal["reject", "interpolate"] = "reject",
     params: Union[Params, Model, None] = None,
     nperseg: Optional[int] = None,
@@ -264,6 +269,9 @@ def budget_from_file(
     *,
     axes: Optional[str] = None,
     quantity: Optional[Literal["angle", "rate"]] = None,
+    units: Optional[Mapping[str, str]] = None,
+    corrected: Optional[Sequence[str]] = None,
+    pendulum_tiltmeter: Optional[Sequence[str]] = None,
     gaps: Optional[Literal["reject", "interpolate"]] = None,
     params: Union[Params, Model, None] = None,
     nperseg: Optional[int] = None,

@@ -224,6 +224,34 @@ def cases_miniseed(inputs: Path) -> list:
     cases.append(C(cat, "subtract --tilt: one sample 1e308 at index 8000",
                    ["subtract", "--tilt", bad, *axes, "--measured", PAIR_MEASURED],
                    setup=pair_setup(), must_fail=True, huge=True, culprit=culprit))
+    # Rotation and translation channels told by their units (miniSEED states none).
+    g = 9.81
+    six = mseed_file(d / "six.mseed", [("XX.TILT.00.BJN", n, 1.0, "float64"),
+                                       ("XX.TILT.00.BHE", [-g * v for v in n], 1.0, "float64")])
+
+    def units(label, given, **kw):
+        args = ["budget", "--tilt", six]
+        for u in given:
+            args += ["--units", u]
+        cases.append(C(cat, f"budget six.mseed: {label}", args, **kw))
+
+    units("--units BJN=rad, BHE=m/s^2", ["BJN=rad", "BHE=m/s^2"], must_succeed=True)
+    units("--units BHE=furlong/s (no unit of the floor's motion)", ["BJN=rad", "BHE=furlong/s"],
+          must_fail=True, culprit=r"BHE.*furlong|furlong.*BHE")
+    units("--units BHE twice", ["BJN=rad", "BHE=m/s^2", "BHE=m/s"], must_fail=True,
+          culprit=r"BHE.*(twice|repeat|more than once)")
+    units("translation channel BHE without a unit", ["BJN=rad"], must_fail=True,
+          culprit=r"BHE.*unit")
+    units("--units BHE=rad/s (the instrument code says translation)", ["BJN=rad", "BHE=rad/s"],
+          must_fail=True, culprit=r"BHE.*(instrument|translation)")
+    units("--units of a channel the file lacks", ["BJN=rad", "BHE=m/s^2", "LHZ=m/s^2"],
+          must_fail=True, culprit=r"LHZ")
+    nano = mseed_file(d / "nano.mseed", [("XX.TILT.00.BAE", [1e9 * v for v in e], 1.0, "float64"),
+                                         ("XX.TILT.00.BAN", [1e9 * v for v in n], 1.0, "float64")])
+    budget("tilt in nrad without a unit (RMS about 1, read as rad)", nano, must_fail=True,
+           culprit=r"(BAE|BAN).*(urad|nrad)")
+    budget("tilt in nrad with --units", nano, ["--units", "BAE=nrad", "--units", "BAN=nrad"],
+           must_succeed=True)
     cases.append(C(cat, "budget --tilt in.mseed --save in.mseed (same file)",
                    ["budget", "--tilt", "in.mseed", *axes, "--save", "in.mseed"],
                    setup=copy_setup((valid, "in.mseed")), must_fail=True))
@@ -541,6 +569,8 @@ def cases_option_edges(inputs: Path) -> list:
         f"{f!r},1e-9" for f in np.logspace(-5, 1, 40).tolist()]))
     add("budget --term a twice", [*lab, "--term", f"a=X:{asd}", "--term", f"a=phi:{asd}"],
         must_fail=True, culprit=rf"a.*{rep}")
+    add("budget --units eta_t=urad (the file states rad)", [*lab, "--units", "eta_t=urad"],
+        must_fail=True, culprit=r"eta_t.*rad")
     add("budget --observables X,X", [*lab, "--observables", "X,X"], must_fail=True,
         culprit=rf"X.*{rep}")
     add("budget --at 1e-3,1e-3", [*lab, "--at", "1e-3,1e-3"], must_fail=True,

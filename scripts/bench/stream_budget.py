@@ -3,6 +3,14 @@
 
     cargo build --release
     python3 scripts/bench/stream_budget.py [--dir /tmp/tiltnoise-bench] [--runs 3] [--limit-mb 256]
+    python3 scripts/bench/stream_budget.py --ground [--runs 3]
+
+With --ground, the input is ground_30d.h5 (the same tilt plus three translation channels in
+m/s^2, 1.24 GB) and the two commands compared are the hourly budget of its three tilt inputs
+(`--axes theta_t=theta_t,eta_t=eta_t,phi_t=phi_t`) and of all six (tilt, translation and ground
+terms from the 6x6 cross-spectra); the script reports the ratio of their median wall times and
+exits 1 if the six-input run exceeds --limit-mb or --max-ratio (default 3) times the three-input
+one's time.
 
 Makes tilt_30d.h5 (25 920 000 samples x 3 axes, about 622 MB) with make_inputs.py if missing,
 then runs, as whole processes under GNU time (/usr/bin/time; `apt-get install time`),
@@ -63,6 +71,10 @@ def main():
     ap.add_argument("--rust", default=os.path.join(REPO, "target", "release", "tiltnoise"))
     ap.add_argument("--limit-mb", type=float, default=256.0, help="peak RSS limit, MB = 1e6 bytes")
     ap.add_argument("--no-whole", action="store_true", help="skip the reference run without segments")
+    ap.add_argument("--ground", action="store_true",
+                    help="six inputs (tilt and translation) against three, on ground_30d.h5")
+    ap.add_argument("--max-ratio", type=float, default=3.0,
+                    help="with --ground: largest six-input / three-input wall-time ratio")
     args = ap.parse_args()
     gnu_time = shutil.which("time", path="/usr/bin:/bin")
     if gnu_time is None:
@@ -71,17 +83,25 @@ def main():
         sys.exit(f"{args.rust} not found: run `cargo build --release` first")
     args.rust = snapshot(args.rust, args.dir)
 
-    tilt = make_inputs.ensure(args.dir, ("30d",))["30d"]
-    n = make_inputs.FILES["30d"][1]
+    key = "ground_30d" if args.ground else "30d"
+    tilt = make_inputs.ensure(args.dir, (key,))[key]
+    n = make_inputs.FILES[key][1]
+    n_ch = len(make_inputs.channels(key))
     size = os.path.getsize(tilt)
     base = [args.rust, "budget", "--tilt", tilt, "--nperseg", str(args.nperseg)]
-    cmds = {
-        "hourly": base + ["--segment-duration", f"{args.segment_duration:g}",
-                          "--save", os.path.join(args.dir, "budget_30d_hourly.h5")],
-    }
-    if not args.no_whole:
-        cmds["whole"] = base + ["--save", os.path.join(args.dir, "budget_30d_whole.h5")]
-    print(f"input {tilt}: {n} samples x 3 axes at 10 Hz ({n / 864000:.0f} days), {size / 1e6:.1f} MB")
+    hourly = ["--segment-duration", f"{args.segment_duration:g}"]
+    save = lambda name: ["--save", os.path.join(args.dir, f"budget_30d_{name}.h5")]  # noqa: E731
+    if args.ground:
+        tilts = ",".join(f"{a}={a}" for a in make_inputs.AXES)
+        cmds = {"three": base + ["--axes", tilts] + hourly + save("three"),
+                "six": base + hourly + save("six")}
+        limited = "six"
+    else:
+        cmds = {"hourly": base + hourly + save("hourly")}
+        if not args.no_whole:
+            cmds["whole"] = base + save("whole")
+        limited = "hourly"
+    print(f"input {tilt}: {n} samples x {n_ch} channels at 10 Hz ({n / 864000:.0f} days), {size / 1e6:.1f} MB")
     for name, c in cmds.items():
         run(gnu_time, c)  # warm-up: puts the input in the page cache
     res = {k: [] for k in cmds}
@@ -98,19 +118,27 @@ def main():
     print()
     print(f"{'run':<7} {'median s':>9} {'user s':>7} {'sys s':>6} {'peak RSS MB':>12} {'MiB':>6} "
           f"{'Msamples/s':>11} {'Mvalues/s':>10} {'MB/s':>7}")
+    channels_read = {"three": 3, "six": 6}
     for name, rs in res.items():
         wall = statistics.median(r[0] for r in rs)
         rss_kb = max(r[1] for r in rs)
         user = statistics.median(r[2] for r in rs)
         sys_s = statistics.median(r[3] for r in rs)
+        read = channels_read.get(name, n_ch)
         print(f"{name:<7} {wall:9.2f} {user:7.2f} {sys_s:6.2f} {rss_kb * 1024 / 1e6:12.1f} {rss_kb / 1024:6.1f} "
-              f"{n / wall / 1e6:11.2f} {3 * n / wall / 1e6:10.2f} {size / wall / 1e6:7.1f}")
-    print("  (samples = per channel; values = samples x 3 axes; MB = 1e6 bytes of the input file)")
-    print(f"  hourly run: {n_seg} segments x {n_bins} bins; per-segment tilt PSDs kept as f32 for 3 "
-          f"observables: estimate {est:.0f} MB of heap on top of the base")
-    peak_mb = max(r[1] for r in res["hourly"]) * 1024 / 1e6
+              f"{n / wall / 1e6:11.2f} {read * n / wall / 1e6:10.2f} {size / wall / 1e6:7.1f}")
+    print("  (samples = per channel; values = samples x channels read; MB = 1e6 bytes of the input file)")
+    print(f"  hourly run: {n_seg} segments x {n_bins} bins; per-segment PSDs of the term that adds to "
+          f"the total kept as f32 for 3 observables: estimate {est:.0f} MB of heap on top of the base")
+    peak_mb = max(r[1] for r in res[limited]) * 1024 / 1e6
     ok = peak_mb <= args.limit_mb
-    print(f"peak RSS of the hourly run {peak_mb:.1f} MB, limit {args.limit_mb:g} MB: {'met' if ok else 'MISSED'}")
+    print(f"peak RSS of the {limited} run {peak_mb:.1f} MB, limit {args.limit_mb:g} MB: {'met' if ok else 'MISSED'}")
+    if args.ground:
+        ratio = statistics.median(r[0] for r in res["six"]) / statistics.median(r[0] for r in res["three"])
+        ratio_ok = ratio <= args.max_ratio
+        print(f"six-input / three-input median wall time {ratio:.2f}, limit {args.max_ratio:g}: "
+              f"{'met' if ratio_ok else 'MISSED'}")
+        ok = ok and ratio_ok
     sys.exit(0 if ok else 1)
 
 

@@ -2,10 +2,11 @@
 //! choices, and the `--readout OBS=ASD` item.
 
 use anyhow::{anyhow, Result};
-use clap::ValueEnum;
+use clap::{Args, ValueEnum};
 use tiltnoise_core::ground::GroundQuantity;
-use tiltnoise_core::input::parse_scales;
+use tiltnoise_core::input::{parse_scales, parse_units};
 use tiltnoise_core::model::Observable;
+use tiltnoise_core::repeats::{list_entries, refuse_repeats};
 use tiltnoise_core::tf::Method;
 use tiltnoise_io::input::{AxisMap, ReadOptions};
 
@@ -93,14 +94,45 @@ pub fn parse_readout_item(item: &str) -> Result<(Observable, f64)> {
     )?)
 }
 
-/// How to read a tilt file from the `--axes MAP`, `--quantity angle|rate`,
-/// `--gaps reject|interpolate` and `--scale CHANNEL=FACTOR` options (each optional; gaps
-/// default to reject). The one reading of these options for every command that reads tilt.
-pub fn tilt_read_options(
+/// What a record's channels are, for the commands that read translation channels too: their
+/// units, and which sensors are declared other than the default (see docs/input_formats.md).
+#[derive(Debug, Clone, Default, Args)]
+pub struct ChannelArgs {
+    /// Unit of a source channel, CHANNEL=UNIT (repeatable), for files that do not state it
+    /// (miniSEED, CSV without `# units:`): rad, urad, nrad (tilt angle), rad/s (rate), or m,
+    /// m/s, m/s^2 and their prefixed forms (floor translation: displacement, velocity,
+    /// acceleration); translation channels need one. Must agree where the file states a unit.
+    #[arg(long, value_name = "CHANNEL=UNIT")]
+    pub units: Vec<String>,
+    /// Translation channels (seismometers, accelerometers) whose tilt part is removed already
+    /// (repeatable or comma-separated): by default an inertial sensor, which reads
+    /// a_x + g eta_t, is corrected with the record's tilt of its axis.
+    #[arg(long, value_name = "CHANNEL")]
+    pub corrected: Vec<String>,
+    /// Tilt channels read by a pendulum tiltmeter, which senses eta_t + a_x/g (repeatable or
+    /// comma-separated): corrected with the record's translation of its axis, which must then
+    /// be free of tilt (--corrected).
+    #[arg(long, value_name = "CHANNEL")]
+    pub pendulum_tiltmeter: Vec<String>,
+}
+
+/// The channel names of a repeatable, comma-separated option, each once.
+fn channel_names(option: &str, items: &[String]) -> Result<Vec<String>> {
+    let names = list_entries(items);
+    refuse_repeats(option, "channel", &names, |n| n.to_string())?;
+    Ok(names.into_iter().map(str::to_string).collect())
+}
+
+/// How to read a record of the floor's motion from the `--axes MAP`, `--quantity angle|rate`,
+/// `--gaps reject|interpolate` and `--scale CHANNEL=FACTOR` options and the channel options
+/// `--units`, `--corrected`, `--pendulum-tiltmeter` (each optional; gaps default to reject).
+/// The one reading of these options for every command that reads tilt.
+pub fn read_options(
     axes: Option<&str>,
     quantity: Option<&str>,
     gaps: Option<&str>,
     scale: &[String],
+    channels: &ChannelArgs,
 ) -> Result<ReadOptions> {
     Ok(ReadOptions {
         axis_map: axes.map(AxisMap::parse).transpose()?,
@@ -113,5 +145,19 @@ pub fn tilt_read_options(
             .parse()
             .map_err(|e: String| anyhow!("--gaps: {e}"))?,
         scale: parse_scales("--scale", scale).map_err(|e| anyhow!(e))?,
+        units: parse_units("--units", &channels.units).map_err(|e| anyhow!(e))?,
+        corrected: channel_names("--corrected", &channels.corrected)?,
+        pendulum: channel_names("--pendulum-tiltmeter", &channels.pendulum_tiltmeter)?,
     })
+}
+
+/// [`read_options`] without the channel options, for the commands that read tilt channels
+/// only.
+pub fn tilt_read_options(
+    axes: Option<&str>,
+    quantity: Option<&str>,
+    gaps: Option<&str>,
+    scale: &[String],
+) -> Result<ReadOptions> {
+    read_options(axes, quantity, gaps, scale, &ChannelArgs::default())
 }

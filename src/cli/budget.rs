@@ -1,7 +1,7 @@
 //! The `budget` subcommand: validated options -> the budget job -> files and a terminal summary.
 //! Owns the progress bar (only when stderr is a terminal).
 
-use super::args::{AverageArg, Format};
+use super::args::{AverageArg, ChannelArgs, Format};
 use super::budget_terms::{parse_observables, parse_readout, parse_terms};
 use super::figure_args::FigureArgs;
 use super::output::save_budget;
@@ -17,7 +17,7 @@ use tiltnoise_core::budget::{
 };
 use tiltnoise_core::error::{Num, Shown};
 use tiltnoise_core::freq;
-use tiltnoise_core::model::{Input, Model};
+use tiltnoise_core::model::Model;
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::noise::BudgetReport;
 use tiltnoise_core::params::Params;
@@ -29,15 +29,22 @@ use tiltnoise_io::{InputMeta, OutputKind, RunMeta};
 /// Arguments of `tiltnoise budget`.
 #[derive(Debug, Args)]
 pub struct BudgetArgs {
-    /// Tilt input: HDF5 or CSV time series (angle or rate) or spectra; see docs/input_formats.md.
+    /// The floor's motion: HDF5, CSV or miniSEED time series of tilt (angle or rate) and
+    /// translation channels (displacement, velocity or acceleration), or tilt spectra; see
+    /// docs/input_formats.md.
     #[arg(long, value_name = "FILE")]
     pub tilt: PathBuf,
-    /// Axis map, e.g. `theta_t=-E,eta_t=-N` (default: from the file, else theta_t=-E, eta_t=-N).
+    /// Axis map, e.g. `theta_t=-E,eta_t=-N` or `theta_t=-LJE,eta_t=-LJN,x_t=LHE,y_t=LHN`
+    /// (default: from the file, else theta_t=-E, eta_t=-N for rotation channels and x_t=E,
+    /// y_t=N, z_t=Z for translation channels).
     #[arg(long, value_name = "MAP", allow_hyphen_values = true)]
     pub axes: Option<String>,
-    /// Quantity of the channels: angle (rad) or rate (rad/s); default from the file, else angle.
+    /// Quantity of the tilt channels: angle (rad) or rate (rad/s); default from the file, else
+    /// angle.
     #[arg(long, value_name = "angle|rate")]
     pub quantity: Option<String>,
+    #[command(flatten)]
+    pub channels: ChannelArgs,
     /// Non-finite samples of a time series: reject (default) or interpolate linearly across
     /// interior gaps.
     #[arg(long, value_name = "reject|interpolate")]
@@ -173,11 +180,12 @@ fn parse_percentiles(text: &str) -> Result<(f64, f64)> {
 }
 
 fn read_options(args: &BudgetArgs) -> Result<ReadOptions> {
-    super::args::tilt_read_options(
+    super::args::read_options(
         args.axes.as_deref(),
         args.quantity.as_deref(),
         args.gaps.as_deref(),
         &args.scale,
+        &args.channels,
     )
 }
 
@@ -190,6 +198,12 @@ fn refuse_series_options(args: &BudgetArgs, path: &std::path::Path) -> Result<()
         ("--segment-duration", args.segment_duration.is_some()),
         ("--gaps", args.gaps.is_some()),
         ("--scale", !args.scale.is_empty()),
+        ("--units", !args.channels.units.is_empty()),
+        ("--corrected", !args.channels.corrected.is_empty()),
+        (
+            "--pendulum-tiltmeter",
+            !args.channels.pendulum_tiltmeter.is_empty(),
+        ),
     ];
     if let Some((name, _)) = given.iter().find(|(_, g)| *g) {
         bail!(
@@ -309,14 +323,14 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     };
     let mut report = report.with_context(|| format!("budget of {}", path.display()))?;
     for x in &opts.witness_noise {
-        if !report.axes.iter().any(|&a| Input::Tilt(a) == x.input) {
+        if !report.inputs.contains(&x.input) {
             bail!(
-                "--witness-noise {}: the tilt record {} has no axis {}; it has {}",
+                "--witness-noise {}: the record {} has no input {}; it has {}",
                 x.input.name(),
                 path.display(),
                 x.input.name(),
                 report
-                    .axes
+                    .inputs
                     .iter()
                     .map(|a| a.name())
                     .collect::<Vec<_>>()

@@ -52,10 +52,14 @@ fn error_text(t: &TermAt) -> String {
     }
 }
 
-/// The terms printed: every term that adds to the total, each user-named one, and the
-/// measured one.
-fn printed(t: &TermAt) -> bool {
-    t.kind.in_total() || matches!(t.kind, TermKind::Measured | TermKind::UserNamed(_))
+/// The terms printed: every term that adds to the total, the floor's tilt and translation
+/// (beside ground, its breakdown), each user-named one, and the measured one.
+fn printed(ob: &ObservableAt, t: &TermAt) -> bool {
+    ob.adds_to_total(&t.kind)
+        || matches!(
+            t.kind,
+            TermKind::Tilt | TermKind::Translation | TermKind::Measured | TermKind::UserNamed(_)
+        )
 }
 
 /// The table of the summary, then the notes.
@@ -71,16 +75,16 @@ pub fn table(report: &BudgetReport) -> String {
         .iter()
         .any(|ob| ob.term(&TermKind::Thermal).is_some());
     for at in &report.summary {
-        let tilt_band = at
+        let floor_band = at
             .observables
             .iter()
             .flat_map(|ob| &ob.terms)
-            .find_map(|t| match (&t.kind, &t.evaluation) {
-                (TermKind::Tilt, Evaluation::BandMean(b)) => Some(b),
+            .find_map(|t| match &t.evaluation {
+                Evaluation::BandMean(b) if t.kind.is_ground_motion() => Some((&t.kind, b)),
                 _ => None,
             });
-        if let Some(b) = tilt_band {
-            let _ = writeln!(s, "  {}", band_text(at.freq_hz, at.band_hz, b));
+        if let Some((kind, b)) = floor_band {
+            let _ = writeln!(s, "  {}", band_text(kind, at.freq_hz, at.band_hz, b));
         }
         for ob in &at.observables {
             let _ = writeln!(s, "  {}", line(at.freq_hz, ob));
@@ -98,15 +102,19 @@ pub fn table(report: &BudgetReport) -> String {
     s
 }
 
-fn band_text(f: f64, band: (f64, f64), b: &BandMean) -> String {
+fn band_text(kind: &TermKind, f: f64, band: (f64, f64), b: &BandMean) -> String {
     let dof = match b.dof {
         Some(nu) => format!("{nu:.1} degrees of freedom"),
         None => "degrees of freedom unknown (median averaging)".to_string(),
     };
     format!(
-        "at {} mHz: tilt is the mean of {} Welch bin{} in {} .. {} mHz (f +- {:.0} %, bins \
+        "at {} mHz: {} is the mean of {} Welch bin{} in {} .. {} mHz (f +- {:.0} %, bins \
          {} .. {} mHz), {dof}",
         mhz(f),
+        match kind {
+            TermKind::Tilt | TermKind::TiltAxis(_) => "tilt",
+            _ => "the floor's motion",
+        },
         b.n_bins,
         if b.n_bins == 1 { "" } else { "s" },
         mhz(band.0),
@@ -119,7 +127,7 @@ fn band_text(f: f64, band: (f64, f64), b: &BandMean) -> String {
 
 fn line(f: f64, ob: &ObservableAt) -> String {
     let mut s = format!("{:<6} at {:>4} mHz:", ob.observable.name(), mhz(f));
-    for t in ob.terms.iter().filter(|t| printed(t)) {
+    for t in ob.terms.iter().filter(|t| printed(ob, t)) {
         let _ = write!(s, "  {} {:.3e}{}", t.kind, t.psd.sqrt(), error_text(t));
     }
     let total = ob.total_psd();

@@ -108,13 +108,15 @@ pub(crate) struct SimulateArgs {
     /// quarter of the nu_1 period, as the paper's Figures 4 and 5 for --kick-x.
     #[arg(long = "save-time", value_name = "PATH")]
     save_time: Vec<PathBuf>,
-    /// Drive the pendulum with a tilt record instead of free motion (HDF5 or CSV time series
-    /// of angle or rate, as for `budget`): the response is interpolated band-limited and
-    /// propagated exactly, from the quasi-static state; the record's rate and length set the
-    /// output's.
+    /// Drive the pendulum with a record of the floor's motion instead of free motion (HDF5, CSV
+    /// or miniSEED time series of tilt and translation channels, as for `budget`): every
+    /// channel becomes its input's displacement in the frequency domain (inertial sensors
+    /// corrected), the response is interpolated band-limited and propagated exactly, from the
+    /// quasi-static state; the record's rate and length set the output's.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["duration", "step", "init", "init_rate", "kick_x", "mode_energy", "save_time"])]
     tilt: Option<PathBuf>,
-    /// Axis map of the tilt record (with --tilt), e.g. `theta_t=-E,eta_t=-N`.
+    /// Axis map of the record (with --tilt), e.g. `theta_t=-E,eta_t=-N` or
+    /// `eta_t=-LJN,x_t=LHE`.
     #[arg(
         long,
         value_name = "MAP",
@@ -133,6 +135,9 @@ pub(crate) struct SimulateArgs {
     /// channels in counts. Repeat for several channels.
     #[arg(long, value_name = "CHANNEL=FACTOR", requires = "tilt")]
     scale: Vec<String>,
+    /// Units and sensors of the record's channels (with --tilt).
+    #[command(flatten)]
+    channels: super::args::ChannelArgs,
     /// Fine steps per record sample of the driven propagation (with --tilt).
     #[arg(
         long,
@@ -142,11 +147,11 @@ pub(crate) struct SimulateArgs {
         requires = "tilt"
     )]
     oversample: usize,
-    /// The pendulum sees GAIN times the record's tilt, AXIS=GAIN,... (with --tilt; default 1):
-    /// a tiltmeter calibration error.
+    /// The pendulum sees GAIN times the record's channel of an input, INPUT=GAIN,... (with
+    /// --tilt; default 1; e.g. eta_t=0.97, x_t=1.02): a sensor's calibration error.
     #[arg(
         long,
-        value_name = "AXIS=GAIN,...",
+        value_name = "INPUT=GAIN,...",
         allow_hyphen_values = true,
         requires = "tilt"
     )]
@@ -207,6 +212,17 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
     let view = args.figure.view_for(ASD_SIZE)?;
     if let Some(path) = &args.tilt {
         return driven::run(params, &model, &args, path, run);
+    }
+    let c = &args.channels;
+    if let Some(option) = [
+        ("--units", c.units.is_empty()),
+        ("--corrected", c.corrected.is_empty()),
+        ("--pendulum-tiltmeter", c.pendulum_tiltmeter.is_empty()),
+    ]
+    .into_iter()
+    .find_map(|(option, empty)| (!empty).then_some(option))
+    {
+        bail!("{option} describes the channels of a record and applies with --tilt FILE only");
     }
     if !(args.step.is_finite() && args.step > 0.0) {
         bail!(

@@ -11,8 +11,8 @@ use std::path::PathBuf;
 use tiltnoise_core::error::{OutputError, TfError};
 use tiltnoise_core::model::{ForceInput, Model, Observable, TiltAxis};
 use tiltnoise_core::noise::{
-    add_measured, tilt_budget, Budget, BudgetReport, Calibration, NoiseTerm, ObservableBudget,
-    Readout, SegmentBand, SpectralSource, TermKind, TiltCsd,
+    add_measured, ground_budget, Budget, BudgetReport, Calibration, GroundCsd, NoiseTerm,
+    ObservableBudget, Readout, SegmentBand, SpectralSource, TermKind,
 };
 use tiltnoise_core::params::Params;
 use tiltnoise_core::tf::{evaluate, plan, Input, Method, Request, TransferFunction};
@@ -55,6 +55,7 @@ fn synthetic_report() -> BudgetReport {
         ],
     );
     let band = |psd: &[f64]| SegmentBand {
+        term: TermKind::Tilt,
         lower_pct: 10.0,
         upper_pct: 90.0,
         median: psd.iter().map(|p| p * 0.9).collect(),
@@ -80,7 +81,7 @@ fn synthetic_report() -> BudgetReport {
             n_welch_segments: 104,
             n_samples: 864_000,
         },
-        axes: vec![TiltAxis::ThetaT, TiltAxis::EtaT],
+        inputs: vec![Input::Tilt(TiltAxis::ThetaT), Input::Tilt(TiltAxis::EtaT)],
         readout: Readout::default(),
         user_terms: Vec::new(),
         notes: vec!["the last 12 samples do not fill a segment".to_string()],
@@ -575,10 +576,11 @@ fn realistic_report() -> BudgetReport {
         let s = (1e-8 * 1e-3 / f).powi(2);
         csd.extend([s, 0.0, 0.0, s].map(Complex64::from));
     }
-    let budget = tilt_budget(
+    let inputs: Vec<Input> = axes.iter().map(|&a| Input::Tilt(a)).collect();
+    let budget = ground_budget(
         &tf,
-        &TiltCsd {
-            axes: &axes,
+        &GroundCsd {
+            inputs: &inputs,
             csd: &csd,
         },
         &Readout::default(),
@@ -590,6 +592,7 @@ fn realistic_report() -> BudgetReport {
             let tilt = &ob.term(&TermKind::Tilt).unwrap().psd;
             let scaled = |s: f64| tilt.iter().map(|p| p * s).collect();
             let band = SegmentBand {
+                term: TermKind::Tilt,
                 lower_pct: 10.0,
                 upper_pct: 90.0,
                 median: scaled(0.9),
@@ -612,7 +615,7 @@ fn realistic_report() -> BudgetReport {
             n_welch_segments: 16,
             n_samples: 86_400,
         },
-        axes: axes.to_vec(),
+        inputs,
         readout: Readout::default(),
         user_terms: Vec::new(),
         notes: vec![],

@@ -332,6 +332,8 @@ fn rate_series_budget_is_the_library_budget_of_the_rate() {
         sample_rate_hz: 2.0,
         axes: vec![TiltAxis::ThetaT, TiltAxis::EtaT],
         data: vec![minus(&e), minus(&n)],
+        translations: Vec::new(),
+        sensors: Default::default(),
         provenance: Provenance {
             path: path.clone(),
             format: InputFormat::Hdf5,

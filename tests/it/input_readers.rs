@@ -9,7 +9,8 @@ use ndarray::{arr0, Array1, Array2, Array3};
 use num_complex::Complex64;
 use std::f64::consts::TAU;
 use std::path::{Path, PathBuf};
-use tiltnoise_core::model::TiltAxis;
+use tiltnoise_core::ground::GroundQuantity;
+use tiltnoise_core::model::{Input, TiltAxis, TranslationAxis};
 use tiltnoise_io::input::{
     read_tilt, read_tilt_series, read_tilt_spectra, AxisMap, GapPolicy, InputError, InputFormat,
     InputKind, Quantity, ReadOptions, Sign, TiltInput, TiltSeriesSource, TiltSpectra,
@@ -95,7 +96,7 @@ fn opts(map: Option<&str>, quantity: Option<Quantity>, gaps: GapPolicy) -> ReadO
         axis_map: map.map(|m| AxisMap::parse(m).unwrap()),
         quantity,
         gaps,
-        scale: Vec::new(),
+        ..ReadOptions::default()
     }
 }
 
@@ -162,10 +163,10 @@ fn fixture(name: &str) -> PathBuf {
 fn axis_map_parses_and_prints() {
     let m = AxisMap::parse("theta_t=-E,eta_t=-N").unwrap();
     assert_eq!(m.entries().len(), 2);
-    assert_eq!(m.entries()[0].target, TiltAxis::ThetaT);
+    assert_eq!(m.entries()[0].target, Input::Tilt(TiltAxis::ThetaT));
     assert_eq!(m.entries()[0].sign, Sign::Minus);
     assert_eq!(m.entries()[0].source, "E");
-    assert_eq!(m.entries()[1].target, TiltAxis::EtaT);
+    assert_eq!(m.entries()[1].target, Input::Tilt(TiltAxis::EtaT));
     assert_eq!(m.to_string(), "theta_t=-E,eta_t=-N");
     let m: AxisMap = " phi_t = +LJZ ".parse().unwrap();
     assert_eq!(m.entries()[0].sign, Sign::Plus);
@@ -176,7 +177,7 @@ fn axis_map_parses_and_prints() {
 fn axis_map_syntax_errors_name_the_entry() {
     for (spec, entry, what) in [
         ("theta_t=-E,eta_t", "eta_t", "missing `=`"),
-        ("x_t=E", "x_t=E", "unknown target `x_t`"),
+        ("u_t=E", "u_t=E", "unknown target `u_t`"),
         ("theta_t=", "theta_t=", "empty source"),
         ("theta_t=--E", "theta_t=--E", "more than one sign"),
         ("theta_t=E,theta_t=N", "theta_t=N", "assigned twice"),
@@ -204,7 +205,7 @@ fn default_mapping_of_instrument_channels_is_minus_e_minus_n_minus_z() {
     let (e, n, z) = (
         vec![1.0, 2.0, 3.0],
         vec![10.0, 20.0, 30.0],
-        vec![0.5, -0.5, 0.25],
+        vec![5e-3, -5e-3, 2.5e-3],
     );
     write_series_h5(
         &p,
@@ -228,7 +229,7 @@ fn default_mapping_of_instrument_channels_is_minus_e_minus_n_minus_z() {
     );
     assert_eq!(s.data[0], vec![-1.0, -2.0, -3.0]);
     assert_eq!(s.data[1], vec![-10.0, -20.0, -30.0]);
-    assert_eq!(s.data[2], vec![-0.5, 0.5, -0.25]);
+    assert_eq!(s.data[2], vec![-5e-3, 5e-3, -2.5e-3]);
     assert_eq!(s.sample_rate_hz, 4.0);
     assert_eq!(s.len(), 3);
     let pr = &s.provenance;
@@ -309,10 +310,10 @@ fn mapping_errors() {
     err_msg(e, &p, &["`Q`", "theta_t", "E, LJE"]);
 
     let p = dir.path().join("none.csv");
-    write_series_csv(&p, 1.0, &["LHN", "foo"], &[&a, &a], "");
+    write_series_csv(&p, 1.0, &["LXN", "foo"], &[&a, &a], "");
     let e = series_err(&p, &ReadOptions::default());
     assert!(matches!(e, InputError::NoAxes { .. }));
-    err_msg(e, &p, &["LHN, foo", "theta_t=-E"]);
+    err_msg(e, &p, &["LXN, foo", "theta_t=-E"]);
 
     let p = dir.path().join("badmap.h5");
     write_series_h5(
@@ -342,10 +343,10 @@ fn romy_layout_fixture_reads_with_mapping_and_rate() {
     assert_eq!(s.len(), 6);
     assert_eq!(s.sample_rate_hz, 1.0);
     assert_eq!(s.axes, vec![TiltAxis::ThetaT, TiltAxis::EtaT]);
-    // A rate is kept as read, signed by the map: LJE = 1, 3, 1, ... -> theta_t = -LJE;
-    // LJN = 0, 2, 4, ... -> eta_t = -LJN.
-    assert_eq!(s.data[0], vec![-1.0, -3.0, -1.0, -3.0, -1.0, -3.0]);
-    assert_eq!(s.data[1], vec![0.0, -2.0, -4.0, -6.0, -8.0, -10.0]);
+    // A rate is kept as read, signed by the map: LJE = 1, 3, 1, ... nrad/s -> theta_t = -LJE;
+    // LJN = 0, 2, 4, ... nrad/s -> eta_t = -LJN.
+    assert_eq!(s.data[0], [-1e-9, -3e-9, -1e-9, -3e-9, -1e-9, -3e-9]);
+    assert_eq!(s.data[1], [0.0, -2e-9, -4e-9, -6e-9, -8e-9, -1e-8]);
     let pr = &s.provenance;
     assert_eq!(
         (pr.quantity, s.quantity()),
@@ -362,12 +363,42 @@ fn romy_layout_fixture_reads_with_mapping_and_rate() {
     );
     assert!(notes.contains("given explicitly"), "{notes}");
 
-    // Default mapping picks the SEED rotation channels ?JE/?JN/?JZ with minus signs.
-    let s2 = series(&p, &opts(None, Some(Quantity::Rate), GapPolicy::Reject));
+    // The default mapping picks the SEED rotation channels ?JE/?JN/?JZ with minus signs and
+    // the seismometer channels ?HE/?HN/?HZ as translations, which need their unit.
+    let rate = opts(None, Some(Quantity::Rate), GapPolicy::Reject);
+    let e = series_err(&p, &rate);
+    assert!(matches!(e, InputError::ChannelUnit { .. }), "{e}");
+    err_msg(
+        e,
+        &p,
+        &[
+            "channel `LHE`",
+            "feeds x_t",
+            "has no unit",
+            "--units LHE=m/s^2",
+        ],
+    );
+    let units = ["LHE", "LHN", "LHZ"].map(|c| format!("{c}=m/s^2").parse().unwrap());
+    let s2 = series(
+        &p,
+        &ReadOptions {
+            units: units.to_vec(),
+            ..rate
+        },
+    );
     assert_eq!(s2.axes, TiltAxis::ALL.to_vec());
-    assert_eq!(s2.provenance.axis_map, "theta_t=-LJE,eta_t=-LJN,phi_t=-LJZ");
+    assert_eq!(
+        s2.provenance.axis_map,
+        "theta_t=-LJE,eta_t=-LJN,phi_t=-LJZ,x_t=LHE,y_t=LHN,z_t=LHZ"
+    );
     assert_eq!(bits(&s2.data[0]), bits(&s.data[0]));
     assert_eq!(bits(&s2.data[1]), bits(&s.data[1]));
+    let x = &s2.translations[0];
+    assert_eq!(
+        (x.axis, x.quantity),
+        (TranslationAxis::XT, GroundQuantity::Acceleration)
+    );
+    assert_eq!(x.data[..2], [2e-8, -2e-8]);
 }
 
 #[test]
@@ -909,7 +940,7 @@ fn rate_series_are_kept_as_rates_bit_for_bit() {
 // ---------------------------------------------------------------------------------------------
 
 fn chunked(src: &mut TiltSeriesSource, sizes: &[usize]) -> Vec<Vec<f64>> {
-    let mut out = vec![Vec::new(); src.axes().len()];
+    let mut out = vec![Vec::new(); src.channels().len()];
     let (mut pos, mut i) = (0, 0);
     while pos < src.len() {
         let n = sizes[i % sizes.len()].min(src.len() - pos);
@@ -953,7 +984,8 @@ fn chunked_reading_is_bit_identical_to_in_memory() {
             let mut src = TiltSeriesSource::open(&p, &o).unwrap();
             assert_eq!(src.len(), n);
             assert_eq!(src.sample_rate_hz(), 10.0);
-            assert_eq!(src.axes(), &TiltAxis::ALL);
+            let inputs: Vec<Input> = src.channels().iter().map(|c| c.input).collect();
+            assert_eq!(inputs, Input::all_tilts());
             assert_eq!(src.provenance(), &whole.provenance);
             for sizes in [&[n][..], &[1000], &[4097, 1, 65_539, 77], &[262_144]] {
                 let got = chunked(&mut src, sizes);
@@ -991,7 +1023,10 @@ fn chunked_reading_is_bit_identical_to_in_memory() {
         &[],
     );
     write_series_csv(&small_c, 10.0, &["E", "N"], &[&e[..m], &nn[..m]], "");
-    let o = opts(None, Some(Quantity::Rate), GapPolicy::Interpolate);
+    let o = ReadOptions {
+        units: ["E=rad/s", "N=rad/s"].map(|u| u.parse().unwrap()).to_vec(),
+        ..opts(None, Some(Quantity::Rate), GapPolicy::Interpolate)
+    };
     let (a, b) = (series(&small_p, &o), series(&small_c, &o));
     for (x, y) in a.data.iter().zip(&b.data) {
         assert_eq!(bits(x), bits(y));

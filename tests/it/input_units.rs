@@ -50,7 +50,8 @@ fn prefixed_units_scale_csv_columns() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("units `deg`; allowed: rad, mrad, urad, nrad (angle), rad/s, mrad/s, urad/s, nrad/s (rate), or counts"),
+        e.contains("units `deg`; allowed: rad, mrad, urad, nrad (angle); rad/s, mrad/s, urad/s, nrad/s (rate); m, cm")
+            && e.contains("m/s^2, mm/s^2, um/s^2, nm/s^2 (acceleration); or counts"),
         "{e}"
     );
 }

@@ -42,6 +42,7 @@ mod process;
 mod romy_budget;
 mod simulate_cli;
 mod simulate_roundtrip;
+mod six_component;
 mod streaming;
 mod subtract;
 mod thermal;

@@ -119,7 +119,7 @@ fn a_key_or_name_given_twice_is_refused_in_every_command() {
                 "--drive-gain",
                 "eta_t=1,eta_t=2",
             ],
-            "--drive-gain: eta_t is given twice; name each axis once",
+            "--drive-gain: eta_t is given twice; name each input once",
         ),
         (
             [&["subtract"][..], &pair, &["--observables", "X,X"]].concat(),

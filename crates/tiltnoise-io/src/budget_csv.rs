@@ -23,8 +23,9 @@ pub const SCHEMA_VERSION_BUDGET_CSV: u32 = 2;
 /// notes, `# units:`), then one header line, `frequency_hz` followed by `OBS.TERM` for every
 /// observable `OBS` and term `TERM` in the report's order
 /// (`X.tilt,X.tilt.eta_t,X.readout,X.total,phi.tilt,...`), then, if the report has segment
-/// bands, `OBS.tilt.median,OBS.tilt.pLO,OBS.tilt.pHI` per band (`LO`, `HI`: the percentiles,
-/// e.g. `X.tilt.p10`), then, for observables whose budget carries the response to their
+/// bands, `OBS.TERM.median,OBS.TERM.pLO,OBS.TERM.pHI` per band (`TERM` the term of the floor's
+/// motion that adds to the total, `tilt`, `translation` or `ground`; `LO`, `HI`: the
+/// percentiles, e.g. `X.tilt.p10`), then, for observables whose budget carries the response to their
 /// equivalent input (damped models), `OBS.equivalent.TERM` for the terms referred to that
 /// input (`X`: test-mass acceleration, m s^-2/sqrt(Hz); `phi`, `phi_a`: torque, N
 /// m/sqrt(Hz); see [`tiltnoise_core::noise::equivalent`]). Then one line per frequency. Every
@@ -107,10 +108,15 @@ fn asd_columns(report: &BudgetReport) -> Vec<(String, String, Vec<f64>)> {
     for (o, band) in &report.segment_bands {
         let unit = asd_unit(o.unit());
         let o = o.name();
-        columns.push((format!("{o}.tilt.median"), unit.clone(), sqrt(&band.median)));
-        let lower = format!("{o}.tilt.p{}", format_f64(band.lower_pct));
+        let term = band.term.name();
+        columns.push((
+            format!("{o}.{term}.median"),
+            unit.clone(),
+            sqrt(&band.median),
+        ));
+        let lower = format!("{o}.{term}.p{}", format_f64(band.lower_pct));
         columns.push((lower, unit.clone(), sqrt(&band.lower)));
-        let upper = format!("{o}.tilt.p{}", format_f64(band.upper_pct));
+        let upper = format!("{o}.{term}.p{}", format_f64(band.upper_pct));
         columns.push((upper, unit, sqrt(&band.upper)));
     }
     // Last, so that the columns above keep their places: the noise referred to the test

@@ -26,9 +26,10 @@ pub const SPECTRAL_CONVENTION: &str =
 ///
 /// Layout: root attributes (schema, provenance, conventions, how the tilt spectra were
 /// obtained); `/frequency_hz`; one group per observable (`/X`, `/phi`, `/phi_a`) holding one
-/// group per term (`/X/tilt`, `/X/tilt.eta_t`, `/X/readout`, `/X/total`, ...) with datasets
-/// `psd` and `asd`; `/segments` with the percentile band of the `tilt` term when the report
-/// has one; `/summary` with the budget read at chosen frequencies. A damped budget adds `thermal`, `thermal.<element>` term groups and, per observable,
+/// group per term (`/X/tilt`, `/X/tilt.eta_t`, `/X/readout`, `/X/total`, ...; `/X/translation`,
+/// `/X/translation.x_t` and `/X/ground` for a record of the floor's translation) with datasets
+/// `psd` and `asd`; `/segments` with the percentile band of the term of the floor's motion
+/// that adds to the total (`tilt`, `translation` or `ground`) when the report has one; `/summary` with the budget read at chosen frequencies. A damped budget adds `thermal`, `thermal.<element>` term groups and, per observable,
 /// an `equivalent` group with every term referred to the test mass's acceleration (X) or
 /// torque (phi, phi_a). Every item is described in `docs/schemas.md`.
 ///
@@ -47,6 +48,16 @@ pub fn write_budget_hdf5(
         write_file(temp, report, meta, input)
             .map_err(|e| format!("HDF5: {}", crate::first_line(&e.to_string())))
     })
+}
+
+/// The names of the report's floor inputs: its translations, or its tilt axes.
+fn input_names(report: &BudgetReport, translation: bool) -> Vec<&'static str> {
+    report
+        .inputs
+        .iter()
+        .filter(|i| matches!(i, tiltnoise_core::model::Input::Translation(_)) == translation)
+        .map(|i| i.name())
+        .collect()
 }
 
 fn write_file(
@@ -103,8 +114,8 @@ fn write_file(
                 .create("data_band_hz")?;
         }
     }
-    let axes: Vec<&str> = report.axes.iter().map(|a| a.name()).collect();
-    strs_attr(&file, "tilt_axes", &axes)?;
+    strs_attr(&file, "tilt_axes", input_names(report, false))?;
+    strs_attr(&file, "translation_axes", input_names(report, true))?;
     let observables: Vec<&str> = report
         .budget
         .observables
@@ -163,6 +174,8 @@ fn write_file(
         scalar_attr(&segments, "n_segments", int(first.n_segments)?)?;
         scalar_attr(&segments, "lower_pct", first.lower_pct)?;
         scalar_attr(&segments, "upper_pct", first.upper_pct)?;
+        let term = first.term.name();
+        str_attr(&segments, "term", &term)?;
         for (o, band) in &report.segment_bands {
             let unit = o.unit();
             let g = segments.create_group(o.name())?;
@@ -177,8 +190,8 @@ fn write_file(
             ] {
                 write_psd_asd(
                     &g,
-                    &format!("tilt_psd_{suffix}"),
-                    &format!("tilt_asd_{suffix}"),
+                    &format!("{term}_psd_{suffix}"),
+                    &format!("{term}_asd_{suffix}"),
                     psd,
                     unit,
                     grid,

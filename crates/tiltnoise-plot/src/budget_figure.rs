@@ -1,14 +1,16 @@
 //! Noise-budget figure in the style of gravitational-wave noise budgets (pygwinc): one log-log
 //! panel of amplitude spectral densities per observable, one curve per noise term, the total
-//! thick and black, the spread of the tilt noise across segments as a shaded band.
+//! thick and black, the spread of the floor's noise across segments as a shaded band.
 
 use super::chart::{Band, Dash, LegendPlacement, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
-use super::labels::{observable_symbol, observable_title, si_asd, significant, tilt_symbol};
+use super::labels::{
+    observable_symbol, observable_title, si_asd, significant, tilt_symbol, translation_symbol,
+};
 use super::{render, DrawError, ImageFormat, View};
 use plotters::style::RGBColor;
 use std::path::Path;
 use tiltnoise_core::input::InputMeta;
-use tiltnoise_core::model::{Observable, TiltAxis};
+use tiltnoise_core::model::{Input, Observable, TiltAxis, TranslationAxis};
 use tiltnoise_core::noise::equivalent::referred_terms;
 use tiltnoise_core::noise::{
     BudgetReport, Component, Readout, SegmentBand, SpectralSource, TermKind, UserSource,
@@ -45,10 +47,11 @@ impl Default for BudgetFigureOptions {
 
 /// Draws the noise budget of `report` as a PNG or SVG file's bytes: one panel per observable
 /// (in the report's order, e.g. X, φ, φₐ), ASD versus frequency, log-log. Terms: `total` thick
-/// black, `tilt` solid, `tilt.<axis>` (each axis alone) thin dashed, `readout` grey, `user`
-/// solid and each `user.<name>` dashed, `measured` black thin, `residual` dotted, and the
-/// segment band of the tilt ASD (lower to upper percentile, with its median as a thin line)
-/// shaded. Terms that are exactly zero at every frequency are listed in the legend as
+/// black, `tilt` and `translation` solid, `ground` (both with their cross-spectra) thicker,
+/// `tilt.<axis>` and `translation.<axis>` (each axis alone) dashed (left out beside `ground`:
+/// the files keep them), `readout` grey, `user` solid and each `user.<name>` dashed,
+/// `measured` black thin, `residual` dotted, and the segment band of the ASD of the floor's
+/// term of the total (lower to upper percentile, with its median as a thin line) shaded. Terms that are exactly zero at every frequency are listed in the legend as
 /// identically 0 instead of drawn (thermal elements and user terms of the other block of the
 /// model are left out). More than four panels: three columns, legends inside, no per-axis or
 /// per-element curves, a one-paragraph caption.
@@ -86,6 +89,19 @@ fn contributes(psd: &[f64], total: &[f64]) -> Vec<bool> {
 
 /// Colour of the whole tilt term and of its segment band.
 const TILT_COLOR: RGBColor = PALETTE[0];
+/// Colour of the whole translation term.
+const TRANSLATION_COLOR: RGBColor = PALETTE[1];
+/// Colour of the ground term (tilt and translation with their cross-spectra).
+const GROUND_COLOR: RGBColor = PALETTE[2];
+
+/// The colour of a term of the floor's motion that may add to the total (and of its band).
+fn ground_color(kind: &TermKind) -> RGBColor {
+    match kind {
+        TermKind::Ground => GROUND_COLOR,
+        TermKind::Translation => TRANSLATION_COLOR,
+        _ => TILT_COLOR,
+    }
+}
 /// Grey of the readout term.
 const READOUT_COLOR: RGBColor = RGBColor(128, 128, 128);
 /// Black of `total` and `measured`.
@@ -122,6 +138,25 @@ fn term_style(component: &Component, readout: Option<ReadoutLabel>) -> (String, 
     };
     match kind {
         TermKind::Tilt => ("tilt".to_string(), style(TILT_COLOR, Dash::Solid, 2)),
+        TermKind::Translation => (
+            "translation".to_string(),
+            style(TRANSLATION_COLOR, Dash::Solid, 2),
+        ),
+        TermKind::Ground => (
+            "ground (tilt + translation)".to_string(),
+            style(GROUND_COLOR, Dash::Solid, 3),
+        ),
+        TermKind::TranslationAxis(axis) => {
+            let color = match axis {
+                TranslationAxis::XT => PALETTE[4],
+                TranslationAxis::YT => PALETTE[3],
+                TranslationAxis::ZT => PALETTE[5],
+            };
+            (
+                format!("translation, {} alone", translation_symbol(*axis)),
+                style(color, Dash::Dashed, 2),
+            )
+        }
         TermKind::WitnessNoise => (
             "tiltmeter noise in the tilt term (not in the total)".to_string(),
             style(TILT_COLOR, Dash::Dotted, 2),
@@ -186,14 +221,17 @@ fn draw_rank(component: &Component) -> u8 {
         Component::Term(kind) => match kind {
             TermKind::Measured => 1,
             TermKind::Residual => 2,
-            TermKind::Tilt => 3,
-            TermKind::TiltAxis(_) => 4,
-            TermKind::WitnessNoise => 4,
-            TermKind::Readout => 5,
-            TermKind::Thermal => 6,
-            TermKind::ThermalElement(_) => 7,
-            TermKind::User => 8,
-            TermKind::UserNamed(_) => 9,
+            TermKind::Ground => 3,
+            TermKind::Tilt => 4,
+            TermKind::Translation => 5,
+            TermKind::TiltAxis(_) => 6,
+            TermKind::WitnessNoise => 6,
+            TermKind::TranslationAxis(_) => 7,
+            TermKind::Readout => 8,
+            TermKind::Thermal => 9,
+            TermKind::ThermalElement(_) => 10,
+            TermKind::User => 11,
+            TermKind::UserNamed(_) => 12,
         },
     }
 }
@@ -236,12 +274,16 @@ pub fn build_budget_figure(
         let total = ob.total();
         let mut components = ob.components();
         components.sort_by_key(|(c, _)| draw_rank(c));
+        let with_ground = ob.term(&TermKind::Ground).is_some();
         for (component, psd) in components {
-            let breakdown = matches!(
+            let axis = matches!(
                 component,
-                Component::Term(TermKind::TiltAxis(_) | TermKind::ThermalElement(_))
+                Component::Term(TermKind::TiltAxis(_) | TermKind::TranslationAxis(_))
             );
-            if compact && breakdown {
+            let breakdown =
+                axis || matches!(component, Component::Term(TermKind::ThermalElement(_)));
+            // Beside ground, tilt and translation are the breakdown; one axis each is too fine.
+            if (compact && breakdown) || (with_ground && axis) {
                 continue;
             }
             let readout = match (report.readout.of(o), report.readout.given_of(o)) {
@@ -261,7 +303,10 @@ pub fn build_budget_figure(
                 ) {
                     continue;
                 }
-                let short = label.strip_prefix("tilt, ").unwrap_or(&label);
+                let short = label
+                    .strip_prefix("tilt, ")
+                    .or(label.strip_prefix("translation, "))
+                    .unwrap_or(&label);
                 panel.notes.push(format!("{short}: identically 0"));
                 continue;
             }
@@ -271,11 +316,17 @@ pub fn build_budget_figure(
                 .map(|(&f, p)| (f, p.sqrt()))
                 .collect();
             let mut trace = Trace::new(label, points, style);
-            // The tilt term, the tool's main result, is always in range; the others where they
-            // contribute.
+            // The floor's terms, the tool's main result, are always in range; the others where
+            // they contribute.
             let always = matches!(
                 component,
-                Component::Total | Component::Term(TermKind::Measured | TermKind::Tilt)
+                Component::Total
+                    | Component::Term(
+                        TermKind::Measured
+                            | TermKind::Tilt
+                            | TermKind::Translation
+                            | TermKind::Ground
+                    )
             );
             if !always {
                 trace.range_mask = Some(contributes(&psd, &total));
@@ -306,8 +357,9 @@ pub fn build_budget_figure(
             .any(|b| b.term(&kind).is_some())
     };
     let (damped, user) = (has(TermKind::Thermal), has(TermKind::User));
+    let floor = floor_name(report);
     let mut title = if damped || user {
-        let mut groups = vec!["tilt"];
+        let mut groups = vec![floor];
         if damped {
             groups.push("thermal");
         }
@@ -320,7 +372,9 @@ pub fn build_budget_figure(
             groups.join(", ")
         )
     } else {
-        "Tilt noise budget: one-sided amplitude spectral densities".to_string()
+        let mut name = floor.to_string();
+        name[..1].make_ascii_uppercase();
+        format!("{name} noise budget: one-sided amplitude spectral densities")
     };
     if let Some(note) = &options.note {
         title.push_str(&format!(" ({note})"));
@@ -367,7 +421,7 @@ fn equivalent_panel(report: &BudgetReport, options: &BudgetFigureOptions) -> Opt
         .iter()
         .filter(|(c, _)| match c {
             Component::Total => true,
-            Component::Term(kind) => kind.in_total(),
+            Component::Term(kind) => ob.adds_to_total(kind),
         })
         .collect();
     terms.sort_by_key(|(c, _)| draw_rank(c));
@@ -404,10 +458,8 @@ fn equivalent_panel(report: &BudgetReport, options: &BudgetFigureOptions) -> Opt
             .map(|(&f, p)| (f, p.sqrt()))
             .collect();
         let mut trace = Trace::new(label, points, style);
-        if !matches!(
-            component,
-            Component::Total | Component::Term(TermKind::Tilt)
-        ) {
+        let floor = matches!(component, Component::Term(k) if k.is_ground_motion());
+        if !(floor || *component == Component::Total) {
             trace.range_mask = Some(contributes(psd, total));
         }
         panel.traces.push(trace);
@@ -415,25 +467,41 @@ fn equivalent_panel(report: &BudgetReport, options: &BudgetFigureOptions) -> Opt
     Some(panel)
 }
 
-/// The shaded band between the lower and upper percentile of the tilt ASD and the median line.
+/// The shaded band between the lower and upper percentile of the ASD of the band's term
+/// (`tilt`, `translation` or `ground`) and the median line.
 fn segment_band(freqs: &[f64], band: &SegmentBand, duration_s: Option<f64>) -> (Band, Trace) {
     let asd = |v: &[f64]| -> Vec<(f64, f64)> {
         freqs.iter().zip(v).map(|(&f, &p)| (f, p.sqrt())).collect()
     };
     let per = segment_adjective(duration_s);
+    let (term, color) = (band.term.name(), ground_color(&band.term));
     let label = format!(
-        "tilt, {per} {}–{} %",
+        "{term}, {per} {}–{} %",
         compact(band.lower_pct),
         compact(band.upper_pct)
     );
-    let mut shaded = Band::new(label, asd(&band.lower), asd(&band.upper), TILT_COLOR);
+    let mut shaded = Band::new(label, asd(&band.lower), asd(&band.upper), color);
     shaded.opacity = 0.22;
     let median = Trace::new(
-        format!("tilt, {per} median"),
+        format!("{term}, {per} median"),
         asd(&band.median),
-        TraceStyle::new(TILT_COLOR, Dash::Solid, 1),
+        TraceStyle::new(color, Dash::Solid, 1),
     );
     (shaded, median)
+}
+
+/// What the report's floor terms are of: `tilt`, `translation`, or `ground` for both.
+fn floor_name(report: &BudgetReport) -> &'static str {
+    let tilt = report.inputs.iter().any(|i| matches!(i, Input::Tilt(_)));
+    let translation = report
+        .inputs
+        .iter()
+        .any(|i| matches!(i, Input::Translation(_)));
+    match (tilt, translation) {
+        (true, true) => "ground",
+        (false, true) => "translation",
+        _ => "tilt",
+    }
 }
 
 /// `hourly`, `daily`, `per-minute`, or `per 4 h segment`, `per 90 s segment`.
@@ -493,6 +561,26 @@ fn pretty(v: f64) -> String {
 
 /// Caption paragraphs: input, spectral estimate, segments, readout, conventions, notes.
 /// With `many_panels` (more than four) the conventions are said in one short paragraph.
+/// What the caption calls the floor's motion of `report` (`Tilt`, `Translation`, `Floor
+/// motion`), and the symbols of its inputs.
+fn floor_inputs(report: &BudgetReport) -> (String, String) {
+    let symbols: Vec<&str> = report
+        .inputs
+        .iter()
+        .filter_map(|i| match i {
+            Input::Tilt(a) => Some(tilt_symbol(*a)),
+            Input::Translation(t) => Some(translation_symbol(*t)),
+            Input::Force(_) => None,
+        })
+        .collect();
+    let mut name = floor_name(report).to_string();
+    name[..1].make_ascii_uppercase();
+    if name == "Ground" {
+        name = "Floor motion".to_string();
+    }
+    (name, symbols.join(", "))
+}
+
 fn caption(report: &BudgetReport, input: Option<&InputMeta>, many_panels: bool) -> Vec<String> {
     let mut out = Vec::new();
     if let Some(i) = input {
@@ -510,8 +598,7 @@ fn caption(report: &BudgetReport, input: Option<&InputMeta>, many_panels: bool) 
         s.push('.');
         out.push(s);
     }
-    let axes: Vec<&str> = report.axes.iter().map(|&a| tilt_symbol(a)).collect();
-    let axes = axes.join(", ");
+    let (floor, axes) = floor_inputs(report);
     out.push(match &report.source {
         SpectralSource::Welch {
             sample_rate_hz,
@@ -524,14 +611,15 @@ fn caption(report: &BudgetReport, input: Option<&InputMeta>, many_panels: bool) 
             let fs = *sample_rate_hz;
             if many_panels {
                 format!(
-                    "Tilt ({axes}): Welch, {n_welch_segments} segments of {segment_len} samples \
-                     at {} Hz, {averaging}.",
+                    "{floor} ({axes}): Welch, {n_welch_segments} segments of {segment_len} \
+                     samples at {} Hz, {averaging}.",
                     compact(fs)
                 )
             } else {
                 format!(
-                    "Tilt ({axes}): Welch estimate at {} Hz, {} segments of {segment_len} samples \
-                 ({}), overlap {overlap}, {averaging} averaging; {n_samples} samples ({}).",
+                    "{floor} ({axes}): Welch estimate at {} Hz, {} segments of {segment_len} \
+                     samples ({}), overlap {overlap}, {averaging} averaging; {n_samples} samples \
+                     ({}).",
                     compact(fs),
                     n_welch_segments,
                     duration(*segment_len as f64 / fs),
@@ -552,9 +640,10 @@ fn caption(report: &BudgetReport, input: Option<&InputMeta>, many_panels: bool) 
             None => format!("{} segments", band.n_segments),
         };
         out.push(format!(
-            "Band: {}th to {}th percentile of the tilt ASD over {per}; thin line: median.",
+            "Band: {}th to {}th percentile of the {} ASD over {per}; thin line: median.",
             compact(band.lower_pct),
-            compact(band.upper_pct)
+            compact(band.upper_pct),
+            band.term.name()
         ));
     }
     out.push(readout_sentence(&report.readout, report));
@@ -584,27 +673,37 @@ fn caption(report: &BudgetReport, input: Option<&InputMeta>, many_panels: bool) 
         .observables
         .iter()
         .any(|b| b.term(&TermKind::Thermal).is_some());
+    let floor_terms = match floor_name(report) {
+        "ground" => {
+            "ground: tilt and translation with every cross-spectrum between them (tilt and \
+             translation: each alone, not added: they are correlated and act alike at low \
+             frequency)"
+        }
+        "translation" => "translation: all axes with their cross-spectra",
+        _ => "tilt: all axes with their cross-spectra",
+    };
+    let floor = floor_name(report);
     let conventions = match (damped, !report.user_terms.is_empty()) {
-        (_, true) => {
-            "All curves are one-sided ASDs (√PSD). tilt: all axes with their cross-spectra; \
-             “alone”: one axis, for diagnosis; thermal: fluctuation-dissipation theorem, sum over \
-             the dissipative elements (dotted: each element alone); user terms: their sum \
-             (dashed: each alone); total: quadrature sum of tilt, thermal, readout and user terms."
-        }
-        (true, false) => {
-            "All curves are one-sided ASDs (√PSD). tilt: all axes with their cross-spectra; \
-             “alone”: one axis, for diagnosis; thermal: fluctuation-dissipation theorem, sum over \
-             the dissipative elements (dotted: each element alone); total: quadrature sum of \
-             tilt, thermal and readout."
-        }
-        (false, false) => {
-            "All curves are one-sided ASDs (√PSD). tilt: all axes with their cross-spectra; \
-             “alone”: one axis, for diagnosis; total: quadrature sum of tilt and readout."
-        }
+        (_, true) => format!(
+            "All curves are one-sided ASDs (√PSD). {floor_terms}; “alone”: one axis, for \
+             diagnosis; thermal: fluctuation-dissipation theorem, sum over the dissipative \
+             elements (dotted: each element alone); user terms: their sum (dashed: each alone); \
+             total: quadrature sum of {floor}, thermal, readout and user terms."
+        ),
+        (true, false) => format!(
+            "All curves are one-sided ASDs (√PSD). {floor_terms}; “alone”: one axis, for \
+             diagnosis; thermal: fluctuation-dissipation theorem, sum over the dissipative \
+             elements (dotted: each element alone); total: quadrature sum of {floor}, thermal \
+             and readout."
+        ),
+        (false, false) => format!(
+            "All curves are one-sided ASDs (√PSD). {floor_terms}; “alone”: one axis, for \
+             diagnosis; total: quadrature sum of {floor} and readout."
+        ),
     };
     // With many panels the title says what the curves are; the rest is in the files.
     if !many_panels {
-        out.push(conventions.to_string());
+        out.push(conventions);
     }
     out.extend(report.notes.iter().map(|n| {
         let n = n.trim();

@@ -1,7 +1,8 @@
-//! `tiltnoise simulate --tilt FILE`: the undamped model driven by a tilt record
-//! ([`tiltnoise_core::simulate::driven`]), optionally through a miscalibrated, late tiltmeter
-//! (`--drive-gain`, `--drive-delay`): a controlled record of the observables, for example to
-//! test `tiltnoise subtract`, which should find those gains and that delay.
+//! `tiltnoise simulate --tilt FILE`: the undamped model driven by a record of the floor's
+//! motion, tilt and translation channels ([`tiltnoise_core::simulate::driven`]), optionally
+//! through miscalibrated, late sensors (`--drive-gain`, `--drive-delay`): a controlled record
+//! of the observables, for example to test `tiltnoise subtract`, which should find those gains
+//! and that delay.
 
 use super::{parse_readout, readout_text, SimulateArgs};
 use crate::cli::output::save_image;
@@ -9,8 +10,9 @@ use crate::cli::Run;
 use anyhow::{anyhow, bail, Result};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::{Num, Shown};
+use tiltnoise_core::input::GroundMap;
 use tiltnoise_core::limits::GAINS;
-use tiltnoise_core::model::{Input, Model, Observable, TiltAxis};
+use tiltnoise_core::model::{Input, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::repeats::{list_entries, refuse_repeated_keys};
@@ -24,24 +26,28 @@ use tiltnoise_io::input::{read_tilt, TiltInput};
 use tiltnoise_io::{write_observable_series_hdf5, OutputKind, RunMeta, SeriesAsd, SimulationMeta};
 use tiltnoise_plot::simulate_figure::{asd_figure, ModeMark, SimAsdData, ASD_SIZE};
 
-/// `--drive-gain AXIS=GAIN,...` for the axes of the record (others 1).
-fn parse_gains(items: &[String], axes: &[TiltAxis]) -> Result<Vec<f64>> {
-    let mut gains = vec![1.0; axes.len()];
+/// `--drive-gain INPUT=GAIN,...` for the inputs of the record (others 1).
+fn parse_gains(items: &[String], inputs: &[Input]) -> Result<Vec<f64>> {
+    let mut gains = vec![1.0; inputs.len()];
     let entries = list_entries(items);
-    refuse_repeated_keys("--drive-gain", "axis", &entries)?;
+    refuse_repeated_keys("--drive-gain", "input", &entries)?;
     for entry in entries {
         let shown = Shown(entry);
-        let (name, value) = entry
-            .split_once('=')
-            .ok_or_else(|| anyhow!("--drive-gain {shown}: expected AXIS=GAIN, e.g. eta_t=0.97"))?;
-        let i = axes
+        let (name, value) = entry.split_once('=').ok_or_else(|| {
+            anyhow!("--drive-gain {shown}: expected INPUT=GAIN, e.g. eta_t=0.97 or x_t=1.02")
+        })?;
+        let i = inputs
             .iter()
             .position(|a| a.name() == name.trim())
             .ok_or_else(|| {
                 anyhow!(
-                    "--drive-gain {shown}: the tilt record has no axis `{}`; it has {}",
+                    "--drive-gain {shown}: the record has no input `{}`; it has {}",
                     Shown(name.trim()),
-                    axes.iter().map(|a| a.name()).collect::<Vec<_>>().join(", ")
+                    inputs
+                        .iter()
+                        .map(|a| a.name())
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 )
             })?;
         let g: f64 = value
@@ -75,20 +81,26 @@ pub(super) fn run(
     let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
     run.check_outputs(&saves, &[("--tilt", path)])?;
     let view = args.figure.view_for(ASD_SIZE)?;
-    let opts = crate::cli::args::tilt_read_options(
+    let opts = crate::cli::args::read_options(
         args.axes.as_deref(),
         args.quantity.as_deref(),
         args.gaps.as_deref(),
         &args.scale,
+        &args.channels,
     )?;
     let series = match read_tilt(path, &opts)? {
-        TiltInput::Series(s) => s.into_angle(),
+        TiltInput::Series(s) => s,
         TiltInput::Spectra(_) => bail!(
             "--tilt {}: holds spectra; a driven simulation needs a time series",
             path.display()
         ),
     };
-    let gains = parse_gains(&args.drive_gain, &series.axes)?;
+    let map = GroundMap::new(&series.channels(), params.environment.g_m_per_s2)
+        .map_err(|e| anyhow!("--tilt {}: {e}", path.display()))?;
+    let inputs: Vec<Input> = map.inputs();
+    let channel_data: Vec<Vec<f64>> = series.channel_data().iter().map(|c| c.to_vec()).collect();
+    let displacements = map.displacements(&channel_data, series.sample_rate_hz);
+    let gains = parse_gains(&args.drive_gain, &inputs)?;
     let fs = series.sample_rate_hz;
     let m = args.oversample;
     let fine_step = 1.0 / (fs * m as f64);
@@ -103,11 +115,10 @@ pub(super) fn run(
         );
     }
     let readout = parse_readout(&args.readout)?;
-    let inputs: Vec<Input> = series.axes.iter().map(|&a| Input::Tilt(a)).collect();
     let drive = drive_from_record(
         1.0 / fs,
         &inputs,
-        &series.data,
+        &displacements,
         m,
         &gains,
         steps.round() as i64,
@@ -137,24 +148,30 @@ pub(super) fn run(
         psds.push((*o, welch(x, fs, &wcfg)?));
     }
     let modes = NormalModes::new(model);
-    let drive_text = series
-        .axes
+    let drive_text = inputs
         .iter()
         .zip(&gains)
         .map(|(a, g)| format!("{} x {g}", a.name()))
         .collect::<Vec<_>>()
         .join(", ");
     let what = format!(
-        "SIMULATED response of the undamped pendulum model (not a measurement) to the tilt \
-         record {} ({drive_text}, delayed by {} s), interpolated band-limited to {} s steps and \
-         propagated exactly for the interpolated tilt; quasi-static start; readout: {}; seed {}.",
+        "SIMULATED response of the undamped pendulum model (not a measurement) to the record \
+         {} of the floor's motion ({drive_text}, delayed by {} s), interpolated band-limited to \
+         {} s steps and propagated exactly for the interpolated motion; quasi-static start; \
+         readout: {}; seed {}.",
         path.display(),
         Num(delay_s),
         Num(fine_step),
         readout_text(&readout),
         args.seed
     );
-    for note in &series.provenance.notes {
+    for note in series
+        .provenance
+        .notes
+        .iter()
+        .chain(map.notes())
+        .chain(&map.series_note())
+    {
         writeln!(run.out, "input: {note}")?;
     }
     writeln!(

@@ -268,6 +268,7 @@ fn read_miniseed(path: &Path) {
             quantity: Some(Quantity::Rate),
             gaps,
             scale: scale.clone(),
+            ..ReadOptions::default()
         };
         if let Some(s) = shown(read_tilt_series(path, &opts)) {
             check_series(&s);

@@ -1,10 +1,15 @@
-//! The budget job: a tilt input (time series or spectra) -> tilt cross-spectra -> transfer
-//! functions on the same grid -> the noise budget of the chosen observables (tilt, readout,
-//! thermal, user-named terms), whole record and per segment, and read at chosen frequencies.
+//! The budget job: a record of the floor's motion (a time series of tilt and translation
+//! channels, or tilt spectra) -> the cross-spectra of the model's inputs -> transfer functions
+//! on the same grid -> the noise budget of the chosen observables (tilt, translation and
+//! ground, readout, thermal, user-named terms), whole record and per segment, and read at
+//! chosen frequencies.
 //!
 //! Time series are streamed in chunks through Welch accumulators, so a month of 10 Hz data is
 //! processed in bounded memory: one whole-record accumulator, one for the current segment, and
-//! the `tilt` PSD of every finished segment (stored as `f32`, enough for percentile bands).
+//! the PSD of the term that adds to the total (`tilt`, `translation` or `ground`) of every
+//! finished segment (stored as `f32`, enough for percentile bands). The channels' cross-spectra
+//! are carried to the inputs' by [`GroundMap`]: bin by bin, in each channel's own quantity, with
+//! inertial sensors corrected.
 //! Progress is reported through a callback; the library never draws to the terminal.
 //! Conventions: one-sided spectra, PSD in unit^2/Hz (see [`crate::noise`]).
 
@@ -18,17 +23,17 @@ pub use summary::{SummaryRequest, DEFAULT_BAND_FRACTION, DEFAULT_SUMMARY_FREQS_H
 
 use crate::cancel::{Cancel, Cancelled};
 use crate::error::TfError;
-use crate::input::rate::angle_csd_above_dc;
-use crate::input::{InputError, Quantity, SeriesSource, TiltSpectra};
+use crate::ground::GroundQuantity;
+use crate::input::{GroundMap, InputError, SeriesSource, TiltSpectra};
 use crate::limits::{check_memory, planned_bytes, LimitError};
-use crate::model::{Model, Observable, TiltAxis};
+use crate::model::{Input, Model, Observable};
 use crate::noise::{
     add_equivalent_response, add_thermal, add_user_terms, add_witness_noise, check_user_terms,
-    check_witness_noise, tilt_budget, Budget, BudgetReport, Readout, SegmentBand, SpectralSource,
-    TermKind, TiltCsd, UserTerm, UserTermError, WitnessNoise, WitnessNoiseError,
+    check_witness_noise, ground_budget, Budget, BudgetReport, GroundCsd, Readout, SegmentBand,
+    SpectralSource, TermKind, UserTerm, UserTermError, WitnessNoise, WitnessNoiseError,
 };
-use crate::spectral::{Averaging, SpectralError, WelchAccumulator, WelchConfig};
-use crate::tf::{self, Input, Request, TransferMatrix};
+use crate::spectral::{Averaging, CrossSpectra, SpectralError, WelchAccumulator, WelchConfig};
+use crate::tf::{self, Request, TransferMatrix};
 
 /// Samples per channel read from the input at a time: 2^18 samples x 3 channels x 8 bytes
 /// = 6 MiB, large enough to amortize HDF5 calls, small against the 256 MB memory goal.
@@ -125,15 +130,17 @@ pub fn default_segment_len(n_samples: usize) -> usize {
     DEFAULT_WELCH_SEGMENT.min(1 << quarter.ilog2())
 }
 
-fn tilt_tf(
+/// The transfer functions from the floor's `inputs` (per unit displacement: rad, m) to
+/// `outputs` on `grid`, by the planner's method.
+fn ground_tf(
     model: &Model,
     outputs: &[Observable],
-    axes: &[TiltAxis],
+    inputs: &[Input],
     grid: &[f64],
 ) -> Result<TransferMatrix, TfError> {
     let request = Request {
         outputs: outputs.to_vec(),
-        inputs: axes.iter().map(|&a| Input::Tilt(a)).collect(),
+        inputs: inputs.to_vec(),
     };
     let (plan, _) = tf::plan_auto(model, &tf::Scene::over_grid(request, grid))?;
     tf::evaluate(plan.as_ref(), grid)
@@ -156,6 +163,18 @@ pub fn add_damping_terms(model: &Model, budget: &mut Budget) -> Result<(), TfErr
 pub const RATE_BUDGET_NOTE: &str = "tilt rate: the Welch cross-spectra of the rate \
      (rad^2/s^2/Hz) divided by (2 pi f)^2 at every bin f > 0, exact up to Nyquist (no time \
      integration); the DC bin carries no angle information and is excluded";
+
+/// The term of the floor's motion that adds to the total of a budget of `inputs`: `ground` for
+/// tilt and translation together, else `tilt` or `translation`.
+fn total_ground_term(inputs: &[Input]) -> TermKind {
+    let tilt = inputs.iter().any(|i| matches!(i, Input::Tilt(_)));
+    let translation = inputs.iter().any(|i| matches!(i, Input::Translation(_)));
+    match (tilt, translation) {
+        (true, true) => TermKind::Ground,
+        (false, true) => TermKind::Translation,
+        _ => TermKind::Tilt,
+    }
+}
 
 /// The Welch settings of a series of `n` samples: the options' segment (or the default for
 /// `n`) and overlap, checked against the record.
@@ -213,8 +232,9 @@ fn segment_samples(
     })
 }
 
-/// Budget from a time series of tilt angle or rate ([`SeriesSource::quantity`]; a rate's
-/// spectra become the angle's by [`crate::input::rate`], the DC bin is dropped for both).
+/// Budget from a time series of the floor's motion ([`SeriesSource::channels`]: tilt angles or
+/// rates, translations as displacement, velocity or acceleration; their spectra become the
+/// inputs' by [`GroundMap`], with inertial sensors corrected, and the DC bin is dropped).
 /// `progress(done, total)` is called with samples processed.
 pub fn budget_from_series(
     model: &Model,
@@ -225,8 +245,11 @@ pub fn budget_from_series(
     opts.summary.validate()?;
     let fs = series.sample_rate_hz();
     let n = series.len();
-    let axes = series.axes().to_vec();
-    let quantity = series.quantity();
+    let channels = series.channels();
+    let map = GroundMap::new(&channels, model.params().environment.g_m_per_s2)
+        .map_err(BudgetError::Config)?;
+    let inputs = map.inputs();
+    let segment_term = total_ground_term(&inputs);
     let cfg = welch_config(opts, n)?;
     let seg_len = cfg.segment_len;
     // The Welch grid's band, known before the record is read: refuse given spectra that do not
@@ -237,10 +260,18 @@ pub fn budget_from_series(
         (seg_len / 2) as f64 * fs / seg_len as f64,
     )?;
     let segment_samples = segment_samples(opts, fs, n, seg_len)?;
-    let n_ax = axes.len();
+    let n_ax = channels.len();
     check_kept_memory(&cfg, n, n_ax, segment_samples, opts.outputs.len())?;
     let mut whole = WelchAccumulator::new(n_ax, fs, &cfg)?;
+    // One accumulator and one matrix buffer for every segment, emptied and reused: a month of
+    // hourly segments of six channels would otherwise map and clear 5 MB twice an hour.
     let mut current: Option<WelchAccumulator> = None;
+    let mut segment_spectra = CrossSpectra {
+        freqs_hz: Vec::new(),
+        n_channels: n_ax,
+        data: Vec::new(),
+        n_segments: 0,
+    };
     let mut in_segment = 0usize;
     let mut tf_cache: Option<TransferMatrix> = None;
     let mut segment_tilt: Vec<Vec<Vec<f32>>> = vec![Vec::new(); opts.outputs.len()];
@@ -265,25 +296,16 @@ pub fn budget_from_series(
                 in_segment += take;
                 offset += take;
                 if in_segment == seg {
-                    let spectra = current.take().expect("segment in progress").finish()?;
+                    acc.finish_into(&mut segment_spectra)?;
                     in_segment = 0;
-                    let (grid, csd) = angle_csd_above_dc(&spectra, quantity);
                     if tf_cache.is_none() {
-                        tf_cache = Some(tilt_tf(model, &opts.outputs, &axes, &grid)?);
+                        let grid = &segment_spectra.freqs_hz[1..];
+                        tf_cache = Some(ground_tf(model, &opts.outputs, &inputs, grid)?);
                     }
                     let tf = tf_cache.as_ref().expect("computed above");
-                    // Reduce each finished segment to its tilt PSDs at once (bounded memory).
-                    let b = tilt_budget(
-                        tf,
-                        &TiltCsd {
-                            axes: &axes,
-                            csd: &csd,
-                        },
-                        &Readout::none(),
-                    );
-                    for (o, ob) in b.observables.iter().enumerate() {
-                        let psd = &ob.term(&TermKind::Tilt).expect("tilt term").psd;
-                        segment_tilt[o].push(psd.iter().map(|&p| p as f32).collect());
+                    let psds = segment_psds(&map, tf, &mut segment_spectra, &segment_term);
+                    for (kept, psd) in segment_tilt.iter_mut().zip(psds) {
+                        kept.push(psd);
                     }
                 }
             }
@@ -292,24 +314,29 @@ pub fn budget_from_series(
         progress(start as u64, n as u64);
     }
     let spectra = whole.finish()?;
-    let (grid, csd) = angle_csd_above_dc(&spectra, quantity);
+    let (grid, csd) = map.apply(&spectra);
     let tf = match tf_cache {
         Some(tf) => tf,
-        None => tilt_tf(model, &opts.outputs, &axes, &grid)?,
+        None => ground_tf(model, &opts.outputs, &inputs, &grid)?,
     };
-    check_csd_finite(&csd, &axes, quantity)?;
-    let mut budget = tilt_budget(
+    check_csd_finite(&csd, &channels)?;
+    let mut budget = ground_budget(
         &tf,
-        &TiltCsd {
-            axes: &axes,
+        &GroundCsd {
+            inputs: &inputs,
             csd: &csd,
         },
         &opts.readout,
     );
     let mut notes = Vec::new();
-    if quantity == Quantity::Rate {
+    if channels
+        .iter()
+        .any(|c| matches!(c.input, Input::Tilt(_)) && c.quantity == GroundQuantity::Velocity)
+    {
         notes.push(RATE_BUDGET_NOTE.to_string());
     }
+    notes.extend(map.notes().iter().cloned());
+    notes.extend(map.spectra_notes());
     if in_segment > 0 {
         notes.push(format!(
             "the last {in_segment} samples ({:.0} s) do not fill a segment and are left out of \
@@ -317,7 +344,12 @@ pub fn budget_from_series(
             in_segment as f64 / fs
         ));
     }
-    let segment_bands = band_per_observable(&opts.outputs, &segment_tilt, opts.percentiles);
+    let segment_bands = band_per_observable(
+        &segment_term,
+        &opts.outputs,
+        &segment_tilt,
+        opts.percentiles,
+    );
     add_damping_terms(model, &mut budget)?;
     add_user_terms(&mut budget, model, &opts.user_terms)?;
     add_witness_noise(&mut budget, model, &opts.witness_noise)?;
@@ -339,7 +371,7 @@ pub fn budget_from_series(
             n_welch_segments: spectra.n_segments,
             n_samples: n,
         },
-        axes,
+        inputs,
         readout: opts.readout.clone(),
         user_terms: opts.user_terms.clone(),
         notes,
@@ -352,6 +384,35 @@ pub fn budget_from_series(
         n_segments: spectra.n_segments,
     };
     with_summary(model, report, &tilt, opts)
+}
+
+/// The PSDs (f32, enough for percentile bands) of the term `term` of the floor's motion of
+/// every output of `tf`, from the channels' cross-spectra of one segment, which become the
+/// inputs' in place: a finished segment reduced at once, so that memory stays bounded.
+fn segment_psds(
+    map: &GroundMap,
+    tf: &TransferMatrix,
+    spectra: &mut CrossSpectra,
+    term: &TermKind,
+) -> Vec<Vec<f32>> {
+    map.apply_in_place(spectra);
+    let nn = spectra.n_channels * spectra.n_channels;
+    let inputs = map.inputs();
+    let b = ground_budget(
+        tf,
+        &GroundCsd {
+            inputs: &inputs,
+            csd: &spectra.data[nn..],
+        },
+        &Readout::none(),
+    );
+    b.observables
+        .iter()
+        .map(|ob| {
+            let psd = &ob.term(term).expect("the total's ground term").psd;
+            psd.iter().map(|&p| p as f32).collect()
+        })
+        .collect()
 }
 
 /// `report` with its summary ([`summary::summarize`]), and a note for every frequency left out.
@@ -411,6 +472,7 @@ fn check_kept_memory(
 }
 
 fn band_per_observable(
+    term: &TermKind,
     outputs: &[Observable],
     per_segment: &[Vec<Vec<f32>>],
     (lo, hi): (f64, f64),
@@ -419,7 +481,7 @@ fn band_per_observable(
         .iter()
         .zip(per_segment)
         .filter(|(_, segs)| !segs.is_empty())
-        .map(|(&o, segs)| (o, SegmentBand::new(segs, lo, hi)))
+        .map(|(&o, segs)| (o, SegmentBand::new(term.clone(), segs, lo, hi)))
         .collect()
 }
 
@@ -450,11 +512,12 @@ pub fn budget_from_spectra(
         }
     }
     check_given_spectra(opts, grid[0], grid[grid.len() - 1])?;
-    let tf = tilt_tf(model, &opts.outputs, &on_grid.axes, &grid)?;
-    let mut budget: Budget = tilt_budget(
+    let inputs: Vec<Input> = on_grid.axes.iter().map(|&a| Input::Tilt(a)).collect();
+    let tf = ground_tf(model, &opts.outputs, &inputs, &grid)?;
+    let mut budget: Budget = ground_budget(
         &tf,
-        &TiltCsd {
-            axes: &on_grid.axes,
+        &GroundCsd {
+            inputs: &inputs,
             csd: &on_grid.csd,
         },
         &opts.readout,
@@ -470,7 +533,7 @@ pub fn budget_from_spectra(
         source: SpectralSource::Spectra {
             data_band_hz: spectra.band_hz(),
         },
-        axes: on_grid.axes.clone(),
+        inputs,
         readout: opts.readout.clone(),
         user_terms: opts.user_terms.clone(),
         notes,
@@ -479,25 +542,24 @@ pub fn budget_from_spectra(
     with_summary(model, report, &summary::TiltData::Spectra(spectra), opts)
 }
 
-/// Refuses tilt cross-spectra that overflowed `f64` (samples far beyond any tilt angle or rate,
-/// e.g. 1e200 rad, square to infinity), naming the axis.
+/// Refuses cross-spectra of the inputs that overflowed `f64` (samples far beyond any tilt or
+/// floor motion, e.g. 1e200 rad, square to infinity), naming the input.
 fn check_csd_finite(
     csd: &[num_complex::Complex64],
-    axes: &[TiltAxis],
-    quantity: Quantity,
+    channels: &[crate::input::GroundChannel],
 ) -> Result<(), BudgetError> {
-    let n = axes.len();
+    let n = channels.len();
     if let Some(j) = csd
         .iter()
         .position(|z| !(z.re.is_finite() && z.im.is_finite()))
     {
-        let axis = axes[(j % (n * n)) / n];
+        let c = channels[(j % (n * n)) / n];
         return Err(BudgetError::NotFinite(format!(
-            "the tilt power spectrum of {} overflows f64: its samples are far too large to be \
-             tilt {}s in {} (check the file's units and --quantity)",
-            axis.name(),
-            quantity.name(),
-            quantity.unit()
+            "the power spectrum of {} overflows f64: its samples are far too large to be a \
+             {} of the floor in {} (check the file's units)",
+            c.input.name(),
+            c.quantity.name(),
+            c.unit()
         )));
     }
     Ok(())

@@ -8,12 +8,12 @@
 //! the transfer functions, evaluated at `f`). Never an interpolation between bins: across a
 //! resonance that is off by tens of percent.
 
-use super::{tilt_tf, BudgetError};
+use super::{ground_tf, BudgetError};
 use crate::input::TiltSpectra;
 use crate::model::{Model, Observable};
 use crate::noise::{
-    add_thermal, add_user_terms, add_witness_noise, tilt_budget, BandMean, BudgetReport,
-    Evaluation, ObservableAt, SummaryAt, TermAt, TermGroup, TermKind, TiltCsd,
+    add_thermal, add_user_terms, add_witness_noise, ground_budget, BandMean, BudgetReport,
+    Evaluation, GroundCsd, ObservableAt, SummaryAt, TermAt,
 };
 use crate::spectral::{band_dof, WelchConfig};
 use num_complex::Complex64;
@@ -140,7 +140,7 @@ fn tilt_csd_at(
 }
 
 /// Reads `report` at the frequencies of `req` (see the module docs): the budget at each
-/// frequency is made by the code that makes it on the grid, [`tilt_budget`] with the transfer
+/// frequency is made by the code that makes it on the grid, [`ground_budget`] with the transfer
 /// functions at exactly `f` and [`add_thermal`], from the tilt cross-spectra at `f`
 /// ([`tilt_csd_at`]). Returns the summary and one note per frequency left out (not
 /// `req.strict`).
@@ -175,7 +175,7 @@ pub(super) fn summarize(
                 "outside the budget's band ({lo:.4e} .. {hi:.4e} Hz)"
             ))
         } else {
-            tilt_csd_at(tilt, report.axes.len(), f, band)
+            tilt_csd_at(tilt, report.inputs.len(), f, band)
         };
         let (csd, tilt_evaluation) = match csd {
             Ok(c) => c,
@@ -194,11 +194,11 @@ pub(super) fn summarize(
             }
         };
         let at_f = [f];
-        let tf = tilt_tf(model, &outputs, &report.axes, &at_f)?;
-        let mut point = tilt_budget(
+        let tf = ground_tf(model, &outputs, &report.inputs, &at_f)?;
+        let mut point = ground_budget(
             &tf,
-            &TiltCsd {
-                axes: &report.axes,
+            &GroundCsd {
+                inputs: &report.inputs,
                 csd: &csd,
             },
             &report.readout,
@@ -227,9 +227,7 @@ pub(super) fn summarize(
                         kind: t.kind.clone(),
                         psd: t.psd[0],
                         // The witness noise is a given spectrum through the model: exact at f.
-                        evaluation: if t.kind.group() == TermGroup::Tilt
-                            && t.kind != TermKind::WitnessNoise
-                        {
+                        evaluation: if t.kind.is_ground_motion() {
                             tilt_evaluation.clone()
                         } else {
                             Evaluation::Exact

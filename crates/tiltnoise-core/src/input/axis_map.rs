@@ -1,9 +1,12 @@
-//! [`AxisMap`]: which source channel (dataset or column) feeds which tilt axis, and with which
-//! sign; and the default mapping used when no map is given.
+//! [`AxisMap`]: which source channel (dataset or column) feeds which input of the floor's
+//! motion (a tilt axis or a translation axis), and with which sign; and the default mapping used
+//! when no map is given, which tells rotation from translation channels by their unit or their
+//! SEED instrument code.
 
 use super::error::InputError;
+use super::unit::Motion;
 use crate::error::{shown_list, Shown};
-use crate::model::TiltAxis;
+use crate::model::{Input, TiltAxis, TranslationAxis};
 use std::fmt;
 use std::path::Path;
 use std::str::FromStr;
@@ -35,29 +38,53 @@ impl Sign {
     }
 }
 
+/// The inputs an axis map may feed, in canonical order: the tilt axes, then the translations.
+pub fn ground_inputs() -> Vec<Input> {
+    Input::all_ground()
+}
+
+/// Position of a ground input in [`ground_inputs`] (theta_t 0 .. phi_t 2, x_t 3 .. z_t 5); the
+/// order of every record's channels.
+pub fn ground_index(input: Input) -> usize {
+    match input {
+        Input::Tilt(a) => a.index(),
+        Input::Translation(t) => 3 + t.index(),
+        Input::Force(f) => 6 + f.index(),
+    }
+}
+
+/// What a ground input is: a rotation (tilt) or a translation.
+pub fn motion_of(input: Input) -> Motion {
+    match input {
+        Input::Translation(_) => Motion::Translation,
+        _ => Motion::Rotation,
+    }
+}
+
 /// One assignment `target = sign * source`.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct AxisMapEntry {
-    /// The tilt axis fed.
-    pub target: TiltAxis,
+    /// The input fed: a tilt axis or a floor translation.
+    pub target: Input,
     /// The sign.
     pub sign: Sign,
     /// The source channel name (HDF5 dataset or CSV column), case-sensitive.
     pub source: String,
 }
 
-/// A mapping from source channels to tilt axes, e.g. `theta_t=-E,eta_t=-N`.
+/// A mapping from source channels to the floor's inputs, e.g. `theta_t=-E,eta_t=-N` or
+/// `theta_t=-LJE,eta_t=-LJN,x_t=LHE,y_t=LHN`.
 ///
-/// Syntax: comma-separated entries `TARGET=[+|-]SOURCE`; `TARGET` is `theta_t`, `eta_t` or
-/// `phi_t`; `SOURCE` is a channel name (no whitespace, `,` or `=`; it may not start with a
+/// Syntax: comma-separated entries `TARGET=[+|-]SOURCE`; `TARGET` is a tilt axis `theta_t`,
+/// `eta_t`, `phi_t` or a translation `x_t`, `y_t`, `z_t`; `SOURCE` is a channel name (no whitespace, `,` or `=`; it may not start with a
 /// sign). Whitespace around tokens is ignored. Each target and each source may appear at most
 /// once. Only the mapped axes are read; other channels in the file are ignored.
 ///
 /// ```
 /// use tiltnoise_core::input::{AxisMap, Sign};
-/// use tiltnoise_core::model::TiltAxis;
+/// use tiltnoise_core::model::{Input, TiltAxis};
 /// let map: AxisMap = "theta_t=-LJE, eta_t=-LJN".parse().unwrap();
-/// assert_eq!(map.entries()[0].target, TiltAxis::ThetaT);
+/// assert_eq!(map.entries()[0].target, Input::Tilt(TiltAxis::ThetaT));
 /// assert_eq!(map.entries()[0].sign, Sign::Minus);
 /// assert_eq!(map.entries()[0].source, "LJE");
 /// assert_eq!(map.to_string(), "theta_t=-LJE,eta_t=-LJN");
@@ -102,14 +129,14 @@ impl AxisMap {
                 return Err(err(entry, "missing `=`".to_string()));
             };
             let target = target.trim();
-            let target = TiltAxis::ALL
+            let target = ground_inputs()
                 .into_iter()
                 .find(|a| a.name() == target)
                 .ok_or_else(|| {
                     err(
                         entry,
                         format!(
-                            "unknown target `{}`, allowed: theta_t, eta_t, phi_t",
+                            "unknown target `{}`, allowed: theta_t, eta_t, phi_t, x_t, y_t, z_t",
                             Shown(target)
                         ),
                     )
@@ -214,19 +241,38 @@ pub enum MapOrigin<'a> {
     Default,
 }
 
-/// One resolved channel: `axis = sign * available[index]`.
+/// One resolved channel: `input = sign * available[index]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mapped {
-    pub axis: TiltAxis,
+    /// The input fed: a tilt axis or a floor translation.
+    pub input: Input,
     pub sign: Sign,
     pub source: String,
     pub index: usize,
 }
 
+impl Mapped {
+    /// The tilt axis fed, if it is one.
+    pub fn tilt_axis(&self) -> Option<TiltAxis> {
+        match self.input {
+            Input::Tilt(a) => Some(a),
+            _ => None,
+        }
+    }
+
+    /// The translation fed, if it is one.
+    pub fn translation_axis(&self) -> Option<TranslationAxis> {
+        match self.input {
+            Input::Translation(t) => Some(t),
+            _ => None,
+        }
+    }
+}
+
 /// The result of resolving a map against the channels a file has.
 #[derive(Debug, Clone)]
 pub struct Resolved {
-    /// In canonical axis order (theta_t, eta_t, phi_t).
+    /// In canonical order ([`ground_inputs`]: theta_t, eta_t, phi_t, x_t, y_t, z_t).
     pub channels: Vec<Mapped>,
     /// The effective map in canonical syntax.
     pub map: AxisMap,
@@ -234,44 +280,121 @@ pub struct Resolved {
     pub notes: Vec<String>,
 }
 
-/// The default assignment of a channel name: tiltnoise names map to themselves; the
-/// seismological rotation channels `E`, `N`, `Z` (or SEED rotation codes `?JE`, `?JN`, `?JZ`)
-/// map with lab x = East, y = North, z = Up and the minus sign of `t = -(floor rotation)`; a
-/// full SEED code `NET.STA.LOC.CHA` maps as its channel code `CHA` does.
-pub fn default_assignment(name: &str) -> Option<(TiltAxis, Sign)> {
-    if let Some(a) = TiltAxis::ALL.into_iter().find(|a| a.name() == name) {
-        return Some((a, Sign::Plus));
-    }
-    // A full SEED code `NET.STA.LOC.CHA` is judged by its channel code.
-    let parts: Vec<&str> = name.split('.').collect();
-    let name = match parts.as_slice() {
+/// The channel code `CHA` of a full SEED code `NET.STA.LOC.CHA`, else the name itself.
+fn channel_code(name: &str) -> &str {
+    match name.split('.').collect::<Vec<_>>().as_slice() {
         [_, _, _, cha] => cha,
         _ => name,
-    };
-    let orientation = match name.as_bytes() {
-        [o] => *o,
-        [band, b'J', o] if band.is_ascii_uppercase() => *o,
-        _ => return None,
-    };
-    match orientation {
-        b'E' => Some((TiltAxis::ThetaT, Sign::Minus)),
-        b'N' => Some((TiltAxis::EtaT, Sign::Minus)),
-        b'Z' => Some((TiltAxis::PhiT, Sign::Minus)),
+    }
+}
+
+/// What a SEED channel code (`CHA`, or a full code `NET.STA.LOC.CHA`) says its sensor measures,
+/// by its instrument code (the second letter, after an upper-case band code): `J` (rotation
+/// sensor) and `A` (tiltmeter) a rotation; `H`, `L` (high- and low-gain seismometer), `N`
+/// (accelerometer) and `P` (geophone) a translation. `None` for other names.
+pub fn instrument_motion(name: &str) -> Option<Motion> {
+    match channel_code(name).as_bytes() {
+        [band, instrument, _] if band.is_ascii_uppercase() => match instrument {
+            b'J' | b'A' => Some(Motion::Rotation),
+            b'H' | b'L' | b'N' | b'P' => Some(Motion::Translation),
+            _ => None,
+        },
         _ => None,
     }
+}
+
+/// What each channel of `available` (of `path`) measures: the motion of its unit where one is
+/// stated (`units[i]`), else what its SEED instrument code says ([`instrument_motion`]), else
+/// nothing known.
+///
+/// # Errors
+///
+/// [`InputError::ChannelUnit`] for a unit that contradicts the instrument code (`LJE` in m/s^2,
+/// `LHE` in rad/s).
+pub fn channel_motions(
+    path: &Path,
+    available: &[String],
+    units: &[Option<Motion>],
+) -> Result<Vec<Option<Motion>>, InputError> {
+    available
+        .iter()
+        .zip(units)
+        .map(|(name, unit)| match (unit, instrument_motion(name)) {
+            (Some(u), Some(code)) if *u != code => Err(InputError::ChannelUnit {
+                path: path.to_path_buf(),
+                channel: name.clone(),
+                message: format!(
+                    "has a unit of {}, but its SEED instrument code `{}` is that of a {} sensor; \
+                     allowed: a unit of {} ({})",
+                    u.name(),
+                    char::from(channel_code(name).as_bytes()[1]),
+                    code.name(),
+                    code.name(),
+                    match code {
+                        Motion::Rotation => "rad or rad/s",
+                        Motion::Translation => "m, m/s or m/s^2",
+                    }
+                ),
+            }),
+            (Some(u), _) => Ok(Some(*u)),
+            (None, code) => Ok(code),
+        })
+        .collect()
+}
+
+/// The default assignment of a channel name, given what its unit (or instrument code) says it
+/// measures (`motion`, `None` when nothing does): tiltnoise names (`theta_t` .. `z_t`) map to
+/// themselves; a channel oriented `E`, `N` or `Z` (the bare letter, or the last letter of a
+/// SEED code) maps with lab x = East, y = North, z = Up: a rotation (the bare letter without a
+/// translation unit, or a SEED rotation-sensor code `?JE`) to `theta_t = -E`, `eta_t = -N`,
+/// `phi_t = -Z` (the minus of `t = -(floor rotation)`), a translation (a unit of length,
+/// velocity or acceleration, or a seismometer or accelerometer code such as `LHE`, `BHN`,
+/// `HNZ`) to `x_t = E`, `y_t = N`, `z_t = Z`. A full SEED code maps as its channel code does.
+pub fn default_assignment(name: &str, motion: Option<Motion>) -> Option<(Input, Sign)> {
+    if let Some(a) = ground_inputs().into_iter().find(|a| a.name() == name) {
+        return Some((a, Sign::Plus));
+    }
+    let code = channel_code(name);
+    let (orientation, motion) = match code.as_bytes() {
+        [o] => (*o, motion.unwrap_or(Motion::Rotation)),
+        [band, b'J', o] if band.is_ascii_uppercase() => (*o, Motion::Rotation),
+        [_, _, o] if instrument_motion(code) == Some(Motion::Translation) => {
+            (*o, Motion::Translation)
+        }
+        _ => return None,
+    };
+    let axis = match orientation {
+        b'E' => 0,
+        b'N' => 1,
+        b'Z' => 2,
+        _ => return None,
+    };
+    Some(match motion {
+        Motion::Rotation => (Input::Tilt(TiltAxis::ALL[axis]), Sign::Minus),
+        Motion::Translation => (Input::Translation(TranslationAxis::ALL[axis]), Sign::Plus),
+    })
 }
 
 /// Text of the default-mapping note in the provenance.
 pub const DEFAULT_MAP_NOTE: &str = "axis map: default (assumption: lab x = East, \
      y = North, z = Up, so theta_t = -E, eta_t = -N, phi_t = -Z for rotation channels E/N/Z or \
-     ?JE/?JN/?JZ; theta_t/eta_t/phi_t channels used as they are); override with an explicit \
-     axis map";
+     ?JE/?JN/?JZ, and x_t = E, y_t = N, z_t = Z for translation channels (a unit of length, \
+     velocity or acceleration, or a seismometer or accelerometer code such as LHE, BHN, HNZ); \
+     theta_t .. z_t channels used as they are); override with an explicit axis map";
 
-/// Resolves `origin` against the channel names `available` of `path`. `kind` is `dataset` or
-/// `column`.
+/// Resolves `origin` against the channel names `available` of `path`, of which `motions` says
+/// what each measures where its unit or instrument code says it ([`channel_motions`]). `kind`
+/// is `dataset` or `column`.
+///
+/// # Errors
+///
+/// As [`AxisMap`] resolution fails: a source the file does not have, several channels for one
+/// input, no channel at all under the default mapping, or an explicit target of the other
+/// motion than its channel's ([`InputError::ChannelMotion`]).
 pub fn resolve(
     path: &Path,
     available: &[String],
+    motions: &[Option<Motion>],
     origin: MapOrigin<'_>,
     kind: &'static str,
 ) -> Result<Resolved, InputError> {
@@ -300,8 +423,20 @@ pub fn resolve(
                         source_name: e.source.clone(),
                         available: shown_list(available),
                     })?;
+                let target = motion_of(e.target);
+                if let Some(motion) = motions.get(index).copied().flatten() {
+                    if motion != target {
+                        return Err(InputError::ChannelMotion {
+                            path: path.to_path_buf(),
+                            kind,
+                            channel: e.source.clone(),
+                            target: e.target,
+                            motion,
+                        });
+                    }
+                }
                 channels.push(Mapped {
-                    axis: e.target,
+                    input: e.target,
                     sign: e.sign,
                     source: e.source.clone(),
                     index,
@@ -310,19 +445,21 @@ pub fn resolve(
         }
         MapOrigin::Default => {
             notes.push(DEFAULT_MAP_NOTE.to_string());
-            for axis in TiltAxis::ALL {
+            for input in ground_inputs() {
                 let cands: Vec<(usize, Sign)> = available
                     .iter()
                     .enumerate()
-                    .filter_map(|(i, n)| match default_assignment(n) {
-                        Some((a, s)) if a == axis => Some((i, s)),
-                        _ => None,
+                    .filter_map(|(i, n)| {
+                        match default_assignment(n, motions.get(i).copied().flatten()) {
+                            Some((a, s)) if a == input => Some((i, s)),
+                            _ => None,
+                        }
                     })
                     .collect();
                 match cands.as_slice() {
                     [] => {}
                     [(index, sign)] => channels.push(Mapped {
-                        axis,
+                        input,
                         sign: *sign,
                         source: available[*index].clone(),
                         index: *index,
@@ -333,7 +470,7 @@ pub fn resolve(
                         return Err(InputError::AmbiguousAxis {
                             path: path.to_path_buf(),
                             kind,
-                            axis: axis.name(),
+                            axis: input.name(),
                             candidates: shown_list(&names),
                             first: names[0].to_string(),
                         });
@@ -353,7 +490,7 @@ pub fn resolve(
             }
         }
     }
-    channels.sort_by_key(|m| m.axis.index());
+    channels.sort_by_key(|m| ground_index(m.input));
     let ignored: Vec<&str> = available
         .iter()
         .enumerate()
@@ -367,7 +504,7 @@ pub fn resolve(
         channels
             .iter()
             .map(|m| AxisMapEntry {
-                target: m.axis,
+                target: m.input,
                 sign: m.sign,
                 source: m.source.clone(),
             })
@@ -386,30 +523,41 @@ mod tests {
 
     #[test]
     fn default_assignments() {
+        use TiltAxis::*;
+        use TranslationAxis::*;
+        let tilt = |a| Some((Input::Tilt(a), Sign::Minus));
+        let translation = |t| Some((Input::Translation(t), Sign::Plus));
+        let rotation = Some(Motion::Rotation);
+        let moving = Some(Motion::Translation);
         assert_eq!(
-            default_assignment("theta_t"),
-            Some((TiltAxis::ThetaT, Sign::Plus))
+            default_assignment("theta_t", None),
+            Some((Input::Tilt(ThetaT), Sign::Plus))
         );
         assert_eq!(
-            default_assignment("E"),
-            Some((TiltAxis::ThetaT, Sign::Minus))
+            default_assignment("y_t", moving),
+            Some((Input::Translation(YT), Sign::Plus))
         );
-        assert_eq!(
-            default_assignment("LJN"),
-            Some((TiltAxis::EtaT, Sign::Minus))
-        );
-        assert_eq!(
-            default_assignment("BJZ"),
-            Some((TiltAxis::PhiT, Sign::Minus))
-        );
-        assert_eq!(
-            default_assignment("BW.ROMY.11.LJE"),
-            Some((TiltAxis::ThetaT, Sign::Minus))
-        );
-        assert_eq!(default_assignment("BW.ROMY.11.LHE"), None);
-        assert_eq!(default_assignment("LHN"), None);
-        assert_eq!(default_assignment("lJN"), None);
-        assert_eq!(default_assignment("X"), None);
+        // Bare letters stay rotations unless their unit says translation.
+        assert_eq!(default_assignment("E", None), tilt(ThetaT));
+        assert_eq!(default_assignment("E", rotation), tilt(ThetaT));
+        assert_eq!(default_assignment("E", moving), translation(XT));
+        assert_eq!(default_assignment("N", moving), translation(YT));
+        assert_eq!(default_assignment("LJN", None), tilt(EtaT));
+        assert_eq!(default_assignment("BJZ", None), tilt(PhiT));
+        assert_eq!(default_assignment("BW.ROMY.11.LJE", None), tilt(ThetaT));
+        // Seismometers, accelerometers and geophones are translations by their code alone.
+        assert_eq!(default_assignment("BW.ROMY.11.LHE", None), translation(XT));
+        assert_eq!(default_assignment("BHN", None), translation(YT));
+        assert_eq!(default_assignment("HNZ", moving), translation(ZT));
+        assert_eq!(default_assignment("EPE", None), translation(XT));
+        // A code that says neither needs its unit, and then only bare letters map.
+        assert_eq!(default_assignment("LXE", moving), None);
+        assert_eq!(default_assignment("LH1", None), None);
+        assert_eq!(default_assignment("lJN", None), None);
+        assert_eq!(default_assignment("X", None), None);
+        assert_eq!(instrument_motion("BW.ROMY.11.LAN"), Some(Motion::Rotation));
+        assert_eq!(instrument_motion("LHZ"), Some(Motion::Translation));
+        assert_eq!(instrument_motion("E"), None);
     }
 
     #[test]
@@ -419,7 +567,8 @@ mod tests {
             "theta_t",
             "theta_t=",
             "theta_t=--E",
-            "x_t=E",
+            "u_t=E",
+            "x_t=E,x_t=N",
             "theta_t=E,theta_t=N",
             "theta_t=E,eta_t=-E",
             "theta_t=E,",
@@ -429,5 +578,10 @@ mod tests {
         }
         let m = AxisMap::parse(" eta_t = +N , theta_t=-E").unwrap();
         assert_eq!(m.to_string(), "eta_t=N,theta_t=-E");
+        let m = AxisMap::parse("theta_t=-LJE,x_t=LHE").unwrap();
+        assert_eq!(
+            m.entries()[1].target,
+            Input::Translation(TranslationAxis::XT)
+        );
     }
 }

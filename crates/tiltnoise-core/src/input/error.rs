@@ -290,8 +290,8 @@ pub enum InputError {
     /// A malformed axis-map specification.
     #[error(
         "{origin}: axis map `{}`, entry `{}`: {message}; syntax: \
-         TARGET=[+|-]SOURCE[,TARGET=[+|-]SOURCE...] with TARGET one of theta_t, eta_t, phi_t, \
-         e.g. theta_t=-E,eta_t=-N",
+         TARGET=[+|-]SOURCE[,TARGET=[+|-]SOURCE...] with TARGET one of theta_t, eta_t, phi_t \
+         (tilt) or x_t, y_t, z_t (translation), e.g. theta_t=-E,eta_t=-N,x_t=LHE",
         Shown(.spec),
         Shown(.entry)
     )]
@@ -325,12 +325,14 @@ pub enum InputError {
         available: String,
     },
 
-    /// No channel could be assigned to a tilt axis.
+    /// No channel could be assigned to an input of the floor's motion.
     #[error(
-        "input file {path}: no tilt channel found among {kind}s {found}; allowed without an \
-         axis map: theta_t, eta_t, phi_t (used as they are) or the rotation channels E, N, Z \
-         (or SEED rotation codes ?JE, ?JN, ?JZ; default mapping theta_t=-E, eta_t=-N, \
-         phi_t=-Z); otherwise give an axis map such as theta_t=-E,eta_t=-N"
+        "input file {path}: no tilt or translation channel found among {kind}s {found}; \
+         allowed without an axis map: theta_t, eta_t, phi_t, x_t, y_t, z_t (used as they are), \
+         the rotation channels E, N, Z (or SEED rotation codes ?JE, ?JN, ?JZ; default mapping \
+         theta_t=-E, eta_t=-N, phi_t=-Z), or translation channels (a unit of length, velocity \
+         or acceleration, or a seismometer code such as LHE; x_t=E, y_t=N, z_t=Z); otherwise \
+         give an axis map such as theta_t=-E,eta_t=-N"
     )]
     NoAxes {
         /// The file.
@@ -358,6 +360,88 @@ pub enum InputError {
         candidates: String,
         /// One of them, for the hint.
         first: String,
+    },
+
+    /// An explicit axis map that feeds a tilt axis from a translation channel, or the other way
+    /// round.
+    #[error(
+        "input file {path}: the axis map assigns {} to {kind} `{}`, which is a {} channel by \
+         its unit or SEED instrument code; allowed: rotation channels for theta_t, eta_t, \
+         phi_t, translation channels for x_t, y_t, z_t",
+        .target.name(),
+        Shown(.channel),
+        .motion.name()
+    )]
+    ChannelMotion {
+        /// The file.
+        path: PathBuf,
+        /// `dataset`, `column` or `channel`.
+        kind: &'static str,
+        /// The source channel.
+        channel: String,
+        /// The input the map assigns it to.
+        target: crate::model::Input,
+        /// What the channel measures.
+        motion: super::unit::Motion,
+    },
+
+    /// A channel's unit that is missing where it is needed, given twice with different values,
+    /// given for a channel the file does not have, or contradicting the channel's instrument
+    /// code.
+    #[error("input file {path}: channel `{}` {message}", Shown(.channel))]
+    ChannelUnit {
+        /// The file.
+        path: PathBuf,
+        /// The source channel.
+        channel: String,
+        /// What is wrong and what is allowed.
+        message: String,
+    },
+
+    /// A series whose unit nobody states (taken as rad or rad/s) with a detrended RMS that no
+    /// laboratory floor reaches ([`super::unstated_rms_bound`]): most likely in a smaller unit.
+    #[error(
+        "input file {path}: channel `{}` states no unit and is read in {}, but its detrended RMS \
+         is {} {}, above the {} {} no laboratory floor reaches; its values are likely in {}: \
+         state the unit in the file (a `# units:` line, a `units` attribute) or with the units \
+         option (--units {}={}, in Python units={{\"{}\": \"{}\"}})",
+        Shown(.channel),
+        .quantity.unit(),
+        Num(*.rms),
+        .quantity.unit(),
+        Num(*.bound),
+        .quantity.unit(),
+        .likely,
+        Shown(.channel),
+        .likely.split(' ').next().unwrap_or(""),
+        Shown(.channel),
+        .likely.split(' ').next().unwrap_or("")
+    )]
+    UnstatedUnit {
+        /// The file.
+        path: PathBuf,
+        /// The source channel.
+        channel: String,
+        /// Its detrended RMS, in the quantity's SI unit.
+        rms: f64,
+        /// Angle or rate.
+        quantity: super::Quantity,
+        /// The bound it exceeds.
+        bound: f64,
+        /// The likely units, e.g. `urad or nrad`.
+        likely: String,
+    },
+
+    /// A sensor declaration (a channel said to be corrected, or read by a pendulum tiltmeter)
+    /// that names no channel of the right kind, or sensors whose readings cannot be told apart.
+    #[error("input file {path}: channel `{}` {message}", Shown(.channel))]
+    Sensor {
+        /// The file.
+        path: PathBuf,
+        /// The source channel.
+        channel: String,
+        /// What is wrong and what is allowed.
+        message: String,
     },
 
     /// A unit string that is not understood.

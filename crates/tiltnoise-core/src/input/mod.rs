@@ -37,10 +37,16 @@
 //! else from the file's metadata (HDF5 attribute `units` on each channel dataset: `rad` or
 //! `rad/s`; CSV: a `# units:` line), else it **defaults to angle** and the provenance says so.
 //! A rate is **kept as a rate** in a time series ([`TiltSeries::quantity`],
-//! [`SeriesSource::quantity`]) and converted to angle where spectra are formed: its one-sided
+//! [`SeriesSource::channels`]) and converted to angle where spectra are formed: its one-sided
 //! CSD divided by `(2 pi f)²` at every `f > 0`, exactly up to Nyquist; the DC bin carries no
 //! angle information and is excluded ([`rate`]). Spectra of a rate are divided by `(2 pi f)²`
 //! as they are read.
+//!
+//! **Translation.** A channel whose unit is one of length, velocity or acceleration ([`Unit`],
+//! [`ChannelUnit`] for files that state none) is the floor's translation `x_t`, `y_t`, `z_t`
+//! ([`TranslationChannel`]); inertial sensors sense tilt too, and [`GroundMap`] carries every
+//! channel's spectra to the inputs' displacements with that corrected ([`motion`]). A tilt
+//! channel whose unit nobody states is bounded ([`unstated_rms_bound`]).
 //!
 //! **Gaps.** NaN or infinite samples are refused ([`InputError::NonFinite`], naming channel
 //! and sample index) unless [`GapPolicy::Interpolate`] is selected: then each interior run of
@@ -57,18 +63,31 @@
 
 mod axis_map;
 mod error;
+pub mod motion;
 pub mod rate;
 mod scale;
 mod series;
 mod source;
 mod spectra;
+mod unit;
 
-pub use axis_map::{resolve, AxisMap, AxisMapEntry, MapOrigin, Mapped, Resolved, Sign};
+pub use axis_map::{
+    channel_motions, default_assignment, ground_index, ground_inputs, instrument_motion, motion_of,
+    resolve, AxisMap, AxisMapEntry, MapOrigin, Mapped, Resolved, Sign,
+};
 pub use error::{check_sample_rate, require_two, InputError};
+pub use motion::{check_sensors, GroundChannel, GroundMap, Sensing, Sensors};
 pub use scale::{check_scales, parse_scales, scale_for, scale_note, ChannelScale};
-pub use series::{gap_note, process_channel, ChannelCtx, Gap, GapScanner, TiltSeries};
+pub use series::{
+    gap_note, process_channel, ChannelCtx, Gap, GapScanner, TiltSeries, TranslationChannel,
+};
 pub use source::SeriesSource;
 pub use spectra::{assemble, check_csd_finite, frequency_refusal, TiltSpectra, CSD_RTOL};
+pub use unit::{
+    likely_units, normalize_unit, parse_unit, parse_units, si_unit, unstated_excess,
+    unstated_rms_bound, ChannelUnit, DetrendedRms, Motion, ParsedUnit, Unit, UnstatedExcess,
+    PHYSICAL_UNITS, UNITS_ALLOWED, UNSTATED_ANGLE_RMS_MAX_RAD,
+};
 
 use crate::error::Shown;
 use std::fmt;
@@ -191,13 +210,23 @@ impl FromStr for GapPolicy {
 }
 
 /// How to read a tilt input. `Default` = default axis mapping, quantity from the file (else
-/// angle), gaps rejected.
+/// angle), gaps rejected, translation channels taken as inertial sensors.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ReadOptions {
     /// Explicit axis map; overrides the file's `axis_map` / `# axes:` and the default mapping.
     pub axis_map: Option<AxisMap>,
-    /// Explicit quantity; overrides the file's units.
+    /// Explicit quantity of the tilt channels; overrides the file's units of tilt channels.
     pub quantity: Option<Quantity>,
+    /// Units of source channels the file does not state them for (time series only): required
+    /// for translation channels of files without units (miniSEED, CSV without a `# units:`
+    /// line); where the file states one it must agree.
+    pub units: Vec<ChannelUnit>,
+    /// Translation channels (source names) whose tilt part is removed already, or whose sensor
+    /// has none: not corrected with the record's tilt ([`motion`]).
+    pub corrected: Vec<String>,
+    /// Tilt channels (source names) read by a pendulum tiltmeter, which senses `t + a / g`:
+    /// corrected with the record's translation of that axis ([`motion`]).
+    pub pendulum: Vec<String>,
     /// Treatment of NaN / infinite samples (time series only).
     pub gaps: GapPolicy,
     /// Factors for source channels (time series only): required for channels in counts,

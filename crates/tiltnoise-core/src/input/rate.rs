@@ -36,34 +36,12 @@ pub fn angle_psd_divisor(quantity: Quantity, f_hz: f64) -> Option<f64> {
     }
 }
 
-/// The angle cross-spectra of Welch cross-spectra `spectra` of a series in `quantity`, on the
-/// bins `f > 0`: `(freqs_hz, csd)` with `csd[((k - 1) * n + i) * n + j] = S_ij(f_k)` in rad²/Hz
-/// for `k = 1 ..`, `n = spectra.n_channels`. The DC bin is dropped for both quantities (for a
-/// rate it has no angle information); a rate's matrices are divided by `(2 pi f_k)^2`.
-pub fn angle_csd_above_dc(
-    spectra: &CrossSpectra,
-    quantity: Quantity,
-) -> (Vec<f64>, Vec<Complex64>) {
-    let nn = spectra.n_channels * spectra.n_channels;
-    let freqs_hz = spectra.freqs_hz[1..].to_vec();
-    let mut csd = spectra.data[nn..].to_vec();
-    if quantity == Quantity::Rate {
-        for (block, &f) in csd.chunks_exact_mut(nn).zip(&freqs_hz) {
-            let w2 = angle_psd_divisor(quantity, f).expect("Welch bins above DC have f > 0");
-            for s in block {
-                *s /= w2;
-            }
-        }
-    }
-    (freqs_hz, csd)
-}
-
 /// Turns the Welch cross-spectral matrices of a mixed set of channels, of which those listed in
 /// `rate_channels` are tilt rates, into those of the angles, in place, on every bin `f > 0`:
 /// with `a_c = 1 / (i w)` for a rate channel and 1 otherwise, `S_ij -> conj(a_i) a_j S_ij`
 /// (`S_ij = conj(X_i) X_j`), so a rate-rate entry is divided by `w^2`, a rate-other entry
 /// multiplied by `i / w` (rate first) or `-i / w` (rate second). Exact bin by bin, as
-/// [`angle_csd_above_dc`]; ordinary and multiple coherences are unchanged by it, transfer
+/// the budget's [`super::GroundMap`]; ordinary and multiple coherences are unchanged by it, transfer
 /// functions become those from the angle. The DC bin is left as it is: it carries no angle
 /// information, and callers must drop it.
 pub fn rate_channels_to_angle(spectra: &mut CrossSpectra, rate_channels: &[usize]) {
@@ -206,11 +184,21 @@ mod tests {
             data: vec![one; 3],
             n_segments: 1,
         };
-        let (f, csd) = angle_csd_above_dc(&spectra, Quantity::Rate);
+        let map = |q| {
+            crate::input::GroundMap::new(
+                &[crate::input::GroundChannel::tilt(
+                    crate::model::TiltAxis::ThetaT,
+                    q,
+                )],
+                9.81,
+            )
+            .unwrap()
+        };
+        let (f, csd) = map(Quantity::Rate).apply(&spectra);
         assert_eq!(f, vec![0.5, 1.0]);
         let w2 = |f: f64| (std::f64::consts::TAU * f).powi(2);
         assert_eq!(csd, vec![one / w2(0.5), one / w2(1.0)]);
-        let (_, csd) = angle_csd_above_dc(&spectra, Quantity::Angle);
+        let (_, csd) = map(Quantity::Angle).apply(&spectra);
         assert_eq!(csd, vec![one, one]);
     }
 }

@@ -4,30 +4,81 @@
 //! rate stays a rate here: spectra convert it to angle ([`super::rate`]).
 
 use super::error::InputError;
+use super::motion::{GroundChannel, Sensors};
 use super::{GapPolicy, Provenance, Quantity};
+use crate::ground::GroundQuantity;
 use crate::limits::SAMPLES;
-use crate::model::TiltAxis;
+use crate::model::{Input, TiltAxis, TranslationAxis};
 use std::path::Path;
 
-/// A uniformly sampled tilt time series in the crate's sign convention: tilt angle `t` (rad) or
-/// its rate `dt/dt` (rad/s), as [`TiltSeries::quantity`] says.
+/// A uniformly sampled record of the floor's motion in the crate's conventions: tilt channels
+/// (angle `t` in rad, or its rate `dt/dt` in rad/s, as [`TiltSeries::quantity`] says) and
+/// translation channels (displacement, velocity or acceleration along the lab axes, each as its
+/// unit says), all of one length and rate.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TiltSeries {
     /// Sample rate (Hz), finite and > 0.
     pub sample_rate_hz: f64,
-    /// The axes present, in canonical order (theta_t, eta_t, phi_t), at least one.
+    /// The tilt axes present, in canonical order (theta_t, eta_t, phi_t); with `translations`,
+    /// at least one channel in all.
     pub axes: Vec<TiltAxis>,
     /// One channel per entry of `axes`, all of length [`TiltSeries::len`]; tilt angle `t` (rad)
     /// or tilt rate (rad/s), see [`TiltSeries::quantity`].
     pub data: Vec<Vec<f64>>,
+    /// The translation channels, in canonical order (x_t, y_t, z_t), each of length
+    /// [`TiltSeries::len`].
+    pub translations: Vec<TranslationChannel>,
+    /// The channels whose sensors are declared other than the default (pendulum tiltmeters,
+    /// translation channels already free of tilt; see [`super::motion`]).
+    pub sensors: Sensors,
     /// Where it came from.
     pub provenance: Provenance,
+}
+
+/// A translation channel of a record: the floor's displacement (m), velocity (m/s) or
+/// acceleration (m/s^2) along a lab axis, as its unit says.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TranslationChannel {
+    /// The lab axis.
+    pub axis: TranslationAxis,
+    /// What the samples are of the floor's displacement.
+    pub quantity: GroundQuantity,
+    /// The samples, in SI (m, m/s or m/s^2).
+    pub data: Vec<f64>,
 }
 
 impl TiltSeries {
     /// Number of samples per channel (at least 2 for anything returned by the readers).
     pub fn len(&self) -> usize {
-        self.data.first().map_or(0, Vec::len)
+        self.data
+            .first()
+            .or(self.translations.first().map(|t| &t.data))
+            .map_or(0, Vec::len)
+    }
+
+    /// Every channel as an input of the model, tilt first then translations: what
+    /// [`super::SeriesSource::read_chunk`] returns one vector for, in that order.
+    pub fn channels(&self) -> Vec<GroundChannel> {
+        let quantity = self.quantity();
+        let tilts = self.axes.iter().map(|&a| GroundChannel {
+            sensing: self.sensors.sensing(Input::Tilt(a)),
+            ..GroundChannel::tilt(a, quantity)
+        });
+        let translations = self.translations.iter().map(|t| GroundChannel {
+            input: Input::Translation(t.axis),
+            quantity: t.quantity,
+            sensing: self.sensors.sensing(Input::Translation(t.axis)),
+        });
+        tilts.chain(translations).collect()
+    }
+
+    /// Every channel's samples, in the order of [`TiltSeries::channels`].
+    pub fn channel_data(&self) -> Vec<&[f64]> {
+        self.data
+            .iter()
+            .map(Vec::as_slice)
+            .chain(self.translations.iter().map(|t| t.data.as_slice()))
+            .collect()
     }
 
     /// Whether there are no samples.
@@ -38,6 +89,8 @@ impl TiltSeries {
     /// The series as tilt angles (rad): unchanged for an angle; a rate integrated in the
     /// frequency domain ([`super::rate::integrate_rate_spectrally`]: exact up to Nyquist, zero
     /// mean), with a provenance note. For the commands that need angles in the time domain.
+    /// Translation channels are left as they are ([`super::GroundMap::displacements`] turns
+    /// every channel into its input's displacement).
     pub fn into_angle(mut self) -> TiltSeries {
         if self.quantity() == Quantity::Rate {
             for channel in &mut self.data {

@@ -1,21 +1,20 @@
-//! [`SeriesSource`]: what the budget job needs of a tilt time series, so that it can stream a
-//! long record from a file (`tiltnoise-io`'s HDF5 reader) or run on one held in memory
+//! [`SeriesSource`]: what the budget job needs of a record of the floor's motion, so that it can
+//! stream a long record from a file (`tiltnoise-io`'s HDF5 reader) or run on one held in memory
 //! ([`TiltSeries`], or arrays handed over by the Python package) without knowing which. Only
-//! samples: where they came from ([`super::Provenance`]) is the caller's to record.
+//! samples and what each channel measures: where they came from ([`super::Provenance`]) is the
+//! caller's to record.
 
 use super::error::InputError;
-use super::{Quantity, TiltSeries};
-use crate::model::TiltAxis;
+use super::motion::GroundChannel;
+use super::TiltSeries;
 
-/// A tilt time series read in sequential chunks: tilt angle `t` (rad) or its rate (rad/s) in the
-/// convention of [`crate::model::tilt`], one channel per axis, uniformly sampled. A consumer
-/// that needs the angle converts the rate's spectra ([`super::rate`]).
+/// A record of the floor's motion read in sequential chunks, uniformly sampled: tilt channels
+/// (angle `t` in rad or its rate in rad/s, in the convention of [`crate::model::tilt`]) and
+/// translation channels (m, m/s or m/s^2), each described by [`SeriesSource::channels`]. A
+/// consumer that needs displacements converts the spectra ([`super::GroundMap`]).
 pub trait SeriesSource {
     /// Sample rate (Hz).
     fn sample_rate_hz(&self) -> f64;
-
-    /// Whether the samples are angles (rad) or rates (rad/s).
-    fn quantity(&self) -> Quantity;
 
     /// Number of samples per channel.
     fn len(&self) -> usize;
@@ -25,11 +24,12 @@ pub trait SeriesSource {
         self.len() == 0
     }
 
-    /// The axes, in canonical order; [`SeriesSource::read_chunk`] returns one vector per entry.
-    fn axes(&self) -> &[TiltAxis];
+    /// The channels, in canonical input order (theta_t .. phi_t, x_t .. z_t), each input once;
+    /// [`SeriesSource::read_chunk`] returns one vector per entry.
+    fn channels(&self) -> Vec<GroundChannel>;
 
-    /// Samples `start .. start + len` of every axis, in rad or rad/s
-    /// ([`SeriesSource::quantity`]).
+    /// Samples `start .. start + len` of every channel, in the SI unit of its quantity
+    /// ([`GroundChannel::unit`]).
     ///
     /// # Errors
     ///
@@ -43,16 +43,12 @@ impl SeriesSource for TiltSeries {
         self.sample_rate_hz
     }
 
-    fn quantity(&self) -> Quantity {
-        TiltSeries::quantity(self)
-    }
-
     fn len(&self) -> usize {
         TiltSeries::len(self)
     }
 
-    fn axes(&self) -> &[TiltAxis] {
-        &self.axes
+    fn channels(&self) -> Vec<GroundChannel> {
+        TiltSeries::channels(self)
     }
 
     fn read_chunk(&mut self, start: usize, len: usize) -> Result<Vec<Vec<f64>>, InputError> {
@@ -66,7 +62,7 @@ impl SeriesSource for TiltSeries {
             });
         }
         Ok(self
-            .data
+            .channel_data()
             .iter()
             .map(|c| c[start..start + len].to_vec())
             .collect())

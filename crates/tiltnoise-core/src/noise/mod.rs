@@ -1,20 +1,24 @@
-//! Noise budgets: floor-tilt cross-spectra propagated through the transfer functions, other
-//! noise terms, and their quadrature sum.
+//! Noise budgets: the cross-spectra of the floor's motion (tilt and translation) propagated
+//! through the transfer functions, other noise terms, and their quadrature sum.
 //!
 //! Conventions at this boundary: every spectrum is **one-sided**; a PSD is in unit^2/Hz and an ASD
-//! is its square root, in unit/sqrt(Hz). Tilt cross-spectra follow `scipy.signal.csd`:
-//! `S_ij = <conj(T_i) T_j>` (rad^2/Hz). With `O = sum_i H_oi T_i`, the propagated PSD is
-//! `S_o = sum_ij conj(H_oi) S_ij H_oj` (the diagonal of `conj(H) S H^T`, real and >= 0 for a
-//! positive semi-definite `S`), so correlated tilt axes are handled exactly.
+//! is its square root, in unit/sqrt(Hz). Cross-spectra of the floor's inputs (tilt angles in
+//! rad, translations in m) follow `scipy.signal.csd`: `S_ij = <conj(U_i) U_j>`. With `O = sum_i
+//! H_oi U_i`, the propagated PSD is `S_o = sum_ij conj(H_oi) S_ij H_oj` (the diagonal of
+//! `conj(H) S H^T`, real and >= 0 for a positive semi-definite `S`), so correlated inputs are
+//! handled exactly.
 //!
-//! Terms of each observable are typed ([`TermKind`]): `tilt` (full cross-spectral
-//! propagation), `tilt.<axis>` (each axis alone, `|H_oi|^2 S_ii`: a diagnostic breakdown, which
-//! does not add up to `tilt` when the axes are correlated), `readout` (white, configurable per
+//! Terms of each observable are typed ([`TermKind`]): `tilt` (full cross-spectral propagation
+//! of the tilt axes), `tilt.<axis>` (each axis alone, `|H_oi|^2 S_ii`: a diagnostic breakdown,
+//! which does not add up to `tilt` when the axes are correlated), `translation` and
+//! `translation.<axis>` likewise for the floor's translations, and, for a record of both,
+//! `ground` (all six with every cross-spectrum, the term that then adds to the total, of which
+//! `tilt` and `translation` are the breakdown), `readout` (white, configurable per
 //! observable), `thermal` (the sum over the dissipative elements, [`crate::thermal`]; only for a
 //! damped model) with `thermal.<element>` per element (independent sources: they add up to
 //! `thermal`), and `measured` / `residual` when a measured spectrum is compared. The total is
 //! never stored: [`ObservableBudget::total`] computes it, the sum in power of the terms whose
-//! kind adds to it ([`TermKind::in_total`]). A damped budget also carries a [`Calibration`] per
+//! kind adds to it ([`TermKind::adds_to_total`]). A damped budget also carries a [`Calibration`] per
 //! observable that has an equivalent input: the squared response that refers every term to
 //! the test mass's acceleration or torque ([`equivalent`]). A report also reads the budget at
 //! chosen frequencies ([`SummaryAt`]: exact for model terms, band means with their statistical
@@ -39,7 +43,8 @@ pub use witness::{
     MAX_NOISE_REL,
 };
 
-use crate::model::{Observable, TiltAxis};
+use crate::input::{motion_of, Motion};
+use crate::model::Observable;
 use crate::tf::{Input, TransferMatrix};
 use num_complex::Complex64;
 
@@ -101,12 +106,26 @@ impl ObservableBudget {
         self.terms.iter().find(|t| t.kind.name() == name)
     }
 
+    /// Whether a term of `kind` adds to this budget's total ([`TermKind::adds_to_total`]: the
+    /// `tilt` and `translation` terms do only when there is no `ground` term).
+    pub fn adds_to_total(&self, kind: &TermKind) -> bool {
+        kind.adds_to_total(self.term(&TermKind::Ground).is_some())
+    }
+
+    /// The term of the floor's motion that adds to the total: `ground`, else `tilt` or
+    /// `translation`; `None` for a budget without one.
+    pub fn ground_total_term(&self) -> Option<&NoiseTerm> {
+        [TermKind::Ground, TermKind::Tilt, TermKind::Translation]
+            .iter()
+            .find_map(|k| self.term(k))
+    }
+
     /// The total PSD: the sum in power, in term order, of every term that adds to it
-    /// ([`TermKind::in_total`]), one value per frequency of `n_freqs`.
+    /// ([`ObservableBudget::adds_to_total`]), one value per frequency of `n_freqs`.
     pub fn total(&self) -> Vec<f64> {
         let n = self.terms.first().map_or(0, |t| t.psd.len());
         let mut total = vec![0.0; n];
-        for t in self.terms.iter().filter(|t| t.kind.in_total()) {
+        for t in self.terms.iter().filter(|t| self.adds_to_total(&t.kind)) {
             for (s, p) in total.iter_mut().zip(&t.psd) {
                 *s += p;
             }
@@ -205,83 +224,160 @@ impl Readout {
     }
 }
 
-/// Tilt cross-spectral matrices on a frequency grid: `csd[(k * n + i) * n + j] = S_ij(f_k)`,
-/// one-sided, rad^2/Hz, `S_ij = <conj(T_i) T_j>`.
+/// Cross-spectral matrices of the floor's inputs (tilt angles in rad, translations in m) on a
+/// frequency grid: `csd[(k * n + i) * n + j] = S_ij(f_k)`, one-sided, `S_ij = <conj(U_i) U_j>`
+/// (rad^2/Hz, rad m/Hz, m^2/Hz). Each matrix is Hermitian, as every estimate of one is: the
+/// budget reads its diagonal and upper triangle.
 #[derive(Debug, Clone, PartialEq)]
-pub struct TiltCsd<'a> {
-    /// Axis order of the matrix.
-    pub axes: &'a [TiltAxis],
+pub struct GroundCsd<'a> {
+    /// Input order of the matrix: tilt axes and translations, each once.
+    pub inputs: &'a [Input],
     /// Row-major `[freq][i][j]`.
     pub csd: &'a [Complex64],
 }
 
-/// Propagated tilt PSD of output `o` at bin `k`: `sum_ij conj(H_oi) S_ij H_oj`, and the
-/// per-axis terms `|H_oi|^2 S_ii`. `cols[i]` is the column of axis `i` in `tf`.
+/// The ground terms of one observable at bin `k`: the whole motion `sum_ij conj(H_oi) S_ij
+/// H_oj`, the same over the tilt inputs and over the translations alone, and each input alone
+/// `|H_oi|^2 S_ii`. `cols[i]` is the column of input `i` in `tf`.
+struct Propagated {
+    all: f64,
+    rotations: f64,
+    translations: f64,
+    per_input: [f64; 6],
+}
+
 fn propagate(
     tf: &TransferMatrix,
-    tilt: &TiltCsd,
+    ground: &GroundCsd,
+    is_rotation: &[bool],
     cols: &[usize],
     k: usize,
     o: usize,
-) -> (f64, [f64; 3]) {
-    let n = tilt.axes.len();
-    let s = &tilt.csd[k * n * n..(k + 1) * n * n];
-    // At most the three tilt axes: fixed arrays, no allocation per bin.
-    let mut h = [Complex64::new(0.0, 0.0); 3];
+) -> Propagated {
+    let n = ground.inputs.len();
+    let s = &ground.csd[k * n * n..(k + 1) * n * n];
+    // At most the six inputs of the floor: fixed arrays, no allocation per bin.
+    let mut h = [Complex64::new(0.0, 0.0); 6];
     for (hi, &c) in h.iter_mut().zip(cols) {
         *hi = tf.get(k, o, c);
     }
-    let mut total = 0.0;
-    let mut per_axis = [0.0; 3];
+    let (mut all, mut rotations, mut translations) = (0.0, 0.0, 0.0);
+    let mut per_input = [0.0; 6];
+    // S is Hermitian: each pair (i, j), i < j, adds 2 Re(conj(H_oi) S_ij H_oj) with (j, i).
     for i in 0..n {
-        for j in 0..n {
-            total += (h[i].conj() * s[i * n + j] * h[j]).re;
+        per_input[i] = h[i].norm_sqr() * s[i * n + i].re;
+        let row = h[i].conj();
+        for j in i..n {
+            let term = if j == i {
+                per_input[i]
+            } else {
+                2.0 * (row * s[i * n + j] * h[j]).re
+            };
+            all += term;
+            match (is_rotation[i], is_rotation[j]) {
+                (true, true) => rotations += term,
+                (false, false) => translations += term,
+                _ => {}
+            }
         }
-        per_axis[i] = h[i].norm_sqr() * s[i * n + i].re;
     }
-    // A positive semi-definite S gives total >= 0; rounding can leave -eps * scale. A NaN (from
+    // A positive semi-definite S gives sums >= 0; rounding can leave -eps * scale. A NaN (from
     // an overflow) stays NaN for the budget's finiteness check: `f64::max` would make it 0.
-    (if total < 0.0 { 0.0 } else { total }, per_axis)
+    let clip = |v: f64| if v < 0.0 { 0.0 } else { v };
+    Propagated {
+        all: clip(all),
+        rotations: clip(rotations),
+        translations: clip(translations),
+        per_input,
+    }
 }
 
-/// Builds the budget of every output of `tf` from the tilt cross-spectra (same grid as `tf`)
-/// and the readout noise. `tf` must have a tilt column for every axis of `tilt`.
+/// Builds the budget of every output of `tf` from the cross-spectra of the floor's inputs (same
+/// grid as `tf`) and the readout noise: `tilt` and `tilt.<axis>` for the tilt inputs,
+/// `translation` and `translation.<axis>` for the translations, and `ground` (first) when there
+/// are both. `tf` must have a column for every input of `ground`.
 ///
 /// # Panics
-/// If `tf` lacks a column for one of the tilt axes, or the grids differ in length.
-pub fn tilt_budget(tf: &TransferMatrix, tilt: &TiltCsd, readout: &Readout) -> Budget {
+/// If `tf` lacks a column for one of the inputs, an input is not one of the floor's, there are
+/// more than six, or the grids differ in length.
+pub fn ground_budget(tf: &TransferMatrix, ground: &GroundCsd, readout: &Readout) -> Budget {
     let n_f = tf.freqs_hz.len();
-    let n = tilt.axes.len();
-    assert_eq!(tilt.csd.len(), n_f * n * n, "tilt CSD and TF grids differ");
-    let cols: Vec<usize> = tilt
-        .axes
+    let n = ground.inputs.len();
+    assert!(n <= 6, "at most the six inputs of the floor");
+    assert_eq!(
+        ground.csd.len(),
+        n_f * n * n,
+        "ground CSD and TF grids differ"
+    );
+    let cols: Vec<usize> = ground
+        .inputs
         .iter()
         .map(|&a| {
-            tf.input_index(Input::Tilt(a))
+            assert!(a.is_ground(), "{} is not an input of the floor", a.name());
+            tf.input_index(a)
                 .unwrap_or_else(|| panic!("transfer matrix has no {} column", a.name()))
         })
         .collect();
+    let is_rotation: Vec<bool> = ground
+        .inputs
+        .iter()
+        .map(|&a| motion_of(a) == Motion::Rotation)
+        .collect();
+    let (has_rotation, has_translation) = (
+        is_rotation.iter().any(|&r| r),
+        is_rotation.iter().any(|&r| !r),
+    );
+    let axis_kind = |input: Input| match input {
+        Input::Tilt(a) => TermKind::TiltAxis(a),
+        Input::Translation(t) => TermKind::TranslationAxis(t),
+        Input::Force(_) => unreachable!("checked above"),
+    };
     let observables = tf
         .outputs
         .iter()
         .enumerate()
         .map(|(o, &observable)| {
-            let mut tilt_psd = vec![0.0; n_f];
-            let mut axis_psd = vec![vec![0.0; n_f]; n];
+            let mut all = vec![0.0; n_f];
+            let mut rotations = vec![0.0; n_f];
+            let mut translations = vec![0.0; n_f];
+            let mut per_input = vec![vec![0.0; n_f]; n];
             for k in 0..n_f {
-                let (t, per) = propagate(tf, tilt, &cols, k, o);
-                tilt_psd[k] = t;
-                for (axis, p) in axis_psd.iter_mut().zip(per) {
-                    axis[k] = p;
+                let p = propagate(tf, ground, &is_rotation, &cols, k, o);
+                all[k] = p.all;
+                rotations[k] = p.rotations;
+                translations[k] = p.translations;
+                for (input, v) in per_input.iter_mut().zip(p.per_input) {
+                    input[k] = v;
                 }
             }
-            let mut terms = vec![NoiseTerm {
-                kind: TermKind::Tilt,
-                psd: tilt_psd,
-            }];
-            for (i, psd) in axis_psd.into_iter().enumerate() {
+            let mut terms = Vec::new();
+            match (has_rotation, has_translation) {
+                (true, true) => {
+                    terms.push(NoiseTerm {
+                        kind: TermKind::Ground,
+                        psd: all,
+                    });
+                    terms.push(NoiseTerm {
+                        kind: TermKind::Tilt,
+                        psd: rotations,
+                    });
+                    terms.push(NoiseTerm {
+                        kind: TermKind::Translation,
+                        psd: translations,
+                    });
+                }
+                (true, false) => terms.push(NoiseTerm {
+                    kind: TermKind::Tilt,
+                    psd: all,
+                }),
+                (false, _) => terms.push(NoiseTerm {
+                    kind: TermKind::Translation,
+                    psd: all,
+                }),
+            }
+            for (&input, psd) in ground.inputs.iter().zip(per_input) {
                 terms.push(NoiseTerm {
-                    kind: TermKind::TiltAxis(tilt.axes[i]),
+                    kind: axis_kind(input),
                     psd,
                 });
             }
@@ -360,6 +456,7 @@ pub fn add_measured(budget: &mut Budget, o: Observable, measured_psd: Vec<f64>) 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::{TiltAxis, TranslationAxis};
     use crate::tf::Method;
 
     fn toy_tf(h: [[Complex64; 2]; 1]) -> TransferMatrix {
@@ -379,11 +476,11 @@ mod tests {
         let (a, b) = (Complex64::new(2.0, 1.0), Complex64::new(-1.0, 3.0));
         let (s1, s2, c) = (4.0, 9.0, Complex64::new(1.5, -2.0));
         let csd = [Complex64::from(s1), c, c.conj(), Complex64::from(s2)];
-        let axes = [TiltAxis::ThetaT, TiltAxis::EtaT];
-        let budget = tilt_budget(
+        let inputs = [Input::Tilt(TiltAxis::ThetaT), Input::Tilt(TiltAxis::EtaT)];
+        let budget = ground_budget(
             &toy_tf([[a, b]]),
-            &TiltCsd {
-                axes: &axes,
+            &GroundCsd {
+                inputs: &inputs,
                 csd: &csd,
             },
             &Readout::default(),
@@ -403,9 +500,60 @@ mod tests {
         assert_eq!(x.total()[0], tilt + readout);
     }
 
+    /// A tilt and a translation correlated: `ground` holds the cross term, `tilt` and
+    /// `translation` each input alone; the total is `ground` plus readout, never the two parts
+    /// in quadrature.
+    #[test]
+    fn tilt_and_translation_add_as_ground_with_their_cross_spectrum() {
+        let (a, b) = (Complex64::new(1.5, -0.5), Complex64::new(-2.0, 0.25));
+        let (s1, s2, c) = (2.0, 3.0, Complex64::new(-1.2, 0.7));
+        let csd = [Complex64::from(s1), c, c.conj(), Complex64::from(s2)];
+        let inputs = [
+            Input::Tilt(TiltAxis::EtaT),
+            Input::Translation(TranslationAxis::XT),
+        ];
+        let tf = TransferMatrix::from_dense(
+            vec![1e-2],
+            vec![Observable::X],
+            inputs.to_vec(),
+            Method::Direct,
+            &[a, b],
+        );
+        let budget = ground_budget(
+            &tf,
+            &GroundCsd {
+                inputs: &inputs,
+                csd: &csd,
+            },
+            &Readout::none(),
+        );
+        let x = budget.observable(Observable::X).unwrap();
+        let names: Vec<String> = x.terms.iter().map(|t| t.name()).collect();
+        assert_eq!(
+            names,
+            [
+                "ground",
+                "tilt",
+                "translation",
+                "tilt.eta_t",
+                "translation.x_t"
+            ]
+        );
+        let ground = x.term(&TermKind::Ground).unwrap().psd[0];
+        let expected = a.norm_sqr() * s1 + b.norm_sqr() * s2 + 2.0 * (a.conj() * c * b).re;
+        assert!((ground - expected).abs() <= 8.0 * f64::EPSILON * 100.0);
+        assert_eq!(x.term(&TermKind::Tilt).unwrap().psd[0], a.norm_sqr() * s1);
+        assert_eq!(
+            x.term(&TermKind::Translation).unwrap().psd[0],
+            b.norm_sqr() * s2
+        );
+        assert_eq!(x.total(), vec![ground]);
+        assert_eq!(x.ground_total_term().unwrap().kind, TermKind::Ground);
+    }
+
     #[test]
     fn residual_is_measured_minus_total_clipped() {
-        let axes = [TiltAxis::ThetaT, TiltAxis::EtaT];
+        let inputs = [Input::Tilt(TiltAxis::ThetaT), Input::Tilt(TiltAxis::EtaT)];
         let csd = [
             Complex64::from(1.0),
             Complex64::from(0.0),
@@ -413,10 +561,10 @@ mod tests {
             Complex64::from(1.0),
         ];
         let one = Complex64::from(1.0);
-        let mut budget = tilt_budget(
+        let mut budget = ground_budget(
             &toy_tf([[one, one]]),
-            &TiltCsd {
-                axes: &axes,
+            &GroundCsd {
+                inputs: &inputs,
                 csd: &csd,
             },
             &Readout::none(),
@@ -459,15 +607,17 @@ pub enum SpectralSource {
 pub struct BudgetReport {
     /// The budget of the whole record (or of the given spectra).
     pub budget: Budget,
-    /// Per-segment statistics of the `tilt` term (PSD), one band per observable, when the record
-    /// was split into segments (for example hourly).
+    /// Per-segment statistics of the term of the floor's motion that adds to the total (`tilt`,
+    /// `translation` or `ground`; [`SegmentBand::term`]), one band per observable, when the
+    /// record was split into segments (for example hourly).
     pub segment_bands: Vec<(Observable, SegmentBand)>,
     /// Segment length (s) of `segment_bands`, if any.
     pub segment_duration_s: Option<f64>,
     /// How the tilt spectra were obtained.
     pub source: SpectralSource,
-    /// The tilt axes that entered the budget.
-    pub axes: Vec<TiltAxis>,
+    /// The inputs of the floor's motion that entered the budget (tilt axes, translations), in
+    /// canonical order.
+    pub inputs: Vec<Input>,
     /// Readout noise used, white or coloured.
     pub readout: Readout,
     /// The user-named terms (their definitions, for provenance; their values are terms).
@@ -536,6 +686,7 @@ impl BudgetReport {
             if seen.contains(o) {
                 return Err(format!("segment band of {} appears twice", o.name()));
             }
+            let term = band.term.name();
             seen.push(*o);
             for (what, v) in [
                 ("median", &band.median),
@@ -544,7 +695,7 @@ impl BudgetReport {
             ] {
                 if v.len() != n_f {
                     return Err(format!(
-                        "segment band {}.tilt {what} has {} values, expected {n_f}",
+                        "segment band {}.{term} {what} has {} values, expected {n_f}",
                         o.name(),
                         v.len()
                     ));

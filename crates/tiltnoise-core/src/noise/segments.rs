@@ -1,9 +1,11 @@
 //! Statistics of per-segment budgets (for example hourly): the median and a percentile band at
 //! every frequency, because floor tilt changes through the day.
 
-/// Median and percentile band of one quantity (a PSD) across segments, per frequency.
+/// Median and percentile band of one term's PSD across segments, per frequency.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SegmentBand {
+    /// The term whose PSD the band is of.
+    pub term: super::TermKind,
     /// Lower percentile (e.g. 10).
     pub lower_pct: f64,
     /// Upper percentile (e.g. 90).
@@ -42,6 +44,7 @@ impl SegmentBand {
     /// values may be stored as `f32` (converted exactly to `f64`); each frequency's column is
     /// copied and sorted once for all three statistics.
     pub fn new<T: Copy + Into<f64>>(
+        term: super::TermKind,
         per_segment: &[Vec<T>],
         lower_pct: f64,
         upper_pct: f64,
@@ -61,6 +64,7 @@ impl SegmentBand {
             upper.push(percentile_of_sorted(&column, upper_pct));
         }
         SegmentBand {
+            term,
             lower_pct,
             upper_pct,
             median,
@@ -90,7 +94,7 @@ mod tests {
     #[test]
     fn band_orders_lower_median_upper() {
         let segs = vec![vec![1.0, 10.0], vec![3.0, 30.0], vec![2.0, 20.0]];
-        let b = SegmentBand::new(&segs, 10.0, 90.0);
+        let b = SegmentBand::new(super::super::TermKind::Tilt, &segs, 10.0, 90.0);
         assert_eq!(b.median, vec![2.0, 20.0]);
         assert!(b.lower[0] < b.median[0] && b.median[0] < b.upper[0]);
         assert_eq!(b.n_segments, 3);

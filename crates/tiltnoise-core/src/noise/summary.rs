@@ -92,11 +92,16 @@ impl ObservableAt {
         self.terms.iter().find(|t| &t.kind == kind)
     }
 
-    /// The total PSD: the sum of the terms that add to the total ([`TermKind::in_total`]).
+    /// Whether a term of `kind` adds to the total here ([`TermKind::adds_to_total`]).
+    pub fn adds_to_total(&self, kind: &TermKind) -> bool {
+        kind.adds_to_total(self.term(&TermKind::Ground).is_some())
+    }
+
+    /// The total PSD: the sum of the terms that add to the total ([`TermKind::adds_to_total`]).
     pub fn total_psd(&self) -> f64 {
         self.terms
             .iter()
-            .filter(|t| t.kind.in_total())
+            .filter(|t| self.adds_to_total(&t.kind))
             .map(|t| t.psd)
             .sum()
     }
@@ -105,7 +110,7 @@ impl ObservableAt {
     /// estimates); `None` if a term of the total has unknown degrees of freedom.
     pub fn total_psd_std(&self) -> Option<f64> {
         let mut var = 0.0;
-        for t in self.terms.iter().filter(|t| t.kind.in_total()) {
+        for t in self.terms.iter().filter(|t| self.adds_to_total(&t.kind)) {
             var += t.psd_std()?.powi(2);
         }
         Some(var.sqrt())

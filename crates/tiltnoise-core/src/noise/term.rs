@@ -2,17 +2,28 @@
 //! `Budget`: the kind decides whether the term adds to the total, which group it belongs to and
 //! the key under which the files store it; its unit is the observable's.
 
-use crate::model::{Observable, TiltAxis};
+use crate::model::{Observable, TiltAxis, TranslationAxis};
 use std::fmt;
 
 /// The kind of a term of an observable's budget.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub enum TermKind {
-    /// Floor tilt through the transfer functions, every axis with its cross-spectra.
+    /// Floor tilt through the transfer functions, every tilt axis with its cross-spectra (the
+    /// rotations alone).
     Tilt,
     /// One tilt axis alone, `|H_oi|^2 S_ii`: a diagnostic breakdown of [`TermKind::Tilt`] (it
     /// does not add up to it when the axes are correlated); not part of the total.
     TiltAxis(TiltAxis),
+    /// Floor translation through the transfer functions, every translation axis with its
+    /// cross-spectra (the translations alone).
+    Translation,
+    /// One translation axis alone: a diagnostic breakdown of [`TermKind::Translation`].
+    TranslationAxis(TranslationAxis),
+    /// The floor's whole motion, tilt and translation with every cross-spectrum between them
+    /// (`H S H^H` over all the inputs): when a record has both, this term adds to the total and
+    /// [`TermKind::Tilt`] and [`TermKind::Translation`] are its breakdown (never added in
+    /// quadrature: tilt and floor acceleration are correlated, and act alike at low frequency).
+    Ground,
     /// The witness instruments' own noise through the model, `sum_i |H_oi|^2 S_nn,i`: the
     /// part of [`TermKind::Tilt`] that is the tiltmeter's noise, not the floor's motion (the
     /// tilt term, computed from the witness record, already contains it); not part of the
@@ -41,6 +52,10 @@ pub enum TermKind {
 pub enum TermGroup {
     /// [`TermKind::Tilt`], its per-axis breakdown and the witness noise in it.
     Tilt,
+    /// [`TermKind::Translation`] and its per-axis breakdown.
+    Translation,
+    /// [`TermKind::Ground`].
+    Ground,
     /// [`TermKind::Readout`].
     Readout,
     /// [`TermKind::Thermal`] and its per-element breakdown.
@@ -52,14 +67,16 @@ pub enum TermGroup {
 }
 
 impl TermKind {
-    /// The key of the term in the budget files (`tilt`, `tilt.eta_t`, `witness_noise`,
-    /// `readout`, `thermal`, `thermal.torsion_b`, `user`, `user.<name>`, `measured`,
-    /// `residual`); see
-    /// `docs/schemas.md`.
+    /// The key of the term in the budget files (`tilt`, `tilt.eta_t`, `translation`,
+    /// `translation.x_t`, `ground`, `witness_noise`, `readout`, `thermal`, `thermal.torsion_b`,
+    /// `user`, `user.<name>`, `measured`, `residual`); see `docs/schemas.md`.
     pub fn name(&self) -> String {
         match self {
             TermKind::Tilt => "tilt".into(),
             TermKind::TiltAxis(a) => format!("tilt.{}", a.name()),
+            TermKind::Translation => "translation".into(),
+            TermKind::TranslationAxis(t) => format!("translation.{}", t.name()),
+            TermKind::Ground => "ground".into(),
             TermKind::WitnessNoise => "witness_noise".into(),
             TermKind::Readout => "readout".into(),
             TermKind::Thermal => "thermal".into(),
@@ -75,6 +92,8 @@ impl TermKind {
     pub fn from_name(name: &str) -> Option<TermKind> {
         Some(match name {
             "tilt" => TermKind::Tilt,
+            "translation" => TermKind::Translation,
+            "ground" => TermKind::Ground,
             "witness_noise" => TermKind::WitnessNoise,
             "readout" => TermKind::Readout,
             "thermal" => TermKind::Thermal,
@@ -84,6 +103,12 @@ impl TermKind {
             _ => {
                 if let Some(axis) = name.strip_prefix("tilt.") {
                     TermKind::TiltAxis(TiltAxis::ALL.into_iter().find(|a| a.name() == axis)?)
+                } else if let Some(axis) = name.strip_prefix("translation.") {
+                    TermKind::TranslationAxis(
+                        TranslationAxis::ALL
+                            .into_iter()
+                            .find(|a| a.name() == axis)?,
+                    )
                 } else if let Some(user) = name.strip_prefix("user.") {
                     if !is_term_name(user) {
                         return None;
@@ -100,13 +125,29 @@ impl TermKind {
         })
     }
 
-    /// Whether the term is an independent noise of the model that adds in power to the total.
-    /// Breakdowns (one tilt axis, one thermal element) and data (measured, residual) do not.
-    pub fn in_total(&self) -> bool {
-        matches!(
-            self,
-            TermKind::Tilt | TermKind::Readout | TermKind::Thermal | TermKind::User
-        )
+    /// Whether the term is an independent noise of the model that adds in power to the total
+    /// of a budget that has (`with_ground`) or has not a [`TermKind::Ground`] term: the
+    /// readout, thermal and user terms, and the one term of the floor's motion that holds all
+    /// its inputs with their cross-spectra, `ground` when the record has tilt and translation,
+    /// else `tilt` or `translation`. Breakdowns (`tilt` and `translation` beside `ground`, one
+    /// axis, one thermal element) and data (measured, residual) do not.
+    pub fn adds_to_total(&self, with_ground: bool) -> bool {
+        match self {
+            TermKind::Ground | TermKind::Readout | TermKind::Thermal | TermKind::User => true,
+            TermKind::Tilt | TermKind::Translation => !with_ground,
+            _ => false,
+        }
+    }
+
+    /// Whether the term is one of the floor's motion: tilt, translation or ground, or one axis
+    /// of them (the terms estimated from the record, read at a frequency as band means; not
+    /// the witness noise, a given spectrum).
+    pub fn is_ground_motion(&self) -> bool {
+        *self != TermKind::WitnessNoise
+            && matches!(
+                self.group(),
+                TermGroup::Tilt | TermGroup::Translation | TermGroup::Ground
+            )
     }
 
     /// Whether the term is a noise the model predicts (everything but measured and residual):
@@ -119,6 +160,8 @@ impl TermKind {
     pub fn group(&self) -> TermGroup {
         match self {
             TermKind::Tilt | TermKind::TiltAxis(_) | TermKind::WitnessNoise => TermGroup::Tilt,
+            TermKind::Translation | TermKind::TranslationAxis(_) => TermGroup::Translation,
+            TermKind::Ground => TermGroup::Ground,
             TermKind::Readout => TermGroup::Readout,
             TermKind::Thermal | TermKind::ThermalElement(_) => TermGroup::Thermal,
             TermKind::User | TermKind::UserNamed(_) => TermGroup::User,
@@ -134,11 +177,13 @@ impl TermKind {
 }
 
 impl TermGroup {
-    /// `tilt`, `readout`, `thermal`, `user` or `measured`: the attribute `group` of a term in
-    /// the budget files.
+    /// `tilt`, `translation`, `ground`, `readout`, `thermal`, `user` or `measured`: the
+    /// attribute `group` of a term in the budget files.
     pub fn name(self) -> &'static str {
         match self {
             TermGroup::Tilt => "tilt",
+            TermGroup::Translation => "translation",
+            TermGroup::Ground => "ground",
             TermGroup::Readout => "readout",
             TermGroup::Thermal => "thermal",
             TermGroup::User => "user",
@@ -160,7 +205,7 @@ pub fn is_term_name(name: &str) -> bool {
 pub enum Component {
     /// A term of the budget.
     Term(TermKind),
-    /// The sum in power of the terms that add to the total ([`TermKind::in_total`]).
+    /// The sum in power of the terms that add to the total ([`TermKind::adds_to_total`]).
     Total,
 }
 
@@ -189,6 +234,9 @@ mod tests {
         let kinds = [
             TermKind::Tilt,
             TermKind::TiltAxis(TiltAxis::EtaT),
+            TermKind::Translation,
+            TermKind::TranslationAxis(TranslationAxis::ZT),
+            TermKind::Ground,
             TermKind::WitnessNoise,
             TermKind::Readout,
             TermKind::Thermal,
@@ -203,6 +251,7 @@ mod tests {
         }
         assert_eq!(TermKind::from_name("total"), None);
         assert_eq!(TermKind::from_name("tilt.x"), None);
+        assert_eq!(TermKind::from_name("translation.theta_t"), None);
         assert_eq!(TermKind::from_name("thermal."), None);
         assert_eq!(TermKind::from_name("user."), None);
         assert_eq!(TermKind::from_name("user.a.b"), None);
@@ -210,12 +259,19 @@ mod tests {
 
     #[test]
     fn only_independent_noises_add_to_the_total() {
-        assert!(TermKind::Tilt.in_total() && TermKind::Readout.in_total());
-        assert!(TermKind::Thermal.in_total() && TermKind::User.in_total());
-        assert!(!TermKind::UserNamed("actuation".into()).in_total());
-        assert!(!TermKind::TiltAxis(TiltAxis::ThetaT).in_total());
-        assert!(!TermKind::WitnessNoise.in_total());
-        assert!(!TermKind::ThermalElement("torsion_b".into()).in_total());
-        assert!(!TermKind::Measured.in_total() && !TermKind::Residual.in_total());
+        for with_ground in [false, true] {
+            let adds = |k: TermKind| k.adds_to_total(with_ground);
+            assert!(adds(TermKind::Readout) && adds(TermKind::Thermal) && adds(TermKind::User));
+            assert!(!adds(TermKind::UserNamed("actuation".into())));
+            assert!(!adds(TermKind::TiltAxis(TiltAxis::ThetaT)));
+            assert!(!adds(TermKind::WitnessNoise));
+            assert!(!adds(TermKind::TranslationAxis(TranslationAxis::XT)));
+            assert!(!adds(TermKind::ThermalElement("torsion_b".into())));
+            assert!(!adds(TermKind::Measured) && !adds(TermKind::Residual));
+        }
+        // The floor's motion adds once: tilt or translation alone, or ground, never both.
+        assert!(TermKind::Tilt.adds_to_total(false) && TermKind::Translation.adds_to_total(false));
+        assert!(!TermKind::Tilt.adds_to_total(true) && !TermKind::Translation.adds_to_total(true));
+        assert!(TermKind::Ground.adds_to_total(true));
     }
 }

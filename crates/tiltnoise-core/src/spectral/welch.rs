@@ -331,6 +331,36 @@ impl WelchAccumulator {
     /// last complete segment are ignored (as in scipy). Fails if not even one segment was
     /// complete.
     pub fn finish(self) -> Result<CrossSpectra, SpectralError> {
+        let mut out = CrossSpectra {
+            freqs_hz: Vec::new(),
+            n_channels: self.n_channels,
+            data: Vec::new(),
+            n_segments: 0,
+        };
+        self.write_into(&mut out)?;
+        Ok(out)
+    }
+
+    /// [`WelchAccumulator::finish`] into `out`, whose buffers are reused, and the accumulator
+    /// emptied for the next record of the same channels (samples after the last complete
+    /// segment are dropped): a caller that averages many consecutive records (the budget's
+    /// hourly segments) allocates, and the system maps, the matrices once rather than per
+    /// record.
+    ///
+    /// # Errors
+    ///
+    /// As [`WelchAccumulator::finish`]; the accumulator is emptied all the same.
+    pub fn finish_into(&mut self, out: &mut CrossSpectra) -> Result<(), SpectralError> {
+        let written = self.write_into(out);
+        self.sums.fill(Complex64::new(0.0, 0.0));
+        self.stored.clear();
+        self.n_segments = 0;
+        self.n_samples = 0;
+        self.filled = 0;
+        written
+    }
+
+    fn write_into(&self, out: &mut CrossSpectra) -> Result<(), SpectralError> {
         if self.n_segments == 0 {
             return Err(SpectralError::SeriesTooShort {
                 n_samples: self.n_samples,
@@ -349,7 +379,9 @@ impl WelchAccumulator {
                 2.0
             }
         };
-        let mut data = vec![Complex64::new(0.0, 0.0); nf * nc * nc];
+        // Every entry is written below (the upper triangle, then its Hermitian completion).
+        let data = &mut out.data;
+        data.resize(nf * nc * nc, Complex64::new(0.0, 0.0));
         match self.cfg.averaging {
             Averaging::Mean => {
                 for k in 0..nf {
@@ -394,15 +426,12 @@ impl WelchAccumulator {
                 }
             }
         }
-        let freqs_hz = (0..nf)
-            .map(|k| k as f64 * self.fs_hz / len as f64)
-            .collect();
-        Ok(CrossSpectra {
-            freqs_hz,
-            n_channels: nc,
-            data,
-            n_segments: nseg,
-        })
+        out.freqs_hz.clear();
+        out.freqs_hz
+            .extend((0..nf).map(|k| k as f64 * self.fs_hz / len as f64));
+        out.n_channels = nc;
+        out.n_segments = nseg;
+        Ok(())
     }
 }
 
@@ -558,6 +587,39 @@ mod tests {
             acc.push_interleaved(&frames[..402]).unwrap();
             acc.push_interleaved(&frames[402..]).unwrap();
             assert_eq!(whole, acc.finish().unwrap());
+        }
+    }
+
+    /// An accumulator emptied by `finish_into` and reused gives, record after record, what a
+    /// fresh one gives (the partial segment left over is dropped), for both averagings.
+    #[test]
+    fn a_reused_accumulator_is_a_fresh_one() {
+        let (a, b) = (series(1000, 5), series(1000, 6));
+        for averaging in [Averaging::Mean, Averaging::Median] {
+            let cfg = WelchConfig {
+                averaging,
+                ..WelchConfig::new(64)
+            };
+            let mut reused = WelchAccumulator::new(2, 4.0, &cfg).unwrap();
+            let mut out = CrossSpectra {
+                freqs_hz: Vec::new(),
+                n_channels: 2,
+                data: Vec::new(),
+                n_segments: 0,
+            };
+            // Records of 300 samples: 8 segments of 64 with a step of 32 and 12 samples left.
+            for record in [0..300, 300..600, 600..900] {
+                let (x, y) = (&a[record.clone()], &b[record]);
+                let mut fresh = WelchAccumulator::new(2, 4.0, &cfg).unwrap();
+                fresh.push(&[x, y]).unwrap();
+                reused.push(&[x, y]).unwrap();
+                reused.finish_into(&mut out).unwrap();
+                assert_eq!(out, fresh.finish().unwrap(), "{averaging:?}");
+            }
+            assert!(matches!(
+                reused.finish_into(&mut out),
+                Err(SpectralError::SeriesTooShort { n_samples: 0, .. })
+            ));
         }
     }
 

@@ -8,7 +8,6 @@ use std::path::PathBuf;
 use tiltnoise_core::budget::{
     add_measured, budget_from_series, series_psds, BudgetError, BudgetOptions, SummaryRequest,
 };
-use tiltnoise_core::input::rate::angle_csd_above_dc;
 use tiltnoise_core::input::{InputFormat, InputKind, Provenance, Quantity, TiltSeries};
 use tiltnoise_core::model::{Model, Observable, TiltAxis};
 use tiltnoise_core::noise::{Evaluation, TermKind};
@@ -81,6 +80,8 @@ fn series(data: Vec<Vec<f64>>) -> TiltSeries {
         sample_rate_hz: FS_HZ,
         axes: vec![TiltAxis::ThetaT, TiltAxis::EtaT],
         data,
+        translations: Vec::new(),
+        sensors: Default::default(),
         provenance: Provenance {
             path: PathBuf::from("(synthetic)"),
             format: InputFormat::Hdf5,
@@ -120,7 +121,7 @@ fn tilt_at_f_is_the_exact_transfer_function_on_the_band_mean_cross_spectra() {
     // Independently: the Welch matrices, their mean over the band, the transfer functions of
     // the direct method at exactly f.
     let m = csd_matrix(&[&a, &eta], FS_HZ, &WelchConfig::new(SEG)).unwrap();
-    let (grid, csd) = angle_csd_above_dc(&m, Quantity::Angle);
+    let (grid, csd) = two_tilt_axes(Quantity::Angle).apply(&m);
     for at in &report.summary {
         let f = at.freq_hz;
         let bins: Vec<usize> = (0..grid.len())
@@ -246,4 +247,15 @@ fn measured_series_is_a_band_mean_of_its_own_bins() {
             .term(&TermKind::Measured)
             .is_none());
     }
+}
+
+/// The map of a record of theta_t and eta_t in `quantity`: the budget's conversion of their
+/// Welch cross-spectra to the angles'.
+fn two_tilt_axes(quantity: Quantity) -> tiltnoise_core::input::GroundMap {
+    use tiltnoise_core::input::{GroundChannel, GroundMap};
+    let channels = [
+        GroundChannel::tilt(TiltAxis::ThetaT, quantity),
+        GroundChannel::tilt(TiltAxis::EtaT, quantity),
+    ];
+    GroundMap::new(&channels, 9.81).expect("rotation sensors alone")
 }

@@ -41,6 +41,8 @@ fn tilt_series(n: usize) -> TiltSeries {
         sample_rate_hz: 10.0,
         axes: vec![TiltAxis::ThetaT, TiltAxis::EtaT],
         data: vec![x.clone(), x],
+        translations: Vec::new(),
+        sensors: Default::default(),
         provenance: Provenance {
             path: PathBuf::from("(synthetic)"),
             format: InputFormat::Hdf5,

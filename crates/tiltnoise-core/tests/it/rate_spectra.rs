@@ -14,7 +14,6 @@ use num_complex::Complex64;
 use std::f64::consts::TAU;
 use std::path::PathBuf;
 use tiltnoise_core::budget::{budget_from_series, BudgetOptions, RATE_BUDGET_NOTE};
-use tiltnoise_core::input::rate::angle_csd_above_dc;
 use tiltnoise_core::input::{InputFormat, InputKind, Provenance, Quantity, TiltSeries};
 use tiltnoise_core::model::{Model, Observable, TiltAxis};
 use tiltnoise_core::noise::TermKind;
@@ -78,7 +77,7 @@ fn bin_rel(amps: &[f64], m_index: usize, on_line: bool) -> f64 {
 fn spectra(series: &[&[f64]], quantity: Quantity) -> (Vec<f64>, Vec<Complex64>, usize) {
     let cfg = WelchConfig::new(SEG);
     let m = csd_matrix(series, FS_HZ, &cfg).unwrap();
-    let (f, csd) = angle_csd_above_dc(&m, quantity);
+    let (f, csd) = two_tilt_axes(quantity).apply(&m);
     (f, csd, m.n_segments)
 }
 
@@ -144,6 +143,8 @@ fn series(data: Vec<Vec<f64>>, quantity: Quantity) -> TiltSeries {
         sample_rate_hz: FS_HZ,
         axes: vec![TiltAxis::ThetaT, TiltAxis::EtaT],
         data,
+        translations: Vec::new(),
+        sensors: Default::default(),
         provenance: Provenance {
             path: PathBuf::from("(synthetic)"),
             format: InputFormat::Hdf5,
@@ -201,4 +202,15 @@ fn budget_of_a_rate_is_the_budget_of_its_angle_at_every_line() {
             xa[m - 1]
         );
     }
+}
+
+/// The map of a record of theta_t and eta_t in `quantity`: the budget's conversion of their
+/// Welch cross-spectra to the angles'.
+fn two_tilt_axes(quantity: Quantity) -> tiltnoise_core::input::GroundMap {
+    use tiltnoise_core::input::{GroundChannel, GroundMap};
+    let channels = [
+        GroundChannel::tilt(TiltAxis::ThetaT, quantity),
+        GroundChannel::tilt(TiltAxis::EtaT, quantity),
+    ];
+    GroundMap::new(&channels, 9.81).expect("rotation sensors alone")
 }

@@ -10,8 +10,9 @@
 //! [`MAX_SERIES_SAMPLES`] records.
 
 use super::meta::decide_quantity;
+use super::series_units::{self, Plan, Stated};
 use super::InputError;
-use super::{resolve, MapOrigin, Resolved};
+use super::{resolve, MapOrigin, Motion, Resolved};
 use std::fs::File;
 use std::io::{BufRead, BufReader, Chain, Cursor, Read};
 use std::path::{Path, PathBuf};
@@ -320,14 +321,14 @@ pub(crate) fn decimal_resolution(text: &str) -> f64 {
     10f64.powi(exp - decimals)
 }
 
-/// The units declared by the `# units:` line for the mapped columns `mapped` (names), either
-/// one unit for every column (`# units: rad/s`) or per column (`# units: LJN=rad/s, LJE=rad/s`).
-/// Returns the declared units and the mapped columns without one.
+/// The units declared by the `# units:` line of a spectrum for the mapped columns `mapped`
+/// (names), either one unit for every column or per column. Returns the declared units and the
+/// mapped columns without one.
 fn declared_units(
     path: &Path,
     prelude: &Prelude,
     mapped: &[String],
-    classify: fn(&str) -> Option<super::meta::Unit>,
+    classify: fn(&str) -> Option<super::meta::SpectrumUnit>,
     allowed: &'static str,
 ) -> Result<(Vec<super::meta::Declared>, Vec<String>), InputError> {
     use super::meta::Declared;
@@ -345,45 +346,13 @@ fn declared_units(
     };
     let mut declared = Vec::new();
     if m.value.contains('=') {
-        let mut seen: Vec<&str> = Vec::new();
-        for item in m.value.split(',') {
-            let Some((name, unit)) = item.split_once('=') else {
-                return Err(InputError::Csv {
-                    path: path.to_path_buf(),
-                    line: m.line,
-                    message: format!(
-                        "`# units:` entry `{}` has no `=`; allowed: one unit for all columns \
-                         (e.g. `# units: rad/s`) or COLUMN=UNIT entries separated by commas",
-                        Shown(item.trim())
-                    ),
-                });
-            };
-            let (name, unit) = (name.trim(), unit.trim());
-            if !prelude.header[1..].iter().any(|h| h == name) || seen.contains(&name) {
-                return Err(InputError::Csv {
-                    path: path.to_path_buf(),
-                    line: m.line,
-                    message: format!(
-                        "`# units:` names column `{}`, which is {}; allowed: each data column \
-                         of the header ({}) at most once",
-                        Shown(name),
-                        if seen.contains(&name) {
-                            "repeated"
-                        } else {
-                            "not a data column"
-                        },
-                        shown_list(&prelude.header[1..])
-                    ),
-                });
-            }
-            seen.push(name);
+        for (name, unit) in unit_entries(path, prelude, m)? {
             let u = classify(unit).ok_or_else(|| bad_unit(Some(name), unit))?;
             if mapped.iter().any(|c| c == name) {
                 declared.push(Declared {
                     channel: name.to_string(),
                     unit: unit.to_string(),
                     quantity: u.quantity,
-                    factor: u.factor,
                 });
             }
         }
@@ -393,7 +362,6 @@ fn declared_units(
             channel: c.clone(),
             unit: m.value.clone(),
             quantity: u.quantity,
-            factor: u.factor,
         }));
     }
     let undeclared = mapped
@@ -420,8 +388,32 @@ fn axis_map(
     )))
 }
 
-/// What a CSV prelude decides for either reader: the channel mapping, the quantity, the start
-/// time and the provenance notes so far.
+/// Resolves the axis map (explicit, else `# axes:`, else the default) against the data columns
+/// of `prelude`, of which `motions` says what each measures; the map's notes first.
+fn map_columns(
+    path: &Path,
+    prelude: &Prelude,
+    opts: &super::ReadOptions,
+    motions: &[Option<Motion>],
+) -> Result<(Resolved, Vec<String>), InputError> {
+    let file_map = axis_map(path, prelude)?;
+    let origin = match (&opts.axis_map, &file_map) {
+        (Some(m), _) => MapOrigin::Options(m),
+        (None, Some((m, from))) => MapOrigin::File(m, from),
+        (None, None) => MapOrigin::Default,
+    };
+    let resolved = resolve(path, &prelude.header[1..], motions, origin, "column")?;
+    let mut notes = resolved.notes.clone();
+    if let (Some(_), Some((m, from))) = (&opts.axis_map, &file_map) {
+        notes.push(format!(
+            "the explicit axis map overrides the file's map {m} ({from})"
+        ));
+    }
+    Ok((resolved, notes))
+}
+
+/// What a CSV spectrum's prelude decides: the channel mapping (tilt axes only), the quantity,
+/// the start time and the provenance notes so far.
 pub(crate) struct Interpreted {
     /// The axis map resolved against the data columns (`prelude.header[1..]`).
     pub resolved: Resolved,
@@ -429,41 +421,27 @@ pub(crate) struct Interpreted {
     pub quantity: super::Quantity,
     /// The validated `# start_time:` value.
     pub start_time: Option<String>,
-    /// Axis-map, quantity, factor and description notes, in that order.
+    /// Axis-map, quantity and description notes, in that order.
     pub notes: Vec<String>,
-    /// Per mapped channel: the factor into rad or rad/s (units prefix times scale).
-    pub factors: Vec<f64>,
 }
 
-/// Interprets the prelude of a CSV input: resolves the axis map (explicit, else `# axes:`,
-/// else the default) against the data columns, decides the quantity from the `# units:` line,
-/// whose units `classify` recognises (`allowed` lists them for the error), and reads
-/// `# start_time:` and `# description:`.
-pub(crate) fn interpret(
+/// Interprets the prelude of a CSV spectrum: resolves the axis map against the data columns
+/// (tilt axes only: spectra of translations are not read), decides the quantity from the
+/// `# units:` line, whose units `classify` recognises (`allowed` lists them for the error), and
+/// reads `# start_time:` and `# description:`.
+pub(crate) fn interpret_spectra(
     path: &Path,
     prelude: &Prelude,
     opts: &super::ReadOptions,
-    classify: fn(&str) -> Option<super::meta::Unit>,
+    classify: fn(&str) -> Option<super::meta::SpectrumUnit>,
     allowed: &'static str,
 ) -> Result<Interpreted, InputError> {
-    let file_map = axis_map(path, prelude)?;
-    let origin = match (&opts.axis_map, &file_map) {
-        (Some(m), _) => MapOrigin::Options(m),
-        (None, Some((m, from))) => MapOrigin::File(m, from),
-        (None, None) => MapOrigin::Default,
-    };
-    let resolved = resolve(path, &prelude.header[1..], origin, "column")?;
-    let mut notes = resolved.notes.clone();
-    if let (Some(_), Some((m, from))) = (&opts.axis_map, &file_map) {
-        notes.push(format!(
-            "the explicit axis map overrides the file's map {m} ({from})"
-        ));
-    }
+    let unknown = vec![None; prelude.header.len() - 1];
+    let (resolved, mut notes) = map_columns(path, prelude, opts, &unknown)?;
+    super::refuse_translation_spectra(path, &resolved)?;
     let mapped: Vec<String> = resolved.channels.iter().map(|m| m.source.clone()).collect();
     let (declared, undeclared) = declared_units(path, prelude, &mapped, classify, allowed)?;
     let quantity = decide_quantity(path, opts.quantity, &declared, &undeclared, &mut notes)?;
-    super::check_scales(path, &opts.scale, &prelude.header[1..], "column")?;
-    let factors = super::meta::series_factors(path, &mapped, &declared, &opts.scale, &mut notes)?;
     let start_time = start_time(path, prelude, &mut notes)?;
     if let Some(d) = prelude.meta("description") {
         notes.push(format!("description: {}", Shown(&d.value)));
@@ -473,7 +451,136 @@ pub(crate) fn interpret(
         quantity,
         start_time,
         notes,
-        factors,
+    })
+}
+
+/// What a CSV time series' prelude decides: the channel mapping, the plan of every mapped
+/// channel (quantity, factor, sensor), the start time and the provenance notes so far.
+pub(crate) struct InterpretedSeries {
+    /// The axis map resolved against the data columns (`prelude.header[1..]`).
+    pub resolved: Resolved,
+    /// One entry per `resolved.channels`.
+    pub plan: Plan,
+    /// The validated `# start_time:` value.
+    pub start_time: Option<String>,
+    /// Axis-map, unit, factor and description notes, in that order.
+    pub notes: Vec<String>,
+}
+
+/// The units the `# units:` line states for the data columns: one for every column
+/// (`# units: rad/s`) or per column (`# units: LJN=rad/s, LHE=m/s^2`).
+fn stated_units(path: &Path, prelude: &Prelude) -> Result<Vec<Option<Stated>>, InputError> {
+    let columns = &prelude.header[1..];
+    let Some(m) = prelude.meta("units") else {
+        return Ok(vec![None; columns.len()]);
+    };
+    let location = |column: Option<&str>| match column {
+        Some(c) => format!("line {} (# units:), column `{}`", m.line, Shown(c)),
+        None => format!("line {} (# units:)", m.line),
+    };
+    let checked = |column: Option<&str>, unit: &str| {
+        let s = Stated::in_file(unit, location(column));
+        match s.parsed {
+            Some(_) => Ok(s),
+            None => Err(InputError::Units {
+                path: path.to_path_buf(),
+                location: location(column),
+                value: unit.to_string(),
+                allowed: tiltnoise_core::input::UNITS_ALLOWED,
+            }),
+        }
+    };
+    if !m.value.contains('=') {
+        let s = checked(None, &m.value)?;
+        return Ok(vec![Some(s); columns.len()]);
+    }
+    let mut out = vec![None; columns.len()];
+    for (name, unit) in unit_entries(path, prelude, m)? {
+        let i = columns
+            .iter()
+            .position(|c| c == name)
+            .expect("unit_entries names data columns");
+        out[i] = Some(checked(Some(name), unit)?);
+    }
+    Ok(out)
+}
+
+/// The `COLUMN=UNIT` entries of a per-column `# units:` line, each naming a data column once.
+fn unit_entries<'a>(
+    path: &Path,
+    prelude: &Prelude,
+    m: &'a MetaLine,
+) -> Result<Vec<(&'a str, &'a str)>, InputError> {
+    let mut entries: Vec<(&str, &str)> = Vec::new();
+    for item in m.value.split(',') {
+        let Some((name, unit)) = item.split_once('=') else {
+            return Err(InputError::Csv {
+                path: path.to_path_buf(),
+                line: m.line,
+                message: format!(
+                    "`# units:` entry `{}` has no `=`; allowed: one unit for all columns \
+                     (e.g. `# units: rad/s`) or COLUMN=UNIT entries separated by commas",
+                    Shown(item.trim())
+                ),
+            });
+        };
+        let (name, unit) = (name.trim(), unit.trim());
+        let repeated = entries.iter().any(|(n, _)| *n == name);
+        if !prelude.header[1..].iter().any(|h| h == name) || repeated {
+            return Err(InputError::Csv {
+                path: path.to_path_buf(),
+                line: m.line,
+                message: format!(
+                    "`# units:` names column `{}`, which is {}; allowed: each data column \
+                     of the header ({}) at most once",
+                    Shown(name),
+                    if repeated {
+                        "repeated"
+                    } else {
+                        "not a data column"
+                    },
+                    shown_list(&prelude.header[1..])
+                ),
+            });
+        }
+        entries.push((name, unit));
+    }
+    Ok(entries)
+}
+
+/// Interprets the prelude of a CSV time series: the units of the data columns (the `# units:`
+/// line, then the options'), the axis map resolved with what they say each column measures,
+/// the plan of the mapped columns ([`series_units::plan`]), `# start_time:` and
+/// `# description:`.
+pub(crate) fn interpret_series(
+    path: &Path,
+    prelude: &Prelude,
+    opts: &super::ReadOptions,
+) -> Result<InterpretedSeries, InputError> {
+    let columns = &prelude.header[1..];
+    let mut unit_notes = Vec::new();
+    let stated = series_units::merge_given(
+        path,
+        columns,
+        stated_units(path, prelude)?,
+        &opts.units,
+        "column",
+        &mut unit_notes,
+    )?;
+    let motions = series_units::motions(path, columns, &stated)?;
+    let (resolved, mut notes) = map_columns(path, prelude, opts, &motions)?;
+    notes.extend(unit_notes);
+    super::check_scales(path, &opts.scale, columns, "column")?;
+    let plan = series_units::plan(path, &resolved, &stated, opts, &mut notes)?;
+    let start_time = start_time(path, prelude, &mut notes)?;
+    if let Some(d) = prelude.meta("description") {
+        notes.push(format!("description: {}", Shown(&d.value)));
+    }
+    Ok(InterpretedSeries {
+        resolved,
+        plan,
+        start_time,
+        notes,
     })
 }
 

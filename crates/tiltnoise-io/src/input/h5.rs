@@ -461,10 +461,12 @@ pub(crate) fn axis_map(
 
 /// Resolves the explicit axis map of `opts`, else the root attribute `axis_map` (`file_map`,
 /// see [`axis_map`]), else the default, against the channels `available` of `path` (`kind`:
-/// `dataset` or `axis name`), and appends the provenance notes to `notes`.
+/// `dataset` or `axis name`), of which `motions` says what each measures, and appends the
+/// provenance notes to `notes`.
 pub(crate) fn resolve_axes(
     path: &Path,
     available: &[String],
+    motions: &[Option<super::Motion>],
     kind: &'static str,
     opts: &ReadOptions,
     file_map: Option<&AxisMap>,
@@ -475,7 +477,7 @@ pub(crate) fn resolve_axes(
         (None, Some(m)) => MapOrigin::File(m, "root attribute axis_map of the file"),
         (None, None) => MapOrigin::Default,
     };
-    let resolved = resolve(path, available, origin, kind)?;
+    let resolved = resolve(path, available, motions, origin, kind)?;
     notes.extend(resolved.notes.iter().cloned());
     if let (Some(_), Some(m)) = (&opts.axis_map, file_map) {
         notes.push(format!(

@@ -25,6 +25,7 @@ mod measured;
 mod meta;
 mod mseed;
 mod series_csv;
+mod series_units;
 mod source;
 mod spectra_csv;
 mod spectra_gwpy;
@@ -164,18 +165,46 @@ fn csv_kind(path: &Path, prelude: &csv::Prelude) -> Result<InputKind, InputError
     }
 }
 
+/// Spectra are read for the tilt axes only: a translation channel mapped from a spectrum file
+/// (an `x_t` column, or a map that asks for one) is refused rather than dropped.
+fn refuse_translation_spectra(path: &Path, resolved: &Resolved) -> Result<(), InputError> {
+    match resolved.channels.iter().find(|m| m.tilt_axis().is_none()) {
+        None => Ok(()),
+        Some(m) => Err(InputError::ChannelUnit {
+            path: path.to_path_buf(),
+            channel: m.source.clone(),
+            message: format!(
+                "feeds {}, a translation of the floor, and the file holds spectra; allowed: \
+                 spectra of the tilt axes (theta_t, eta_t, phi_t); give translations as a time \
+                 series",
+                m.input.name()
+            ),
+        }),
+    }
+}
+
 /// Scale factors apply to the samples of a time series; spectra refuse them rather than
 /// ignore them.
 fn no_scale_for_spectra(path: &Path, opts: &ReadOptions) -> Result<(), InputError> {
-    match opts.scale.first() {
-        None => Ok(()),
-        Some(s) => Err(InputError::Scale {
+    let series_only = |channel: &str, what: &str| {
+        Err(InputError::Scale {
             path: path.to_path_buf(),
-            channel: s.channel.clone(),
-            message: "is given a scale, but the file holds spectra; allowed: scales for time \
-                      series only"
-                .to_string(),
-        }),
+            channel: channel.to_string(),
+            message: format!(
+                "is given {what}, but the file holds spectra; allowed: {what} for time series \
+                 only"
+            ),
+        })
+    };
+    if let Some(s) = opts.scale.first() {
+        return series_only(&s.channel, "a scale");
+    }
+    if let Some(u) = opts.units.first() {
+        return series_only(&u.channel, "a unit");
+    }
+    match opts.corrected.first().or(opts.pendulum.first()) {
+        Some(c) => series_only(c, "a sensor declaration"),
+        None => Ok(()),
     }
 }
 

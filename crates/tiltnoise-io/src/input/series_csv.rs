@@ -1,7 +1,8 @@
-//! Tilt time series from CSV: header `time_s,CH1,CH2,...`, optional `#` metadata lines.
+//! Time series of the floor's motion from CSV: header `time_s,CH1,CH2,...`, optional `#`
+//! metadata lines.
 
 use super::csv::{self, decimal_resolution, parse_field, CsvFile, Prelude};
-use super::meta::{series_unit, SERIES_UNITS};
+use super::series_units::{check_unstated_data, into_series, units_note};
 use super::{check_sample_rate, require_two, InputError};
 use super::{gap_note, process_channel, ChannelCtx, TiltSeries};
 use super::{GapPolicy, InputFormat, InputKind, Provenance, ReadOptions};
@@ -15,15 +16,13 @@ pub(crate) fn read(
     opts: &ReadOptions,
 ) -> Result<TiltSeries, InputError> {
     let path = file.path.clone();
-    let csv::Interpreted {
+    let csv::InterpretedSeries {
         resolved,
-        quantity,
+        plan,
         start_time,
         mut notes,
-        factors,
-    } = csv::interpret(&path, &prelude, opts, series_unit, SERIES_UNITS)?;
+    } = csv::interpret_series(&path, &prelude, opts)?;
 
-    let unit = quantity.unit();
     let mut times: Vec<f64> = Vec::new();
     let mut resolution: Vec<f64> = Vec::new();
     let mut lines: Vec<usize> = Vec::new();
@@ -57,7 +56,13 @@ pub(crate) fn read(
         times.push(t);
         resolution.push(decimal_resolution(fields[0]));
         lines.push(line);
-        for ((m, out), &factor) in resolved.channels.iter().zip(data.iter_mut()).zip(&factors) {
+        for ((m, out), p) in resolved
+            .channels
+            .iter()
+            .zip(data.iter_mut())
+            .zip(&plan.channels)
+        {
+            let (factor, unit) = (p.factor, p.unit());
             let text = fields[m.index + 1];
             let raw = match parse_field(text) {
                 Ok(Some(v)) => v,
@@ -110,32 +115,35 @@ pub(crate) fn read(
         notes.push(format!("time_s starts at {} s", times[0]));
     }
 
-    for (m, ch) in resolved.channels.iter().zip(data.iter_mut()) {
+    for ((m, ch), p) in resolved
+        .channels
+        .iter()
+        .zip(data.iter_mut())
+        .zip(&plan.channels)
+    {
         let ctx = ChannelCtx {
             path: &path,
             channel: &m.source,
-            unit,
+            unit: p.unit(),
         };
         let bridged = process_channel(ch, opts.gaps, &ctx)?;
         if bridged > 0 {
             notes.push(gap_note(&m.source, bridged));
         }
+        check_unstated_data(&path, &m.source, p, ch, sample_rate_hz)?;
     }
 
-    Ok(TiltSeries {
-        sample_rate_hz,
-        axes: resolved.channels.iter().map(|m| m.axis).collect(),
-        data,
-        provenance: Provenance {
-            path,
-            format: InputFormat::Csv,
-            kind: InputKind::Series,
-            quantity,
-            axis_map: resolved.map.to_string(),
-            start_time,
-            notes,
-        },
-    })
+    notes.push(units_note(&plan));
+    let provenance = Provenance {
+        path,
+        format: InputFormat::Csv,
+        kind: InputKind::Series,
+        quantity: plan.quantity,
+        axis_map: resolved.map.to_string(),
+        start_time,
+        notes,
+    };
+    Ok(into_series(&plan, data, sample_rate_hz, provenance))
 }
 
 /// Checks that the (strictly increasing) times are uniform and returns `dt`.

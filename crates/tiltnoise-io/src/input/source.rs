@@ -1,47 +1,47 @@
-//! [`TiltSeriesSource`]: streaming access to an HDF5 tilt time series (schema
+//! [`TiltSeriesSource`]: streaming access to an HDF5 time series of the floor's motion (schema
 //! `tiltnoise.tilt_series`), chunk by chunk, in bounded memory.
 
 use super::h5::{self, h5err, AttrValue};
-use super::meta::{decide_quantity, series_factors, series_unit, Declared, SERIES_UNITS};
+use super::series_units::{self, check_unstated, into_series, Plan, Stated};
 use super::Mapped;
 use super::{check_sample_rate, require_two, InputError};
-use super::{gap_note, ChannelCtx, Gap, GapScanner, TiltSeries};
+use super::{gap_note, ChannelCtx, DetrendedRms, Gap, GapScanner, GroundChannel, TiltSeries};
 use super::{GapPolicy, InputFormat, InputKind, Provenance, Quantity, ReadOptions, SeriesSource};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::Num;
 use tiltnoise_core::limits::{check_count, MAX_STREAMED_SAMPLES};
-use tiltnoise_core::model::TiltAxis;
 
 /// Samples per channel read at a time by the scanning pass at open (2 MiB of `f64`).
 const SCAN_BLOCK: usize = 1 << 18;
 
-/// An open HDF5 tilt time series read in chunks.
+/// An open HDF5 time series of the floor's motion read in chunks.
 ///
-/// [`TiltSeriesSource::read_chunk`] returns samples `start .. start + len` of every axis as
-/// tilt angle (rad) or rate (rad/s, [`TiltSeriesSource::quantity`]; a rate is not integrated:
-/// its spectra are converted, see [`tiltnoise_core::input::rate`]) in the crate's sign
-/// convention: the axis map and sign applied, finiteness validated (errors name the absolute
-/// sample index) or gaps bridged. The values are **bit-identical** to those of
-/// [`super::read_tilt_series`] for any chunking, and chunks may be read in any order.
+/// [`TiltSeriesSource::read_chunk`] returns samples `start .. start + len` of every channel
+/// ([`TiltSeriesSource::channels`]: tilt angle in rad or rate in rad/s, translations in m, m/s
+/// or m/s^2; nothing is integrated: the spectra are converted, see
+/// [`tiltnoise_core::input::GroundMap`]) in the crate's sign convention: the axis map and sign
+/// applied, finiteness validated (errors name the absolute sample index) or gaps bridged. The
+/// values are **bit-identical** to those of [`super::read_tilt_series`] for any chunking, and
+/// chunks may be read in any order.
 ///
 /// # Cost and memory
 ///
 /// At most [`MAX_STREAMED_SAMPLES`] per channel. Opening reads only metadata, except when gaps
-/// are interpolated: then one streaming pass over every mapped channel (in blocks of 2^18
-/// samples) records the interior gaps (32 bytes per gap). A chunk costs `n_axes * len * 8`
-/// bytes.
+/// are interpolated or a tilt channel's unit is not stated: then one streaming pass over every
+/// mapped channel (in blocks of 2^18 samples) records the interior gaps (32 bytes per gap) and
+/// checks the detrended RMS of the channels without a unit. A chunk costs
+/// `n_channels * len * 8` bytes.
 #[derive(Debug)]
 pub struct TiltSeriesSource {
     path: PathBuf,
     _file: hdf5::File,
     datasets: Vec<hdf5::Dataset>,
     channels: Vec<Mapped>,
-    /// Per channel: sign times the factor into rad or rad/s (units prefix, scale).
+    /// Per channel: the factor into SI (units prefix, scale), before the sign.
     factors: Vec<f64>,
-    axes: Vec<TiltAxis>,
+    plan: Plan,
     sample_rate_hz: f64,
     len: usize,
-    quantity: Quantity,
     policy: GapPolicy,
     gaps: Vec<Vec<Gap>>,
     provenance: Provenance,
@@ -105,14 +105,30 @@ impl TiltSeriesSource {
             Some(name) => vec![name.clone()],
             None => h5::root_datasets(path, &group)?,
         };
+        let mut unit_notes = Vec::new();
+        let in_file = available
+            .iter()
+            .map(|n| stated_unit(path, &group, &prefix, n))
+            .collect::<Result<Vec<_>, _>>()?;
+        let stated = series_units::merge_given(
+            path,
+            &available,
+            in_file,
+            &opts.units,
+            "dataset",
+            &mut unit_notes,
+        )?;
+        let motions = series_units::motions(path, &available, &stated)?;
         let resolved = h5::resolve_axes(
             path,
             &available,
+            &motions,
             "dataset",
             opts,
             file_map.as_ref(),
             &mut notes,
         )?;
+        notes.extend(unit_notes);
         let has_rate = object.is_none() && h5::attr(path, &file, "/", "sample_rate_hz")?.is_some();
         let gwpy = resolved
             .channels
@@ -125,8 +141,6 @@ impl TiltSeriesSource {
         };
 
         let mut datasets = Vec::new();
-        let mut declared = Vec::new();
-        let mut undeclared = Vec::new();
         let mut first_len: Option<(String, usize)> = None;
         for m in &resolved.channels {
             let name = format!("{prefix}/{}", m.source);
@@ -158,13 +172,11 @@ impl TiltSeriesSource {
                 }
                 Some(_) => {}
             }
-            declare_units(path, &ds, &name, &m.source, &mut declared, &mut undeclared)?;
             datasets.push(ds);
         }
-        let quantity = decide_quantity(path, opts.quantity, &declared, &undeclared, &mut notes)?;
         super::check_scales(path, &opts.scale, &available, "dataset")?;
-        let mapped: Vec<String> = resolved.channels.iter().map(|m| m.source.clone()).collect();
-        let factors = series_factors(path, &mapped, &declared, &opts.scale, &mut notes)?;
+        let plan = series_units::plan(path, &resolved, &stated, opts, &mut notes)?;
+        let factors = plan.channels.iter().map(|p| p.factor).collect();
         let (first_name, len) = first_len.unwrap_or_default();
         require_two(path, &format!("dataset /{first_name}"), len, "samples")?;
         check_count(
@@ -179,16 +191,16 @@ impl TiltSeriesSource {
             ));
         }
 
+        let quantity = plan.quantity;
         let mut src = TiltSeriesSource {
             path: path.to_path_buf(),
             _file: file,
             datasets,
-            axes: resolved.channels.iter().map(|m| m.axis).collect(),
             channels: resolved.channels.clone(),
             factors,
+            plan,
             sample_rate_hz,
             len,
-            quantity,
             policy: opts.gaps,
             gaps: vec![Vec::new(); resolved.channels.len()],
             provenance: Provenance {
@@ -201,40 +213,57 @@ impl TiltSeriesSource {
                 notes,
             },
         };
-        if opts.gaps == GapPolicy::Interpolate {
-            src.scan()?;
+        src.provenance
+            .notes
+            .push(series_units::units_note(&src.plan));
+        for ch in 0..src.channels.len() {
+            if opts.gaps == GapPolicy::Interpolate || src.plan.channels[ch].unstated {
+                src.scan(ch)?;
+            }
         }
         Ok(src)
     }
 
-    /// The scanning pass: the interior gaps of every channel.
-    fn scan(&mut self) -> Result<(), InputError> {
-        for ch in 0..self.channels.len() {
-            let source = self.channels[ch].source.clone();
-            let ctx = ChannelCtx {
-                path: &self.path,
-                channel: &source,
-                unit: self.quantity.unit(),
-            };
-            let mut scanner = GapScanner::new(self.policy, self.len);
-            let mut pos = 0;
-            while pos < self.len {
-                let n = SCAN_BLOCK.min(self.len - pos);
-                let mut block = self.read_raw(ch, pos, n)?;
-                let (s, f) = (self.channels[ch].sign.factor(), self.factors[ch]);
-                for v in &mut block {
-                    *v = s * (f * *v);
-                }
+    /// The scanning pass over channel `ch`: its interior gaps (when they are interpolated; a
+    /// rejected gap is found where it is read), and the detrended RMS of a channel whose unit
+    /// is not stated, checked against its bound.
+    fn scan(&mut self, ch: usize) -> Result<(), InputError> {
+        let source = self.channels[ch].source.clone();
+        let planned = self.plan.channels[ch];
+        let ctx = ChannelCtx {
+            path: &self.path,
+            channel: &source,
+            unit: planned.unit(),
+        };
+        let mut scanner = GapScanner::new(self.policy, self.len);
+        let mut rms = DetrendedRms::new(self.len);
+        let mut pos = 0;
+        while pos < self.len {
+            let n = SCAN_BLOCK.min(self.len - pos);
+            let mut block = self.read_raw(ch, pos, n)?;
+            let (s, f) = (self.channels[ch].sign.factor(), self.factors[ch]);
+            for v in &mut block {
+                *v = s * (f * *v);
+            }
+            if self.policy == GapPolicy::Interpolate {
                 scanner.push(&block, &ctx)?;
-                pos += n;
             }
-            let gaps = scanner.finish(&ctx)?;
-            let bridged: usize = gaps.iter().map(|g| g.after - g.before - 1).sum();
-            if bridged > 0 {
-                self.provenance.notes.push(gap_note(&source, bridged));
-            }
-            self.gaps[ch] = gaps;
+            rms.push(&block);
+            pos += n;
         }
+        let gaps = scanner.finish(&ctx)?;
+        check_unstated(
+            &self.path,
+            &source,
+            &planned,
+            rms.finish(),
+            self.sample_rate_hz,
+        )?;
+        let bridged: usize = gaps.iter().map(|g| g.after - g.before - 1).sum();
+        if bridged > 0 {
+            self.provenance.notes.push(gap_note(&source, bridged));
+        }
+        self.gaps[ch] = gaps;
         Ok(())
     }
 
@@ -262,7 +291,7 @@ impl TiltSeriesSource {
         let ctx = ChannelCtx {
             path: &self.path,
             channel: &self.channels[ch].source,
-            unit: self.quantity.unit(),
+            unit: self.plan.channels[ch].unit(),
         };
         for (i, x) in v.iter_mut().enumerate() {
             let y = s * (f * *x);
@@ -296,15 +325,15 @@ impl TiltSeriesSource {
         self.len == 0
     }
 
-    /// The axes, in canonical order; [`TiltSeriesSource::read_chunk`] returns one vector per
-    /// entry.
-    pub fn axes(&self) -> &[TiltAxis] {
-        &self.axes
+    /// The channels, in canonical input order; [`TiltSeriesSource::read_chunk`] returns one
+    /// vector per entry.
+    pub fn channels(&self) -> Vec<GroundChannel> {
+        self.plan.channels.iter().map(|p| p.channel).collect()
     }
 
-    /// The quantity of the samples: angle (rad) or rate (rad/s), as stored in the file.
+    /// The quantity of the tilt channels: angle (rad) or rate (rad/s), as stored in the file.
     pub fn quantity(&self) -> Quantity {
-        self.quantity
+        self.plan.quantity
     }
 
     /// Provenance (the notes include the gaps bridged during the scanning pass).
@@ -312,7 +341,7 @@ impl TiltSeriesSource {
         &self.provenance
     }
 
-    /// Samples `start .. start + len` of every axis, tilt angle (rad) or rate (rad/s).
+    /// Samples `start .. start + len` of every channel, in the SI unit of its quantity.
     ///
     /// # Errors
     ///
@@ -350,12 +379,12 @@ impl TiltSeriesSource {
             .map_or(String::new(), |m| format!("/{}", m.source));
         h5::check_whole_read(&self.path, &first, self.len, self.channels.len(), "samples")?;
         let data = self.read_chunk(0, self.len)?;
-        Ok(TiltSeries {
-            sample_rate_hz: self.sample_rate_hz,
-            axes: self.axes.clone(),
+        Ok(into_series(
+            &self.plan,
             data,
-            provenance: self.provenance.clone(),
-        })
+            self.sample_rate_hz,
+            self.provenance.clone(),
+        ))
     }
 }
 
@@ -364,21 +393,47 @@ impl SeriesSource for TiltSeriesSource {
         TiltSeriesSource::sample_rate_hz(self)
     }
 
-    fn quantity(&self) -> Quantity {
-        TiltSeriesSource::quantity(self)
-    }
-
     fn len(&self) -> usize {
         TiltSeriesSource::len(self)
     }
 
-    fn axes(&self) -> &[TiltAxis] {
-        TiltSeriesSource::axes(self)
+    fn channels(&self) -> Vec<GroundChannel> {
+        TiltSeriesSource::channels(self)
     }
 
     fn read_chunk(&mut self, start: usize, len: usize) -> Result<Vec<Vec<f64>>, InputError> {
         TiltSeriesSource::read_chunk(self, start, len)
     }
+}
+
+/// The unit attribute (`units`, else `unit`) of dataset `name` of `group`, if it has one; a
+/// dataset that cannot be opened has none here (opening it fails, naming it, if it is mapped).
+fn stated_unit(
+    path: &Path,
+    group: &hdf5::Group,
+    prefix: &str,
+    name: &str,
+) -> Result<Option<Stated>, InputError> {
+    let Ok(ds) = group.dataset(name) else {
+        return Ok(None);
+    };
+    let object = format!("dataset {prefix}/{name}");
+    let units = match h5::attr(path, &ds, &object, "units")? {
+        None => h5::attr(path, &ds, &object, "unit")?,
+        some => some,
+    };
+    let origin = format!("attribute `units` of {object}");
+    Ok(match units {
+        None => None,
+        Some(AttrValue::Str(u)) => Some(Stated::in_file(&u, origin)),
+        Some(other) => Some(Stated {
+            text: other.describe(),
+            parsed: None,
+            origin,
+            assumed: false,
+            counts: false,
+        }),
+    })
 }
 
 /// The sample rate of gwpy TimeSeries datasets: `1 / dx` of their attribute `dx` (s), which
@@ -463,49 +518,4 @@ fn gwpy_rate(
         ))
     ));
     Ok(rate)
-}
-
-/// The `units` (or gwpy's `unit`) attribute of dataset `name`: a series unit goes to
-/// `declared`, no attribute puts `source` in `undeclared`.
-fn declare_units(
-    path: &Path,
-    ds: &hdf5::Dataset,
-    name: &str,
-    source: &str,
-    declared: &mut Vec<Declared>,
-    undeclared: &mut Vec<String>,
-) -> Result<(), InputError> {
-    let object = format!("dataset {name}");
-    let units = match h5::attr(path, ds, &object, "units")? {
-        None => h5::attr(path, ds, &object, "unit")?,
-        some => some,
-    };
-    match units {
-        None => undeclared.push(source.to_string()),
-        Some(AttrValue::Str(u)) => match series_unit(&u) {
-            Some(q) => declared.push(Declared {
-                channel: source.to_string(),
-                unit: u,
-                quantity: q.quantity,
-                factor: q.factor,
-            }),
-            None => {
-                return Err(InputError::Units {
-                    path: path.to_path_buf(),
-                    location: format!("attribute `units` of {object}"),
-                    value: u,
-                    allowed: SERIES_UNITS,
-                })
-            }
-        },
-        Some(other) => {
-            return Err(InputError::Units {
-                path: path.to_path_buf(),
-                location: format!("attribute `units` of {object}"),
-                value: other.describe(),
-                allowed: SERIES_UNITS,
-            })
-        }
-    }
-    Ok(())
 }

@@ -23,8 +23,7 @@ pub(crate) fn read(
         quantity,
         start_time,
         mut notes,
-        ..
-    } = csv::interpret(&path, &prelude, opts, asd_unit, ASD_UNITS)?;
+    } = csv::interpret_spectra(&path, &prelude, opts, asd_unit, ASD_UNITS)?;
     notes.push("CSV spectra: axes taken as uncorrelated (off-diagonal CSD = 0)".to_string());
     let unit = quantity.asd_unit();
 
@@ -93,7 +92,11 @@ pub(crate) fn read(
             Complex64::new(0.0, 0.0)
         }
     });
-    let axes: Vec<_> = resolved.channels.iter().map(|c| c.axis).collect();
+    let axes: Vec<_> = resolved
+        .channels
+        .iter()
+        .filter_map(|c| c.tilt_axis())
+        .collect();
     check_csd_finite(&path, &freqs, &axes, &csd)?;
     Ok(TiltSpectra {
         freqs_hz: freqs,

@@ -61,11 +61,13 @@ pub(crate) fn read(
     let resolved = h5::resolve_axes(
         path,
         available,
+        &vec![None; available.len()],
         "dataset",
         opts,
         file_map.as_ref(),
         &mut notes,
     )?;
+    super::refuse_translation_spectra(path, &resolved)?;
     let mut grid: Option<(String, f64, f64, usize)> = None;
     let mut values: Vec<Vec<f64>> = Vec::new();
     let mut declared = Vec::new();
@@ -141,7 +143,11 @@ pub(crate) fn read(
             Complex64::new(0.0, 0.0)
         }
     });
-    let axes: Vec<_> = resolved.channels.iter().map(|c| c.axis).collect();
+    let axes: Vec<_> = resolved
+        .channels
+        .iter()
+        .filter_map(|c| c.tilt_axis())
+        .collect();
     check_csd_finite(path, &freqs, &axes, &csd)?;
     Ok(TiltSpectra {
         freqs_hz: freqs,
@@ -223,7 +229,6 @@ fn unit_and_density(
                 channel: m.source.clone(),
                 unit: u.clone(),
                 quantity: unit.quantity,
-                factor: unit.factor,
             });
             d
         }

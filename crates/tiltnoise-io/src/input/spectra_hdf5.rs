@@ -2,7 +2,9 @@
 //! `[n, n_axes]` or `/csd` `[n, n_axes, n_axes]` (complex), root attribute `axes`.
 
 use super::h5::{self, h5err, AttrValue};
-use super::meta::{asd_unit, csd_unit, decide_quantity, Declared, Unit, ASD_UNITS, CSD_UNITS};
+use super::meta::{
+    asd_unit, csd_unit, decide_quantity, Declared, SpectrumUnit, ASD_UNITS, CSD_UNITS,
+};
 use super::{assemble, check_csd_finite, TiltSpectra, CSD_RTOL};
 use super::{frequency_refusal, require_two, InputError};
 use super::{InputFormat, InputKind, Provenance, Quantity, ReadOptions, ACCEPTED_LAYOUTS};
@@ -68,11 +70,13 @@ pub(crate) fn read(
     let resolved = h5::resolve_axes(
         path,
         &names,
+        &vec![None; names.len()],
         "axis name",
         opts,
         file_map.as_ref(),
         &mut notes,
     )?;
+    super::refuse_translation_spectra(path, &resolved)?;
     let mapped: Vec<String> = resolved.channels.iter().map(|c| c.source.clone()).collect();
     let (declared, undeclared) = match declared {
         Some(d) => (
@@ -91,7 +95,11 @@ pub(crate) fn read(
     let csd = assemble(&freqs, &resolved.channels, quantity, |k, a, b| {
         src[(k * m + a) * m + b]
     });
-    let axes: Vec<_> = resolved.channels.iter().map(|c| c.axis).collect();
+    let axes: Vec<_> = resolved
+        .channels
+        .iter()
+        .filter_map(|c| c.tilt_axis())
+        .collect();
     check_csd_finite(path, &freqs, &axes, &csd)?;
     Ok(TiltSpectra {
         freqs_hz: freqs,
@@ -191,7 +199,7 @@ fn units(
     path: &Path,
     ds: &hdf5::Dataset,
     name: &str,
-    classify: fn(&str) -> Option<Unit>,
+    classify: fn(&str) -> Option<SpectrumUnit>,
     allowed: &'static str,
 ) -> Result<Option<Declared>, InputError> {
     let object = format!("dataset /{name}");
@@ -208,7 +216,6 @@ fn units(
                 channel: String::new(),
                 unit: u,
                 quantity: q.quantity,
-                factor: q.factor,
             })),
             None => Err(bad(u)),
         },
@@ -223,7 +230,7 @@ struct ValuesKind {
     /// Checks the element type; returns whether it fits and the type's description.
     is_type: fn(&hdf5::Dataset) -> hdf5::Result<(bool, String)>,
     /// Recognises the units of its `units` attribute.
-    classify: fn(&str) -> Option<Unit>,
+    classify: fn(&str) -> Option<SpectrumUnit>,
     /// The accepted units, for messages.
     units_allowed: &'static str,
 }

@@ -3,21 +3,24 @@
 //! one channel per SEED code `NET.STA.LOC.CHA`, chosen with the axis map (full codes or bare
 //! channel codes such as `LJE`; by default the rotation channels `?JE`, `?JN`, `?JZ`).
 //!
-//! miniSEED stores no units. The quantity comes from the options, else from the instrument
-//! code (second letter of the channel code): `J` (rotation sensor) is a rate (rad/s), `A`
-//! (tiltmeter) an angle (rad). Integer samples (INT16, INT32, Steim-1, Steim-2) are digitizer
-//! counts and need a scale factor per channel ([`super::ChannelScale`]); floating-point
-//! samples (FLOAT32, FLOAT64) are taken to be in rad or rad/s already, which the provenance
-//! says. See `docs/input_formats.md`.
+//! miniSEED stores no units. A channel's unit comes from the options (`ReadOptions::units`),
+//! else, for a tilt channel, from the options' quantity or the instrument code (second letter
+//! of the channel code): `J` (rotation sensor) is a rate (rad/s), `A` (tiltmeter) an angle
+//! (rad). Seismometer and accelerometer channels (`H`, `L`, `N`, `P`) are translations and
+//! need their unit from the options. Integer samples (INT16, INT32, Steim-1, Steim-2) are
+//! digitizer counts and need a scale factor per channel ([`super::ChannelScale`]);
+//! floating-point samples (FLOAT32, FLOAT64) are taken to be in their unit already, which the
+//! provenance says. See `docs/input_formats.md`.
 
 mod channels;
 mod record;
 mod steim;
 
-use super::meta::{decide_quantity, Declared};
+use super::series_units::{self, check_unstated_data, into_series, units_note, Planned, Stated};
+use super::TiltSeries;
 use super::{check_sample_rate, Provenance, Quantity, ReadOptions};
-use super::{check_scales, gap_note, process_channel, require_two, scale_for, scale_note};
-use super::{resolve, ChannelCtx, InputError, MapOrigin, Mapped, Resolved, TiltSeries};
+use super::{check_scales, gap_note, process_channel, require_two, scale_for};
+use super::{resolve, ChannelCtx, ChannelUnit, InputError, MapOrigin, Mapped, Resolved};
 use super::{AxisMap, AxisMapEntry, ChannelScale, GapPolicy, InputFormat, InputKind};
 use channels::{Channel, Placed};
 use std::io::Read;
@@ -165,6 +168,31 @@ fn full_scales(
     Ok(out)
 }
 
+/// The units given in the options, with channel codes replaced by full SEED codes.
+fn full_units(
+    path: &Path,
+    units: &[ChannelUnit],
+    ids: &[String],
+) -> Result<Vec<ChannelUnit>, InputError> {
+    units
+        .iter()
+        .map(|u| {
+            Ok(ChannelUnit {
+                channel: full_code(path, &u.channel, ids)?.unwrap_or_else(|| u.channel.clone()),
+                ..u.clone()
+            })
+        })
+        .collect()
+}
+
+/// Channel names of the options (sensor declarations) as full SEED codes.
+fn full_names(path: &Path, names: &[String], ids: &[String]) -> Result<Vec<String>, InputError> {
+    names
+        .iter()
+        .map(|n| Ok(full_code(path, n, ids)?.unwrap_or_else(|| n.clone())))
+        .collect()
+}
+
 /// The quantity an instrument code says: `J` rotation sensor -> rate, `A` tiltmeter -> angle.
 fn code_quantity(id: &str) -> Option<(Quantity, &'static str)> {
     let cha = id.rsplit('.').next().unwrap_or("");
@@ -173,6 +201,15 @@ fn code_quantity(id: &str) -> Option<(Quantity, &'static str)> {
         Some(b'A') => Some((Quantity::Angle, "instrument code A: tiltmeter, rad")),
         _ => None,
     }
+}
+
+/// The unit an instrument code implies, as an assumption the options may replace.
+fn code_unit(id: &str) -> Option<Stated> {
+    let (quantity, why) = code_quantity(id)?;
+    Some(Stated {
+        assumed: true,
+        ..Stated::in_file(quantity.unit(), why.to_string())
+    })
 }
 
 /// Reads a miniSEED 2 file as a tilt time series.
@@ -190,7 +227,18 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
         Some(m) => MapOrigin::Options(m),
         None => MapOrigin::Default,
     };
-    let resolved = resolve(path, &ids, origin, "channel")?;
+    let given = full_units(path, &opts.units, &ids)?;
+    let mut unit_notes = Vec::new();
+    let stated = series_units::merge_given(
+        path,
+        &ids,
+        ids.iter().map(|id| code_unit(id)).collect(),
+        &given,
+        "channel",
+        &mut unit_notes,
+    )?;
+    let motions = series_units::motions(path, &ids, &stated)?;
+    let resolved = resolve(path, &ids, &motions, origin, "channel")?;
     let scales = full_scales(path, &opts.scale, &ids)?;
     let mut notes = vec![format!(
         "miniSEED 2: {} records, channels {}{}",
@@ -203,35 +251,46 @@ pub(crate) fn read(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputE
         }
     )];
     notes.extend(resolved.notes.iter().cloned());
+    notes.extend(unit_notes);
 
     let groups: Vec<Option<Vec<Placed>>> = groups.into_iter().map(|(_, v)| Some(v)).collect();
     let chans = merge_mapped(path, groups, &resolved)?;
     let span = common_span(path, &chans, &mut notes)?;
-    let quantity = quantity_from_codes(path, &chans, opts.quantity, &mut notes)?;
+    check_tilt_units(path, &resolved, &chans, &stated, opts.quantity, &mut notes)?;
+    let sensor_opts = ReadOptions {
+        scale: scales.clone(),
+        corrected: full_names(path, &opts.corrected, &ids)?,
+        pendulum: full_names(path, &opts.pendulum, &ids)?,
+        ..opts.clone()
+    };
+    let plan = series_units::plan(path, &resolved, &stated, &sensor_opts, &mut notes)?;
     let mut data = Vec::new();
-    for ((m, ch), &k) in resolved.channels.iter().zip(&chans).zip(&span.starts) {
+    for (((m, ch), &k), planned) in resolved
+        .channels
+        .iter()
+        .zip(&chans)
+        .zip(&span.starts)
+        .zip(&plan.channels)
+    {
         let part = ChannelPart {
             start: k,
             len: span.len,
         };
-        data.push(channel_samples(
-            path, m, ch, part, &scales, opts, quantity, &mut notes,
-        )?);
+        let v = channel_samples(path, m, ch, part, planned, &scales, opts, &mut notes)?;
+        check_unstated_data(path, &m.source, planned, &v, span.rate)?;
+        data.push(v);
     }
-    Ok(TiltSeries {
-        sample_rate_hz: span.rate,
-        axes: resolved.channels.iter().map(|m| m.axis).collect(),
-        data,
-        provenance: Provenance {
-            path: path.to_path_buf(),
-            format: InputFormat::Miniseed,
-            kind: InputKind::Series,
-            quantity,
-            axis_map: resolved.map.to_string(),
-            start_time: Some(chans[0].time(span.starts[0])),
-            notes,
-        },
-    })
+    notes.push(units_note(&plan));
+    let provenance = Provenance {
+        path: path.to_path_buf(),
+        format: InputFormat::Miniseed,
+        kind: InputKind::Series,
+        quantity: plan.quantity,
+        axis_map: resolved.map.to_string(),
+        start_time: Some(chans[0].time(span.starts[0])),
+        notes,
+    };
+    Ok(into_series(&plan, data, span.rate, provenance))
 }
 
 /// Merges the records of the mapped channels only (a file of many channels costs the memory of
@@ -351,45 +410,40 @@ fn common_span(
     Ok(Span { rate, starts, len })
 }
 
-/// The quantity: the options', else the one the instrument codes say (miniSEED stores no
-/// units), with a note per channel.
-fn quantity_from_codes(
+/// Notes the units the instrument codes imply (miniSEED stores none), and refuses a tilt
+/// channel whose unit nothing gives: neither the options, nor the quantity, nor its code.
+fn check_tilt_units(
     path: &Path,
+    resolved: &Resolved,
     chans: &[Channel],
-    given: Option<Quantity>,
+    stated: &[Option<Stated>],
+    quantity: Option<Quantity>,
     notes: &mut Vec<String>,
-) -> Result<Quantity, InputError> {
-    let mut declared = Vec::new();
-    for ch in chans {
-        match code_quantity(&ch.id) {
-            Some((q, why)) => {
-                notes.push(format!(
-                    "channel {}: {why} (miniSEED stores no units)",
-                    ch.id
-                ));
-                declared.push(Declared {
-                    channel: ch.id.clone(),
-                    unit: q.unit().to_string(),
-                    quantity: Some(q),
-                    factor: 1.0,
-                })
-            }
-            None if given.is_none() => {
+) -> Result<(), InputError> {
+    for (m, ch) in resolved.channels.iter().zip(chans) {
+        match &stated[m.index] {
+            Some(s) if s.assumed => notes.push(format!(
+                "channel {}: {} (miniSEED stores no units)",
+                ch.id, s.origin
+            )),
+            Some(_) => {}
+            None if quantity.is_none() && m.tilt_axis().is_some() => {
                 return Err(fault(
                     path,
                     None,
                     format!(
                         "channel {}: miniSEED stores no units and the instrument code (second \
                          letter of the channel code) is neither J (rotation sensor, rad/s) nor A \
-                         (tiltmeter, rad); allowed: give the quantity explicitly (angle or rate)",
-                        ch.id
+                         (tiltmeter, rad); allowed: give its unit (units {}=rad/s) or the \
+                         quantity explicitly (angle or rate)",
+                        ch.id, ch.id
                     ),
                 ))
             }
             None => {}
         }
     }
-    decide_quantity(path, given, &declared, &[], notes)
+    Ok(())
 }
 
 /// Samples `start .. start + len` of a channel.
@@ -399,33 +453,31 @@ struct ChannelPart {
     len: usize,
 }
 
-/// The samples of channel `ch` (mapped by `m`) in `part`, scaled into the quantity's unit,
-/// signed by the map and with gaps handled by the gap policy; notes for each assumption.
+/// The samples of channel `ch` (mapped by `m`, planned as `planned`) in `part`, scaled into
+/// its unit, signed by the map and with gaps handled by the gap policy; notes for each
+/// assumption.
 #[allow(clippy::too_many_arguments)]
 fn channel_samples(
     path: &Path,
     m: &Mapped,
     ch: &Channel,
     part: ChannelPart,
+    planned: &Planned,
     scales: &[ChannelScale],
     opts: &ReadOptions,
-    quantity: Quantity,
     notes: &mut Vec<String>,
 ) -> Result<Vec<f64>, InputError> {
     let (k, len) = (part.start, part.len);
-    let unit = quantity.unit();
-    let factor = match (scale_for(scales, &ch.id), ch.counts) {
-        (Some(f), _) => {
-            notes.push(scale_note(&ch.id, f, "given explicitly"));
-            f
-        }
+    let unit = planned.unit();
+    match (scale_for(scales, &ch.id), ch.counts) {
+        (Some(_), _) => {}
         (None, true) => {
             return Err(InputError::Scale {
                 path: path.to_path_buf(),
                 channel: ch.id.clone(),
                 message: format!(
-                    "holds digitizer counts ({}); allowed: give a scale CHANNEL=FACTOR \
-                     with the {unit} per count of the instrument's response",
+                    "holds digitizer counts ({}); allowed: give a scale CHANNEL=FACTOR with the \
+                     {unit} per count of the instrument's response",
                     ch.encodings.join(", ")
                 ),
             })
@@ -437,9 +489,8 @@ fn channel_samples(
                 ch.id,
                 ch.encodings.join(", ")
             ));
-            1.0
         }
-    };
+    }
     if opts.gaps == GapPolicy::Reject {
         if let Some(&(a, b)) = ch.gaps.iter().find(|&&(a, b)| b > k && a < k + len) {
             return Err(fault(
@@ -447,8 +498,8 @@ fn channel_samples(
                 None,
                 format!(
                     "channel {}: no records for {} samples from {} to {} (sample indices \
-                     {}..={} of the series); allowed: no gaps, or gap interpolation to \
-                     bridge interior gaps linearly",
+                     {}..={} of the series); allowed: no gaps, or gap interpolation to bridge \
+                     interior gaps linearly",
                     ch.id,
                     b - a,
                     ch.time(a),
@@ -470,7 +521,7 @@ fn channel_samples(
             ch.overlapping
         ));
     }
-    let s = m.sign.factor();
+    let (s, factor) = (m.sign.factor(), planned.factor);
     let mut v: Vec<f64> = ch.data[k..k + len]
         .iter()
         .map(|x| s * (factor * x))
