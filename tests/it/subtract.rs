@@ -689,6 +689,14 @@ fn bad_input_is_refused_without_output() {
             vec!["environment.temperature_k", "not a free parameter"],
         ),
         (
+            vec![p("m.h5"), "--fit".into(), "asymmetry.tm_com_x_m".into()],
+            vec![
+                "asymmetry.tm_com_x_m",
+                "not fitted by subtract",
+                "with `fit`",
+            ],
+        ),
+        (
             vec![p("m.h5"), "--nperseg".into(), "4096".into()],
             vec!["m.h5", "overlap for 4096 samples", "--nperseg"],
         ),

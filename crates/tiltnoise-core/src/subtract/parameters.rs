@@ -193,6 +193,11 @@ fn not_free_reason(key: &str, value: f64) -> String {
                                fitted with the model's damping held fixed)"
             .to_string(),
         "environment" => "it does not enter the tilt transfer functions".to_string(),
+        "asymmetry" => "the assembly's offsets are not fitted by subtract (its fit boxes are \
+                        relative to a nominal value, and the pendulum as built is evaluated \
+                        by methods other than the one the subtraction uses); fit them to the \
+                        mode frequencies and visibilities with `fit`"
+            .to_string(),
         _ if value == 0.0 => "its nominal value is 0, so it has no scale to fit".to_string(),
         _ => "it is not a parameter of the tilt transfer functions".to_string(),
     }
