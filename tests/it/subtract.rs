@@ -690,11 +690,7 @@ fn bad_input_is_refused_without_output() {
         ),
         (
             vec![p("m.h5"), "--fit".into(), "asymmetry.tm_com_x_m".into()],
-            vec![
-                "asymmetry.tm_com_x_m",
-                "not fitted by subtract",
-                "with `fit`",
-            ],
+            vec!["asymmetry.tm_com_x_m", "gives it none", "[uncertainty]"],
         ),
         (
             vec![p("m.h5"), "--nperseg".into(), "4096".into()],

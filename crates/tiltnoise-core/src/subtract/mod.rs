@@ -883,3 +883,14 @@ fn check_config(
 fn names<'a>(it: impl Iterator<Item = &'a str>) -> String {
     it.collect::<Vec<_>>().join(", ")
 }
+
+/// The method of the subtraction's transfer functions: `split` (full relative accuracy on
+/// every entry) for the symmetric pendulum, `polezero` for the pendulum as built (split serves
+/// only the symmetric model's blocks).
+pub(crate) fn method_for(model: &Model) -> crate::tf::Method {
+    if model.is_symmetric() {
+        crate::tf::Method::Split
+    } else {
+        crate::tf::Method::PoleZero
+    }
+}

@@ -4,6 +4,7 @@
 
 use super::SubtractError;
 use crate::fit::jacobian::with_value;
+use crate::params::uncertainty::is_absolute_key;
 use crate::params::Params;
 
 /// Half-width of the box of a gain, in its logarithm: the gain stays within `[1/2, 2]`.
@@ -27,7 +28,17 @@ pub const NOISE_LN_MAX_HALF_WIDTH: f64 = 1.386_294_361_119_890_6;
 
 /// Parameter files' sections whose keys `subtract` may fit: everything that shapes the
 /// undamped transfer functions from the floor.
-pub const FREE_SECTIONS: [&str; 5] = ["mass", "inertia", "torsion", "bouncing", "length"];
+pub const FREE_SECTIONS: [&str; 6] = [
+    "mass",
+    "inertia",
+    "torsion",
+    "bouncing",
+    "length",
+    "asymmetry",
+];
+/// Half-widths of the box of an assembly offset tried in turn, in units of its absolute error
+/// bar from the parameter file: the first whose edges are physical is used.
+pub const OFFSET_HALF_WIDTH_SIGMAS: [f64; 3] = [3.0, 2.0, 1.0];
 /// The one environment key that may be fitted.
 pub const FREE_ENVIRONMENT_KEY: &str = "environment.g_m_per_s2";
 
@@ -133,6 +144,10 @@ pub(crate) fn key_params(base: &Params, keys: &[String]) -> Result<Vec<Param>, S
             return Err(SubtractError::DuplicateKey { key: key.clone() });
         }
         let p0 = field.value;
+        if is_absolute_key(key) {
+            out.push(offset_param(base, key, p0, field.unit, &sigmas, &allowed)?);
+            continue;
+        }
         let half_width = KEY_HALF_WIDTHS
             .iter()
             .map(|h| h * p0.abs())
@@ -180,10 +195,62 @@ pub fn allowed_keys(params: &Params) -> Vec<&'static str> {
         .iter()
         .filter(|f| {
             let section = f.key.split('.').next().unwrap_or("");
-            (FREE_SECTIONS.contains(&section) || f.key == FREE_ENVIRONMENT_KEY) && f.value != 0.0
+            (FREE_SECTIONS.contains(&section) || f.key == FREE_ENVIRONMENT_KEY)
+                && (f.value != 0.0 || is_absolute_key(f.key))
         })
         .map(|f| f.key)
         .collect()
+}
+
+/// The parameter of an assembly offset (`asymmetry.*`, nominal usually 0): its scale and prior
+/// are the absolute error bar of the parameter file, which it must have; its box the largest of
+/// [`OFFSET_HALF_WIDTH_SIGMAS`] error bars whose edges stay within the body.
+fn offset_param(
+    base: &Params,
+    key: &str,
+    p0: f64,
+    unit: &str,
+    sigmas: &[crate::params::uncertainty::Uncertainty],
+    allowed: &str,
+) -> Result<Param, SubtractError> {
+    let sigma = sigmas
+        .iter()
+        .find(|u| u.key == key)
+        .map_or(0.0, |u| u.abs_sigma);
+    let not_free = |reason: String| SubtractError::NotFreeKey {
+        key: key.to_string(),
+        reason,
+        allowed: allowed.to_string(),
+    };
+    if sigma <= 0.0 || !sigma.is_finite() {
+        return Err(not_free(format!(
+            "an assembly offset is fitted within its error bar, and the parameter file gives it \
+             none (give an absolute sigma in {unit} in [uncertainty], e.g. \
+             \"{key}\" = {{ sigma = 1e-3 }})"
+        )));
+    }
+    let half_width = OFFSET_HALF_WIDTH_SIGMAS
+        .iter()
+        .map(|k| k * sigma)
+        .find(|&hw| {
+            [p0 - hw, p0 + hw]
+                .iter()
+                .all(|&edge| with_value(base, key, edge).is_ok())
+        })
+        .ok_or_else(|| {
+            not_free(format!(
+                "even +/-1 error bar ({sigma} {unit}) around {p0} {unit} leaves the body"
+            ))
+        })?;
+    Ok(Param {
+        kind: Kind::Key(key.to_string()),
+        name: key.to_string(),
+        unit: unit.to_string(),
+        nominal: p0,
+        half_width,
+        scale: sigma,
+        prior: Some(sigma),
+    })
 }
 
 fn not_free_reason(key: &str, value: f64) -> String {
@@ -193,11 +260,6 @@ fn not_free_reason(key: &str, value: f64) -> String {
                                fitted with the model's damping held fixed)"
             .to_string(),
         "environment" => "it does not enter the tilt transfer functions".to_string(),
-        "asymmetry" => "the assembly's offsets are not fitted by subtract (its fit boxes are \
-                        relative to a nominal value, and the pendulum as built is evaluated \
-                        by methods other than the one the subtraction uses); fit them to the \
-                        mode frequencies and visibilities with `fit`"
-            .to_string(),
         _ if value == 0.0 => "its nominal value is 0, so it has no scale to fit".to_string(),
         _ => "it is not a parameter of the tilt transfer functions".to_string(),
     }

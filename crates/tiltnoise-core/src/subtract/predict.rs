@@ -42,7 +42,7 @@
 
 use super::SubtractError;
 use crate::model::{Input, Model, Observable, Request};
-use crate::tf::{plan, Method};
+use crate::tf::plan;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 use realfft::RealFftPlanner;
@@ -211,8 +211,8 @@ pub fn predictor(
         outputs: outputs.to_vec(),
         inputs: inputs.to_vec(),
     };
-    let tf =
-        plan(model, &request, Method::Split).map_err(|e| SubtractError::Plan(e.to_string()))?;
+    let tf = plan(model, &request, super::method_for(model))
+        .map_err(|e| SubtractError::Plan(e.to_string()))?;
     let (n_out, n_in) = (outputs.len(), inputs.len());
     let mut planner = RealFftPlanner::<f64>::new();
     let fwd = planner.plan_fft_forward(n);

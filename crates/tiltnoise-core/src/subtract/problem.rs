@@ -11,7 +11,7 @@ use super::SubtractError;
 use crate::fit::jacobian::with_value;
 use crate::model::{Model, Request};
 use crate::params::Params;
-use crate::tf::{plan, Method};
+use crate::tf::plan;
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 use std::f64::consts::TAU;
@@ -134,8 +134,8 @@ pub(crate) fn transfer(
     freqs: &[f64],
 ) -> Result<Vec<Complex64>, SubtractError> {
     let model = Model::new(params).map_err(|e| SubtractError::Params(e.to_string()))?;
-    let tf =
-        plan(&model, request, Method::Split).map_err(|e| SubtractError::Plan(e.to_string()))?;
+    let tf = plan(&model, request, super::method_for(&model))
+        .map_err(|e| SubtractError::Plan(e.to_string()))?;
     let block = request.outputs.len() * request.inputs.len();
     let mut out = vec![Complex64::new(0.0, 0.0); freqs.len() * block];
     tf.eval_grid_into(freqs, &mut out)?;
@@ -271,7 +271,8 @@ impl Problem<'_> {
         for &j in free {
             if let Kind::Key(key) = &self.params[j].kind {
                 let p = theta[j];
-                let step = KEY_STEP_REL * p.abs();
+                // An assembly offset's nominal is 0: its step is relative to its scale.
+                let step = KEY_STEP_REL * p.abs().max(self.params[j].scale);
                 let at = |v: f64| -> Result<Vec<Complex64>, SubtractError> {
                     let q = with_value(&params, key, v)
                         .map_err(|e| SubtractError::Params(e.to_string()))?;
