@@ -338,6 +338,18 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
     };
     let read_series = |option: &str, path: &Path| -> Result<_> {
         match read_tilt(path, &read_options(&args)?)? {
+            // The library takes translation witnesses; the command line reads its witness as
+            // tilt alone, and a translation channel it would drop is refused instead.
+            TiltInput::Series(s) if !s.translations.is_empty() => {
+                let names: Vec<&str> = s.translations.iter().map(|t| t.axis.name()).collect();
+                bail!(
+                    "{option} {}: the record has translation channels ({}); subtract takes tilt \
+                     witnesses from the command line: pick the rotation channels with --axes \
+                     (e.g. --axes theta_t=CHANNEL,eta_t=CHANNEL)",
+                    path.display(),
+                    names.join(", ")
+                )
+            }
             TiltInput::Series(s) => Ok(s.into_angle()),
             TiltInput::Spectra(_) => bail!(
                 "{option} {}: holds spectra; subtract needs a time series of the tilt (angle or \

@@ -655,6 +655,20 @@ fn bad_input_is_refused_without_output() {
         csv.push_str(&format!("{i},{x:e}\n"));
     }
     std::fs::write(p("late.csv"), csv).unwrap();
+    // A witness with a floor translation channel beside the tilt.
+    let mut csv = String::from(
+        "# start_time: 2024-03-01T00:00:00Z\n# units: theta_t=rad, eta_t=rad, x_t=m\n\
+         time_s,theta_t,eta_t,x_t\n",
+    );
+    for i in 0..n {
+        csv.push_str(&format!(
+            "{i},{:e},{:e},{:e}\n",
+            rec.tilt[0][i],
+            rec.tilt[1][i],
+            1e-6 * rec.tilt[0][i]
+        ));
+    }
+    std::fs::write(p("ground.csv"), csv).unwrap();
     // A witness noise spectrum that covers only 1-10 mHz of the record's band.
     std::fs::write(p("short.csv"), "frequency_hz,asd\n1e-3,1e-9\n1e-2,1e-9\n").unwrap();
     let save = out_dir.join("c.h5");
@@ -761,9 +775,24 @@ fn bad_input_is_refused_without_output() {
         args.extend(["--save", save]);
         assert_fails_without_output(&args, &out_dir, &needles);
     }
+    // A translation channel in the witness is refused, not dropped.
+    let ground = p("ground.csv");
+    let m = p("m.h5");
+    assert_fails_without_output(
+        &[
+            "subtract",
+            "--tilt",
+            &ground,
+            "--measured",
+            &m,
+            "--save",
+            save,
+        ],
+        &out_dir,
+        &["ground.csv", "translation channels (x_t)", "--axes"],
+    );
     // Tilt spectra are not a record to subtract; an unknown output kind is refused first.
     let spectra = common::repo("tilt_data/peterson_tilt_asd.csv");
-    let m = p("m.h5");
     assert_fails_without_output(
         &[
             "subtract",
