@@ -1,4 +1,4 @@
-//! `tiltnoise subtract` end to end: the verification (a known tilt through the model
+//! `tiltnoise subtract` end to end: the verification case (a known tilt through the model
 //! with another h, a tiltmeter gain error and a delay, plus white readout; records aligned by
 //! their start times), the outputs (the cleaned record that `budget --measured` reads, the JSON
 //! report, the figure), the real ROMY record as the witness of a simulated pendulum, and the

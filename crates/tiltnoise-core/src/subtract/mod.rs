@@ -66,7 +66,7 @@ use weighting::{prediction_margin, weighting as weigh, WitnessSpectra};
 pub const DEFAULT_HOLDOUT_FRACTION: f64 = 0.25;
 /// Largest held-out fraction: the fit needs the larger part.
 pub const MAX_HOLDOUT_FRACTION: f64 = 0.5;
-/// Default report band (Hz): where the pendulum is quiet between its torsion and
+/// Default report band (Hz): where the paper's pendulum is quiet between its torsion and
 /// swing modes.
 pub const DEFAULT_REPORT_BAND_HZ: (f64, f64) = (3e-3, 3e-2);
 /// The default segment is the largest power of two that fits this many times into the

@@ -7,7 +7,7 @@
 //! torsional model, the 4-DoF pole-zero product form, the block LU, the split formulation, modal
 //! superposition, the full 8x8 LU -- and takes the first that meets the tolerance **measured**
 //! against the ~30-digit reference ([`crate::reference`]) on a verification grid of the band.
-//! Points within 1 % of a normal mode are left out of the verification (the accuracy
+//! Points within 1 % of a normal mode are left out of the verification (the accuracy
 //! target excludes the poles), and a structurally zero entry must come out exactly zero. The
 //! [`Choice`] keeps every candidate's verdict, so `--explain` can say what was picked and why;
 //! so does [`NoChoice`] when nothing meets the tolerance, whose message names only the best.

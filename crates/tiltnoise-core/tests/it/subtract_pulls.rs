@@ -13,7 +13,7 @@
 //! tests whether the stated sigma covers it (simulation-based calibration: S. Talts et al.,
 //! arXiv:1804.06788). Every RMS pull must lie in 0.85 .. 1.15 (3 standard deviations of the
 //! RMS of 200 standard normal pulls, `1 / sqrt(400) = 0.05`). With
-//! `TILTNOISE_PULL_H=fixed` the true h is the 1.7 m in every realisation instead; an
+//! `TILTNOISE_PULL_H=fixed` the true h is the noisy-witness case's 1.7 m in every realisation instead; an
 //! estimate the data leave to its prior in most realisations is then reported, not judged (its
 //! RMS pull is where 1.7 m sits in the prior, 0.75).
 //!
