@@ -25,8 +25,20 @@ pub(crate) fn run_with(
     rec: &Record,
     cfg: &SubtractConfig,
 ) -> Result<SubtractResult, SubtractError> {
+    run_from(&Params::table_i(), spec, inputs, data, rec, cfg)
+}
+
+/// [`run_with`] from the parameters `base`.
+fn run_from(
+    base: &Params,
+    spec: &Spec,
+    inputs: &[Input],
+    data: &[Vec<f64>],
+    rec: &Record,
+    cfg: &SubtractConfig,
+) -> Result<SubtractResult, SubtractError> {
     subtract(
-        &Params::table_i(),
+        base,
         &WitnessRecord {
             fs_hz: spec.fs_hz,
             inputs,
@@ -555,22 +567,12 @@ fn an_assembly_offset_is_fitted_from_the_torsion_it_lights() {
     let text = Params::table_i().to_toml()
         + "\n[uncertainty]\n\"asymmetry.tm_com_x_m\" = { sigma = 2e-3 }\n";
     let base = Params::from_toml_str(&text, "as built").unwrap();
-    let inputs = spec.witness_inputs();
-    let data = rec.witness();
-    let r = subtract(
+    let r = run_from(
         &base,
-        &WitnessRecord {
-            fs_hz: spec.fs_hz,
-            inputs: &inputs,
-            data: &data,
-            start: None,
-        },
-        &[],
-        &MeasuredRecord {
-            fs_hz: spec.fs_hz,
-            channels: &rec.measured,
-            start: None,
-        },
+        &spec,
+        &spec.witness_inputs(),
+        &rec.witness(),
+        &rec,
         &SubtractConfig {
             keys: vec!["asymmetry.tm_com_x_m".into()],
             ..SubtractConfig::default()
