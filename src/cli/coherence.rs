@@ -5,7 +5,7 @@
 use super::args::tilt_read_options;
 use super::figure_args::FigureArgs;
 use super::output::save_coherence;
-use super::tf::parse_outputs;
+use super::tf::parse_observables;
 use super::Run;
 use anyhow::{anyhow, bail, Result};
 use clap::Args;
@@ -53,7 +53,7 @@ pub struct CoherenceArgs {
     #[arg(long, value_name = "CHANNEL=FACTOR")]
     pub scale: Vec<String>,
     /// Observables to analyse, comma-separated (default: every observable in the measured file).
-    #[arg(long = "output", value_name = "NAME[,NAME...]")]
+    #[arg(long = "observables", alias = "output", value_name = "OBS,...")]
     pub outputs: Vec<String>,
     /// Welch segment length in samples (default 2^14, or the largest power of two <= N/4 of the
     /// common stretch).
@@ -95,7 +95,7 @@ fn parse_fit_band(text: &str) -> Result<(f64, f64)> {
     Ok((lo, hi))
 }
 
-/// The measured observables to analyse: `--output` (each must be in the file) or all of them.
+/// The measured observables to analyse: `--observables` (each must be in the file) or all of them.
 fn select_outputs<'a>(
     args: &CoherenceArgs,
     channels: &'a [(Observable, Vec<f64>)],
@@ -110,7 +110,7 @@ fn select_outputs<'a>(
     if args.outputs.is_empty() {
         return Ok(channels.iter().map(|(o, x)| (*o, x.as_slice())).collect());
     }
-    parse_outputs(&args.outputs)?
+    parse_observables(&args.outputs)?
         .into_iter()
         .map(|o| {
             channels
@@ -119,7 +119,7 @@ fn select_outputs<'a>(
                 .map(|(c, x)| (*c, x.as_slice()))
                 .ok_or_else(|| {
                     anyhow!(
-                        "--output {}: the measured file {} has no channel {}; it has {}",
+                        "--observables {}: the measured file {} has no channel {}; it has {}",
                         o.name(),
                         args.measured.display(),
                         o.name(),

@@ -114,7 +114,7 @@ enum Command {
         save: Vec<PathBuf>,
         // Size and resolution of the histograms (their axes follow the draws).
         #[command(flatten)]
-        figure: figure_args::FigureArgs,
+        figure: figure_args::SizeArgs,
     },
     /// Every evaluation method's worst error against the double-double reference and its time
     /// per point, for the 7x3 tilt matrix on the given grid (table, JSON, chart).

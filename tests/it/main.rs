@@ -48,3 +48,4 @@ mod subtract;
 mod thermal;
 mod translation_cli;
 mod visibility_cli;
+mod vocabulary;
