@@ -20,6 +20,7 @@ mod cli;
 mod cli_budget;
 mod coherence_cli;
 mod damping;
+mod docs_run;
 mod figures;
 mod finiteness;
 mod fit;
