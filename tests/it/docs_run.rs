@@ -316,3 +316,113 @@ fn quoted_lines_match_word_for_word_but_in_ignored_columns() {
         Some(("tiltnoise modes".to_string(), vec![]))
     );
 }
+
+/// Every schema the program writes, with the version its files carry.
+const WRITTEN_SCHEMAS: [(&str, i64); 10] = [
+    (tiltnoise_io::SCHEMA_TF, tiltnoise_io::SCHEMA_VERSION_TF),
+    (
+        tiltnoise_io::SCHEMA_TF_CSV,
+        tiltnoise_io::SCHEMA_VERSION_TF_CSV as i64,
+    ),
+    (
+        tiltnoise_io::SCHEMA_BUDGET,
+        tiltnoise_io::SCHEMA_VERSION_BUDGET,
+    ),
+    (
+        tiltnoise_io::SCHEMA_BUDGET_CSV,
+        tiltnoise_io::SCHEMA_VERSION_BUDGET_CSV as i64,
+    ),
+    (
+        tiltnoise_io::SCHEMA_COHERENCE,
+        tiltnoise_io::SCHEMA_VERSION_COHERENCE,
+    ),
+    (
+        tiltnoise_io::SCHEMA_COHERENCE_CSV,
+        tiltnoise_io::SCHEMA_VERSION_COHERENCE_CSV as i64,
+    ),
+    (tiltnoise_io::SCHEMA_FIT, tiltnoise_io::SCHEMA_VERSION_FIT),
+    (tiltnoise_io::SCHEMA_MC, tiltnoise_io::SCHEMA_VERSION_MC),
+    (
+        tiltnoise_io::SCHEMA_OBSERVABLE_SERIES,
+        tiltnoise_io::SCHEMA_VERSION_OBSERVABLE_SERIES,
+    ),
+    (
+        tiltnoise_io::SCHEMA_OBSERVABLE_ASD_CSV,
+        tiltnoise_io::SCHEMA_VERSION_OBSERVABLE_ASD_CSV as i64,
+    ),
+];
+
+/// The leading digits of `text`, as a number.
+fn leading_number(text: &str) -> Option<i64> {
+    let digits: String = text.chars().take_while(char::is_ascii_digit).collect();
+    digits.parse().ok()
+}
+
+/// The versions a line quotes: `` `tiltnoise.NAME`, version N `` or `` `tiltnoise.NAME`, N ``.
+fn quoted_versions(line: &str) -> Vec<(&str, i64)> {
+    let mut found = Vec::new();
+    for (at, _) in line.match_indices("`tiltnoise.") {
+        let rest = &line[at + 1..];
+        let Some(end) = rest.find('`') else { continue };
+        let (name, after) = (&rest[..end], &rest[end + 1..]);
+        let after = after.trim_start_matches([',', ' ']);
+        let after = after.strip_prefix("version ").unwrap_or(after);
+        if let Some(v) = leading_number(after) {
+            found.push((name, v));
+        }
+    }
+    found
+}
+
+#[test]
+fn the_docs_quote_the_schema_versions_the_files_carry() {
+    let written: std::collections::BTreeMap<&str, i64> = WRITTEN_SCHEMAS.into_iter().collect();
+    let mut wrong = Vec::new();
+    let mut checked = 0;
+    for doc in documents() {
+        let name = doc.strip_prefix(repo("")).unwrap().display().to_string();
+        let text = std::fs::read_to_string(&doc).unwrap();
+        // The schema of the section: its heading names it.
+        let mut section: Option<String> = None;
+        for (k, line) in text.lines().enumerate() {
+            if line.starts_with('#') {
+                section = line
+                    .split('`')
+                    .find(|w| w.starts_with("tiltnoise."))
+                    .map(str::to_string);
+            }
+            let mut quoted = quoted_versions(line);
+            let table_cell = line
+                .starts_with('|')
+                .then(|| line.trim_end_matches('|').rsplit('|').next())
+                .flatten()
+                .map(|c| c.trim().trim_matches('`'));
+            if let (true, Some(cell), Some(schema)) = (
+                line.contains("`schema_version`"),
+                table_cell,
+                section.as_deref(),
+            ) {
+                if let Some(v) = leading_number(cell).filter(|_| cell.len() <= 2) {
+                    quoted.push((schema, v));
+                }
+            }
+            for (schema, v) in quoted {
+                if let Some(&version) = written.get(schema) {
+                    checked += 1;
+                    if v != version {
+                        wrong.push(format!(
+                            "{name}:{}: {schema} version {v}; the files carry {version}",
+                            k + 1
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    eprintln!("docs-run: {checked} quoted schema versions checked");
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+    assert!(
+        checked >= WRITTEN_SCHEMAS.len(),
+        "only {checked} versions found in the docs"
+    );
+}
