@@ -14,7 +14,10 @@ const VOCABULARY: &[(&str, &str)] = &[
     ("params", "parameter file (TOML)"),
     ("set", "one parameter override KEY=VALUE"),
     ("help", "print help"),
-    ("format", "how results print on the terminal"),
+    (
+        "format",
+        "how results print on the terminal (table or json)",
+    ),
     ("save", "output file, format from the extension"),
     ("save-time", "time-series figure of a simulation"),
     ("observables", "which observables to compute"),
@@ -339,4 +342,84 @@ fn ranges_accept_both_separators() {
     );
     let out = tiltnoise(&["mc", "--samples", "10", "--xlim", "1e-3:1"]);
     assert_eq!(out.status.code(), Some(2), "mc takes no --xlim");
+}
+
+#[test]
+fn commands_that_print_a_summary_take_format() {
+    for (command, args) in commands() {
+        if [
+            "modes",
+            "budget",
+            "coherence",
+            "subtract",
+            "fit",
+            "mc",
+            "methods",
+        ]
+        .contains(&command.as_str())
+        {
+            let format = args.iter().find(|a| a.get_long() == Some("format"));
+            let values: Vec<String> = format
+                .map(|a| {
+                    a.get_possible_values()
+                        .iter()
+                        .map(|v| v.get_name().to_string())
+                        .collect()
+                })
+                .unwrap_or_default();
+            assert_eq!(values, ["table", "json"], "{command} --format");
+        }
+    }
+}
+
+#[test]
+fn coherence_json_holds_the_numbers_of_its_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let (tilt, measured) = write_tilt_and_measured(dir.path());
+    let run = |format: &str| {
+        results(&tiltnoise(&[
+            "coherence",
+            "--tilt",
+            &tilt,
+            "--measured",
+            &measured,
+            "--nperseg",
+            "512",
+            "--format",
+            format,
+        ]))
+    };
+    let (table, json) = (run("table"), run("json"));
+    let json: serde_json::Value = serde_json::from_str(&json).expect("--format json is JSON");
+    let thresholds = format!(
+        "ordinary coherence {:.3}, multiple coherence with 2 axes {:.3}",
+        json["coherence_threshold"].as_f64().unwrap(),
+        json["multiple_coherence_threshold"].as_f64().unwrap()
+    );
+    assert!(table.contains(&thresholds), "{thresholds}\n{table}");
+    let observables = json["observables"].as_array().unwrap();
+    assert_eq!(observables.len(), 2, "X and phi");
+    for ob in observables {
+        let name = ob["observable"].as_str().unwrap();
+        let line = format!(
+            "  {name}: multiple coherence significant in {} of {} bins",
+            ob["significant_bins"], json["bins"]
+        );
+        assert!(table.contains(&line), "{line}\n{table}");
+        for axis in ob["axes"].as_array().unwrap() {
+            let peak = format!(
+                "    {:<7} max coherence {:.3} at {:.3e} Hz",
+                axis["axis"].as_str().unwrap(),
+                axis["max_coherence"].as_f64().unwrap(),
+                axis["max_coherence_at_hz"].as_f64().unwrap()
+            );
+            assert!(table.contains(&peak), "{peak}\n{table}");
+        }
+    }
+    let eta = &observables[0]["axes"][1];
+    assert_eq!(eta["axis"], "eta_t");
+    let gain = eta["measured_over_model"]["gain"].as_f64().unwrap();
+    // X sees eta_t in the model (and the measured X holds a part of the N channel, eta_t = -N
+    // by the default axis map): the comparison with the model is there, with a gain.
+    assert!(gain.is_finite() && gain > 0.0, "{gain}");
 }
