@@ -17,7 +17,7 @@ use tiltnoise_io::write_atomic;
 pub(crate) struct VisibilityArgs {
     /// A free-motion or ring-down record of the observables: HDF5 or CSV time series as
     /// `budget --measured` reads them (the layout `simulate --save` writes).
-    #[arg(long, value_name = "FILE")]
+    #[arg(long = "measured", alias = "record", value_name = "FILE")]
     record: PathBuf,
     /// Output CSV `mode,observable,reference,ratio,sigma` for `fit --visibility`.
     #[arg(long, value_name = "PATH")]
@@ -35,11 +35,11 @@ pub(crate) fn run_visibility(params: &Params, args: VisibilityArgs, run: &mut Ru
         }
     }
     let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
-    run.check_outputs(&saves, &[("--record", args.record.as_path())])?;
+    run.check_outputs(&saves, &[("--measured", args.record.as_path())])?;
     let series = match read_measured_input(&args.record)? {
         MeasuredInput::Series(s) => s,
         MeasuredInput::Spectra(_) => bail!(
-            "--record {}: holds spectra; the visibilities need the time series (header time_s, \
+            "--measured {}: holds spectra; the visibilities need the time series (header time_s, \
              or HDF5)",
             args.record.display()
         ),

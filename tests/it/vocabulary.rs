@@ -31,11 +31,8 @@ const VOCABULARY: &[(&str, &str)] = &[
         "floor motion per unit displacement, velocity or acceleration",
     ),
     ("tilt", "file: the tilt (witness) record"),
-    (
-        "measured",
-        "file: measured record of the observables (or mode frequencies)",
-    ),
-    ("record", "file: free-motion record"),
+    ("measured", "file: measured record of the observables"),
+    ("measured-modes", "file: measured mode frequencies"),
     ("colocated", "file: a second witness beside the first"),
     (
         "colocated-ratio",
@@ -108,6 +105,9 @@ const ALIASES: &[(&str, &str, &str)] = &[
     ("tf", "output", "observables"),
     ("coherence", "output", "observables"),
     ("subtract", "tilt-noise", "witness-noise"),
+    ("visibility", "record", "measured"),
+    // In `fit` alone, where it has always meant the mode frequencies.
+    ("fit", "measured", "measured-modes"),
 ];
 
 /// Every subcommand with its long options (visible and hidden), global ones included.
@@ -310,6 +310,27 @@ fn old_spellings_still_work_as_hidden_aliases() {
     let (new, old) = (coherence("--observables"), coherence("--output"));
     assert_eq!(new, old, "coherence --output is --observables");
     assert!(new.contains("  X: ") && !new.contains("  phi: "), "{new}");
+
+    let modes = crate::REPO_ROOT.to_string() + "/examples/fit/torsion_modes.csv";
+    let fit = |spelling: &str| {
+        results(&tiltnoise(&[
+            "fit",
+            spelling,
+            &modes,
+            "--free",
+            "torsion.k_a_n_m_per_rad",
+            "--format",
+            "json",
+        ]))
+    };
+    let (new, old) = (fit("--measured-modes"), fit("--measured"));
+    assert_eq!(new, old, "fit --measured is --measured-modes");
+    let json: serde_json::Value = serde_json::from_str(&new).unwrap();
+    assert_eq!(
+        json["modes"].as_array().unwrap().len(),
+        2,
+        "the file's two modes"
+    );
 }
 
 #[test]
