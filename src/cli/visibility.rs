@@ -22,6 +22,17 @@ pub(crate) struct VisibilityArgs {
     /// Output CSV `mode,observable,reference,ratio,sigma` for `fit --visibility`.
     #[arg(long, value_name = "PATH")]
     save: Option<PathBuf>,
+    /// Output format on the terminal: table (the peaks and the ratios), or csv (the file
+    /// --save writes; `wrote` lines then go to standard error).
+    #[arg(long, value_enum, default_value_t = VisibilityFormat::Table)]
+    format: VisibilityFormat,
+}
+
+/// What `tiltnoise visibility` prints.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum VisibilityFormat {
+    Table,
+    Csv,
 }
 
 /// Runs `tiltnoise visibility`.
@@ -61,11 +72,6 @@ pub(crate) fn run_visibility(params: &Params, args: VisibilityArgs, run: &mut Ru
         &origin,
         &run.cancel,
     )?;
-    let names: Vec<&str> = series.channels.iter().map(|(o, _)| o.name()).collect();
-    write!(run.out, "{}", table(&measured, &names))?;
-    let Some(path) = &args.save else {
-        return Ok(());
-    };
     let comment = [
         format!("mode visibilities measured from {origin} by tiltnoise visibility"),
         format!(
@@ -75,7 +81,17 @@ pub(crate) fn run_visibility(params: &Params, args: VisibilityArgs, run: &mut Ru
         ),
     ];
     let text = measured.visibilities.to_csv(&comment);
-    run.write_outputs(false, || {
+    match args.format {
+        VisibilityFormat::Table => {
+            let names: Vec<&str> = series.channels.iter().map(|(o, _)| o.name()).collect();
+            write!(run.out, "{}", table(&measured, &names))?;
+        }
+        VisibilityFormat::Csv => write!(run.out, "{text}")?,
+    }
+    let Some(path) = &args.save else {
+        return Ok(());
+    };
+    run.write_outputs(args.format == VisibilityFormat::Csv, || {
         write_atomic(path, |tmp| {
             std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
         })?;

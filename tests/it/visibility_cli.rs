@@ -33,6 +33,14 @@ fn simulated_record_to_fitted_offset() {
         csv.starts_with("# mode visibilities measured from"),
         "{csv}"
     );
+    // `--format csv` prints the file `--save` writes, and the table's ratios are its rows.
+    let printed = tiltnoise(&["visibility", "--measured", &record, "--format", "csv"]);
+    assert!(printed.status.success(), "{}", stderr(&printed));
+    assert_eq!(String::from_utf8(printed.stdout).unwrap(), csv);
+    for row in csv.lines().filter(|l| l.starts_with("6,Z,X,")) {
+        let ratio: f64 = row.split(',').nth(3).unwrap().parse().unwrap();
+        assert!(table.contains(&format!("{ratio:.5e}")), "{row}\n{table}");
+    }
 
     let toml = tiltnoise(&["params"]).stdout;
     let mut toml = String::from_utf8(toml).unwrap();

@@ -14,10 +14,7 @@ const VOCABULARY: &[(&str, &str)] = &[
     ("params", "parameter file (TOML)"),
     ("set", "one parameter override KEY=VALUE"),
     ("help", "print help"),
-    (
-        "format",
-        "how results print on the terminal (table or json)",
-    ),
+    ("format", "how results print on the terminal"),
     ("save", "output file, format from the extension"),
     ("save-time", "time-series figure of a simulation"),
     ("observables", "which observables to compute"),
@@ -367,6 +364,20 @@ fn ranges_accept_both_separators() {
 
 #[test]
 fn commands_that_print_a_summary_take_format() {
+    let visibility = commands()
+        .into_iter()
+        .find(|(c, _)| c == "visibility")
+        .unwrap();
+    let format = visibility.1.iter().find(|a| a.get_long() == Some("format"));
+    let values: Vec<String> = format
+        .map(|a| {
+            a.get_possible_values()
+                .iter()
+                .map(|v| v.get_name().to_string())
+                .collect()
+        })
+        .unwrap_or_default();
+    assert_eq!(values, ["table", "csv"], "visibility prints its CSV");
     for (command, args) in commands() {
         if [
             "modes",
