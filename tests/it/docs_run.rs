@@ -22,6 +22,13 @@ use crate::common::{disable_hdf5_file_locking, repo};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// One line on standard error past the test harness's capture, so that `cargo test` shows
+/// what ran and what was skipped.
+fn say(line: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr(), "{line}");
+}
+
 /// A fenced block of a Markdown file.
 struct Block {
     /// `README.md:27`: the file and the line of the opening fence.
@@ -254,16 +261,20 @@ fn readme_and_docs_blocks_run_and_quote_what_the_program_prints() {
                 continue;
             }
             if let Some(why) = marker.strip_prefix("skip") {
-                eprintln!("docs-run: skipped {}: {}", block.place, why.trim());
+                say(&format!(
+                    "docs-run: skipped {}: {}",
+                    block.place,
+                    why.trim()
+                ));
                 skipped += 1;
                 continue;
             }
             if block.text.contains("../shared/") && !shared_present {
-                eprintln!(
+                say(&format!(
                     "docs-run: skipped {}: reads ../shared/tilt_data, not beside the repository \
                      (GPL/LGPL data kept out of it; CI has it)",
                     block.place
-                );
+                ));
                 skipped += 1;
                 continue;
             }
@@ -273,9 +284,9 @@ fn readme_and_docs_blocks_run_and_quote_what_the_program_prints() {
             }
         }
     }
-    eprintln!(
+    say(&format!(
         "docs-run: {ran} command blocks ran, {skipped} skipped, {checked} quoted outputs checked"
-    );
+    ));
     assert!(failures.is_empty(), "{}", failures.join("\n\n"));
     assert!(ran > 0 && checked > 0, "no block ran or was checked");
 }
@@ -419,7 +430,9 @@ fn the_docs_quote_the_schema_versions_the_files_carry() {
             }
         }
     }
-    eprintln!("docs-run: {checked} quoted schema versions checked");
+    say(&format!(
+        "docs-run: {checked} quoted schema versions checked"
+    ));
     assert!(wrong.is_empty(), "{}", wrong.join("\n"));
     assert!(
         checked >= WRITTEN_SCHEMAS.len(),
