@@ -67,9 +67,9 @@ pub struct BudgetArgs {
     /// hold one Welch segment (--nperseg samples), e.g. 14400 with --nperseg 4096 at 1 Hz.
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     pub segment_duration: Option<f64>,
-    /// Percentiles of the band across segments, LOWER,UPPER (default 10,90; with
-    /// --segment-duration).
-    #[arg(long, value_name = "LO,HI", allow_hyphen_values = true)]
+    /// Percentiles of the band across segments, LO:HI (default 10:90; with
+    /// --segment-duration; LO,HI is accepted too).
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
     pub percentiles: Option<String>,
     /// Observables to budget, e.g. X,Y,Z,theta,eta,phi,phi_a (default X,phi,phi_a).
     #[arg(long, value_name = "OBS,...")]
@@ -164,15 +164,14 @@ fn summary_request(args: &BudgetArgs) -> Result<SummaryRequest> {
 fn parse_percentiles(text: &str) -> Result<(f64, f64)> {
     let err = || {
         anyhow!(
-            "--percentiles {}: expected LOWER,UPPER with 0 <= LOWER < UPPER <= 100",
+            "--percentiles {}: expected LO:HI with 0 <= LO < HI <= 100, e.g. 10:90",
             Shown(text)
         )
     };
-    let (a, b) = text.split_once(',').ok_or_else(err)?;
-    let (a, b): (f64, f64) = (
-        a.trim().parse().map_err(|_| err())?,
-        b.trim().parse().map_err(|_| err())?,
-    );
+    let [a, b] = super::args::range_parts(text)[..] else {
+        return Err(err());
+    };
+    let (a, b): (f64, f64) = (a.parse().map_err(|_| err())?, b.parse().map_err(|_| err())?);
     if !(0.0 <= a && a < b && b <= 100.0) {
         return Err(err());
     }
