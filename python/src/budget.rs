@@ -551,6 +551,9 @@ pub fn budget(
             .zip(&described.channels)
             .zip(&described.factors)
         {
+            // Each step is a pass over a whole channel (a tenth of a second at the largest
+            // size): the token is polled between them.
+            interrupt::check(&cancel)?;
             if factor != 1.0 {
                 data.iter_mut().for_each(|v| *v *= factor);
             }
@@ -564,6 +567,7 @@ pub fn budget(
                 notes.push(tiltnoise_core::input::gap_note(input.name(), bridged));
             }
             if !stated {
+                interrupt::check(&cancel)?;
                 check_unstated_array(input.name(), described.quantity, data, fs)?;
             }
         }

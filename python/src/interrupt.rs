@@ -71,3 +71,13 @@ where
         }
     })
 }
+
+/// `Err` once `cancel` is set, for the steps of a watched computation that are not the
+/// library's own (whose errors say `Cancelled`): [`watch`] returns the signal's exception
+/// instead of this one.
+pub fn check(cancel: &Cancel) -> PyResult<()> {
+    match cancel.check() {
+        Ok(()) => Ok(()),
+        Err(e) => Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(e.to_string())),
+    }
+}
