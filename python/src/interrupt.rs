@@ -78,6 +78,8 @@ where
 pub fn check(cancel: &Cancel) -> PyResult<()> {
     match cancel.check() {
         Ok(()) => Ok(()),
-        Err(e) => Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(e.to_string())),
+        Err(e) => Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(
+            e.to_string(),
+        )),
     }
 }

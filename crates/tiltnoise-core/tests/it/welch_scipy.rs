@@ -406,7 +406,10 @@ fn csd_matrix_is_hermitian_with_psd_diagonal() {
             // in the Python tests).
             for (k, f) in m.freqs_hz.iter().enumerate() {
                 let exact = k as f64 * 3.0 / len as f64;
-                assert!((f - exact).abs() <= 2.5 * f64::EPSILON * exact, "{f} vs {exact}");
+                assert!(
+                    (f - exact).abs() <= 2.5 * f64::EPSILON * exact,
+                    "{f} vs {exact}"
+                );
             }
             let psds: Vec<Vec<f64>> = refs
                 .iter()
