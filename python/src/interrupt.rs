@@ -72,6 +72,20 @@ where
     })
 }
 
+/// [`watch`] when `long`, else `work` on the calling thread with the GIL released: a call of a
+/// millisecond or less ends before anyone could interrupt it, and starting a thread would be
+/// most of its cost.
+pub fn watch_if<T, W>(py: Python<'_>, long: bool, cancel: &Cancel, work: W) -> PyResult<T>
+where
+    T: Send,
+    W: FnOnce() -> PyResult<T> + Send,
+{
+    match long {
+        true => watch(py, cancel, work),
+        false => py.detach(work),
+    }
+}
+
 /// `Err` once `cancel` is set, for the steps of a watched computation that are not the
 /// library's own (whose errors say `Cancelled`): [`watch`] returns the signal's exception
 /// instead of this one.

@@ -15,6 +15,10 @@ use tiltnoise_core::spectral::{self, Averaging, Detrend, WelchConfig};
 /// `(f, Pxx)` or `(f, Pxy)`: frequencies (Hz) and one-sided densities, as scipy returns them.
 type Spectrum<'py, T> = PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<T>>)>;
 
+/// Series at least this long are estimated under [`interrupt::watch`] (a millisecond or more
+/// of work; shorter ones end before an interrupt could matter).
+const WATCHED_SAMPLES: usize = 1 << 16;
+
 /// The size of a series held in memory ([`MAX_SERIES_SAMPLES`]).
 pub const SERIES: Size = Size {
     limit: MAX_SERIES_SAMPLES,
@@ -137,7 +141,8 @@ pub fn welch<'py>(
     check_fs(fs)?;
     let x = checked_series("x", x)?;
     let cancel = Cancel::new();
-    let psd = interrupt::watch(py, &cancel, || {
+    let long = x.len() >= WATCHED_SAMPLES;
+    let psd = interrupt::watch_if(py, long, &cancel, || {
         welch_cancellable(&x, fs, &cfg, &cancel).py()
     })?;
     Ok((
@@ -178,7 +183,8 @@ pub fn csd<'py>(
     check_fs(fs)?;
     let (x, y) = (checked_series("x", x)?, checked_series("y", y)?);
     let cancel = Cancel::new();
-    let m = interrupt::watch(py, &cancel, || {
+    let long = x.len() >= WATCHED_SAMPLES;
+    let m = interrupt::watch_if(py, long, &cancel, || {
         spectral::csd_matrix_cancellable(&[&x, &y], fs, &cfg, &cancel).py()
     })?;
     Ok((
