@@ -48,6 +48,17 @@ pub fn check_size(what: &str, n: usize, size: Size) -> PyResult<()> {
     .map_err(limit_error)
 }
 
+/// Room for `n` more values in `out`, or a `MemoryError` naming `what` when the system refuses
+/// the memory (the sizes are checked first, but the memory available can change meanwhile).
+pub fn reserve(what: &str, out: &mut Vec<f64>, n: usize) -> PyResult<()> {
+    out.try_reserve_exact(n).map_err(|e| {
+        PyMemoryError::new_err(format!(
+            "{what}: cannot allocate {n} values ({} MiB): {e}",
+            n.saturating_mul(8) >> 20
+        ))
+    })
+}
+
 /// `arg` as a NumPy array without copying one (`numpy.asarray` of a list or a number makes
 /// an array the size of what Python already holds).
 fn as_ndarray<'py>(what: &str, arg: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyUntypedArray>> {
@@ -105,7 +116,7 @@ pub fn series(what: &str, arg: &Bound<'_, PyAny>, size: Size) -> PyResult<Vec<f6
     }
     let mut out = Vec::new();
     check_size(what, a.len(), size)?;
-    out.reserve_exact(a.len());
+    reserve(what, &mut out, a.len())?;
     append_f64(what, &a, &mut out)?;
     Ok(out)
 }
@@ -127,7 +138,7 @@ pub fn grid_into(
         )));
     }
     check_size(what, a.len(), size)?;
-    out.reserve(a.len());
+    reserve(what, out, a.len())?;
     append_f64(what, &a, out)
 }
 
@@ -145,11 +156,23 @@ pub fn rows(what: &str, arg: &Bound<'_, PyAny>, size: Size) -> PyResult<Vec<Vec<
     (0..shape[0])
         .map(|i| {
             let row = a.get_item(i)?.cast_into::<PyUntypedArray>()?;
-            let mut out = Vec::with_capacity(shape[1]);
+            let mut out = Vec::new();
+            reserve(what, &mut out, shape[1])?;
             append_f64(&format!("{what}[{i}]"), &row, &mut out)?;
             Ok(out)
         })
         .collect()
+}
+
+/// `a`, made read-only: an array a result hands out is a view of the result's values, not a
+/// place to change them (a write raises `ValueError: assignment destination is read-only`).
+pub fn read_only<T: numpy::Element, D: numpy::ndarray::Dimension>(
+    a: Bound<'_, numpy::PyArray<T, D>>,
+) -> PyResult<Bound<'_, numpy::PyArray<T, D>>> {
+    let kwargs = pyo3::types::PyDict::new(a.py());
+    kwargs.set_item("write", false)?;
+    a.call_method("setflags", (), Some(&kwargs))?;
+    Ok(a)
 }
 
 /// Refuses the first value of `values` (the argument `what`) outside `allowed`, naming its index

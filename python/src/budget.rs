@@ -3,10 +3,14 @@
 
 use crate::arrays::{self, check_size, series};
 use crate::errors::{value_error, IntoPyErr, PyResultExt};
+use crate::figure;
 use crate::inputs::Inputs;
+use crate::interrupt;
 use crate::model::PyModel;
 use crate::params::PyParams;
+use crate::python_side;
 use crate::spectral::{averaging, check_fs, SERIES};
+use crate::state;
 use numpy::{PyArray1, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
@@ -14,6 +18,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use tiltnoise_core::budget::option_checks::{self, InputKind};
 use tiltnoise_core::budget::{budget_from_series, budget_from_spectra, BudgetError, BudgetOptions};
+use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::error::Num;
 use tiltnoise_core::freq;
 use tiltnoise_core::ground::GroundQuantity;
@@ -538,12 +543,17 @@ pub fn budget(
     }
     .apply(&mut opts)?;
     let mut notes = Vec::new();
-    let report = py.detach(|| -> PyResult<BudgetReport> {
+    let cancel = Cancel::new();
+    opts.cancel = cancel.clone();
+    let report = interrupt::watch(py, &cancel, || -> PyResult<BudgetReport> {
         for (((input, data), channel), &(factor, stated)) in channels
             .iter_mut()
             .zip(&described.channels)
             .zip(&described.factors)
         {
+            // Each step is a pass over a whole channel (a tenth of a second at the largest
+            // size): the token is polled between them.
+            interrupt::check(&cancel)?;
             if factor != 1.0 {
                 data.iter_mut().for_each(|v| *v *= factor);
             }
@@ -557,6 +567,7 @@ pub fn budget(
                 notes.push(tiltnoise_core::input::gap_note(input.name(), bridged));
             }
             if !stated {
+                interrupt::check(&cancel)?;
                 check_unstated_array(input.name(), described.quantity, data, fs)?;
             }
         }
@@ -695,7 +706,9 @@ pub fn budget_from_file(
     };
     let refuse_series_options = || refuse(InputKind::Spectra);
     let refuse_spectra_options = || refuse(InputKind::Series);
-    let (report, provenance) = py.detach(|| -> PyResult<_> {
+    let cancel = Cancel::new();
+    opts.cancel = cancel.clone();
+    let (report, provenance) = interrupt::watch(py, &cancel, || -> PyResult<_> {
         let streamed = match InputFormat::from_path(&path).py()? {
             InputFormat::Hdf5 => TiltSeriesSource::open(&path, &ropts).ok(),
             InputFormat::Csv | InputFormat::Miniseed => None,
@@ -766,6 +779,7 @@ fn names_once(option: &str, names: Vec<String>) -> PyResult<Vec<String>> {
 /// terms referred to the test mass's acceleration (X) or torque (phi, phi_a) for a damped
 /// model; ``segment_bands`` the per-segment percentile band of the ``tilt`` term.
 #[pyclass(module = "tiltnoise", frozen)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct Budget {
     report: BudgetReport,
     params: PyParams,
@@ -834,6 +848,18 @@ fn asd<'py>(py: Python<'py>, psd: &[f64]) -> Bound<'py, PyArray1<f64>> {
     PyArray1::from_iter(py, psd.iter().map(|p| p.sqrt()))
 }
 
+/// The ASD of `psd` as a read-only array (the budget's values, not a place to change them).
+fn fixed_asd<'py>(py: Python<'py>, psd: &[f64]) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    arrays::read_only(asd(py, psd))
+}
+
+/// `d` as a read-only mapping (`types.MappingProxyType`): assigning to a key raises
+/// `TypeError` instead of changing a copy that the budget never sees.
+fn read_only_dict<'py>(d: Bound<'py, PyDict>) -> PyResult<Bound<'py, PyAny>> {
+    let py = d.py();
+    py.import("types")?.getattr("MappingProxyType")?.call1((d,))
+}
+
 impl Budget {
     /// The provenance written into files: this process, the budget's parameters and modes.
     fn run_meta(&self) -> RunMeta {
@@ -846,15 +872,15 @@ impl Budget {
 
 #[pymethods]
 impl Budget {
-    /// Frequencies (Hz), increasing, all > 0: the files' ``frequency_hz``.
+    /// Frequencies (Hz), increasing, all > 0: the files' ``frequency_hz`` (read-only).
     #[getter]
-    fn frequency_hz<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_slice(py, &self.report.budget.freqs_hz)
+    fn frequency_hz<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        arrays::read_only(PyArray1::from_slice(py, &self.report.budget.freqs_hz))
     }
 
     /// The same as ``frequency_hz`` (the name of ``transfer``'s argument).
     #[getter]
-    fn freq_hz<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+    fn freq_hz<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         self.frequency_hz(py)
     }
 
@@ -869,28 +895,31 @@ impl Budget {
             .collect()
     }
 
-    /// ``{observable: {term: ASD}}``, every term in report order (not the total).
+    /// ``{observable: {term: ASD}}``, every term in report order (not the total). Read-only,
+    /// mappings and arrays: a budget is a result, and an edit would change a copy it never
+    /// sees (a different budget is computed anew; ``np.array(...)`` copies an ASD to work on).
     #[getter]
-    fn terms<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+    fn terms<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let d = PyDict::new(py);
         for ob in &self.report.budget.observables {
             let t = PyDict::new(py);
             for term in &ob.terms {
-                t.set_item(term.name(), asd(py, &term.psd))?;
+                t.set_item(term.name(), fixed_asd(py, &term.psd)?)?;
             }
-            d.set_item(ob.observable.name(), t)?;
+            d.set_item(ob.observable.name(), read_only_dict(t)?)?;
         }
-        Ok(d)
+        read_only_dict(d)
     }
 
-    /// ``{observable: ASD}`` of the total: the sum in power of tilt, thermal and readout.
+    /// ``{observable: ASD}`` of the total: the sum in power of tilt, thermal and readout
+    /// (read-only, as ``terms``).
     #[getter]
-    fn total<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+    fn total<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let d = PyDict::new(py);
         for ob in &self.report.budget.observables {
-            d.set_item(ob.observable.name(), asd(py, &ob.total()))?;
+            d.set_item(ob.observable.name(), fixed_asd(py, &ob.total())?)?;
         }
-        Ok(d)
+        read_only_dict(d)
     }
 
     /// ``{observable: unit of its ASDs}``: ``m/sqrt(Hz)`` or ``rad/sqrt(Hz)``.
@@ -1081,11 +1110,13 @@ impl Budget {
     }
 
     /// Writes the budget as the command line's ``--save`` does: ``.h5``/``.hdf5`` (schema
-    /// ``tiltnoise.budget``, with the parameters and the input's provenance) or ``.csv``;
-    /// atomically (nothing is left at ``path`` on failure). Raises ``OSError`` if it cannot
-    /// be written or is one of the files the budget was computed from (the tilt file, the
-    /// measured record, the parameter file; compared as files, whatever the spelling),
-    /// ``ValueError`` for another extension. ``keep_zero_columns``: as ``to_csv``.
+    /// ``tiltnoise.budget``, with the parameters and the input's provenance), ``.csv``, or the
+    /// command line's figure as ``.png`` or ``.svg`` (one panel per observable, the same
+    /// image as ``tiltnoise budget --save x.png`` for the same budget); atomically (nothing
+    /// is left at ``path`` on failure). Raises ``OSError`` if it cannot be written or is one
+    /// of the files the budget was computed from (the tilt file, the measured record, the
+    /// parameter file; compared as files, whatever the spelling), ``ValueError`` for another
+    /// extension. ``keep_zero_columns``: as ``to_csv``.
     #[pyo3(signature = (path, *, keep_zero_columns=false))]
     fn save(&self, py: Python<'_>, path: PathBuf, keep_zero_columns: bool) -> PyResult<()> {
         use tiltnoise_io::OutputKind;
@@ -1099,21 +1130,62 @@ impl Budget {
             OutputKind::Csv => {
                 tiltnoise_io::write_budget_csv(&path, &self.report, &meta, keep_zero_columns)
             }
-            OutputKind::Png | OutputKind::Svg => Err(tiltnoise_io::OutputError::UnknownFormat {
-                path: path.clone(),
-                allowed: ".h5, .hdf5, .csv (figures: see examples/budget_matplotlib.py)",
-            }),
+            OutputKind::Png | OutputKind::Svg => {
+                let options = tiltnoise_plot::BudgetFigureOptions {
+                    input: Some(self.input.clone()),
+                    ..tiltnoise_plot::BudgetFigureOptions::default()
+                };
+                figure::save(&path, |format| {
+                    tiltnoise_plot::budget_figure_with(&self.report, format, &options)
+                })
+            }
         })
         .py()
     }
 
     /// ``{observable: {term: gwpy.frequencyseries.FrequencySeries}}`` of the ASDs, ``total``
-    /// included, with their units. Needs gwpy (``pip install gwpy``); raises ``ImportError``
-    /// saying so without it.
+    /// included, each named ``"OBS.TERM"`` with its unit (``m / Hz(1/2)``). Needs gwpy
+    /// (``pip install gwpy``); raises ``ImportError`` saying so without it.
     fn to_gwpy<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
-        slf.py()
-            .import("tiltnoise._gwpy")?
-            .call_method1("to_gwpy", (slf,))
+        python_side::call(slf.as_any(), "_convert", "budget_to_gwpy", &[])
+    }
+
+    /// The ASDs as a ``pandas.DataFrame`` indexed by ``frequency_hz``, one column per
+    /// ``"OBS.TERM"`` (the CSV's columns, ``OBS.total`` included), the unit of each column in
+    /// ``df.attrs["units"]``. Needs pandas (``pip install pandas``); raises ``ImportError``
+    /// saying so without it.
+    fn to_pandas<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        python_side::call(slf.as_any(), "_convert", "budget_to_pandas", &[])
+    }
+
+    /// The budget drawn with matplotlib: one panel per observable, every term and the total
+    /// (thick black) against frequency, log-log. Returns a new ``matplotlib.figure.Figure``
+    /// (of ``matplotlib.pyplot``, so a notebook shows it). ``observables``: the panels (default
+    /// every observable). Needs matplotlib; raises ``ImportError`` saying so without it. The
+    /// command line's own figure is :meth:`save` to a ``.png`` or ``.svg`` path.
+    #[pyo3(signature = (observables=None))]
+    fn plot<'py>(
+        slf: &Bound<'py, Self>,
+        observables: Option<Vec<String>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let observables = observables.into_pyobject(slf.py())?.into_any();
+        python_side::call(slf.as_any(), "_plots", "budget_plot", &[observables])
+    }
+
+    /// Pickles as its state (see the module's pickling notes).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<state::Reduced<'py>> {
+        state::reduce(slf.as_any(), slf.get())
+    }
+
+    /// The object of a pickled state.
+    #[staticmethod]
+    fn _from_state(version: u32, state: &[u8]) -> PyResult<Self> {
+        state::load("Budget", version, state)
+    }
+
+    /// Equal when every value is equal bit for bit and the same files are behind them.
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> PyResult<bool> {
+        state::equal(self, other)
     }
 
     fn __repr__(&self) -> String {

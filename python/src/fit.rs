@@ -2,10 +2,13 @@
 //! frequencies (the command line's `tiltnoise fit`).
 
 use crate::errors::{value_error, InputFileError};
+use crate::interrupt;
 use crate::params::PyParams;
+use crate::state;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
+use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::fit::{
     self, FitConfig, FitError, FitResult, Measured, SigmaSource, Visibilities,
 };
@@ -69,11 +72,12 @@ pub fn run(
         free: free.unwrap_or_else(|| FitConfig::default().free),
         bound_sigmas,
         prior,
-        ..FitConfig::default()
+        cancel: Cancel::new(),
     };
-    let result = py
-        .detach(|| fit::fit_with_visibilities(params, &measured, &visibilities, &config))
-        .map_err(|e| value_error(e.to_string()))?;
+    let result = interrupt::watch(py, &config.cancel, || {
+        fit::fit_with_visibilities(params, &measured, &visibilities, &config)
+            .map_err(|e| value_error(e.to_string()))
+    })?;
     Ok(Fit {
         result,
         origin: measured.origin,
@@ -86,6 +90,7 @@ pub fn run(
 /// ``weak_directions``, ``iterations``, ``evaluations``, ``stop``, ``projected_gradient``,
 /// ``measured_origin``.
 #[pyclass(module = "tiltnoise", frozen)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct Fit {
     result: FitResult,
     origin: String,
@@ -255,6 +260,22 @@ impl Fit {
     #[getter]
     fn measured_origin(&self) -> &str {
         &self.origin
+    }
+
+    /// Pickles as its state (see the module's pickling notes).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<state::Reduced<'py>> {
+        state::reduce(slf.as_any(), slf.get())
+    }
+
+    /// The object of a pickled state.
+    #[staticmethod]
+    fn _from_state(version: u32, state: &[u8]) -> PyResult<Self> {
+        state::load("Fit", version, state)
+    }
+
+    /// Equal when every value is equal bit for bit and the same files are behind them.
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> PyResult<bool> {
+        state::equal(self, other)
     }
 
     fn __repr__(&self) -> String {

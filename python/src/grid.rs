@@ -45,6 +45,7 @@ fn frequencies_into(
         // SAFETY: the values are copied at once, holding the GIL, so no Python code runs
         // meanwhile; no Rust code of this module holds a mutable view of an array here.
         if let Ok(slice) = unsafe { a.as_slice() } {
+            arrays::reserve("freq_hz", freqs, slice.len())?;
             return Ok(copy_with_band(slice, freqs));
         }
     } else if arg.cast::<PyUntypedArray>().is_err() {

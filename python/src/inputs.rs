@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 /// The input files of a result, each with the argument that named it (`path`, `measured`,
 /// `Params.from_toml`), for the message.
-#[derive(Debug, Clone, Default)]
-pub struct Inputs(Vec<(&'static str, PathBuf)>);
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
+pub struct Inputs(Vec<(String, PathBuf)>);
 
 impl Inputs {
     /// The parameter file of the model, if its parameters were read from one.
@@ -19,14 +19,19 @@ impl Inputs {
 
     /// These inputs and `path` (if any), named by the argument `arg`.
     pub fn with(mut self, arg: &'static str, path: Option<&Path>) -> Inputs {
-        self.0.extend(path.map(|p| (arg, p.to_path_buf())));
+        self.0
+            .extend(path.map(|p| (arg.to_string(), p.to_path_buf())));
         self
     }
 
     /// Refuses to save to `path` when it is one of the inputs, or when it cannot be written
     /// (its directory is missing or not writable): `OSError` naming the path and the rule.
     pub fn check_save(&self, path: &Path) -> PyResult<()> {
-        let inputs: Vec<(&str, &Path)> = self.0.iter().map(|(a, p)| (*a, p.as_path())).collect();
+        let inputs: Vec<(&str, &Path)> = self
+            .0
+            .iter()
+            .map(|(a, p)| (a.as_str(), p.as_path()))
+            .collect();
         tiltnoise_io::check_outputs(&[path], &inputs).py()
     }
 }

@@ -10,13 +10,17 @@
 mod arrays;
 mod budget;
 mod errors;
+mod figure;
 mod fit;
 mod grid;
 mod inputs;
+mod interrupt;
 mod model;
 mod params;
+mod python_side;
 mod simulate;
 mod spectral;
+mod state;
 
 use pyo3::prelude::*;
 
@@ -45,6 +49,10 @@ fn panic_on_purpose(where_: &str) {
 #[pymodule]
 #[pyo3(name = "_tiltnoise")]
 fn tiltnoise_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // NumPy's C API is looked up on first use by importing a NumPy module, which runs Python
+    // code: at a later first use, a pending Ctrl-C would fail the import and the lookup would
+    // panic. Looked up here, while the import of tiltnoise runs, it is never looked up again.
+    numpy::PyArray1::<f64>::zeros(m.py(), 0, false);
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("hdf5_version", tiltnoise_io::hdf5_version())?;
     m.add(

@@ -4,18 +4,24 @@
 use crate::arrays;
 use crate::errors::{value_error, PyResultExt};
 use crate::grid::{self, GridBuffer};
+use crate::interrupt;
 use crate::params::PyParams;
+use crate::state;
 use numpy::{Complex64, PyArray1, PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::sync::{Arc, Mutex, OnceLock};
+use std::time::{Duration, Instant};
+use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::mc::{self, McConfig};
 use tiltnoise_core::model::{Coord, ForceInput, Input, Model, Observable, Request};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::options;
 use tiltnoise_core::simulate::DEFAULT_MODE_ENERGY_J;
-use tiltnoise_core::tf::{self, eval_grid_threads, Destination, Method, Scene, TransferFunction};
+use tiltnoise_core::tf::{
+    self, eval_grid_threads_cancellable, Destination, Method, Scene, TransferFunction,
+};
 
 // The defaults of `transfer`, `explain` and `simulate` are written as literals in their
 // signatures, so that Python's `inspect.signature` (and the type stubs) show the numbers; they
@@ -33,7 +39,8 @@ const DOMINANT_SHARE: f64 = 0.05;
 const HOLD_GIL_MAX_POINTS: usize = 16;
 
 /// Grids at least this long are evaluated on every core: below it, starting a thread costs
-/// more than the points it takes over (about 10 ns each).
+/// more than the points it takes over (about 10 ns each). They are also the grids evaluated
+/// under [`interrupt::watch`] (one more thread), so that Ctrl-C stops them.
 const THREADED_GRID: usize = 8192;
 
 /// The cores this process may use, asked once: `available_parallelism` reads the cgroup's
@@ -189,6 +196,58 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
+/// Work between two polls of the cancellation token in [`eval_in_parts`]: a tenth of the
+/// half second an interrupt may take.
+const PART_TIME: Duration = Duration::from_millis(50);
+
+/// [`eval_grid_threads_cancellable`] in consecutive parts of the grid whose size follows the
+/// time each part takes (doubled while under half of [`PART_TIME`], halved above it), polling
+/// `cancel` between parts: the library polls it per block of points, which the slowest
+/// methods take a second or more to evaluate. The values are the same: every point is
+/// evaluated alone.
+fn eval_in_parts(
+    plan: &dyn TransferFunction,
+    freqs: &[f64],
+    buffer: &mut [Complex64],
+    threads: usize,
+    destination: Destination,
+    cancel: &Cancel,
+) -> Result<(), tiltnoise_core::error::TfError> {
+    // The whole output decides how it is written, as in one call.
+    let destination = match destination.streams(std::mem::size_of_val(buffer)) {
+        true => Destination::Streamed,
+        false => destination,
+    };
+    let block = buffer.len() / freqs.len().max(1);
+    let (mut start, mut points) = (0, THREADED_GRID);
+    while start < freqs.len() {
+        cancel.check()?;
+        let end = (start + points).min(freqs.len());
+        let began = Instant::now();
+        eval_grid_threads_cancellable(
+            plan,
+            &freqs[start..end],
+            &mut buffer[start * block..end * block],
+            threads,
+            destination,
+            cancel,
+        )?;
+        let took = began.elapsed();
+        if took < PART_TIME / 2 {
+            points = points.saturating_mul(2);
+        } else if took > PART_TIME {
+            points = (points / 2).max(1);
+        }
+        start = end;
+    }
+    Ok(())
+}
+
+/// The names of `observables`.
+fn names_of(observables: &[Observable]) -> Vec<String> {
+    observables.iter().map(|o| o.name().to_string()).collect()
+}
+
 /// A band and a tolerance as a cache key.
 fn scene_bits(band: (f64, f64), rel_tol: f64) -> [u64; 3] {
     [band.0.to_bits(), band.1.to_bits(), rel_tol.to_bits()]
@@ -304,34 +363,26 @@ impl PyModel {
                 omega_sq_rad2_per_s2: m.omega_sq,
                 quality_factor: m.quality_factor,
                 loss_angle_rad: m.loss_angle,
-                block: m.block_name(),
+                block: m.block_name().to_string(),
                 overlap: m.overlap,
                 ratio: Observable::ALL
                     .iter()
-                    .map(|o| (o.name(), modes.ratio[k][o.index()]))
+                    .map(|o| (o.name().to_string(), modes.ratio[k][o.index()]))
                     .collect(),
-                seen_above_ratio: modes
-                    .observables_above_ratio(k)
-                    .iter()
-                    .map(|o| o.name())
-                    .collect(),
+                seen_above_ratio: names_of(&modes.observables_above_ratio(k)),
                 dominant_coordinates: m
                     .dominant_coords(DOMINANT_SHARE)
                     .into_iter()
-                    .map(|(c, s)| (c.name(), s))
+                    .map(|(c, s)| (c.name().to_string(), s))
                     .collect(),
                 energy_share: Coord::ALL
                     .iter()
-                    .map(|c| (c.name(), m.energy_share[c.index()]))
+                    .map(|c| (c.name().to_string(), m.energy_share[c.index()]))
                     .collect(),
-                seen_by: modes
-                    .observables_seeing(k)
-                    .iter()
-                    .map(|o| o.name())
-                    .collect(),
+                seen_by: names_of(&modes.observables_seeing(k)),
                 observable_amplitude: Observable::ALL
                     .iter()
-                    .map(|o| (o.name(), m.observable_amplitude[o.index()]))
+                    .map(|o| (o.name().to_string(), m.observable_amplitude[o.index()]))
                     .collect(),
                 shape: m.shape.iter().copied().collect(),
             })
@@ -402,12 +453,21 @@ impl PyModel {
         });
         let plan = plan.as_ref();
         let eval = |buffer: &mut [Complex64], destination| -> PyResult<()> {
-            let mut run = move || eval_grid_threads(plan, freqs, buffer, threads, destination);
-            match freqs.len() <= HOLD_GIL_MAX_POINTS {
-                true => run(),
-                false => py.detach(run),
+            let never = Cancel::never();
+            let mut run = || {
+                eval_grid_threads_cancellable(plan, freqs, buffer, threads, destination, &never)
+                    .py()
+            };
+            match freqs.len() {
+                n if n <= HOLD_GIL_MAX_POINTS => run(),
+                n if n < THREADED_GRID => py.detach(run),
+                _ => {
+                    let cancel = Cancel::new();
+                    interrupt::watch(py, &cancel, || {
+                        eval_in_parts(plan, freqs, buffer, threads, destination, &cancel).py()
+                    })
+                }
             }
-            .py()
         };
         match out {
             Some(h) => {
@@ -435,6 +495,33 @@ impl PyModel {
                 Ok(h)
             }
         }
+    }
+
+    /// :meth:`transfer` as a :class:`TransferFunction`: the complex values with the
+    /// frequencies, the names and the units of every input and output, convertible to gwpy
+    /// (``to_gwpy()``) and pandas (``to_pandas()``), drawn by ``plot()``. The arguments are
+    /// :meth:`transfer`'s.
+    #[pyo3(signature = (freq_hz, inputs=None, outputs=None, method="auto", rel_tol=1e-9))]
+    fn transfer_function<'py>(
+        &self,
+        py: Python<'py>,
+        freq_hz: &Bound<'py, PyAny>,
+        inputs: Option<&Bound<'py, PyAny>>,
+        outputs: Option<&Bound<'py, PyAny>>,
+        method: &str,
+        rel_tol: f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let h = self.transfer(py, freq_hz, inputs, outputs, method, rel_tol, None, None)?;
+        let freqs = PyArray1::from_vec(py, grid::frequencies(freq_hz, grid::GRID)?);
+        let (ins, outs) = (parse_inputs(inputs)?, parse_outputs(outputs)?);
+        let names_units = |n: Vec<(&'static str, &'static str)>| n.into_iter().unzip();
+        let (in_names, in_units): (Vec<_>, Vec<_>) =
+            names_units(ins.iter().map(|i| (i.name(), i.unit())).collect());
+        let (out_names, out_units): (Vec<_>, Vec<_>) =
+            names_units(outs.iter().map(|o| (o.name(), o.unit())).collect());
+        py.import("tiltnoise._transfer")?
+            .getattr("TransferFunction")?
+            .call1((freqs, h, in_names, out_names, in_units, out_units, method))
     }
 
     /// Which method ``method="auto"`` picks for this request and grid, and why: every
@@ -532,23 +619,20 @@ impl PyModel {
         threads: usize,
     ) -> PyResult<MonteCarlo> {
         let params = self.model.params();
+        let cancel = Cancel::new();
         let cfg = McConfig {
             samples,
             seed,
             threads,
+            cancel: cancel.clone(),
             ..McConfig::default_for(params)
         };
-        let r = py.detach(|| mc::run(params, &cfg, &|_| {})).py()?;
+        let r = interrupt::watch(py, &cancel, || mc::run(params, &cfg, &|_| {}).py())?;
         Ok(MonteCarlo {
             samples: r.samples,
             rejected: r.rejected,
-            freqs_hz: PyArray2::from_vec2(
-                py,
-                &r.freqs_hz.iter().map(|f| f.to_vec()).collect::<Vec<_>>(),
-            )
-            .map_err(|e| value_error(e.to_string()))?
-            .unbind(),
-            sample_index: PyArray1::from_vec(py, r.sample_index).unbind(),
+            freqs_hz: r.freqs_hz,
+            sample_index: r.sample_index,
             mean_hz: r.mean_hz.to_vec(),
             std_hz: r.std_hz.to_vec(),
         })
@@ -623,6 +707,28 @@ impl PyModel {
         crate::simulate::run(py, &self.model, self.params_file.as_deref(), args)
     }
 
+    /// Pickles as its parameters (and the file they were read from).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<state::Reduced<'py>> {
+        state::reduce(slf.as_any(), &slf.get().params())
+    }
+
+    /// The model of pickled parameters.
+    #[staticmethod]
+    fn _from_state(version: u32, state: &[u8]) -> PyResult<Self> {
+        PyModel::build(Some(&state::load("Model", version, state)?))
+    }
+
+    /// Equal when built from equal parameters (read from the same file, if any).
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> PyResult<bool> {
+        Ok(match other.cast::<PyModel>() {
+            Ok(o) => {
+                let o = o.get();
+                self.model.params() == o.model.params() && self.params_file == o.params_file
+            }
+            Err(_) => false,
+        })
+    }
+
     fn __repr__(&self) -> String {
         format!("Model({})", self.params().describe())
     }
@@ -630,6 +736,7 @@ impl PyModel {
 
 /// One normal mode (see :meth:`Model.modes`).
 #[pyclass(module = "tiltnoise", frozen, get_all)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct Mode {
     /// The label k of nu_k: the rank in frequency (the paper's nu_1 ... nu_8) for the
     /// symmetric pendulum, the symmetric mode it overlaps most for the pendulum as built.
@@ -643,21 +750,21 @@ pub struct Mode {
     /// Modal loss angle 1/Q (rad).
     loss_angle_rad: f64,
     /// The decoupled block of the model the mode lives in, or ``coupled``.
-    block: &'static str,
+    block: String,
     /// Mass-metric overlap with the symmetric pendulum's mode nu_index (1 when symmetric).
     overlap: f64,
     /// Amplitude in each observable over the largest of its unit group in this mode.
-    ratio: HashMap<&'static str, f64>,
+    ratio: BTreeMap<String, f64>,
     /// Observables whose ``ratio`` reaches 1e-4.
-    seen_above_ratio: Vec<&'static str>,
+    seen_above_ratio: Vec<String>,
     /// ``(coordinate, share)`` of the coordinates with at least 5 % of the kinetic energy.
-    dominant_coordinates: Vec<(&'static str, f64)>,
+    dominant_coordinates: Vec<(String, f64)>,
     /// Share of the modal kinetic energy per coordinate (sums to 1).
-    energy_share: HashMap<&'static str, f64>,
+    energy_share: BTreeMap<String, f64>,
     /// Observables that see the mode.
-    seen_by: Vec<&'static str>,
+    seen_by: Vec<String>,
     /// Observable amplitudes of the mass-normalized shape.
-    observable_amplitude: HashMap<&'static str, f64>,
+    observable_amplitude: BTreeMap<String, f64>,
     /// Mass-normalized shape, coordinates in ``Model.matrices()["coordinates"]`` order.
     shape: Vec<f64>,
 }
@@ -668,6 +775,22 @@ impl Mode {
     #[getter]
     fn q(&self) -> f64 {
         self.quality_factor
+    }
+
+    /// Pickles as its state (see the module's pickling notes).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<state::Reduced<'py>> {
+        state::reduce(slf.as_any(), slf.get())
+    }
+
+    /// The object of a pickled state.
+    #[staticmethod]
+    fn _from_state(version: u32, state: &[u8]) -> PyResult<Self> {
+        state::load("Mode", version, state)
+    }
+
+    /// Equal when every value is equal bit for bit and the same files are behind them.
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> PyResult<bool> {
+        state::equal(self, other)
     }
 
     fn __repr__(&self) -> String {
@@ -688,24 +811,58 @@ impl Mode {
 }
 
 /// The result of :meth:`Model.monte_carlo`.
-#[pyclass(module = "tiltnoise", frozen, get_all)]
+#[pyclass(module = "tiltnoise", frozen)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct MonteCarlo {
     /// Draws made (accepted + rejected).
+    #[pyo3(get)]
     samples: usize,
     /// Draws rejected as non-physical.
+    #[pyo3(get)]
     rejected: usize,
-    /// Mode frequencies (Hz) of every accepted draw, ``[n_accepted, 8]``, each row ascending.
-    freqs_hz: Py<PyArray2<f64>>,
-    /// 0-based draw number of each row of ``freqs_hz``.
-    sample_index: Py<PyArray1<usize>>,
+    freqs_hz: Vec<[f64; 8]>,
+    sample_index: Vec<usize>,
     /// Mean frequency per mode (Hz).
+    #[pyo3(get)]
     mean_hz: Vec<f64>,
     /// Standard deviation (n - 1) per mode (Hz).
+    #[pyo3(get)]
     std_hz: Vec<f64>,
 }
 
 #[pymethods]
 impl MonteCarlo {
+    /// Mode frequencies (Hz) of every accepted draw, ``[n_accepted, 8]``, each row ascending
+    /// (read-only).
+    #[getter]
+    fn freqs_hz<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let flat: Vec<f64> = self.freqs_hz.iter().flatten().copied().collect();
+        let a = PyArray1::from_vec(py, flat).reshape([self.freqs_hz.len(), 8])?;
+        arrays::read_only(a)
+    }
+
+    /// 0-based draw number of each row of ``freqs_hz`` (read-only).
+    #[getter]
+    fn sample_index<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<usize>>> {
+        arrays::read_only(PyArray1::from_slice(py, &self.sample_index))
+    }
+
+    /// Pickles as its state (see the module's pickling notes).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<state::Reduced<'py>> {
+        state::reduce(slf.as_any(), slf.get())
+    }
+
+    /// The object of a pickled state.
+    #[staticmethod]
+    fn _from_state(version: u32, state: &[u8]) -> PyResult<Self> {
+        state::load("MonteCarlo", version, state)
+    }
+
+    /// Equal when every value is equal bit for bit and the same files are behind them.
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> PyResult<bool> {
+        state::equal(self, other)
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "MonteCarlo({} draws, {} rejected; mean_hz={:?}, std_hz={:?})",

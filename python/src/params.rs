@@ -18,7 +18,7 @@ use tiltnoise_core::params::Params;
 /// Keys are the command line's (``tiltnoise --set length.h_m=1.5``, the TOML file of
 /// ``tiltnoise params``); :meth:`keys` lists them with value, unit and allowed range.
 #[pyclass(name = "Params", module = "tiltnoise", frozen, eq)]
-#[derive(Clone)]
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
 pub struct PyParams {
     pub inner: Params,
     /// The parameter file the set was read from (and derived from by `set`, `update`), which

@@ -3,10 +3,15 @@
 
 use crate::errors::{value_error, PyResultExt};
 use crate::inputs::Inputs;
+use crate::interrupt;
+use crate::python_side;
+use crate::spectral::welch_cancellable;
+use crate::state;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use std::path::PathBuf;
+use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::model::{Coord, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::noise::Readout;
@@ -18,7 +23,7 @@ use tiltnoise_core::simulate::{
     set_coordinate, simulate_with_progress, Excitation, InitialState, ModalPropagator, SimConfig,
     SimError, Simulation as CoreSimulation,
 };
-use tiltnoise_core::spectral::{welch, WelchConfig};
+use tiltnoise_core::spectral::WelchConfig;
 use tiltnoise_io::{OutputKind, RunMeta, SeriesAsd, SimulationMeta};
 
 /// The options of `Model.simulate`, as given.
@@ -121,16 +126,16 @@ pub fn run(
         duration_s: args.duration,
         readout_asd: readout.clone(),
         seed: args.seed,
-        ..SimConfig::default()
+        cancel: Cancel::new(),
     };
     let wcfg = WelchConfig::new(nperseg);
-    let (sim, asd, check, modes) = py.detach(|| -> PyResult<_> {
+    let (sim, asd, check, modes) = interrupt::watch(py, &cfg.cancel, || -> PyResult<_> {
         let sim = simulate_with_progress(model, &init, &cfg, &mut |_, _| {})
             .map_err(|e| value_error(e.to_string()))?;
         let fs = sim.fs_hz();
         let mut psds = Vec::new();
         for (o, x) in &sim.observables {
-            psds.push((*o, welch(x, fs, &wcfg).py()?));
+            psds.push((*o, welch_cancellable(x, fs, &wcfg, &cfg.cancel).py()?));
         }
         let modes = NormalModes::new(model);
         let prop =
@@ -180,6 +185,7 @@ pub fn run(
 /// against the observability table) and ``resonances_agree``. :meth:`save` writes the
 /// command line's files; an ``.h5`` file is a measured record for ``budget(measured=...)``.
 #[pyclass(module = "tiltnoise", frozen)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct Simulation {
     sim: CoreSimulation,
     asd: SeriesAsd,
@@ -308,6 +314,12 @@ impl Simulation {
         Ok(d)
     }
 
+    /// ``[(k, frequency_hz)]`` of the model's modes nu_k (Hz).
+    #[getter]
+    fn modes_hz(&self) -> Vec<(usize, f64)> {
+        self.modes.clone()
+    }
+
     /// Welch segment of the ASDs (samples).
     #[getter]
     fn nperseg(&self) -> usize {
@@ -374,6 +386,44 @@ impl Simulation {
             }),
         })
         .py()
+    }
+
+    /// ``{"observables": {observable: gwpy.timeseries.TimeSeries}, "asd": {observable:
+    /// gwpy.frequencyseries.FrequencySeries}}``: the samples (``t0 = 0``, ``dt = dt_s``) and
+    /// the ASDs, each named by its observable, with its unit. Needs gwpy (``pip install
+    /// gwpy``); raises ``ImportError`` saying so without it.
+    fn to_gwpy<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        python_side::call(slf.as_any(), "_convert", "simulation_to_gwpy", &[])
+    }
+
+    /// ``{"observables": DataFrame indexed by time_s, "asd": DataFrame indexed by
+    /// frequency_hz}``, one column per observable, units in each frame's ``attrs["units"]``.
+    /// Needs pandas (``pip install pandas``); raises ``ImportError`` saying so without it.
+    fn to_pandas<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        python_side::call(slf.as_any(), "_convert", "simulation_to_pandas", &[])
+    }
+
+    /// The ASDs drawn with matplotlib, log-log, displacements and angles in two panels, the
+    /// modes marked. Returns a new ``matplotlib.figure.Figure`` (of ``matplotlib.pyplot``).
+    /// Needs matplotlib; raises ``ImportError`` saying so without it.
+    fn plot<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        python_side::call(slf.as_any(), "_plots", "simulation_plot", &[])
+    }
+
+    /// Pickles as its state (see the module's pickling notes).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<state::Reduced<'py>> {
+        state::reduce(slf.as_any(), slf.get())
+    }
+
+    /// The object of a pickled state.
+    #[staticmethod]
+    fn _from_state(version: u32, state: &[u8]) -> PyResult<Self> {
+        state::load("Simulation", version, state)
+    }
+
+    /// Equal when every value is equal bit for bit and the same files are behind them.
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> PyResult<bool> {
+        state::equal(self, other)
     }
 
     fn __repr__(&self) -> String {

@@ -4,14 +4,20 @@
 
 use crate::arrays::{self, Size};
 use crate::errors::{value_error, PyResultExt};
+use crate::interrupt;
 use numpy::{Complex64, PyArray1};
 use pyo3::prelude::*;
+use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::error::Num;
 use tiltnoise_core::limits::{MAX_SERIES_SAMPLES, SAMPLES, SAMPLE_RATES, SERIES_BYTES_PER_SAMPLE};
 use tiltnoise_core::spectral::{self, Averaging, Detrend, WelchConfig};
 
 /// `(f, Pxx)` or `(f, Pxy)`: frequencies (Hz) and one-sided densities, as scipy returns them.
 type Spectrum<'py, T> = PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<T>>)>;
+
+/// Series at least this long are estimated under [`interrupt::watch`] (a millisecond or more
+/// of work; shorter ones end before an interrupt could matter).
+const WATCHED_SAMPLES: usize = 1 << 16;
 
 /// The size of a series held in memory ([`MAX_SERIES_SAMPLES`]).
 pub const SERIES: Size = Size {
@@ -40,6 +46,21 @@ fn checked_series(what: &str, arg: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
     let x = arrays::series(what, arg, SERIES)?;
     arrays::check_values(what, &x, &SAMPLES, &format!("in the unit of {what}"))?;
     Ok(x)
+}
+
+/// [`spectral::welch`] polling `cancel` before each segment.
+pub fn welch_cancellable(
+    x: &[f64],
+    fs: f64,
+    cfg: &WelchConfig,
+    cancel: &Cancel,
+) -> Result<spectral::Psd, spectral::SpectralError> {
+    let m = spectral::csd_matrix_cancellable(&[x], fs, cfg, cancel)?;
+    Ok(spectral::Psd {
+        psd: m.psd(0),
+        freqs_hz: m.freqs_hz,
+        n_segments: m.n_segments,
+    })
 }
 
 /// `average` as on the command line's `budget --average`.
@@ -90,7 +111,8 @@ fn config(
 /// ``scipy.signal.welch(x, fs, window="hann", nperseg, noverlap, detrend, average=average)``
 /// with ``scaling="density"`` and ``return_onesided=True``: the same frequencies and values.
 ///
-/// Returns ``(f, Pxx)``: frequencies ``k fs / nperseg`` (Hz) for ``k = 0 .. nperseg // 2``
+/// Returns ``(f, Pxx)``: frequencies ``k fs / nperseg`` (Hz) for ``k = 0 .. nperseg // 2``,
+/// equal to scipy's bit for bit (rounded as ``numpy.fft.rfftfreq(nperseg, 1 / fs)``),
 /// and the PSD in ``unit**2/Hz`` for ``x`` in ``unit`` (its integral over ``0 .. fs/2`` is
 /// the variance). Unlike scipy, a series shorter than ``nperseg`` raises ``ValueError``
 /// instead of shortening the segment. ``average`` is ``"mean"`` or ``"median"`` (with
@@ -118,7 +140,11 @@ pub fn welch<'py>(
     )?;
     check_fs(fs)?;
     let x = checked_series("x", x)?;
-    let psd = py.detach(|| spectral::welch(&x, fs, &cfg)).py()?;
+    let cancel = Cancel::new();
+    let long = x.len() >= WATCHED_SAMPLES;
+    let psd = interrupt::watch_if(py, long, &cancel, || {
+        welch_cancellable(&x, fs, &cfg, &cancel).py()
+    })?;
     Ok((
         PyArray1::from_vec(py, psd.freqs_hz),
         PyArray1::from_vec(py, psd.psd),
@@ -156,9 +182,13 @@ pub fn csd<'py>(
     )?;
     check_fs(fs)?;
     let (x, y) = (checked_series("x", x)?, checked_series("y", y)?);
-    let c = py.detach(|| spectral::csd(&x, &y, fs, &cfg)).py()?;
+    let cancel = Cancel::new();
+    let long = x.len() >= WATCHED_SAMPLES;
+    let m = interrupt::watch_if(py, long, &cancel, || {
+        spectral::csd_matrix_cancellable(&[&x, &y], fs, &cfg, &cancel).py()
+    })?;
     Ok((
-        PyArray1::from_vec(py, c.freqs_hz),
-        PyArray1::from_vec(py, c.csd),
+        PyArray1::from_slice(py, &m.freqs_hz),
+        PyArray1::from_vec(py, m.csd(0, 1)),
     ))
 }

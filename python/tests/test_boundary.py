@@ -75,6 +75,28 @@ def test_sizes_are_checked_before_any_copy_under_a_memory_limit(code, needle):
     assert out.startswith("ValueError: ") and needle in out, out
 
 
+# Every call whose size the caller chooses, at sizes that would not fit into a 6 GiB address
+# space: refused before anything is allocated, naming the argument and the limit.
+@pytest.mark.parametrize("code, needle", [
+    ("tn.Model().transfer(np.broadcast_to(np.float64(1e-3), (10**8,)), inputs='forces')",
+     "freq_hz: 100000000 frequencies, more than the 1000000 allowed"),
+    ("tn.Model().transfer_function(np.broadcast_to(np.float64(1e-3), (10**9,)))",
+     "freq_hz: 1000000000 frequencies, more than the 1000000 allowed"),
+    ("tn.Model().explain(np.broadcast_to(np.float64(1e-3), (10**9,)))",
+     "freq_hz: 1000000000 frequencies, more than the 1000000 allowed"),
+    ("tn.Model().monte_carlo(10**12)", "samples 1000000000000: 1000000000000 Monte Carlo draws, "
+                                       "more than the 10000000 allowed"),
+    ("tn.Model().simulate(duration=1e12, step=0.1)",
+     "duration 1e12 s at step 0.1 s: 10000000010000 samples, more than the 16777216 allowed"),
+    ("tn.budget_from_file(REPO + '/tilt_data/peterson_tilt_asd.csv', freq=np.broadcast_to("
+     "np.float64(1e-2), (10**9,)))", "1000000000 frequencies, more than the 1000000 allowed"),
+])
+def test_absurd_sizes_are_refused_under_a_6_gib_address_space(code, needle):
+    out, rc, err = run_limited(f"REPO = {str(REPO)!r}\n{code}", limit="6 << 30")
+    assert rc == 0, f"the interpreter died (exit {rc}): {err[-500:]}"
+    assert out.startswith(("ValueError: ", "MemoryError: ")) and needle in out, out
+
+
 def test_memory_beyond_the_address_space_left_is_a_memory_error():
     # 2^25 samples (at the count limit) plan 512 MiB, more than half of the 768 MiB of address
     # space left to the child.

@@ -159,7 +159,7 @@ def test_file_errors(tmp_path):
         tiltnoise.budget_from_file(LAB_TILT, freq="1e-3:10:1e-1")
     b = tiltnoise.budget_from_file(LAB_TILT, nperseg=4096)
     with pytest.raises(ValueError, match="unknown extension"):
-        b.save(tmp_path / "budget.png")
+        b.save(tmp_path / "budget.jpg")
     with pytest.raises(OSError, match="cannot save .* does not exist"):
         b.save(tmp_path / "no" / "such" / "dir" / "budget.csv")
 

@@ -40,7 +40,9 @@ def test_stub_names_equal_the_modules():
     runtime = set(_tiltnoise.__all__)
     assert set(stub_all) == runtime
     assert runtime <= set(stub)
-    assert set(tiltnoise.__all__) == {n for n in runtime if not n.startswith("_p")}
+    # The package adds its pure-Python classes to the extension's names.
+    python_side = {"TransferFunction"}
+    assert set(tiltnoise.__all__) == {n for n in runtime if not n.startswith("_p")} | python_side
     for name in runtime:
         members = stub[name]
         if members is None or name == "InputFileError":

@@ -42,8 +42,29 @@ def test_welch_equals_scipy(kw):
     x = np.cumsum(rng.standard_normal(40_000)) * 1e-9 + 3e-7
     f, p = tiltnoise.welch(x, fs=10.0, **kw)
     fs, ps = signal.welch(x, fs=10.0, window="hann", **kw)
-    np.testing.assert_allclose(f, fs, rtol=2 * EPS, atol=0)  # k fs / n vs scipy's k / (n / fs)
+    assert_same_bits(f, fs)
     close(p, ps, rounding_tol(len(x), kw))
+
+
+def assert_same_bits(f, f_scipy):
+    """The frequencies are scipy's, bit for bit (not within an ulp)."""
+    assert f.dtype == f_scipy.dtype == np.float64 and f.shape == f_scipy.shape
+    differ = np.flatnonzero(f.view(np.int64) != f_scipy.view(np.int64))
+    assert differ.size == 0, (
+        f"{differ.size} of {f.size} bins differ, first at {differ[0]}: "
+        f"{f[differ[0]]!r} vs scipy's {f_scipy[differ[0]]!r}")
+
+
+# Segments and rates whose k fs / n rounds differently from scipy's k * (1 / (n * (1 / fs))) in
+# many bins (1000 at 1 Hz: 62 of 501), and rates that are not binary fractions.
+@pytest.mark.parametrize("nperseg", [1000, 256, 513, 4096, 3])
+@pytest.mark.parametrize("fs", [1.0, 10.0, 2.5, 1 / 3, 200.0, 0.1, 16384.0, 1e-3, 7.3])
+def test_frequencies_are_scipys_bit_for_bit(nperseg, fs):
+    x = np.random.default_rng(nperseg).standard_normal(2 * nperseg)
+    f, _ = tiltnoise.welch(x, fs=fs, nperseg=nperseg)
+    assert_same_bits(f, signal.welch(x, fs=fs, nperseg=nperseg)[0])
+    f, _ = tiltnoise.csd(x, x[::-1], fs=fs, nperseg=nperseg)
+    assert_same_bits(f, signal.csd(x, x[::-1], fs=fs, nperseg=nperseg)[0])
 
 
 @pytest.mark.parametrize("kw", CASES)
@@ -53,7 +74,7 @@ def test_csd_equals_scipy(kw):
     y = 0.3 * np.roll(x, 5) + rng.standard_normal(30_000)
     f, p = tiltnoise.csd(x, y, fs=2.5, **kw)
     fs, ps = signal.csd(x, y, fs=2.5, window="hann", **kw)
-    np.testing.assert_allclose(f, fs, rtol=2 * EPS, atol=0)  # k fs / n vs scipy's k / (n / fs)
+    assert_same_bits(f, fs)
     assert p.dtype == np.complex128
     close(p, ps, rounding_tol(len(x), kw))
 

@@ -17,6 +17,11 @@ Conventions: SI units; one-sided spectra (PSD in unit**2/Hz, ASD its square root
 amplitudes for ``exp(+i w t)``; the tilt ``(theta_t, eta_t, phi_t)`` is the rotation taking
 the floor frame to the inertial frame, so ``X -> -eta_t (Z + Z_b + h_c)`` as ``f -> 0``.
 
+Results carry their frequencies, names and units: ``to_gwpy()`` and ``to_pandas()`` convert
+them (gwpy and pandas are optional), ``plot()`` draws them with matplotlib, and a budget's
+``save("b.png")`` writes the command line's figure. Every object pickles (multiprocessing,
+joblib). Ctrl-C stops any long call with ``KeyboardInterrupt``.
+
 Errors are ``ValueError`` (parameters, names, options), ``OSError`` subclasses for files that
 cannot be read (``FileNotFoundError``, ...) and :class:`InputFileError` (an ``OSError``) for
 files that are read but not valid.
@@ -38,6 +43,7 @@ from ._tiltnoise import (
     hdf5_version,
     welch,
 )
+from ._transfer import TransferFunction
 
 __all__ = [
     "Budget",
@@ -48,6 +54,7 @@ __all__ = [
     "MonteCarlo",
     "Params",
     "Simulation",
+    "TransferFunction",
     "__version__",
     "budget",
     "budget_from_file",

@@ -23,7 +23,7 @@ pub const SCHEMA_OBSERVABLE_SERIES: &str = "tiltnoise.observable_series";
 pub const SCHEMA_VERSION_OBSERVABLE_SERIES: i64 = 2;
 
 /// One-sided Welch ASDs of the observables, stored in the group `/asd`.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SeriesAsd {
     /// Frequencies (Hz), `k fs / segment_len`, `k = 0 ..= segment_len / 2`.
     pub freqs_hz: Vec<f64>,

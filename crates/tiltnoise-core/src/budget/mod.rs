@@ -262,7 +262,9 @@ pub fn budget_from_series(
     let segment_samples = segment_samples(opts, fs, n, seg_len)?;
     let n_ax = channels.len();
     check_kept_memory(&cfg, n, n_ax, segment_samples, opts.outputs.len())?;
-    let mut whole = WelchAccumulator::new(n_ax, fs, &cfg)?;
+    // Polled per Welch segment, not only per chunk: a chunk of short segments of many channels
+    // can take a second.
+    let mut whole = WelchAccumulator::new(n_ax, fs, &cfg)?.with_cancel(opts.cancel.clone());
     // One accumulator and one matrix buffer for every segment, emptied and reused: a month of
     // hourly segments of six channels would otherwise map and clear 5 MB twice an hour.
     let mut current: Option<WelchAccumulator> = None;
@@ -288,7 +290,9 @@ pub fn budget_from_series(
             while offset < len {
                 let acc = match current.as_mut() {
                     Some(acc) => acc,
-                    None => current.insert(WelchAccumulator::new(n_ax, fs, &cfg)?),
+                    None => current.insert(
+                        WelchAccumulator::new(n_ax, fs, &cfg)?.with_cancel(opts.cancel.clone()),
+                    ),
                 };
                 let take = (seg - in_segment).min(len - offset);
                 let part: Vec<&[f64]> = views.iter().map(|c| &c[offset..offset + take]).collect();
@@ -296,6 +300,7 @@ pub fn budget_from_series(
                 in_segment += take;
                 offset += take;
                 if in_segment == seg {
+                    opts.cancel.check()?;
                     acc.finish_into(&mut segment_spectra)?;
                     in_segment = 0;
                     if tf_cache.is_none() {
@@ -344,6 +349,7 @@ pub fn budget_from_series(
             in_segment as f64 / fs
         ));
     }
+    opts.cancel.check()?;
     let segment_bands = band_per_observable(
         &segment_term,
         &opts.outputs,

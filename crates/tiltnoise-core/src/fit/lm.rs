@@ -38,7 +38,7 @@ pub struct LmOptions {
 }
 
 /// Why the iteration stopped.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Stop {
     /// Projected gradient below `gtol`.
     Gradient,

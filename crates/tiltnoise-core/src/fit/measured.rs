@@ -32,7 +32,7 @@ pub const MIN_MEASURED_HZ: f64 = 1e-9;
 pub const MIN_SIGMA_REL: f64 = 8.881784197001252e-16;
 
 /// Where a default sigma came from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum SigmaSource {
     /// Given in the `sigma_hz` column.
     File,
@@ -41,7 +41,7 @@ pub enum SigmaSource {
 }
 
 /// One measured mode frequency.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MeasuredMode {
     /// Rank of the mode, 1..=8 (nu_1 is the lowest frequency).
     pub mode: usize,

@@ -94,7 +94,7 @@ pub const MAX_SIGN_STARTS: usize = 16;
 pub const RANK_TOL: f64 = 16.0 * f64::EPSILON;
 
 /// What to fit and how.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FitConfig {
     /// Dotted keys of the free parameters (each once, each with an error bar).
     pub free: Vec<String>,
@@ -102,7 +102,9 @@ pub struct FitConfig {
     pub bound_sigmas: f64,
     /// Add the Gaussian prior `sum ((p - p0) / sigma_p)^2` to the objective.
     pub prior: bool,
-    /// Polled before each evaluation of the model's frequencies and Jacobian.
+    /// Polled before each evaluation of the model's frequencies and Jacobian (not part of a
+    /// stored configuration: a restored one is never cancelled).
+    #[serde(skip)]
     pub cancel: Cancel,
 }
 
@@ -118,7 +120,7 @@ impl Default for FitConfig {
 }
 
 /// Which bound a parameter ended on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Bound {
     /// `p = p0 - n sigma_p`.
     Lower,
@@ -137,7 +139,7 @@ impl Bound {
 }
 
 /// One fitted parameter.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FittedParam {
     /// Dotted key.
     pub key: String,
@@ -161,7 +163,7 @@ pub struct FittedParam {
 }
 
 /// One measured mode at the nominal and the fitted parameters.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ModeFit {
     /// The measurement.
     pub measured: MeasuredMode,
@@ -184,7 +186,7 @@ impl ModeFit {
 }
 
 /// One measured visibility at the nominal and the fitted parameters.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct VisibilityFit {
     /// The measurement.
     pub measured: MeasuredVisibility,
@@ -208,7 +210,7 @@ impl VisibilityFit {
 }
 
 /// A combination of free parameters the data determine poorly.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct WeakDirection {
     /// Singular value of the data Jacobian (< 1): the combination is known to `1 / s` error bars.
     pub singular_value: f64,
@@ -217,7 +219,7 @@ pub struct WeakDirection {
 }
 
 /// The outcome of a fit.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct FitResult {
     /// The free parameters, in the order given.
     pub params: Vec<FittedParam>,

@@ -34,7 +34,7 @@ pub const MAX_RATIO: f64 = 1e6;
 pub const HEADER: &str = "mode,observable,reference,ratio[,sigma]";
 
 /// One measured visibility.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MeasuredVisibility {
     /// Label of the mode, 1..=8 (nu_k).
     pub mode: usize,

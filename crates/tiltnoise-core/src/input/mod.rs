@@ -354,7 +354,7 @@ impl TiltInput {
 /// Provenance of the tilt input of a budget run, stored in the budget's HDF5 file and shown in
 /// its figure. Plain strings, so that this module does not depend on [`crate::input`]; the
 /// caller fills it from the reader's `tiltnoise_core::input::Provenance`.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct InputMeta {
     /// The input file, as given.
     pub path: String,

@@ -62,7 +62,7 @@ impl Coord {
 /// Observables (section II.D): test-mass position X, Y, Z of the cube centre and attitude theta,
 /// eta, phi, as read by the GRS in the enclosure frame, and the crossbar torsion phi_a read by the
 /// autocollimator.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum Observable {
     /// Cube centre along x (m).
     X,
@@ -118,7 +118,7 @@ impl Observable {
 
 /// Floor tilt angles. Sign convention: see [`crate::model::tilt`]. Positive `theta_t` makes the
 /// test mass settle at +Y, positive `eta_t` at -X (the paper's stated quasi-static limits).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum TiltAxis {
     /// Tilt about x (rad).
     ThetaT,
@@ -153,7 +153,7 @@ impl TiltAxis {
 /// sensor housing. Lab axes as the model's: the crossbar arm lies along y (the test mass at
 /// `(0, -d, .)`), x is perpendicular to it (the test mass's X), z is up. See
 /// [`crate::model::translation`] for the forcing and its low-frequency equivalence with tilt.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum TranslationAxis {
     /// Displacement along x, perpendicular to the crossbar arm (m).
     XT,
@@ -189,7 +189,7 @@ impl TranslationAxis {
 
 /// The 12 components of the external forces F_a, F_b (N, at the centres of mass) and torques
 /// M_a, M_b (N m, about the centres of mass), inertial axes, in the order of [`ForceInput::ALL`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct ForceInput(usize);
 
 impl ForceInput {

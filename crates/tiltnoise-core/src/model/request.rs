@@ -5,7 +5,7 @@
 use super::{ForceInput, Observable, TiltAxis, TranslationAxis};
 
 /// An input of a transfer function.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum Input {
     /// A floor tilt angle (rad).
     Tilt(TiltAxis),

@@ -19,7 +19,7 @@ use crate::model::{ForceInput, Model, Observable};
 use crate::tf::{self, Input, Request};
 
 /// The calibration of an observable's budget to its equivalent input (see the module docs).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Calibration {
     /// The equivalent input (`F_b.x` for X, `M_b.z` for phi and phi_a).
     pub input: ForceInput,

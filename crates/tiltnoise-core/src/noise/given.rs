@@ -5,7 +5,7 @@
 use std::fmt;
 
 /// A one-sided ASD on its own frequency points, with where it came from.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GivenAsd {
     freqs_hz: Vec<f64>,
     asd: Vec<f64>,

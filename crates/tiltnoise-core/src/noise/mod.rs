@@ -55,7 +55,7 @@ pub const PAPER_X_READOUT_ASD_M: f64 = 9e-9;
 pub const TOTAL_NAME: &str = "total";
 
 /// One term of a budget: a one-sided PSD on the budget's frequency grid.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct NoiseTerm {
     /// What the term is.
     pub kind: TermKind,
@@ -76,7 +76,7 @@ impl NoiseTerm {
 }
 
 /// The budget of one observable.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ObservableBudget {
     /// The observable (X in m, phi and phi_a in rad).
     pub observable: Observable,
@@ -147,7 +147,7 @@ impl ObservableBudget {
 }
 
 /// A noise budget on one frequency grid.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Budget {
     /// Frequencies (Hz), increasing, all > 0.
     pub freqs_hz: Vec<f64>,
@@ -164,7 +164,7 @@ impl Budget {
 
 /// Readout noise per observable: white (an ASD in the observable's unit/sqrt(Hz)) or coloured
 /// (a [`GivenAsd`]). An observable is in at most one of the two lists.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Readout {
     /// White readout, `(observable, ASD)`.
     pub asd: Vec<(Observable, f64)>,
@@ -578,7 +578,7 @@ mod tests {
 }
 
 /// How the tilt spectra of a budget were estimated, for provenance in the output files.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum SpectralSource {
     /// Welch estimate from a time series.
     Welch {
@@ -603,7 +603,7 @@ pub enum SpectralSource {
 }
 
 /// A complete budget run: the whole-record budget, the per-segment statistics and what went in.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BudgetReport {
     /// The budget of the whole record (or of the given spectra).
     pub budget: Budget,

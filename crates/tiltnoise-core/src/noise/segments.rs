@@ -2,7 +2,7 @@
 //! every frequency, because floor tilt changes through the day.
 
 /// Median and percentile band of one term's PSD across segments, per frequency.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SegmentBand {
     /// The term whose PSD the band is of.
     pub term: super::TermKind,

@@ -16,7 +16,7 @@ use super::TermKind;
 use crate::model::Observable;
 
 /// A Welch term averaged over the bins of a band.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BandMean {
     /// Frequency of the first bin in the band (Hz).
     pub first_bin_hz: f64,
@@ -37,7 +37,7 @@ impl BandMean {
 }
 
 /// How a summary value was obtained (see the module docs).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Evaluation {
     /// At exactly the frequency.
     Exact,
@@ -56,7 +56,7 @@ impl Evaluation {
 }
 
 /// One term at one frequency.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TermAt {
     /// What the term is.
     pub kind: TermKind,
@@ -78,7 +78,7 @@ impl TermAt {
 }
 
 /// The terms of one observable at one frequency, in the budget's term order.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ObservableAt {
     /// The observable.
     pub observable: Observable,
@@ -118,7 +118,7 @@ impl ObservableAt {
 }
 
 /// The budget at one frequency.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SummaryAt {
     /// The frequency (Hz).
     pub freq_hz: f64,

@@ -6,7 +6,7 @@ use crate::model::{Observable, TiltAxis, TranslationAxis};
 use std::fmt;
 
 /// The kind of a term of an observable's budget.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum TermKind {
     /// Floor tilt through the transfer functions, every tilt axis with its cross-spectra (the
     /// rotations alone).

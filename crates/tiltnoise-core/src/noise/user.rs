@@ -10,7 +10,7 @@ use crate::model::{Input, Model, Observable};
 use crate::tf::{self, Request};
 
 /// What a user term's ASD is of.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum UserSource {
     /// The observable itself (its unit/sqrt(Hz)); a term of that observable only.
     Observable(Observable),
@@ -39,7 +39,7 @@ impl UserSource {
 
 /// A user-named term: its name (a file key, [`super::is_term_name`]), what its ASD is of, and
 /// the ASD.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct UserTerm {
     /// The name, stored as `user.<name>`.
     pub name: String,

@@ -73,7 +73,7 @@ pub fn check_samples(what: impl Fn() -> String, n_samples: f64) -> Result<(), Li
 
 /// Initial conditions in crate coordinate order ([`crate::model::Coord::ALL`]), SI units
 /// (rad, m; rad/s, m/s).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct InitialState {
     /// Generalized coordinates at t = 0.
     pub q: [f64; 8],
@@ -127,7 +127,7 @@ impl SimConfig {
 }
 
 /// A simulated record.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Simulation {
     /// Sampling step (s); sample `i` is at `t = i dt_s`.
     pub dt_s: f64,

@@ -35,7 +35,8 @@
 //! * **Cross spectra** are in `U_i·U_j/Hz` and follow scipy: `S_ij = conj(X_i)·X_j`, so
 //!   `S_ji = conj(S_ij)` (the matrix at each frequency is Hermitian) and `S_ii` is the real,
 //!   non-negative PSD of channel `i`. If `x_j` is `x_i` delayed by `τ`, `arg S_ij = -2π f τ`.
-//! * **Frequencies** are `k * fs_hz / segment_len` for `k = 0 ..= segment_len/2`.
+//! * **Frequencies** are `k fs_hz / segment_len` for `k = 0 ..= segment_len/2`, rounded as
+//!   scipy rounds them ([`bin_freqs`]).
 //! * The number of segments is `(n - overlap) / step` (integer division), as in scipy; the
 //!   trailing `(n - overlap) % step` samples that do not complete a segment are ignored.
 //!
@@ -76,7 +77,8 @@ pub use config::{Averaging, Detrend, WelchConfig};
 pub use cross::{coherence, multiple_input, MultipleInput, INPUT_RCOND_MIN};
 pub use dof::band_dof;
 pub use welch::{
-    csd, csd_matrix, csd_matrix_cancellable, welch, CrossSpectra, Csd, Psd, WelchAccumulator,
+    bin_freqs, csd, csd_matrix, csd_matrix_cancellable, welch, CrossSpectra, Csd, Psd,
+    WelchAccumulator,
 };
 pub use window::hann_periodic;
 

@@ -14,7 +14,7 @@ use crate::limits::check_memory;
 /// One-sided power spectral density of one series.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Psd {
-    /// Bin frequencies `k * fs_hz / segment_len`, `k = 0 ..= segment_len/2`, in Hz.
+    /// Bin frequencies ([`bin_freqs`]), `k = 0 ..= segment_len/2`, in Hz.
     pub freqs_hz: Vec<f64>,
     /// One-sided PSD in `U²/Hz` for an input in `U`.
     pub psd: Vec<f64>,
@@ -47,7 +47,7 @@ pub struct Csd {
 /// diagonal is the real, non-negative PSD of each channel.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CrossSpectra {
-    /// Bin frequencies `k * fs_hz / segment_len`, in Hz.
+    /// Bin frequencies ([`bin_freqs`]), in Hz.
     pub freqs_hz: Vec<f64>,
     /// Number of channels (the matrix dimension).
     pub n_channels: usize,
@@ -427,12 +427,20 @@ impl WelchAccumulator {
             }
         }
         out.freqs_hz.clear();
-        out.freqs_hz
-            .extend((0..nf).map(|k| k as f64 * self.fs_hz / len as f64));
+        out.freqs_hz.extend(bin_freqs(len, self.fs_hz, nf));
         out.n_channels = nc;
         out.n_segments = nseg;
         Ok(())
     }
+}
+
+/// The first `n_bins` bin frequencies (Hz) of a segment of `segment_len` samples at `fs_hz`,
+/// `k / (segment_len / fs_hz)`, rounded as NumPy's `rfftfreq(segment_len, 1 / fs_hz)` rounds them
+/// (`k * (1 / (segment_len * (1 / fs_hz)))`), which `scipy.signal.welch` and `csd` return: so a
+/// grid compared with scipy's or gwpy's is equal bit for bit, not within an ulp.
+pub fn bin_freqs(segment_len: usize, fs_hz: f64, n_bins: usize) -> impl Iterator<Item = f64> {
+    let df = 1.0 / (segment_len as f64 * (1.0 / fs_hz));
+    (0..n_bins).map(move |k| k as f64 * df)
 }
 
 fn check_equal_lengths(channels: &[&[f64]]) -> Result<(), SpectralError> {

@@ -1,0 +1,84 @@
+"""Figures of results with matplotlib (optional): Budget.plot, Simulation.plot,
+TransferFunction.plot. The command line's own figures are written by ``save("x.png")``."""
+
+import numpy as np
+
+
+def _pyplot(what):
+    try:
+        import matplotlib.pyplot as plt
+    except ImportError as e:
+        raise ImportError(
+            f"{what} needs matplotlib, which is not installed: pip install matplotlib ({e})"
+        ) from e
+    return plt
+
+
+def budget_plot(budget, observables=None):
+    """One log-log panel of ASDs per observable: the total thick black, each term that is not
+    zero everywhere (a term's per-axis or per-element breakdown dashed)."""
+    plt = _pyplot("Budget.plot()")
+    names = list(budget.observables) if observables is None else list(observables)
+    for o in names:
+        if o not in budget.observables:
+            raise KeyError(f"observable {o!r} is not in the budget; it has "
+                           f"{', '.join(budget.observables)}")
+    fig, axes = plt.subplots(len(names), 1, figsize=(8, 3.4 * len(names)), sharex=True,
+                             squeeze=False)
+    f = budget.frequency_hz
+    for ax, o in zip(axes[:, 0], names):
+        ax.loglog(f, budget.total[o], color="black", lw=2.5, label="total")
+        for term, asd in budget.terms[o].items():
+            if np.any(asd > 0):
+                ax.loglog(f, asd, lw=1.2, ls="--" if "." in term else "-", label=term)
+        ax.set_ylabel(f"{o} ASD ({budget.units[o]})")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8, ncol=2)
+    axes[-1, 0].set_xlabel("frequency (Hz)")
+    fig.suptitle("noise budget (one-sided ASD)")
+    fig.tight_layout()
+    return fig
+
+
+def simulation_plot(sim):
+    """The observables' ASDs, log-log, displacements and angles in two panels, the modes as
+    dotted vertical lines (above Nyquist, none)."""
+    plt = _pyplot("Simulation.plot()")
+    fig, axes = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
+    f = sim.frequency_hz
+    for ax, unit, names in ((axes[0], "m", ("X", "Y", "Z")),
+                            (axes[1], "rad", ("theta", "eta", "phi", "phi_a"))):
+        for o in names:
+            asd = sim.asd[o]
+            if np.any(asd[1:] > 0):
+                ax.loglog(f[1:], asd[1:], lw=1.2, label=o)
+        for k, fk in sim.modes_hz:
+            if fk <= f[-1]:
+                ax.axvline(fk, color="grey", ls=":", lw=0.8)
+        ax.set_ylabel(f"ASD ({unit}/sqrt(Hz))")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8, ncol=4)
+    axes[1].set_xlabel("frequency (Hz); dotted: the modes")
+    fig.suptitle(f"simulated free motion: {sim.n_samples} samples at {sim.dt_s} s")
+    fig.tight_layout()
+    return fig
+
+
+def transfer_plot(tf):
+    """Bode plot of every ratio of a TransferFunction."""
+    plt = _pyplot("TransferFunction.plot()")
+    fig, (mag, phase) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
+    f = tf.freq_hz
+    for (o, i), unit in tf.units.items():
+        h = tf[o, i]
+        (line,) = mag.loglog(f, np.abs(h), lw=1.2, label=f"{o}/{i} ({unit})")
+        phase.semilogx(f, np.degrees(np.angle(h)), lw=1.0, color=line.get_color())
+    mag.set_ylabel("|H|")
+    mag.grid(True, which="both", alpha=0.3)
+    mag.legend(fontsize=8, ncol=2)
+    phase.set_ylabel("phase (deg), exp(+i w t)")
+    phase.set_yticks(range(-180, 181, 90))
+    phase.grid(True, which="both", alpha=0.3)
+    phase.set_xlabel("frequency (Hz)")
+    fig.tight_layout()
+    return fig
