@@ -19,8 +19,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from case_kit import (LAB_H5, PETERSON, C, chain, copy_setup, h5_measured, joined, measured_lines,
-                      write)
+from case_kit import (LAB_H5, PETERSON, REPO, C, chain, copy_setup, h5_measured, joined,
+                      measured_lines, write)
 
 # A valid pair of records: the lab tilt (86400 s at 1 Hz) and the observables the pendulum
 # model answers it with (made by the first binary's `simulate --tilt` when the inputs are
@@ -205,7 +205,7 @@ def cases_miniseed(inputs: Path) -> list:
                                                ("XX.TILT.00.BAN", n, 2.0, "float64")])
     budget("channels at different rates", rates, must_fail=True, culprit=r"rate")
     for rel in ("gap_overlap.mseed", "overlap_differs.mseed"):
-        src = Path(__file__).resolve().parents[2] / "tests/fixtures/input/miniseed" / rel
+        src = REPO / "tests/fixtures/input/miniseed" / rel
         cases.append(C(cat, f"budget: fixture {rel} (Steim-2 counts without --scale)",
                        ["budget", "--tilt", str(src)], must_fail=True))
     # The same reader under the other commands.
