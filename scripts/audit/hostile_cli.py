@@ -108,22 +108,19 @@ import threading
 import time
 import tomllib
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
 
 import h5py
 import numpy as np
 
-REPO = Path(__file__).resolve().parents[2]
-LAB_H5 = str(REPO / "tilt_data" / "lab_tilt_24h.h5")
-PETERSON = str(REPO / "tilt_data" / "peterson_tilt_asd.csv")
-DAMPED = str(REPO / "examples" / "damped.toml")
+import surfaces
+from case_kit import (DAMPED, LAB_H5, PETERSON, QUICK_TIMEOUT, REPO, SHORT_TIMEOUT, ArgFromFile,
+                      Case, Ctx, C, copy_setup, fifo_setup, h5_measured, h5_series, h5_spectra,
+                      joined, measured_lines, replace_dataset, series_lines, spectrum_lines,
+                      write)
 
 MEM_LIMIT = 4 << 30
 DEFAULT_TIMEOUT = 20.0
-SHORT_TIMEOUT = 10.0
-QUICK_TIMEOUT = 4.0  # inputs that must be handled quickly (endless devices, 100 MB of spaces)
 STDOUT_HEAD = 64 << 10
 STDERR_CAP = 1 << 20
 TEXT_SCAN_CAP = 256 << 20
@@ -182,55 +179,7 @@ TEMP_NAME_RES = [
 
 
 # --------------------------------------------------------------------------------------------
-# Cases
-
-
-@dataclass
-class Ctx:
-    """What a case's setup sees: its scratch directory and the binary under test."""
-
-    dir: Path
-    bin: str
-    finalizers: list = field(default_factory=list)
-
-
-@dataclass
-class Case:
-    cat: str
-    name: str
-    args: list
-    setup: Callable[[Ctx], None] | None = None
-    desc: str = ""
-    timeout: float | None = None
-    must_fail: bool = False
-    must_succeed: bool = False
-    huge: bool = False
-    stdin: str = "devnull"  # devnull | closed
-    stdout: str = "pipe"  # pipe | closed | devfull | close_after_1 | broken_pipe
-    stderr: str = "pipe"  # pipe | closed | devfull
-    sig: int | None = None  # signal to send
-    sig_when: object = "tempfile"  # "tempfile" (a temporary output appears) or seconds
-    artifacts: list = field(default_factory=list)  # files (relative to the scratch dir) to keep
-    serial: bool = False
-    culprit: str | None = None  # regex the one-line error must match (what it must name)
-    python: str | None = None  # a Python snippet run by py_case.py instead of the binary
-
-
-def C(cat, name, args, **kw) -> Case:
-    """A case; an option value that starts with '-' is joined to its option (`--x=-1`) so that
-    it reaches the program's validation instead of the argument parser's."""
-    out: list = []
-    for a in args:
-        if isinstance(a, ArgFromFile):
-            out.append(a)
-            continue
-        a = str(a)
-        if (out and a.startswith("-") and len(a) > 1 and not a.startswith("--")
-                and isinstance(out[-1], str) and out[-1].startswith("--") and "=" not in out[-1]):
-            out[-1] = f"{out[-1]}={a}"
-        else:
-            out.append(a)
-    return Case(cat, name, out, **kw)
+# How a case is shown
 
 
 def shown(arg: str) -> str:
@@ -260,167 +209,6 @@ def display_command(case: Case, binary: str) -> str:
                 else f"after {case.sig_when} s")
         cmd += f"   # {signal.Signals(case.sig).name} {when}"
     return cmd
-
-
-# --------------------------------------------------------------------------------------------
-# Helpers to write inputs
-
-
-def write(path: Path, data) -> Path:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    if isinstance(data, str):
-        data = data.encode()
-    path.write_bytes(data)
-    return path
-
-
-def series_lines(n=4096, fs=1.0, seed=11, header="time_s,theta_t,eta_t", scale=1e-9):
-    rng = np.random.default_rng(seed)
-    a = scale * rng.standard_normal(n)
-    b = scale * rng.standard_normal(n)
-    dt = 1.0 / fs
-    rows = [f"{i * dt!r},{float(a[i])!r},{float(b[i])!r}" for i in range(n)]
-    return [header] + rows
-
-
-def spectrum_lines(n=60, header="freq_hz,theta_t,eta_t"):
-    f = np.logspace(-5, 1, n)
-    asd = 1e-9 * (f / 1e-3) ** -1.0
-    f, asd = f.tolist(), asd.tolist()
-    return [header] + [f"{f[i]!r},{asd[i]!r},{0.7 * asd[i]!r}" for i in range(n)]
-
-
-def measured_lines(n=60, header="freq_hz,X,phi,phi_a"):
-    f = np.logspace(-4, 0, n)
-    x = 1e-8 * (f / 1e-3) ** -1.0
-    f, x = f.tolist(), x.tolist()
-    return [header] + [f"{f[i]!r},{x[i]!r},{1e-9 * x[i]!r},{1e-9 * x[i]!r}" for i in range(n)]
-
-
-def joined(lines, eol="\n") -> str:
-    return eol.join(lines) + eol
-
-
-def h5_series(path: Path, n=4096, fs=1.0, channels=("theta_t", "eta_t"), edit=None, seed=7,
-              data=None):
-    path.parent.mkdir(parents=True, exist_ok=True)
-    rng = np.random.default_rng(seed)
-    with h5py.File(path, "w") as f:
-        f.attrs["sample_rate_hz"] = fs
-        for ch in channels:
-            d = f.create_dataset(ch, data=1e-9 * rng.standard_normal(n) if data is None else data)
-            d.attrs["units"] = "rad"
-        if edit:
-            edit(f)
-    return path
-
-
-def h5_spectra(path: Path, n=60, edit=None, csd=False):
-    path.parent.mkdir(parents=True, exist_ok=True)
-    f_hz = np.logspace(-5, 1, n)
-    asd = 1e-9 * (f_hz / 1e-3) ** -1.0
-    with h5py.File(path, "w") as f:
-        f.attrs["schema"] = "tiltnoise.tilt_spectra"
-        f.attrs["axes"] = np.array(["theta_t", "eta_t"], dtype=h5py.string_dtype())
-        f.create_dataset("frequency_hz", data=f_hz)
-        if csd:
-            s = np.zeros((n, 2, 2), dtype=np.complex128)
-            s[:, 0, 0] = asd ** 2
-            s[:, 1, 1] = 0.5 * asd ** 2
-            c = 0.3 * np.sqrt(s[:, 0, 0].real * s[:, 1, 1].real)
-            s[:, 0, 1] = c
-            s[:, 1, 0] = c
-            f.create_dataset("csd", data=s)
-        else:
-            f.create_dataset("asd", data=np.stack([asd, 0.7 * asd], axis=1))
-        if edit:
-            edit(f)
-    return path
-
-
-def h5_measured(path: Path, n=86400, fs=1.0, edit=None, names=("X", "phi", "phi_a")):
-    path.parent.mkdir(parents=True, exist_ok=True)
-    rng = np.random.default_rng(5)
-    with h5py.File(path, "w") as f:
-        f.attrs["schema"] = "tiltnoise.observable_series"
-        f.attrs["sample_rate_hz"] = fs
-        for name in names:
-            d = f.create_dataset(name, data=(1e-8 if name == "X" else 1e-12)
-                                 * rng.standard_normal(n))
-            d.attrs["units"] = "m" if name in ("X", "Y", "Z") else "rad"
-        if edit:
-            edit(f)
-    return path
-
-
-def replace_dataset(f, name, data=None, **kw):
-    if name in f:
-        del f[name]
-    if data is None:
-        return f.create_dataset(name, **kw)
-    return f.create_dataset(name, data=data, **kw)
-
-
-def fifo_setup(name: str, content: bytes):
-    """A FIFO in the scratch directory, fed `content` once by a writer thread."""
-
-    def setup(ctx: Ctx):
-        p = ctx.dir / name
-        os.mkfifo(p)
-
-        def writer():
-            try:
-                fd = os.open(p, os.O_WRONLY)
-                try:
-                    view = memoryview(content)
-                    while view:
-                        k = os.write(fd, view[:65536])
-                        view = view[k:]
-                finally:
-                    os.close(fd)
-            except OSError:
-                pass
-
-        t = threading.Thread(target=writer, daemon=True)
-        t.start()
-
-        def finish():
-            if t.is_alive():
-                try:
-                    fd = os.open(p, os.O_RDONLY | os.O_NONBLOCK)
-                    time.sleep(0.05)
-                    os.close(fd)
-                except OSError:
-                    pass
-            t.join(2)
-
-        ctx.finalizers.append(finish)
-
-    return setup
-
-
-def copy_setup(*pairs):
-    """Copies (source, name) pairs into the scratch directory; also makes dirs ending in '/'."""
-
-    def setup(ctx: Ctx):
-        for src, name in pairs:
-            dst = ctx.dir / name
-            if src is None:
-                dst.mkdir(parents=True, exist_ok=True)
-            else:
-                dst.parent.mkdir(parents=True, exist_ok=True)
-                shutil.copyfile(src, dst)
-
-    return setup
-
-
-def chain(*setups):
-    def setup(ctx):
-        for s in setups:
-            if s:
-                s(ctx)
-
-    return setup
 
 
 _MODES_CACHE: dict[str, list[float]] = {}
@@ -1205,10 +993,6 @@ def resonance_setup(index: int, style: str):
     return setup
 
 
-class ArgFromFile(str):
-    """An argument whose value is read from a file the setup wrote (see execute())."""
-
-
 def cases_frequency(inputs: Path) -> list[Case]:
     cat = "frequency options"
     d = inputs / "freq"
@@ -1587,8 +1371,6 @@ def fuzz_corpus(first_bin: str) -> dict[str, tuple[bytes, str, list[str]]]:
     fit = (b"mode,frequency_hz,sigma_hz\n1,1.331e-3,1e-5\n2,2.117e-3,1e-5\n3,0.406,0.002\n"
            b"4,0.4065,0.002\n5,0.58815,0.001\n6,0.617,0.001\n7,7.926,0.05\n8,10.393,0.05\n")
     # The readers added since: miniSEED, gwpy addresses, HDF5 spectra, ASD files.
-    sys.modules.setdefault("hostile_cli", sys.modules[__name__])
-    import surfaces
     x = (1e-9 * rng.standard_normal(200)).tolist()
     mseed = (surfaces.mseed_records("XX.TILT.00.BAE", x, 1.0)
              + surfaces.mseed_records("XX.TILT.00.BAN", x[::-1], 1.0))
@@ -2350,9 +2132,6 @@ def main(argv=None) -> int:
     if "outputs" in only:
         cases += cases_outputs(inputs, have_chattr)
     if only & set(NEW_SURFACES) or "process" in only:
-        # surfaces.py imports this module by name; when run as a script it is __main__.
-        sys.modules.setdefault("hostile_cli", sys.modules[__name__])
-        import surfaces
         surfaces.pair_inputs(inputs, binaries[0])
         for cat, build in [("miniseed", surfaces.cases_miniseed),
                            ("gwpy addressing", surfaces.cases_gwpy),

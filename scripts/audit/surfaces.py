@@ -3,8 +3,8 @@ addressing, `coherence` and `subtract` on pairs of records, the options of every
 edges (repeated keys, values whose derived quantities overflow or underflow), the Python package,
 and the process conditions of the new commands.
 
-Imported by hostile_cli.py (which registers itself as the module `hostile_cli` first), so the
-case type, the runner and the input helpers are shared. See README.md for the categories.
+Imported by hostile_cli.py, which runs the cases; the case type and the input helpers come from
+case_kit.py, shared with hostile_cli.py. See README.md for the categories.
 """
 from __future__ import annotations
 
@@ -19,8 +19,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from hostile_cli import (LAB_H5, PETERSON, SHORT_TIMEOUT, C, copy_setup, h5_measured, joined,
-                         measured_lines, write)
+from case_kit import (LAB_H5, PETERSON, REPO, C, chain, copy_setup, h5_measured, joined,
+                      measured_lines, write)
 
 # A valid pair of records: the lab tilt (86400 s at 1 Hz) and the observables the pendulum
 # model answers it with (made by the first binary's `simulate --tilt` when the inputs are
@@ -205,7 +205,7 @@ def cases_miniseed(inputs: Path) -> list:
                                                ("XX.TILT.00.BAN", n, 2.0, "float64")])
     budget("channels at different rates", rates, must_fail=True, culprit=r"rate")
     for rel in ("gap_overlap.mseed", "overlap_differs.mseed"):
-        src = Path(__file__).resolve().parents[2] / "tests/fixtures/input/miniseed" / rel
+        src = REPO / "tests/fixtures/input/miniseed" / rel
         cases.append(C(cat, f"budget: fixture {rel} (Steim-2 counts without --scale)",
                        ["budget", "--tilt", str(src)], must_fail=True))
     # The same reader under the other commands.
@@ -326,11 +326,11 @@ def cases_gwpy(inputs: Path) -> list:
             files = [(gw, "gw.h5"), *[p for p in setup_extra if isinstance(p, tuple)]]
             setup = copy_setup(*files)
             if "link" in setup_extra:
-                setup = chain_setup(setup, lambda c: os.symlink("gw.h5", c.dir / "link.h5"))
+                setup = chain(setup, lambda c: os.symlink("gw.h5", c.dir / "link.h5"))
             if "hard" in setup_extra:
-                setup = chain_setup(setup, lambda c: os.link(c.dir / "gw.h5", c.dir / "hard.h5"))
+                setup = chain(setup, lambda c: os.link(c.dir / "gw.h5", c.dir / "hard.h5"))
             if cmd in ("coherence", "subtract"):
-                setup = chain_setup(setup, pair_setup())
+                setup = chain(setup, pair_setup())
             add(f"{cmd} --tilt {label}", [cmd, "--tilt", tilt, *theta, *extra, "--save", save],
                 setup=setup, must_fail=True, culprit=same)
     add("budget --tilt gw.h5:/theta --measured m.csv --save m.csv",
@@ -396,13 +396,6 @@ def cases_gwpy(inputs: Path) -> list:
         add(f"budget --tilt fs.h5:/theta with {label}", ["budget", "--tilt", f"{p}:/theta", *theta],
             must_fail=True, huge=True, culprit=culprit)
     return cases
-
-
-def chain_setup(*setups):
-    def setup(ctx):
-        for s in setups:
-            s(ctx)
-    return setup
 
 
 # --------------------------------------------------------------------------------------------
@@ -778,13 +771,13 @@ def cases_python(inputs: Path) -> list:
        setup=copy_setup((PETERSON, "in.csv")), must_fail=True, culprit=same)
     py("Budget.save onto its input via a symlink",
        pre + "b = tn.budget_from_file('in.csv')\nb.save('link.csv')",
-       setup=chain_setup(copy_setup((PETERSON, "in.csv")),
-                         lambda c: os.symlink("in.csv", c.dir / "link.csv")),
+       setup=chain(copy_setup((PETERSON, "in.csv")),
+                   lambda c: os.symlink("in.csv", c.dir / "link.csv")),
        must_fail=True, culprit=same)
     py("Budget.save onto its measured file",
        pre + "b = tn.budget_from_file('in.csv', measured='m.csv')\nb.save('m.csv')",
-       setup=chain_setup(copy_setup((PETERSON, "in.csv")),
-                         lambda c: write(c.dir / "m.csv", joined(measured_lines()))),
+       setup=chain(copy_setup((PETERSON, "in.csv")),
+                   lambda c: write(c.dir / "m.csv", joined(measured_lines()))),
        must_fail=True, culprit=same)
     py("Simulation.save onto its parameter file",
        pre + "p = tn.Params.from_toml('p.csv')\nsim = tn.Model(p).simulate(1000.0)\n"
@@ -828,4 +821,4 @@ def cases_process_new() -> list:
 
 
 __all__ = ["cases_miniseed", "cases_gwpy", "cases_pairs", "cases_option_edges", "cases_python",
-           "cases_process_new", "pair_inputs", "SHORT_TIMEOUT", "mseed_records"]
+           "cases_process_new", "pair_inputs", "mseed_records"]
