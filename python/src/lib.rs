@@ -13,6 +13,7 @@ mod errors;
 mod fit;
 mod grid;
 mod inputs;
+mod job_args;
 mod model;
 mod params;
 mod simulate;

@@ -219,6 +219,8 @@ class Budget:
     @property
     def input(self) -> dict[str, Optional[str]]: ...
     @property
+    def summary(self) -> dict[str, Any]: ...
+    @property
     def params(self) -> Params: ...
     def psd(self, observable: str, term: str = "total") -> npt.NDArray[np.float64]: ...
     def asd(self, observable: str, term: str = "total") -> npt.NDArray[np.float64]: ...
@@ -261,8 +263,12 @@ def budget(
     average: Optional[Literal["mean", "median"]] = None,
     segment_duration: Optional[float] = None,
     percentiles: Optional[Tuple[float, float]] = None,
-    readout: Optional[Mapping[str, float]] = None,
+    observables: Optional[_Names] = None,
+    readout: Optional[Mapping[str, Union[float, _Path]]] = None,
+    term: Optional[Mapping[str, Tuple[str, _Path]]] = None,
     measured: Optional[_Path] = None,
+    at: Optional[Sequence[float]] = None,
+    at_band: Optional[float] = None,
 ) -> Budget: ...
 def budget_from_file(
     path: _Path,
@@ -279,10 +285,14 @@ def budget_from_file(
     average: Optional[Literal["mean", "median"]] = None,
     segment_duration: Optional[float] = None,
     percentiles: Optional[Tuple[float, float]] = None,
-    readout: Optional[Mapping[str, float]] = None,
+    observables: Optional[_Names] = None,
+    readout: Optional[Mapping[str, Union[float, _Path]]] = None,
+    term: Optional[Mapping[str, Tuple[str, _Path]]] = None,
     freq: Union[str, npt.ArrayLike, None] = None,
     measured: Optional[_Path] = None,
     scale: Optional[Mapping[str, float]] = None,
+    at: Optional[Sequence[float]] = None,
+    at_band: Optional[float] = None,
 ) -> Budget: ...
 def _panic_for_tests(where_: Literal["here", "detached", "thread"]) -> None:
     """Panics on purpose (tests only): a Rust panic is a PanicException, never an abort."""

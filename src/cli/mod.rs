@@ -180,6 +180,11 @@ impl Run {
     }
 }
 
+/// A job's error in the command line's spelling of its options.
+pub(crate) fn job_error(e: tiltnoise_job::JobError) -> anyhow::Error {
+    anyhow::anyhow!(e.message(tiltnoise_job::Spelling::Flag))
+}
+
 /// Runs the parsed command line. Everything printed is flushed before it returns; when the
 /// command fails, what it printed before is still flushed (its failure is not reported).
 pub fn run(cli: Cli, cancel: Cancel) -> Result<()> {

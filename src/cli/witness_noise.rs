@@ -4,7 +4,6 @@
 //! for `--readout`), and optionally its relative uncertainty REL (1 sigma of the ASD, e.g.
 //! `:0.1` for 10 %). `--tilt-noise` is the same option under its former name.
 
-use super::budget_terms::read_given;
 use anyhow::{anyhow, Result};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::Shown;
@@ -12,6 +11,7 @@ use tiltnoise_core::model::Input;
 use tiltnoise_core::noise::{NoiseLevel, WitnessNoise};
 use tiltnoise_core::repeats::refuse_repeated_keys;
 use tiltnoise_io::input::InputFormat;
+use tiltnoise_job::{read_given, Spelling};
 
 /// The model inputs a witness can record.
 const FLOOR_INPUTS: &str = "theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)";
@@ -51,12 +51,8 @@ pub fn parse_witness_noise(items: &[String]) -> Result<(Vec<WitnessNoise>, Vec<P
         };
         let level = if InputFormat::from_path(Path::new(level)).is_ok() {
             let path = PathBuf::from(level);
-            let given = read_given(
-                &format!("--witness-noise {shown}"),
-                &path,
-                input.name(),
-                input.unit(),
-            )?;
+            let given = read_given("witness_noise", item, &path, input.name(), input.unit())
+                .map_err(|e| anyhow!(e.message(Spelling::Flag)))?;
             files.push(path);
             NoiseLevel::Curve(given)
         } else {
