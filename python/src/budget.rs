@@ -18,16 +18,15 @@ use tiltnoise_core::error::Num;
 use tiltnoise_core::freq;
 use tiltnoise_core::ground::GroundQuantity;
 use tiltnoise_core::input::{
-    check_sensors, ground_index, ground_inputs, motion_of, parse_scales, parse_units,
-    process_channel, unstated_excess, ChannelCtx, DetrendedRms, GapPolicy, GroundChannel,
-    InputError, InputMeta, Motion, Quantity, Sensors, SeriesSource,
+    check_sensors, ground_index, ground_inputs, motion_of, parse_units, process_channel,
+    unstated_excess, ChannelCtx, DetrendedRms, GapPolicy, GroundChannel, InputError, InputMeta,
+    Motion, Quantity, Sensors, SeriesSource,
 };
 use tiltnoise_core::model::{Input, Model, Observable};
 use tiltnoise_core::noise::equivalent::referred_terms;
 use tiltnoise_core::noise::{BudgetReport, SpectralSource};
 use tiltnoise_core::params::Params;
 use tiltnoise_core::repeats::refuse_repeats;
-use tiltnoise_io::input::AxisMap;
 use tiltnoise_io::RunMeta;
 use tiltnoise_job::budget::{BudgetRequest, BudgetResult, ReadRequest, TiltSource, WelchRequest};
 
@@ -72,7 +71,7 @@ impl SeriesSource for ArraySeries {
 
 /// The model of `params`: a `Model` (reused as it is), a `Params`, or Table I for `None`; and
 /// its parameters (with the file they were read from).
-fn model_of(params: Option<&Bound<'_, PyAny>>) -> PyResult<(Arc<Model>, PyParams)> {
+pub(crate) fn model_of(params: Option<&Bound<'_, PyAny>>) -> PyResult<(Arc<Model>, PyParams)> {
     let Some(p) = params else {
         let params = Params::table_i();
         return Ok((
@@ -613,17 +612,7 @@ pub fn budget_from_file(
     at_band: Option<f64>,
 ) -> PyResult<Budget> {
     let (model, params) = model_of(params)?;
-    let scale: Vec<String> = scale
-        .unwrap_or_default()
-        .iter()
-        .map(|(c, f)| format!("{c}={f:?}"))
-        .collect();
     let read = ReadRequest {
-        axis_map: axes
-            .map(AxisMap::parse)
-            .transpose()
-            .map_err(|e| value_error(e.to_string()))?,
-        quantity: quantity.map(str::parse).transpose().map_err(value_error)?,
         units: parse_units(
             "units",
             &units
@@ -638,8 +627,7 @@ pub fn budget_from_file(
             "pendulum_tiltmeter",
             pendulum_tiltmeter.unwrap_or_default(),
         )?,
-        gaps: gaps.map(str::parse).transpose().map_err(value_error)?,
-        scale: parse_scales("scale", &scale).map_err(value_error)?,
+        ..job_args::read_request(axes, quantity, gaps, scale)?
     };
     let freq_hz = match freq {
         None => None,

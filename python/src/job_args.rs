@@ -4,13 +4,16 @@
 //! does for the command line.
 
 use crate::errors::{value_error, IntoPyErr, PyResultExt};
+use crate::model::names;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString};
+use pyo3::types::PyDict;
 use std::path::PathBuf;
 use tiltnoise_core::budget::BudgetError;
+use tiltnoise_core::input::{parse_scales, AxisMap};
 use tiltnoise_core::model::{Input, Observable};
 use tiltnoise_core::noise::UserSource;
 use tiltnoise_core::options::{self, observable_names};
+use tiltnoise_job::budget::ReadRequest;
 use tiltnoise_job::{AsdSpec, JobError, ReadoutItem, Spelling, TermItem};
 
 /// A job's error as the exception of its kind (`errors`' rules), with the message in keyword
@@ -28,24 +31,39 @@ pub fn job_error(e: JobError) -> PyErr {
     Python::attach(|py| PyErr::from_type(kind.get_type(py), message))
 }
 
+/// How to read a record of the floor's motion from `axes` (the axis map), `quantity`,
+/// `gaps` and `scale` (`{channel: factor}`), as the command line's options of the same names.
+pub fn read_request(
+    axes: Option<&str>,
+    quantity: Option<&str>,
+    gaps: Option<&str>,
+    scale: Option<std::collections::BTreeMap<String, f64>>,
+) -> PyResult<ReadRequest> {
+    let scale: Vec<String> = scale
+        .unwrap_or_default()
+        .iter()
+        .map(|(c, f)| format!("{c}={f:?}"))
+        .collect();
+    Ok(ReadRequest {
+        axis_map: axes
+            .map(AxisMap::parse)
+            .transpose()
+            .map_err(|e| value_error(e.to_string()))?,
+        quantity: quantity.map(str::parse).transpose().map_err(value_error)?,
+        gaps: gaps.map(str::parse).transpose().map_err(value_error)?,
+        scale: parse_scales("scale", &scale).map_err(value_error)?,
+        ..ReadRequest::default()
+    })
+}
+
 /// `observables`: a list of names or a comma-separated string, each once.
 pub fn observables(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<Observable>>> {
     let Some(arg) = arg else {
         return Ok(None);
     };
-    let names: Vec<String> = match arg.cast::<PyString>() {
-        Ok(s) => vec![s.to_cow()?.into_owned()],
-        Err(_) => arg.extract().map_err(|_| {
-            value_error("observables: expected a list of names, e.g. [\"X\", \"phi\"]")
-        })?,
-    };
-    if names.is_empty() {
-        return Err(value_error(format!(
-            "observables: empty; allowed: one or more of {}",
-            observable_names()
-        )));
-    }
-    options::parse_outputs("observables", &names).py().map(Some)
+    options::parse_outputs("observables", &names("observables", arg)?)
+        .py()
+        .map(Some)
 }
 
 /// A path given as `str` or `os.PathLike`, or `None` for anything else.

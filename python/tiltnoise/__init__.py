@@ -24,6 +24,7 @@ files that are read but not valid.
 
 from ._tiltnoise import (
     Budget,
+    Coherence,
     Fit,
     InputFileError,
     Mode,
@@ -34,6 +35,7 @@ from ._tiltnoise import (
     __version__,
     budget,
     budget_from_file,
+    coherence,
     csd,
     hdf5_version,
     welch,
@@ -41,6 +43,7 @@ from ._tiltnoise import (
 
 __all__ = [
     "Budget",
+    "Coherence",
     "Fit",
     "InputFileError",
     "Mode",
@@ -51,6 +54,7 @@ __all__ = [
     "__version__",
     "budget",
     "budget_from_file",
+    "coherence",
     "csd",
     "hdf5_version",
     "welch",

@@ -10,6 +10,7 @@ __all__ = [
     "__version__",
     "_panic_for_tests",
     "Budget",
+    "Coherence",
     "Fit",
     "InputFileError",
     "Mode",
@@ -19,6 +20,7 @@ __all__ = [
     "Simulation",
     "budget",
     "budget_from_file",
+    "coherence",
     "csd",
     "hdf5_version",
     "welch",
@@ -187,6 +189,41 @@ class Model:
     ) -> Simulation: ...
 
 @final
+class Coherence:
+    @property
+    def frequency_hz(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def axes(self) -> list[str]: ...
+    @property
+    def observables(self) -> list[str]: ...
+    @property
+    def units(self) -> dict[str, str]: ...
+    @property
+    def coherence(self) -> dict[str, dict[str, npt.NDArray[np.float64]]]: ...
+    @property
+    def multiple_coherence(self) -> dict[str, npt.NDArray[np.float64]]: ...
+    @property
+    def transfer(self) -> dict[str, dict[str, npt.NDArray[np.complex128]]]: ...
+    @property
+    def transfer_radius(self) -> dict[str, dict[str, npt.NDArray[np.float64]]]: ...
+    @property
+    def model(self) -> dict[str, dict[str, npt.NDArray[np.complex128]]]: ...
+    @property
+    def psd(self) -> dict[str, npt.NDArray[np.float64]]: ...
+    @property
+    def agreement(self) -> dict[str, dict[str, dict[str, Any]]]: ...
+    @property
+    def confidence(self) -> float: ...
+    @property
+    def coherence_threshold(self) -> float: ...
+    @property
+    def multiple_coherence_threshold(self) -> float: ...
+    @property
+    def notes(self) -> list[str]: ...
+    def to_csv(self) -> str: ...
+    def save(self, path: _Path) -> None: ...
+
+@final
 class Budget:
     @property
     def frequency_hz(self) -> npt.NDArray[np.float64]: ...
@@ -294,5 +331,20 @@ def budget_from_file(
     at: Optional[Sequence[float]] = None,
     at_band: Optional[float] = None,
 ) -> Budget: ...
+def coherence(
+    tilt: _Path,
+    measured: _Path,
+    *,
+    axes: Optional[str] = None,
+    quantity: Optional[Literal["angle", "rate"]] = None,
+    gaps: Optional[Literal["reject", "interpolate"]] = None,
+    scale: Optional[Mapping[str, float]] = None,
+    output: Optional[_Names] = None,
+    nperseg: Optional[int] = None,
+    overlap: Optional[float] = None,
+    confidence: Optional[float] = None,
+    fit_band: Optional[Tuple[float, float]] = None,
+    params: Union[Params, Model, None] = None,
+) -> Coherence: ...
 def _panic_for_tests(where_: Literal["here", "detached", "thread"]) -> None:
     """Panics on purpose (tests only): a Rust panic is a PanicException, never an abort."""

@@ -47,7 +47,7 @@ pub struct ReadRequest {
 
 impl ReadRequest {
     /// The readers' options.
-    fn options(&self) -> ReadOptions {
+    pub(crate) fn options(&self) -> ReadOptions {
         ReadOptions {
             axis_map: self.axis_map.clone(),
             quantity: self.quantity,

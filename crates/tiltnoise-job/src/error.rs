@@ -6,6 +6,7 @@ use tiltnoise_core::budget::option_checks::{
     percentiles_error, require_segments_for_percentiles, InputKind,
 };
 use tiltnoise_core::budget::BudgetError;
+use tiltnoise_core::coherence::CoherenceError;
 use tiltnoise_core::error::{Num, Shown};
 use tiltnoise_core::input::InputError;
 use tiltnoise_core::model::Observable;
@@ -76,6 +77,8 @@ pub enum JobError {
         /// Why.
         source: Box<BudgetError>,
     },
+    /// The records give no coherence estimate (or the run was cancelled).
+    Coherence(Box<CoherenceError>),
 }
 
 impl JobError {
@@ -154,6 +157,7 @@ impl JobError {
             }
             .to_string(),
             JobError::Budget { path, source } => format!("budget of {}: {source}", Shown(path)),
+            JobError::Coherence(e) => e.to_string(),
         }
     }
 
@@ -187,6 +191,7 @@ impl std::error::Error for JobError {
         match self {
             JobError::Input(e) | JobError::OptionFile { source: e, .. } => Some(e.as_ref()),
             JobError::Budget { source, .. } => Some(source.as_ref()),
+            JobError::Coherence(e) => Some(e.as_ref()),
             _ => None,
         }
     }

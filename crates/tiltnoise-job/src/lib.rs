@@ -13,6 +13,7 @@
 #![forbid(unsafe_code)]
 
 pub mod budget;
+pub mod coherence;
 mod error;
 mod given;
 mod summary;
