@@ -4,7 +4,7 @@
 //! layout `budget --measured` reads), the report (.json), the figure (.png, .svg). Documented
 //! in `docs/subtract.md`.
 
-use super::args::{parse_readout_item, Format};
+use super::args::{parse_readout_item, ChannelArgs, Format};
 use super::figure_args::FigureArgs;
 use super::output::save_image;
 use super::witness_noise::{is_floor_input, parse_witness_noise};
@@ -16,6 +16,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 use tiltnoise_core::error::{Num, OutputError, Shown};
+use tiltnoise_core::input::{GroundMap, Provenance, Sensors, TiltSeries};
 use tiltnoise_core::model::{Input, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::options;
@@ -35,8 +36,9 @@ use tiltnoise_plot::subtract_figure::{subtract_figure, ObservablePanel, Subtract
 /// Arguments of `tiltnoise subtract`.
 #[derive(Debug, Args)]
 pub(crate) struct SubtractArgs {
-    /// Tilt record (the witness): HDF5 or CSV time series of tilt angle or rate, as for
-    /// `budget` (docs/input_formats.md).
+    /// Record of the floor's motion (the witness): HDF5, CSV or miniSEED time series of tilt
+    /// (angle or rate) and, beside it, floor translation (displacement, velocity or
+    /// acceleration, as each channel's unit says), as for `budget` (docs/input_formats.md).
     #[arg(long, value_name = "FILE")]
     tilt: PathBuf,
     /// Measured record of the observables: HDF5 (as `simulate` writes) or CSV `time_s,X,...`
@@ -62,6 +64,8 @@ pub(crate) struct SubtractArgs {
     /// channels in counts. Repeat for several channels.
     #[arg(long, value_name = "CHANNEL=FACTOR")]
     scale: Vec<String>,
+    #[command(flatten)]
+    channels: ChannelArgs,
     /// Model parameters to fit besides a gain per tilt axis and the delay, comma-separated
     /// parameter-file keys (e.g. `length.h_m`).
     #[arg(long, value_name = "KEY,...", value_delimiter = ',')]
@@ -214,12 +218,59 @@ fn parse_colocated_ratio(items: &[String]) -> Result<Vec<(Input, f64)>> {
 }
 
 fn read_options(args: &SubtractArgs) -> Result<ReadOptions> {
-    super::args::tilt_read_options(
+    super::args::read_options(
         args.axes.as_deref(),
         args.quantity.as_deref(),
         args.gaps.as_deref(),
         &args.scale,
+        &args.channels,
     )
+}
+
+/// A witness record as the subtraction takes it: one series per input, each the input's
+/// displacement (rad, m), with the provenance of the file it came from.
+struct Witness {
+    inputs: Vec<Input>,
+    data: Vec<Vec<f64>>,
+    sample_rate_hz: f64,
+    provenance: Provenance,
+}
+
+impl Witness {
+    /// The record's channels as displacements. A record of tilt alone keeps its angles (a rate
+    /// integrated as `budget`'s series are); with translation channels, or sensors declared
+    /// other than the default, every channel goes through the floor's [`GroundMap`]: velocity
+    /// and acceleration integrated to displacement in the frequency domain, an inertial
+    /// seismometer's tilt part removed with the record's tilt (`x_t = u - g II(eta_t)`,
+    /// `y_t = u + g II(theta_t)`), a pendulum tiltmeter's translation part with the record's
+    /// translation.
+    fn from_series(series: TiltSeries, g_m_per_s2: f64) -> std::result::Result<Witness, String> {
+        if series.translations.is_empty() && series.sensors == Sensors::default() {
+            let series = series.into_angle();
+            return Ok(Witness {
+                inputs: series.axes.iter().map(|&a| Input::Tilt(a)).collect(),
+                data: series.data,
+                sample_rate_hz: series.sample_rate_hz,
+                provenance: series.provenance,
+            });
+        }
+        let map = GroundMap::new(&series.channels(), g_m_per_s2)?;
+        let channel_data: Vec<Vec<f64>> =
+            series.channel_data().iter().map(|c| c.to_vec()).collect();
+        let data = map.displacements(&channel_data, series.sample_rate_hz);
+        let mut provenance = series.provenance;
+        provenance
+            .notes
+            .retain(|note| !note.starts_with("rate to angle"));
+        provenance.notes.extend(map.series_note());
+        provenance.notes.extend(map.notes().iter().cloned());
+        Ok(Witness {
+            inputs: map.inputs(),
+            data,
+            sample_rate_hz: series.sample_rate_hz,
+            provenance,
+        })
+    }
 }
 
 fn start_of(path: &Path, what: &str, start: &Option<String>) -> Result<Option<StartTime>> {
@@ -336,24 +387,13 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
         readout_asd: readout,
         report_band_hz: parse_band("--report-band", &args.report_band)?,
     };
-    let read_series = |option: &str, path: &Path| -> Result<_> {
+    let read_series = |option: &str, path: &Path| -> Result<Witness> {
         match read_tilt(path, &read_options(&args)?)? {
-            // The library takes translation witnesses; the command line reads its witness as
-            // tilt alone, and a translation channel it would drop is refused instead.
-            TiltInput::Series(s) if !s.translations.is_empty() => {
-                let names: Vec<&str> = s.translations.iter().map(|t| t.axis.name()).collect();
-                bail!(
-                    "{option} {}: the record has translation channels ({}); subtract takes tilt \
-                     witnesses from the command line: pick the rotation channels with --axes \
-                     (e.g. --axes theta_t=CHANNEL,eta_t=CHANNEL)",
-                    path.display(),
-                    names.join(", ")
-                )
-            }
-            TiltInput::Series(s) => Ok(s.into_angle()),
+            TiltInput::Series(s) => Witness::from_series(s, params.environment.g_m_per_s2)
+                .map_err(|e| anyhow!("{option} {}: {e}", path.display())),
             TiltInput::Spectra(_) => bail!(
-                "{option} {}: holds spectra; subtract needs a time series of the tilt (angle or \
-                 rate)",
+                "{option} {}: holds spectra; subtract needs a time series of the floor's motion \
+                 (tilt angle or rate, and translation)",
                 path.display()
             ),
         }
@@ -382,22 +422,13 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
             args.measured.display()
         )
     };
-    let inputs_of = |axes: &[tiltnoise_core::model::TiltAxis]| -> Vec<Input> {
-        axes.iter().map(|&a| Input::Tilt(a)).collect()
-    };
-    let witness_inputs = inputs_of(&series.axes);
-    let colocated_inputs: Vec<Vec<Input>> = colocated_series
-        .iter()
-        .map(|s| inputs_of(&s.axes))
-        .collect();
     let colocated = colocated_series
         .iter()
         .zip(&args.colocated)
-        .zip(&colocated_inputs)
-        .map(|((s, path), inputs)| {
+        .map(|(s, path)| {
             Ok(WitnessRecord {
                 fs_hz: s.sample_rate_hz,
-                inputs,
+                inputs: &s.inputs,
                 data: &s.data,
                 start: start_of(path, "--colocated", &s.provenance.start_time)?,
             })
@@ -407,7 +438,7 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
         params,
         &WitnessRecord {
             fs_hz: series.sample_rate_hz,
-            inputs: &witness_inputs,
+            inputs: &series.inputs,
             data: &series.data,
             start: tilt_start,
         },
