@@ -429,7 +429,11 @@ fn check_unstated_array(name: &str, quantity: Quantity, data: &[f64], fs: f64) -
 /// user-named term ``user.NAME`` added in quadrature to the total, ``source`` an observable,
 /// whose ASD the file holds, or an input of the model, ``theta_t`` .. ``z_t``, ``F_a.x`` ..
 /// ``M_b.z``, whose ASD the file holds and which is propagated through the transfer
-/// functions); ``measured`` (a file of measured ASDs or series of the observables: adds the
+/// functions); ``witness_noise`` (``{input: ASD or path}`` or ``{input: (ASD or path,
+/// rel)}``: the own noise of the tiltmeter or seismometer that recorded an input, in its
+/// unit/sqrt(Hz), shown through the model as ``witness_noise`` beside the tilt term, which
+/// already contains it; not added to the total); ``measured`` (a file of measured ASDs or
+/// series of the observables: adds the
 /// terms ``measured`` and ``residual``); ``at`` (frequencies, Hz, to read the budget at, each
 /// in its band; default 1e-3, 2e-3, 5e-3 where they are) and ``at_band`` (half-width of the
 /// Welch band means, relative, default 0.1): :attr:`Budget.summary`.
@@ -437,7 +441,7 @@ fn check_unstated_array(name: &str, quantity: Quantity, data: &[f64], fs: f64) -
 ///
 /// Returns a :class:`Budget`. Raises ``ValueError`` for options or data that do not fit.
 #[pyfunction]
-#[pyo3(signature = (tilt, fs, *, axes=None, quantity="angle", units=None, corrected=None, pendulum_tiltmeter=None, gaps="reject", params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, observables=None, readout=None, term=None, measured=None, at=None, at_band=None))]
+#[pyo3(signature = (tilt, fs, *, axes=None, quantity="angle", units=None, corrected=None, pendulum_tiltmeter=None, gaps="reject", params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, observables=None, readout=None, term=None, witness_noise=None, measured=None, at=None, at_band=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn budget(
     py: Python<'_>,
@@ -458,6 +462,7 @@ pub fn budget(
     observables: Option<&Bound<'_, PyAny>>,
     readout: Option<&Bound<'_, PyDict>>,
     term: Option<&Bound<'_, PyDict>>,
+    witness_noise: Option<&Bound<'_, PyDict>>,
     measured: Option<PathBuf>,
     at: Option<Vec<f64>>,
     at_band: Option<f64>,
@@ -494,6 +499,7 @@ pub fn budget(
     let observables = job_args::observables(observables)?;
     let readout = job_args::readout(readout)?;
     let terms = job_args::terms(term)?;
+    let witness_noise = job_args::witness_noise(witness_noise)?;
     let axis_map = described
         .channels
         .iter()
@@ -548,7 +554,7 @@ pub fn budget(
             observables,
             readout,
             terms,
-            witness_noise: Vec::new(),
+            witness_noise,
             measured,
             at_hz: at,
             at_band,
@@ -577,15 +583,15 @@ pub fn budget(
 /// ``gaps`` ``"reject"``/``"interpolate"``, ``scale`` a dict ``{channel: factor}`` (SI units
 /// per count, required for channels in counts, applied before the axis map); ``freq`` is the
 /// model grid of spectra input (``"FLO:N:FHI"`` or an array of Hz; default 1e-4..30 Hz plus
-/// points around every resonance). The Welch, segment, observables, readout, term, measured
-/// and ``at`` options are those of :func:`budget`; options of a series are refused for spectra
+/// points around every resonance). The Welch, segment, observables, readout, term,
+/// witness_noise, measured and ``at`` options are those of :func:`budget`; options of a series are refused for spectra
 /// and ``freq`` for a series, as on the command line.
 ///
 /// Raises ``FileNotFoundError``/``OSError`` if a file cannot be read, :class:`InputFileError`
 /// (an ``OSError``) if it is not a valid input (the message names the file, the dataset
 /// or column and what is allowed), ``ValueError`` for options that do not fit.
 #[pyfunction]
-#[pyo3(signature = (path, *, axes=None, quantity=None, units=None, corrected=None, pendulum_tiltmeter=None, gaps=None, params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, observables=None, readout=None, term=None, freq=None, measured=None, scale=None, at=None, at_band=None))]
+#[pyo3(signature = (path, *, axes=None, quantity=None, units=None, corrected=None, pendulum_tiltmeter=None, gaps=None, params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, observables=None, readout=None, term=None, witness_noise=None, freq=None, measured=None, scale=None, at=None, at_band=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn budget_from_file(
     py: Python<'_>,
@@ -605,6 +611,7 @@ pub fn budget_from_file(
     observables: Option<&Bound<'_, PyAny>>,
     readout: Option<&Bound<'_, PyDict>>,
     term: Option<&Bound<'_, PyDict>>,
+    witness_noise: Option<&Bound<'_, PyDict>>,
     freq: Option<&Bound<'_, PyAny>>,
     measured: Option<PathBuf>,
     scale: Option<std::collections::BTreeMap<String, f64>>,
@@ -644,7 +651,7 @@ pub fn budget_from_file(
         observables: job_args::observables(observables)?,
         readout: job_args::readout(readout)?,
         terms: job_args::terms(term)?,
-        witness_noise: Vec::new(),
+        witness_noise: job_args::witness_noise(witness_noise)?,
         measured,
         at_hz: at,
         at_band,

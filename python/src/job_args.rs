@@ -14,7 +14,7 @@ use tiltnoise_core::model::{Input, Observable};
 use tiltnoise_core::noise::UserSource;
 use tiltnoise_core::options::{self, observable_names};
 use tiltnoise_job::budget::ReadRequest;
-use tiltnoise_job::{AsdSpec, JobError, ReadoutItem, Spelling, TermItem};
+use tiltnoise_job::{AsdSpec, JobError, ReadoutItem, Spelling, TermItem, WitnessItem};
 
 /// A job's error as the exception of its kind (`errors`' rules), with the message in keyword
 /// spelling.
@@ -158,4 +158,42 @@ pub fn python_names<'a>(
         };
         (arg, path)
     })
+}
+
+/// `witness_noise`: `{input: ASD}` (white, in the input's unit/sqrt(Hz)), `{input: path}` (an
+/// ASD file), or either as `(value, rel)` with the ASD's relative uncertainty; `input` a floor
+/// input of the model, `theta_t` .. `z_t`.
+pub fn witness_noise(arg: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<WitnessItem>> {
+    let Some(d) = arg else {
+        return Ok(Vec::new());
+    };
+    let mut items = Vec::new();
+    for (name, value) in d.iter() {
+        let name: String = name
+            .extract()
+            .map_err(|_| value_error("witness_noise: the keys must be input names (str)"))?;
+        let input = Input::from_name(&name)
+            .filter(|i| i.is_ground())
+            .ok_or_else(|| {
+                value_error(format!(
+                    "witness_noise {name}=...: `{name}` is not a floor input of the model; \
+                     allowed: theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)"
+                ))
+            })?;
+        let (level, rel) = match value.extract::<(Bound<'_, PyAny>, f64)>() {
+            Ok((level, rel)) => (level, rel),
+            Err(_) => (value, 0.0),
+        };
+        let asd = match path_of(&level) {
+            Some(path) => AsdSpec::File(path),
+            None => AsdSpec::White(level.extract().map_err(|_| {
+                value_error(format!(
+                    "witness_noise {name}: expected an ASD (a number) or an ASD file (a path), \
+                     or either with its relative uncertainty as (value, rel)"
+                ))
+            })?),
+        };
+        items.push(WitnessItem { input, asd, rel });
+    }
+    Ok(items)
 }

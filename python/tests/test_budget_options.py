@@ -134,3 +134,17 @@ def test_a_missing_readout_file_is_a_file_not_found_error(tmp_path):
     with pytest.raises(FileNotFoundError) as e:
         tiltnoise.budget_from_file(LAB_TILT, readout={"phi": tmp_path / "none.csv"})
     assert str(e.value).startswith(f"readout phi={tmp_path / 'none.csv'}: ")
+
+
+def test_witness_noise_equals_the_command_lines(files, cli, tmp_path, tmp_path_factory):
+    noise = write_asd_csv(tmp_path_factory.mktemp("witness") / "eta.csv", "eta_t", 6e-8, -0.5)
+    csv = tmp_path / "cli.csv"
+    cli("budget", "--tilt", LAB_TILT, "--nperseg", 4096, "--witness-noise", f"eta_t={noise}:0.1",
+        "--witness-noise", "theta_t=6e-8", "--save", csv)
+    b = tiltnoise.budget_from_file(LAB_TILT, nperseg=4096,
+                                   witness_noise={"eta_t": (noise, 0.1), "theta_t": 6e-8})
+    assert without_command_line(b.to_csv()) == without_command_line(csv.read_text())
+    assert "witness_noise" in b.terms["X"]
+    with pytest.raises(ValueError) as e:
+        tiltnoise.budget_from_file(LAB_TILT, witness_noise={"eta_t": 1e300})
+    assert str(e.value).startswith("witness_noise eta_t: the ASD 1e300")

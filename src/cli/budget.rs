@@ -5,7 +5,7 @@ use super::args::{AverageArg, ChannelArgs, Format};
 use super::budget_terms::{parse_observables, parse_readout, parse_terms};
 use super::figure_args::FigureArgs;
 use super::output::save_budget;
-use super::witness_noise::parse_witness_noise;
+use super::witness_noise::parse_witness_items;
 use super::Run;
 use anyhow::{anyhow, Result};
 use clap::Args;
@@ -179,7 +179,6 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
             .view_for(tiltnoise_plot::BudgetFigureOptions::default().size)?,
         ..tiltnoise_plot::BudgetFigureOptions::default()
     };
-    let (witness_noise, witness_files) = parse_witness_noise(&args.witness_noise)?;
     let model = Model::new(params)?;
     let req = BudgetRequest {
         model: &model,
@@ -209,22 +208,17 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
             .transpose()?,
         readout: parse_readout(&args.readout)?,
         terms: parse_terms(&args.term)?,
-        witness_noise,
+        witness_noise: parse_witness_items(&args.witness_noise)?,
         measured: args.measured.clone(),
         at_hz: args.at.as_deref().map(parse_at).transpose()?,
         at_band: args.at_band,
     };
     let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
-    let mut inputs: Vec<(String, &Path)> = req
+    let inputs: Vec<(String, &Path)> = req
         .input_files()
         .into_iter()
         .map(|(option, path)| (Spelling::Flag.option(option), path))
         .collect();
-    inputs.extend(
-        witness_files
-            .iter()
-            .map(|p| ("--witness-noise".to_string(), p.as_path())),
-    );
     let inputs: Vec<(&str, &Path)> = inputs.iter().map(|(o, p)| (o.as_str(), *p)).collect();
     run.check_outputs(&saves, &inputs)?;
     let mut bar = None;

@@ -4,7 +4,7 @@
 //! provenance.
 
 use crate::error::{shown_path, JobError};
-use crate::given::{self, ReadoutItem, TermItem};
+use crate::given::{self, ReadoutItem, TermItem, WitnessItem};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::budget::option_checks::InputKind;
 use tiltnoise_core::budget::{
@@ -18,7 +18,7 @@ use tiltnoise_core::input::{
     AxisMap, ChannelScale, ChannelUnit, GapPolicy, InputMeta, Quantity, ReadOptions, SeriesSource,
 };
 use tiltnoise_core::model::{Model, Observable};
-use tiltnoise_core::noise::{BudgetReport, WitnessNoise};
+use tiltnoise_core::noise::BudgetReport;
 use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_core::spectral::Averaging;
 use tiltnoise_io::input::{add_measured_file, open_tilt, OpenedTilt};
@@ -110,7 +110,7 @@ pub struct BudgetRequest<'a> {
     /// User-named terms.
     pub terms: Vec<TermItem>,
     /// Own noise of the instruments that recorded inputs of the floor (shown, not added).
-    pub witness_noise: Vec<WitnessNoise>,
+    pub witness_noise: Vec<WitnessItem>,
     /// A measured record of the observables (adds `measured` and `residual`).
     pub measured: Option<PathBuf>,
     /// Frequencies (Hz) to read the budget at; given ones must lie in its band (default:
@@ -144,6 +144,11 @@ impl BudgetRequest<'_> {
             }
         }
         files.extend(self.terms.iter().map(|t| ("term", t.file.as_path())));
+        for w in &self.witness_noise {
+            if let given::AsdSpec::File(p) = &w.asd {
+                files.push(("witness_noise", p.as_path()));
+            }
+        }
         files
     }
 
@@ -213,7 +218,7 @@ fn options(req: &BudgetRequest<'_>, cancel: &Cancel) -> Result<BudgetOptions, Jo
         percentiles: w.percentiles.unwrap_or(defaults.percentiles),
         readout: given::readout(&req.readout, &outputs)?,
         user_terms: given::terms(&req.terms, &outputs)?,
-        witness_noise: req.witness_noise.clone(),
+        witness_noise: given::witness_noise(&req.witness_noise)?,
         spectra_grid_hz: Vec::new(),
         summary: summary(req.at_hz.as_deref(), req.at_band)?,
         cancel: cancel.clone(),

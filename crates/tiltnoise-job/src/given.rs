@@ -4,8 +4,10 @@
 use crate::error::JobError;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::{Num, Shown};
-use tiltnoise_core::model::Observable;
-use tiltnoise_core::noise::{is_term_name, GivenAsd, Readout, UserSource, UserTerm};
+use tiltnoise_core::model::{Input, Observable};
+use tiltnoise_core::noise::{
+    is_term_name, GivenAsd, NoiseLevel, Readout, UserSource, UserTerm, WitnessNoise,
+};
 use tiltnoise_io::input::read_asd_column;
 
 /// A one-sided ASD as the user gives it: white (a number, in the quantity's unit/sqrt(Hz),
@@ -66,6 +68,74 @@ impl TermItem {
             self.file.display()
         )
     }
+}
+
+/// The own noise of the instrument that records a floor input of the model (a tilt or a
+/// translation): its ASD in the input's unit/sqrt(Hz), and the ASD's relative uncertainty
+/// (1 sigma; 0 when exact).
+#[derive(Debug, Clone, PartialEq)]
+pub struct WitnessItem {
+    /// The floor input recorded.
+    pub input: Input,
+    /// The instrument's noise.
+    pub asd: AsdSpec,
+    /// Relative uncertainty of the ASD.
+    pub rel: f64,
+}
+
+impl WitnessItem {
+    /// `INPUT=VALUE[:REL]`, for messages.
+    fn item(&self) -> String {
+        let rel = if self.rel == 0.0 {
+            String::new()
+        } else {
+            format!(":{}", Num(self.rel))
+        };
+        format!("{}={}{rel}", self.input.name(), self.asd.shown())
+    }
+}
+
+/// The witness noise of `items`, every file read and every level checked.
+///
+/// # Errors
+///
+/// A [`JobError`] naming the item: a file that cannot be read, a level or an uncertainty
+/// that is not allowed.
+pub fn witness_noise(items: &[WitnessItem]) -> Result<Vec<WitnessNoise>, JobError> {
+    items
+        .iter()
+        .map(|it| {
+            let input = it.input;
+            let level = match &it.asd {
+                AsdSpec::White(a) => NoiseLevel::White(*a),
+                AsdSpec::File(path) => NoiseLevel::Curve(read_given(
+                    "witness_noise",
+                    &it.item(),
+                    path,
+                    input.name(),
+                    input.unit(),
+                )?),
+            };
+            let noise = WitnessNoise {
+                input,
+                level,
+                rel: it.rel,
+            };
+            // The check names the input first; the message names it once, with the item.
+            noise.check("").map_err(|e| {
+                let problem = e.trim_start();
+                let problem = problem
+                    .strip_prefix(&format!("{}: ", input.name()))
+                    .unwrap_or(problem);
+                JobError::option(
+                    "witness_noise",
+                    Some(input.name()),
+                    format!("{problem} (in {})", it.item()),
+                )
+            })?;
+            Ok(noise)
+        })
+        .collect()
 }
 
 /// The unit of an ASD of a quantity of SI unit `unit`.

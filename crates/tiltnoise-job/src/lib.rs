@@ -19,6 +19,6 @@ mod given;
 mod summary;
 
 pub use error::JobError;
-pub use given::{read_given, AsdSpec, ReadoutItem, TermItem};
+pub use given::{read_given, witness_noise, AsdSpec, ReadoutItem, TermItem, WitnessItem};
 pub use tiltnoise_core::cancel::Cancel;
 pub use tiltnoise_core::options::Spelling;
