@@ -1,11 +1,11 @@
 //! The `tiltnoise` binary: parse, run, map errors to exit code 2 with a one-line message.
 
-mod cli;
 mod interrupt;
 
 use clap::error::ErrorKind;
 use clap::{CommandFactory, FromArgMatches};
 use std::process::ExitCode;
+use tiltnoise::cli;
 use tiltnoise_core::error::shown_within;
 
 /// The longest error line printed (characters); values inside it are already cut to 200.

@@ -12,7 +12,6 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::coherence::CoherenceReport;
-use tiltnoise_core::options;
 use tiltnoise_io::{CoherenceInputs, OutputKind, RunMeta};
 use tiltnoise_job::coherence::{CoherenceRequest, CoherenceResult};
 
@@ -24,7 +23,7 @@ use tiltnoise_job::coherence::{CoherenceRequest, CoherenceResult};
 /// ``axes`` (axis map), ``quantity``, ``gaps`` and ``scale`` as :func:`budget_from_file`
 /// reads it. ``measured``: a time series of the observables (HDF5 as ``simulate`` writes
 /// it, or CSV ``time_s,X,...`` in m, rad); the records are aligned by their start times.
-/// ``output``: the observables to analyse (default: every channel of ``measured``);
+/// ``observables``: the observables to analyse (default: every channel of ``measured``);
 /// ``nperseg``, ``overlap``: Welch segment and overlap; ``confidence``: level of every
 /// interval and threshold (default 0.95); ``fit_band``: ``(FLO, FHI)`` Hz of the
 /// measured/model fit (default every bin). ``params``: a :class:`Params` or :class:`Model`.
@@ -33,7 +32,7 @@ use tiltnoise_job::coherence::{CoherenceRequest, CoherenceResult};
 /// read, :class:`InputFileError` if it is not a valid record, ``ValueError`` for options or
 /// records that give no estimate.
 #[pyfunction]
-#[pyo3(signature = (tilt, measured, *, axes=None, quantity=None, gaps=None, scale=None, output=None, nperseg=None, overlap=None, confidence=None, fit_band=None, params=None))]
+#[pyo3(signature = (tilt, measured, *, axes=None, quantity=None, gaps=None, scale=None, observables=None, nperseg=None, overlap=None, confidence=None, fit_band=None, params=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn coherence(
     py: Python<'_>,
@@ -43,7 +42,7 @@ pub fn coherence(
     quantity: Option<&str>,
     gaps: Option<&str>,
     scale: Option<std::collections::BTreeMap<String, f64>>,
-    output: Option<&Bound<'_, PyAny>>,
+    observables: Option<&Bound<'_, PyAny>>,
     nperseg: Option<usize>,
     overlap: Option<f64>,
     confidence: Option<f64>,
@@ -51,19 +50,13 @@ pub fn coherence(
     params: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Coherence> {
     let (model, params) = model_of(params)?;
-    let outputs = match output {
-        None => None,
-        Some(o) => {
-            let names = crate::model::names("output", o)?;
-            Some(options::parse_outputs("output", &names).py()?)
-        }
-    };
+    let observables = job_args::observables(observables)?;
     let req = CoherenceRequest {
         model: &model,
         tilt,
         read: job_args::read_request(axes, quantity, gaps, scale)?,
         measured,
-        outputs,
+        observables,
         nperseg,
         overlap,
         confidence,

@@ -76,9 +76,10 @@ def test_errors_say_what_the_command_line_says(measured, cli_error, tmp_path):
     assert str(e.value) == cli_error("coherence", "--tilt", LAB_TILT, "--measured",
                                      spectra).replace("--measured", "measured")
     with pytest.raises(ValueError) as e:
-        tiltnoise.coherence(LAB_TILT, measured, output="phi")
+        tiltnoise.coherence(LAB_TILT, measured, observables="phi")
     assert str(e.value) == cli_error("coherence", "--tilt", LAB_TILT, "--measured", measured,
-                                     "--output", "phi").replace("--output", "output")
+                                     "--observables", "phi").replace("--observables",
+                                                                     "observables")
     with pytest.raises(ValueError) as e:
         tiltnoise.coherence(LAB_TILT, measured, fit_band=(0.1, 0.01))
     assert str(e.value) == cli_error("coherence", "--tilt", LAB_TILT, "--measured", measured,

@@ -341,7 +341,7 @@ def coherence(
     quantity: Optional[Literal["angle", "rate"]] = None,
     gaps: Optional[Literal["reject", "interpolate"]] = None,
     scale: Optional[Mapping[str, float]] = None,
-    output: Optional[_Names] = None,
+    observables: Optional[_Names] = None,
     nperseg: Optional[int] = None,
     overlap: Optional[float] = None,
     confidence: Optional[float] = None,

@@ -1,5 +1,5 @@
 //! Value types shared by several subcommands: the method, averaging and output-format
-//! choices, and the `--readout OBS=ASD` item.
+//! choices, the `LO:HI` range and the `--readout OBS=ASD` item.
 
 use anyhow::{anyhow, Result};
 use clap::{Args, ValueEnum};
@@ -83,6 +83,19 @@ impl MethodArg {
             MethodArg::Torsion2 => Some(Method::Torsion2),
         }
     }
+}
+
+/// The two ends of a range written `LO:HI`, or `LO,HI` as it was written before ranges took
+/// the band syntax; anything else (one part, three parts, both separators) is a single part
+/// list the caller refuses.
+pub fn range_parts(text: &str) -> Vec<&str> {
+    let separator = if text.contains(':') { ':' } else { ',' };
+    text.split(separator).map(str::trim).collect()
+}
+
+/// A default value as help prints it, in scientific notation (`1e-9`, not `0.000000001`).
+pub fn scientific(x: f64) -> String {
+    format!("{x:e}")
 }
 
 /// One `--readout OBS=ASD` item (also used by `simulate`): the observable and its white

@@ -11,7 +11,6 @@ use anyhow::{anyhow, Result};
 use clap::Args;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use tiltnoise_core::budget::option_checks::percentiles_error;
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::freq;
 use tiltnoise_core::model::Model;
@@ -63,9 +62,9 @@ pub struct BudgetArgs {
     /// hold one Welch segment (--nperseg samples), e.g. 14400 with --nperseg 4096 at 1 Hz.
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     pub segment_duration: Option<f64>,
-    /// Percentiles of the band across segments, LOWER,UPPER (default 10,90; with
-    /// --segment-duration).
-    #[arg(long, value_name = "LO,HI", allow_hyphen_values = true)]
+    /// Percentiles of the band across segments, LO:HI (default 10:90; with
+    /// --segment-duration; LO,HI is accepted too).
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
     pub percentiles: Option<String>,
     /// Observables to budget, e.g. X,Y,Z,theta,eta,phi,phi_a (default X,phi,phi_a).
     #[arg(long, value_name = "OBS,...")]
@@ -136,14 +135,22 @@ fn parse_at(text: &str) -> Result<Vec<f64>> {
         .collect()
 }
 
-/// `--percentiles LOWER,UPPER` as numbers (the job checks their order and range).
+/// `--percentiles LO:HI`: numbers, 0 <= LO < HI <= 100.
 fn parse_percentiles(text: &str) -> Result<(f64, f64)> {
-    let err = || percentiles_error(Spelling::Flag, text);
-    let (a, b) = text.split_once(',').ok_or_else(err)?;
-    Ok((
-        a.trim().parse().map_err(|_| err())?,
-        b.trim().parse().map_err(|_| err())?,
-    ))
+    let err = || {
+        anyhow!(
+            "--percentiles {}: expected LO:HI with 0 <= LO < HI <= 100, e.g. 10:90",
+            Shown(text)
+        )
+    };
+    let [a, b] = super::args::range_parts(text)[..] else {
+        return Err(err());
+    };
+    let (a, b): (f64, f64) = (a.parse().map_err(|_| err())?, b.parse().map_err(|_| err())?);
+    if !(0.0 <= a && a < b && b <= 100.0) {
+        return Err(err());
+    }
+    Ok((a, b))
 }
 
 /// How to read `--tilt`: the channel options as every command reads them, `--gaps` kept as

@@ -2,16 +2,16 @@
 //! coherence, measured transfer functions with confidence intervals, the model's beside them ->
 //! files and a terminal summary.
 
-use super::args::tilt_read_options;
+use super::args::{tilt_read_options, Format};
 use super::figure_args::FigureArgs;
 use super::output::save_coherence;
-use super::tf::parse_outputs;
+use super::tf::parse_observables;
 use super::Run;
 use anyhow::{anyhow, Result};
 use clap::Args;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use tiltnoise_core::coherence::{with_error, CoherenceReport, ObservableEstimate};
+use tiltnoise_core::coherence::{with_error, AxisEstimate, CoherenceReport, ObservableEstimate};
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::Model;
 use tiltnoise_core::modes::NormalModes;
@@ -49,7 +49,7 @@ pub struct CoherenceArgs {
     #[arg(long, value_name = "CHANNEL=FACTOR")]
     pub scale: Vec<String>,
     /// Observables to analyse, comma-separated (default: every observable in the measured file).
-    #[arg(long = "output", value_name = "NAME[,NAME...]")]
+    #[arg(long = "observables", alias = "output", value_name = "OBS,...")]
     pub outputs: Vec<String>,
     /// Welch segment length in samples (default 2^14, or the largest power of two <= N/4 of the
     /// common stretch).
@@ -64,6 +64,10 @@ pub struct CoherenceArgs {
     /// Band of the measured/model fit, FLO:FHI in Hz (default: every bin).
     #[arg(long, value_name = "FLO:FHI", allow_hyphen_values = true)]
     pub fit_band: Option<String>,
+    /// Output format on the terminal: table (default) or json (the summary, the input notes
+    /// and the notes; `wrote` lines then go to standard error).
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    pub format: Format,
     /// Output file (.h5, .csv, .png, .svg), repeatable.
     #[arg(long, value_name = "PATH")]
     pub save: Vec<PathBuf>,
@@ -113,9 +117,9 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
             ..ReadRequest::default()
         },
         measured: args.measured.clone(),
-        outputs: match args.outputs.is_empty() {
+        observables: match args.outputs.is_empty() {
             true => None,
-            false => Some(parse_outputs(&args.outputs)?),
+            false => Some(parse_observables(&args.outputs)?),
         },
         nperseg: args.nperseg,
         overlap: args.overlap,
@@ -132,16 +136,24 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
     run.check_outputs(&saves, &inputs)?;
     let CoherenceResult { report, inputs } =
         tiltnoise_job::coherence::run(req, &run.cancel).map_err(super::job_error)?;
-    for note in &inputs.tilt.notes {
-        writeln!(run.out, "input: {note}")?;
+    match args.format {
+        Format::Table => {
+            for note in &inputs.tilt.notes {
+                writeln!(run.out, "input: {note}")?;
+            }
+            write!(run.out, "{}", summary(&report))?;
+        }
+        Format::Json => {
+            let json = summary_json(&report, &inputs.tilt.notes);
+            writeln!(run.out, "{}", serde_json::to_string_pretty(&json)?)?;
+        }
     }
-    write!(run.out, "{}", summary(&report))?;
     let meta = RunMeta::of_this_run(params, Some(&NormalModes::new(&model)));
     let names = (
         args.tilt.display().to_string(),
         args.measured.display().to_string(),
     );
-    run.write_outputs(false, || {
+    run.write_outputs(args.format == Format::Json, || {
         for out in &args.save {
             save_coherence(out, &report, &meta, &inputs, &names, &view)?;
         }
@@ -196,12 +208,86 @@ fn summary(report: &CoherenceReport) -> String {
     s
 }
 
+/// The bins where the multiple coherence of `ob` is above the noise threshold.
+fn significant_bins(report: &CoherenceReport, ob: &ObservableEstimate) -> Vec<usize> {
+    (0..report.freqs_hz.len())
+        .filter(|&k| ob.multiple_coherence[k] >= report.multiple_coherence_threshold)
+        .collect()
+}
+
+/// The bin of the largest finite coherence of `axis`, if any.
+fn peak_bin(axis: &AxisEstimate) -> Option<usize> {
+    (0..axis.coherence.len())
+        .filter(|&k| axis.coherence[k].is_finite())
+        .max_by(|&i, &j| axis.coherence[i].total_cmp(&axis.coherence[j]))
+}
+
+/// The summary as JSON (`--format json`): the numbers the table prints, unrounded; NaN is
+/// null.
+fn summary_json(report: &CoherenceReport, input_notes: &[String]) -> serde_json::Value {
+    use serde_json::json;
+    let f = &report.freqs_hz;
+    let w = &report.welch;
+    let observables: Vec<serde_json::Value> = report
+        .observables
+        .iter()
+        .map(|ob| {
+            let significant = significant_bins(report, ob);
+            let axes: Vec<serde_json::Value> = ob
+                .axes
+                .iter()
+                .map(|a| {
+                    let peak = peak_bin(a);
+                    let model_zero = a.model.iter().all(|z| z.norm() == 0.0);
+                    let agreement = a.agreement.as_ref().filter(|_| !model_zero).map(|g| {
+                        json!({
+                            "gain": g.gain(), "gain_sigma": g.sigma,
+                            "phase_deg": g.phase_deg(), "phase_sigma_deg": g.phase_sigma_deg(),
+                            "n_bins": g.n_bins, "band_hz": [g.band_hz.0, g.band_hz.1],
+                            "chi2_per_dof": g.chi2_per_dof,
+                        })
+                    });
+                    json!({
+                        "axis": a.axis.name(),
+                        "max_coherence": peak.map(|k| a.coherence[k]),
+                        "max_coherence_at_hz": peak.map(|k| f[k]),
+                        "model_identically_zero": model_zero,
+                        "measured_over_model": agreement,
+                        "transfer_unit": format!("{}/rad", ob.observable.unit()),
+                    })
+                })
+                .collect();
+            json!({
+                "observable": ob.observable.name(),
+                "unit": ob.observable.unit(),
+                "significant_bins": significant.len(),
+                "significant_band_hz": significant.first().zip(significant.last())
+                    .map(|(&a, &b)| [f[a], f[b]]),
+                "expected_from_noise": (1.0 - report.confidence) * f.len() as f64,
+                "axes": axes,
+            })
+        })
+        .collect();
+    json!({
+        "welch": {
+            "n_samples": w.n_samples, "sample_rate_hz": w.sample_rate_hz,
+            "segment_len": w.segment_len, "overlap": w.overlap,
+            "n_segments": w.n_segments, "n_equivalent": w.n_equivalent,
+        },
+        "bins": f.len(),
+        "confidence": report.confidence,
+        "coherence_threshold": report.coherence_threshold,
+        "multiple_coherence_threshold": report.multiple_coherence_threshold,
+        "observables": observables,
+        "input_notes": input_notes,
+        "notes": report.notes,
+    })
+}
+
 fn observable_summary(s: &mut String, report: &CoherenceReport, ob: &ObservableEstimate) {
     let f = &report.freqs_hz;
     let unit = ob.observable.unit();
-    let significant: Vec<usize> = (0..f.len())
-        .filter(|&k| ob.multiple_coherence[k] >= report.multiple_coherence_threshold)
-        .collect();
+    let significant = significant_bins(report, ob);
     let _ = writeln!(
         s,
         "  {}: multiple coherence significant in {} (about {:.0} expected from noise alone)",
@@ -210,10 +296,7 @@ fn observable_summary(s: &mut String, report: &CoherenceReport, ob: &ObservableE
         (1.0 - report.confidence) * f.len() as f64
     );
     for a in &ob.axes {
-        let best = (0..f.len())
-            .filter(|&k| a.coherence[k].is_finite())
-            .max_by(|&i, &j| a.coherence[i].total_cmp(&a.coherence[j]));
-        let peak = best
+        let peak = peak_bin(a)
             .map(|k| format!("max coherence {:.3} at {:.3e} Hz", a.coherence[k], f[k]))
             .unwrap_or_else(|| "no finite coherence".into());
         let model_zero = a.model.iter().all(|z| z.norm() == 0.0);

@@ -1,6 +1,9 @@
-//! Figure options shared by every command that draws: `--xlim`, `--ylim`, `--size`, `--dpi`.
-//! One parser and one set of messages, so the options mean the same everywhere.
+//! Figure options shared by every command that draws: `--size` and `--dpi` everywhere, and
+//! `--xlim`, `--ylim` where the figures have a frequency axis. One parser and one set of
+//! messages, so the options mean the same everywhere, and a command's help lists only the
+//! ones it takes.
 
+use super::args::range_parts;
 use anyhow::{bail, Result};
 use clap::Args;
 use tiltnoise_core::error::Shown;
@@ -11,17 +14,10 @@ const SIZE_RANGE_PX: (u32, u32) = (200, 10_000);
 /// Resolutions accepted by `--dpi`.
 const DPI_RANGE: (f64, f64) = (30.0, 600.0);
 
-/// Axis limits, size and resolution of the figures a command saves (.png, .svg).
+/// Size and resolution of the figures a command saves (.png, .svg), for figures whose axes
+/// follow the results (histograms, the methods chart).
 #[derive(Debug, Clone, Default, Args)]
-pub struct FigureArgs {
-    /// Frequency range of the figures, LO,HI in Hz with 0 < LO < HI (e.g. 1e-3,1).
-    #[arg(long, value_name = "LO,HI", allow_hyphen_values = true)]
-    pub xlim: Option<String>,
-    /// Range of the figures' log y axes (ASDs, |H|), LO,HI in the panels' units with
-    /// 0 < LO < HI (e.g. 1e-14,1e-6); default: chosen so every curve is visible where it
-    /// matters, resonance peaks clipped at the top.
-    #[arg(long, value_name = "LO,HI", allow_hyphen_values = true)]
-    pub ylim: Option<String>,
+pub struct SizeArgs {
     /// Figure size WxH in pixels at 100 dpi, each side 200 to 10000 (e.g. 1600x1200).
     #[arg(long, value_name = "WxH")]
     pub size: Option<String>,
@@ -31,20 +27,32 @@ pub struct FigureArgs {
     pub dpi: Option<f64>,
 }
 
-impl FigureArgs {
-    /// The validated view.
+/// Axis limits, size and resolution of the figures a command saves (.png, .svg), for figures
+/// with a frequency axis.
+#[derive(Debug, Clone, Default, Args)]
+pub struct FigureArgs {
+    /// Frequency range of the figures, LO:HI in Hz with 0 < LO < HI (e.g. 1e-3:1; LO,HI is
+    /// accepted too).
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
+    pub xlim: Option<String>,
+    /// Range of the figures' log y axes (ASDs, |H|), LO:HI in the panels' units with
+    /// 0 < LO < HI (e.g. 1e-14:1e-6; LO,HI is accepted too); default: chosen so every curve
+    /// is visible where it matters, resonance peaks clipped at the top.
+    #[arg(long, value_name = "LO:HI", allow_hyphen_values = true)]
+    pub ylim: Option<String>,
+    #[command(flatten)]
+    pub size: SizeArgs,
+}
+
+impl SizeArgs {
+    /// The validated view (size and resolution), also checking that the image of `default`
+    /// size (when `--size` is absent) stays below the pixel bound at the chosen resolution.
     ///
     /// # Errors
     ///
     /// One line naming the option, the value and what is allowed.
-    pub fn view(&self) -> Result<View> {
+    pub fn view_for(&self, default: (u32, u32)) -> Result<View> {
         let mut view = View::default();
-        if let Some(text) = &self.xlim {
-            view.x_range = Some(parse_limits("--xlim", text, "Hz")?);
-        }
-        if let Some(text) = &self.ylim {
-            view.y_range = Some(parse_limits("--ylim", text, "the panels' unit")?);
-        }
         if let Some(text) = &self.size {
             view.size = Some(parse_size(text)?);
         }
@@ -58,13 +66,6 @@ impl FigureArgs {
             }
             view.dpi = dpi;
         }
-        Ok(view)
-    }
-
-    /// [`FigureArgs::view`], also checking that the image of `default` size (when `--size`
-    /// is absent) stays below the pixel bound at the chosen resolution.
-    pub fn view_for(&self, default: (u32, u32)) -> Result<View> {
-        let view = self.view()?;
         let (w, h) = view.pixels(default);
         if u64::from(w) * u64::from(h) > tiltnoise_plot::MAX_PIXELS {
             bail!(
@@ -77,27 +78,27 @@ impl FigureArgs {
 }
 
 impl FigureArgs {
-    /// [`FigureArgs::view_for`] for a figure without a frequency axis shared by its panels
-    /// (`what`, e.g. "the Monte Carlo histograms"): `--size` and `--dpi` apply, `--xlim` and
-    /// `--ylim` are refused in one line saying why.
-    pub fn size_only_view(&self, what: &str, default: (u32, u32)) -> Result<View> {
-        for (option, value) in [("--xlim", &self.xlim), ("--ylim", &self.ylim)] {
-            if let Some(text) = value {
-                bail!(
-                    "{option} {}: {what} have axes chosen from the results; --xlim and --ylim \
-                     apply to spectra and transfer-function figures (use --size and --dpi here)",
-                    Shown(text)
-                );
-            }
+    /// The validated view: [`SizeArgs::view_for`] and the axis limits.
+    ///
+    /// # Errors
+    ///
+    /// One line naming the option, the value and what is allowed.
+    pub fn view_for(&self, default: (u32, u32)) -> Result<View> {
+        let mut view = self.size.view_for(default)?;
+        if let Some(text) = &self.xlim {
+            view.x_range = Some(parse_range("--xlim", text, "Hz")?);
         }
-        self.view_for(default)
+        if let Some(text) = &self.ylim {
+            view.y_range = Some(parse_range("--ylim", text, "the panels' unit")?);
+        }
+        Ok(view)
     }
 }
 
-/// `LO,HI` with 0 < LO < HI, both finite.
-fn parse_limits(option: &str, text: &str, unit: &str) -> Result<(f64, f64)> {
-    let expected = format!("expected LO,HI in {unit} with 0 < LO < HI (log axes), e.g. 1e-3,1");
-    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+/// `LO:HI` (or `LO,HI`) with 0 < LO < HI, both finite.
+fn parse_range(option: &str, text: &str, unit: &str) -> Result<(f64, f64)> {
+    let expected = format!("expected LO:HI in {unit} with 0 < LO < HI (log axes), e.g. 1e-3:1");
+    let parts: Vec<&str> = range_parts(text);
     if parts.len() != 2 {
         bail!("{option} {}: {expected}", Shown(text));
     }
@@ -143,12 +144,11 @@ mod tests {
 
     #[test]
     fn limits_and_sizes_parse_or_say_why_not() {
-        assert_eq!(
-            parse_limits("--xlim", "1e-3, 1", "Hz").unwrap(),
-            (1e-3, 1.0)
-        );
-        for bad in ["1", "0,1", "2,1", "a,1", "1,inf", "1,2,3"] {
-            let e = parse_limits("--xlim", bad, "Hz").unwrap_err().to_string();
+        for good in ["1e-3:1", "1e-3, 1", " 1e-3 : 1 "] {
+            assert_eq!(parse_range("--xlim", good, "Hz").unwrap(), (1e-3, 1.0));
+        }
+        for bad in ["1", "0,1", "2:1", "a,1", "1,inf", "1,2,3", "1:2:3", "1:2,3"] {
+            let e = parse_range("--xlim", bad, "Hz").unwrap_err().to_string();
             assert!(e.starts_with("--xlim ") && e.contains("0 < LO < HI"), "{e}");
         }
         assert_eq!(parse_size("1600x1200").unwrap(), (1600, 1200));

@@ -17,9 +17,10 @@ use tiltnoise_io::{read_measured_modes, read_visibilities, write_atomic, write_f
 /// Arguments of `tiltnoise fit`.
 #[derive(Debug, Args)]
 pub(crate) struct FitArgs {
-    /// Measured frequencies: CSV `mode,frequency_hz[,sigma_hz]` (any subset of modes 1..8; see
-    /// docs/fit.md). Default: the measured column of Table II, or none with --visibility.
-    #[arg(long, value_name = "FILE")]
+    /// Measured mode frequencies: CSV `mode,frequency_hz[,sigma_hz]` (any subset of modes
+    /// 1..8; see docs/fit.md). Default: the measured column of Table II, or none with
+    /// --visibility.
+    #[arg(long = "measured-modes", alias = "measured", value_name = "FILE")]
     measured: Option<PathBuf>,
     /// Measured mode visibilities, fitted together with the frequencies: CSV
     /// `mode,observable,reference,ratio[,sigma]`, the signed ratio of mode nu_k's component in
@@ -65,7 +66,7 @@ pub(crate) fn run_fit(params: &Params, args: FitArgs, run: &mut Run) -> Result<(
     let inputs: Vec<(&str, &Path)> = args
         .measured
         .iter()
-        .map(|p| ("--measured", p.as_path()))
+        .map(|p| ("--measured-modes", p.as_path()))
         .chain(
             args.visibility
                 .iter()

@@ -2,7 +2,7 @@
 //! the parameter file, see [`tiltnoise_core::params::uncertainty`]); a table or JSON on stdout, histograms
 //! (PNG/SVG) and HDF5 with `--save`.
 
-use super::figure_args::FigureArgs;
+use super::figure_args::SizeArgs;
 use super::Run;
 use anyhow::Result;
 use serde::Serialize;
@@ -30,7 +30,7 @@ pub(crate) struct McOptions {
     /// Output files (format from the extension).
     pub(crate) save: Vec<PathBuf>,
     /// Size and resolution of the histograms.
-    pub(crate) figure: FigureArgs,
+    pub(crate) figure: SizeArgs,
 }
 
 /// What `--save PATH` writes.
@@ -63,10 +63,9 @@ pub(crate) fn run_mc(params: &Params, opts: McOptions, run: &mut Run) -> Result<
         .iter()
         .map(|p| output_kind(p))
         .collect::<Result<Vec<_>, _>>()?;
-    let view = opts.figure.size_only_view(
-        "the Monte Carlo histograms (one frequency axis per mode)",
-        tiltnoise_plot::mc_figure::DEFAULT_SIZE,
-    )?;
+    let view = opts
+        .figure
+        .view_for(tiltnoise_plot::mc_figure::DEFAULT_SIZE)?;
     tiltnoise_core::mc::check_size(opts.samples, opts.threads, ("--samples", "--threads"))?;
     let saves: Vec<&Path> = opts.save.iter().map(PathBuf::as_path).collect();
     run.check_outputs(&saves, &[])?;

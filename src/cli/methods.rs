@@ -2,7 +2,7 @@
 //! reference and its time per point (table, JSON, chart).
 
 use super::args::Format;
-use super::figure_args::FigureArgs;
+use super::figure_args::SizeArgs;
 use super::output::save_image;
 use super::Run;
 use anyhow::Result;
@@ -36,7 +36,7 @@ pub struct MethodsArgs {
     save: Vec<PathBuf>,
     // Size and resolution of the chart (its axes follow the results).
     #[command(flatten)]
-    figure: FigureArgs,
+    figure: SizeArgs,
 }
 
 /// One method's row of the JSON output (keys in alphabetical order, as documented).
@@ -75,10 +75,7 @@ pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> 
     for path in save {
         tiltnoise_plot::ImageFormat::from_path(path)?;
     }
-    let view = figure.size_only_view(
-        "the methods chart's time and error axes",
-        tiltnoise_plot::methods_figure::DEFAULT_SIZE,
-    )?;
+    let view = figure.view_for(tiltnoise_plot::methods_figure::DEFAULT_SIZE)?;
     let saves: Vec<&Path> = save.iter().map(PathBuf::as_path).collect();
     run.check_outputs(&saves, &[])?;
     let out = &mut run.out;

@@ -2,7 +2,7 @@
 //! library inputs and the run of each subcommand. `main.rs` only maps the result to an exit code.
 //! Results are printed on standard output through [`Out`]; errors are returned to `main`.
 //! Every command that saves files checks all their paths before it computes anything
-//! ([`Run::check_outputs`]) and writes them all or none ([`Run::write_outputs`]).
+//! (`Run::check_outputs`) and writes them all or none (`Run::write_outputs`).
 
 mod args;
 mod budget;
@@ -114,7 +114,7 @@ enum Command {
         save: Vec<PathBuf>,
         // Size and resolution of the histograms (their axes follow the draws).
         #[command(flatten)]
-        figure: figure_args::FigureArgs,
+        figure: figure_args::SizeArgs,
     },
     /// Every evaluation method's worst error against the double-double reference and its time
     /// per point, for the 7x3 tilt matrix on the given grid (table, JSON, chart).

@@ -3,6 +3,7 @@
 //! and the outputs (HDF5 series + ASDs, CSV ASDs, Figure 3, Figures 4/5). Owns the progress
 //! bar (only when stderr is a terminal and the run is long). Documented in `docs/simulate.md`.
 
+use super::args::scientific;
 use super::figure_args::FigureArgs;
 use super::output::save_image;
 use super::Run;
@@ -77,7 +78,7 @@ pub(crate) struct SimulateArgs {
           conflicts_with_all = ["init", "init_rate"])]
     kick_x: Option<f64>,
     /// Energy per mode (J) of the default excitation (no --init, --init-rate, --kick-x).
-    #[arg(long, value_name = "JOULES", default_value_t = DEFAULT_MODE_ENERGY_J,
+    #[arg(long, value_name = "JOULES", default_value = scientific(DEFAULT_MODE_ENERGY_J),
           allow_negative_numbers = true)]
     mode_energy: f64,
     /// White readout noise OBS=ASD in the observable's unit/sqrt(Hz) (repeatable; default

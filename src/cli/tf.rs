@@ -10,7 +10,7 @@
 //! `eta`, `phi`, `phi_a` (rad). Entries are complex responses per unit input: m/rad, rad/rad,
 //! m/m, rad/m, m/N, rad/(N m), ...
 
-use super::args::{MethodArg, PerArg};
+use super::args::{scientific, MethodArg, PerArg};
 use super::figure_args::FigureArgs;
 use super::output::save_tf;
 use super::Run;
@@ -60,7 +60,7 @@ pub struct TfArgs {
     per: PerArg,
     /// Observables (rows), comma-separated and/or repeated: X, Y, Z (m), theta, eta, phi, phi_a
     /// (rad). Default: all seven.
-    #[arg(long = "output", value_name = "NAME[,NAME...]")]
+    #[arg(long = "observables", alias = "output", value_name = "OBS,...")]
     outputs: Vec<String>,
     /// Output file, format from the extension: .h5 (all numbers), .csv, .png/.svg (|H| per
     /// observable, one panel per kind of input: tilt, translation, forces, torques; tilt alone
@@ -75,7 +75,7 @@ pub struct TfArgs {
     #[arg(
         long,
         value_name = "REL",
-        default_value_t = DEFAULT_REL_TOL,
+        default_value = scientific(DEFAULT_REL_TOL),
         allow_negative_numbers = true
     )]
     rel_tol: f64,
@@ -88,10 +88,10 @@ pub struct TfArgs {
     /// measured error, on standard error).
     #[arg(long)]
     explain: bool,
-    /// Observables drawn in the figures, a subset of --output (default: every --output; with
-    /// neither option X, phi, phi_a as the paper's Figure 5).
-    #[arg(long, value_name = "NAME[,NAME...]")]
-    observables: Vec<String>,
+    /// Observables drawn in the figures, a subset of --observables (default: every one of
+    /// --observables; without either option X, phi, phi_a as the paper's Figure 5).
+    #[arg(long, value_name = "OBS,...")]
+    plot_observables: Vec<String>,
     /// Bode figure: a phase panel (degrees) beside every magnitude panel.
     #[arg(long)]
     phase: bool,
@@ -104,24 +104,26 @@ pub fn parse_inputs(specs: &[String]) -> Result<Vec<Input>> {
     Ok(options::parse_inputs("--input", specs)?)
 }
 
-/// Parses `--output` values (see [`TfArgs`]); empty means all seven observables.
-pub fn parse_outputs(specs: &[String]) -> Result<Vec<Observable>> {
-    Ok(options::parse_outputs("--output", specs)?)
+/// Parses `--observables` values (see [`TfArgs`]); empty means all seven observables.
+pub fn parse_observables(specs: &[String]) -> Result<Vec<Observable>> {
+    Ok(options::parse_outputs("--observables", specs)?)
 }
 
-/// The figure's options: panels from `--observables` (each one of the outputs), else every
-/// `--output`, else the paper's Figure 5 (X, phi, phi_a); phase, limits, size, resolution.
+/// The figure's options: panels from `--plot-observables` (each one of the computed
+/// observables), else every one of `--observables`, else the paper's Figure 5 (X, phi, phi_a);
+/// phase, limits, size, resolution.
 fn figure_options(
     args: &TfArgs,
     request: &Request,
     params: &Params,
 ) -> Result<tiltnoise_plot::TfFigureOptions> {
-    let observables = if !args.observables.is_empty() {
-        let chosen = options::parse_outputs("--observables", &args.observables)?;
+    let observables = if !args.plot_observables.is_empty() {
+        let chosen = options::parse_outputs("--plot-observables", &args.plot_observables)?;
         if let Some(o) = chosen.iter().find(|o| !request.outputs.contains(o)) {
             let have: Vec<&str> = request.outputs.iter().map(|o| o.name()).collect();
             bail!(
-                "--observables: {} is not among the computed outputs ({}); add it to --output",
+                "--plot-observables: {} is not among the computed observables ({}); add it to \
+                 --observables",
                 o.name(),
                 have.join(", ")
             );
@@ -149,7 +151,7 @@ fn figure_options(
 /// Runs `tiltnoise tf`.
 pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()> {
     let request = Request {
-        outputs: parse_outputs(&args.outputs)?,
+        outputs: parse_observables(&args.outputs)?,
         inputs: parse_inputs(&args.inputs)?,
     };
     if !(args.rel_tol.is_finite() && args.rel_tol > 0.0 && args.rel_tol < 1.0) {

@@ -17,11 +17,22 @@ use tiltnoise_io::write_atomic;
 pub(crate) struct VisibilityArgs {
     /// A free-motion or ring-down record of the observables: HDF5 or CSV time series as
     /// `budget --measured` reads them (the layout `simulate --save` writes).
-    #[arg(long, value_name = "FILE")]
+    #[arg(long = "measured", alias = "record", value_name = "FILE")]
     record: PathBuf,
     /// Output CSV `mode,observable,reference,ratio,sigma` for `fit --visibility`.
     #[arg(long, value_name = "PATH")]
     save: Option<PathBuf>,
+    /// Output format on the terminal: table (the peaks and the ratios), or csv (the file
+    /// --save writes; `wrote` lines then go to standard error).
+    #[arg(long, value_enum, default_value_t = VisibilityFormat::Table)]
+    format: VisibilityFormat,
+}
+
+/// What `tiltnoise visibility` prints.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum VisibilityFormat {
+    Table,
+    Csv,
 }
 
 /// Runs `tiltnoise visibility`.
@@ -35,11 +46,11 @@ pub(crate) fn run_visibility(params: &Params, args: VisibilityArgs, run: &mut Ru
         }
     }
     let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
-    run.check_outputs(&saves, &[("--record", args.record.as_path())])?;
+    run.check_outputs(&saves, &[("--measured", args.record.as_path())])?;
     let series = match read_measured_input(&args.record)? {
         MeasuredInput::Series(s) => s,
         MeasuredInput::Spectra(_) => bail!(
-            "--record {}: holds spectra; the visibilities need the time series (header time_s, \
+            "--measured {}: holds spectra; the visibilities need the time series (header time_s, \
              or HDF5)",
             args.record.display()
         ),
@@ -61,11 +72,6 @@ pub(crate) fn run_visibility(params: &Params, args: VisibilityArgs, run: &mut Ru
         &origin,
         &run.cancel,
     )?;
-    let names: Vec<&str> = series.channels.iter().map(|(o, _)| o.name()).collect();
-    write!(run.out, "{}", table(&measured, &names))?;
-    let Some(path) = &args.save else {
-        return Ok(());
-    };
     let comment = [
         format!("mode visibilities measured from {origin} by tiltnoise visibility"),
         format!(
@@ -75,7 +81,17 @@ pub(crate) fn run_visibility(params: &Params, args: VisibilityArgs, run: &mut Ru
         ),
     ];
     let text = measured.visibilities.to_csv(&comment);
-    run.write_outputs(false, || {
+    match args.format {
+        VisibilityFormat::Table => {
+            let names: Vec<&str> = series.channels.iter().map(|(o, _)| o.name()).collect();
+            write!(run.out, "{}", table(&measured, &names))?;
+        }
+        VisibilityFormat::Csv => write!(run.out, "{text}")?,
+    }
+    let Some(path) = &args.save else {
+        return Ok(());
+    };
+    run.write_outputs(args.format == VisibilityFormat::Csv, || {
         write_atomic(path, |tmp| {
             std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
         })?;

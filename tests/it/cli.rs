@@ -309,14 +309,30 @@ fn mc_json_reports_every_mode_and_refuses_zero_samples() {
 /// cannot verify names the mode and the two ways out, and the first of them works.
 #[test]
 fn tf_takes_one_frequency_and_explains_a_point_next_to_a_mode() {
-    let out = tiltnoise(&["tf", "--freq", "1e-3", "--input", "eta_t", "--output", "X"]);
+    let out = tiltnoise(&[
+        "tf",
+        "--freq",
+        "1e-3",
+        "--input",
+        "eta_t",
+        "--observables",
+        "X",
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let (_, freqs, values) = common::parse_tf_csv(&String::from_utf8_lossy(&out.stdout));
     assert_eq!(freqs, vec![1e-3]);
     // X -> -eta_t (Z + Z_b + h_c) as f -> 0: negative and finite at 1 mHz.
     assert!(values[0][0].re.is_finite() && values[0][0].re < 0.0);
 
-    let near = ["tf", "--freq", "0.415", "--input", "eta_t", "--output", "X"];
+    let near = [
+        "tf",
+        "--freq",
+        "0.415",
+        "--input",
+        "eta_t",
+        "--observables",
+        "X",
+    ];
     assert_fails(
         &near,
         &[

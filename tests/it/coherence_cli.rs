@@ -287,10 +287,10 @@ fn bad_samples_channels_and_options_are_refused() {
     refused(
         |d| {
             let (t, m) = inputs(d, 1.0, "2024-03-20T00:00:00Z");
-            command(&t, &m, &["--output", "phi"])
+            command(&t, &m, &["--observables", "phi"])
         },
         &[
-            "--output phi",
+            "--observables phi",
             "pendulum.h5 has no channel phi",
             "it has X, phi_a",
         ],
@@ -299,7 +299,7 @@ fn bad_samples_channels_and_options_are_refused() {
     refused(
         |d| {
             let (t, m) = inputs(d, 1.0, "2024-03-20T00:00:00Z");
-            command(&t, &m, &["--output", "psi"])
+            command(&t, &m, &["--observables", "psi"])
         },
         &["unknown observable", "psi"],
     );

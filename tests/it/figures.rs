@@ -94,7 +94,7 @@ mod options {
             "tf",
             "--freq",
             "1e-3:40:1",
-            "--output",
+            "--observables",
             "Y,Z,theta,eta",
             "--phase",
             "--save",
@@ -159,8 +159,8 @@ mod options {
                 vec!["too large"],
             ),
             (
-                vec!["--output", "X", "--observables", "phi"],
-                vec!["--observables", "phi", "--output"],
+                vec!["--observables", "X", "--plot-observables", "phi"],
+                vec!["--plot-observables", "phi", "--observables"],
             ),
         ] {
             let mut all = vec!["tf", "--freq", "1e-3:10:1"];
@@ -271,7 +271,7 @@ mod options {
             let mut args: Vec<&str> = command.iter().map(String::as_str).collect();
             args.extend([png.to_str().unwrap(), "--size", "640x480", "--dpi", "50"]);
             if *spectra {
-                args.extend(["--xlim", "2e-3,0.2", "--ylim", "1e-15,1e-3"]);
+                args.extend(["--xlim", "2e-3:0.2", "--ylim", "1e-15:1e-3"]);
             }
             let out = tiltnoise(&args);
             assert_eq!(out.status.code(), Some(0), "{args:?}: {out:?}");
@@ -300,12 +300,13 @@ mod options {
                 ),
             ];
             if *spectra {
-                cases.push((vec!["--xlim", "1,0.1"], vec!["--xlim 1,0.1", "0 < LO < HI"]));
+                cases.push((vec!["--xlim", "1:0.1"], vec!["--xlim 1:0.1", "0 < LO < HI"]));
                 cases.push((vec!["--ylim", "0,1"], vec!["--ylim 0,1", "0 < LO < HI"]));
             } else if command[0] != "simulate" {
+                // Their axes follow the results: the options are not theirs (nor in their help).
                 cases.push((
-                    vec!["--xlim", "1e-3,1"],
-                    vec!["--xlim 1e-3,1", "--size and --dpi"],
+                    vec!["--xlim", "1e-3:1"],
+                    vec!["unexpected argument", "--xlim"],
                 ));
             }
             for (extra, needles) in cases {
@@ -328,7 +329,7 @@ mod options {
             "1e-3:40:1",
             "--input",
             "tilt,forces",
-            "--output",
+            "--observables",
             "X",
             "--save",
             svg.to_str().unwrap(),

@@ -426,21 +426,21 @@ fn cli_bad_input_exits_2_without_output() {
     );
     let cases: Vec<(Vec<String>, Vec<&str>)> = vec![
         (
-            vec!["--measured".into(), three.clone(), "--free".into(),
+            vec!["--measured-modes".into(), three.clone(), "--free".into(),
                  "torsion.k_a_n_m_per_rad,torsion.k_b_n_m_per_rad,bouncing.kappa_a_n_per_m,bouncing.kappa_b_n_per_m".into()],
             vec!["4 free parameters", "3 measured modes"],
         ),
-        (vec!["--measured".into(), three.clone()], vec!["8 free parameters", "3 measured modes"]),
+        (vec!["--measured-modes".into(), three.clone()], vec!["8 free parameters", "3 measured modes"]),
         (vec!["--free".into(), "length.hh_m".into()], vec!["`length.hh_m`", "allowed keys"]),
         (vec!["--free".into(), "environment.g_m_per_s2".into()], vec!["`environment.g_m_per_s2`", "exact"]),
         (vec!["--free".into(), "mass.m_a_kg,mass.m_a_kg".into()], vec!["--free: mass.m_a_kg is given twice"]),
         (vec!["--bound-sigmas".into(), "0".into()], vec!["--bound-sigmas 0", "> 0"]),
-        (vec!["--measured".into(), file("neg.csv", "mode,frequency_hz\n1,-0.001\n")], vec!["neg.csv", "`-0.001`", ">= 1e-9 Hz"]),
-        (vec!["--measured".into(), file("nan.csv", "mode,frequency_hz\n1,NaN\n")], vec!["nan.csv", "`NaN`", "finite"]),
-        (vec!["--measured".into(), file("nine.csv", "mode,frequency_hz\n9,1.0\n")], vec!["nine.csv", "mode `9`", "1..8"]),
-        (vec!["--measured".into(), file("dup.csv", "mode,frequency_hz\n2,1.0\n2,1.1\n")], vec!["dup.csv", "mode 2", "twice"]),
-        (vec!["--measured".into(), file("bad.csv", "freq\n1\n")], vec!["bad.csv", "header"]),
-        (vec!["--measured".into(), dir.path().join("missing.csv").to_str().unwrap().into()], vec!["missing.csv"]),
+        (vec!["--measured-modes".into(), file("neg.csv", "mode,frequency_hz\n1,-0.001\n")], vec!["neg.csv", "`-0.001`", ">= 1e-9 Hz"]),
+        (vec!["--measured-modes".into(), file("nan.csv", "mode,frequency_hz\n1,NaN\n")], vec!["nan.csv", "`NaN`", "finite"]),
+        (vec!["--measured-modes".into(), file("nine.csv", "mode,frequency_hz\n9,1.0\n")], vec!["nine.csv", "mode `9`", "1..8"]),
+        (vec!["--measured-modes".into(), file("dup.csv", "mode,frequency_hz\n2,1.0\n2,1.1\n")], vec!["dup.csv", "mode 2", "twice"]),
+        (vec!["--measured-modes".into(), file("bad.csv", "freq\n1\n")], vec!["bad.csv", "header"]),
+        (vec!["--measured-modes".into(), dir.path().join("missing.csv").to_str().unwrap().into()], vec!["missing.csv"]),
     ];
     for (extra, needles) in cases {
         let mut args: Vec<&str> = vec!["fit", "--save", out_s];

@@ -110,7 +110,7 @@ fn cli_writes_hdf5_csv_and_figures_for_force_inputs() {
         "tf",
         "--input",
         "F_b.x,M_b.z",
-        "--output",
+        "--observables",
         "X,phi,phi_a",
         "--freq",
         "1e-4:200:20",
@@ -175,7 +175,7 @@ fn torque_on_the_test_mass_near_torsion_agrees_with_the_two_dof_model() {
         "tf",
         "--input",
         "M_b.z",
-        "--output",
+        "--observables",
         "phi,phi_a,X",
         "--freq",
         "5e-4:80:5e-3",
@@ -319,9 +319,9 @@ fn bad_input_and_output_names_are_refused() {
         &["F_b.x is given twice"],
     );
     assert_fails_without_output(
-        &["tf", "--output", "Phi", "--save", out],
+        &["tf", "--observables", "Phi", "--save", out],
         dir.path(),
-        &["--output", "\"Phi\"", "phi_a"],
+        &["--observables", "\"Phi\"", "phi_a"],
     );
     assert_fails_without_output(
         &["tf", "--rel-tol", "0", "--save", out],
@@ -331,7 +331,15 @@ fn bad_input_and_output_names_are_refused() {
     // The 2-DoF model cannot represent a swing-only force.
     assert_fails_without_output(
         &[
-            "tf", "--input", "F_b.y", "--output", "phi", "--method", "torsion2", "--save", out,
+            "tf",
+            "--input",
+            "F_b.y",
+            "--observables",
+            "phi",
+            "--method",
+            "torsion2",
+            "--save",
+            out,
         ],
         dir.path(),
         &["F_b.y"],

@@ -293,7 +293,7 @@ fn text_files_over_their_length() {
     )
     .unwrap();
     refused(
-        &["fit", "--measured", measured.to_str().unwrap()],
+        &["fit", "--measured-modes", measured.to_str().unwrap()],
         &[
             &format!("measured frequencies {}, line 2: ", measured.display()),
             "the limit for one line",
@@ -491,11 +491,11 @@ mod devices {
             &["frequency file /dev/urandom: longer than 64 MiB (67108864 bytes)"],
         );
         refused(
-            &["fit", "--measured", "/dev/zero"],
+            &["fit", "--measured-modes", "/dev/zero"],
             &["measured frequencies /dev/zero, line 1: longer than 64 KiB"],
         );
         refused(
-            &["fit", "--measured", "/dev/urandom"],
+            &["fit", "--measured-modes", "/dev/urandom"],
             &["measured frequencies /dev/urandom: longer than 1 MiB"],
         );
         let zero = csv_link(dir.path(), "/dev/zero");

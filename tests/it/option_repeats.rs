@@ -74,8 +74,16 @@ fn a_key_or_name_given_twice_is_refused_in_every_command() {
             "--input: eta_t is given twice; name each input once",
         ),
         (
-            vec!["tf", "--freq", "1e-3:5:1", "--output", "X", "--output", "X"],
-            "--output: X is given twice; name each observable once",
+            vec![
+                "tf",
+                "--freq",
+                "1e-3:5:1",
+                "--observables",
+                "X",
+                "--observables",
+                "X",
+            ],
+            "--observables: X is given twice; name each observable once",
         ),
         (
             vec![
@@ -153,8 +161,8 @@ fn a_key_or_name_given_twice_is_refused_in_every_command() {
             "--fit: length.h_m is given twice; name each parameter key once",
         ),
         (
-            [&["coherence"][..], &pair, &["--output", "X,phi,X"]].concat(),
-            "--output: X is given twice; name each observable once",
+            [&["coherence"][..], &pair, &["--observables", "X,phi,X"]].concat(),
+            "--observables: X is given twice; name each observable once",
         ),
         (
             [

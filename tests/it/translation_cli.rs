@@ -25,7 +25,7 @@ fn tf_writes_translation_columns_with_their_units_and_convention() {
         "tf",
         "--input",
         "translation",
-        "--output",
+        "--observables",
         "X,Y,Z,phi",
         "--freq",
         "1e-4:120:30",
@@ -189,7 +189,7 @@ fn tf_per_unit_floor_acceleration() {
     let args = [
         "--input",
         "x_t,eta_t,F_b.x",
-        "--output",
+        "--observables",
         "X",
         "--freq",
         "1e-6:4:10",

@@ -24,7 +24,7 @@ fn simulated_record_to_fitted_offset() {
     sim.extend(["--save", &record]);
     let out = tiltnoise(&sim);
     assert!(out.status.success(), "{}", stderr(&out));
-    let out = tiltnoise(&["visibility", "--record", &record, "--save", &vis]);
+    let out = tiltnoise(&["visibility", "--measured", &record, "--save", &vis]);
     assert!(out.status.success(), "{}", stderr(&out));
     let table = String::from_utf8(out.stdout).unwrap();
     assert!(table.contains("nu_6") && table.contains("Z/X"), "{table}");
@@ -33,6 +33,14 @@ fn simulated_record_to_fitted_offset() {
         csv.starts_with("# mode visibilities measured from"),
         "{csv}"
     );
+    // `--format csv` prints the file `--save` writes, and the table's ratios are its rows.
+    let printed = tiltnoise(&["visibility", "--measured", &record, "--format", "csv"]);
+    assert!(printed.status.success(), "{}", stderr(&printed));
+    assert_eq!(String::from_utf8(printed.stdout).unwrap(), csv);
+    for row in csv.lines().filter(|l| l.starts_with("6,Z,X,")) {
+        let ratio: f64 = row.split(',').nth(3).unwrap().parse().unwrap();
+        assert!(table.contains(&format!("{ratio:.5e}")), "{row}\n{table}");
+    }
 
     let toml = tiltnoise(&["params"]).stdout;
     let mut toml = String::from_utf8(toml).unwrap();
@@ -144,13 +152,19 @@ fn bad_input_exits_2_without_output() {
     let vis_s = vis_out.to_str().unwrap();
     for (args, needles) in [
         (
-            vec!["visibility", "--record", spectra.as_str(), "--save", vis_s],
+            vec![
+                "visibility",
+                "--measured",
+                spectra.as_str(),
+                "--save",
+                vis_s,
+            ],
             vec!["asd.csv", "spectra"],
         ),
         (
             vec![
                 "visibility",
-                "--record",
+                "--measured",
                 spectra.as_str(),
                 "--save",
                 "v.txt",
@@ -160,7 +174,7 @@ fn bad_input_exits_2_without_output() {
         (
             vec![
                 "visibility",
-                "--record",
+                "--measured",
                 missing.to_str().unwrap(),
                 "--save",
                 vis_s,

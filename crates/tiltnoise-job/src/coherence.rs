@@ -25,7 +25,7 @@ pub struct CoherenceRequest<'a> {
     /// The measured time series of the observables (HDF5 as `simulate` writes it, or CSV).
     pub measured: PathBuf,
     /// The observables to analyse, each in the measured file (default: all of its channels).
-    pub outputs: Option<Vec<Observable>>,
+    pub observables: Option<Vec<Observable>>,
     /// Welch segment length (default: 2^14, or the largest power of two <= N/4).
     pub nperseg: Option<usize>,
     /// Welch overlap as a fraction of the segment (default 0.5).
@@ -83,13 +83,13 @@ pub fn run(req: CoherenceRequest<'_>, cancel: &Cancel) -> Result<CoherenceResult
             )),
         };
     let measured_start = read_start_time(&req.measured)?;
-    let channels: Vec<(Observable, &[f64])> = match &req.outputs {
+    let channels: Vec<(Observable, &[f64])> = match &req.observables {
         None => measured
             .channels
             .iter()
             .map(|(o, x)| (*o, x.as_slice()))
             .collect(),
-        Some(outputs) => outputs
+        Some(observables) => observables
             .iter()
             .map(|&o| {
                 let found = measured.channels.iter().find(|(c, _)| *c == o);
@@ -97,7 +97,7 @@ pub fn run(req: CoherenceRequest<'_>, cancel: &Cancel) -> Result<CoherenceResult
                     let present: Vec<&str> =
                         measured.channels.iter().map(|(o, _)| o.name()).collect();
                     JobError::option(
-                        "output",
+                        "observables",
                         Some(o.name()),
                         format!(
                             "the measured file {measured_path} has no channel {}; it has {}",

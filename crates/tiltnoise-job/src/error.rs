@@ -144,13 +144,17 @@ impl JobError {
             JobError::PercentilesNeedSegments => require_segments_for_percentiles(spelling, false)
                 .err()
                 .map_or_else(String::new, |e| e.to_string()),
-            JobError::Percentiles { lower, upper } => {
-                let given = match spelling {
-                    Spelling::Flag => format!("{},{}", Num(*lower), Num(*upper)),
-                    Spelling::Keyword => format!("({}, {})", Num(*lower), Num(*upper)),
-                };
-                percentiles_error(spelling, &given).to_string()
-            }
+            JobError::Percentiles { lower, upper } => match spelling {
+                Spelling::Flag => format!(
+                    "--percentiles {}:{}: expected LO:HI with 0 <= LO < HI <= 100, e.g. 10:90",
+                    Num(*lower),
+                    Num(*upper)
+                ),
+                Spelling::Keyword => {
+                    let given = format!("({}, {})", Num(*lower), Num(*upper));
+                    percentiles_error(spelling, &given).to_string()
+                }
+            },
             JobError::Repeated(r) => Repeated {
                 option: opt(&r.option),
                 ..r.clone()
