@@ -10,7 +10,7 @@ use super::Run;
 use anyhow::{anyhow, Result};
 use clap::Args;
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::freq;
 use tiltnoise_core::model::Model;
@@ -19,7 +19,6 @@ use tiltnoise_core::params::Params;
 use tiltnoise_core::spectral::Averaging;
 use tiltnoise_io::{OutputKind, RunMeta};
 use tiltnoise_job::budget::{BudgetRequest, BudgetResult, ReadRequest, TiltSource, WelchRequest};
-use tiltnoise_job::Spelling;
 
 /// Arguments of `tiltnoise budget`.
 #[derive(Debug, Args)]
@@ -220,14 +219,7 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
         at_hz: args.at.as_deref().map(parse_at).transpose()?,
         at_band: args.at_band,
     };
-    let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
-    let inputs: Vec<(String, &Path)> = req
-        .input_files()
-        .into_iter()
-        .map(|(option, path)| (Spelling::Flag.option(option), path))
-        .collect();
-    let inputs: Vec<(&str, &Path)> = inputs.iter().map(|(o, p)| (o.as_str(), *p)).collect();
-    run.check_outputs(&saves, &inputs)?;
+    run.check_job_outputs(&args.save, req.input_files())?;
     let mut bar = None;
     let result = tiltnoise_job::budget::run(req, &run.cancel, &mut |done, total| {
         bar.get_or_insert_with(|| progress_bar(total))

@@ -10,7 +10,7 @@ use super::Run;
 use anyhow::{anyhow, Result};
 use clap::Args;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use tiltnoise_core::coherence::{with_error, AxisEstimate, CoherenceReport, ObservableEstimate};
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::Model;
@@ -19,7 +19,6 @@ use tiltnoise_core::params::Params;
 use tiltnoise_io::{OutputKind, RunMeta};
 use tiltnoise_job::budget::ReadRequest;
 use tiltnoise_job::coherence::{CoherenceRequest, CoherenceResult};
-use tiltnoise_job::Spelling;
 
 /// Arguments of `tiltnoise coherence`.
 #[derive(Debug, Args)]
@@ -126,14 +125,7 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
         confidence: args.confidence,
         fit_band_hz: args.fit_band.as_deref().map(parse_fit_band).transpose()?,
     };
-    let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
-    let inputs: Vec<(String, &Path)> = req
-        .input_files()
-        .into_iter()
-        .map(|(option, path)| (Spelling::Flag.option(option), path))
-        .collect();
-    let inputs: Vec<(&str, &Path)> = inputs.iter().map(|(o, p)| (o.as_str(), *p)).collect();
-    run.check_outputs(&saves, &inputs)?;
+    run.check_job_outputs(&args.save, req.input_files())?;
     let CoherenceResult { report, inputs } =
         tiltnoise_job::coherence::run(req, &run.cancel).map_err(super::job_error)?;
     match args.format {
