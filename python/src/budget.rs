@@ -2,10 +2,11 @@
 //! --tilt FILE`), and the `Budget` they return.
 
 use crate::arrays::{self, check_size, series};
-use crate::errors::{value_error, IntoPyErr, PyResultExt};
+use crate::errors::{value_error, PyResultExt};
 use crate::figure;
 use crate::inputs::Inputs;
 use crate::interrupt;
+use crate::job_args;
 use crate::model::PyModel;
 use crate::params::PyParams;
 use crate::python_side;
@@ -16,27 +17,22 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use tiltnoise_core::budget::option_checks::{self, InputKind};
-use tiltnoise_core::budget::{budget_from_series, budget_from_spectra, BudgetError, BudgetOptions};
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::error::Num;
 use tiltnoise_core::freq;
 use tiltnoise_core::ground::GroundQuantity;
 use tiltnoise_core::input::{
-    check_sensors, ground_index, ground_inputs, motion_of, parse_scales, parse_units,
-    process_channel, unstated_excess, ChannelCtx, DetrendedRms, GapPolicy, GroundChannel,
-    InputError, InputMeta, Motion, Quantity, Sensors, SeriesSource,
+    check_sensors, ground_index, ground_inputs, motion_of, parse_units, process_channel,
+    unstated_excess, ChannelCtx, DetrendedRms, GapPolicy, GroundChannel, InputError, InputMeta,
+    Motion, Quantity, Sensors, SeriesSource,
 };
 use tiltnoise_core::model::{Input, Model, Observable};
 use tiltnoise_core::noise::equivalent::referred_terms;
-use tiltnoise_core::noise::{BudgetReport, Readout, SpectralSource};
-use tiltnoise_core::options::{self, Spelling};
+use tiltnoise_core::noise::{BudgetReport, SpectralSource};
 use tiltnoise_core::params::Params;
 use tiltnoise_core::repeats::refuse_repeats;
-use tiltnoise_io::input::{
-    add_measured_file, read_tilt, AxisMap, InputFormat, ReadOptions, TiltInput, TiltSeriesSource,
-};
 use tiltnoise_io::RunMeta;
+use tiltnoise_job::budget::{BudgetRequest, BudgetResult, ReadRequest, TiltSource, WelchRequest};
 
 /// A record of the floor's motion handed over as arrays: one channel per input, in canonical
 /// order, each in the SI unit of its quantity.
@@ -79,7 +75,7 @@ impl SeriesSource for ArraySeries {
 
 /// The model of `params`: a `Model` (reused as it is), a `Params`, or Table I for `None`; and
 /// its parameters (with the file they were read from).
-fn model_of(params: Option<&Bound<'_, PyAny>>) -> PyResult<(Arc<Model>, PyParams)> {
+pub(crate) fn model_of(params: Option<&Bound<'_, PyAny>>) -> PyResult<(Arc<Model>, PyParams)> {
     let Some(p) = params else {
         let params = Params::table_i();
         return Ok((
@@ -103,67 +99,21 @@ fn model_of(params: Option<&Bound<'_, PyAny>>) -> PyResult<(Arc<Model>, PyParams
     Ok((Arc::new(Model::new(&params.inner).py()?), params))
 }
 
-/// The readout of `readout` (`{observable: ASD}`), over the default 9e-9 m/sqrt(Hz) on X as
-/// the command line's `--readout OBS=ASD`: a value replaces the observable's readout, 0
-/// removes it; only budgeted observables.
-fn readout(arg: Option<&Bound<'_, PyDict>>, budgeted: &[Observable]) -> PyResult<Readout> {
-    let Some(d) = arg else {
-        return Ok(Readout::default());
-    };
-    let mut items = Vec::new();
-    for (name, value) in d.iter() {
-        let name: String = name
-            .extract()
-            .map_err(|_| value_error("readout: the keys must be observable names (str)"))?;
-        let asd: f64 = value
-            .extract()
-            .map_err(|_| value_error(format!("readout {name}: the ASD must be a number")))?;
-        items.push(options::readout_item("readout", &name, asd).py()?);
-    }
-    options::apply_readout("readout", Readout::default(), &items, Some(budgeted)).py()
-}
-
-/// The Welch and segment options common to both entry points, as on the command line.
-struct SeriesOptions {
+/// The Welch and segment options of both entry points, as on the command line.
+fn welch(
     nperseg: Option<usize>,
     overlap: Option<f64>,
-    average: Option<String>,
+    average: Option<&str>,
     segment_duration: Option<f64>,
     percentiles: Option<(f64, f64)>,
-}
-
-impl SeriesOptions {
-    /// The options given (snake case), for refusing them with spectra input.
-    fn given(&self) -> Vec<&'static str> {
-        [
-            ("nperseg", self.nperseg.is_some()),
-            ("overlap", self.overlap.is_some()),
-            ("average", self.average.is_some()),
-            ("segment_duration", self.segment_duration.is_some()),
-        ]
-        .into_iter()
-        .filter_map(|(name, given)| given.then_some(name))
-        .collect()
-    }
-
-    fn apply(&self, opts: &mut BudgetOptions) -> PyResult<()> {
-        opts.welch_segment_len = self.nperseg;
-        if let Some(o) = self.overlap {
-            opts.welch_overlap_fraction = o;
-        }
-        if let Some(a) = &self.average {
-            opts.averaging = averaging(a)?;
-        }
-        opts.segment_duration_s = self.segment_duration;
-        if let Some((lo, hi)) = self.percentiles {
-            let given = self.segment_duration.is_some();
-            option_checks::require_segments_for_percentiles(Spelling::Keyword, given).py()?;
-            let shown = format!("({}, {})", Num(lo), Num(hi));
-            opts.percentiles =
-                option_checks::check_percentiles(Spelling::Keyword, &shown, lo, hi).py()?;
-        }
-        Ok(())
-    }
+) -> PyResult<WelchRequest> {
+    Ok(WelchRequest {
+        nperseg,
+        overlap,
+        averaging: average.map(averaging).transpose()?,
+        segment_duration_s: segment_duration,
+        percentiles,
+    })
 }
 
 /// The input of the floor of a name, or a `ValueError` naming what is allowed.
@@ -450,7 +400,8 @@ fn check_unstated_array(name: &str, quantity: Quantity, data: &[f64], fs: f64) -
     )))
 }
 
-/// Noise budget of X, phi and phi_a from a time series of the floor's motion given as arrays.
+/// Noise budget of X, phi and phi_a (or any observables) from a time series of the floor's
+/// motion given as arrays.
 ///
 /// ``tilt``: a dict ``{"theta_t": x, "eta_t": y, "x_t": a}`` of 1-D arrays, or a 2-D array
 /// whose rows are the inputs named by ``axes``. The inputs are the crate's tilt angles
@@ -474,14 +425,27 @@ fn check_unstated_array(name: &str, quantity: Quantity, data: &[f64], fs: f64) -
 /// The other options are the command line's ``budget`` options: ``nperseg`` (Welch segment,
 /// default 2**14 or the largest power of two <= n/4), ``overlap`` (fraction, default 0.5),
 /// ``average`` (``"mean"``/``"median"``), ``segment_duration`` (s) and ``percentiles``
-/// (default (10, 90)) for the per-segment band, ``readout`` (``{observable: ASD}`` over the
-/// default ``{"X": 9e-9}`` m/sqrt(Hz); 0 removes one), ``measured`` (a file of measured ASDs
-/// or series of the observables: adds the terms ``measured`` and ``residual``).
+/// (default (10, 90)) for the per-segment band; ``observables`` (names, default ``["X",
+/// "phi", "phi_a"]``; any of X, Y, Z, theta, eta, phi, phi_a); ``readout`` (``{observable:
+/// ASD}`` white, in the observable's unit/sqrt(Hz), or ``{observable: path}`` coloured, a CSV
+/// ``frequency_hz,OBS`` or HDF5 ASD file covering the budget's band; over the default
+/// ``{"X": 9e-9}`` m/sqrt(Hz); 0 removes one); ``term`` (``{name: (source, path)}``: a
+/// user-named term ``user.NAME`` added in quadrature to the total, ``source`` an observable,
+/// whose ASD the file holds, or an input of the model, ``theta_t`` .. ``z_t``, ``F_a.x`` ..
+/// ``M_b.z``, whose ASD the file holds and which is propagated through the transfer
+/// functions); ``witness_noise`` (``{input: ASD or path}`` or ``{input: (ASD or path,
+/// rel)}``: the own noise of the tiltmeter or seismometer that recorded an input, in its
+/// unit/sqrt(Hz), shown through the model as ``witness_noise`` beside the tilt term, which
+/// already contains it; not added to the total); ``measured`` (a file of measured ASDs or
+/// series of the observables: adds the
+/// terms ``measured`` and ``residual``); ``at`` (frequencies, Hz, to read the budget at, each
+/// in its band; default 1e-3, 2e-3, 5e-3 where they are) and ``at_band`` (half-width of the
+/// Welch band means, relative, default 0.1): :attr:`Budget.summary`.
 /// ``params``: a :class:`Params` or a :class:`Model` (default Table I).
 ///
 /// Returns a :class:`Budget`. Raises ``ValueError`` for options or data that do not fit.
 #[pyfunction]
-#[pyo3(signature = (tilt, fs, *, axes=None, quantity="angle", units=None, corrected=None, pendulum_tiltmeter=None, gaps="reject", params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, readout=None, measured=None))]
+#[pyo3(signature = (tilt, fs, *, axes=None, quantity="angle", units=None, corrected=None, pendulum_tiltmeter=None, gaps="reject", params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, observables=None, readout=None, term=None, witness_noise=None, measured=None, at=None, at_band=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn budget(
     py: Python<'_>,
@@ -496,11 +460,16 @@ pub fn budget(
     params: Option<&Bound<'_, PyAny>>,
     nperseg: Option<usize>,
     overlap: Option<f64>,
-    average: Option<String>,
+    average: Option<&str>,
     segment_duration: Option<f64>,
     percentiles: Option<(f64, f64)>,
+    observables: Option<&Bound<'_, PyAny>>,
     readout: Option<&Bound<'_, PyDict>>,
+    term: Option<&Bound<'_, PyDict>>,
+    witness_noise: Option<&Bound<'_, PyDict>>,
     measured: Option<PathBuf>,
+    at: Option<Vec<f64>>,
+    at_band: Option<f64>,
 ) -> PyResult<Budget> {
     let (model, params) = model_of(params)?;
     let gaps: GapPolicy = gaps.parse().map_err(value_error)?;
@@ -530,22 +499,20 @@ pub fn budget(
             )));
         }
     }
-    let mut opts = BudgetOptions {
-        readout: self::readout(readout, &BudgetOptions::default().outputs)?,
-        ..BudgetOptions::default()
-    };
-    SeriesOptions {
-        nperseg,
-        overlap,
-        average,
-        segment_duration,
-        percentiles,
-    }
-    .apply(&mut opts)?;
-    let mut notes = Vec::new();
+    let welch = welch(nperseg, overlap, average, segment_duration, percentiles)?;
+    let observables = job_args::observables(observables)?;
+    let readout = job_args::readout(readout)?;
+    let terms = job_args::terms(term)?;
+    let witness_noise = job_args::witness_noise(witness_noise)?;
+    let axis_map = described
+        .channels
+        .iter()
+        .map(|c| format!("{0}={0}", c.input.name()))
+        .collect::<Vec<_>>()
+        .join(",");
     let cancel = Cancel::new();
-    opts.cancel = cancel.clone();
-    let report = interrupt::watch(py, &cancel, || -> PyResult<BudgetReport> {
+    let result = interrupt::watch(py, &cancel, || -> PyResult<(BudgetResult, Inputs)> {
+        let mut notes = Vec::new();
         for (((input, data), channel), &(factor, stated)) in channels
             .iter_mut()
             .zip(&described.channels)
@@ -571,45 +538,48 @@ pub fn budget(
                 check_unstated_array(input.name(), described.quantity, data, fs)?;
             }
         }
+        notes.push(described.units_note.clone());
         let mut source = ArraySeries {
             sample_rate_hz: fs,
             channels: described.channels.clone(),
             data: channels.into_iter().map(|(_, d)| d).collect(),
         };
-        let mut report = budget_from_series(&model, &mut source, &opts, &mut |_, _| {}).py()?;
-        if let Some(path) = &measured {
-            add_measured_file(&mut report, path, "measured").py()?;
-        }
-        Ok(report)
+        let req = BudgetRequest {
+            model: &model,
+            tilt: TiltSource::Series {
+                source: &mut source,
+                input: InputMeta {
+                    path: "(arrays)".into(),
+                    format: "numpy".into(),
+                    kind: "series".into(),
+                    quantity: described.quantity.name().into(),
+                    axis_map,
+                    start_time: None,
+                    notes,
+                },
+            },
+            welch,
+            freq_hz: None,
+            observables,
+            readout,
+            terms,
+            witness_noise,
+            measured,
+            at_hz: at,
+            at_band,
+        };
+        let inputs = Inputs::of_params(params.file.as_deref())
+            .with_all(job_args::python_names(req.input_files()));
+        let result = tiltnoise_job::budget::run(req, &cancel, &mut |_, _| {});
+        Ok((result.map_err(job_args::job_error)?, inputs))
     })?;
-    let axis_map = report
-        .inputs
-        .iter()
-        .map(|a| format!("{0}={0}", a.name()))
-        .collect::<Vec<_>>()
-        .join(",");
-    notes.push(described.units_note);
-    let inputs = Inputs::of_params(params.file.as_deref()).with("measured", measured.as_deref());
-    Ok(Budget::new(
-        &model,
-        report,
-        params,
-        inputs,
-        InputMeta {
-            path: "(arrays)".into(),
-            format: "numpy".into(),
-            kind: "series".into(),
-            quantity: described.quantity.name().into(),
-            axis_map,
-            start_time: None,
-            notes,
-        },
-    ))
+    let (BudgetResult { report, input }, inputs) = result;
+    Ok(Budget::new(&model, report, params, inputs, input))
 }
 
-/// Noise budget of X, phi and phi_a from a tilt file (the command line's ``tiltnoise budget
-/// --tilt FILE``): HDF5 (``FILE.h5:/group`` addresses gwpy layouts), CSV or miniSEED time
-/// series (angle or rate) or spectra, as described in
+/// Noise budget of X, phi and phi_a (or any observables) from a tilt file (the command line's
+/// ``tiltnoise budget --tilt FILE``): HDF5 (``FILE.h5:/group`` addresses gwpy layouts), CSV or
+/// miniSEED time series (angle or rate) or spectra, as described in
 /// ``docs/input_formats.md``; an HDF5 series is streamed from disk in bounded memory.
 ///
 /// ``axes`` is the axis map (``"theta_t=-E,eta_t=-N"`` or ``"theta_t=-LJE,x_t=LHE"``; default
@@ -620,16 +590,17 @@ pub fn budget(
 /// states must agree), ``corrected`` the translation channels whose tilt is removed already,
 /// ``pendulum_tiltmeter`` the tilt channels read by a pendulum tiltmeter (see :func:`budget`),
 /// ``gaps`` ``"reject"``/``"interpolate"``, ``scale`` a dict ``{channel: factor}`` (SI units
-/// per count, required for channels in counts, applied before the axis map); ``freq`` is the model grid of spectra input (``"FLO:N:FHI"``
-/// or an array of Hz; default 1e-4..30 Hz plus points around every resonance). The Welch,
-/// segment, readout and measured options are those of :func:`budget`; series options are
-/// refused for spectra and ``freq`` for a series, as on the command line.
+/// per count, required for channels in counts, applied before the axis map); ``freq`` is the
+/// model grid of spectra input (``"FLO:N:FHI"`` or an array of Hz; default 1e-4..30 Hz plus
+/// points around every resonance). The Welch, segment, observables, readout, term,
+/// witness_noise, measured and ``at`` options are those of :func:`budget`; options of a series are refused for spectra
+/// and ``freq`` for a series, as on the command line.
 ///
-/// Raises ``FileNotFoundError``/``OSError`` if the file cannot be read, :class:`InputFileError`
-/// (an ``OSError``) if it is not a valid tilt input (the message names the file, the dataset
+/// Raises ``FileNotFoundError``/``OSError`` if a file cannot be read, :class:`InputFileError`
+/// (an ``OSError``) if it is not a valid input (the message names the file, the dataset
 /// or column and what is allowed), ``ValueError`` for options that do not fit.
 #[pyfunction]
-#[pyo3(signature = (path, *, axes=None, quantity=None, units=None, corrected=None, pendulum_tiltmeter=None, gaps=None, params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, readout=None, freq=None, measured=None, scale=None))]
+#[pyo3(signature = (path, *, axes=None, quantity=None, units=None, corrected=None, pendulum_tiltmeter=None, gaps=None, params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, observables=None, readout=None, term=None, witness_noise=None, freq=None, measured=None, scale=None, at=None, at_band=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn budget_from_file(
     py: Python<'_>,
@@ -643,29 +614,21 @@ pub fn budget_from_file(
     params: Option<&Bound<'_, PyAny>>,
     nperseg: Option<usize>,
     overlap: Option<f64>,
-    average: Option<String>,
+    average: Option<&str>,
     segment_duration: Option<f64>,
     percentiles: Option<(f64, f64)>,
+    observables: Option<&Bound<'_, PyAny>>,
     readout: Option<&Bound<'_, PyDict>>,
+    term: Option<&Bound<'_, PyDict>>,
+    witness_noise: Option<&Bound<'_, PyDict>>,
     freq: Option<&Bound<'_, PyAny>>,
     measured: Option<PathBuf>,
     scale: Option<std::collections::BTreeMap<String, f64>>,
+    at: Option<Vec<f64>>,
+    at_band: Option<f64>,
 ) -> PyResult<Budget> {
     let (model, params) = model_of(params)?;
-    let scale: Vec<String> = scale
-        .unwrap_or_default()
-        .iter()
-        .map(|(c, f)| format!("{c}={f:?}"))
-        .collect();
-    let scale = parse_scales("scale", &scale).map_err(value_error)?;
-    let ropts = ReadOptions {
-        axis_map: axes
-            .map(AxisMap::parse)
-            .transpose()
-            .map_err(|e| value_error(e.to_string()))?,
-        quantity: quantity.map(str::parse).transpose().map_err(value_error)?,
-        gaps: gaps.unwrap_or("reject").parse().map_err(value_error)?,
-        scale,
+    let read = ReadRequest {
         units: parse_units(
             "units",
             &units
@@ -676,89 +639,39 @@ pub fn budget_from_file(
         )
         .map_err(value_error)?,
         corrected: names_once("corrected", corrected.unwrap_or_default())?,
-        pendulum: names_once("pendulum_tiltmeter", pendulum_tiltmeter.unwrap_or_default())?,
+        pendulum_tiltmeter: names_once(
+            "pendulum_tiltmeter",
+            pendulum_tiltmeter.unwrap_or_default(),
+        )?,
+        ..job_args::read_request(axes, quantity, gaps, scale)?
     };
-    let series_opts = SeriesOptions {
-        nperseg,
-        overlap,
-        average,
-        segment_duration,
-        percentiles,
-    };
-    let mut opts = BudgetOptions {
-        readout: self::readout(readout, &BudgetOptions::default().outputs)?,
-        ..BudgetOptions::default()
-    };
-    series_opts.apply(&mut opts)?;
-    let grid = match freq {
+    let freq_hz = match freq {
         None => None,
         Some(f) => Some(match f.cast::<PyString>() {
             Ok(spec) => freq::parse_spec(&spec.to_cow()?).py()?,
             Err(_) => crate::grid::frequencies(f, crate::grid::GRID)?,
         }),
     };
-    let mut given = series_opts.given();
-    given.extend(gaps.map(|_| "gaps"));
-    given.extend(grid.as_ref().map(|_| "freq"));
-    let source = path.display().to_string();
-    let refuse = |kind| {
-        option_checks::refuse_options_for_input(&given, kind, &source, Spelling::Keyword).py()
+    let req = BudgetRequest {
+        model: &model,
+        tilt: TiltSource::File { path, read },
+        welch: welch(nperseg, overlap, average, segment_duration, percentiles)?,
+        freq_hz,
+        observables: job_args::observables(observables)?,
+        readout: job_args::readout(readout)?,
+        terms: job_args::terms(term)?,
+        witness_noise: job_args::witness_noise(witness_noise)?,
+        measured,
+        at_hz: at,
+        at_band,
     };
-    let refuse_series_options = || refuse(InputKind::Spectra);
-    let refuse_spectra_options = || refuse(InputKind::Series);
-    let cancel = Cancel::new();
-    opts.cancel = cancel.clone();
-    let (report, provenance) = interrupt::watch(py, &cancel, || -> PyResult<_> {
-        let streamed = match InputFormat::from_path(&path).py()? {
-            InputFormat::Hdf5 => TiltSeriesSource::open(&path, &ropts).ok(),
-            InputFormat::Csv | InputFormat::Miniseed => None,
-        };
-        let (report, provenance) = match streamed {
-            Some(mut source) => {
-                refuse_spectra_options()?;
-                let provenance = source.provenance().clone();
-                (
-                    budget_from_series(&model, &mut source, &opts, &mut |_, _| {}),
-                    provenance,
-                )
-            }
-            None => match read_tilt(&path, &ropts).py()? {
-                TiltInput::Series(mut series) => {
-                    refuse_spectra_options()?;
-                    let provenance = series.provenance.clone();
-                    (
-                        budget_from_series(&model, &mut series, &opts, &mut |_, _| {}),
-                        provenance,
-                    )
-                }
-                TiltInput::Spectra(spectra) => {
-                    refuse_series_options()?;
-                    let provenance = spectra.provenance.clone();
-                    opts.spectra_grid_hz =
-                        grid.clone().unwrap_or_else(|| freq::default_grid(&model));
-                    (budget_from_spectra(&model, &spectra, &opts), provenance)
-                }
-            },
-        };
-        let mut report = report.map_err(|e| match e {
-            BudgetError::Input(e) => e.into_py_err(),
-            other => value_error(format!("budget of {}: {other}", path.display())),
-        })?;
-        if let Some(m) = &measured {
-            add_measured_file(&mut report, m, "measured").py()?;
-        }
-        Ok((report, provenance))
-    })?;
     let inputs = Inputs::of_params(params.file.as_deref())
-        .with("path", Some(&path))
-        .with("measured", measured.as_deref());
-    Ok(Budget::new(
-        &model,
-        report,
-        params,
-        inputs,
-        InputMeta::from(&provenance),
-    ))
+        .with_all(job_args::python_names(req.input_files()));
+    let cancel = Cancel::new();
+    let BudgetResult { report, input } = interrupt::watch(py, &cancel, || {
+        tiltnoise_job::budget::run(req, &cancel, &mut |_, _| {}).map_err(job_args::job_error)
+    })?;
+    Ok(Budget::new(&model, report, params, inputs, input))
 }
 
 /// `names`, each given once, for the option `option`.
@@ -1092,6 +1005,20 @@ impl Budget {
         d.set_item("axis_map", &i.axis_map)?;
         d.set_item("start_time", &i.start_time)?;
         Ok(d)
+    }
+
+    /// The budget read at the ``at`` frequencies (default 1e-3, 2e-3, 5e-3 Hz where they lie in
+    /// its band), as the command line's ``budget --format json`` prints it: ``{"notes": [...],
+    /// "summary": [{"frequency_hz", "band_hz", "observables": [{"observable", "asd_unit",
+    /// "terms": [{"term", "group", "psd", "asd", "asd_rel_std", "evaluation", "band"}],
+    /// "total": {"psd", "asd", "asd_rel_std"}}]}]}``: model terms exact at the frequency, Welch
+    /// estimates the mean PSD of their bins in ``band_hz`` with their 1-sigma relative error
+    /// (``None`` where unknown).
+    #[getter]
+    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let text = tiltnoise_job::budget::summary_json(&self.report, &self.input.notes)
+            .map_err(|e| value_error(e.to_string()))?;
+        py.import("json")?.call_method1("loads", (text,))
     }
 
     /// The parameters of the model the budget was computed with.

@@ -24,6 +24,19 @@ impl Inputs {
         self
     }
 
+    /// These inputs and every `(argument, path)` of `files`.
+    pub fn with_all<'a>(
+        mut self,
+        files: impl IntoIterator<Item = (&'static str, &'a Path)>,
+    ) -> Inputs {
+        self.0.extend(
+            files
+                .into_iter()
+                .map(|(a, p)| (a.to_string(), p.to_path_buf())),
+        );
+        self
+    }
+
     /// Refuses to save to `path` when it is one of the inputs, or when it cannot be written
     /// (its directory is missing or not writable): `OSError` naming the path and the rule.
     pub fn check_save(&self, path: &Path) -> PyResult<()> {

@@ -9,12 +9,14 @@
 
 mod arrays;
 mod budget;
+mod coherence;
 mod errors;
 mod figure;
 mod fit;
 mod grid;
 mod inputs;
 mod interrupt;
+mod job_args;
 mod model;
 mod params;
 mod python_side;
@@ -66,10 +68,12 @@ fn tiltnoise_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<fit::Fit>()?;
     m.add_class::<simulate::Simulation>()?;
     m.add_class::<budget::Budget>()?;
+    m.add_class::<coherence::Coherence>()?;
     m.add_function(wrap_pyfunction!(spectral::welch, m)?)?;
     m.add_function(wrap_pyfunction!(spectral::csd, m)?)?;
     m.add_function(wrap_pyfunction!(budget::budget, m)?)?;
     m.add_function(wrap_pyfunction!(budget::budget_from_file, m)?)?;
+    m.add_function(wrap_pyfunction!(coherence::coherence, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
     Ok(())
 }

@@ -254,7 +254,7 @@ fn scene_bits(band: (f64, f64), rel_tol: f64) -> [u64; 3] {
 }
 
 /// Names from a `str` (comma-separated, as on the command line) or a sequence of `str`.
-fn names(what: &str, arg: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
+pub(crate) fn names(what: &str, arg: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
     let items: Vec<String> = if let Ok(s) = arg.cast::<PyString>() {
         vec![s.to_cow()?.into_owned()]
     } else {

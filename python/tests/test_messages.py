@@ -88,12 +88,16 @@ def test_budget_messages_equal_the_command_lines(cli_error, cli_args, kwargs, pa
     assert got == as_keywords(cli_error("budget", *cli_args), *pairs)
 
 
-def test_readout_of_an_observable_not_budgeted():
-    # The command line can budget theta (--observables) and says so in its message; Python's
-    # budget has the default observables only, so its message names what is allowed instead.
+def test_readout_of_an_observable_not_budgeted(cli_error):
+    # Both front ends budget any observable, and say how to add one.
     message = python_message(
         lambda: tiltnoise.budget_from_file(LAB_TILT, readout={"theta": 1e-9}))
-    assert message == "readout theta=...: theta is not budgeted; allowed: X, phi, phi_a"
+    expected = as_keywords(
+        cli_error("budget", "--tilt", LAB_TILT, "--readout", "theta=1e-9"),
+        ("--readout", "readout"), ("--observables", "observables"))
+    assert message == expected
+    assert message == ("readout theta=1e-9: theta is not budgeted; allowed: X, phi, phi_a "
+                       "(add it with observables)")
 
 
 def test_percentile_order_message_names_the_value():

@@ -29,6 +29,7 @@ files that are read but not valid.
 
 from ._tiltnoise import (
     Budget,
+    Coherence,
     Fit,
     InputFileError,
     Mode,
@@ -39,6 +40,7 @@ from ._tiltnoise import (
     __version__,
     budget,
     budget_from_file,
+    coherence,
     csd,
     hdf5_version,
     welch,
@@ -47,6 +49,7 @@ from ._transfer import TransferFunction
 
 __all__ = [
     "Budget",
+    "Coherence",
     "Fit",
     "InputFileError",
     "Mode",
@@ -58,6 +61,7 @@ __all__ = [
     "__version__",
     "budget",
     "budget_from_file",
+    "coherence",
     "csd",
     "hdf5_version",
     "welch",

@@ -14,6 +14,7 @@ __all__ = [
     "__version__",
     "_panic_for_tests",
     "Budget",
+    "Coherence",
     "Fit",
     "InputFileError",
     "Mode",
@@ -23,6 +24,7 @@ __all__ = [
     "Simulation",
     "budget",
     "budget_from_file",
+    "coherence",
     "csd",
     "hdf5_version",
     "welch",
@@ -228,6 +230,41 @@ class Model:
     def __eq__(self, other: object, /) -> bool: ...
 
 @final
+class Coherence:
+    @property
+    def frequency_hz(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def axes(self) -> list[str]: ...
+    @property
+    def observables(self) -> list[str]: ...
+    @property
+    def units(self) -> dict[str, str]: ...
+    @property
+    def coherence(self) -> dict[str, dict[str, npt.NDArray[np.float64]]]: ...
+    @property
+    def multiple_coherence(self) -> dict[str, npt.NDArray[np.float64]]: ...
+    @property
+    def transfer(self) -> dict[str, dict[str, npt.NDArray[np.complex128]]]: ...
+    @property
+    def transfer_radius(self) -> dict[str, dict[str, npt.NDArray[np.float64]]]: ...
+    @property
+    def model(self) -> dict[str, dict[str, npt.NDArray[np.complex128]]]: ...
+    @property
+    def psd(self) -> dict[str, npt.NDArray[np.float64]]: ...
+    @property
+    def agreement(self) -> dict[str, dict[str, dict[str, Any]]]: ...
+    @property
+    def confidence(self) -> float: ...
+    @property
+    def coherence_threshold(self) -> float: ...
+    @property
+    def multiple_coherence_threshold(self) -> float: ...
+    @property
+    def notes(self) -> list[str]: ...
+    def to_csv(self) -> str: ...
+    def save(self, path: _Path) -> None: ...
+
+@final
 class Budget:
     @property
     def frequency_hz(self) -> npt.NDArray[np.float64]: ...
@@ -259,6 +296,8 @@ class Budget:
     def notes(self) -> list[str]: ...
     @property
     def input(self) -> dict[str, Optional[str]]: ...
+    @property
+    def summary(self) -> dict[str, Any]: ...
     @property
     def params(self) -> Params: ...
     def psd(self, observable: str, term: str = "total") -> npt.NDArray[np.float64]: ...
@@ -308,8 +347,13 @@ def budget(
     average: Optional[Literal["mean", "median"]] = None,
     segment_duration: Optional[float] = None,
     percentiles: Optional[Tuple[float, float]] = None,
-    readout: Optional[Mapping[str, float]] = None,
+    observables: Optional[_Names] = None,
+    readout: Optional[Mapping[str, Union[float, _Path]]] = None,
+    term: Optional[Mapping[str, Tuple[str, _Path]]] = None,
+    witness_noise: Optional[Mapping[str, Union[float, _Path, Tuple[Union[float, _Path], float]]]] = None,
     measured: Optional[_Path] = None,
+    at: Optional[Sequence[float]] = None,
+    at_band: Optional[float] = None,
 ) -> Budget: ...
 def budget_from_file(
     path: _Path,
@@ -326,10 +370,30 @@ def budget_from_file(
     average: Optional[Literal["mean", "median"]] = None,
     segment_duration: Optional[float] = None,
     percentiles: Optional[Tuple[float, float]] = None,
-    readout: Optional[Mapping[str, float]] = None,
+    observables: Optional[_Names] = None,
+    readout: Optional[Mapping[str, Union[float, _Path]]] = None,
+    term: Optional[Mapping[str, Tuple[str, _Path]]] = None,
+    witness_noise: Optional[Mapping[str, Union[float, _Path, Tuple[Union[float, _Path], float]]]] = None,
     freq: Union[str, npt.ArrayLike, None] = None,
     measured: Optional[_Path] = None,
     scale: Optional[Mapping[str, float]] = None,
+    at: Optional[Sequence[float]] = None,
+    at_band: Optional[float] = None,
 ) -> Budget: ...
+def coherence(
+    tilt: _Path,
+    measured: _Path,
+    *,
+    axes: Optional[str] = None,
+    quantity: Optional[Literal["angle", "rate"]] = None,
+    gaps: Optional[Literal["reject", "interpolate"]] = None,
+    scale: Optional[Mapping[str, float]] = None,
+    observables: Optional[_Names] = None,
+    nperseg: Optional[int] = None,
+    overlap: Optional[float] = None,
+    confidence: Optional[float] = None,
+    fit_band: Optional[Tuple[float, float]] = None,
+    params: Union[Params, Model, None] = None,
+) -> Coherence: ...
 def _panic_for_tests(where_: Literal["here", "detached", "thread"]) -> None:
     """Panics on purpose (tests only): a Rust panic is a PanicException, never an abort."""

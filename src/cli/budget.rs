@@ -5,26 +5,20 @@ use super::args::{AverageArg, ChannelArgs, Format};
 use super::budget_terms::{parse_observables, parse_readout, parse_terms};
 use super::figure_args::FigureArgs;
 use super::output::save_budget;
-use super::witness_noise::parse_witness_noise;
+use super::witness_noise::parse_witness_items;
 use super::Run;
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, Result};
 use clap::Args;
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
-use tiltnoise_core::budget::{
-    add_measured, budget_from_series, budget_from_spectra, series_psds, BudgetOptions,
-    MeasuredPsds, SummaryRequest, DEFAULT_BAND_FRACTION,
-};
-use tiltnoise_core::error::{Num, Shown};
+use std::path::PathBuf;
+use tiltnoise_core::error::Shown;
 use tiltnoise_core::freq;
 use tiltnoise_core::model::Model;
 use tiltnoise_core::modes::NormalModes;
-use tiltnoise_core::noise::BudgetReport;
 use tiltnoise_core::params::Params;
-use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_core::spectral::Averaging;
-use tiltnoise_io::input::{read_tilt, InputFormat, ReadOptions, TiltInput, TiltSeriesSource};
-use tiltnoise_io::{InputMeta, OutputKind, RunMeta};
+use tiltnoise_io::{OutputKind, RunMeta};
+use tiltnoise_job::budget::{BudgetRequest, BudgetResult, ReadRequest, TiltSource, WelchRequest};
 
 /// Arguments of `tiltnoise budget`.
 #[derive(Debug, Args)]
@@ -124,43 +118,23 @@ pub struct BudgetArgs {
     pub figure: FigureArgs,
 }
 
-/// The `--at` and `--at-band` request: explicit frequencies are refused when the budget cannot
-/// be read there; the default ones are left out with a note.
-fn summary_request(args: &BudgetArgs) -> Result<SummaryRequest> {
-    let mut req = SummaryRequest {
-        band_fraction: args.at_band.unwrap_or(DEFAULT_BAND_FRACTION),
-        ..SummaryRequest::default()
-    };
-    if let Some(text) = &args.at {
-        req.strict = true;
-        req.freqs_hz = text
-            .split(',')
-            .map(|item| {
-                item.trim().parse::<f64>().map_err(|_| {
-                    anyhow!(
-                        "--at {}: `{}` is not a frequency in Hz; expected F1,F2,... e.g. \
-                         1e-3,2e-3,5e-3",
-                        Shown(text),
-                        Shown(item)
-                    )
-                })
+/// `--at F1,F2,...`: frequencies in Hz (the job checks them against the budget).
+fn parse_at(text: &str) -> Result<Vec<f64>> {
+    text.split(',')
+        .map(|item| {
+            item.trim().parse::<f64>().map_err(|_| {
+                anyhow!(
+                    "--at {}: `{}` is not a frequency in Hz; expected F1,F2,... e.g. \
+                     1e-3,2e-3,5e-3",
+                    Shown(text),
+                    Shown(item)
+                )
             })
-            .collect::<Result<_>>()?;
-        refuse_repeats("--at", "frequency", &req.freqs_hz, |f| Num(*f).to_string())?;
-    }
-    req.validate().map_err(|e| {
-        anyhow!(
-            "{}: {e}",
-            if args.at_band.is_some() {
-                "--at-band"
-            } else {
-                "--at"
-            }
-        )
-    })?;
-    Ok(req)
+        })
+        .collect()
 }
 
+/// `--percentiles LO:HI`: numbers, 0 <= LO < HI <= 100.
 fn parse_percentiles(text: &str) -> Result<(f64, f64)> {
     let err = || {
         anyhow!(
@@ -178,55 +152,29 @@ fn parse_percentiles(text: &str) -> Result<(f64, f64)> {
     Ok((a, b))
 }
 
-fn read_options(args: &BudgetArgs) -> Result<ReadOptions> {
-    super::args::read_options(
+/// How to read `--tilt`: the channel options as every command reads them, `--gaps` kept as
+/// given (the job refuses it for spectra).
+fn read_request(args: &BudgetArgs) -> Result<ReadRequest> {
+    let o = super::args::read_options(
         args.axes.as_deref(),
         args.quantity.as_deref(),
         args.gaps.as_deref(),
         &args.scale,
         &args.channels,
-    )
+    )?;
+    Ok(ReadRequest {
+        axis_map: o.axis_map,
+        quantity: o.quantity,
+        units: o.units,
+        corrected: o.corrected,
+        pendulum_tiltmeter: o.pendulum,
+        gaps: args.gaps.as_ref().map(|_| o.gaps),
+        scale: o.scale,
+    })
 }
 
-/// Options of a time series, refused for spectra input rather than ignored.
-fn refuse_series_options(args: &BudgetArgs, path: &std::path::Path) -> Result<()> {
-    let given = [
-        ("--nperseg", args.nperseg.is_some()),
-        ("--overlap", args.overlap.is_some()),
-        ("--average", args.average.is_some()),
-        ("--segment-duration", args.segment_duration.is_some()),
-        ("--gaps", args.gaps.is_some()),
-        ("--scale", !args.scale.is_empty()),
-        ("--units", !args.channels.units.is_empty()),
-        ("--corrected", !args.channels.corrected.is_empty()),
-        (
-            "--pendulum-tiltmeter",
-            !args.channels.pendulum_tiltmeter.is_empty(),
-        ),
-    ];
-    if let Some((name, _)) = given.iter().find(|(_, g)| *g) {
-        bail!(
-            "{name} applies to time-series input, and {} holds spectra; leave it out (the \
-             model grid of spectra input is set with --freq)",
-            path.display()
-        );
-    }
-    Ok(())
-}
-
-/// Options of spectra input, refused for a time series rather than ignored.
-fn refuse_spectra_options(args: &BudgetArgs, path: &std::path::Path) -> Result<()> {
-    if args.freq.is_some() {
-        bail!(
-            "--freq applies to spectra input, and {} holds a time series, whose budget is on \
-             the Welch grid (set its resolution with --nperseg)",
-            path.display()
-        );
-    }
-    Ok(())
-}
-
-/// Runs `tiltnoise budget`.
+/// Runs `tiltnoise budget`: the options parsed into the budget job's request, the job run
+/// (with a progress bar on a terminal), the summary printed and the files written.
 pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Result<()> {
     for path in &args.save {
         OutputKind::from_path(path)?;
@@ -237,161 +185,71 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
             .view_for(tiltnoise_plot::BudgetFigureOptions::default().size)?,
         ..tiltnoise_plot::BudgetFigureOptions::default()
     };
-    let defaults = BudgetOptions::default();
-    let outputs = match &args.observables {
-        Some(text) => parse_observables(text)?,
-        None => defaults.outputs.clone(),
-    };
-    let (readout, readout_files) = parse_readout(&args.readout, &outputs)?;
-    let (user_terms, term_files) = parse_terms(&args.term, &outputs)?;
-    let (witness_noise, witness_files) = parse_witness_noise(&args.witness_noise)?;
-    let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
-    let mut inputs = vec![("--tilt", args.tilt.as_path())];
-    inputs.extend(args.measured.as_deref().map(|p| ("--measured", p)));
-    inputs.extend(readout_files.iter().map(|p| ("--readout", p.as_path())));
-    inputs.extend(term_files.iter().map(|p| ("--term", p.as_path())));
-    inputs.extend(
-        witness_files
-            .iter()
-            .map(|p| ("--witness-noise", p.as_path())),
-    );
-    run.check_outputs(&saves, &inputs)?;
     let model = Model::new(params)?;
-    if args.percentiles.is_some() {
-        tiltnoise_core::budget::option_checks::require_segments_for_percentiles(
-            tiltnoise_core::options::Spelling::Flag,
-            args.segment_duration.is_some(),
-        )?;
-    }
-    let opts = BudgetOptions {
-        welch_segment_len: args.nperseg,
-        welch_overlap_fraction: args.overlap.unwrap_or(defaults.welch_overlap_fraction),
-        averaging: match args.average.unwrap_or(AverageArg::Mean) {
-            AverageArg::Mean => Averaging::Mean,
-            AverageArg::Median => Averaging::Median,
+    let req = BudgetRequest {
+        model: &model,
+        tilt: TiltSource::File {
+            path: args.tilt.clone(),
+            read: read_request(&args)?,
         },
-        segment_duration_s: args.segment_duration,
-        percentiles: match &args.percentiles {
-            Some(text) => parse_percentiles(text)?,
-            None => defaults.percentiles,
+        welch: WelchRequest {
+            nperseg: args.nperseg,
+            overlap: args.overlap,
+            averaging: args.average.map(|a| match a {
+                AverageArg::Mean => Averaging::Mean,
+                AverageArg::Median => Averaging::Median,
+            }),
+            segment_duration_s: args.segment_duration,
+            percentiles: args
+                .percentiles
+                .as_deref()
+                .map(parse_percentiles)
+                .transpose()?,
         },
-        outputs,
-        readout,
-        user_terms,
-        witness_noise,
-        spectra_grid_hz: match &args.freq {
-            Some(spec) => freq::parse_spec(spec)?,
-            None => freq::default_grid(&model),
-        },
-        summary: summary_request(&args)?,
-        cancel: run.cancel.clone(),
+        freq_hz: args.freq.as_deref().map(freq::parse_spec).transpose()?,
+        observables: args
+            .observables
+            .as_deref()
+            .map(parse_observables)
+            .transpose()?,
+        readout: parse_readout(&args.readout)?,
+        terms: parse_terms(&args.term)?,
+        witness_noise: parse_witness_items(&args.witness_noise)?,
+        measured: args.measured.clone(),
+        at_hz: args.at.as_deref().map(parse_at).transpose()?,
+        at_band: args.at_band,
     };
-    let ropts = read_options(&args)?;
-    let path = &args.tilt;
-    // Opened once: an HDF5 series streams from the file; anything else is read whole below
-    // (which reports why an HDF5 file is not a series).
-    let streamed = match InputFormat::from_path(path)? {
-        InputFormat::Hdf5 => TiltSeriesSource::open(path, &ropts).ok(),
-        InputFormat::Csv | InputFormat::Miniseed => None,
-    };
-    let (report, provenance) = if let Some(mut source) = streamed {
-        refuse_spectra_options(&args, path)?;
-        let provenance = source.provenance().clone();
-        let bar = progress_bar(source.len() as u64);
-        let report = budget_from_series(&model, &mut source, &opts, &mut |done, _| {
-            bar.as_ref().map_or((), |b| b.set_position(done))
-        });
-        if let Some(b) = bar {
-            b.finish_and_clear();
-        }
-        (report, provenance)
-    } else {
-        match read_tilt(path, &ropts)? {
-            TiltInput::Series(mut series) => {
-                refuse_spectra_options(&args, path)?;
-                let provenance = series.provenance.clone();
-                let report = budget_from_series(&model, &mut series, &opts, &mut |_, _| {});
-                (report, provenance)
-            }
-            TiltInput::Spectra(spectra) => {
-                refuse_series_options(&args, path)?;
-                let provenance = spectra.provenance.clone();
-                (budget_from_spectra(&model, &spectra, &opts), provenance)
-            }
-        }
-    };
-    let mut report = report.with_context(|| format!("budget of {}", path.display()))?;
-    for x in &opts.witness_noise {
-        if !report.inputs.contains(&x.input) {
-            bail!(
-                "--witness-noise {}: the record {} has no input {}; it has {}",
-                x.input.name(),
-                path.display(),
-                x.input.name(),
-                report
-                    .inputs
-                    .iter()
-                    .map(|a| a.name())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            );
-        }
+    run.check_job_outputs(&args.save, req.input_files())?;
+    let mut bar = None;
+    let result = tiltnoise_job::budget::run(req, &run.cancel, &mut |done, total| {
+        bar.get_or_insert_with(|| progress_bar(total))
+            .as_ref()
+            .map_or((), |b| b.set_position(done))
+    });
+    if let Some(Some(b)) = bar {
+        b.finish_and_clear();
     }
-    if let Some(measured) = &args.measured {
-        add_measured_file(&mut report, measured)?;
-    }
+    let BudgetResult { report, input } = result.map_err(super::job_error)?;
     let json = args.format == Format::Json;
     if json {
         writeln!(
             run.out,
             "{}",
-            super::budget_summary::json(&report, &provenance.notes)?
+            tiltnoise_job::budget::summary_json(&report, &input.notes)?
         )?;
     } else {
-        for note in &provenance.notes {
+        for note in &input.notes {
             writeln!(run.out, "input: {note}")?;
         }
         write!(run.out, "{}", super::budget_summary::table(&report))?;
     }
     let meta = RunMeta::of_this_run(params, Some(&NormalModes::new(&model)));
-    let input = InputMeta::from(&provenance);
     run.write_outputs(json, || {
         for out in &args.save {
             save_budget(out, &report, &meta, &input, &figure, args.keep_zero_columns)?;
         }
         Ok(())
     })
-}
-
-/// Adds the `measured` and `residual` terms from `--measured FILE`: a CSV of ASDs is
-/// interpolated log-log onto the budget grid (NaN where it does not reach); a time series of
-/// the observables (HDF5 from `tiltnoise simulate`, or CSV `time_s,...`) is first turned into
-/// one-sided PSDs by [`series_psds`].
-fn add_measured_file(report: &mut BudgetReport, path: &std::path::Path) -> Result<()> {
-    use tiltnoise_io::input::MeasuredInput;
-    let (freqs_hz, psds, what, welch) = match tiltnoise_io::input::read_measured_input(path)? {
-        MeasuredInput::Spectra(m) => {
-            let psds = m
-                .asd
-                .iter()
-                .map(|(o, asd)| (*o, asd.iter().map(|a| a * a).collect()))
-                .collect();
-            (m.freqs_hz, psds, "measured spectrum".to_string(), None)
-        }
-        MeasuredInput::Series(series) => {
-            let m = series_psds(&series.channels, series.sample_rate_hz, &report.source)
-                .with_context(|| format!("--measured {}", path.display()))?;
-            (m.freqs_hz, m.psds, m.description, m.welch)
-        }
-    };
-    let measured = MeasuredPsds {
-        freqs_hz,
-        psds,
-        description: what,
-        welch,
-    };
-    add_measured(report, &measured, &path.display().to_string());
-    Ok(())
 }
 
 /// A progress bar on stderr when it is a terminal and the input is long enough to wait for.

@@ -1,10 +1,11 @@
 //! The budget read at the `--at` frequencies, for the terminal: a table (values exact at the
 //! frequency for the model's terms, band means with their 1-sigma statistical error for Welch
-//! estimates) or JSON (`--format json`).
+//! estimates); `--format json` prints the budget job's summary document
+//! (`tiltnoise_job::budget::summary_json`).
 
-use serde::Serialize;
 use std::fmt::Write as _;
 use tiltnoise_core::noise::{BandMean, BudgetReport, Evaluation, ObservableAt, TermAt, TermKind};
+use tiltnoise_job::budget::asd_rel_std;
 
 /// A frequency for a line of the table: `1`, `2.5`, `0.25` (mHz, up to 4 significant digits).
 fn mhz(f: f64) -> String {
@@ -28,16 +29,6 @@ fn pct(rel: f64) -> String {
         0
     };
     format!("{p:.decimals$} %")
-}
-
-/// Relative 1-sigma error of an ASD from the PSD's standard deviation: `std / (2 psd)` (to
-/// first order).
-fn asd_rel_std(psd: f64, psd_std: f64) -> f64 {
-    if psd > 0.0 {
-        psd_std / (2.0 * psd)
-    } else {
-        0.0
-    }
 }
 
 /// ` ±12 %` for a band mean with known degrees of freedom, ` (error unknown)` without, nothing
@@ -142,114 +133,4 @@ fn line(f: f64, ob: &ObservableAt) -> String {
         ob.observable.unit()
     );
     s
-}
-
-// JSON: fields in alphabetical order, as every JSON report of the tool.
-
-#[derive(Serialize)]
-struct SummaryJson<'a> {
-    notes: Vec<&'a str>,
-    summary: Vec<FrequencyJson>,
-}
-
-#[derive(Serialize)]
-struct FrequencyJson {
-    band_hz: [f64; 2],
-    frequency_hz: f64,
-    observables: Vec<ObservableJson>,
-}
-
-#[derive(Serialize)]
-struct ObservableJson {
-    asd_unit: String,
-    observable: &'static str,
-    terms: Vec<TermJson>,
-    total: TotalJson,
-}
-
-#[derive(Serialize)]
-struct TermJson {
-    asd: f64,
-    /// Relative 1-sigma error of the ASD (`null`: exact, or degrees of freedom unknown).
-    asd_rel_std: Option<f64>,
-    band: Option<BandJson>,
-    evaluation: &'static str,
-    group: &'static str,
-    psd: f64,
-    term: String,
-}
-
-#[derive(Serialize)]
-struct BandJson {
-    dof: Option<f64>,
-    first_bin_hz: f64,
-    last_bin_hz: f64,
-    n_bins: usize,
-}
-
-#[derive(Serialize)]
-struct TotalJson {
-    asd: f64,
-    asd_rel_std: Option<f64>,
-    psd: f64,
-}
-
-/// The summary as JSON, with the input's and the budget's notes.
-pub fn json(report: &BudgetReport, input_notes: &[String]) -> serde_json::Result<String> {
-    let doc = SummaryJson {
-        notes: input_notes
-            .iter()
-            .chain(&report.notes)
-            .map(String::as_str)
-            .collect(),
-        summary: report
-            .summary
-            .iter()
-            .map(|at| FrequencyJson {
-                band_hz: [at.band_hz.0, at.band_hz.1],
-                frequency_hz: at.freq_hz,
-                observables: at
-                    .observables
-                    .iter()
-                    .map(|ob| ObservableJson {
-                        asd_unit: format!("{}/sqrt(Hz)", ob.observable.unit()),
-                        observable: ob.observable.name(),
-                        terms: ob.terms.iter().map(term_json).collect(),
-                        total: TotalJson {
-                            asd: ob.total_psd().sqrt(),
-                            asd_rel_std: ob
-                                .total_psd_std()
-                                .map(|std| asd_rel_std(ob.total_psd(), std)),
-                            psd: ob.total_psd(),
-                        },
-                    })
-                    .collect(),
-            })
-            .collect(),
-    };
-    serde_json::to_string_pretty(&doc)
-}
-
-fn term_json(t: &TermAt) -> TermJson {
-    let band = match &t.evaluation {
-        Evaluation::Exact => None,
-        Evaluation::BandMean(b) => Some(BandJson {
-            dof: b.dof,
-            first_bin_hz: b.first_bin_hz,
-            last_bin_hz: b.last_bin_hz,
-            n_bins: b.n_bins,
-        }),
-    };
-    TermJson {
-        asd: t.psd.sqrt(),
-        asd_rel_std: match t.evaluation {
-            Evaluation::Exact => None,
-            Evaluation::BandMean(_) => t.psd_std().map(|std| asd_rel_std(t.psd, std)),
-        },
-        band,
-        evaluation: t.evaluation.name(),
-        group: t.kind.group().name(),
-        psd: t.psd,
-        term: t.kind.name(),
-    }
 }

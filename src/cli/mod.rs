@@ -157,6 +157,22 @@ impl Run {
         Ok(tiltnoise_io::check_outputs(outputs, &all)?)
     }
 
+    /// [`Run::check_outputs`] for a job: `files` are the job's inputs, named by their options
+    /// in snake case (`BudgetRequest::input_files`).
+    pub(crate) fn check_job_outputs(
+        &self,
+        outputs: &[PathBuf],
+        files: Vec<(&'static str, &Path)>,
+    ) -> Result<()> {
+        let outputs: Vec<&Path> = outputs.iter().map(PathBuf::as_path).collect();
+        let flags: Vec<(String, &Path)> = files
+            .into_iter()
+            .map(|(option, path)| (tiltnoise_job::Spelling::Flag.option(option), path))
+            .collect();
+        let inputs: Vec<(&str, &Path)> = flags.iter().map(|(o, p)| (o.as_str(), *p)).collect();
+        self.check_outputs(&outputs, &inputs)
+    }
+
     /// Writes every output of the run all or none: `write` saves them (each through
     /// `tiltnoise_io::write_atomic`), and they appear only once all are written and standard
     /// output has taken everything printed before (so a run whose standard output fails
@@ -178,6 +194,11 @@ impl Run {
         }
         Ok(())
     }
+}
+
+/// A job's error in the command line's spelling of its options.
+pub(crate) fn job_error(e: tiltnoise_job::JobError) -> anyhow::Error {
+    anyhow::anyhow!(e.message(tiltnoise_job::Spelling::Flag))
 }
 
 /// Runs the parsed command line. Everything printed is flushed before it returns; when the

@@ -4,14 +4,14 @@
 //! for `--readout`), and optionally its relative uncertainty REL (1 sigma of the ASD, e.g.
 //! `:0.1` for 10 %). `--tilt-noise` is the same option under its former name.
 
-use super::budget_terms::read_given;
 use anyhow::{anyhow, Result};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::Input;
-use tiltnoise_core::noise::{NoiseLevel, WitnessNoise};
+use tiltnoise_core::noise::WitnessNoise;
 use tiltnoise_core::repeats::refuse_repeated_keys;
 use tiltnoise_io::input::InputFormat;
+use tiltnoise_job::{witness_noise, AsdSpec, WitnessItem};
 
 /// The model inputs a witness can record.
 const FLOOR_INPUTS: &str = "theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)";
@@ -21,59 +21,63 @@ pub fn is_floor_input(input: Input) -> bool {
     input.is_ground()
 }
 
-/// Parses every `--witness-noise` item, each input once; returns the levels and the files read.
-pub fn parse_witness_noise(items: &[String]) -> Result<(Vec<WitnessNoise>, Vec<PathBuf>)> {
-    let mut out: Vec<WitnessNoise> = Vec::new();
-    let mut files = Vec::new();
+/// Parses every `--witness-noise` item into the job's items, each input once.
+pub fn parse_witness_items(items: &[String]) -> Result<Vec<WitnessItem>> {
     refuse_repeated_keys("--witness-noise", "input", items)?;
-    for item in items {
-        let shown = Shown(item);
-        let (name, value) = item.split_once('=').ok_or_else(|| {
-            anyhow!(
-                "--witness-noise {shown}: expected INPUT=ASD|FILE[:REL], e.g. eta_t=6e-8 or \
-                 eta_t=noise.csv:0.1"
-            )
-        })?;
-        let input = Input::from_name(name.trim())
-            .filter(|&i| is_floor_input(i))
-            .ok_or_else(|| {
+    items
+        .iter()
+        .map(|item| {
+            let shown = Shown(item);
+            let (name, value) = item.split_once('=').ok_or_else(|| {
                 anyhow!(
-                    "--witness-noise {shown}: `{}` is not a floor input of the model; allowed: \
-                     {FLOOR_INPUTS}",
-                    Shown(name)
+                    "--witness-noise {shown}: expected INPUT=ASD|FILE[:REL], e.g. eta_t=6e-8 or \
+                     eta_t=noise.csv:0.1"
                 )
             })?;
-        let (level, rel) = match value.rsplit_once(':') {
-            Some((head, tail)) if !head.trim().is_empty() && tail.trim().parse::<f64>().is_ok() => {
-                (head.trim(), tail.trim().parse::<f64>().expect("checked"))
-            }
-            _ => (value.trim(), 0.0),
-        };
-        let level = if InputFormat::from_path(Path::new(level)).is_ok() {
-            let path = PathBuf::from(level);
-            let given = read_given(
-                &format!("--witness-noise {shown}"),
-                &path,
-                input.name(),
-                input.unit(),
-            )?;
-            files.push(path);
-            NoiseLevel::Curve(given)
-        } else {
-            NoiseLevel::White(level.parse().map_err(|_| {
-                anyhow!(
-                    "--witness-noise {shown}: `{}` is neither a number (the ASD in {}/sqrt(Hz)) \
-                     nor an ASD file (.csv, .h5, .hdf5)",
-                    Shown(level),
-                    input.unit()
-                )
-            })?)
-        };
-        let noise = WitnessNoise { input, level, rel };
-        noise
-            .check("--witness-noise")
-            .map_err(|e| anyhow!("{e} (in {shown})"))?;
-        out.push(noise);
-    }
-    Ok((out, files))
+            let input = Input::from_name(name.trim())
+                .filter(|&i| is_floor_input(i))
+                .ok_or_else(|| {
+                    anyhow!(
+                        "--witness-noise {shown}: `{}` is not a floor input of the model; \
+                         allowed: {FLOOR_INPUTS}",
+                        Shown(name)
+                    )
+                })?;
+            let (level, rel) = match value.rsplit_once(':') {
+                Some((head, tail))
+                    if !head.trim().is_empty() && tail.trim().parse::<f64>().is_ok() =>
+                {
+                    (head.trim(), tail.trim().parse::<f64>().expect("checked"))
+                }
+                _ => (value.trim(), 0.0),
+            };
+            let asd = if InputFormat::from_path(Path::new(level)).is_ok() {
+                AsdSpec::File(PathBuf::from(level))
+            } else {
+                AsdSpec::White(level.parse().map_err(|_| {
+                    anyhow!(
+                        "--witness-noise {shown}: `{}` is neither a number (the ASD in \
+                         {}/sqrt(Hz)) nor an ASD file (.csv, .h5, .hdf5)",
+                        Shown(level),
+                        input.unit()
+                    )
+                })?)
+            };
+            Ok(WitnessItem { input, asd, rel })
+        })
+        .collect()
+}
+
+/// Parses and reads every `--witness-noise` item; returns the levels and the files read.
+pub fn parse_witness_noise(items: &[String]) -> Result<(Vec<WitnessNoise>, Vec<PathBuf>)> {
+    let items = parse_witness_items(items)?;
+    let files = items
+        .iter()
+        .filter_map(|w| match &w.asd {
+            AsdSpec::File(p) => Some(p.clone()),
+            AsdSpec::White(_) => None,
+        })
+        .collect();
+    let noise = witness_noise(&items).map_err(super::job_error)?;
+    Ok((noise, files))
 }

@@ -99,7 +99,7 @@ fn user_terms_and_coloured_readout_add_in_quadrature_with_their_groups() {
     );
     assert_eq!(
         str_attr(&file.group("phi").unwrap(), "readout_given"),
-        format!("--readout phi={} (column phi)", readout.display())
+        format!("{} (column phi)", readout.display())
     );
     let y_readout = psd(&file, "Y/readout");
     assert!(y_readout.iter().all(|&p| p == 2e-9 * 2e-9));

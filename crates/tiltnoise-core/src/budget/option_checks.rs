@@ -1,17 +1,10 @@
-//! Checks of a budget's options that depend on which options were given and on the kind of
-//! tilt input: an option of the other kind of input is refused rather than ignored, and the
-//! percentile band needs segments. The command line and the Python package both call these,
-//! each with its [`Spelling`] of the options.
+//! Checks of a budget's options that depend on which options were given: the percentile band
+//! needs segments and ordered percentiles; and the kinds of tilt input, against which the
+//! budget job refuses the options of the other kind. The messages name the options in the
+//! caller's [`Spelling`].
 
 use crate::error::Shown;
 use crate::options::{OptionError, Spelling};
-
-/// Options (snake case) that apply to time-series input only, in the order they are reported.
-pub const SERIES_ONLY_OPTIONS: [&str; 5] =
-    ["nperseg", "overlap", "average", "segment_duration", "gaps"];
-
-/// Options that apply to spectra input only.
-pub const SPECTRA_ONLY_OPTIONS: [&str; 1] = ["freq"];
 
 /// What a tilt input holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -20,38 +13,6 @@ pub enum InputKind {
     Series,
     /// Spectra, interpolated onto the model grid.
     Spectra,
-}
-
-/// Refuses the first option of `given` (the snake-case names of the options the caller set)
-/// that does not apply to the `kind` of input `source` (the file, as shown) holds.
-pub fn refuse_options_for_input(
-    given: &[&str],
-    kind: InputKind,
-    source: &str,
-    spelling: Spelling,
-) -> Result<(), OptionError> {
-    let (other_kind, what_instead) = match kind {
-        InputKind::Spectra => (&SERIES_ONLY_OPTIONS[..], "spectra"),
-        InputKind::Series => (&SPECTRA_ONLY_OPTIONS[..], "a time series"),
-    };
-    let Some(name) = other_kind.iter().find(|o| given.contains(o)) else {
-        return Ok(());
-    };
-    let source = Shown(source);
-    Err(OptionError::Conflict(match kind {
-        InputKind::Spectra => format!(
-            "{} applies to time-series input, and {source} holds {what_instead}; leave it out \
-             (the model grid of spectra input is set with {})",
-            spelling.option(name),
-            spelling.option("freq")
-        ),
-        InputKind::Series => format!(
-            "{} applies to spectra input, and {source} holds {what_instead}, whose budget is on \
-             the Welch grid (set its resolution with {})",
-            spelling.option(name),
-            spelling.option("nperseg")
-        ),
-    }))
 }
 
 /// Refuses percentiles without a segment duration: the band is across segments.
@@ -72,20 +33,6 @@ pub fn require_segments_for_percentiles(
     )))
 }
 
-/// The percentiles `(lower, upper)` of the band, `0 <= lower < upper <= 100`; `given` is
-/// the value as the caller wrote it, for the message.
-pub fn check_percentiles(
-    spelling: Spelling,
-    given: &str,
-    lower: f64,
-    upper: f64,
-) -> Result<(f64, f64), OptionError> {
-    if 0.0 <= lower && lower < upper && upper <= 100.0 {
-        return Ok((lower, upper));
-    }
-    Err(percentiles_error(spelling, given))
-}
-
 /// The error for percentiles that do not parse or are out of order or range.
 pub fn percentiles_error(spelling: Spelling, given: &str) -> OptionError {
     let form = match spelling {
@@ -104,26 +51,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn options_of_the_other_kind_of_input_are_refused_by_name() {
-        let given = ["overlap", "gaps"];
-        let e = refuse_options_for_input(&given, InputKind::Spectra, "s.csv", Spelling::Flag);
-        assert_eq!(
-            e.unwrap_err().to_string(),
-            "--overlap applies to time-series input, and s.csv holds spectra; leave it out (the \
-             model grid of spectra input is set with --freq)"
-        );
-        assert!(
-            refuse_options_for_input(&given, InputKind::Series, "t.h5", Spelling::Flag).is_ok()
-        );
-        let e = refuse_options_for_input(&["freq"], InputKind::Series, "t.h5", Spelling::Keyword);
-        assert_eq!(
-            e.unwrap_err().to_string(),
-            "freq applies to spectra input, and t.h5 holds a time series, whose budget is on \
-             the Welch grid (set its resolution with nperseg)"
-        );
-    }
-
-    #[test]
     fn percentiles_need_segments_and_order() {
         assert_eq!(
             require_segments_for_percentiles(Spelling::Keyword, false)
@@ -135,16 +62,9 @@ mod tests {
         );
         assert!(require_segments_for_percentiles(Spelling::Flag, true).is_ok());
         assert_eq!(
-            check_percentiles(Spelling::Flag, "5,95", 5.0, 95.0).unwrap(),
-            (5.0, 95.0)
+            percentiles_error(Spelling::Flag, "x").to_string(),
+            "--percentiles x: expected LOWER,UPPER with 0 <= LOWER < UPPER <= 100"
         );
-        for (lo, hi) in [(90.0, 10.0), (-1.0, 50.0), (50.0, 101.0), (f64::NAN, 50.0)] {
-            let e = check_percentiles(Spelling::Flag, "x", lo, hi).unwrap_err();
-            assert_eq!(
-                e.to_string(),
-                "--percentiles x: expected LOWER,UPPER with 0 <= LOWER < UPPER <= 100"
-            );
-        }
         assert_eq!(
             percentiles_error(Spelling::Keyword, "(90, 10)").to_string(),
             "percentiles (90, 10): expected (LOWER, UPPER) with 0 <= LOWER < UPPER <= 100"

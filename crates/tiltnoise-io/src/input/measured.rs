@@ -81,19 +81,14 @@ pub fn read_measured_input(path: &Path) -> Result<MeasuredInput, InputError> {
 /// Adds the terms `measured` and `residual` from the measured record in `path` (any layout of
 /// the module docs) to a budget: a spectrum is interpolated log-log onto the budget grid (NaN
 /// where it does not reach); a time series is first turned into one-sided PSDs with the
-/// budget's own Welch settings ([`series_psds`]). `option` names the record in messages
-/// (`--measured` on the command line, `measured` in Python).
+/// budget's own Welch settings ([`series_psds`]).
 ///
 /// # Errors
 ///
-/// [`BudgetError::Input`] when the file cannot be read or is not valid;
-/// [`BudgetError::Config`] (prefixed with `option` and the path) when a series does not fit
-/// the budget's Welch settings.
-pub fn add_measured_file(
-    report: &mut BudgetReport,
-    path: &Path,
-    option: &str,
-) -> Result<(), BudgetError> {
+/// [`BudgetError::Input`] when the file cannot be read or is not valid; the error of
+/// [`series_psds`] when a series does not fit the budget's Welch settings (the caller names
+/// the file and the option that gave it).
+pub fn add_measured_file(report: &mut BudgetReport, path: &Path) -> Result<(), BudgetError> {
     let (freqs_hz, psds, description, welch) = match read_measured_input(path)? {
         MeasuredInput::Spectra(m) => {
             let psds = m
@@ -104,8 +99,7 @@ pub fn add_measured_file(
             (m.freqs_hz, psds, "measured spectrum".to_string(), None)
         }
         MeasuredInput::Series(series) => {
-            let m = series_psds(&series.channels, series.sample_rate_hz, &report.source)
-                .map_err(|e| BudgetError::Config(format!("{option} {}: {e}", path.display())))?;
+            let m = series_psds(&series.channels, series.sample_rate_hz, &report.source)?;
             (m.freqs_hz, m.psds, m.description, m.welch)
         }
     };

@@ -6,6 +6,7 @@
 //!
 //! # Entry points
 //!
+//! * [`open_tilt`]: opens a tilt input once, leaving an HDF5 series in the file to stream.
 //! * [`read_tilt`]: decides by extension (`.h5`/`.hdf5`, `.csv`, `.mseed`/`.miniseed`/`.ms`)
 //!   and content whether the file holds a series or spectra, and returns a [`TiltInput`]
 //!   (miniSEED always holds a series).
@@ -44,24 +45,35 @@ pub use tiltnoise_core::input::*;
 use std::path::Path;
 use tiltnoise_core::error::Shown;
 
-/// Reads a tilt input of either kind: the format from the extension (`.h5`/`.hdf5`, `.csv`,
-/// `.mseed`/`.miniseed`/`.ms`),
-/// the kind from the content (HDF5: `schema` attribute if present, else root attribute
-/// `sample_rate_hz` -> series, dataset `/frequency_hz` -> spectra; CSV: first header column
-/// `time_s` -> series, `freq_hz` -> spectra).
+/// A tilt input opened once, by what it holds: an HDF5 time series to stream from the file in
+/// bounded memory, a time series of another format read whole, or spectra.
+pub enum OpenedTilt {
+    /// An HDF5 time series, not yet read: stream it ([`TiltSeriesSource`]).
+    Streamed(TiltSeriesSource),
+    /// A CSV or miniSEED time series, read whole.
+    Series(TiltSeries),
+    /// Tilt spectra.
+    Spectra(TiltSpectra),
+}
+
+/// Opens a tilt input of either kind once: the format from the extension (`.h5`/`.hdf5`,
+/// `.csv`, `.mseed`/`.miniseed`/`.ms`), the kind from the content (HDF5: `schema` attribute if
+/// present, else root attribute `sample_rate_hz` -> series, dataset `/frequency_hz` ->
+/// spectra; CSV: first header column `time_s` -> series, `freq_hz` -> spectra). An HDF5 series
+/// is left in the file to be streamed; anything else is read.
 ///
 /// # Errors
 ///
 /// [`InputError::Extension`], [`InputError::UnknownLayout`] (naming the accepted layouts), or
 /// any validation error of the specific reader.
-pub fn read_tilt(path: &Path, opts: &ReadOptions) -> Result<TiltInput, InputError> {
+pub fn open_tilt(path: &Path, opts: &ReadOptions) -> Result<OpenedTilt, InputError> {
     match InputFormat::from_path(path)? {
         InputFormat::Csv => {
             let (file, prelude) = csv::CsvFile::open(path)?;
             match csv_kind(path, &prelude)? {
-                InputKind::Series => series_csv::read(file, prelude, opts).map(TiltInput::Series),
+                InputKind::Series => series_csv::read(file, prelude, opts).map(OpenedTilt::Series),
                 InputKind::Spectra => {
-                    spectra_csv::read(file, prelude, opts).map(TiltInput::Spectra)
+                    spectra_csv::read(file, prelude, opts).map(OpenedTilt::Spectra)
                 }
             }
         }
@@ -69,23 +81,37 @@ pub fn read_tilt(path: &Path, opts: &ReadOptions) -> Result<TiltInput, InputErro
             let (file_path, object) = split_hdf5_address(path);
             let file = h5::open(&file_path)?;
             if let Some(s) = gwpy_spectra(&file_path, &file, object.as_deref(), opts)? {
-                return Ok(TiltInput::Spectra(s));
+                return Ok(OpenedTilt::Spectra(s));
             }
             if object.is_some() {
-                let mut src =
-                    TiltSeriesSource::from_file(&file_path, file, opts, object.as_deref())?;
-                return src.read_all().map(TiltInput::Series);
+                return TiltSeriesSource::from_file(&file_path, file, opts, object.as_deref())
+                    .map(OpenedTilt::Streamed);
             }
             match h5::detect_kind(path, &file, None)? {
                 InputKind::Series => {
-                    let mut src = TiltSeriesSource::from_file(path, file, opts, None)?;
-                    src.read_all().map(TiltInput::Series)
+                    TiltSeriesSource::from_file(path, file, opts, None).map(OpenedTilt::Streamed)
                 }
-                InputKind::Spectra => spectra_hdf5::read(path, &file, opts).map(TiltInput::Spectra),
+                InputKind::Spectra => {
+                    spectra_hdf5::read(path, &file, opts).map(OpenedTilt::Spectra)
+                }
             }
         }
-        InputFormat::Miniseed => mseed::read(path, opts).map(TiltInput::Series),
+        InputFormat::Miniseed => mseed::read(path, opts).map(OpenedTilt::Series),
     }
+}
+
+/// Reads a tilt input of either kind whole: [`open_tilt`], then an HDF5 series is read into
+/// memory.
+///
+/// # Errors
+///
+/// As [`open_tilt`], and the errors of reading an HDF5 series.
+pub fn read_tilt(path: &Path, opts: &ReadOptions) -> Result<TiltInput, InputError> {
+    Ok(match open_tilt(path, opts)? {
+        OpenedTilt::Streamed(mut src) => TiltInput::Series(src.read_all()?),
+        OpenedTilt::Series(s) => TiltInput::Series(s),
+        OpenedTilt::Spectra(s) => TiltInput::Spectra(s),
+    })
 }
 
 /// Reads a tilt time series (angle, rad), all in memory. For long HDF5 series use

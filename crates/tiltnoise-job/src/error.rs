@@ -1,0 +1,213 @@
+//! The errors of a job, naming the option or key that failed by its snake-case name; each
+//! front end renders them in its own spelling ([`JobError::message`]).
+
+use std::fmt;
+use tiltnoise_core::budget::option_checks::{
+    percentiles_error, require_segments_for_percentiles, InputKind,
+};
+use tiltnoise_core::budget::BudgetError;
+use tiltnoise_core::coherence::CoherenceError;
+use tiltnoise_core::error::{Num, Shown};
+use tiltnoise_core::input::InputError;
+use tiltnoise_core::model::Observable;
+use tiltnoise_core::options::Spelling;
+use tiltnoise_core::repeats::Repeated;
+
+/// Why a job did not run to its end. Options are named in snake case (`segment_duration`);
+/// [`JobError::message`] spells them as the front end does. `Display` uses the keyword
+/// spelling.
+#[derive(Debug)]
+pub enum JobError {
+    /// A file the job reads cannot be read or is not valid (the error names the file).
+    Input(Box<InputError>),
+    /// A file named in an item of an option (a coloured readout, a user term) cannot be read
+    /// or is not valid.
+    OptionFile {
+        /// The option.
+        option: &'static str,
+        /// The item, as `KEY=VALUE`.
+        item: String,
+        /// What is wrong with the file.
+        source: Box<InputError>,
+    },
+    /// An option or an item of one whose value does not fit.
+    Option {
+        /// The option.
+        option: &'static str,
+        /// The item or value, when the message shows it.
+        value: Option<String>,
+        /// What is wrong and what is allowed.
+        problem: String,
+    },
+    /// An option that applies to the other kind of input than the one `path` holds.
+    NotForInput {
+        /// The option.
+        option: &'static str,
+        /// What the input holds.
+        holds: InputKind,
+        /// The input, as given.
+        path: String,
+    },
+    /// An item on an observable the budget does not compute.
+    NotBudgeted {
+        /// The option.
+        option: &'static str,
+        /// The item, as `KEY=VALUE`.
+        item: String,
+        /// Its observable.
+        observable: Observable,
+        /// The observables budgeted.
+        budgeted: Vec<Observable>,
+    },
+    /// Percentiles without segments.
+    PercentilesNeedSegments,
+    /// Percentiles out of order or range.
+    Percentiles {
+        /// The lower percentile given.
+        lower: f64,
+        /// The upper percentile given.
+        upper: f64,
+    },
+    /// A key given twice (`Repeated::option` in snake case).
+    Repeated(Repeated),
+    /// The computation on the input `path` failed.
+    Budget {
+        /// The input, as given.
+        path: String,
+        /// Why.
+        source: Box<BudgetError>,
+    },
+    /// The records give no coherence estimate (or the run was cancelled).
+    Coherence(Box<CoherenceError>),
+}
+
+impl JobError {
+    /// The message, one line, with the options spelled as `spelling` does.
+    pub fn message(&self, spelling: Spelling) -> String {
+        let opt = |name: &str| spelling.option(name);
+        match self {
+            JobError::Input(e) => e.to_string(),
+            JobError::OptionFile {
+                option,
+                item,
+                source,
+            } => format!("{} {}: {source}", opt(option), Shown(item)),
+            JobError::Option {
+                option,
+                value: Some(value),
+                problem,
+            } => format!("{} {}: {problem}", opt(option), Shown(value)),
+            JobError::Option {
+                option,
+                value: None,
+                problem,
+            } => format!("{}: {problem}", opt(option)),
+            JobError::NotForInput {
+                option,
+                holds: InputKind::Spectra,
+                path,
+            } => format!(
+                "{} applies to time-series input, and {} holds spectra; leave it out (the model \
+                 grid of spectra input is set with {})",
+                opt(option),
+                Shown(path),
+                opt("freq")
+            ),
+            JobError::NotForInput {
+                option,
+                holds: InputKind::Series,
+                path,
+            } => format!(
+                "{} applies to spectra input, and {} holds a time series, whose budget is on the \
+                 Welch grid (set its resolution with {})",
+                opt(option),
+                Shown(path),
+                opt("nperseg")
+            ),
+            JobError::NotBudgeted {
+                option,
+                item,
+                observable,
+                budgeted,
+            } => format!(
+                "{} {}: {} is not budgeted; allowed: {} (add it with {})",
+                opt(option),
+                Shown(item),
+                observable.name(),
+                budgeted
+                    .iter()
+                    .map(|o| o.name())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                opt("observables")
+            ),
+            JobError::PercentilesNeedSegments => require_segments_for_percentiles(spelling, false)
+                .err()
+                .map_or_else(String::new, |e| e.to_string()),
+            JobError::Percentiles { lower, upper } => match spelling {
+                Spelling::Flag => format!(
+                    "--percentiles {}:{}: expected LO:HI with 0 <= LO < HI <= 100, e.g. 10:90",
+                    Num(*lower),
+                    Num(*upper)
+                ),
+                Spelling::Keyword => {
+                    let given = format!("({}, {})", Num(*lower), Num(*upper));
+                    percentiles_error(spelling, &given).to_string()
+                }
+            },
+            JobError::Repeated(r) => Repeated {
+                option: opt(&r.option),
+                ..r.clone()
+            }
+            .to_string(),
+            JobError::Budget { path, source } => format!("budget of {}: {source}", Shown(path)),
+            JobError::Coherence(e) => e.to_string(),
+        }
+    }
+
+    /// A file named by an option item.
+    pub(crate) fn option_file(option: &'static str, item: &str, source: InputError) -> JobError {
+        JobError::OptionFile {
+            option,
+            item: item.to_string(),
+            source: Box::new(source),
+        }
+    }
+
+    /// An option item that does not fit.
+    pub(crate) fn option(option: &'static str, value: Option<&str>, problem: String) -> JobError {
+        JobError::Option {
+            option,
+            value: value.map(str::to_string),
+            problem,
+        }
+    }
+}
+
+impl fmt::Display for JobError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message(Spelling::Keyword))
+    }
+}
+
+impl std::error::Error for JobError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            JobError::Input(e) | JobError::OptionFile { source: e, .. } => Some(e.as_ref()),
+            JobError::Budget { source, .. } => Some(source.as_ref()),
+            JobError::Coherence(e) => Some(e.as_ref()),
+            _ => None,
+        }
+    }
+}
+
+impl From<InputError> for JobError {
+    fn from(e: InputError) -> JobError {
+        JobError::Input(Box::new(e))
+    }
+}
+
+/// The path of an input as messages and files show it.
+pub(crate) fn shown_path(path: &std::path::Path) -> String {
+    path.display().to_string()
+}

@@ -1,0 +1,199 @@
+//! The budget job's options from Python arguments: `observables`, `readout` (white or
+//! coloured), `term`, `at`; and the job's errors as Python exceptions, in keyword spelling.
+//! The job (`tiltnoise_job`) reads the files and checks everything against the budget, as it
+//! does for the command line.
+
+use crate::errors::{value_error, IntoPyErr, PyResultExt};
+use crate::model::names;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::PathBuf;
+use tiltnoise_core::budget::BudgetError;
+use tiltnoise_core::input::{parse_scales, AxisMap};
+use tiltnoise_core::model::{Input, Observable};
+use tiltnoise_core::noise::UserSource;
+use tiltnoise_core::options::{self, observable_names};
+use tiltnoise_job::budget::ReadRequest;
+use tiltnoise_job::{AsdSpec, JobError, ReadoutItem, Spelling, TermItem, WitnessItem};
+
+/// A job's error as the exception of its kind (`errors`' rules), with the message in keyword
+/// spelling.
+pub fn job_error(e: JobError) -> PyErr {
+    let message = e.message(Spelling::Keyword);
+    let kind = match e {
+        JobError::Input(e) | JobError::OptionFile { source: e, .. } => (*e).into_py_err(),
+        JobError::Budget { source, .. } => match *source {
+            BudgetError::Input(e) => e.into_py_err(),
+            other => other.into_py_err(),
+        },
+        _ => return value_error(message),
+    };
+    Python::attach(|py| PyErr::from_type(kind.get_type(py), message))
+}
+
+/// How to read a record of the floor's motion from `axes` (the axis map), `quantity`,
+/// `gaps` and `scale` (`{channel: factor}`), as the command line's options of the same names.
+pub fn read_request(
+    axes: Option<&str>,
+    quantity: Option<&str>,
+    gaps: Option<&str>,
+    scale: Option<std::collections::BTreeMap<String, f64>>,
+) -> PyResult<ReadRequest> {
+    let scale: Vec<String> = scale
+        .unwrap_or_default()
+        .iter()
+        .map(|(c, f)| format!("{c}={f:?}"))
+        .collect();
+    Ok(ReadRequest {
+        axis_map: axes
+            .map(AxisMap::parse)
+            .transpose()
+            .map_err(|e| value_error(e.to_string()))?,
+        quantity: quantity.map(str::parse).transpose().map_err(value_error)?,
+        gaps: gaps.map(str::parse).transpose().map_err(value_error)?,
+        scale: parse_scales("scale", &scale).map_err(value_error)?,
+        ..ReadRequest::default()
+    })
+}
+
+/// `observables`: a list of names or a comma-separated string, each once.
+pub fn observables(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<Observable>>> {
+    let Some(arg) = arg else {
+        return Ok(None);
+    };
+    options::parse_outputs("observables", &names("observables", arg)?)
+        .py()
+        .map(Some)
+}
+
+/// A path given as `str` or `os.PathLike`, or `None` for anything else.
+fn path_of(value: &Bound<'_, PyAny>) -> Option<PathBuf> {
+    if value.is_instance_of::<pyo3::types::PyFloat>()
+        || value.is_instance_of::<pyo3::types::PyInt>()
+    {
+        return None;
+    }
+    value.extract::<PathBuf>().ok()
+}
+
+/// `readout`: `{observable: ASD}` (white, unit/sqrt(Hz); 0 removes it) or `{observable:
+/// path}` (coloured, a CSV or HDF5 ASD file), over the default 9e-9 m/sqrt(Hz) on X.
+pub fn readout(arg: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<ReadoutItem>> {
+    let Some(d) = arg else {
+        return Ok(Vec::new());
+    };
+    let mut items = Vec::new();
+    for (name, value) in d.iter() {
+        let name: String = name
+            .extract()
+            .map_err(|_| value_error("readout: the keys must be observable names (str)"))?;
+        if let Some(path) = path_of(&value) {
+            let observable = Observable::from_name(&name).ok_or_else(|| {
+                value_error(format!(
+                    "readout {name}=...: unknown observable `{name}`; allowed: {}",
+                    observable_names()
+                ))
+            })?;
+            items.push(ReadoutItem {
+                observable,
+                asd: AsdSpec::File(path),
+            });
+            continue;
+        }
+        let asd: f64 = value.extract().map_err(|_| {
+            value_error(format!(
+                "readout {name}: expected an ASD (a number) or an ASD file (a path)"
+            ))
+        })?;
+        let (observable, asd) = options::readout_item("readout", &name, asd).py()?;
+        items.push(ReadoutItem {
+            observable,
+            asd: AsdSpec::White(asd),
+        });
+    }
+    Ok(items)
+}
+
+/// `term`: `{name: (source, path)}`, `source` an observable or an input of the model.
+pub fn terms(arg: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<TermItem>> {
+    let Some(d) = arg else {
+        return Ok(Vec::new());
+    };
+    let mut items = Vec::new();
+    for (name, value) in d.iter() {
+        let name: String = name
+            .extract()
+            .map_err(|_| value_error("term: the keys must be term names (str)"))?;
+        let (source, file): (String, PathBuf) = value.extract().map_err(|_| {
+            value_error(format!(
+                "term[{name:?}]: expected (source, path), e.g. (\"phi\", \"phi_mag.csv\")"
+            ))
+        })?;
+        let source = match (Observable::from_name(&source), Input::from_name(&source)) {
+            (Some(o), _) => UserSource::Observable(o),
+            (None, Some(i)) => UserSource::Input(i),
+            (None, None) => {
+                return Err(value_error(format!(
+                    "term[{name:?}]: unknown source {source:?}; allowed: an observable ({}) or \
+                     an input of the model (theta_t, eta_t, phi_t, x_t, y_t, z_t, F_a.x .. \
+                     F_b.z, M_a.x .. M_b.z)",
+                    observable_names()
+                )))
+            }
+        };
+        items.push(TermItem { name, source, file });
+    }
+    Ok(items)
+}
+
+/// The argument that names each of the job's input files in Python (`files` from
+/// `BudgetRequest::input_files`), for the rule that no `save` replaces one.
+pub fn python_names<'a>(
+    files: Vec<(&'static str, &'a std::path::Path)>,
+) -> impl Iterator<Item = (&'static str, &'a std::path::Path)> {
+    files.into_iter().map(|(option, path)| {
+        let arg = match option {
+            "tilt" => "path",
+            other => other,
+        };
+        (arg, path)
+    })
+}
+
+/// `witness_noise`: `{input: ASD}` (white, in the input's unit/sqrt(Hz)), `{input: path}` (an
+/// ASD file), or either as `(value, rel)` with the ASD's relative uncertainty; `input` a floor
+/// input of the model, `theta_t` .. `z_t`.
+pub fn witness_noise(arg: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<WitnessItem>> {
+    let Some(d) = arg else {
+        return Ok(Vec::new());
+    };
+    let mut items = Vec::new();
+    for (name, value) in d.iter() {
+        let name: String = name
+            .extract()
+            .map_err(|_| value_error("witness_noise: the keys must be input names (str)"))?;
+        let input = Input::from_name(&name)
+            .filter(|i| i.is_ground())
+            .ok_or_else(|| {
+                value_error(format!(
+                    "witness_noise {name}=...: `{name}` is not a floor input of the model; \
+                     allowed: theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)"
+                ))
+            })?;
+        let (level, rel) = match value.extract::<(Bound<'_, PyAny>, f64)>() {
+            Ok((level, rel)) => (level, rel),
+            Err(_) => (value, 0.0),
+        };
+        let asd = match path_of(&level) {
+            Some(path) => AsdSpec::File(path),
+            None => AsdSpec::White(level.extract().map_err(|_| {
+                value_error(format!(
+                    "witness_noise {name}: expected an ASD (a number) or an ASD file (a path), \
+                     or either with its relative uncertainty as (value, rel)"
+                ))
+            })?),
+        };
+        items.push(WitnessItem { input, asd, rel });
+    }
+    Ok(items)
+}
