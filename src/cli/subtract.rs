@@ -1,36 +1,28 @@
-//! The `subtract` subcommand: the tilt record and the measured record read and checked, the
-//! coupling fitted, the tilt part predicted and removed ([`tiltnoise_core::subtract`]), then
-//! the report (table or JSON) and the outputs: the cleaned record (.h5, the observable-series
-//! layout `budget --measured` reads), the report (.json), the figure (.png, .svg). Documented
-//! in `docs/subtract.md`.
+//! The `subtract` subcommand: the options parsed into the subtract job's request
+//! ([`tiltnoise_job::subtract`]: the records read and checked, the coupling fitted, the tilt
+//! part predicted and removed), the job run, then the report (table or JSON) and the outputs:
+//! the cleaned record (.h5, the observable-series layout `budget --measured` reads), the
+//! report (.json), the figure (.png, .svg). Documented in `docs/subtract.md`.
 
 use super::args::{parse_readout_item, ChannelArgs, Format};
 use super::figure_args::FigureArgs;
 use super::output::save_image;
-use super::witness_noise::{is_floor_input, parse_witness_noise};
+use super::witness_noise::{is_floor_input, parse_witness_items};
 use super::Run;
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, bail, Result};
 use clap::Args;
-use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::time::Duration;
 use tiltnoise_core::error::{Num, OutputError, Shown};
-use tiltnoise_core::input::{GroundMap, Provenance, Sensors, TiltSeries};
-use tiltnoise_core::model::{Input, Observable};
-use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::model::{Input, Model};
 use tiltnoise_core::options;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::repeats::{refuse_repeated_keys, refuse_repeats};
-use tiltnoise_core::subtract::{
-    subtract, MeasuredRecord, Method, NoiseLevel, StartTime, Status, SubtractConfig,
-    SubtractResult, WitnessNoise, WitnessRecord,
-};
-use tiltnoise_io::input::{
-    parse_start_time, read_measured_input, read_tilt, utc_text, MeasuredInput, ReadOptions,
-    TiltInput,
-};
-use tiltnoise_io::{write_atomic, write_subtract_hdf5, InputMeta, RunMeta, SubtractMeta};
+use tiltnoise_core::subtract::{Method, Status, SubtractResult};
+use tiltnoise_io::write_subtract_hdf5;
+use tiltnoise_job::budget::ReadRequest;
+use tiltnoise_job::subtract::SubtractRequest;
+use tiltnoise_job::subtract_report::band_top;
 use tiltnoise_plot::subtract_figure::{subtract_figure, ObservablePanel, SubtractFigureData};
 
 /// Arguments of `tiltnoise subtract`.
@@ -217,610 +209,94 @@ fn parse_colocated_ratio(items: &[String]) -> Result<Vec<(Input, f64)>> {
     Ok(out)
 }
 
-fn read_options(args: &SubtractArgs) -> Result<ReadOptions> {
-    super::args::read_options(
+/// How to read `--tilt` and every `--colocated` record.
+fn read_request(args: &SubtractArgs) -> Result<ReadRequest> {
+    let o = super::args::read_options(
         args.axes.as_deref(),
         args.quantity.as_deref(),
         args.gaps.as_deref(),
         &args.scale,
         &args.channels,
-    )
+    )?;
+    Ok(ReadRequest {
+        axis_map: o.axis_map,
+        quantity: o.quantity,
+        units: o.units,
+        corrected: o.corrected,
+        pendulum_tiltmeter: o.pendulum,
+        gaps: Some(o.gaps),
+        scale: o.scale,
+    })
 }
 
-/// A witness record as the subtraction takes it: one series per input, each the input's
-/// displacement (rad, m), with the provenance of the file it came from.
-struct Witness {
-    inputs: Vec<Input>,
-    data: Vec<Vec<f64>>,
-    sample_rate_hz: f64,
-    provenance: Provenance,
-}
-
-impl Witness {
-    /// The record's channels as displacements. A record of tilt alone keeps its angles (a rate
-    /// integrated as `budget`'s series are); with translation channels, or sensors declared
-    /// other than the default, every channel goes through the floor's [`GroundMap`]: velocity
-    /// and acceleration integrated to displacement in the frequency domain, an inertial
-    /// seismometer's tilt part removed with the record's tilt (`x_t = u - g II(eta_t)`,
-    /// `y_t = u + g II(theta_t)`), a pendulum tiltmeter's translation part with the record's
-    /// translation.
-    fn from_series(series: TiltSeries, g_m_per_s2: f64) -> std::result::Result<Witness, String> {
-        if series.translations.is_empty() && series.sensors == Sensors::default() {
-            let series = series.into_angle();
-            return Ok(Witness {
-                inputs: series.axes.iter().map(|&a| Input::Tilt(a)).collect(),
-                data: series.data,
-                sample_rate_hz: series.sample_rate_hz,
-                provenance: series.provenance,
-            });
-        }
-        let map = GroundMap::new(&series.channels(), g_m_per_s2)?;
-        let channel_data: Vec<Vec<f64>> =
-            series.channel_data().iter().map(|c| c.to_vec()).collect();
-        let data = map.displacements(&channel_data, series.sample_rate_hz);
-        let mut provenance = series.provenance;
-        provenance
-            .notes
-            .retain(|note| !note.starts_with("rate to angle"));
-        provenance.notes.extend(map.series_note());
-        provenance.notes.extend(map.notes().iter().cloned());
-        Ok(Witness {
-            inputs: map.inputs(),
-            data,
-            sample_rate_hz: series.sample_rate_hz,
-            provenance,
-        })
-    }
-}
-
-fn start_of(path: &Path, what: &str, start: &Option<String>) -> Result<Option<StartTime>> {
-    start
-        .as_deref()
-        .map(|s| {
-            parse_start_time(s)
-                .map(|t| {
-                    let ns = t.as_nanosecond();
-                    StartTime {
-                        unix_s: ns.div_euclid(1_000_000_000) as i64,
-                        frac_s: ns.rem_euclid(1_000_000_000) as f64 * 1e-9,
-                    }
-                })
-                .ok_or_else(|| {
-                    anyhow!(
-                        "{what} {}: start time `{}` is not an ISO 8601 date-time",
-                        path.display(),
-                        Shown(s)
-                    )
-                })
-        })
-        .transpose()
-}
-
-/// The channels of the measured record named by `--observables` (all when none is named).
-fn select_observables(
-    path: &Path,
-    names: &[String],
-    channels: Vec<(Observable, Vec<f64>)>,
-) -> Result<Vec<(Observable, Vec<f64>)>> {
-    for (i, (o, _)) in channels.iter().enumerate() {
-        if channels[..i].iter().any(|(x, _)| x == o) {
-            bail!(
-                "--measured {}: channel {} appears twice; give each observable once",
-                path.display(),
-                o.name()
-            );
-        }
-    }
-    if names.is_empty() {
-        return Ok(channels);
-    }
-    let available = || {
-        channels
-            .iter()
-            .map(|c| c.0.name())
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    let wanted = options::parse_outputs("--observables", names)?;
-    for o in &wanted {
-        if !channels.iter().any(|c| c.0 == *o) {
-            bail!(
-                "--observables {0}: --measured {1} has no channel {0}; it has {2}",
-                o.name(),
-                path.display(),
-                available()
-            );
-        }
-    }
-    Ok(channels
-        .into_iter()
-        .filter(|c| wanted.contains(&c.0))
-        .collect())
-}
-
-/// Runs `tiltnoise subtract`.
+/// Runs `tiltnoise subtract`: the options parsed into the subtract job's request, the job run,
+/// the report printed and the files written.
 pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -> Result<()> {
     for path in &args.save {
         save_kind(path)?;
     }
     // A figure of two rows of panels at 100 dpi, for the early check of `--dpi`.
     let view = args.figure.view_for((1800, 1360))?;
-    let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
-    let (witness_noise, noise_files) = parse_witness_noise(&args.witness_noise)?;
-    let mut inputs: Vec<(&str, &Path)> =
-        vec![("--tilt", &args.tilt), ("--measured", &args.measured)];
-    inputs.extend(noise_files.iter().map(|p| ("--witness-noise", p.as_path())));
-    inputs.extend(args.colocated.iter().map(|p| ("--colocated", p.as_path())));
-    run.check_outputs(&saves, &inputs)?;
-    if args.colocated.len() > 2 {
-        bail!(
-            "--colocated is given {} times: give one record (a huddle test with the witness) or \
-             two (a three-cornered hat)",
-            args.colocated.len()
-        );
-    }
-    let colocated_noise_ratio = parse_colocated_ratio(&args.colocated_ratio)?;
-    if !colocated_noise_ratio.is_empty() && args.colocated.len() != 1 {
-        bail!(
-            "--colocated-ratio applies to a huddle test: give exactly one --colocated record \
-             (a three-cornered hat needs no noise ratio)"
-        );
-    }
+    let witness_noise = parse_witness_items(&args.witness_noise)?;
+    let colocated_ratio = parse_colocated_ratio(&args.colocated_ratio)?;
     refuse_repeated_keys("--readout", "observable", &args.readout)?;
-    let readout = args
+    let readout_asd = args
         .readout
         .iter()
         .map(|item| parse_readout_item(item))
         .collect::<Result<Vec<_>>>()?;
-    let cfg = SubtractConfig {
-        segment_len: args.nperseg,
-        holdout_fraction: args.holdout,
-        keys: fit_keys(&args.fit)?,
-        fit_band_hz: args
+    let model = Model::new(params)?;
+    let req = SubtractRequest {
+        model: &model,
+        tilt: args.tilt.clone(),
+        read: read_request(&args)?,
+        measured: args.measured.clone(),
+        observables: match args.observables.is_empty() {
+            true => None,
+            false => Some(options::parse_outputs("--observables", &args.observables)?),
+        },
+        colocated: args.colocated.clone(),
+        colocated_ratio,
+        witness_noise,
+        readout_asd,
+        fit: fit_keys(&args.fit)?,
+        band_hz: args
             .band
             .as_deref()
             .map(|b| parse_band("--band", b))
             .transpose()?,
-        max_delay_s: args.max_delay,
-        witness_noise,
-        colocated_noise_ratio,
-        readout_asd: readout,
         report_band_hz: parse_band("--report-band", &args.report_band)?,
+        nperseg: args.nperseg,
+        holdout: args.holdout,
+        max_delay_s: args.max_delay,
     };
-    let read_series = |option: &str, path: &Path| -> Result<Witness> {
-        match read_tilt(path, &read_options(&args)?)? {
-            TiltInput::Series(s) => Witness::from_series(s, params.environment.g_m_per_s2)
-                .map_err(|e| anyhow!("{option} {}: {e}", path.display())),
-            TiltInput::Spectra(_) => bail!(
-                "{option} {}: holds spectra; subtract needs a time series of the floor's motion \
-                 (tilt angle or rate, and translation)",
-                path.display()
-            ),
-        }
-    };
-    let series = read_series("--tilt", &args.tilt)?;
-    let colocated_series = args
-        .colocated
-        .iter()
-        .map(|p| read_series("--colocated", p))
-        .collect::<Result<Vec<_>>>()?;
-    let measured = match read_measured_input(&args.measured)? {
-        MeasuredInput::Series(m) => m,
-        MeasuredInput::Spectra(_) => bail!(
-            "--measured {}: holds spectra; subtract needs a time series of the observables \
-             (HDF5 as `tiltnoise simulate` writes, or CSV time_s,X,...)",
-            args.measured.display()
-        ),
-    };
-    let channels = select_observables(&args.measured, &args.observables, measured.channels)?;
-    let tilt_start = start_of(&args.tilt, "--tilt", &series.provenance.start_time)?;
-    let measured_start = start_of(&args.measured, "--measured", &measured.start_time)?;
-    let context = || {
-        format!(
-            "subtract --tilt {} --measured {}",
-            args.tilt.display(),
-            args.measured.display()
-        )
-    };
-    let colocated = colocated_series
-        .iter()
-        .zip(&args.colocated)
-        .map(|(s, path)| {
-            Ok(WitnessRecord {
-                fs_hz: s.sample_rate_hz,
-                inputs: &s.inputs,
-                data: &s.data,
-                start: start_of(path, "--colocated", &s.provenance.start_time)?,
-            })
-        })
-        .collect::<Result<Vec<_>>>()?;
-    let result = subtract(
-        params,
-        &WitnessRecord {
-            fs_hz: series.sample_rate_hz,
-            inputs: &series.inputs,
-            data: &series.data,
-            start: tilt_start,
-        },
-        &colocated,
-        &MeasuredRecord {
-            fs_hz: measured.sample_rate_hz,
-            channels: &channels,
-            start: measured_start,
-        },
-        &cfg,
-    )
-    .with_context(context)?;
-    check_finite(&result).with_context(context)?;
-    let skipped =
-        Duration::from_secs_f64(result.alignment.measured_first as f64 / result.alignment.fs_hz);
-    let overlap_start = measured
-        .start_time
-        .as_deref()
-        .and_then(parse_start_time)
-        .and_then(|t| t.checked_add(skipped).ok())
-        .map(utc_text);
-    let input = InputMeta::from(&series.provenance);
-    for note in &series.provenance.notes {
+    run.check_job_outputs(&args.save, req.input_files())?;
+    let outcome = tiltnoise_job::subtract::run(req, &run.cancel).map_err(super::job_error)?;
+    let (result, meta) = (&outcome.result, &outcome.meta);
+    for note in &outcome.input_notes {
         match args.format {
             Format::Json => super::note(&format!("input: {note}")),
             Format::Table => writeln!(run.out, "input: {note}")?,
         }
     }
-    let json = report_json(&result, &args, &cfg.witness_noise, &overlap_start);
+    let json = outcome.report();
     match args.format {
-        Format::Json => writeln!(run.out, "{}", serde_json::to_string_pretty(&json)?)?,
-        Format::Table => write!(run.out, "{}", report_table(&result))?,
+        Format::Json => writeln!(run.out, "{}", json.to_json())?,
+        Format::Table => write!(run.out, "{}", report_table(result))?,
     }
-    let model = tiltnoise_core::model::Model::new(params)?;
-    let meta = SubtractMeta {
-        run: RunMeta::of_this_run(params, Some(&NormalModes::new(&model))),
-        tilt: input,
-        measured_path: args.measured.display().to_string(),
-        start_time: overlap_start.clone(),
-    };
     run.write_outputs(args.format == Format::Json, || {
         for path in &args.save {
             match save_kind(path)? {
-                SaveKind::Hdf5 => write_subtract_hdf5(path, &result, &meta)?,
-                SaveKind::Json => {
-                    let text = serde_json::to_string_pretty(&json)? + "\n";
-                    write_atomic(path, |tmp| {
-                        std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
-                    })?
-                }
+                SaveKind::Hdf5 => write_subtract_hdf5(path, result, meta)?,
+                SaveKind::Json => json.write(path)?,
                 SaveKind::Image => {
-                    let data = figure_data(&result);
+                    let data = figure_data(result);
                     save_image(path, |format| subtract_figure(&data, &view, format))?
                 }
             }
         }
         Ok(())
     })
-}
-
-/// Every number the run reports or writes must be finite, except the uncertainty of a
-/// parameter the data do not constrain at all (reported as not available).
-fn check_finite(r: &SubtractResult) -> Result<()> {
-    for e in &r.fit.estimates {
-        if !e.value.is_finite() || (e.status != Status::NotConstrained && !e.sigma.is_finite()) {
-            bail!(
-                "the fit of {} gave {} +/- {}: not finite (the data may be degenerate; fit \
-                 fewer parameters)",
-                e.name,
-                e.value,
-                e.sigma
-            );
-        }
-    }
-    if !(r.fit.chi2.is_finite() && r.fit.sigma_factor.is_finite()) {
-        bail!("the fit's chi^2 is {}: not finite", r.fit.chi2);
-    }
-    for res in &r.residuals {
-        let b = &res.band;
-        let values = [
-            ("measured", b.measured_asd),
-            ("predicted", b.predicted_asd),
-            ("cleaned", b.cleaned_asd),
-            ("Wiener residual", b.wiener_asd),
-            ("coherence limit", b.expected_asd),
-            ("cleaned / coherence limit", b.cleaned_to_expected.0),
-            ("its sigma", b.cleaned_to_expected.1),
-        ];
-        let readout = b.cleaned_to_readout.map_or([0.0; 2], |(x, s)| [x, s]);
-        if let Some((what, v)) = values
-            .into_iter()
-            .chain([("cleaned / readout", readout[0]), ("its sigma", readout[1])])
-            .find(|(_, v)| !v.is_finite())
-        {
-            bail!(
-                "the {what} ASD of {} in the report band is {v}: not finite (is the channel \
-                 constant or noiseless there? leave it out with --observables)",
-                res.observable.name()
-            );
-        }
-    }
-    for (o, x) in r.cleaned.iter().chain(&r.prediction.series) {
-        if let Some((i, v)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            bail!(
-                "the prediction of {} at sample {i} is {v}: not finite",
-                o.name()
-            );
-        }
-    }
-    Ok(())
-}
-
-fn finite(v: f64) -> Option<f64> {
-    v.is_finite().then_some(v)
-}
-
-// Keys in alphabetical order (fields declared in that order), as every JSON report of the tool.
-
-#[derive(Serialize)]
-struct ReportJson {
-    alignment: AlignmentJson,
-    bands: Vec<BandCheckJson>,
-    estimates: Vec<EstimateJson>,
-    fit: FitJson,
-    measured: String,
-    notes: Vec<String>,
-    residuals: Vec<ResidualJson>,
-    tilt: String,
-    witness_noise: Vec<NoiseJson>,
-}
-
-#[derive(Serialize)]
-struct BandCheckJson {
-    bands: Vec<BandJson>,
-    left_raw: bool,
-    observable: &'static str,
-    unit: String,
-    variance_ratio: f64,
-}
-
-#[derive(Serialize)]
-struct BandJson {
-    band_hz: [f64; 2],
-    bins: usize,
-    cleaned_asd: f64,
-    expected_asd: f64,
-    left_raw: bool,
-    limit: f64,
-    ratio: f64,
-    raw_asd: f64,
-    sigma: f64,
-    witness_limited_asd: f64,
-}
-
-#[derive(Serialize)]
-struct NoiseJson {
-    asd: Option<f64>,
-    file: Option<String>,
-    fitted_scale: f64,
-    input: &'static str,
-    method: &'static str,
-    rel: f64,
-    relative_gains: Vec<f64>,
-    unit: String,
-}
-
-#[derive(Serialize)]
-struct AlignmentJson {
-    fraction_s: f64,
-    holdout_samples: usize,
-    measured_first_sample: usize,
-    note: String,
-    overlap_start_time: Option<String>,
-    sample_rate_hz: f64,
-    samples: usize,
-    segment_len: usize,
-    start_offset_s: Option<f64>,
-    tilt_first_sample: usize,
-    training_samples: usize,
-}
-
-#[derive(Serialize)]
-struct EstimateJson {
-    lower: f64,
-    name: String,
-    nominal: f64,
-    prior_sigma: Option<f64>,
-    scale: f64,
-    sigma: Option<f64>,
-    status: &'static str,
-    unit: String,
-    upper: f64,
-    value: f64,
-}
-
-#[derive(Serialize)]
-struct FitJson {
-    band_hz: [f64; 2],
-    bins: std::collections::BTreeMap<&'static str, usize>,
-    chi2: f64,
-    coherent_top_hz: Option<f64>,
-    dof: usize,
-    fitted: Vec<String>,
-    iterations: usize,
-    max_delay_s: f64,
-    sigma_factor: f64,
-    stop: &'static str,
-    witness_bias: std::collections::BTreeMap<&'static str, f64>,
-}
-
-#[derive(Serialize)]
-struct ResidualJson {
-    band_hz: [f64; 2],
-    bins: usize,
-    below_coherence_bound: bool,
-    cleaned_asd: f64,
-    cleaned_to_expected: [f64; 2],
-    cleaned_to_readout: Option<[f64; 2]>,
-    expected_asd: f64,
-    measured_asd: f64,
-    observable: &'static str,
-    predicted_asd: f64,
-    psd_rel_sigma: f64,
-    readout_asd: Option<f64>,
-    unit: String,
-    wiener_asd: f64,
-    wiener_corrected_asd: f64,
-    wiener_training_excess: f64,
-    witness_limited_asd: f64,
-}
-
-/// The upper edge of a band as reported: the last band reaches the Nyquist frequency.
-fn band_top(hi: f64, fs_hz: f64) -> f64 {
-    hi.min(fs_hz / 2.0)
-}
-
-fn report_json(
-    r: &SubtractResult,
-    args: &SubtractArgs,
-    noise: &[WitnessNoise],
-    start: &Option<String>,
-) -> ReportJson {
-    let a = &r.alignment;
-    let fs = a.fs_hz;
-    ReportJson {
-        bands: r
-            .bands
-            .iter()
-            .map(|(o, c)| BandCheckJson {
-                bands: c
-                    .bands
-                    .iter()
-                    .map(|b| BandJson {
-                        band_hz: [b.lo_hz, band_top(b.hi_hz, fs)],
-                        bins: b.bins,
-                        cleaned_asd: b.cleaned_psd.sqrt(),
-                        expected_asd: b.expected_psd.sqrt(),
-                        left_raw: b.left_raw,
-                        limit: b.limit,
-                        ratio: b.ratio,
-                        raw_asd: b.raw_psd.sqrt(),
-                        sigma: b.sigma,
-                        witness_limited_asd: b.witness_limited_psd.sqrt(),
-                    })
-                    .collect(),
-                left_raw: c.left_raw,
-                observable: o.name(),
-                unit: format!("{}/sqrt(Hz)", o.unit()),
-                variance_ratio: c.variance_ratio,
-            })
-            .collect(),
-        witness_noise: noise
-            .iter()
-            .map(|x| (x, None))
-            .chain(r.colocated.iter().map(|e| (&e.noise, Some(&e.method))))
-            .map(|(x, method)| {
-                let a = r
-                    .witness_noise_psd
-                    .iter()
-                    .position(|(i, _)| *i == x.input)
-                    .expect("every stated noise belongs to a witness input");
-                let (asd, file) = match &x.level {
-                    NoiseLevel::White(v) => (Some(*v), None),
-                    NoiseLevel::Curve(c) => (None, Some(c.origin().to_string())),
-                };
-                let (method, relative_gains) = match method {
-                    None => ("given", Vec::new()),
-                    Some(Method::Huddle { relative_gain, .. }) => ("huddle", vec![*relative_gain]),
-                    Some(Method::ThreeCorneredHat { relative_gains }) => {
-                        ("three-cornered hat", relative_gains.to_vec())
-                    }
-                };
-                NoiseJson {
-                    asd,
-                    file,
-                    fitted_scale: r.fit.noise_factors[a].sqrt(),
-                    input: x.input.name(),
-                    method,
-                    rel: x.rel,
-                    relative_gains,
-                    unit: format!("{}/sqrt(Hz)", x.input.unit()),
-                }
-            })
-            .collect(),
-        alignment: AlignmentJson {
-            fraction_s: a.fraction_s,
-            holdout_samples: r.n_holdout,
-            measured_first_sample: a.measured_first,
-            note: a.note.clone(),
-            overlap_start_time: start.clone(),
-            sample_rate_hz: a.fs_hz,
-            samples: a.len,
-            segment_len: r.segment_len,
-            start_offset_s: a.start_offset_s,
-            tilt_first_sample: a.witness_first,
-            training_samples: r.n_train,
-        },
-        estimates: r
-            .fit
-            .estimates
-            .iter()
-            .map(|e| EstimateJson {
-                lower: e.bounds.0,
-                name: e.name.clone(),
-                nominal: e.nominal,
-                prior_sigma: e.prior_sigma,
-                scale: e.scale,
-                sigma: finite(e.sigma),
-                status: e.status.name(),
-                unit: e.unit.clone(),
-                upper: e.bounds.1,
-                value: e.value,
-            })
-            .collect(),
-        fit: FitJson {
-            band_hz: [r.fit.band_hz.0, r.fit.band_hz.1],
-            bins: r.fit.bins.iter().map(|(o, n)| (o.name(), *n)).collect(),
-            chi2: r.fit.chi2,
-            coherent_top_hz: r.fit.coherent_top_hz,
-            dof: r.fit.dof,
-            fitted: r.fit.fitted.clone(),
-            iterations: r.fit.iterations,
-            max_delay_s: r.max_delay_s,
-            sigma_factor: r.fit.sigma_factor,
-            stop: r.fit.stop.describe(),
-            witness_bias: r
-                .witness_noise_psd
-                .iter()
-                .map(|(i, _)| i.name())
-                .zip(r.fit.witness_bias.iter().copied())
-                .collect(),
-        },
-        measured: args.measured.display().to_string(),
-        notes: r.notes.clone(),
-        residuals: r
-            .residuals
-            .iter()
-            .map(|s| {
-                let b = &s.band;
-                ResidualJson {
-                    band_hz: [b.band_hz.0, b.band_hz.1],
-                    bins: b.bins,
-                    below_coherence_bound: b.below_coherence_bound,
-                    cleaned_asd: b.cleaned_asd,
-                    cleaned_to_expected: [b.cleaned_to_expected.0, b.cleaned_to_expected.1],
-                    cleaned_to_readout: b.cleaned_to_readout.map(|(x, s)| [x, s]),
-                    expected_asd: b.expected_asd,
-                    measured_asd: b.measured_asd,
-                    observable: s.observable.name(),
-                    predicted_asd: b.predicted_asd,
-                    psd_rel_sigma: b.psd_rel_sigma,
-                    readout_asd: s.readout_asd,
-                    unit: format!("{}/sqrt(Hz)", s.observable.unit()),
-                    wiener_asd: b.wiener_asd,
-                    wiener_corrected_asd: b.wiener_corrected_asd,
-                    wiener_training_excess: s.wiener_training_excess,
-                    witness_limited_asd: b.witness_limited_asd,
-                }
-            })
-            .collect(),
-        tilt: args.tilt.display().to_string(),
-    }
 }
 
 /// A value with its uncertainty for the table: `0.97015 +/- 9.2e-05`.

@@ -8,10 +8,9 @@ use anyhow::{anyhow, Result};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::Input;
-use tiltnoise_core::noise::WitnessNoise;
 use tiltnoise_core::repeats::refuse_repeated_keys;
 use tiltnoise_io::input::InputFormat;
-use tiltnoise_job::{witness_noise, AsdSpec, WitnessItem};
+use tiltnoise_job::{AsdSpec, WitnessItem};
 
 /// The model inputs a witness can record.
 const FLOOR_INPUTS: &str = "theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)";
@@ -66,18 +65,4 @@ pub fn parse_witness_items(items: &[String]) -> Result<Vec<WitnessItem>> {
             Ok(WitnessItem { input, asd, rel })
         })
         .collect()
-}
-
-/// Parses and reads every `--witness-noise` item; returns the levels and the files read.
-pub fn parse_witness_noise(items: &[String]) -> Result<(Vec<WitnessNoise>, Vec<PathBuf>)> {
-    let items = parse_witness_items(items)?;
-    let files = items
-        .iter()
-        .filter_map(|w| match &w.asd {
-            AsdSpec::File(p) => Some(p.clone()),
-            AsdSpec::White(_) => None,
-        })
-        .collect();
-    let noise = witness_noise(&items).map_err(super::job_error)?;
-    Ok((noise, files))
 }

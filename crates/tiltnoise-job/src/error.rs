@@ -1,6 +1,7 @@
 //! The errors of a job, naming the option or key that failed by its snake-case name; each
 //! front end renders them in its own spelling ([`JobError::message`]).
 
+use crate::subtract::SubtractFailure;
 use std::fmt;
 use tiltnoise_core::budget::option_checks::{
     percentiles_error, require_segments_for_percentiles, InputKind,
@@ -79,6 +80,8 @@ pub enum JobError {
     },
     /// The records give no coherence estimate (or the run was cancelled).
     Coherence(Box<CoherenceError>),
+    /// The subtraction's records do not fit it, or its result is not finite.
+    Subtract(Box<SubtractFailure>),
 }
 
 impl JobError {
@@ -162,6 +165,7 @@ impl JobError {
             .to_string(),
             JobError::Budget { path, source } => format!("budget of {}: {source}", Shown(path)),
             JobError::Coherence(e) => e.to_string(),
+            JobError::Subtract(e) => e.message(spelling),
         }
     }
 

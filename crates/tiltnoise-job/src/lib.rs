@@ -16,6 +16,8 @@ pub mod budget;
 pub mod coherence;
 mod error;
 mod given;
+pub mod subtract;
+pub mod subtract_report;
 mod summary;
 
 pub use error::JobError;

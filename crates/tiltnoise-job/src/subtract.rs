@@ -1,0 +1,589 @@
+//! The subtract job: the record of the floor's motion (the witness, tilt and translation
+//! channels), records of co-located instruments beside it and the measured record of the
+//! observables, each read once; the coupling fitted, the tilt part predicted and removed
+//! ([`tiltnoise_core::subtract`]), every number of the result checked finite, and the metadata
+//! the cleaned record is written with.
+
+use crate::budget::ReadRequest;
+use crate::error::{shown_path, JobError};
+use crate::given::{witness_noise, AsdSpec, WitnessItem};
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+use tiltnoise_core::cancel::{Cancel, Cancelled};
+use tiltnoise_core::error::Shown;
+use tiltnoise_core::input::{GroundMap, InputMeta, Provenance, Sensors, TiltSeries};
+use tiltnoise_core::model::{Input, Model, Observable};
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::options::Spelling;
+use tiltnoise_core::subtract::{
+    subtract, MeasuredRecord, StartTime, Status, SubtractConfig, SubtractError, SubtractResult,
+    WitnessNoise, WitnessRecord,
+};
+use tiltnoise_io::input::{
+    parse_start_time, read_measured_input, read_tilt, utc_text, MeasuredInput, TiltInput,
+};
+use tiltnoise_io::{RunMeta, SubtractMeta};
+
+/// A subtraction to run.
+pub struct SubtractRequest<'a> {
+    /// The model (its parameters are the nominal values of the fit).
+    pub model: &'a Model,
+    /// The record of the floor's motion (HDF5, CSV or miniSEED time series).
+    pub tilt: PathBuf,
+    /// How to read it and every co-located record.
+    pub read: ReadRequest,
+    /// The measured record of the observables (HDF5 as `simulate` writes it, or CSV).
+    pub measured: PathBuf,
+    /// The observables to use, each in the measured record (default: all of its channels).
+    pub observables: Option<Vec<Observable>>,
+    /// Records of one or two instruments beside the witness (a huddle test, a three-cornered
+    /// hat).
+    pub colocated: Vec<PathBuf>,
+    /// Huddle test: the co-located instrument's noise ASD over the witness's, per input.
+    pub colocated_ratio: Vec<(Input, f64)>,
+    /// The stated own noise of the witness, per input.
+    pub witness_noise: Vec<WitnessItem>,
+    /// White readout ASD of measured observables (unit/sqrt(Hz)).
+    pub readout_asd: Vec<(Observable, f64)>,
+    /// Parameter-file keys fitted besides the gains and the delay.
+    pub fit: Vec<String>,
+    /// Fit band (Hz) (default: chosen from the records).
+    pub band_hz: Option<(f64, f64)>,
+    /// Band (Hz) of the residual summaries.
+    pub report_band_hz: (f64, f64),
+    /// Welch segment length (default: chosen from the overlap).
+    pub nperseg: Option<usize>,
+    /// Fraction of the overlap held out at its end, in (0, 0.5].
+    pub holdout: f64,
+    /// Largest delay between the records to search (s) (default: 5 % of a segment).
+    pub max_delay_s: Option<f64>,
+}
+
+impl SubtractRequest<'_> {
+    /// The files the job reads, each with the option (snake case) that names it.
+    pub fn input_files(&self) -> Vec<(&'static str, &Path)> {
+        let mut files: Vec<(&'static str, &Path)> =
+            vec![("tilt", &self.tilt), ("measured", &self.measured)];
+        files.extend(self.witness_noise.iter().filter_map(|w| match &w.asd {
+            AsdSpec::File(p) => Some(("witness_noise", p.as_path())),
+            AsdSpec::White(_) => None,
+        }));
+        files.extend(self.colocated.iter().map(|p| ("colocated", p.as_path())));
+        files
+    }
+}
+
+/// A subtraction and what its outputs are written with.
+pub struct SubtractOutcome {
+    /// The fit, the cleaned record and the residual checks.
+    pub result: SubtractResult,
+    /// The witness noise as stated (the co-located estimates are in the result).
+    pub witness_noise: Vec<WitnessNoise>,
+    /// The witness record's path, as given.
+    pub tilt_path: String,
+    /// The notes of reading the witness record.
+    pub input_notes: Vec<String>,
+    /// The metadata of the cleaned record.
+    pub meta: SubtractMeta,
+}
+
+/// Why a subtraction did not run, beyond the readers' and the options' errors.
+#[derive(Debug)]
+pub enum SubtractFailure {
+    /// The run was cancelled (between its stages: the subtraction itself does not poll).
+    Cancelled,
+    /// More than two co-located records.
+    TooManyColocated(usize),
+    /// A noise ratio without exactly one co-located record.
+    RatioNeedsOneColocated,
+    /// A record of the floor's motion (`option`) holds spectra.
+    WitnessSpectra {
+        /// The option.
+        option: &'static str,
+        /// The file.
+        path: String,
+    },
+    /// The measured record holds spectra.
+    MeasuredSpectra(String),
+    /// A record of the floor's motion whose channels do not map to the model's inputs.
+    Channels {
+        /// The option.
+        option: &'static str,
+        /// The file.
+        path: String,
+        /// Why.
+        problem: String,
+    },
+    /// A start time that is not ISO 8601.
+    StartTime {
+        /// The option.
+        option: &'static str,
+        /// The file.
+        path: String,
+        /// The start time as the file gives it.
+        value: String,
+    },
+    /// An observable twice in the measured record.
+    RepeatedChannel {
+        /// The file.
+        path: String,
+        /// The observable.
+        observable: Observable,
+    },
+    /// An observable asked for that the measured record lacks.
+    MissingChannel {
+        /// The file.
+        path: String,
+        /// The observable.
+        observable: Observable,
+        /// The observables it has.
+        present: Vec<Observable>,
+    },
+    /// The subtraction was refused, or its result has a number that is not finite.
+    Run {
+        /// The witness record.
+        tilt: String,
+        /// The measured record.
+        measured: String,
+        /// Why.
+        reason: RunFailure,
+    },
+}
+
+/// Why the subtraction of two readable records failed.
+#[derive(Debug)]
+pub enum RunFailure {
+    /// The subtraction refused the records or the options.
+    Refused(SubtractError),
+    /// A fitted value or its uncertainty is not finite.
+    Estimate {
+        /// The parameter.
+        name: String,
+        /// Its value.
+        value: f64,
+        /// Its uncertainty.
+        sigma: f64,
+    },
+    /// The fit's chi^2 is not finite.
+    Chi2(f64),
+    /// A band summary of the residuals is not finite.
+    Band {
+        /// Which summary.
+        what: &'static str,
+        /// The observable.
+        observable: Observable,
+        /// Its value.
+        value: f64,
+    },
+    /// A sample of the prediction or the cleaned record is not finite.
+    Sample {
+        /// The observable.
+        observable: Observable,
+        /// The sample.
+        index: usize,
+        /// Its value.
+        value: f64,
+    },
+}
+
+impl SubtractFailure {
+    /// The message, one line, with the options spelled as `spelling` does.
+    pub(crate) fn message(&self, spelling: Spelling) -> String {
+        let opt = |name: &str| spelling.option(name);
+        match self {
+            SubtractFailure::Cancelled => Cancelled.to_string(),
+            SubtractFailure::TooManyColocated(n) => format!(
+                "{} is given {n} times: give one record (a huddle test with the witness) or two \
+                 (a three-cornered hat)",
+                opt("colocated")
+            ),
+            SubtractFailure::RatioNeedsOneColocated => format!(
+                "{} applies to a huddle test: give exactly one {} record (a three-cornered hat \
+                 needs no noise ratio)",
+                opt("colocated_ratio"),
+                opt("colocated")
+            ),
+            SubtractFailure::WitnessSpectra { option, path } => format!(
+                "{} {path}: holds spectra; subtract needs a time series of the floor's motion \
+                 (tilt angle or rate, and translation)",
+                opt(option)
+            ),
+            SubtractFailure::MeasuredSpectra(path) => format!(
+                "{} {path}: holds spectra; subtract needs a time series of the observables \
+                 (HDF5 as `tiltnoise simulate` writes, or CSV time_s,X,...)",
+                opt("measured")
+            ),
+            SubtractFailure::Channels {
+                option,
+                path,
+                problem,
+            } => format!("{} {path}: {problem}", opt(option)),
+            SubtractFailure::StartTime {
+                option,
+                path,
+                value,
+            } => format!(
+                "{} {path}: start time `{}` is not an ISO 8601 date-time",
+                opt(option),
+                Shown(value)
+            ),
+            SubtractFailure::RepeatedChannel { path, observable } => format!(
+                "{} {path}: channel {} appears twice; give each observable once",
+                opt("measured"),
+                observable.name()
+            ),
+            SubtractFailure::MissingChannel {
+                path,
+                observable,
+                present,
+            } => format!(
+                "{} {name}: {} {path} has no channel {name}; it has {}",
+                opt("observables"),
+                opt("measured"),
+                present
+                    .iter()
+                    .map(|o| o.name())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                name = observable.name()
+            ),
+            SubtractFailure::Run {
+                tilt,
+                measured,
+                reason,
+            } => format!(
+                "subtract {} {tilt} {} {measured}: {}",
+                opt("tilt"),
+                opt("measured"),
+                reason.message(spelling)
+            ),
+        }
+    }
+}
+
+impl RunFailure {
+    fn message(&self, spelling: Spelling) -> String {
+        match self {
+            RunFailure::Refused(e) => e.to_string(),
+            RunFailure::Estimate { name, value, sigma } => format!(
+                "the fit of {name} gave {value} +/- {sigma}: not finite (the data may be \
+                 degenerate; fit fewer parameters)"
+            ),
+            RunFailure::Chi2(chi2) => format!("the fit's chi^2 is {chi2}: not finite"),
+            RunFailure::Band {
+                what,
+                observable,
+                value,
+            } => format!(
+                "the {what} ASD of {} in the report band is {value}: not finite (is the channel \
+                 constant or noiseless there? leave it out with {})",
+                observable.name(),
+                spelling.option("observables")
+            ),
+            RunFailure::Sample {
+                observable,
+                index,
+                value,
+            } => format!(
+                "the prediction of {} at sample {index} is {value}: not finite",
+                observable.name()
+            ),
+        }
+    }
+}
+
+/// A witness record as the subtraction takes it: one series per input, each the input's
+/// displacement (rad, m), with the provenance of the file it came from.
+struct Witness {
+    inputs: Vec<Input>,
+    data: Vec<Vec<f64>>,
+    sample_rate_hz: f64,
+    provenance: Provenance,
+}
+
+impl Witness {
+    /// The record's channels as displacements. A record of tilt alone keeps its angles (a rate
+    /// integrated as `budget`'s series are); with translation channels, or sensors declared
+    /// other than the default, every channel goes through the floor's [`GroundMap`]: velocity
+    /// and acceleration integrated to displacement in the frequency domain, an inertial
+    /// seismometer's tilt part removed with the record's tilt (`x_t = u - g II(eta_t)`,
+    /// `y_t = u + g II(theta_t)`), a pendulum tiltmeter's translation part with the record's
+    /// translation.
+    fn from_series(series: TiltSeries, g_m_per_s2: f64) -> Result<Witness, String> {
+        if series.translations.is_empty() && series.sensors == Sensors::default() {
+            let series = series.into_angle();
+            return Ok(Witness {
+                inputs: series.axes.iter().map(|&a| Input::Tilt(a)).collect(),
+                data: series.data,
+                sample_rate_hz: series.sample_rate_hz,
+                provenance: series.provenance,
+            });
+        }
+        let map = GroundMap::new(&series.channels(), g_m_per_s2)?;
+        let channel_data: Vec<Vec<f64>> =
+            series.channel_data().iter().map(|c| c.to_vec()).collect();
+        let data = map.displacements(&channel_data, series.sample_rate_hz);
+        let mut provenance = series.provenance;
+        provenance
+            .notes
+            .retain(|note| !note.starts_with("rate to angle"));
+        provenance.notes.extend(map.series_note());
+        provenance.notes.extend(map.notes().iter().cloned());
+        Ok(Witness {
+            inputs: map.inputs(),
+            data,
+            sample_rate_hz: series.sample_rate_hz,
+            provenance,
+        })
+    }
+
+    /// Reads the record of the floor's motion `path`, named by `option`.
+    fn read(
+        option: &'static str,
+        path: &Path,
+        req: &SubtractRequest<'_>,
+    ) -> Result<Witness, JobError> {
+        match read_tilt(path, &req.read.options())? {
+            TiltInput::Series(s) => {
+                Witness::from_series(s, req.model.params().environment.g_m_per_s2).map_err(
+                    |problem| {
+                        failure(SubtractFailure::Channels {
+                            option,
+                            path: shown_path(path),
+                            problem,
+                        })
+                    },
+                )
+            }
+            TiltInput::Spectra(_) => Err(failure(SubtractFailure::WitnessSpectra {
+                option,
+                path: shown_path(path),
+            })),
+        }
+    }
+}
+
+fn failure(f: SubtractFailure) -> JobError {
+    JobError::Subtract(Box::new(f))
+}
+
+fn start_of(
+    option: &'static str,
+    path: &Path,
+    start: &Option<String>,
+) -> Result<Option<StartTime>, JobError> {
+    start
+        .as_deref()
+        .map(|s| {
+            parse_start_time(s)
+                .map(|t| {
+                    let ns = t.as_nanosecond();
+                    StartTime {
+                        unix_s: ns.div_euclid(1_000_000_000) as i64,
+                        frac_s: ns.rem_euclid(1_000_000_000) as f64 * 1e-9,
+                    }
+                })
+                .ok_or_else(|| {
+                    failure(SubtractFailure::StartTime {
+                        option,
+                        path: shown_path(path),
+                        value: s.to_string(),
+                    })
+                })
+        })
+        .transpose()
+}
+
+/// The channels of the measured record named by `observables` (all when `None`).
+fn select_observables(
+    path: &Path,
+    observables: Option<&[Observable]>,
+    channels: Vec<(Observable, Vec<f64>)>,
+) -> Result<Vec<(Observable, Vec<f64>)>, JobError> {
+    for (i, (o, _)) in channels.iter().enumerate() {
+        if channels[..i].iter().any(|(x, _)| x == o) {
+            return Err(failure(SubtractFailure::RepeatedChannel {
+                path: shown_path(path),
+                observable: *o,
+            }));
+        }
+    }
+    let Some(wanted) = observables else {
+        return Ok(channels);
+    };
+    if let Some(&missing) = wanted.iter().find(|o| !channels.iter().any(|c| c.0 == **o)) {
+        return Err(failure(SubtractFailure::MissingChannel {
+            path: shown_path(path),
+            observable: missing,
+            present: channels.iter().map(|c| c.0).collect(),
+        }));
+    }
+    Ok(channels
+        .into_iter()
+        .filter(|c| wanted.contains(&c.0))
+        .collect())
+}
+
+/// Runs the subtraction: checks the options, reads every record once, fits and removes the
+/// tilt part, and checks that every number of the result is finite.
+///
+/// # Errors
+///
+/// A [`JobError`] naming the option or file that failed; `Subtract` for records the
+/// subtraction refuses, for a result that is not finite and when `cancel` was set.
+pub fn run(req: SubtractRequest<'_>, cancel: &Cancel) -> Result<SubtractOutcome, JobError> {
+    let stage = || {
+        cancel
+            .check()
+            .map_err(|_| failure(SubtractFailure::Cancelled))
+    };
+    if req.colocated.len() > 2 {
+        return Err(failure(SubtractFailure::TooManyColocated(
+            req.colocated.len(),
+        )));
+    }
+    if !req.colocated_ratio.is_empty() && req.colocated.len() != 1 {
+        return Err(failure(SubtractFailure::RatioNeedsOneColocated));
+    }
+    let cfg = SubtractConfig {
+        segment_len: req.nperseg,
+        holdout_fraction: req.holdout,
+        keys: req.fit.clone(),
+        fit_band_hz: req.band_hz,
+        max_delay_s: req.max_delay_s,
+        witness_noise: witness_noise(&req.witness_noise)?,
+        colocated_noise_ratio: req.colocated_ratio.clone(),
+        readout_asd: req.readout_asd.clone(),
+        report_band_hz: req.report_band_hz,
+    };
+    stage()?;
+    let series = Witness::read("tilt", &req.tilt, &req)?;
+    let colocated_series = req
+        .colocated
+        .iter()
+        .map(|p| Witness::read("colocated", p, &req))
+        .collect::<Result<Vec<_>, _>>()?;
+    stage()?;
+    let measured = match read_measured_input(&req.measured)? {
+        MeasuredInput::Series(m) => m,
+        MeasuredInput::Spectra(_) => {
+            return Err(failure(SubtractFailure::MeasuredSpectra(shown_path(
+                &req.measured,
+            ))))
+        }
+    };
+    let channels =
+        select_observables(&req.measured, req.observables.as_deref(), measured.channels)?;
+    let tilt_start = start_of("tilt", &req.tilt, &series.provenance.start_time)?;
+    let measured_start = start_of("measured", &req.measured, &measured.start_time)?;
+    let colocated = colocated_series
+        .iter()
+        .zip(&req.colocated)
+        .map(|(s, path)| {
+            Ok(WitnessRecord {
+                fs_hz: s.sample_rate_hz,
+                inputs: &s.inputs,
+                data: &s.data,
+                start: start_of("colocated", path, &s.provenance.start_time)?,
+            })
+        })
+        .collect::<Result<Vec<_>, JobError>>()?;
+    stage()?;
+    let failed = |reason| {
+        failure(SubtractFailure::Run {
+            tilt: shown_path(&req.tilt),
+            measured: shown_path(&req.measured),
+            reason,
+        })
+    };
+    let params = req.model.params();
+    let result = subtract(
+        params,
+        &WitnessRecord {
+            fs_hz: series.sample_rate_hz,
+            inputs: &series.inputs,
+            data: &series.data,
+            start: tilt_start,
+        },
+        &colocated,
+        &MeasuredRecord {
+            fs_hz: measured.sample_rate_hz,
+            channels: &channels,
+            start: measured_start,
+        },
+        &cfg,
+    )
+    .map_err(|e| failed(RunFailure::Refused(e)))?;
+    check_finite(&result).map_err(failed)?;
+    stage()?;
+    let skipped =
+        Duration::from_secs_f64(result.alignment.measured_first as f64 / result.alignment.fs_hz);
+    let overlap_start = measured
+        .start_time
+        .as_deref()
+        .and_then(parse_start_time)
+        .and_then(|t| t.checked_add(skipped).ok())
+        .map(utc_text);
+    let meta = SubtractMeta {
+        run: RunMeta::of_this_run(params, Some(&NormalModes::new(req.model))),
+        tilt: InputMeta::from(&series.provenance),
+        measured_path: shown_path(&req.measured),
+        start_time: overlap_start,
+    };
+    Ok(SubtractOutcome {
+        result,
+        witness_noise: cfg.witness_noise,
+        tilt_path: shown_path(&req.tilt),
+        input_notes: series.provenance.notes,
+        meta,
+    })
+}
+
+/// Every number the run reports or writes must be finite, except the uncertainty of a
+/// parameter the data do not constrain at all (reported as not available).
+fn check_finite(r: &SubtractResult) -> Result<(), RunFailure> {
+    for e in &r.fit.estimates {
+        if !e.value.is_finite() || (e.status != Status::NotConstrained && !e.sigma.is_finite()) {
+            return Err(RunFailure::Estimate {
+                name: e.name.clone(),
+                value: e.value,
+                sigma: e.sigma,
+            });
+        }
+    }
+    if !(r.fit.chi2.is_finite() && r.fit.sigma_factor.is_finite()) {
+        return Err(RunFailure::Chi2(r.fit.chi2));
+    }
+    for res in &r.residuals {
+        let b = &res.band;
+        let readout = b.cleaned_to_readout.map_or([0.0; 2], |(x, s)| [x, s]);
+        let values = [
+            ("measured", b.measured_asd),
+            ("predicted", b.predicted_asd),
+            ("cleaned", b.cleaned_asd),
+            ("Wiener residual", b.wiener_asd),
+            ("coherence limit", b.expected_asd),
+            ("cleaned / coherence limit", b.cleaned_to_expected.0),
+            ("its sigma", b.cleaned_to_expected.1),
+            ("cleaned / readout", readout[0]),
+            ("its sigma", readout[1]),
+        ];
+        if let Some((what, value)) = values.into_iter().find(|(_, v)| !v.is_finite()) {
+            return Err(RunFailure::Band {
+                what,
+                observable: res.observable,
+                value,
+            });
+        }
+    }
+    for (o, x) in r.cleaned.iter().chain(&r.prediction.series) {
+        if let Some((index, &value)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(RunFailure::Sample {
+                observable: *o,
+                index,
+                value,
+            });
+        }
+    }
+    Ok(())
+}
