@@ -32,7 +32,7 @@ use tiltnoise_core::noise::{BudgetReport, SpectralSource};
 use tiltnoise_core::params::Params;
 use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_io::RunMeta;
-use tiltnoise_job::budget::{BudgetRequest, BudgetResult, ReadRequest, TiltSource, WelchRequest};
+use tiltnoise_job::budget::{BudgetRequest, BudgetResult, TiltSource, WelchRequest};
 
 /// A record of the floor's motion handed over as arrays: one channel per input, in canonical
 /// order, each in the SI unit of its quantity.
@@ -628,23 +628,15 @@ pub fn budget_from_file(
     at_band: Option<f64>,
 ) -> PyResult<Budget> {
     let (model, params) = model_of(params)?;
-    let read = ReadRequest {
-        units: parse_units(
-            "units",
-            &units
-                .unwrap_or_default()
-                .iter()
-                .map(|(c, u)| format!("{c}={u}"))
-                .collect::<Vec<_>>(),
-        )
-        .map_err(value_error)?,
-        corrected: names_once("corrected", corrected.unwrap_or_default())?,
-        pendulum_tiltmeter: names_once(
-            "pendulum_tiltmeter",
-            pendulum_tiltmeter.unwrap_or_default(),
-        )?,
-        ..job_args::read_request(axes, quantity, gaps, scale)?
-    };
+    let read = job_args::file_read_request(
+        axes,
+        quantity,
+        units,
+        corrected,
+        pendulum_tiltmeter,
+        gaps,
+        scale,
+    )?;
     let freq_hz = match freq {
         None => None,
         Some(f) => Some(match f.cast::<PyString>() {
@@ -672,13 +664,6 @@ pub fn budget_from_file(
         tiltnoise_job::budget::run(req, &cancel, &mut |_, _| {}).map_err(job_args::job_error)
     })?;
     Ok(Budget::new(&model, report, params, inputs, input))
-}
-
-/// `names`, each given once, for the option `option`.
-fn names_once(option: &str, names: Vec<String>) -> PyResult<Vec<String>> {
-    refuse_repeats(option, "channel", &names, |n| n.clone())
-        .map_err(|e| value_error(e.to_string()))?;
-    Ok(names)
 }
 
 /// A noise budget: one-sided spectra of each observable's terms on one frequency grid.

@@ -9,10 +9,11 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
 use tiltnoise_core::budget::BudgetError;
-use tiltnoise_core::input::{parse_scales, AxisMap};
+use tiltnoise_core::input::{parse_scales, parse_units, AxisMap};
 use tiltnoise_core::model::{Input, Observable};
 use tiltnoise_core::noise::UserSource;
 use tiltnoise_core::options::{self, observable_names};
+use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_job::budget::ReadRequest;
 use tiltnoise_job::{AsdSpec, JobError, ReadoutItem, Spelling, TermItem, WitnessItem};
 
@@ -53,6 +54,40 @@ pub fn read_request(
         gaps: gaps.map(str::parse).transpose().map_err(value_error)?,
         scale: parse_scales("scale", &scale).map_err(value_error)?,
         ..ReadRequest::default()
+    })
+}
+
+/// How to read a record of the floor's motion from a file: [`read_request`]'s options and
+/// `units` (`{channel: unit}`), the translation channels `corrected` already and the tilt
+/// channels read by a `pendulum_tiltmeter`, each channel once.
+pub fn file_read_request(
+    axes: Option<&str>,
+    quantity: Option<&str>,
+    units: Option<std::collections::BTreeMap<String, String>>,
+    corrected: Option<Vec<String>>,
+    pendulum_tiltmeter: Option<Vec<String>>,
+    gaps: Option<&str>,
+    scale: Option<std::collections::BTreeMap<String, f64>>,
+) -> PyResult<ReadRequest> {
+    let names_once = |option: &str, names: Option<Vec<String>>| -> PyResult<Vec<String>> {
+        let names = names.unwrap_or_default();
+        refuse_repeats(option, "channel", &names, |n| n.clone())
+            .map_err(|e| value_error(e.to_string()))?;
+        Ok(names)
+    };
+    Ok(ReadRequest {
+        units: parse_units(
+            "units",
+            &units
+                .unwrap_or_default()
+                .iter()
+                .map(|(c, u)| format!("{c}={u}"))
+                .collect::<Vec<_>>(),
+        )
+        .map_err(value_error)?,
+        corrected: names_once("corrected", corrected)?,
+        pendulum_tiltmeter: names_once("pendulum_tiltmeter", pendulum_tiltmeter)?,
+        ..read_request(axes, quantity, gaps, scale)?
     })
 }
 

@@ -37,12 +37,14 @@ from ._tiltnoise import (
     MonteCarlo,
     Params,
     Simulation,
+    Subtraction,
     __version__,
     budget,
     budget_from_file,
     coherence,
     csd,
     hdf5_version,
+    subtract,
     welch,
 )
 from ._transfer import TransferFunction
@@ -57,6 +59,7 @@ __all__ = [
     "MonteCarlo",
     "Params",
     "Simulation",
+    "Subtraction",
     "TransferFunction",
     "__version__",
     "budget",
@@ -64,5 +67,6 @@ __all__ = [
     "coherence",
     "csd",
     "hdf5_version",
+    "subtract",
     "welch",
 ]

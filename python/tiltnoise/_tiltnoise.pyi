@@ -22,11 +22,13 @@ __all__ = [
     "MonteCarlo",
     "Params",
     "Simulation",
+    "Subtraction",
     "budget",
     "budget_from_file",
     "coherence",
     "csd",
     "hdf5_version",
+    "subtract",
     "welch",
 ]
 
@@ -265,6 +267,16 @@ class Coherence:
     def save(self, path: _Path) -> None: ...
 
 @final
+class Subtraction:
+    @property
+    def estimates(self) -> list[dict[str, Any]]: ...
+    @property
+    def report(self) -> dict[str, Any]: ...
+    @property
+    def input_notes(self) -> list[str]: ...
+    def save(self, path: _Path) -> None: ...
+
+@final
 class Budget:
     @property
     def frequency_hz(self) -> npt.NDArray[np.float64]: ...
@@ -395,5 +407,29 @@ def coherence(
     fit_band: Optional[Tuple[float, float]] = None,
     params: Union[Params, Model, None] = None,
 ) -> Coherence: ...
+def subtract(
+    tilt: _Path,
+    measured: _Path,
+    *,
+    fit: Optional[Sequence[str]] = None,
+    band: Optional[Tuple[float, float]] = None,
+    report_band: Optional[Tuple[float, float]] = None,
+    nperseg: Optional[int] = None,
+    holdout: float = 0.25,
+    max_delay: Optional[float] = None,
+    witness_noise: Optional[Mapping[str, Union[float, _Path, Tuple[Union[float, _Path], float]]]] = None,
+    colocated: Optional[Sequence[_Path]] = None,
+    colocated_ratio: Optional[Mapping[str, float]] = None,
+    readout: Optional[Mapping[str, float]] = None,
+    observables: Optional[_Names] = None,
+    axes: Optional[str] = None,
+    quantity: Optional[Literal["angle", "rate"]] = None,
+    gaps: Optional[Literal["reject", "interpolate"]] = None,
+    scale: Optional[Mapping[str, float]] = None,
+    units: Optional[Mapping[str, str]] = None,
+    corrected: Optional[Sequence[str]] = None,
+    pendulum_tiltmeter: Optional[Sequence[str]] = None,
+    params: Union[Params, Model, None] = None,
+) -> Subtraction: ...
 def _panic_for_tests(where_: Literal["here", "detached", "thread"]) -> None:
     """Panics on purpose (tests only): a Rust panic is a PanicException, never an abort."""
