@@ -25,7 +25,7 @@ use tiltnoise_core::input::{
 use tiltnoise_core::model::{Input, Model, Observable};
 use tiltnoise_core::noise::equivalent::referred_terms;
 use tiltnoise_core::noise::{BudgetReport, Readout, SpectralSource};
-use tiltnoise_core::options::{self, Spelling};
+use tiltnoise_core::options;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_io::input::{
@@ -152,10 +152,9 @@ impl SeriesOptions {
         opts.segment_duration_s = self.segment_duration;
         if let Some((lo, hi)) = self.percentiles {
             let given = self.segment_duration.is_some();
-            option_checks::require_segments_for_percentiles(Spelling::Keyword, given).py()?;
+            option_checks::require_segments_for_percentiles(given).py()?;
             let shown = format!("({}, {})", Num(lo), Num(hi));
-            opts.percentiles =
-                option_checks::check_percentiles(Spelling::Keyword, &shown, lo, hi).py()?;
+            opts.percentiles = option_checks::check_percentiles(&shown, lo, hi).py()?;
         }
         Ok(())
     }
@@ -690,9 +689,7 @@ pub fn budget_from_file(
     given.extend(gaps.map(|_| "gaps"));
     given.extend(grid.as_ref().map(|_| "freq"));
     let source = path.display().to_string();
-    let refuse = |kind| {
-        option_checks::refuse_options_for_input(&given, kind, &source, Spelling::Keyword).py()
-    };
+    let refuse = |kind| option_checks::refuse_options_for_input(&given, kind, &source).py();
     let refuse_series_options = || refuse(InputKind::Spectra);
     let refuse_spectra_options = || refuse(InputKind::Series);
     let (report, provenance) = py.detach(|| -> PyResult<_> {

@@ -45,6 +45,8 @@ fn panic_on_purpose(where_: &str) {
 #[pymodule]
 #[pyo3(name = "_tiltnoise")]
 fn tiltnoise_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // Before any message: the libraries' errors name options as keyword arguments.
+    tiltnoise_core::option_key::install_style(&errors::Keywords);
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("hdf5_version", tiltnoise_io::hdf5_version())?;
     m.add(

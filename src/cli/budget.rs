@@ -260,7 +260,6 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     let model = Model::new(params)?;
     if args.percentiles.is_some() {
         tiltnoise_core::budget::option_checks::require_segments_for_percentiles(
-            tiltnoise_core::options::Spelling::Flag,
             args.segment_duration.is_some(),
         )?;
     }

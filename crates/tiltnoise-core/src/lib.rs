@@ -65,6 +65,7 @@ pub mod model;
 pub mod modes;
 pub mod noise;
 mod num_text;
+pub mod option_key;
 pub mod options;
 pub mod params;
 pub mod reference;

@@ -68,7 +68,7 @@ pub fn budget_csv_string(
     let mut columns = asd_columns(report);
     let dropped = drop_zero_columns(&mut columns, keep_zero_columns);
     let mut notes = vec![format!("every column an ASD; {SPECTRAL_CONVENTION}")];
-    notes.extend(zero_columns_note(&dropped, "--keep-zero-columns"));
+    notes.extend(zero_columns_note(&dropped));
     let preamble = CsvPreamble {
         schema: SCHEMA_BUDGET_CSV,
         schema_version: SCHEMA_VERSION_BUDGET_CSV,

@@ -1,10 +1,11 @@
 //! Checks of a budget's options that depend on which options were given and on the kind of
 //! tilt input: an option of the other kind of input is refused rather than ignored, and the
 //! percentile band needs segments. The command line and the Python package both call these,
-//! each with its [`Spelling`] of the options.
+//! and each spells the options its own way ([`OptionKey`]).
 
 use crate::error::Shown;
-use crate::options::{OptionError, Spelling};
+use crate::option_key::{self, OptionKey};
+use crate::options::OptionError;
 
 /// Options (snake case) that apply to time-series input only, in the order they are reported.
 pub const SERIES_ONLY_OPTIONS: [&str; 5] =
@@ -28,7 +29,6 @@ pub fn refuse_options_for_input(
     given: &[&str],
     kind: InputKind,
     source: &str,
-    spelling: Spelling,
 ) -> Result<(), OptionError> {
     let (other_kind, what_instead) = match kind {
         InputKind::Spectra => (&SERIES_ONLY_OPTIONS[..], "spectra"),
@@ -42,59 +42,48 @@ pub fn refuse_options_for_input(
         InputKind::Spectra => format!(
             "{} applies to time-series input, and {source} holds {what_instead}; leave it out \
              (the model grid of spectra input is set with {})",
-            spelling.option(name),
-            spelling.option("freq")
+            OptionKey::new(*name),
+            OptionKey::FREQ
         ),
         InputKind::Series => format!(
             "{} applies to spectra input, and {source} holds {what_instead}, whose budget is on \
              the Welch grid (set its resolution with {})",
-            spelling.option(name),
-            spelling.option("nperseg")
+            OptionKey::new(*name),
+            OptionKey::NPERSEG
         ),
     }))
 }
 
 /// Refuses percentiles without a segment duration: the band is across segments.
-pub fn require_segments_for_percentiles(
-    spelling: Spelling,
-    segment_duration_given: bool,
-) -> Result<(), OptionError> {
+pub fn require_segments_for_percentiles(segment_duration_given: bool) -> Result<(), OptionError> {
     if segment_duration_given {
         return Ok(());
     }
     Err(OptionError::Conflict(format!(
         "{} applies to the per-segment band and needs {} (e.g. {} with {} at 1 Hz: each \
          segment holds a Welch segment)",
-        spelling.option("percentiles"),
-        spelling.option("segment_duration"),
-        spelling.example("segment_duration", "14400"),
-        spelling.example("nperseg", "4096")
+        OptionKey::PERCENTILES,
+        OptionKey::SEGMENT_DURATION,
+        OptionKey::SEGMENT_DURATION.given("14400"),
+        OptionKey::NPERSEG.given("4096")
     )))
 }
 
 /// The percentiles `(lower, upper)` of the band, `0 <= lower < upper <= 100`; `given` is
 /// the value as the caller wrote it, for the message.
-pub fn check_percentiles(
-    spelling: Spelling,
-    given: &str,
-    lower: f64,
-    upper: f64,
-) -> Result<(f64, f64), OptionError> {
+pub fn check_percentiles(given: &str, lower: f64, upper: f64) -> Result<(f64, f64), OptionError> {
     if 0.0 <= lower && lower < upper && upper <= 100.0 {
         return Ok((lower, upper));
     }
-    Err(percentiles_error(spelling, given))
+    Err(percentiles_error(given))
 }
 
 /// The error for percentiles that do not parse or are out of order or range.
-pub fn percentiles_error(spelling: Spelling, given: &str) -> OptionError {
-    let form = match spelling {
-        Spelling::Flag => "LOWER,UPPER",
-        Spelling::Keyword => "(LOWER, UPPER)",
-    };
+pub fn percentiles_error(given: &str) -> OptionError {
+    let form = option_key::pair("LOWER", "UPPER");
     OptionError::Conflict(format!(
         "{} {}: expected {form} with 0 <= LOWER < UPPER <= 100",
-        spelling.option("percentiles"),
+        OptionKey::PERCENTILES,
         Shown(given)
     ))
 }
@@ -106,16 +95,14 @@ mod tests {
     #[test]
     fn options_of_the_other_kind_of_input_are_refused_by_name() {
         let given = ["overlap", "gaps"];
-        let e = refuse_options_for_input(&given, InputKind::Spectra, "s.csv", Spelling::Flag);
+        let e = refuse_options_for_input(&given, InputKind::Spectra, "s.csv");
         assert_eq!(
             e.unwrap_err().to_string(),
-            "--overlap applies to time-series input, and s.csv holds spectra; leave it out (the \
-             model grid of spectra input is set with --freq)"
+            "overlap applies to time-series input, and s.csv holds spectra; leave it out (the \
+             model grid of spectra input is set with freq)"
         );
-        assert!(
-            refuse_options_for_input(&given, InputKind::Series, "t.h5", Spelling::Flag).is_ok()
-        );
-        let e = refuse_options_for_input(&["freq"], InputKind::Series, "t.h5", Spelling::Keyword);
+        assert!(refuse_options_for_input(&given, InputKind::Series, "t.h5").is_ok());
+        let e = refuse_options_for_input(&["freq"], InputKind::Series, "t.h5");
         assert_eq!(
             e.unwrap_err().to_string(),
             "freq applies to spectra input, and t.h5 holds a time series, whose budget is on \
@@ -126,27 +113,24 @@ mod tests {
     #[test]
     fn percentiles_need_segments_and_order() {
         assert_eq!(
-            require_segments_for_percentiles(Spelling::Keyword, false)
+            require_segments_for_percentiles(false)
                 .unwrap_err()
                 .to_string(),
             "percentiles applies to the per-segment band and needs segment_duration (e.g. \
              segment_duration=14400 with nperseg=4096 at 1 Hz: each segment holds a Welch \
              segment)"
         );
-        assert!(require_segments_for_percentiles(Spelling::Flag, true).is_ok());
-        assert_eq!(
-            check_percentiles(Spelling::Flag, "5,95", 5.0, 95.0).unwrap(),
-            (5.0, 95.0)
-        );
+        assert!(require_segments_for_percentiles(true).is_ok());
+        assert_eq!(check_percentiles("5,95", 5.0, 95.0).unwrap(), (5.0, 95.0));
         for (lo, hi) in [(90.0, 10.0), (-1.0, 50.0), (50.0, 101.0), (f64::NAN, 50.0)] {
-            let e = check_percentiles(Spelling::Flag, "x", lo, hi).unwrap_err();
+            let e = check_percentiles("x", lo, hi).unwrap_err();
             assert_eq!(
                 e.to_string(),
-                "--percentiles x: expected LOWER,UPPER with 0 <= LOWER < UPPER <= 100"
+                "percentiles x: expected (LOWER, UPPER) with 0 <= LOWER < UPPER <= 100"
             );
         }
         assert_eq!(
-            percentiles_error(Spelling::Keyword, "(90, 10)").to_string(),
+            percentiles_error("(90, 10)").to_string(),
             "percentiles (90, 10): expected (LOWER, UPPER) with 0 <= LOWER < UPPER <= 100"
         );
     }

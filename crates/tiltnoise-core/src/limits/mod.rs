@@ -499,12 +499,12 @@ mod tests {
     #[test]
     fn counts_over_the_limit_and_nan_are_refused() {
         assert!(check_count(|| "x".into(), 10.0, "points", 10).is_ok());
-        let e = check_count(|| "--freq 1:11:2".into(), 11.0, "frequency points", 10)
+        let e = check_count(|| "freq=1:11:2".into(), 11.0, "frequency points", 10)
             .unwrap_err()
             .to_string();
         assert_eq!(
             e,
-            "--freq 1:11:2: 11 frequency points, more than the 10 allowed (see docs/limits.md)"
+            "freq=1:11:2: 11 frequency points, more than the 10 allowed (see docs/limits.md)"
         );
         assert!(check_count(|| "x".into(), f64::NAN, "samples", 10).is_err());
         let e = check_count(|| "x".into(), 1.8446744073709552e19, "draws", 10).unwrap_err();
@@ -528,12 +528,12 @@ mod tests {
         assert!(check_memory_against(|| "x".into(), 10, None).is_ok());
         assert!(check_memory_against(|| "x".into(), 10, Some(20)).is_ok());
         assert!(check_memory_against(|| "x".into(), 11, Some(20)).is_err());
-        let e = check_memory_against(|| "--samples 5".into(), 3 << 30, Some(4 << 30))
+        let e = check_memory_against(|| "samples=5".into(), 3 << 30, Some(4 << 30))
             .unwrap_err()
             .to_string();
         assert_eq!(
             e,
-            "--samples 5: needs about 3 GiB of memory, more than half of the 4 GiB available; \
+            "samples=5: needs about 3 GiB of memory, more than half of the 4 GiB available; \
              ask for less (see docs/limits.md)"
         );
         // The machine running the tests has some memory, and not 16 EiB.

@@ -14,6 +14,7 @@ use tiltnoise_core::error::{shown_list, Shown};
 use tiltnoise_core::ground::GroundQuantity;
 use tiltnoise_core::input::{unstated_excess, DetrendedRms, UNITS_ALLOWED};
 use tiltnoise_core::model::Input;
+use tiltnoise_core::option_key::OptionKey;
 
 /// A channel's unit as stated, and where.
 #[derive(Debug, Clone)]
@@ -239,16 +240,14 @@ pub(crate) fn plan(
                             "feeds {}, a translation of the floor, and {}; allowed: a unit of \
                              length, velocity or acceleration (m, m/s, m/s^2 or a prefixed \
                              form), stated in the file (a `# units:` line, a `units` \
-                             attribute) or with the units option (--units {}=m/s^2, in Python \
-                             units={{\"{}\": \"m/s^2\"}})",
+                             attribute) or with the units option ({})",
                             m.input.name(),
                             if s.is_some_and(|s| s.counts) {
                                 "is in counts with no unit for its scaled values"
                             } else {
                                 "has no unit"
                             },
-                            m.source,
-                            m.source
+                            OptionKey::UNITS.entry(&m.source, "m/s^2")
                         ),
                     })
                 }
