@@ -17,7 +17,7 @@
 //! ignore (the others), so an output can be read back; pandas reads it with
 //! `pd.read_csv(path, comment="#")`.
 
-use crate::RunMeta;
+use crate::run_meta::RunMeta;
 use tiltnoise_core::option_key::OptionKey;
 
 /// Name of the first column of every CSV file tiltnoise writes (and of the frequency dataset

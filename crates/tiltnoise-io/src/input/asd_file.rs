@@ -12,9 +12,10 @@
 
 use super::csv::{parse_field, CsvFile};
 use super::h5::{self, h5err};
-use super::{frequency_refusal, InputError, InputFormat};
 use std::path::Path;
 use tiltnoise_core::error::Shown;
+use tiltnoise_core::input::require_two;
+use tiltnoise_core::input::{frequency_refusal, InputError, InputFormat};
 use tiltnoise_core::limits::ASDS;
 
 /// Frequencies (Hz) and one-sided ASD of the column read, and the column's name.
@@ -110,7 +111,7 @@ fn read_csv(path: &Path, quantity: &str, asd_unit: &'static str) -> Result<AsdCo
         asd.push(a);
         Ok(())
     })?;
-    super::require_two(path, "column frequency_hz", freqs.len(), "frequencies")?;
+    require_two(path, "column frequency_hz", freqs.len(), "frequencies")?;
     Ok(AsdColumn {
         freqs_hz: freqs,
         asd,
@@ -172,7 +173,7 @@ fn read_hdf5(path: &Path, quantity: &str, asd_unit: &'static str) -> Result<AsdC
             format!("/{column}[{k}]")
         })?;
     }
-    super::require_two(path, "dataset /frequency_hz", freqs_hz.len(), "frequencies")?;
+    require_two(path, "dataset /frequency_hz", freqs_hz.len(), "frequencies")?;
     Ok(AsdColumn {
         freqs_hz,
         asd,

@@ -19,10 +19,13 @@
 
 use super::csv::{decimal_resolution, parse_field, CsvFile, Prelude};
 use super::h5::{self, h5err, AttrValue};
-use super::{check_sample_rate, frequency_refusal, ChannelCtx, InputError, InputFormat};
 use std::path::Path;
 use tiltnoise_core::budget::{add_measured, series_psds, BudgetError, MeasuredPsds};
 use tiltnoise_core::error::{Num, Shown};
+use tiltnoise_core::input::require_two;
+use tiltnoise_core::input::{
+    check_sample_rate, frequency_refusal, ChannelCtx, InputError, InputFormat,
+};
 use tiltnoise_core::limits::{ASDS, SAMPLES};
 use tiltnoise_core::model::Observable;
 use tiltnoise_core::noise::BudgetReport;
@@ -243,7 +246,7 @@ fn finish_series(
             return Err(ctx.non_finite(index, value, line));
         }
     }
-    super::require_two(path, &format!("channel {}", o0.name()), n, "samples")?;
+    require_two(path, &format!("channel {}", o0.name()), n, "samples")?;
     Ok(MeasuredSeries {
         sample_rate_hz,
         channels,
@@ -323,7 +326,7 @@ fn read_series_csv(
         Ok(())
     })?;
     let n = times.len();
-    super::require_two(path, "column time_s", n, "samples")?;
+    require_two(path, "column time_s", n, "samples")?;
     let dt = (times[n - 1] - times[0]) / (n - 1) as f64;
     for (index, &t) in times.iter().enumerate() {
         let expected = times[0] + index as f64 * dt;
