@@ -693,7 +693,7 @@ pub fn budget_from_file(
     let refuse_series_options = || refuse(InputKind::Spectra);
     let refuse_spectra_options = || refuse(InputKind::Series);
     let (report, provenance) = py.detach(|| -> PyResult<_> {
-        let streamed = match InputFormat::from_path(&path).py()? {
+        let streamed = match tiltnoise_io::input::input_format(&path).py()? {
             InputFormat::Hdf5 => TiltSeriesSource::open(&path, &ropts).ok(),
             InputFormat::Csv | InputFormat::Miniseed => None,
         };

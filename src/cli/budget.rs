@@ -290,7 +290,7 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     let path = &args.tilt;
     // Opened once: an HDF5 series streams from the file; anything else is read whole below
     // (which reports why an HDF5 file is not a series).
-    let streamed = match InputFormat::from_path(path)? {
+    let streamed = match tiltnoise_io::input::input_format(path)? {
         InputFormat::Hdf5 => TiltSeriesSource::open(path, &ropts).ok(),
         InputFormat::Csv | InputFormat::Miniseed => None,
     };

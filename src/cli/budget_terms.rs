@@ -11,7 +11,7 @@ use tiltnoise_core::model::{Input, Observable};
 use tiltnoise_core::noise::{is_term_name, GivenAsd, Readout, UserSource, UserTerm};
 use tiltnoise_core::options;
 use tiltnoise_core::repeats::refuse_repeated_keys;
-use tiltnoise_io::input::{read_asd_column, InputFormat};
+use tiltnoise_io::input::{input_format, read_asd_column};
 
 const OBSERVABLES: &str = "X, Y, Z, theta, eta, phi, phi_a";
 const INPUTS: &str =
@@ -58,7 +58,7 @@ pub fn parse_readout(items: &[String], budgeted: &[Observable]) -> Result<(Reado
         let file = item
             .split_once('=')
             .map(|(_, v)| Path::new(v.trim()))
-            .filter(|p| InputFormat::from_path(p).is_ok());
+            .filter(|p| input_format(p).is_ok());
         let o = match file {
             None => {
                 let (o, asd) = parse_readout_item(item)?;

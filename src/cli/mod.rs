@@ -124,7 +124,7 @@ enum Command {
 impl ParamArgs {
     fn resolve(&self) -> Result<Params> {
         let mut params = match &self.params {
-            Some(path) => Params::from_file(path)?,
+            Some(path) => tiltnoise_io::read_params(path)?,
             None => Params::table_i(),
         };
         refuse_repeated_keys("--set", "parameter key", &self.set)?;

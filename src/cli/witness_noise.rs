@@ -11,7 +11,7 @@ use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::Input;
 use tiltnoise_core::noise::{NoiseLevel, WitnessNoise};
 use tiltnoise_core::repeats::refuse_repeated_keys;
-use tiltnoise_io::input::InputFormat;
+use tiltnoise_io::input::input_format;
 
 /// The model inputs a witness can record.
 const FLOOR_INPUTS: &str = "theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)";
@@ -49,7 +49,7 @@ pub fn parse_witness_noise(items: &[String]) -> Result<(Vec<WitnessNoise>, Vec<P
             }
             _ => (value.trim(), 0.0),
         };
-        let level = if InputFormat::from_path(Path::new(level)).is_ok() {
+        let level = if input_format(Path::new(level)).is_ok() {
             let path = PathBuf::from(level);
             let given = read_given(
                 &format!("--witness-noise {shown}"),

@@ -30,10 +30,12 @@ mod mc_hdf5;
 mod measured_modes;
 mod messages;
 mod output_paths;
+mod params_file;
 mod run_meta;
 mod series_hdf5;
 mod series_hdf5_stream;
 mod subtract_hdf5;
+mod text_file;
 mod tf_csv;
 mod tf_hdf5;
 mod tf_notes;
@@ -58,6 +60,7 @@ pub use freq_file::read_freq_file;
 pub use mc_hdf5::{write_mc_hdf5, REJECTED_DRAWS, SCHEMA_MC, SCHEMA_VERSION_MC};
 pub use measured_modes::{read_measured_modes, read_visibilities};
 pub use output_paths::check_outputs;
+pub use params_file::read_params;
 pub use run_meta::{RunMeta, TOOL_VERSION};
 pub use series_hdf5::{
     write_observable_series_hdf5, SeriesAsd, SimulationMeta, SCHEMA_OBSERVABLE_SERIES,

@@ -3,9 +3,9 @@
 //! replaces one of its own inputs.
 
 use crate::atomic::{probe_directory, NAME_MAX};
+use crate::input::split_hdf5_address;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::OutputError;
-use tiltnoise_core::input::split_hdf5_address;
 
 /// Checks every output path of a run against the rules below and against the files the run
 /// reads (`inputs`: the option that names each, such as `--tilt`, and its path); the

@@ -10,6 +10,7 @@
 //! the quantity's unit per sqrt(Hz). Errors name the file, the line or index, the column and the
 //! value.
 
+use super::address::input_format;
 use super::csv::{parse_field, CsvFile};
 use super::h5::{self, h5err};
 use std::path::Path;
@@ -39,7 +40,7 @@ pub fn read_asd_column(
     quantity: &str,
     asd_unit: &'static str,
 ) -> Result<AsdColumn, InputError> {
-    match InputFormat::from_path(path)? {
+    match input_format(path)? {
         InputFormat::Csv => read_csv(path, quantity, asd_unit),
         InputFormat::Hdf5 => read_hdf5(path, quantity, asd_unit),
         InputFormat::Miniseed => Err(InputError::UnknownLayout {

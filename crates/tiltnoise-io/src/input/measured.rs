@@ -17,6 +17,7 @@
 //! [`read_measured_input`] reads any of them; the budget turns a series into one-sided ASDs
 //! with its own Welch settings.
 
+use super::address::input_format;
 use super::csv::{decimal_resolution, parse_field, CsvFile, Prelude};
 use super::h5::{self, h5err, AttrValue};
 use std::path::Path;
@@ -58,7 +59,7 @@ pub enum MeasuredInput {
 /// time series; CSV is a spectrum when the header starts with `freq_hz`, a series when it
 /// starts with `time_s`.
 pub fn read_measured_input(path: &Path) -> Result<MeasuredInput, InputError> {
-    match InputFormat::from_path(path)? {
+    match input_format(path)? {
         InputFormat::Hdf5 => read_series_hdf5(path).map(MeasuredInput::Series),
         InputFormat::Miniseed => Err(InputError::UnknownLayout {
             path: path.to_path_buf(),

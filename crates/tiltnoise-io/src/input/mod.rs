@@ -18,6 +18,7 @@
 //!   [`parse_start_time`] the instant it names, [`utc_text`] the text of an instant.
 //! * [`read_asd_column`]: the ASD of one quantity (a coloured readout, a user-named term).
 
+mod address;
 mod asd_file;
 mod csv;
 mod h5;
@@ -33,6 +34,7 @@ mod spectra_gwpy;
 mod spectra_hdf5;
 mod start_time;
 
+pub use address::{input_format, split_hdf5_address};
 pub use asd_file::{read_asd_column, AsdColumn, GENERIC_ASD_COLUMN};
 pub use measured::{
     add_measured_file, read_measured, read_measured_input, MeasuredInput, MeasuredSeries,
@@ -56,7 +58,7 @@ use tiltnoise_core::error::Shown;
 /// [`InputError::Extension`], [`InputError::UnknownLayout`] (naming the accepted layouts), or
 /// any validation error of the specific reader.
 pub fn read_tilt(path: &Path, opts: &ReadOptions) -> Result<TiltInput, InputError> {
-    match InputFormat::from_path(path)? {
+    match input_format(path)? {
         InputFormat::Csv => {
             let (file, prelude) = csv::CsvFile::open(path)?;
             match csv_kind(path, &prelude)? {
@@ -96,7 +98,7 @@ pub fn read_tilt(path: &Path, opts: &ReadOptions) -> Result<TiltInput, InputErro
 ///
 /// [`InputError::WrongKind`] if the file holds spectra; otherwise as [`read_tilt`].
 pub fn read_tilt_series(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputError> {
-    match InputFormat::from_path(path)? {
+    match input_format(path)? {
         InputFormat::Hdf5 => {
             let mut src = TiltSeriesSource::open(path, opts)?;
             src.read_all()
@@ -115,7 +117,7 @@ pub fn read_tilt_series(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, I
 ///
 /// [`InputError::WrongKind`] if the file holds a time series; otherwise as [`read_tilt`].
 pub fn read_tilt_spectra(path: &Path, opts: &ReadOptions) -> Result<TiltSpectra, InputError> {
-    match InputFormat::from_path(path)? {
+    match input_format(path)? {
         InputFormat::Hdf5 => {
             let (file_path, object) = split_hdf5_address(path);
             let file = h5::open(&file_path)?;
@@ -148,7 +150,7 @@ pub fn read_tilt_spectra(path: &Path, opts: &ReadOptions) -> Result<TiltSpectra,
 /// The reader's errors: an extension other than `.h5`, `.hdf5`, `.csv`, a file that cannot be
 /// opened, a `start_time` that is not a string or not ISO 8601.
 pub fn read_start_time(path: &Path) -> Result<Option<String>, InputError> {
-    match InputFormat::from_path(path)? {
+    match input_format(path)? {
         InputFormat::Hdf5 => {
             let file = h5::open(path)?;
             h5::start_and_description(path, &file, &mut Vec::new())

@@ -1,13 +1,15 @@
 //! [`TiltSeriesSource`]: streaming access to an HDF5 time series of the floor's motion (schema
 //! `tiltnoise.tilt_series`), chunk by chunk, in bounded memory.
 
+use super::address::input_format;
+use super::address::split_hdf5_address;
 use super::h5::{self, h5err, AttrValue};
 use super::series_units::{self, check_unstated, into_series, Plan, Stated};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::Num;
+use tiltnoise_core::input::check_scales;
 use tiltnoise_core::input::Mapped;
 use tiltnoise_core::input::{check_sample_rate, require_two, InputError};
-use tiltnoise_core::input::{check_scales, split_hdf5_address};
 use tiltnoise_core::input::{
     gap_note, ChannelCtx, DetrendedRms, Gap, GapScanner, GroundChannel, TiltSeries,
 };
@@ -63,7 +65,7 @@ impl TiltSeriesSource {
     /// `docs/input_formats.md`); with gap interpolation, also the errors of the scanning pass
     /// (edge gaps).
     pub fn open(path: &Path, opts: &ReadOptions) -> Result<Self, InputError> {
-        let format = InputFormat::from_path(path)?;
+        let format = input_format(path)?;
         if format != InputFormat::Hdf5 {
             return Err(InputError::UnknownLayout {
                 path: path.to_path_buf(),
