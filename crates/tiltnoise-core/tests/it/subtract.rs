@@ -365,10 +365,7 @@ fn refusals() {
             witness_noise: white_noise(&[(TiltAxis::EtaT, asd)], rel),
             ..SubtractConfig::default()
         });
-        assert!(
-            e.contains("witness_noise eta_t") && e.contains(what),
-            "{e}"
-        );
+        assert!(e.contains("witness_noise eta_t") && e.contains(what), "{e}");
     }
     let short =
         tiltnoise_core::noise::GivenAsd::new(vec![1e-3, 1e-2], vec![1e-9, 1e-9], "n.csv").unwrap();
