@@ -47,6 +47,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 pub mod align;
+pub mod appendix;
 pub mod budget;
 pub mod cancel;
 pub mod coherence;
