@@ -42,13 +42,13 @@ pub fn refuse_options_for_input(
         InputKind::Spectra => format!(
             "{} applies to time-series input, and {source} holds {what_instead}; leave it out \
              (the model grid of spectra input is set with {})",
-            OptionKey::new(*name),
+            OptionKey::new(name),
             OptionKey::FREQ
         ),
         InputKind::Series => format!(
             "{} applies to spectra input, and {source} holds {what_instead}, whose budget is on \
              the Welch grid (set its resolution with {})",
-            OptionKey::new(*name),
+            OptionKey::new(name),
             OptionKey::NPERSEG
         ),
     }))
