@@ -21,4 +21,3 @@ mod summary;
 pub use error::JobError;
 pub use given::{read_given, witness_noise, AsdSpec, ReadoutItem, TermItem, WitnessItem};
 pub use tiltnoise_core::cancel::Cancel;
-pub use tiltnoise_core::options::Spelling;

@@ -55,6 +55,7 @@ pub use residuals::{BandSummary, ResidualSpectra};
 
 use crate::error::{Num, TfError};
 use crate::model::{Input, Model, Observable};
+use crate::option_key::OptionKey;
 use crate::params::Params;
 use crate::spectral::confidence::equivalent_averages;
 use crate::spectral::{csd_matrix, welch, SpectralError, WelchConfig};
@@ -256,8 +257,8 @@ pub enum SubtractError {
     #[error(
         "no bin of the fit band {} .. {} Hz is usable (every one is near a resonance of the \
          model, or the witness records no floor motion above its own noise there); choose \
-         another band with --band",
-        Num(.band_hz.0), Num(.band_hz.1)
+         another band with {}",
+        Num(.band_hz.0), Num(.band_hz.1), OptionKey::BAND
     )]
     NoFitBins {
         /// The band (Hz).
@@ -268,11 +269,12 @@ pub enum SubtractError {
         "the witness record is not coherent with any measured observable at any frequency (its \
          multiple coherence is what noise alone gives): it cannot be subtracted; check that the \
          records overlap in time, their axis maps and sign conventions, or give a fit band with \
-         --band"
+         {}",
+        OptionKey::BAND
     )]
     NotCoherent,
     /// A key that is not a parameter.
-    #[error("--fit: unknown parameter key `{}`; allowed: {allowed}", crate::error::Shown(.key))]
+    #[error("{}: unknown parameter key `{}`; allowed: {allowed}", OptionKey::FIT, crate::error::Shown(.key))]
     UnknownKey {
         /// The key given.
         key: String,
@@ -280,7 +282,10 @@ pub enum SubtractError {
         allowed: String,
     },
     /// A key that cannot be fitted.
-    #[error("--fit: parameter `{key}` is not a free parameter here: {reason}; allowed: {allowed}")]
+    #[error(
+        "{}: parameter `{key}` is not a free parameter here: {reason}; allowed: {allowed}",
+        OptionKey::FIT
+    )]
     NotFreeKey {
         /// The key.
         key: String,
@@ -290,7 +295,10 @@ pub enum SubtractError {
         allowed: String,
     },
     /// The same key twice.
-    #[error("--fit: parameter `{key}` is listed twice; give each key once")]
+    #[error(
+        "{}: parameter `{key}` is listed twice; give each key once",
+        OptionKey::FIT
+    )]
     DuplicateKey {
         /// The key.
         key: String,
@@ -361,11 +369,12 @@ pub fn subtract(
         return Err(SubtractError::TooShort(format!(
             "the records overlap for {}: with a held-out fraction of {} and a Welch segment of {} \
              the overlap must be at least {} (training >= {MIN_TRAINING_SEGMENTS} segments, \
-             held-out >= {MIN_HOLDOUT_SEGMENTS}); use longer records or a shorter --nperseg",
+             held-out >= {MIN_HOLDOUT_SEGMENTS}); use longer records or a shorter {}",
             span(n),
             cfg.holdout_fraction,
             span(needed_seg),
             span(needed.ceil() as usize),
+            OptionKey::NPERSEG,
         )));
     }
     let segment_s = segment_len as f64 / fs;
@@ -373,11 +382,12 @@ pub fn subtract(
         Some(d) if d.is_finite() && d > 0.0 && d <= MAX_DELAY_FRACTION * segment_s => d,
         Some(d) => {
             return Err(SubtractError::Config(format!(
-                "--max-delay {} s is not allowed: must be > 0 and at most {} of the Welch \
-                 segment, {} s (longer delays need a longer --nperseg)",
-                Num(d),
+                "{} is not allowed: must be > 0 and at most {} of the Welch segment, {} s \
+                 (longer delays need a longer {})",
+                OptionKey::MAX_DELAY.given(format!("{} s", Num(d))),
                 MAX_DELAY_FRACTION,
-                Num(MAX_DELAY_FRACTION * segment_s)
+                Num(MAX_DELAY_FRACTION * segment_s),
+                OptionKey::NPERSEG
             )))
         }
         None => DEFAULT_MAX_DELAY_FRACTION * segment_s,
@@ -411,9 +421,9 @@ pub fn subtract(
     for e in &colocated {
         if noise.iter().any(|x| x.input == e.noise.input) {
             return Err(SubtractError::Config(format!(
-                "--witness-noise {}: the noise of {} is also estimated from the co-located \
-                 records; give one or the other",
-                e.noise.input.name(),
+                "{}: the noise of {} is also estimated from the co-located records; give one \
+                 or the other",
+                OptionKey::WITNESS_NOISE.given(e.noise.input.name()),
                 e.noise.input.name()
             )));
         }
@@ -802,9 +812,9 @@ fn check_config(
     let f = cfg.holdout_fraction;
     if !(f > 0.0 && f <= MAX_HOLDOUT_FRACTION) {
         return Err(SubtractError::Config(format!(
-            "--holdout {} is not allowed: must be > 0 and <= {MAX_HOLDOUT_FRACTION} (the fit \
-             needs the larger part of the overlap)",
-            Num(f)
+            "{} is not allowed: must be > 0 and <= {MAX_HOLDOUT_FRACTION} (the fit needs the \
+             larger part of the overlap)",
+            OptionKey::HOLDOUT.given(Num(f))
         )));
     }
     for (i, input) in witness.inputs.iter().enumerate() {
@@ -825,37 +835,36 @@ fn check_config(
     for (input, r) in &cfg.colocated_noise_ratio {
         if !(r.is_finite() && *r > 0.0) {
             return Err(SubtractError::Config(format!(
-                "--colocated-ratio {}={}: the ratio of noise ASDs must be finite and > 0",
-                input.name(),
-                Num(*r)
+                "{}: the ratio of noise ASDs must be finite and > 0",
+                OptionKey::COLOCATED_RATIO.given(format!("{}={}", input.name(), Num(*r)))
             )));
         }
     }
     for x in &cfg.witness_noise {
         if !witness.inputs.contains(&x.input) {
             return Err(SubtractError::Config(format!(
-                "--witness-noise {}: the witness record has no input {}; it has {}",
-                x.input.name(),
+                "{}: the witness record has no input {}; it has {}",
+                OptionKey::WITNESS_NOISE.given(x.input.name()),
                 x.input.name(),
                 names(witness.inputs.iter().map(|a| a.name()))
             )));
         }
-        x.check("--witness-noise").map_err(SubtractError::Config)?;
+        x.check(&OptionKey::WITNESS_NOISE.to_string())
+            .map_err(SubtractError::Config)?;
     }
     for (o, asd) in &cfg.readout_asd {
         if !measured.channels.iter().any(|c| c.0 == *o) {
             return Err(SubtractError::Config(format!(
-                "--readout {}: the measured record has no channel {}; it has {}",
-                o.name(),
+                "{}: the measured record has no channel {}; it has {}",
+                OptionKey::READOUT.given(o.name()),
                 o.name(),
                 names(measured.channels.iter().map(|c| c.0.name()))
             )));
         }
         if !(asd.is_finite() && *asd >= 0.0) {
             return Err(SubtractError::Config(format!(
-                "--readout {}={}: the ASD ({}/sqrt(Hz)) must be finite and >= 0",
-                o.name(),
-                Num(*asd),
+                "{}: the ASD ({}/sqrt(Hz)) must be finite and >= 0",
+                OptionKey::READOUT.given(format!("{}={}", o.name(), Num(*asd))),
                 o.unit()
             )));
         }
@@ -863,18 +872,16 @@ fn check_config(
     if let Some((a, b)) = cfg.fit_band_hz {
         if !(a.is_finite() && b.is_finite() && 0.0 < a && a < b) {
             return Err(SubtractError::Config(format!(
-                "--band {}:{}: must be FLO:FHI with 0 < FLO < FHI (Hz)",
-                Num(a),
-                Num(b)
+                "{}: must be FLO:FHI with 0 < FLO < FHI (Hz)",
+                OptionKey::BAND.given(format!("{}:{}", Num(a), Num(b)))
             )));
         }
     }
     let (a, b) = cfg.report_band_hz;
     if !(a.is_finite() && b.is_finite() && 0.0 < a && a < b) {
         return Err(SubtractError::Config(format!(
-            "--report-band {}:{}: must be FLO:FHI with 0 < FLO < FHI (Hz)",
-            Num(a),
-            Num(b)
+            "{}: must be FLO:FHI with 0 < FLO < FHI (Hz)",
+            OptionKey::REPORT_BAND.given(format!("{}:{}", Num(a), Num(b)))
         )));
     }
     Ok(())
