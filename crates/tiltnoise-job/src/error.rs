@@ -85,7 +85,7 @@ impl JobError {
     /// The message, one line, with the options spelled as the front end in use does
     /// ([`tiltnoise_core::option_key`]).
     pub fn message(&self) -> String {
-        let opt = |name: &str| spelled(name);
+        let opt = |name: &'static str| OptionKey::new(name).to_string();
         match self {
             JobError::Input(e) => e.to_string(),
             JobError::OptionFile {
@@ -150,7 +150,7 @@ impl JobError {
                 percentiles_error(&given).to_string()
             }
             JobError::Repeated(r) => Repeated {
-                option: opt(&r.option),
+                option: spelled(&r.option),
                 ..r.clone()
             }
             .to_string(),
@@ -178,8 +178,8 @@ impl JobError {
     }
 }
 
-/// The options a job names, by key: how [`spelled`] finds the [`OptionKey`] of a name that is
-/// not `'static` (an option carried as a `String`).
+/// The options a job refuses repeated items of, by key: how [`spelled`] finds the
+/// [`OptionKey`] of a name carried as a `String`.
 const KEYS: &[&str] = &[
     "tilt",
     "measured",
