@@ -46,7 +46,7 @@ pub struct RecordClock<'a> {
 }
 
 /// How the records' times were related.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum TimeBasis {
     /// Both records state a start time; they are aligned by it.
     StartTimes,
@@ -55,7 +55,7 @@ pub enum TimeBasis {
 }
 
 /// The overlapping samples of two records `a` and `b` ([`align`]).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Alignment {
     /// First sample of `a` in the overlap.
     pub start_a: usize,

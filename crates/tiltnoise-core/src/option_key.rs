@@ -90,8 +90,6 @@ impl OptionKey {
     pub const HOLDOUT: Self = Self("holdout");
     /// The ratio of noise ASDs of co-located witnesses.
     pub const COLOCATED_RATIO: Self = Self("colocated_ratio");
-    /// Whether identically zero columns are written.
-    pub const KEEP_ZERO_COLUMNS: Self = Self("keep_zero_columns");
     /// The observables a figure draws (a subset of those computed).
     pub const DRAWN_OBSERVABLES: Self = Self("drawn_observables");
     /// A figure's size (pixels).

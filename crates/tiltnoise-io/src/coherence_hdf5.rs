@@ -20,7 +20,7 @@ pub const SCHEMA_COHERENCE: &str = "tiltnoise.coherence";
 pub const SCHEMA_VERSION_COHERENCE: i64 = 2;
 
 /// Where the two records of a coherence run came from.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CoherenceInputs {
     /// The tilt record (`--tilt`).
     pub tilt: InputMeta,

@@ -18,7 +18,6 @@
 //! `pd.read_csv(path, comment="#")`.
 
 use crate::run_meta::RunMeta;
-use tiltnoise_core::option_key::OptionKey;
 
 /// Name of the first column of every CSV file tiltnoise writes (and of the frequency dataset
 /// of every HDF5 file).
@@ -94,8 +93,7 @@ pub fn drop_zero_columns(columns: &mut Vec<(String, String, Vec<f64>)>, keep: bo
 pub fn zero_columns_note(dropped: &[String]) -> Option<String> {
     (!dropped.is_empty()).then(|| {
         format!(
-            "identically zero, left out ({} keeps them): {}",
-            OptionKey::KEEP_ZERO_COLUMNS,
+            "identically zero, left out (the keep-zero-columns option keeps them): {}",
             dropped.join(", ")
         )
     })
@@ -152,7 +150,7 @@ mod tests {
         assert_eq!(cols, vec![kept[1].clone()]);
         assert_eq!(
             zero_columns_note(&dropped).unwrap(),
-            "identically zero, left out (keep_zero_columns keeps them): a, c"
+            "identically zero, left out (the keep-zero-columns option keeps them): a, c"
         );
     }
 }

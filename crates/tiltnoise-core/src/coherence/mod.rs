@@ -114,7 +114,7 @@ impl Default for CoherenceOptions {
 }
 
 /// The Welch estimate behind the report.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct WelchSummary {
     /// Sample rate (Hz).
     pub sample_rate_hz: f64,
@@ -131,7 +131,7 @@ pub struct WelchSummary {
 }
 
 /// One observable against one tilt axis.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct AxisEstimate {
     /// The tilt axis.
     pub axis: TiltAxis,
@@ -158,7 +158,7 @@ pub struct AxisEstimate {
 }
 
 /// One measured observable against all tilt axes.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ObservableEstimate {
     /// The observable.
     pub observable: Observable,
@@ -177,7 +177,7 @@ pub struct ObservableEstimate {
 }
 
 /// Everything the coherence job found.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CoherenceReport {
     /// Welch bins (Hz), DC left out.
     pub freqs_hz: Vec<f64>,
