@@ -11,7 +11,6 @@ mod arrays;
 mod budget;
 mod coherence;
 mod errors;
-mod figure;
 mod fit;
 mod grid;
 mod inputs;

@@ -15,9 +15,11 @@
 pub mod budget;
 pub mod coherence;
 mod error;
+mod figure;
 mod given;
 mod summary;
 
 pub use error::JobError;
+pub use figure::save_image;
 pub use given::{read_given, witness_noise, AsdSpec, ReadoutItem, TermItem, WitnessItem};
 pub use tiltnoise_core::cancel::Cancel;
