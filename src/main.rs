@@ -1,6 +1,7 @@
 //! The `tiltnoise` binary: parse, run, map errors to exit code 2 with a one-line message.
 
 mod interrupt;
+mod option_style;
 
 use clap::error::ErrorKind;
 use clap::{CommandFactory, FromArgMatches};
@@ -12,6 +13,8 @@ use tiltnoise_core::error::shown_within;
 const MAX_ERROR_CHARS: usize = 2000;
 
 fn main() -> ExitCode {
+    // Before any message: the libraries' errors name options as flags (`--nperseg`).
+    tiltnoise_core::option_key::install_style(&option_style::Flags);
     // First: SIGINT, SIGTERM and SIGHUP cancel the run, remove the temporary files of the
     // outputs being written, print one line and end the process with exit code 2.
     let cancel = interrupt::install();

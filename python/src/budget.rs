@@ -3,7 +3,6 @@
 
 use crate::arrays::{self, check_size, series};
 use crate::errors::{value_error, PyResultExt};
-use crate::figure;
 use crate::inputs::Inputs;
 use crate::interrupt;
 use crate::job_args;
@@ -1047,7 +1046,7 @@ impl Budget {
                     input: Some(self.input.clone()),
                     ..tiltnoise_plot::BudgetFigureOptions::default()
                 };
-                figure::save(&path, |format| {
+                tiltnoise_job::save_image(&path, |format| {
                     tiltnoise_plot::budget_figure_with(&self.report, format, &options)
                 })
             }

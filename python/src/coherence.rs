@@ -91,6 +91,7 @@ pub fn coherence(
 /// confidence radius, and the model's. The names are the files' (``docs/schemas.md``,
 /// ``tiltnoise.coherence``).
 #[pyclass(module = "tiltnoise", frozen)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct Coherence {
     report: CoherenceReport,
     records: CoherenceInputs,
@@ -289,6 +290,22 @@ impl Coherence {
             }),
         })
         .py()
+    }
+
+    /// Pickles as its state (see the module's pickling notes).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<crate::state::Reduced<'py>> {
+        crate::state::reduce(slf.as_any(), slf.get())
+    }
+
+    /// The object of a pickled state.
+    #[staticmethod]
+    fn _from_state(version: u32, state: &[u8]) -> PyResult<Self> {
+        crate::state::load("Coherence", version, state)
+    }
+
+    /// Equal when every value is equal bit for bit and the same files are behind them.
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> PyResult<bool> {
+        crate::state::equal(self, other)
     }
 
     fn __repr__(&self) -> String {

@@ -21,6 +21,7 @@ use tiltnoise_core::error::{FreqError, OutputError, ParamError, TfError};
 use tiltnoise_core::input::InputError;
 use tiltnoise_core::limits::LimitError;
 use tiltnoise_core::mc::McError;
+use tiltnoise_core::option_key::{OptionKey, OptionStyle};
 use tiltnoise_core::options::OptionError;
 use tiltnoise_core::spectral::SpectralError;
 
@@ -31,6 +32,36 @@ pyo3::create_exception!(
     "A file that was read but is not valid: its layout, an attribute or a value is not what \
      tiltnoise accepts (the message names the file, the object and what is allowed)."
 );
+
+/// Python's spelling of the options the libraries name in their messages: the keyword
+/// argument (`nperseg`, `nperseg=8`), a mapping entry as a dict (`units={"eta_t": "urad"}`), a
+/// pair as a tuple; a parameter override is `Params.set`.
+pub struct Keywords;
+
+impl OptionStyle for Keywords {
+    fn option(&self, key: OptionKey) -> String {
+        match key {
+            OptionKey::SET => "Params.set".to_string(),
+            OptionKey::DRAWN_OBSERVABLES => "observables".to_string(),
+            _ => key.key().to_string(),
+        }
+    }
+
+    fn given(&self, key: OptionKey, value: &str) -> String {
+        match key {
+            OptionKey::SET => format!("{} {value}", self.option(key)),
+            _ => format!("{}={value}", self.option(key)),
+        }
+    }
+
+    fn entry(&self, key: OptionKey, name: &str, value: &str) -> String {
+        format!("{}={{\"{name}\": \"{value}\"}}", self.option(key))
+    }
+
+    fn pair(&self, first: &str, second: &str) -> String {
+        format!("({first}, {second})")
+    }
+}
 
 /// The `OSError` subclass for an operating-system failure to open or read a file.
 fn os_error(kind: ErrorKind, message: String) -> PyErr {

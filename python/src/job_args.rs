@@ -15,12 +15,12 @@ use tiltnoise_core::noise::UserSource;
 use tiltnoise_core::options::{self, observable_names};
 use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_job::budget::ReadRequest;
-use tiltnoise_job::{AsdSpec, JobError, ReadoutItem, Spelling, TermItem, WitnessItem};
+use tiltnoise_job::{AsdSpec, JobError, ReadoutItem, TermItem, WitnessItem};
 
 /// A job's error as the exception of its kind (`errors`' rules), with the message in keyword
 /// spelling.
 pub fn job_error(e: JobError) -> PyErr {
-    let message = e.message(Spelling::Keyword);
+    let message = e.message();
     let kind = match e {
         JobError::Input(e) | JobError::OptionFile { source: e, .. } => (*e).into_py_err(),
         JobError::Budget { source, .. } => match *source {

@@ -15,7 +15,7 @@ use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::model::{Coord, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::noise::Readout;
-use tiltnoise_core::options::{self, Spelling};
+use tiltnoise_core::options;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::simulate::resonance::check_resonances;
 use tiltnoise_core::simulate::{
@@ -102,8 +102,7 @@ pub fn run(
     if !model.is_undamped() {
         return Err(value_error(SimError::Damped.to_string()));
     }
-    let (_, nperseg) =
-        check_sampling(Spelling::Keyword, args.duration, args.step, args.nperseg).py()?;
+    let (_, nperseg) = check_sampling(args.duration, args.step, args.nperseg).py()?;
     let mut items = Vec::new();
     if let Some(d) = args.readout {
         for (name, value) in d.iter() {
@@ -120,7 +119,7 @@ pub fn run(
         .py()?
         .asd;
     readout.sort_by_key(|(o, _)| o.index());
-    let (init, init_source) = initial_state(model, &excitation(&args)?, Spelling::Keyword).py()?;
+    let (init, init_source) = initial_state(model, &excitation(&args)?).py()?;
     let cfg = SimConfig {
         dt_s: args.step,
         duration_s: args.duration,

@@ -106,3 +106,19 @@ def test_percentile_order_message_names_the_value():
         {"eta_t": x}, 1.0, segment_duration=2000, percentiles=(90, 10)))
     assert message == ("percentiles (90, 10): expected (LOWER, UPPER) with "
                        "0 <= LOWER < UPPER <= 100")
+
+
+@pytest.mark.parametrize(
+    "call, start",
+    [
+        (lambda: tiltnoise.Params().set("length.hh", 1.0), "Params.set length.hh=1.0: "),
+        (lambda: tiltnoise.budget({"eta_t": np.zeros(10_000)}, 1.0, percentiles=(10, 90)),
+         "percentiles applies to the per-segment band and needs segment_duration (e.g. "
+         "segment_duration=14400 with nperseg=4096"),
+    ],
+)
+def test_messages_spell_options_as_python_does(call, start):
+    # The library names the option by its key; Python spells it as a keyword (or the method
+    # that takes it), never as a command-line flag.
+    message = python_message(call)
+    assert message.startswith(start) and "--" not in message, message

@@ -4,7 +4,9 @@ multiprocessing and joblib use it; an unknown state is refused, never misread.""
 
 import copy
 import pickle
+import tempfile
 from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -30,6 +32,20 @@ def fit():
     return tiltnoise.Model().fit(free=["mass.m_b_kg", "length.d_m"], prior=True)
 
 
+def coherence():
+    """The coherence of a small pair of records written for it: X partly eta_t, partly noise."""
+    rng = np.random.default_rng(5)
+    n = 8192
+    theta, eta = 1e-9 * rng.standard_normal(n), 1e-9 * rng.standard_normal(n)
+    x = 1e-3 * eta + 1e-13 * rng.standard_normal(n)
+    d = Path(tempfile.mkdtemp())
+    tilt, measured = d / "tilt.csv", d / "measured.csv"
+    tilt.write_text("time_s,theta_t,eta_t\n" + "".join(
+        f"{i},{a!r},{b!r}\n" for i, (a, b) in enumerate(zip(theta.tolist(), eta.tolist()))))
+    measured.write_text("time_s,X\n" + "".join(f"{i},{a!r}\n" for i, a in enumerate(x.tolist())))
+    return tiltnoise.coherence(tilt, measured, nperseg=1024)
+
+
 MAKERS = {
     "Params": params,
     "Model": lambda: tiltnoise.Model(params()),
@@ -38,6 +54,7 @@ MAKERS = {
     "Fit": fit,
     "Simulation": lambda: tiltnoise.Model().simulate(duration=2000.0, step=1.0, seed=9),
     "Budget": budget,
+    "Coherence": coherence,
 }
 
 

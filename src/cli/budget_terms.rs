@@ -11,7 +11,6 @@ use tiltnoise_core::model::{Input, Observable};
 use tiltnoise_core::noise::UserSource;
 use tiltnoise_core::options;
 use tiltnoise_core::repeats::refuse_repeated_keys;
-use tiltnoise_io::input::InputFormat;
 use tiltnoise_job::{AsdSpec, ReadoutItem, TermItem};
 
 const OBSERVABLES: &str = "X, Y, Z, theta, eta, phi, phi_a";
@@ -35,7 +34,7 @@ pub fn parse_readout(items: &[String]) -> Result<Vec<ReadoutItem>> {
             let file = item
                 .split_once('=')
                 .map(|(_, v)| Path::new(v.trim()))
-                .filter(|p| InputFormat::from_path(p).is_ok());
+                .filter(|p| tiltnoise_io::input::input_format(p).is_ok());
             let Some(path) = file else {
                 let (observable, asd) = parse_readout_item(item)?;
                 return Ok(ReadoutItem {

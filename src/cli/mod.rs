@@ -124,7 +124,7 @@ enum Command {
 impl ParamArgs {
     fn resolve(&self) -> Result<Params> {
         let mut params = match &self.params {
-            Some(path) => Params::from_file(path)?,
+            Some(path) => tiltnoise_io::read_params(path)?,
             None => Params::table_i(),
         };
         refuse_repeated_keys("--set", "parameter key", &self.set)?;
@@ -167,7 +167,12 @@ impl Run {
         let outputs: Vec<&Path> = outputs.iter().map(PathBuf::as_path).collect();
         let flags: Vec<(String, &Path)> = files
             .into_iter()
-            .map(|(option, path)| (tiltnoise_job::Spelling::Flag.option(option), path))
+            .map(|(option, path)| {
+                (
+                    tiltnoise_core::option_key::OptionKey::new(option).to_string(),
+                    path,
+                )
+            })
             .collect();
         let inputs: Vec<(&str, &Path)> = flags.iter().map(|(o, p)| (o.as_str(), *p)).collect();
         self.check_outputs(&outputs, &inputs)
@@ -198,7 +203,7 @@ impl Run {
 
 /// A job's error in the command line's spelling of its options.
 pub(crate) fn job_error(e: tiltnoise_job::JobError) -> anyhow::Error {
-    anyhow::anyhow!(e.message(tiltnoise_job::Spelling::Flag))
+    anyhow::anyhow!(e.message())
 }
 
 /// Runs the parsed command line. Everything printed is flushed before it returns; when the

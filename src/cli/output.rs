@@ -1,6 +1,5 @@
 //! Output files by extension: HDF5 and CSV through `tiltnoise-io`, figures drawn by
-//! `tiltnoise-plot` and written through `tiltnoise-io`'s atomic writer. The only place where the
-//! two crates meet.
+//! `tiltnoise-plot` and written by the job layer's [`save_image`], which Python uses too.
 
 use std::path::Path;
 use tiltnoise_core::coherence::CoherenceReport;
@@ -9,31 +8,12 @@ use tiltnoise_core::input::InputMeta;
 use tiltnoise_core::noise::BudgetReport;
 use tiltnoise_core::tf::TransferMatrix;
 use tiltnoise_io::{
-    write_atomic, write_budget_csv, write_budget_hdf5, write_coherence_csv, write_coherence_hdf5,
-    write_tf_csv, write_tf_hdf5,
+    write_budget_csv, write_budget_hdf5, write_coherence_csv, write_coherence_hdf5, write_tf_csv,
+    write_tf_hdf5,
 };
 use tiltnoise_io::{CoherenceInputs, OutputKind, RunMeta};
-use tiltnoise_plot::{DrawError, ImageFormat};
 
-/// Draws a figure in the format named by the extension of `path` and writes it atomically.
-///
-/// # Errors
-///
-/// [`OutputError::UnknownFormat`] for an extension other than `.png`/`.svg` (nothing is drawn),
-/// [`OutputError::Write`] naming `path` for a drawing or write failure (nothing is left there).
-pub fn save_image(
-    path: &Path,
-    draw: impl FnOnce(ImageFormat) -> Result<Vec<u8>, DrawError>,
-) -> Result<(), OutputError> {
-    let format = ImageFormat::from_path(path)?;
-    let bytes = draw(format).map_err(|e| OutputError::Write {
-        path: path.to_path_buf(),
-        message: e.0,
-    })?;
-    write_atomic(path, |temp| {
-        std::fs::write(temp, &bytes).map_err(|e| e.to_string())
-    })
-}
+pub use tiltnoise_job::save_image;
 
 /// Saves a transfer matrix in the format named by the extension of `path`: HDF5 (with
 /// `meta`), CSV (`meta` is not stored), or a PNG/SVG figure.

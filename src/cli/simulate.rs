@@ -18,7 +18,6 @@ use tiltnoise_core::model::{Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::noise::Readout;
 use tiltnoise_core::options;
-use tiltnoise_core::options::Spelling;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::simulate::resonance::check_resonances;
 use tiltnoise_core::simulate::stream::{
@@ -197,7 +196,7 @@ fn initial_state(model: &Model, args: &SimulateArgs) -> Result<(InitialState, St
             energy_j: args.mode_energy,
         }
     };
-    Ok(simulate::initial_state(model, &excitation, Spelling::Flag)?)
+    Ok(simulate::initial_state(model, &excitation)?)
 }
 
 /// Runs `tiltnoise simulate`.

@@ -9,7 +9,6 @@ use std::path::{Path, PathBuf};
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::Input;
 use tiltnoise_core::repeats::refuse_repeated_keys;
-use tiltnoise_io::input::InputFormat;
 use tiltnoise_job::{AsdSpec, WitnessItem};
 
 /// The model inputs a witness can record.
@@ -50,7 +49,7 @@ pub fn parse_witness_items(items: &[String]) -> Result<Vec<WitnessItem>> {
                 }
                 _ => (value.trim(), 0.0),
             };
-            let asd = if InputFormat::from_path(Path::new(level)).is_ok() {
+            let asd = if tiltnoise_io::input::input_format(Path::new(level)).is_ok() {
                 AsdSpec::File(PathBuf::from(level))
             } else {
                 AsdSpec::White(level.parse().map_err(|_| {

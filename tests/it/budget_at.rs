@@ -9,7 +9,6 @@ use crate::tolerances::{DOF_REL, LU_GAMMA, PIPELINE_REL};
 
 use common::{assert_fails_without_output, floats, json, repo, tiltnoise};
 use serde_json::Value;
-use tiltnoise_core::params::Params;
 use tiltnoise_core::reference::ReferenceModel;
 
 fn run_json(args: &[&str]) -> Value {
@@ -59,7 +58,7 @@ fn thermal_at_f_is_exact_not_interpolated_between_bins() {
     let mut with_json = args.to_vec();
     with_json.extend(["--format", "json"]);
     let doc = run_json(&with_json);
-    let model = ReferenceModel::new(&Params::from_file(&damped).unwrap());
+    let model = ReferenceModel::new(&tiltnoise_io::read_params(&damped).unwrap());
     for (i, row) in reference["thermal_psd"]
         .as_array()
         .unwrap()

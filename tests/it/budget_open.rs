@@ -9,7 +9,6 @@ use crate::tolerances::{LOGLOG_REL, TARGET_REL, U};
 use common::{assert_fails_without_output, repo, str_attr, tiltnoise};
 use std::path::Path;
 use tiltnoise_core::model::{ForceInput, Input, Observable};
-use tiltnoise_core::params::Params;
 use tiltnoise_core::reference::ReferenceModel;
 use tiltnoise_core::tf::Request;
 
@@ -154,7 +153,7 @@ fn user_terms_and_coloured_readout_add_in_quadrature_with_their_groups() {
     // At the --at frequencies: the input's ASD through the transfer function at exactly f,
     // against the double-double reference (the planner's TARGET_REL on H, twice in |H|^2).
     let doc: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let reference = ReferenceModel::new(&Params::from_file(&damped).unwrap());
+    let reference = ReferenceModel::new(&tiltnoise_io::read_params(&damped).unwrap());
     let f_b_x = Input::Force(ForceInput::from_name("F_b.x").unwrap());
     for at in doc["summary"].as_array().unwrap() {
         let f = at["frequency_hz"].as_f64().unwrap();

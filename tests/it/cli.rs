@@ -17,7 +17,7 @@ fn params_prints_toml_that_reads_back() {
     assert!(out.status.success());
     let path = dir.path().join("p.toml");
     std::fs::write(&path, &out.stdout).unwrap();
-    let back = tiltnoise_core::params::Params::from_file(&path).unwrap();
+    let back = tiltnoise_io::read_params(&path).unwrap();
     assert_eq!(back.length.h_m, 1.5);
     assert_eq!(
         back.with_override("length.h_m=2.0").unwrap(),

@@ -375,7 +375,8 @@ fn romy_layout_fixture_reads_with_mapping_and_rate() {
             "channel `LHE`",
             "feeds x_t",
             "has no unit",
-            "--units LHE=m/s^2",
+            // The option by its key: no front end spells it in a library call.
+            "units LHE=m/s^2",
         ],
     );
     let units = ["LHE", "LHN", "LHZ"].map(|c| format!("{c}=m/s^2").parse().unwrap());

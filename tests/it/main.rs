@@ -19,6 +19,7 @@ mod budget_outputs;
 mod cli;
 mod cli_budget;
 mod coherence_cli;
+mod crate_roles;
 mod damping;
 mod docs_run;
 mod figures;

@@ -23,7 +23,7 @@ fn with(base: Params, sets: &[&str]) -> Params {
 }
 
 fn damped_example() -> Params {
-    Params::from_file(&repo("examples/damped.toml")).unwrap()
+    tiltnoise_io::read_params(&repo("examples/damped.toml")).unwrap()
 }
 
 fn log_grid(lo: f64, hi: f64, n: usize) -> Vec<f64> {

@@ -46,7 +46,7 @@ pub struct RecordClock<'a> {
 }
 
 /// How the records' times were related.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum TimeBasis {
     /// Both records state a start time; they are aligned by it.
     StartTimes,
@@ -55,7 +55,7 @@ pub enum TimeBasis {
 }
 
 /// The overlapping samples of two records `a` and `b` ([`align`]).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Alignment {
     /// First sample of `a` in the overlap.
     pub start_a: usize,
@@ -268,18 +268,18 @@ mod tests {
 
     #[test]
     fn without_start_times_both_start_together() {
-        let a = clock("--tilt t.h5", 1.0, 50, None);
-        let b = clock("--measured m.h5", 1.0, 80, Some("2020-01-01T00:00:00Z"));
+        let a = clock("tilt t.h5", 1.0, 50, None);
+        let b = clock("measured m.h5", 1.0, 80, Some("2020-01-01T00:00:00Z"));
         let al = align(&a, &b).unwrap();
         assert_eq!((al.start_a, al.start_b, al.len), (0, 0, 50));
         assert_eq!(al.basis, TimeBasis::AssumedSimultaneous);
         assert!(
-            al.notes[0].contains("--tilt t.h5 states no start time"),
+            al.notes[0].contains("tilt t.h5 states no start time"),
             "{:?}",
             al.notes
         );
         assert!(
-            al.notes[1].contains("--measured m.h5: 30 of 80 samples"),
+            al.notes[1].contains("measured m.h5: 30 of 80 samples"),
             "{:?}",
             al.notes
         );

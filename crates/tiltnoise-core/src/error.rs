@@ -4,6 +4,7 @@
 
 use crate::limits::LimitError;
 pub use crate::num_text::Num;
+use crate::option_key::OptionKey;
 use std::fmt::{self, Write as _};
 use std::path::PathBuf;
 
@@ -181,7 +182,7 @@ pub enum ParamError {
         detail: String,
     },
     /// `--set KEY=VALUE` with a malformed assignment or a key that does not exist.
-    #[error("--set {}: {message}", Shown(.assignment))]
+    #[error("{}: {message}", OptionKey::SET.given(Shown(.assignment)))]
     Override {
         /// The assignment as given.
         assignment: String,

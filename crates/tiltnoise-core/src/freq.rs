@@ -9,6 +9,7 @@ use crate::error::{FreqError, Num, Shown};
 use crate::limits::{check_count, MAX_FREQUENCY_HZ, MAX_GRID_POINTS};
 use crate::model::Model;
 use crate::modes::NormalModes;
+use crate::option_key::OptionKey;
 
 /// Lower end of the default grid (Hz): 0.1 mHz, below the torsion modes.
 pub const DEFAULT_F_LO_HZ: f64 = 1e-4;
@@ -141,7 +142,7 @@ pub fn parse_spec(spec: &str) -> Result<Vec<f64>, FreqError> {
 /// Parses `FLO:N:FHI` as [`parse_spec`] into a [`LogGrid`] of at most `limit` points (for a
 /// grid evaluated block by block, [`crate::limits::MAX_STREAMED_GRID_POINTS`]).
 pub fn parse_log_spec(spec: &str, limit: usize) -> Result<LogGrid, FreqError> {
-    let origin = || format!("--freq {}", Shown(spec));
+    let origin = || OptionKey::FREQ.given(Shown(spec)).to_string();
     let err = |message: &str| FreqError::Spec {
         origin: origin(),
         message: message.into(),
@@ -279,7 +280,7 @@ mod tests {
             assert!(matches!(e, FreqError::TooLarge(_)), "{spec}: {e}");
             let e = e.to_string();
             assert!(
-                e.starts_with(&format!("--freq {spec}: "))
+                e.starts_with(&format!("freq={spec}: "))
                     && e.contains("frequency points")
                     && e.contains("more than the 1000000 allowed"),
                 "{e}"

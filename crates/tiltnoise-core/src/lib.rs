@@ -47,6 +47,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 pub mod align;
+pub mod appendix;
 pub mod budget;
 pub mod cancel;
 pub mod coherence;
@@ -65,6 +66,7 @@ pub mod model;
 pub mod modes;
 pub mod noise;
 mod num_text;
+pub mod option_key;
 pub mod options;
 pub mod params;
 pub mod reference;

@@ -2,41 +2,14 @@
 //! command line (`--input F_b.x,M_b.z`, `--readout X=9e-9`) and the Python package
 //! (`inputs=["F_b.x", "M_b.z"]`, `readout={"X": 9e-9}`) call these functions and so say the
 //! same thing about the same mistake. A message starts with the option as the caller spells it
-//! ([`Spelling`]), then the value given and what is allowed.
+//! (the `option` argument; options the library names itself are [`crate::option_key::OptionKey`]s),
+//! then the value given and what is allowed.
 
 use crate::error::{Num, Shown};
 use crate::limits::{LimitError, ASDS};
 use crate::model::{ForceInput, Input, Observable};
 use crate::noise::Readout;
 use crate::repeats::{refuse_repeats, Repeated};
-
-/// How a front end spells its options in messages.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Spelling {
-    /// The command line's flags: `--segment-duration 3600`.
-    Flag,
-    /// Keyword arguments (Python): `segment_duration=3600`.
-    Keyword,
-}
-
-impl Spelling {
-    /// The option `name` (snake case, as a keyword: `segment_duration`) as this front end
-    /// spells it: `--segment-duration` or `segment_duration`.
-    pub fn option(self, name: &str) -> String {
-        match self {
-            Spelling::Flag => format!("--{}", name.replace('_', "-")),
-            Spelling::Keyword => name.to_string(),
-        }
-    }
-
-    /// The option `name` set to `value`: `--segment-duration 3600` or `segment_duration=3600`.
-    pub fn example(self, name: &str, value: &str) -> String {
-        match self {
-            Spelling::Flag => format!("{} {value}", self.option(name)),
-            Spelling::Keyword => format!("{name}={value}"),
-        }
-    }
-}
 
 /// A name or option value that is not allowed; the message names the option, the value and
 /// what is allowed.
@@ -308,44 +281,24 @@ mod tests {
     use super::*;
 
     #[test]
-    fn spellings_of_an_option() {
-        assert_eq!(
-            Spelling::Flag.option("segment_duration"),
-            "--segment-duration"
-        );
-        assert_eq!(
-            Spelling::Keyword.option("segment_duration"),
-            "segment_duration"
-        );
-        assert_eq!(
-            Spelling::Flag.example("segment_duration", "3600"),
-            "--segment-duration 3600"
-        );
-        assert_eq!(
-            Spelling::Keyword.example("segment_duration", "3600"),
-            "segment_duration=3600"
-        );
-    }
-
-    #[test]
     fn inputs_parse_lists_groups_and_repeats() {
-        let got = parse_inputs("--input", &["F_b.x, M_b.z", "theta_t"]).unwrap();
+        let got = parse_inputs("inputs", &["F_b.x, M_b.z", "theta_t"]).unwrap();
         let names: Vec<&str> = got.iter().map(|i| i.name()).collect();
         assert_eq!(names, ["F_b.x", "M_b.z", "theta_t"]);
         assert_eq!(
-            parse_inputs::<&str>("--input", &[]).unwrap(),
+            parse_inputs::<&str>("inputs", &[]).unwrap(),
             Input::all_tilts()
         );
-        assert_eq!(parse_inputs("--input", &["forces"]).unwrap().len(), 12);
-        assert_eq!(parse_inputs("--input", &["tilt,forces"]).unwrap().len(), 15);
+        assert_eq!(parse_inputs("inputs", &["forces"]).unwrap().len(), 12);
+        assert_eq!(parse_inputs("inputs", &["tilt,forces"]).unwrap().len(), 15);
         assert_eq!(
-            parse_inputs("--input", &["translation"]).unwrap(),
+            parse_inputs("inputs", &["translation"]).unwrap(),
             Input::all_translations()
         );
-        let ground = parse_inputs("--input", &["ground"]).unwrap();
+        let ground = parse_inputs("inputs", &["ground"]).unwrap();
         let names: Vec<&str> = ground.iter().map(|i| i.name()).collect();
         assert_eq!(names, ["theta_t", "eta_t", "phi_t", "x_t", "y_t", "z_t"]);
-        let e = parse_inputs("--input", &["ground,y_t"]).unwrap_err();
+        let e = parse_inputs("inputs", &["ground,y_t"]).unwrap_err();
         assert!(e.to_string().contains("y_t is given twice"), "{e}");
     }
 
@@ -358,33 +311,33 @@ mod tests {
                 && e.contains("theta_t"),
             "{e}"
         );
-        let e = parse_inputs("--input", &["F_b.x,F_b.x"]).unwrap_err();
+        let e = parse_inputs("inputs", &["F_b.x,F_b.x"]).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "--input: F_b.x is given twice; name each input once"
+            "inputs: F_b.x is given twice; name each input once"
         );
-        let e = parse_inputs("--input", &["tilt,eta_t"]).unwrap_err();
+        let e = parse_inputs("inputs", &["tilt,eta_t"]).unwrap_err();
         assert!(e.to_string().contains("eta_t is given twice"), "{e}");
-        let e = parse_inputs("--input", &["F_b.x,,M_b.z"]).unwrap_err();
+        let e = parse_inputs("inputs", &["F_b.x,,M_b.z"]).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "--input \"F_b.x,,M_b.z\": empty name in the list (names are separated by single \
+            "inputs \"F_b.x,,M_b.z\": empty name in the list (names are separated by single \
              commas)"
         );
     }
 
     #[test]
     fn outputs_parse_and_refuse_unknown_names() {
-        let got = parse_outputs("--output", &["phi,X"]).unwrap();
+        let got = parse_outputs("outputs", &["phi,X"]).unwrap();
         assert_eq!(got, [Observable::Phi, Observable::X]);
         assert_eq!(
-            parse_outputs::<&str>("--output", &[]).unwrap(),
+            parse_outputs::<&str>("outputs", &[]).unwrap(),
             Observable::ALL.to_vec()
         );
-        let e = parse_outputs("--output", &["x"]).unwrap_err().to_string();
+        let e = parse_outputs("outputs", &["x"]).unwrap_err().to_string();
         assert_eq!(
             e,
-            "--output: unknown observable \"x\"; allowed: X, Y, Z, theta, eta, phi, phi_a"
+            "outputs: unknown observable \"x\"; allowed: X, Y, Z, theta, eta, phi, phi_a"
         );
         let e = parse_outputs("outputs", &["X", "X"])
             .unwrap_err()
@@ -395,7 +348,7 @@ mod tests {
     #[test]
     fn readout_items_as_text_and_as_keywords() {
         assert_eq!(
-            parse_readout_item("--readout", "phi = 1e-9").unwrap(),
+            parse_readout_item("readout", "phi = 1e-9").unwrap(),
             (Observable::Phi, 1e-9)
         );
         assert_eq!(
@@ -403,23 +356,21 @@ mod tests {
             (Observable::Phi, 1e-9)
         );
         let cases = [
-            ("X", "--readout X: expected OBS=ASD, e.g. X=9e-9"),
+            ("X", "readout X: expected OBS=ASD, e.g. X=9e-9"),
             (
                 "q=1",
-                "--readout q=1: unknown observable `q`; allowed: X, Y, Z, theta, eta, phi, phi_a",
+                "readout q=1: unknown observable `q`; allowed: X, Y, Z, theta, eta, phi, phi_a",
             ),
-            ("X=abc", "--readout X=abc: `abc` is not a number"),
+            ("X=abc", "readout X=abc: `abc` is not a number"),
             (
                 "X=-1",
-                "--readout X=-1: ASD -1 m/sqrt(Hz) is not allowed: must be 0 or a value from \
+                "readout X=-1: ASD -1 m/sqrt(Hz) is not allowed: must be 0 or a value from \
                  1e-40 to 1e40 m/sqrt(Hz) (see docs/limits.md)",
             ),
         ];
         for (item, want) in cases {
             assert_eq!(
-                parse_readout_item("--readout", item)
-                    .unwrap_err()
-                    .to_string(),
+                parse_readout_item("readout", item).unwrap_err().to_string(),
                 want
             );
         }
@@ -436,7 +387,7 @@ mod tests {
     fn readout_items_replace_remove_and_are_checked_against_the_budget() {
         let budgeted = [Observable::X, Observable::Phi];
         let r = apply_readout(
-            "--readout",
+            "readout",
             Readout::default(),
             &[(Observable::Phi, 1e-9), (Observable::X, 0.0)],
             Some(&budgeted),
@@ -455,14 +406,14 @@ mod tests {
             "readout theta=...: theta is not budgeted; allowed: X, phi"
         );
         let r = apply_readout(
-            "--readout",
+            "readout",
             Readout::default(),
             &[(Observable::Theta, 1e-9)],
             None,
         );
         assert_eq!(r.unwrap().asd.len(), 2);
         let e = apply_readout(
-            "--readout",
+            "readout",
             Readout::default(),
             &[(Observable::X, 1e-9), (Observable::X, 2e-9)],
             None,
@@ -470,7 +421,7 @@ mod tests {
         .unwrap_err();
         assert_eq!(
             e.to_string(),
-            "--readout: X is given twice; name each observable once"
+            "readout: X is given twice; name each observable once"
         );
     }
 }

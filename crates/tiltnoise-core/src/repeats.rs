@@ -94,23 +94,23 @@ mod tests {
     fn the_first_repeat_is_named_with_its_option() {
         let keys = keys_of(&["length.h_m=1", " mass.m_a_kg = 2", "length.h_m =3"]);
         assert_eq!(keys, ["length.h_m", "mass.m_a_kg", "length.h_m"]);
-        let e = refuse_repeats("--set", "parameter key", &keys, |k| k.to_string()).unwrap_err();
+        let e = refuse_repeats("set", "parameter key", &keys, |k| k.to_string()).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "--set: length.h_m is given twice; name each parameter key once"
+            "set: length.h_m is given twice; name each parameter key once"
         );
         // Typed keys: equal values are one key however they were written.
-        let e = refuse_repeats("--at", "frequency", &[1e-3, 2e-3, 0.001], |f| f.to_string())
-            .unwrap_err();
+        let e =
+            refuse_repeats("at", "frequency", &[1e-3, 2e-3, 0.001], |f| f.to_string()).unwrap_err();
         assert_eq!(e.name, "0.001");
-        assert!(refuse_repeats::<f64>("--at", "frequency", &[], |f| f.to_string()).is_ok());
+        assert!(refuse_repeats::<f64>("at", "frequency", &[], |f| f.to_string()).is_ok());
         assert_eq!(keys_of(&["no-equals"]), ["no-equals"]);
         let entries = list_entries(&["theta_a=1, phi_b=2,", "theta_a=3"]);
         assert_eq!(entries, ["theta_a=1", "phi_b=2", "theta_a=3"]);
-        let e = refuse_repeated_keys("--init", "coordinate", &entries).unwrap_err();
+        let e = refuse_repeated_keys("init", "coordinate", &entries).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "--init: theta_a is given twice; name each coordinate once"
+            "init: theta_a is given twice; name each coordinate once"
         );
     }
 }

@@ -1,8 +1,10 @@
 //! ASDs of observables as CSV (`tiltnoise simulate --save asd.csv`), in the layout the budget
 //! reads as a measured spectrum (`docs/input_formats.md`).
 
+use crate::atomic::write_atomic;
 use crate::csv_layout::{csv_head, CsvPreamble};
-use crate::{format_f64, write_atomic, RunMeta};
+use crate::run_meta::RunMeta;
+use crate::tf_csv::format_f64;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
 use tiltnoise_core::model::Observable;

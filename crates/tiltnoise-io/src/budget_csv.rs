@@ -1,11 +1,11 @@
 //! Noise budget as CSV: one ASD column per observable and term (schema `docs/schemas.md`,
 //! section "Noise budgets, CSV").
 
-use super::format_f64;
 use crate::atomic::write_atomic;
 use crate::budget_hdf5::SPECTRAL_CONVENTION;
 use crate::csv_layout::{csv_head, drop_zero_columns, zero_columns_note, CsvPreamble};
-use crate::RunMeta;
+use crate::run_meta::RunMeta;
+use crate::tf_csv::format_f64;
 use std::io::{BufWriter, Write as _};
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
@@ -68,7 +68,7 @@ pub fn budget_csv_string(
     let mut columns = asd_columns(report);
     let dropped = drop_zero_columns(&mut columns, keep_zero_columns);
     let mut notes = vec![format!("every column an ASD; {SPECTRAL_CONVENTION}")];
-    notes.extend(zero_columns_note(&dropped, "--keep-zero-columns"));
+    notes.extend(zero_columns_note(&dropped));
     let preamble = CsvPreamble {
         schema: SCHEMA_BUDGET_CSV,
         schema_version: SCHEMA_VERSION_BUDGET_CSV,

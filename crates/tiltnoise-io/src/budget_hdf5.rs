@@ -1,10 +1,12 @@
 //! Noise budget as HDF5 (schema `tiltnoise.budget`, documented in `docs/schemas.md`).
 
 use super::h5util::{dataset, provenance, scalar_attr, str_attr, strs_attr};
-use super::{InputMeta, RunMeta, SIGN_CONVENTION};
 use crate::atomic::write_atomic;
+use crate::run_meta::RunMeta;
+use crate::tf_hdf5::SIGN_CONVENTION;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
+use tiltnoise_core::input::InputMeta;
 use tiltnoise_core::noise::equivalent::referred_terms;
 use tiltnoise_core::noise::{
     BudgetReport, Component, Evaluation, SpectralSource, SummaryAt, TermKind, TOTAL_NAME,
@@ -46,7 +48,7 @@ pub fn write_budget_hdf5(
     write_atomic(path, |temp| {
         report.check()?;
         write_file(temp, report, meta, input)
-            .map_err(|e| format!("HDF5: {}", crate::first_line(&e.to_string())))
+            .map_err(|e| format!("HDF5: {}", crate::messages::first_line(&e.to_string())))
     })
 }
 

@@ -1,10 +1,10 @@
 //! Coherence and measured transfer functions as CSV, units in the header (schema
 //! `docs/schemas.md`, section "Coherence, CSV").
 
-use super::format_f64;
 use crate::atomic::write_atomic;
 use crate::csv_layout::{csv_head, CsvPreamble};
-use crate::RunMeta;
+use crate::run_meta::RunMeta;
+use crate::tf_csv::format_f64;
 use std::io::{BufWriter, Write as _};
 use std::path::Path;
 use tiltnoise_core::coherence::CoherenceReport;

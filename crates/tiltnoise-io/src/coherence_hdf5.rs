@@ -2,13 +2,16 @@
 //! in `docs/schemas.md` and `docs/coherence.md`).
 
 use super::h5util::{dataset, provenance, scalar_attr, str_attr, strs_attr};
-use super::{InputMeta, RunMeta, SIGN_CONVENTION, SPECTRAL_CONVENTION, TIME_DEPENDENCE};
 use crate::atomic::write_atomic;
+use crate::budget_hdf5::SPECTRAL_CONVENTION;
+use crate::run_meta::RunMeta;
+use crate::tf_hdf5::{SIGN_CONVENTION, TIME_DEPENDENCE};
 use num_complex::Complex64;
 use std::path::Path;
 use tiltnoise_core::align::TimeBasis;
 use tiltnoise_core::coherence::CoherenceReport;
 use tiltnoise_core::error::OutputError;
+use tiltnoise_core::input::InputMeta;
 
 /// Value of the root attribute `schema`.
 pub const SCHEMA_COHERENCE: &str = "tiltnoise.coherence";
@@ -17,7 +20,7 @@ pub const SCHEMA_COHERENCE: &str = "tiltnoise.coherence";
 pub const SCHEMA_VERSION_COHERENCE: i64 = 2;
 
 /// Where the two records of a coherence run came from.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CoherenceInputs {
     /// The tilt record (`--tilt`).
     pub tilt: InputMeta,
@@ -48,7 +51,7 @@ pub fn write_coherence_hdf5(
 ) -> Result<(), OutputError> {
     write_atomic(path, |temp| {
         write_file(temp, report, meta, inputs)
-            .map_err(|e| format!("HDF5: {}", crate::first_line(&e.to_string())))
+            .map_err(|e| format!("HDF5: {}", crate::messages::first_line(&e.to_string())))
     })
 }
 

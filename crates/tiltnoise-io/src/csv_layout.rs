@@ -17,7 +17,7 @@
 //! ignore (the others), so an output can be read back; pandas reads it with
 //! `pd.read_csv(path, comment="#")`.
 
-use crate::RunMeta;
+use crate::run_meta::RunMeta;
 
 /// Name of the first column of every CSV file tiltnoise writes (and of the frequency dataset
 /// of every HDF5 file).
@@ -90,10 +90,10 @@ pub fn drop_zero_columns(columns: &mut Vec<(String, String, Vec<f64>)>, keep: bo
 }
 
 /// The `# note:` line for columns left out because they are identically zero.
-pub fn zero_columns_note(dropped: &[String], keep_option: &str) -> Option<String> {
+pub fn zero_columns_note(dropped: &[String]) -> Option<String> {
     (!dropped.is_empty()).then(|| {
         format!(
-            "identically zero, left out ({keep_option} keeps them): {}",
+            "identically zero, left out (the keep-zero-columns option keeps them): {}",
             dropped.join(", ")
         )
     })
@@ -107,7 +107,7 @@ mod tests {
     fn head_has_one_unit_per_column_and_plain_names() {
         let meta = RunMeta {
             tool_version: "9.9.9".into(),
-            command_line: "tiltnoise budget --x\nINJECTED".into(),
+            command_line: "tiltnoise budget -x\nINJECTED".into(),
             ..RunMeta::default()
         };
         let p = CsvPreamble {
@@ -127,7 +127,7 @@ mod tests {
             [
                 "# schema: tiltnoise.test_csv",
                 "# schema_version: 3",
-                "# created_by: tiltnoise budget --x INJECTED",
+                "# created_by: tiltnoise budget -x INJECTED",
                 "# tool_version: 9.9.9",
                 "# note: one-sided",
                 "# units: X.tilt=m/sqrt(Hz), phi.tilt=rad/sqrt(Hz)",
@@ -149,8 +149,8 @@ mod tests {
         assert_eq!(dropped, ["a", "c"]);
         assert_eq!(cols, vec![kept[1].clone()]);
         assert_eq!(
-            zero_columns_note(&dropped, "--keep-zero-columns").unwrap(),
-            "identically zero, left out (--keep-zero-columns keeps them): a, c"
+            zero_columns_note(&dropped).unwrap(),
+            "identically zero, left out (the keep-zero-columns option keeps them): a, c"
         );
     }
 }

@@ -2,7 +2,7 @@
 //! `docs/fit.md` and `docs/schemas.md`).
 
 use super::h5util::{dataset, provenance, scalar_attr, str_attr, strings, strs_attr};
-use super::RunMeta;
+use crate::run_meta::RunMeta;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
 use tiltnoise_core::fit::{Bound, FitResult};
@@ -29,8 +29,8 @@ pub fn write_fit_hdf5(
     origin: &str,
     meta: &RunMeta,
 ) -> Result<(), OutputError> {
-    crate::write_atomic(path, |tmp| {
-        write_h5(tmp, r, origin, meta).map_err(|e| crate::first_line(&e.to_string()))
+    crate::atomic::write_atomic(path, |tmp| {
+        write_h5(tmp, r, origin, meta).map_err(|e| crate::messages::first_line(&e.to_string()))
     })
 }
 

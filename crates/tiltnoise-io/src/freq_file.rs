@@ -2,13 +2,11 @@
 //! `#` comment lines are ignored; CSV text as [`tiltnoise_core::csv_text`] reads it, with a
 //! single column. At most [`MAX_FREQ_FILE_BYTES`] and [`MAX_GRID_POINTS`] frequencies.
 
+use crate::text_file::{read_text_file, TextFileError};
 use std::path::Path;
 use tiltnoise_core::csv_text::{line_text, CsvRecords};
 use tiltnoise_core::error::{FreqError, Shown};
-use tiltnoise_core::limits::{
-    check_count, read_text_file, TextFileError, MAX_FREQUENCY_HZ, MAX_FREQ_FILE_BYTES,
-    MAX_GRID_POINTS,
-};
+use tiltnoise_core::limits::{check_count, MAX_FREQUENCY_HZ, MAX_FREQ_FILE_BYTES, MAX_GRID_POINTS};
 
 /// Reads a frequency file. Every value must be finite, >= 0 and at most
 /// [`MAX_FREQUENCY_HZ`]; at least one is required.

@@ -62,7 +62,7 @@ pub(super) fn provenance(
     file: &hdf5::File,
     schema: &str,
     schema_version: i64,
-    meta: &super::RunMeta,
+    meta: &crate::run_meta::RunMeta,
 ) -> hdf5::Result<()> {
     str_attr(file, "schema", schema)?;
     scalar_attr(file, "schema_version", schema_version)?;

@@ -28,12 +28,17 @@ mod h5util;
 pub mod input;
 mod mc_hdf5;
 mod measured_modes;
+mod messages;
 mod output_paths;
+mod params_file;
+mod run_meta;
 mod series_hdf5;
 mod series_hdf5_stream;
 mod subtract_hdf5;
+mod text_file;
 mod tf_csv;
 mod tf_hdf5;
+mod tf_notes;
 mod tf_stream;
 
 pub use asd_csv::{write_asd_csv, SCHEMA_OBSERVABLE_ASD_CSV, SCHEMA_VERSION_OBSERVABLE_ASD_CSV};
@@ -55,6 +60,8 @@ pub use freq_file::read_freq_file;
 pub use mc_hdf5::{write_mc_hdf5, REJECTED_DRAWS, SCHEMA_MC, SCHEMA_VERSION_MC};
 pub use measured_modes::{read_measured_modes, read_visibilities};
 pub use output_paths::check_outputs;
+pub use params_file::read_params;
+pub use run_meta::{RunMeta, TOOL_VERSION};
 pub use series_hdf5::{
     write_observable_series_hdf5, SeriesAsd, SimulationMeta, SCHEMA_OBSERVABLE_SERIES,
     SCHEMA_VERSION_OBSERVABLE_SERIES,
@@ -72,59 +79,12 @@ use std::path::Path;
 pub use tiltnoise_core::error::OutputError;
 pub use tiltnoise_core::input::InputMeta;
 
-/// Provenance of a run, stored alongside the results in self-describing formats (HDF5).
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct RunMeta {
-    /// Version of the tool that wrote the file: [`TOOL_VERSION`].
-    pub tool_version: String,
-    /// The full effective parameter set as TOML text ([`tiltnoise_core::params::Params::to_toml`]).
-    pub params_toml: String,
-    /// The command line that produced the file.
-    pub command_line: String,
-    /// Normal modes to record: `(index, frequency in Hz)`. The index is stored unchanged; by
-    /// convention it is the mode's `index` from the `modes` module (1-based, in order of
-    /// increasing frequency: the paper's nu_1 ... nu_8). Empty: no `/modes` group is written.
-    pub modes: Vec<(usize, f64)>,
-}
-
-impl RunMeta {
-    /// The provenance of the running process: this tool's version, `params` as TOML, the
-    /// command line, and the frequencies of `modes` when given.
-    pub fn of_this_run(
-        params: &tiltnoise_core::params::Params,
-        modes: Option<&tiltnoise_core::modes::NormalModes>,
-    ) -> RunMeta {
-        RunMeta {
-            tool_version: TOOL_VERSION.to_string(),
-            params_toml: params.to_toml(),
-            command_line: std::env::args().collect::<Vec<_>>().join(" "),
-            modes: modes
-                .map(|m| m.modes.iter().map(|m| (m.index, m.frequency_hz)).collect())
-                .unwrap_or_default(),
-        }
-    }
-}
-
-/// The first line of a library's message: HDF5 errors can span several lines (the library's
-/// error stack), and every error tiltnoise prints is one line.
-pub(crate) fn first_line(message: &str) -> String {
-    message
-        .lines()
-        .next()
-        .unwrap_or_default()
-        .trim_end()
-        .to_string()
-}
-
 /// Version of the HDF5 library linked into this build (`major.minor.release`): the one
 /// bundled with `hdf5-metno`, built from source and linked statically.
 pub fn hdf5_version() -> String {
     let (major, minor, release) = hdf5::library_version();
     format!("{major}.{minor}.{release}")
 }
-
-/// This crate's version, `env!("CARGO_PKG_VERSION")`, for [`RunMeta::tool_version`].
-pub const TOOL_VERSION: &str = env!("CARGO_PKG_VERSION");
 
 /// Extensions accepted by [`OutputKind::from_path`], as shown in error messages.
 pub const ALLOWED_EXTENSIONS: &str = ".h5, .hdf5, .csv, .png, .svg";
@@ -164,29 +124,5 @@ impl OutputKind {
                 allowed: ALLOWED_EXTENSIONS,
             }),
         }
-    }
-}
-
-/// What a file that is not a regular file is, for messages: `a directory`, `a FIFO`, ...
-pub(crate) fn file_kind(kind: &std::fs::FileType) -> &'static str {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt;
-        if kind.is_fifo() {
-            return "a FIFO";
-        } else if kind.is_char_device() {
-            return "a character device";
-        } else if kind.is_block_device() {
-            return "a block device";
-        } else if kind.is_socket() {
-            return "a socket";
-        }
-    }
-    if kind.is_dir() {
-        "a directory"
-    } else if kind.is_file() {
-        "a regular file"
-    } else {
-        "a special file"
     }
 }

@@ -2,8 +2,8 @@
 //! `docs/schemas.md`).
 
 use super::h5util::{dataset, provenance, scalar_attr, str_attr, strings, unit_dataset};
-use super::RunMeta;
 use crate::atomic::write_atomic;
+use crate::run_meta::RunMeta;
 use ndarray::Array2;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
@@ -37,7 +37,7 @@ pub fn write_mc_hdf5(
 ) -> Result<(), OutputError> {
     write_atomic(path, |temp| {
         write_file(temp, result, cfg, nominal_hz, meta)
-            .map_err(|e| format!("HDF5: {}", crate::first_line(&e.to_string())))
+            .map_err(|e| format!("HDF5: {}", crate::messages::first_line(&e.to_string())))
     })
 }
 

@@ -2,9 +2,10 @@
 //! the formats that [`tiltnoise_core::fit::Measured::parse`] and
 //! [`tiltnoise_core::fit::Visibilities::parse`] validate.
 
+use crate::text_file::{read_text_file, TextFileError};
 use std::path::Path;
 use tiltnoise_core::fit::{FitError, Measured, Visibilities};
-use tiltnoise_core::limits::{read_text_file, TextFileError, MAX_SETTINGS_FILE_BYTES};
+use tiltnoise_core::limits::MAX_SETTINGS_FILE_BYTES;
 
 /// Reads and validates a measured-frequency file; its path names it in messages.
 ///

@@ -3,9 +3,9 @@
 //! replaces one of its own inputs.
 
 use crate::atomic::{probe_directory, NAME_MAX};
+use crate::input::split_hdf5_address;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::OutputError;
-use tiltnoise_core::input::split_hdf5_address;
 
 /// Checks every output path of a run against the rules below and against the files the run
 /// reads (`inputs`: the option that names each, such as `--tilt`, and its path); the
@@ -199,20 +199,17 @@ mod tests {
         let d = dir.path();
         let input = d.join("tilt.h5");
         std::fs::write(&input, "x").unwrap();
-        let e = refusal(&[&input], &[("--tilt", &input)]);
-        assert!(
-            e.contains("--tilt") && e.contains("replace an input"),
-            "{e}"
-        );
+        let e = refusal(&[&input], &[("tilt", &input)]);
+        assert!(e.contains("tilt") && e.contains("replace an input"), "{e}");
         #[cfg(unix)]
         {
             let link = d.join("link.h5");
             std::os::unix::fs::symlink(&input, &link).unwrap();
-            let e = refusal(&[&link], &[("--tilt", &input)]);
-            assert!(e.contains("link.h5") && e.contains("--tilt"), "{e}");
+            let e = refusal(&[&link], &[("tilt", &input)]);
+            assert!(e.contains("link.h5") && e.contains("tilt"), "{e}");
         }
         let other = d.join("other.h5");
-        assert!(check_outputs(&[&other], &[("--tilt", &input)]).is_ok());
+        assert!(check_outputs(&[&other], &[("tilt", &input)]).is_ok());
     }
 
     #[test]
@@ -222,23 +219,20 @@ mod tests {
         let file = d.join("gw.h5");
         std::fs::write(&file, "x").unwrap();
         let address = d.join("gw.h5:/tilt/theta");
-        let e = refusal(&[&file], &[("--tilt", &address)]);
-        assert!(
-            e.contains("--tilt") && e.contains("replace an input"),
-            "{e}"
-        );
+        let e = refusal(&[&file], &[("tilt", &address)]);
+        assert!(e.contains("tilt") && e.contains("replace an input"), "{e}");
         let roundabout = d.join("sub/../gw.h5");
         std::fs::create_dir(d.join("sub")).unwrap();
-        assert!(check_outputs(&[&roundabout], &[("--tilt", &address)]).is_err());
+        assert!(check_outputs(&[&roundabout], &[("tilt", &address)]).is_err());
         #[cfg(unix)]
         {
             std::os::unix::fs::symlink(&file, d.join("link.h5")).unwrap();
             let through_link = d.join("link.h5:/theta");
-            assert!(check_outputs(&[&file], &[("--tilt", &through_link)]).is_err());
+            assert!(check_outputs(&[&file], &[("tilt", &through_link)]).is_err());
             std::fs::hard_link(&file, d.join("hard.h5")).unwrap();
-            assert!(check_outputs(&[&d.join("hard.h5")], &[("--tilt", &address)]).is_err());
+            assert!(check_outputs(&[&d.join("hard.h5")], &[("tilt", &address)]).is_err());
         }
         let other = d.join("other.h5");
-        assert!(check_outputs(&[&other], &[("--tilt", &address)]).is_ok());
+        assert!(check_outputs(&[&other], &[("tilt", &address)]).is_ok());
     }
 }

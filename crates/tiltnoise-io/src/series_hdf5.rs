@@ -9,8 +9,9 @@
 //! groups, which series readers ignore.
 
 use super::h5util::{dataset, scalar_attr, str_attr, strs_attr, unit_dataset, units_dataset};
-use super::{RunMeta, SPECTRAL_CONVENTION};
 use crate::atomic::write_atomic;
+use crate::budget_hdf5::SPECTRAL_CONVENTION;
+use crate::run_meta::RunMeta;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
 use tiltnoise_core::model::{Coord, Observable};
@@ -76,7 +77,7 @@ pub fn write_observable_series_hdf5(
     write_atomic(path, |temp| {
         check_asd(asd)?;
         write_file(temp, sim, asd, meta)
-            .map_err(|e| format!("HDF5: {}", crate::first_line(&e.to_string())))
+            .map_err(|e| format!("HDF5: {}", crate::messages::first_line(&e.to_string())))
     })
 }
 

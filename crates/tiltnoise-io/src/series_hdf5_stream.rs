@@ -7,8 +7,8 @@
 
 use super::h5util::str_attr;
 use super::series_hdf5::{check_asd, series_attrs, write_groups, write_root};
-use super::{SeriesAsd, SimulationMeta};
 use crate::atomic::AtomicFile;
+use crate::series_hdf5::{SeriesAsd, SimulationMeta};
 use ndarray::{s, ArrayView1};
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
@@ -42,7 +42,7 @@ impl std::fmt::Debug for ObservableSeriesWriter {
 }
 
 fn h5_error(e: hdf5::Error) -> String {
-    format!("HDF5: {}", crate::first_line(&e.to_string()))
+    format!("HDF5: {}", crate::messages::first_line(&e.to_string()))
 }
 
 /// A 1-D float64 dataset of length 0 that grows by [`ObservableSeriesWriter::append`].

@@ -10,10 +10,12 @@
 
 use super::h5util::{dataset, scalar_attr, str_attr, strs_attr, unit_dataset, units_dataset};
 use super::series_hdf5::{SCHEMA_OBSERVABLE_SERIES, SCHEMA_VERSION_OBSERVABLE_SERIES};
-use super::{InputMeta, RunMeta, SPECTRAL_CONVENTION};
 use crate::atomic::write_atomic;
+use crate::budget_hdf5::SPECTRAL_CONVENTION;
+use crate::run_meta::RunMeta;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
+use tiltnoise_core::input::InputMeta;
 use tiltnoise_core::subtract::{Method, SubtractResult};
 
 /// Provenance of a subtraction run.
@@ -51,7 +53,7 @@ pub fn write_subtract_hdf5(
 ) -> Result<(), OutputError> {
     write_atomic(path, |temp| {
         write_file(temp, result, meta)
-            .map_err(|e| format!("HDF5: {}", crate::first_line(&e.to_string())))
+            .map_err(|e| format!("HDF5: {}", crate::messages::first_line(&e.to_string())))
     })
 }
 

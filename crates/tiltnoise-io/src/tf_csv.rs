@@ -2,12 +2,12 @@
 
 use crate::atomic::write_atomic;
 use crate::csv_layout::{csv_head, CsvPreamble};
-use crate::tf_hdf5::{has_translation, SIGN_CONVENTION, TIME_DEPENDENCE, TRANSLATION_CONVENTION};
-use crate::RunMeta;
+use crate::run_meta::RunMeta;
+use crate::tf_hdf5::{SIGN_CONVENTION, TIME_DEPENDENCE, TRANSLATION_CONVENTION};
+use crate::tf_notes::{ground_quantity_note, has_translation};
 use std::io::{BufWriter, Write as _};
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
-use tiltnoise_core::ground::GroundQuantity;
 use tiltnoise_core::tf::TransferMatrix;
 
 /// Writes `tf` as CSV, atomically (see [`super::write_atomic`]).
@@ -77,23 +77,6 @@ pub fn tf_csv_header(tf: &TransferMatrix, meta: &RunMeta) -> String {
         notes,
     };
     csv_head(&preamble, &columns)
-}
-
-/// What the floor's motion is per unit of, when not its displacement: the CSV note and the
-/// HDF5 attribute `ground_quantity`.
-pub(crate) fn ground_quantity_note(tf: &TransferMatrix) -> Option<String> {
-    let q = tf.ground_quantity();
-    (q != GroundQuantity::Displacement).then(|| {
-        format!(
-            "floor motion (tilt and translation inputs) per unit {}: the displacement's H \
-             times {}",
-            q.name(),
-            match q {
-                GroundQuantity::Velocity => "1/(i w)",
-                _ => "-1/w^2",
-            }
-        )
-    })
 }
 
 /// Appends the data lines of [`tf_csv_string`] for every frequency of `tf` to `s`: a grid

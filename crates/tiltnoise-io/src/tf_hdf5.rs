@@ -1,8 +1,9 @@
 //! Transfer matrix as HDF5 (schema `tiltnoise.tf`, documented in `docs/schemas.md`).
 
 use super::h5util::{dataset, provenance, str_attr, strings, strs_attr, unit_dataset};
-use super::RunMeta;
 use crate::atomic::write_atomic;
+use crate::run_meta::RunMeta;
+use crate::tf_notes::{ground_quantity_note, has_translation};
 use ndarray::ArrayView3;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
@@ -25,13 +26,6 @@ pub const TRANSLATION_CONVENTION: &str = "x_t, y_t, z_t = displacement of the fl
      m; per unit floor acceleration a = -w^2 u: X/x_t -> X/eta_t / g, Y/y_t -> -Y/theta_t / g \
      as f -> 0 (equivalence principle)";
 
-/// True when `inputs` has a floor translation, whose convention the files then state.
-pub(crate) fn has_translation(inputs: &[tiltnoise_core::tf::Input]) -> bool {
-    inputs
-        .iter()
-        .any(|i| matches!(i, tiltnoise_core::tf::Input::Translation(_)))
-}
-
 /// Value of the root attribute `time_dependence`: values are complex amplitudes of
 /// `exp(+i w t)`.
 pub const TIME_DEPENDENCE: &str = "exp(+i w t)";
@@ -52,7 +46,7 @@ pub const TIME_DEPENDENCE: &str = "exp(+i w t)";
 pub fn write_tf_hdf5(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> Result<(), OutputError> {
     write_atomic(path, |temp| {
         write_file(temp, tf, meta)
-            .map_err(|e| format!("HDF5: {}", crate::first_line(&e.to_string())))
+            .map_err(|e| format!("HDF5: {}", crate::messages::first_line(&e.to_string())))
     })
 }
 
@@ -99,7 +93,7 @@ pub(crate) fn write_root(
     if has_translation(&tf.inputs) {
         str_attr(file, "translation_convention", TRANSLATION_CONVENTION)?;
     }
-    if let Some(per) = crate::tf_csv::ground_quantity_note(tf) {
+    if let Some(per) = ground_quantity_note(tf) {
         str_attr(file, "ground_quantity", &per)?;
     }
     Ok(())

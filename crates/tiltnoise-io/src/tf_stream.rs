@@ -8,8 +8,8 @@
 use super::h5util::str_attr;
 use super::tf_csv::{push_tf_csv_rows, tf_csv_header};
 use super::tf_hdf5::{transfer_attrs, write_labels, write_modes, write_root};
-use super::RunMeta;
 use crate::atomic::AtomicFile;
+use crate::run_meta::RunMeta;
 use ndarray::{s, ArrayView1, ArrayView3};
 use num_complex::Complex64;
 use std::fs::File;
@@ -23,7 +23,7 @@ use tiltnoise_core::tf::TransferMatrix;
 pub const TF_CHUNK_FREQS: usize = 4096;
 
 fn h5_error(e: hdf5::Error) -> String {
-    format!("HDF5: {}", crate::first_line(&e.to_string()))
+    format!("HDF5: {}", crate::messages::first_line(&e.to_string()))
 }
 
 /// A `tiltnoise.tf` HDF5 file being written block by block.

@@ -11,7 +11,7 @@ use tiltnoise_core::coherence::CoherenceError;
 use tiltnoise_core::error::{Num, Shown};
 use tiltnoise_core::input::InputError;
 use tiltnoise_core::model::Observable;
-use tiltnoise_core::options::Spelling;
+use tiltnoise_core::option_key::{self, OptionKey};
 use tiltnoise_core::repeats::Repeated;
 
 /// Why a job did not run to its end. Options are named in snake case (`segment_duration`);
@@ -85,9 +85,10 @@ pub enum JobError {
 }
 
 impl JobError {
-    /// The message, one line, with the options spelled as `spelling` does.
-    pub fn message(&self, spelling: Spelling) -> String {
-        let opt = |name: &str| spelling.option(name);
+    /// The message, one line, with the options spelled as the front end in use does
+    /// ([`tiltnoise_core::option_key`]).
+    pub fn message(&self) -> String {
+        let opt = |name: &'static str| OptionKey::new(name).to_string();
         match self {
             JobError::Input(e) => e.to_string(),
             JobError::OptionFile {
@@ -144,28 +145,21 @@ impl JobError {
                     .join(", "),
                 opt("observables")
             ),
-            JobError::PercentilesNeedSegments => require_segments_for_percentiles(spelling, false)
+            JobError::PercentilesNeedSegments => require_segments_for_percentiles(false)
                 .err()
                 .map_or_else(String::new, |e| e.to_string()),
-            JobError::Percentiles { lower, upper } => match spelling {
-                Spelling::Flag => format!(
-                    "--percentiles {}:{}: expected LO:HI with 0 <= LO < HI <= 100, e.g. 10:90",
-                    Num(*lower),
-                    Num(*upper)
-                ),
-                Spelling::Keyword => {
-                    let given = format!("({}, {})", Num(*lower), Num(*upper));
-                    percentiles_error(spelling, &given).to_string()
-                }
-            },
+            JobError::Percentiles { lower, upper } => {
+                let given = option_key::pair(&Num(*lower).to_string(), &Num(*upper).to_string());
+                percentiles_error(&given).to_string()
+            }
             JobError::Repeated(r) => Repeated {
-                option: opt(&r.option),
+                option: spelled(&r.option),
                 ..r.clone()
             }
             .to_string(),
             JobError::Budget { path, source } => format!("budget of {}: {source}", Shown(path)),
             JobError::Coherence(e) => e.to_string(),
-            JobError::Subtract(e) => e.message(spelling),
+            JobError::Subtract(e) => e.message(),
         }
     }
 
@@ -188,9 +182,45 @@ impl JobError {
     }
 }
 
+/// The options a job refuses repeated items of, by key: how [`spelled`] finds the
+/// [`OptionKey`] of a name carried as a `String`.
+const KEYS: &[&str] = &[
+    "tilt",
+    "measured",
+    "readout",
+    "term",
+    "witness_noise",
+    "observables",
+    "at",
+    "at_band",
+    "nperseg",
+    "overlap",
+    "average",
+    "segment_duration",
+    "percentiles",
+    "freq",
+    "gaps",
+    "scale",
+    "units",
+    "corrected",
+    "pendulum_tiltmeter",
+    "axes",
+    "quantity",
+    "save",
+    "set",
+    "params",
+];
+
+/// `name` as the front end in use spells it (itself when it is not a known key).
+fn spelled(name: &str) -> String {
+    KEYS.iter()
+        .find(|k| **k == name)
+        .map_or_else(|| name.to_string(), |k| OptionKey::new(k).to_string())
+}
+
 impl fmt::Display for JobError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.message(Spelling::Keyword))
+        f.write_str(&self.message())
     }
 }
 

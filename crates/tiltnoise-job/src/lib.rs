@@ -15,12 +15,13 @@
 pub mod budget;
 pub mod coherence;
 mod error;
+mod figure;
 mod given;
 pub mod subtract;
 pub mod subtract_report;
 mod summary;
 
 pub use error::JobError;
+pub use figure::save_image;
 pub use given::{read_given, witness_noise, AsdSpec, ReadoutItem, TermItem, WitnessItem};
 pub use tiltnoise_core::cancel::Cancel;
-pub use tiltnoise_core::options::Spelling;

@@ -14,7 +14,7 @@ use tiltnoise_core::error::Shown;
 use tiltnoise_core::input::{GroundMap, InputMeta, Provenance, Sensors, TiltSeries};
 use tiltnoise_core::model::{Input, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
-use tiltnoise_core::options::Spelling;
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::subtract::{
     subtract, MeasuredRecord, StartTime, Status, SubtractConfig, SubtractError, SubtractResult,
     WitnessNoise, WitnessRecord,
@@ -187,9 +187,9 @@ pub enum RunFailure {
 }
 
 impl SubtractFailure {
-    /// The message, one line, with the options spelled as `spelling` does.
-    pub(crate) fn message(&self, spelling: Spelling) -> String {
-        let opt = |name: &str| spelling.option(name);
+    /// The message, one line, with the options spelled as the front end in use does.
+    pub(crate) fn message(&self) -> String {
+        let opt = |name: &'static str| OptionKey::new(name).to_string();
         match self {
             SubtractFailure::Cancelled => Cancelled.to_string(),
             SubtractFailure::TooManyColocated(n) => format!(
@@ -255,14 +255,14 @@ impl SubtractFailure {
                 "subtract {} {tilt} {} {measured}: {}",
                 opt("tilt"),
                 opt("measured"),
-                reason.message(spelling)
+                reason.message()
             ),
         }
     }
 }
 
 impl RunFailure {
-    fn message(&self, spelling: Spelling) -> String {
+    fn message(&self) -> String {
         match self {
             RunFailure::Refused(e) => e.to_string(),
             RunFailure::Estimate { name, value, sigma } => format!(
@@ -278,7 +278,7 @@ impl RunFailure {
                 "the {what} ASD of {} in the report band is {value}: not finite (is the channel \
                  constant or noiseless there? leave it out with {})",
                 observable.name(),
-                spelling.option("observables")
+                OptionKey::OBSERVABLES
             ),
             RunFailure::Sample {
                 observable,

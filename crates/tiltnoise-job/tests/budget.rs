@@ -10,7 +10,7 @@ use tiltnoise_core::model::{Model, Observable};
 use tiltnoise_core::params::Params;
 use tiltnoise_io::input::{read_tilt, ReadOptions};
 use tiltnoise_job::budget::{run, BudgetRequest, ReadRequest, TiltSource, WelchRequest};
-use tiltnoise_job::{AsdSpec, Cancel, JobError, ReadoutItem, Spelling};
+use tiltnoise_job::{AsdSpec, Cancel, JobError, ReadoutItem};
 
 fn tilt_data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -93,19 +93,17 @@ fn options_of_the_other_kind_of_input_are_refused_in_each_spelling() {
         }
     ));
     assert_eq!(
-        e.message(Spelling::Flag),
+        e.message(),
         format!(
-            "--gaps applies to time-series input, and {} holds spectra; leave it out (the model \
-             grid of spectra input is set with --freq)",
+            "gaps applies to time-series input, and {} holds spectra; leave it out (the model \
+             grid of spectra input is set with freq)",
             spectra.display()
         )
     );
     let mut req = request(&model, file(tilt_data("lab_tilt_24h.h5")));
     req.freq_hz = Some(vec![1e-3, 1e-2]);
     let e = run(req, &Cancel::never(), &mut |_, _| {}).unwrap_err();
-    assert!(e
-        .message(Spelling::Keyword)
-        .starts_with("freq applies to spectra input"));
+    assert!(e.message().starts_with("freq applies to spectra input"));
 }
 
 #[test]
@@ -117,8 +115,8 @@ fn options_are_checked_before_any_file_is_opened() {
     let e = run(req, &Cancel::never(), &mut |_, _| {}).unwrap_err();
     assert!(matches!(e, JobError::PercentilesNeedSegments), "{e}");
     assert!(e
-        .message(Spelling::Flag)
-        .starts_with("--percentiles applies to the per-segment band and needs --segment-duration"));
+        .message()
+        .starts_with("percentiles applies to the per-segment band and needs segment_duration"));
 
     let mut req = request(&model, file(missing.clone()));
     req.readout = vec![ReadoutItem {
@@ -127,18 +125,14 @@ fn options_are_checked_before_any_file_is_opened() {
     }];
     let e = run(req, &Cancel::never(), &mut |_, _| {}).unwrap_err();
     assert_eq!(
-        e.message(Spelling::Keyword),
+        e.message(),
         "readout Y=1e-9: Y is not budgeted; allowed: X, phi, phi_a (add it with observables)"
     );
 
     let mut req = request(&model, file(missing));
     req.at_hz = Some(vec![1e-3, 1e-3]);
     let e = run(req, &Cancel::never(), &mut |_, _| {}).unwrap_err();
-    assert!(
-        e.message(Spelling::Flag).starts_with("--at: "),
-        "{}",
-        e.message(Spelling::Flag)
-    );
+    assert!(e.message().starts_with("at: "), "{}", e.message());
 }
 
 #[test]

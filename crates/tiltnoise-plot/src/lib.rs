@@ -50,6 +50,7 @@ use plotters::prelude::{IntoDrawingArea, SVGBackend};
 use std::path::Path;
 use std::sync::OnceLock;
 use tiltnoise_core::error::OutputError;
+use tiltnoise_core::option_key::OptionKey;
 
 /// The embedded font (DejaVu Sans 2.37, Bitstream Vera / DejaVu licence).
 static FONT_BYTES: &[u8] = include_bytes!("../../../assets/DejaVuSans.ttf");
@@ -257,8 +258,10 @@ pub fn render(format: ImageFormat, figure: &impl Figure) -> Result<Vec<u8>, Draw
     let (w, h) = figure.size();
     if u64::from(w) * u64::from(h) > MAX_PIXELS {
         return Err(DrawError(format!(
-            "a {w} x {h} pixel image is too large (at most {} megapixels; lower --size or --dpi)",
-            MAX_PIXELS / 1_000_000
+            "a {w} x {h} pixel image is too large (at most {} megapixels; lower {} or {})",
+            MAX_PIXELS / 1_000_000,
+            OptionKey::SIZE,
+            OptionKey::DPI
         )));
     }
     match format {

@@ -4,6 +4,7 @@
 //! and kind of input, so each panel has one unit: m/m, m/N, rad/(N m), ...).
 
 use super::chart::{Dash, LogLogFigure, Panel, Trace, TraceStyle, PALETTE};
+use tiltnoise_core::option_key::OptionKey;
 // Re-exported: `plot::tf_figure::observable_symbol` is a public path.
 use super::chart::{LegendPlacement, YScale};
 pub use super::labels::observable_symbol;
@@ -406,8 +407,9 @@ fn caption(
         .collect();
     if !omitted.is_empty() {
         caption.push(format!(
-            "Not drawn (in the files): {}; --observables chooses the panels.",
-            omitted.join(", ")
+            "Not drawn (in the files): {}; {} chooses the panels.",
+            omitted.join(", "),
+            OptionKey::DRAWN_OBSERVABLES
         ));
     }
     caption

@@ -400,7 +400,7 @@ fn check_round_trip(p: &Params) {
 }
 
 fn read_params(path: &Path) {
-    if let Some(p) = shown(Params::from_file(path)) {
+    if let Some(p) = shown(tiltnoise_io::read_params(path)) {
         check_round_trip(&p);
     }
 }

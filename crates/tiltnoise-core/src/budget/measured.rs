@@ -5,6 +5,7 @@
 use super::BudgetError;
 use crate::model::Observable;
 use crate::noise::{BandMean, BudgetReport, Evaluation, SpectralSource, TermAt, TermKind};
+use crate::option_key::OptionKey;
 use crate::spectral::{band_dof, welch, Averaging, WelchConfig};
 
 /// A measured record on its own grid: frequencies (Hz), one-sided PSD per observable
@@ -140,9 +141,10 @@ pub fn series_psds(
                 return Err(BudgetError::Config(format!(
                     "the measured series has {n} samples ({:.6e} s at {fs} Hz): the budget's \
                      Welch segment of {:.6e} s needs {seg} samples at this rate; use a longer \
-                     record or a shorter --nperseg",
+                     record or a shorter {}",
                     n as f64 / fs,
-                    *segment_len as f64 / sample_rate_hz
+                    *segment_len as f64 / sample_rate_hz,
+                    OptionKey::NPERSEG
                 )));
             }
             WelchConfig::new(seg)

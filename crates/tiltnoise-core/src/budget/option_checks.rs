@@ -1,10 +1,11 @@
 //! Checks of a budget's options that depend on which options were given: the percentile band
 //! needs segments and ordered percentiles; and the kinds of tilt input, against which the
-//! budget job refuses the options of the other kind. The messages name the options in the
-//! caller's [`Spelling`].
+//! budget job refuses the options of the other kind. Each front end spells the options its
+//! own way ([`OptionKey`]).
 
 use crate::error::Shown;
-use crate::options::{OptionError, Spelling};
+use crate::option_key::{self, OptionKey};
+use crate::options::OptionError;
 
 /// What a tilt input holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -16,32 +17,26 @@ pub enum InputKind {
 }
 
 /// Refuses percentiles without a segment duration: the band is across segments.
-pub fn require_segments_for_percentiles(
-    spelling: Spelling,
-    segment_duration_given: bool,
-) -> Result<(), OptionError> {
+pub fn require_segments_for_percentiles(segment_duration_given: bool) -> Result<(), OptionError> {
     if segment_duration_given {
         return Ok(());
     }
     Err(OptionError::Conflict(format!(
         "{} applies to the per-segment band and needs {} (e.g. {} with {} at 1 Hz: each \
          segment holds a Welch segment)",
-        spelling.option("percentiles"),
-        spelling.option("segment_duration"),
-        spelling.example("segment_duration", "14400"),
-        spelling.example("nperseg", "4096")
+        OptionKey::PERCENTILES,
+        OptionKey::SEGMENT_DURATION,
+        OptionKey::SEGMENT_DURATION.given("14400"),
+        OptionKey::NPERSEG.given("4096")
     )))
 }
 
 /// The error for percentiles that do not parse or are out of order or range.
-pub fn percentiles_error(spelling: Spelling, given: &str) -> OptionError {
-    let form = match spelling {
-        Spelling::Flag => "LOWER,UPPER",
-        Spelling::Keyword => "(LOWER, UPPER)",
-    };
+pub fn percentiles_error(given: &str) -> OptionError {
+    let form = option_key::pair("LOWER", "UPPER");
     OptionError::Conflict(format!(
         "{} {}: expected {form} with 0 <= LOWER < UPPER <= 100",
-        spelling.option("percentiles"),
+        OptionKey::PERCENTILES,
         Shown(given)
     ))
 }
@@ -53,20 +48,16 @@ mod tests {
     #[test]
     fn percentiles_need_segments_and_order() {
         assert_eq!(
-            require_segments_for_percentiles(Spelling::Keyword, false)
+            require_segments_for_percentiles(false)
                 .unwrap_err()
                 .to_string(),
             "percentiles applies to the per-segment band and needs segment_duration (e.g. \
              segment_duration=14400 with nperseg=4096 at 1 Hz: each segment holds a Welch \
              segment)"
         );
-        assert!(require_segments_for_percentiles(Spelling::Flag, true).is_ok());
+        assert!(require_segments_for_percentiles(true).is_ok());
         assert_eq!(
-            percentiles_error(Spelling::Flag, "x").to_string(),
-            "--percentiles x: expected LOWER,UPPER with 0 <= LOWER < UPPER <= 100"
-        );
-        assert_eq!(
-            percentiles_error(Spelling::Keyword, "(90, 10)").to_string(),
+            percentiles_error("(90, 10)").to_string(),
             "percentiles (90, 10): expected (LOWER, UPPER) with 0 <= LOWER < UPPER <= 100"
         );
     }

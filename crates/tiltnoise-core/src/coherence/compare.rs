@@ -21,7 +21,7 @@
 use num_complex::Complex64;
 
 /// The measured/model factor of one transfer-function entry (module docs).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Agreement {
     /// Bins used.
     pub n_bins: usize,

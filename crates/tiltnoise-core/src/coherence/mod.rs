@@ -39,6 +39,7 @@ use crate::align::{align, AlignError, Alignment, RecordClock};
 use crate::budget::default_segment_len;
 use crate::error::{Num, TfError};
 use crate::model::{Input, Model, Observable, Request, TiltAxis};
+use crate::option_key::OptionKey;
 use crate::spectral::confidence::{
     bin_correlation, coherence_interval, coherence_threshold, equivalent_averages, tf_radius,
     tf_sigma,
@@ -113,7 +114,7 @@ impl Default for CoherenceOptions {
 }
 
 /// The Welch estimate behind the report.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct WelchSummary {
     /// Sample rate (Hz).
     pub sample_rate_hz: f64,
@@ -130,7 +131,7 @@ pub struct WelchSummary {
 }
 
 /// One observable against one tilt axis.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct AxisEstimate {
     /// The tilt axis.
     pub axis: TiltAxis,
@@ -157,7 +158,7 @@ pub struct AxisEstimate {
 }
 
 /// One measured observable against all tilt axes.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ObservableEstimate {
     /// The observable.
     pub observable: Observable,
@@ -176,7 +177,7 @@ pub struct ObservableEstimate {
 }
 
 /// Everything the coherence job found.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CoherenceReport {
     /// Welch bins (Hz), DC left out.
     pub freqs_hz: Vec<f64>,
@@ -255,12 +256,13 @@ pub fn coherence_from_series(
         return Err(CoherenceError::Config(format!(
             "the common stretch of {} and {} ({n} samples) gives {n_segments} Welch segments of \
              {} samples, {n_d:.2} independent averages: {} tilt axes need at least {}; use a \
-             shorter --nperseg",
+             shorter {}",
             tilt.name,
             measured.name,
             cfg.segment_len,
             q,
-            q + 1
+            q + 1,
+            OptionKey::NPERSEG
         )));
     }
     let mut channels: Vec<&[f64]> = tilt
@@ -333,9 +335,10 @@ pub fn coherence_from_series(
         return Err(CoherenceError::Config(format!(
             "the tilt axes {} of {} are linearly dependent at every frequency (largest \
              reciprocal condition {worst:.1e} of their cross-spectral matrix): analyse one of \
-             them at a time (--axes)",
+             them at a time ({})",
             axes.iter().map(|a| a.name()).collect::<Vec<_>>().join(", "),
-            tilt.name
+            tilt.name,
+            OptionKey::AXES
         )));
     }
     let level = opts.confidence;
@@ -552,9 +555,10 @@ fn welch_config(
     if n < seg {
         return Err(CoherenceError::Config(format!(
             "the common stretch of {tilt} and {measured} is {n} samples ({} s at {fs} Hz), \
-             shorter than one Welch segment of {seg} samples: use a shorter --nperseg or longer \
+             shorter than one Welch segment of {seg} samples: use a shorter {} or longer \
              records",
-            n as f64 / fs
+            n as f64 / fs,
+            OptionKey::NPERSEG
         )));
     }
     Ok(cfg)

@@ -1,10 +1,13 @@
 //! The model's matrices in double-double, written from the paper's formulas (Appendix A,
 //! eqs. (def_I) and (EM), the zeroth-order generalized forces, section II.D and section IV.B),
-//! the apparent forces of the floor's translation, and the parameter values. Deliberately shares nothing with `crate::model` (the `f64` model) but the
-//! coordinate order, which is fixed by the paper and restated here.
+//! the apparent forces of the floor's translation, and the parameter values. It shares with
+//! `crate::model` (the `f64` model) only the formulas of M and K ([`crate::appendix`], evaluated
+//! here in double-double) and the coordinate order, which is fixed by the paper and restated
+//! here; everything else is written independently.
 
 use super::complex::CDd;
 use super::real::Dd;
+use crate::appendix;
 use crate::params::Params;
 
 /// q = (theta_a, eta_a, phi_a, delta_a, theta_b, eta_b, phi_b, delta_b): the paper's order,
@@ -154,65 +157,17 @@ pub fn build(p: &Params) -> Matrices {
     let g = dd(p.environment.g_m_per_s2);
 
     // Section II.A: the crossbar's centre of mass balances the test mass on the upper fibre.
-    let y_a = d * m_b / m_a;
+    let y_a = appendix::y_a::<Dd>(p);
     let zza = z + z_a;
     let zzb = z + z_b;
 
-    // Appendix A, eq. (def_I), with I^b_22 for rotations of the test mass about its y axis.
-    let ia1 = a11 + m_a * (zza.sqr() + y_a.sqr());
-    let ib1 = b11 + m_b * (zzb.sqr() + d.sqr());
-    let ia2 = a22 + m_a * zza.sqr();
-    let ib2 = b22 + m_b * zzb.sqr();
-    let ia3 = a33 + m_a * y_a.sqr();
-    let ib3 = b33 + m_b * d.sqr();
-    let ia4 = a23 + m_b * d * (z_a - z_b);
-    let ib4_theta = b11 + m_b * z_b.sqr();
-    let ib4_eta = b22 + m_b * z_b.sqr();
-    let ib5_theta = b11 + m_b * z_b * zzb;
-    let ib5_eta = b22 + m_b * z_b * zzb;
-    let c1 = m_b * zzb + m_a * zza;
-
-    // Eq. (EM): coefficients of the second derivatives.
-    let mut mass = [[Dd::ZERO; 8]; 8];
-    {
-        let mut sym = |r: usize, c: usize, v: Dd| {
-            mass[r][c] = v;
-            mass[c][r] = v;
-        };
-        sym(TA, TA, ia1 + ib1);
-        sym(TA, TB, ib5_theta);
-        sym(TA, DB, m_b * d);
-        sym(EA, EA, ia2 + ib2);
-        sym(EA, PA, ia4);
-        sym(EA, EB, ib5_eta);
-        sym(PA, PA, ia3 + ib3);
-        sym(PA, PB, b33);
-        sym(PA, EB, -(m_b * d * z_b));
-        sym(DA, DA, m_a + m_b);
-        sym(DA, DB, m_b);
-        sym(TB, TB, ib4_theta);
-        sym(EB, EB, ib4_eta);
-        sym(PB, PB, b33);
-        sym(DB, DB, m_b);
-    }
-
-    // Eq. (EM): gravity stiffness (lossless) ...
-    let mut kg = [[Dd::ZERO; 8]; 8];
-    for (a, b) in [(TA, TB), (EA, EB)] {
-        kg[a][a] = g * c1;
-        kg[a][b] = m_b * g * z_b;
-        kg[b][a] = m_b * g * z_b;
-        kg[b][b] = m_b * g * z_b;
-    }
+    // Appendix A: M and the gravity part of K (eqs. (def_I) and (EM)), in double-double.
+    let mass = appendix::mass::<Dd>(p);
+    let kg = appendix::stiffness_gravity::<Dd>(p);
     // ... and the fibres' elastic stiffness with structural damping k (1 + i phi).
     let mut stiffness = kg.map(|row| row.map(CDd::real));
     let lp = &p.loss;
-    for (c, k, phi) in [
-        (PA, p.torsion.k_a_n_m_per_rad, lp.torsion_a_rad),
-        (PB, p.torsion.k_b_n_m_per_rad, lp.torsion_b_rad),
-        (DA, p.bouncing.kappa_a_n_per_m, lp.bouncing_a_rad),
-        (DB, p.bouncing.kappa_b_n_per_m, lp.bouncing_b_rad),
-    ] {
+    for (c, k, phi) in appendix::stiffness_elastic(p) {
         stiffness[c][c] += CDd::new(dd(k), Dd::mul_f64_exact(k, phi));
     }
     // Swing: the gravity potential is a sum over the fibres' pendulums,

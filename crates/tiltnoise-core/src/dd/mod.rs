@@ -4,7 +4,7 @@
 //! Shared by the double-double reference evaluator ([`crate::reference`], the oracle of every
 //! method's accuracy) and the pole-zero method ([`crate::tf::PoleZero`], which finds its poles
 //! and zeros in double-double). Neither depends on the other. This module depends on nothing
-//! but [`crate::params`]; the matrices of the pendulum as built are the exact kinematics in
+//! but [`crate::params`] and the formulas of M and K ([`crate::appendix`]); the matrices of the pendulum as built are the exact kinematics in
 //! double-double ([`crate::geometry::dd_matrices`]).
 
 mod complex;

@@ -52,6 +52,7 @@ pub use visibility::{MeasuredVisibility, Visibilities};
 
 use crate::cancel::{Cancel, Cancelled};
 use crate::error::{ParamError, Shown};
+use crate::option_key::OptionKey;
 use crate::params::Params;
 use crate::repeats::{refuse_repeats, Repeated};
 use nalgebra::{DMatrix, DVector};
@@ -288,13 +289,14 @@ pub enum FitError {
     #[error(transparent)]
     TooLarge(#[from] crate::limits::LimitError),
     /// No free parameter.
-    #[error("fit: no free parameter; give at least one with --free KEY,...")]
+    #[error("fit: no free parameter; give at least one with {}", OptionKey::FREE.given("KEY,..."))]
     NoFree,
     /// More free parameters than measurements.
     #[error(
         "fit: {free} free parameters but only {modes} measured modes and {visibilities} \
          visibilities; at most as many free parameters as measurements are allowed (drop some \
-         from --free or measure more)"
+         from {} or measure more)",
+        OptionKey::FREE
     )]
     TooManyFree {
         /// Number of free parameters.
@@ -306,8 +308,9 @@ pub enum FitError {
     },
     /// A free key that is not a parameter.
     #[error(
-        "fit: unknown parameter key `{}` in --free; allowed keys: {allowed}",
-        Shown(.key)
+        "fit: unknown parameter key `{}` in {}; allowed keys: {allowed}",
+        Shown(.key),
+        OptionKey::FREE
     )]
     UnknownKey {
         /// The key given.
@@ -317,8 +320,9 @@ pub enum FitError {
     },
     /// A free key whose parameter has no error bar.
     #[error(
-        "fit: parameter `{key}` in --free is exact (error bar 0), so it cannot move; allowed \
-         keys (with an error bar): {allowed}"
+        "fit: parameter `{key}` in {} is exact (error bar 0), so it cannot move; allowed \
+         keys (with an error bar): {allowed}",
+        OptionKey::FREE
     )]
     ExactKey {
         /// The key given.
@@ -330,7 +334,7 @@ pub enum FitError {
     #[error(transparent)]
     Repeated(#[from] Repeated),
     /// A box width that is not a positive finite number.
-    #[error("fit: --bound-sigmas {value} is not allowed: must be finite and > 0")]
+    #[error("fit: {} is not allowed: must be finite and > 0", OptionKey::BOUND_SIGMAS.given(.value))]
     BoundSigmas {
         /// The value given.
         value: f64,
@@ -338,7 +342,8 @@ pub enum FitError {
     /// The box reaches non-physical values of a parameter.
     #[error(
         "fit: the box {lower:e}..{upper:e} {unit} of `{key}` (nominal +/- {n} error bars) reaches \
-         non-physical values ({reason}); reduce --bound-sigmas or the parameter's error bar"
+         non-physical values ({reason}); reduce {} or the parameter's error bar",
+        OptionKey::BOUND_SIGMAS
     )]
     BoxNotPhysical {
         /// The parameter.
@@ -678,7 +683,12 @@ fn check_config(
     if config.free.is_empty() {
         return Err(FitError::NoFree);
     }
-    refuse_repeats("--free", "parameter key", &config.free, String::clone)?;
+    refuse_repeats(
+        &OptionKey::FREE.to_string(),
+        "parameter key",
+        &config.free,
+        String::clone,
+    )?;
     let fields = params.fields();
     let sigma_of = |key: &str, value: f64| {
         crate::mc::uncertainties(params)

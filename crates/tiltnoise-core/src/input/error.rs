@@ -6,6 +6,7 @@
 //! sample index in the series); CSV line numbers are 1-based (as shown by an editor).
 
 use crate::error::{Num, Shown};
+use crate::option_key::OptionKey;
 use std::path::{Path, PathBuf};
 
 /// Formats an optional CSV line number as ` (line N)`.
@@ -404,7 +405,7 @@ pub enum InputError {
         "input file {path}: channel `{}` states no unit and is read in {}, but its detrended RMS \
          is {} {}, above the {} {} no laboratory floor reaches; its values are likely in {}: \
          state the unit in the file (a `# units:` line, a `units` attribute) or with the units \
-         option (--units {}={}, in Python units={{\"{}\": \"{}\"}})",
+         option ({})",
         Shown(.channel),
         .quantity.unit(),
         Num(*.rms),
@@ -412,10 +413,7 @@ pub enum InputError {
         Num(*.bound),
         .quantity.unit(),
         .likely,
-        Shown(.channel),
-        .likely.split(' ').next().unwrap_or(""),
-        Shown(.channel),
-        .likely.split(' ').next().unwrap_or("")
+        OptionKey::UNITS.entry(Shown(.channel), .likely.split(' ').next().unwrap_or(""))
     )]
     UnstatedUnit {
         /// The file.

@@ -425,14 +425,14 @@ mod tests {
     #[test]
     fn channel_units_are_parsed_once_per_channel() {
         let items = ["LHE=m/s^2", " LJE = rad/s"];
-        let u = parse_units("--units", &items).unwrap();
+        let u = parse_units("units", &items).unwrap();
         assert_eq!(u[1].channel, "LJE");
         assert_eq!(u[1].unit.si(), "rad/s");
-        let e = parse_units("--units", &["LHE=m/s^2", "LHE=m/s"]).unwrap_err();
-        assert_eq!(e, "--units: LHE is given twice; name each channel once");
-        let e = parse_units("--units", &["LJE=rad/s^2"]).unwrap_err();
+        let e = parse_units("units", &["LHE=m/s^2", "LHE=m/s"]).unwrap_err();
+        assert_eq!(e, "units: LHE is given twice; name each channel once");
+        let e = parse_units("units", &["LJE=rad/s^2"]).unwrap_err();
         assert!(
-            e.starts_with("--units: unit `rad/s^2` of channel `LJE`"),
+            e.starts_with("units: unit `rad/s^2` of channel `LJE`"),
             "{e}"
         );
     }

@@ -32,7 +32,6 @@ pub use magnitude::*;
 use crate::num_text::Num;
 use std::fmt;
 use std::io::{self, Read};
-use std::path::Path;
 
 /// Where users find the limits, named in every message.
 const DOCS: &str = "docs/limits.md";
@@ -457,41 +456,6 @@ impl<R: Read> Read for BoundedReader<R> {
     }
 }
 
-/// Why [`read_text_file`] failed.
-#[derive(Debug)]
-pub enum TextFileError {
-    /// The file could not be opened or read, or is not UTF-8.
-    Io(io::Error),
-    /// The file or one of its lines is over its limit.
-    TooLarge(LimitError),
-}
-
-/// Reads the text file `path` whole, refusing a file longer than `max_bytes` (from its
-/// metadata when it is a regular file, else after `max_bytes + 1` bytes) or a line longer
-/// than [`MAX_LINE_BYTES`]. `name` names the file in messages (e.g. `parameter file p.toml`),
-/// `of` says what the limit is for (e.g. `a parameter file`).
-pub fn read_text_file(
-    path: &Path,
-    max_bytes: u64,
-    name: &str,
-    of: &'static str,
-) -> Result<String, TextFileError> {
-    let file = std::fs::File::open(path).map_err(TextFileError::Io)?;
-    let meta = file.metadata().map_err(TextFileError::Io)?;
-    if meta.is_file() {
-        check_file_len(|| name.to_string(), meta.len(), max_bytes, of)
-            .map_err(TextFileError::TooLarge)?;
-    }
-    let mut text = String::new();
-    BoundedReader::new(file, max_bytes, MAX_LINE_BYTES)
-        .read_to_string(&mut text)
-        .map_err(|e| match Overrun::of(&e) {
-            Some(o) => TextFileError::TooLarge(o.to_limit_error(name, of)),
-            None => TextFileError::Io(e),
-        })?;
-    Ok(text)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -499,12 +463,12 @@ mod tests {
     #[test]
     fn counts_over_the_limit_and_nan_are_refused() {
         assert!(check_count(|| "x".into(), 10.0, "points", 10).is_ok());
-        let e = check_count(|| "--freq 1:11:2".into(), 11.0, "frequency points", 10)
+        let e = check_count(|| "freq=1:11:2".into(), 11.0, "frequency points", 10)
             .unwrap_err()
             .to_string();
         assert_eq!(
             e,
-            "--freq 1:11:2: 11 frequency points, more than the 10 allowed (see docs/limits.md)"
+            "freq=1:11:2: 11 frequency points, more than the 10 allowed (see docs/limits.md)"
         );
         assert!(check_count(|| "x".into(), f64::NAN, "samples", 10).is_err());
         let e = check_count(|| "x".into(), 1.8446744073709552e19, "draws", 10).unwrap_err();
@@ -528,12 +492,12 @@ mod tests {
         assert!(check_memory_against(|| "x".into(), 10, None).is_ok());
         assert!(check_memory_against(|| "x".into(), 10, Some(20)).is_ok());
         assert!(check_memory_against(|| "x".into(), 11, Some(20)).is_err());
-        let e = check_memory_against(|| "--samples 5".into(), 3 << 30, Some(4 << 30))
+        let e = check_memory_against(|| "samples=5".into(), 3 << 30, Some(4 << 30))
             .unwrap_err()
             .to_string();
         assert_eq!(
             e,
-            "--samples 5: needs about 3 GiB of memory, more than half of the 4 GiB available; \
+            "samples=5: needs about 3 GiB of memory, more than half of the 4 GiB available; \
              ask for less (see docs/limits.md)"
         );
         // The machine running the tests has some memory, and not 16 EiB.

@@ -30,7 +30,7 @@ impl RestLinear {
     /// The closed forms of Appendix A: every `[asymmetry]` key is 0.
     pub fn symmetric(p: &Params) -> RestLinear {
         let derived = matrices::derived(p);
-        let mass = matrices::mass(p, &derived);
+        let mass = matrices::mass(p);
         let (stiffness_gravity, _) = matrices::stiffness(p);
         let force = matrices::force_matrix(p, &derived);
         let tilt = tilt::TiltForcing::new(p, &derived, &force, &stiffness_gravity);

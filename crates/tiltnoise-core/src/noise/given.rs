@@ -2,6 +2,7 @@
 //! a one-sided ASD read between its points log-log (a power law between neighbours, exact at
 //! them) and never beyond them: a budget whose band the spectrum does not cover is refused.
 
+use crate::option_key::OptionKey;
 use std::fmt;
 
 /// A one-sided ASD on its own frequency points, with where it came from.
@@ -85,8 +86,9 @@ impl GivenAsd {
             return Err(GivenAsdError(format!(
                 "{}: the spectrum covers {a:e} .. {b:e} Hz, the budget's band is {lo:e} .. \
                  {hi:e} Hz; a given spectrum is never extrapolated: give one that covers the \
-                 band, or narrow the band (Welch segments, or --freq for spectra input)",
-                self.origin
+                 band, or narrow the band (Welch segments, or {} for spectra input)",
+                self.origin,
+                OptionKey::FREQ
             )));
         }
         Ok(())

@@ -8,7 +8,6 @@
 
 use crate::error::{shown_within, ParamError, Shown, SHOWN_MAX_CHARS};
 use serde::{Deserialize, Serialize};
-use std::path::Path;
 
 pub mod asymmetry;
 pub mod uncertainty;
@@ -179,8 +178,9 @@ pub struct Viscous {
     pub swing_b_n_m_s_per_rad: f64,
 }
 
-/// A complete parameter set. Build it with [`Params::table_i`], [`Params::from_toml_str`] or
-/// [`Params::from_file`]; all of them validate, so a `Params` in hand is physical.
+/// A complete parameter set. Build it with [`Params::table_i`] or [`Params::from_toml_str`]
+/// (a file is read by `tiltnoise_io::read_params`); all of them validate, so a `Params` in hand
+/// is physical.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Params {
@@ -309,24 +309,6 @@ impl Params {
         })?;
         params.validate()?;
         Ok(params)
-    }
-
-    /// Reads, parses and validates a TOML parameter file of at most
-    /// [`MAX_SETTINGS_FILE_BYTES`](crate::limits::MAX_SETTINGS_FILE_BYTES) (a device or pipe
-    /// is read no further) and lines of at most
-    /// [`MAX_LINE_BYTES`](crate::limits::MAX_LINE_BYTES).
-    pub fn from_file(path: &Path) -> Result<Params, ParamError> {
-        use crate::limits::{read_text_file, TextFileError, MAX_SETTINGS_FILE_BYTES};
-        let name = format!("parameter file {}", path.display());
-        let text = read_text_file(path, MAX_SETTINGS_FILE_BYTES, &name, "a parameter file")
-            .map_err(|e| match e {
-                TextFileError::Io(reason) => ParamError::Read {
-                    path: path.to_path_buf(),
-                    reason,
-                },
-                TextFileError::TooLarge(e) => ParamError::TooLarge(e),
-            })?;
-        Params::from_toml_str(&text, &path.display().to_string())
     }
 
     /// The effective parameter set as TOML, with units in the keys; it reads back unchanged.

@@ -2,7 +2,7 @@
 //! line's `tiltnoise simulate` and the Python package's `Model.simulate`): the sampling
 //! (`duration`, `step`, the Welch segment of the ASDs) and the initial state (the kick test,
 //! given coordinates and rates, or equal energy in every mode), with messages that name the
-//! option as the caller spells it ([`Spelling`]).
+//! option as the caller spells it ([`OptionKey`]).
 
 use super::{
     check_initial_state, check_samples, equal_energy_init, kick_x, InitialState, Simulation,
@@ -10,7 +10,8 @@ use super::{
 use crate::error::{Num, Shown};
 use crate::limits::MIN_SAMPLE;
 use crate::model::{Coord, Model, Observable};
-use crate::options::{OptionError, Spelling};
+use crate::option_key::OptionKey;
+use crate::options::OptionError;
 use crate::repeats::{list_entries, refuse_repeated_keys};
 use std::fmt::Write as _;
 
@@ -118,19 +119,14 @@ pub fn parse_coordinates<S: AsRef<str>>(
 pub fn initial_state(
     model: &Model,
     excitation: &Excitation,
-    spelling: Spelling,
 ) -> Result<(InitialState, String), OptionError> {
-    let (init, text) = excitation_state(model, excitation, spelling)?;
+    let (init, text) = excitation_state(model, excitation)?;
     let option = match *excitation {
-        Excitation::KickX { x_m } => spelling.example("kick_x", &Num(x_m).to_string()),
+        Excitation::KickX { x_m } => OptionKey::KICK_X.given(Num(x_m)).to_string(),
         Excitation::EqualEnergy { energy_j } => {
-            spelling.example("mode_energy", &Num(energy_j).to_string())
+            OptionKey::MODE_ENERGY.given(Num(energy_j)).to_string()
         }
-        Excitation::Given { .. } => format!(
-            "{}/{}",
-            spelling.option("init"),
-            spelling.option("init_rate")
-        ),
+        Excitation::Given { .. } => format!("{}/{}", OptionKey::INIT, OptionKey::INIT_RATE),
     };
     for c in Coord::ALL {
         for (what, value, unit) in [
@@ -155,11 +151,10 @@ pub fn initial_state(
 fn excitation_state(
     model: &Model,
     excitation: &Excitation,
-    spelling: Spelling,
 ) -> Result<(InitialState, String), OptionError> {
     match *excitation {
         Excitation::KickX { x_m: x } => {
-            let option = spelling.option("kick_x");
+            let option = OptionKey::KICK_X;
             if !(x.is_finite() && x != 0.0) {
                 return Err(OptionError::Conflict(format!(
                     "{option} {x}: the displacement (m) must be finite and non-zero"
@@ -188,8 +183,8 @@ fn excitation_state(
             if q.iter().chain(&qdot).all(|&v| v == 0.0) {
                 return Err(OptionError::Conflict(format!(
                     "{}/{}: every coordinate and rate is 0: nothing moves",
-                    spelling.option("init"),
-                    spelling.option("init_rate")
+                    OptionKey::INIT,
+                    OptionKey::INIT_RATE
                 )));
             }
             let mut text = String::from("given:");
@@ -214,7 +209,7 @@ fn excitation_state(
             if !(e.is_finite() && e > 0.0) {
                 return Err(OptionError::Conflict(format!(
                     "{} {e}: the energy per mode (J) must be finite and > 0",
-                    spelling.option("mode_energy")
+                    OptionKey::MODE_ENERGY
                 )));
             }
             Ok((
@@ -245,12 +240,11 @@ pub const MAX_DEFAULT_SIM_NPERSEG: usize = 1 << 18;
 /// samples and not more than the limits allow, a segment of at least [`MIN_SIM_NPERSEG`]
 /// samples that fits into the record.
 pub fn check_sampling(
-    spelling: Spelling,
     duration_s: f64,
     step_s: f64,
     nperseg: Option<usize>,
 ) -> Result<(usize, usize), OptionError> {
-    let (step, duration) = (spelling.option("step"), spelling.option("duration"));
+    let (step, duration) = (OptionKey::STEP, OptionKey::DURATION);
     if !(step_s.is_finite() && step_s > 0.0) {
         return Err(OptionError::Conflict(format!(
             "{step} {step_s}: the sampling step (s) must be finite and > 0"
@@ -280,7 +274,7 @@ pub fn check_sampling(
     )?;
     let n = n_f as usize;
     let seg = nperseg.unwrap_or_else(|| default_sim_nperseg(n));
-    let option = spelling.option("nperseg");
+    let option = OptionKey::NPERSEG;
     if seg < MIN_SIM_NPERSEG {
         return Err(OptionError::Conflict(format!(
             "{option} {seg}: the Welch segment must have at least {MIN_SIM_NPERSEG} samples"
@@ -342,77 +336,65 @@ mod tests {
     #[test]
     fn coordinates_parse_and_are_refused_by_name() {
         let mut q = [0.0; 8];
-        parse_coordinates("--init", &["theta_a=1e-5, phi_b=0.01", ""], false, &mut q).unwrap();
+        parse_coordinates("init", &["theta_a=1e-5, phi_b=0.01", ""], false, &mut q).unwrap();
         assert_eq!((q[0], q[6]), (1e-5, 0.01));
         let mut q = [0.0; 8];
         let cases = [
-            ("phi_b", "--init phi_b: expected COORD=VALUE, e.g. phi_b=0.01"),
-            ("phi_c=1", "--init phi_c=1: unknown coordinate `phi_c`; allowed: theta_a, eta_a, phi_a, delta_a, theta_b, eta_b, phi_b, delta_b"),
-            ("phi_b=x", "--init phi_b=x: `x` is not a number"),
-            ("phi_b=inf", "--init phi_b=inf: inf rad is not allowed: must be finite"),
-            ("phi_b=1,phi_b=2", "--init: phi_b is given twice; name each coordinate once"),
+            ("phi_b", "init phi_b: expected COORD=VALUE, e.g. phi_b=0.01"),
+            ("phi_c=1", "init phi_c=1: unknown coordinate `phi_c`; allowed: theta_a, eta_a, phi_a, delta_a, theta_b, eta_b, phi_b, delta_b"),
+            ("phi_b=x", "init phi_b=x: `x` is not a number"),
+            ("phi_b=inf", "init phi_b=inf: inf rad is not allowed: must be finite"),
+            ("phi_b=1,phi_b=2", "init: phi_b is given twice; name each coordinate once"),
         ];
         for (item, want) in cases {
-            let e = parse_coordinates("--init", &[item], false, &mut q).unwrap_err();
+            let e = parse_coordinates("init", &[item], false, &mut q).unwrap_err();
             assert_eq!(e.to_string(), want);
         }
-        let e = parse_coordinates("--init-rate", &["delta_b=nan"], true, &mut q).unwrap_err();
+        let e = parse_coordinates("init_rate", &["delta_b=nan"], true, &mut q).unwrap_err();
         assert_eq!(
             e.to_string(),
-            "--init-rate delta_b=nan: NaN m/s is not allowed: must be finite"
+            "init_rate delta_b=nan: NaN m/s is not allowed: must be finite"
         );
     }
 
     #[test]
     fn initial_states_and_their_refusals() {
         let model = Model::new(&Params::table_i()).unwrap();
-        let (init, text) =
-            initial_state(&model, &Excitation::KickX { x_m: 1e-6 }, Spelling::Flag).unwrap();
+        let (init, text) = initial_state(&model, &Excitation::KickX { x_m: 1e-6 }).unwrap();
         assert!(init.qdot.iter().all(|&v| v == 0.0) && text.starts_with("kick:"));
-        let e = initial_state(&model, &Excitation::KickX { x_m: 0.0 }, Spelling::Keyword);
+        let e = initial_state(&model, &Excitation::KickX { x_m: 0.0 });
         assert_eq!(
             e.unwrap_err().to_string(),
             "kick_x 0: the displacement (m) must be finite and non-zero"
         );
-        let e = initial_state(&model, &Excitation::KickX { x_m: 10.0 }, Spelling::Flag);
+        let e = initial_state(&model, &Excitation::KickX { x_m: 10.0 });
         assert!(e
             .unwrap_err()
             .to_string()
-            .starts_with("--kick-x 10 m: the static deflection"));
+            .starts_with("kick_x 10 m: the static deflection"));
         let zero = Excitation::Given {
             q: [0.0; 8],
             qdot: [0.0; 8],
         };
         assert_eq!(
-            initial_state(&model, &zero, Spelling::Keyword)
-                .unwrap_err()
-                .to_string(),
+            initial_state(&model, &zero).unwrap_err().to_string(),
             "init/init_rate: every coordinate and rate is 0: nothing moves"
         );
         let mut q = [0.0; 8];
         q[6] = 0.01;
-        let (_, text) = initial_state(
-            &model,
-            &Excitation::Given { q, qdot: [0.0; 8] },
-            Spelling::Flag,
-        )
-        .unwrap();
+        let (_, text) = initial_state(&model, &Excitation::Given { q, qdot: [0.0; 8] }).unwrap();
         assert_eq!(text, "given: phi_b=1e-2 rad, rate 0e0 rad/s");
-        let e = initial_state(
-            &model,
-            &Excitation::EqualEnergy { energy_j: -1.0 },
-            Spelling::Flag,
-        );
+        let e = initial_state(&model, &Excitation::EqualEnergy { energy_j: -1.0 });
         assert_eq!(
             e.unwrap_err().to_string(),
-            "--mode-energy -1: the energy per mode (J) must be finite and > 0"
+            "mode_energy -1: the energy per mode (J) must be finite and > 0"
         );
     }
 
     #[test]
     fn sampling_is_checked() {
         assert_eq!(
-            check_sampling(Spelling::Flag, 43_200.0, 0.1, None).unwrap(),
+            check_sampling(43_200.0, 0.1, None).unwrap(),
             (432_000, 1 << 17)
         );
         let cases = [
@@ -420,36 +402,31 @@ mod tests {
                 1.0,
                 0.0,
                 None,
-                "--step 0: the sampling step (s) must be finite and > 0",
+                "step 0: the sampling step (s) must be finite and > 0",
             ),
             (
                 -1.0,
                 0.1,
                 None,
-                "--duration -1: the duration (s) must be finite and > 0",
+                "duration -1: the duration (s) must be finite and > 0",
             ),
             (
                 0.1,
                 0.1,
                 None,
-                "--duration 0.1 s at --step 0.1 s gives 1 sample(s): at least 2 are needed",
+                "duration 0.1 s at step 0.1 s gives 1 sample(s): at least 2 are needed",
             ),
             (
                 100.0,
                 0.1,
                 Some(8),
-                "--nperseg 8: the Welch segment must have at least 16 samples",
+                "nperseg 8: the Welch segment must have at least 16 samples",
             ),
         ];
         for (d, s, n, want) in cases {
-            assert_eq!(
-                check_sampling(Spelling::Flag, d, s, n)
-                    .unwrap_err()
-                    .to_string(),
-                want
-            );
+            assert_eq!(check_sampling(d, s, n).unwrap_err().to_string(), want);
         }
-        let e = check_sampling(Spelling::Keyword, 10.0, 0.1, Some(128)).unwrap_err();
+        let e = check_sampling(10.0, 0.1, Some(128)).unwrap_err();
         assert_eq!(
             e.to_string(),
             "duration 10 s at step 0.1 s gives 100 samples, shorter than one Welch segment \

@@ -240,19 +240,7 @@ pub fn fit(
     let segment_s = training.segment_len as f64 / training.fs_hz;
     let dt = 1.0 / training.fs_hz;
     let bin_variance_factor = super::stats::bin_variance_factor(training.segment_len, 2);
-    let mut params: Vec<Param> = inputs
-        .iter()
-        .enumerate()
-        .map(|(a, input)| Param::gain(a, input.name()))
-        .collect();
-    params.push(Param::delay(req.max_delay_s, dt));
-    params.extend(key_params(base, &req.keys)?);
-    for (a, input) in inputs.iter().enumerate() {
-        let rel = req.noise_rel[a];
-        if rel > 0.0 && req.noise_psd[a].iter().any(|&m| m > 0.0) {
-            params.push(Param::noise_scale(a, input.name(), rel));
-        }
-    }
+    let params = candidates(base, inputs, req, dt)?;
     let mut notes = Vec::new();
 
     let noise_at = |k: usize| -> Vec<f64> { req.noise_psd.iter().map(|m| m[k]).collect() };
@@ -474,8 +462,76 @@ pub fn fit(
     // What the data alone say of a key with a prior: whether it is constrained.
     let (sig_data, _) = covariance(&at_solution.data_only(data_rows), data_rows, sigma_factor);
     let params_fit = problem.params_at(&theta)?;
-    let estimates = problem
-        .params
+    let estimates = estimates_of(
+        &problem.params,
+        &theta,
+        &free,
+        &Sigmas {
+            fitted: &sig_u,
+            all: &sig_all,
+            data_only: &sig_data,
+        },
+    );
+    Ok(FitReport {
+        estimates,
+        params: params_fit,
+        noise_factors: problem.noise_factors(&theta),
+        chi2,
+        dof,
+        sigma_factor,
+        correlation,
+        fitted: free
+            .iter()
+            .map(|&j| problem.params[j].name.clone())
+            .collect(),
+        band_hz: band,
+        coherent_top_hz: coherent_top,
+        bins: counts,
+        iterations,
+        stop,
+        witness_bias,
+        notes,
+    })
+}
+
+/// The candidate parameters: a gain per input, the delay, the requested keys, and the scale of
+/// every witness noise given with an uncertainty.
+fn candidates(
+    base: &Params,
+    inputs: &[Input],
+    req: &FitRequest,
+    dt: f64,
+) -> Result<Vec<Param>, SubtractError> {
+    let mut params: Vec<Param> = inputs
+        .iter()
+        .enumerate()
+        .map(|(a, input)| Param::gain(a, input.name()))
+        .collect();
+    params.push(Param::delay(req.max_delay_s, dt));
+    params.extend(key_params(base, &req.keys)?);
+    for (a, input) in inputs.iter().enumerate() {
+        let rel = req.noise_rel[a];
+        if rel > 0.0 && req.noise_psd[a].iter().any(|&m| m > 0.0) {
+            params.push(Param::noise_scale(a, input.name(), rel));
+        }
+    }
+    Ok(params)
+}
+
+/// The uncertainties (in units of each parameter's half-width) [`estimates_of`] reports: of the
+/// fitted parameters together, of every candidate free together (for the held ones), and of the
+/// data alone (whether a key with a prior is constrained).
+struct Sigmas<'a> {
+    fitted: &'a [f64],
+    all: &'a [f64],
+    data_only: &'a [f64],
+}
+
+/// Every candidate's estimate at `theta`: fitted, on its bound, or not constrained (held, or a
+/// key the data leave to its prior).
+fn estimates_of(params: &[Param], theta: &[f64], free: &[usize], sig: &Sigmas) -> Vec<Estimate> {
+    let (sig_u, sig_all, sig_data) = (sig.fitted, sig.all, sig.data_only);
+    params
         .iter()
         .enumerate()
         .map(|(j, p)| {
@@ -526,27 +582,7 @@ pub fn fit(
                 }
             }
         })
-        .collect();
-    Ok(FitReport {
-        estimates,
-        params: params_fit,
-        noise_factors: problem.noise_factors(&theta),
-        chi2,
-        dof,
-        sigma_factor,
-        correlation,
-        fitted: free
-            .iter()
-            .map(|&j| problem.params[j].name.clone())
-            .collect(),
-        band_hz: band,
-        coherent_top_hz: coherent_top,
-        bins: counts,
-        iterations,
-        stop,
-        witness_bias,
-        notes,
-    })
+        .collect()
 }
 
 /// `(Z^T Z)^-1/2 Z^T` for instruments `Z` (through the eigenvalues of `Z^T Z`; directions it

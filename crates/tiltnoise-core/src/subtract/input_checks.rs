@@ -7,6 +7,7 @@
 use super::SubtractError;
 use crate::error::Num;
 use crate::model::{Input, Observable};
+use crate::option_key::OptionKey;
 use crate::spectral::CrossSpectra;
 
 /// The names of the witness's inputs and then of the measured observables, for messages:
@@ -47,7 +48,9 @@ pub(super) fn check_channels(
                 };
                 return Err(SubtractError::Record(format!(
                     "{name} {what} of the overlap: a dead channel has no power to fit or \
-                     subtract; leave it out (--observables, --axes) or check the record"
+                     subtract; leave it out ({}, {}) or check the record",
+                    OptionKey::OBSERVABLES,
+                    OptionKey::AXES
                 )));
             }
         }

@@ -55,6 +55,7 @@ pub use residuals::{BandSummary, ResidualSpectra};
 
 use crate::error::{Num, TfError};
 use crate::model::{Input, Model, Observable};
+use crate::option_key::OptionKey;
 use crate::params::Params;
 use crate::spectral::confidence::equivalent_averages;
 use crate::spectral::{csd_matrix, welch, SpectralError, WelchConfig};
@@ -256,8 +257,8 @@ pub enum SubtractError {
     #[error(
         "no bin of the fit band {} .. {} Hz is usable (every one is near a resonance of the \
          model, or the witness records no floor motion above its own noise there); choose \
-         another band with --band",
-        Num(.band_hz.0), Num(.band_hz.1)
+         another band with {}",
+        Num(.band_hz.0), Num(.band_hz.1), OptionKey::BAND
     )]
     NoFitBins {
         /// The band (Hz).
@@ -268,11 +269,12 @@ pub enum SubtractError {
         "the witness record is not coherent with any measured observable at any frequency (its \
          multiple coherence is what noise alone gives): it cannot be subtracted; check that the \
          records overlap in time, their axis maps and sign conventions, or give a fit band with \
-         --band"
+         {}",
+        OptionKey::BAND
     )]
     NotCoherent,
     /// A key that is not a parameter.
-    #[error("--fit: unknown parameter key `{}`; allowed: {allowed}", crate::error::Shown(.key))]
+    #[error("{}: unknown parameter key `{}`; allowed: {allowed}", OptionKey::FIT, crate::error::Shown(.key))]
     UnknownKey {
         /// The key given.
         key: String,
@@ -280,7 +282,10 @@ pub enum SubtractError {
         allowed: String,
     },
     /// A key that cannot be fitted.
-    #[error("--fit: parameter `{key}` is not a free parameter here: {reason}; allowed: {allowed}")]
+    #[error(
+        "{}: parameter `{key}` is not a free parameter here: {reason}; allowed: {allowed}",
+        OptionKey::FIT
+    )]
     NotFreeKey {
         /// The key.
         key: String,
@@ -290,7 +295,10 @@ pub enum SubtractError {
         allowed: String,
     },
     /// The same key twice.
-    #[error("--fit: parameter `{key}` is listed twice; give each key once")]
+    #[error(
+        "{}: parameter `{key}` is listed twice; give each key once",
+        OptionKey::FIT
+    )]
     DuplicateKey {
         /// The key.
         key: String,
@@ -341,47 +349,12 @@ pub fn subtract(
     let fs = alignment.fs_hz;
     check_config(witness, measured, cfg)?;
     let n = alignment.len;
-    let n_hold = (n as f64 * cfg.holdout_fraction).round() as usize;
-    let n_train = n - n_hold;
-    let segment_len = match cfg.segment_len {
-        Some(l) => l,
-        None => {
-            pow2_floor((n_train / DEFAULT_SEGMENTS_IN_TRAINING).min(n_hold / MIN_HOLDOUT_SEGMENTS))
-                .min(MAX_DEFAULT_SEGMENT)
-        }
-    };
-    let span = |m: usize| format!("{m} samples ({} s)", Num(m as f64 / fs));
-    if segment_len < MIN_SEGMENT
-        || n_train < MIN_TRAINING_SEGMENTS * segment_len
-        || n_hold < MIN_HOLDOUT_SEGMENTS * segment_len
-    {
-        let needed_seg = segment_len.max(MIN_SEGMENT);
-        let needed = (MIN_TRAINING_SEGMENTS * needed_seg) as f64 / (1.0 - cfg.holdout_fraction);
-        let needed = needed.max((MIN_HOLDOUT_SEGMENTS * needed_seg) as f64 / cfg.holdout_fraction);
-        return Err(SubtractError::TooShort(format!(
-            "the records overlap for {}: with a held-out fraction of {} and a Welch segment of {} \
-             the overlap must be at least {} (training >= {MIN_TRAINING_SEGMENTS} segments, \
-             held-out >= {MIN_HOLDOUT_SEGMENTS}); use longer records or a shorter --nperseg",
-            span(n),
-            cfg.holdout_fraction,
-            span(needed_seg),
-            span(needed.ceil() as usize),
-        )));
-    }
-    let segment_s = segment_len as f64 / fs;
-    let max_delay_s = match cfg.max_delay_s {
-        Some(d) if d.is_finite() && d > 0.0 && d <= MAX_DELAY_FRACTION * segment_s => d,
-        Some(d) => {
-            return Err(SubtractError::Config(format!(
-                "--max-delay {} s is not allowed: must be > 0 and at most {} of the Welch \
-                 segment, {} s (longer delays need a longer --nperseg)",
-                Num(d),
-                MAX_DELAY_FRACTION,
-                Num(MAX_DELAY_FRACTION * segment_s)
-            )))
-        }
-        None => DEFAULT_MAX_DELAY_FRACTION * segment_s,
-    };
+    let SegmentPlan {
+        segment_len,
+        n_train,
+        n_hold,
+        max_delay_s,
+    } = SegmentPlan::new(n, fs, cfg)?;
     let inputs = witness.inputs;
     let n_in = inputs.len();
     let w: Vec<&[f64]> = witness
@@ -407,18 +380,7 @@ pub fn subtract(
     let freqs = &training_spectra.freqs_hz;
     let colocated =
         colocated::estimate_all(witness, colocated, &cfg.colocated_noise_ratio, segment_len)?;
-    let mut noise = cfg.witness_noise.clone();
-    for e in &colocated {
-        if noise.iter().any(|x| x.input == e.noise.input) {
-            return Err(SubtractError::Config(format!(
-                "--witness-noise {}: the noise of {} is also estimated from the co-located \
-                 records; give one or the other",
-                e.noise.input.name(),
-                e.noise.input.name()
-            )));
-        }
-        noise.push(e.noise.clone());
-    }
+    let noise = all_witness_noise(&cfg.witness_noise, &colocated)?;
     let noise_psd = noise_on_grid(inputs, &noise, freqs)?;
     let noise_rel: Vec<f64> = inputs
         .iter()
@@ -450,23 +412,7 @@ pub fn subtract(
         .map(|(m, k)| m.iter().map(|v| v * k).collect())
         .collect();
     let noise_at = |k: usize| -> Vec<f64> { noise_psd.iter().map(|m| m[k]).collect() };
-    let coupling = Coupling {
-        gains: inputs
-            .iter()
-            .map(|i| {
-                fit.estimates
-                    .iter()
-                    .find(|e| e.name == format!("gain.{}", i.name()))
-                    .map_or(1.0, |e| e.value)
-            })
-            .collect(),
-        delay_s: fit
-            .estimates
-            .iter()
-            .find(|e| e.name == "delay_s")
-            .map_or(0.0, |e| e.value)
-            - alignment.fraction_s,
-    };
+    let coupling = coupling_of(&fit, inputs, alignment.fraction_s);
     let fitted_model = Model::new(&fit.params).map_err(|e| SubtractError::Params(e.to_string()))?;
     let weights = predict::Weights {
         freqs_hz: freqs[1..].to_vec(),
@@ -488,96 +434,15 @@ pub fn subtract(
         &noise_at,
     )?;
 
-    // The cleaned record against the raw one, band by band, before it is written; the
-    // residual expected of it is the coherence limit of the whole overlap.
-    let whole: Vec<&[f64]> = w.iter().chain(&y).copied().collect();
-    let whole_spectra = csd_matrix(&whole, fs, &welch_cfg)?;
-    let n_segments_whole = whole_spectra.n_segments;
-    let n_eff_whole = equivalent_averages(&welch_cfg, n_segments_whole);
-    let raw_psd: Vec<Vec<f64>> = (0..outputs.len())
-        .map(|o| whole_spectra.psd(n_in + o))
-        .collect();
-    let coherence_limit: Vec<Vec<f64>> = (0..outputs.len())
-        .map(|o| residuals::coherence_limit(&whole_spectra, n_in, n_in + o, n_eff_whole))
-        .collect();
-    let mut left: Vec<Vec<(f64, f64)>> = vec![Vec::new(); outputs.len()];
-    let mut whole_left = vec![false; outputs.len()];
-    let (prediction, cleaned, bands) = loop {
-        let mask = |o: usize, f: f64| {
-            if whole_left[o] {
-                0.0
-            } else {
-                bands::mask(&left[o], f)
-            }
-        };
-        let mut prediction = predictor.series(&mask);
-        for (o, (_, p)) in prediction.series.iter_mut().enumerate() {
-            if whole_left[o] {
-                p.iter_mut().for_each(|v| *v = 0.0);
-            }
-        }
-        let cleaned: Vec<(Observable, Vec<f64>)> = prediction
-            .series
-            .iter()
-            .zip(&y)
-            .map(|((o, p), m)| (*o, m.iter().zip(p).map(|(a, b)| a - b).collect()))
-            .collect();
-        let mut new_left: Vec<(usize, (f64, f64))> = Vec::new();
-        let mut new_whole: Vec<usize> = Vec::new();
-        let mut checks = Vec::with_capacity(outputs.len());
-        for (o, (obs, c)) in cleaned.iter().enumerate() {
-            let cleaned_psd = welch(c, fs, &welch_cfg)?.psd;
-            let ms = &model_spectra[o];
-            let expected: Vec<f64> = (0..freqs.len())
-                .map(|k| {
-                    let c = ms.guard[k] * mask(o, freqs[k]);
-                    raw_psd[o][k] - c * (2.0 - c) * (raw_psd[o][k] - coherence_limit[o][k])
-                })
-                .collect();
-            let judged = bands::judge(
-                freqs,
-                &bands::BinSpectra {
-                    raw: &raw_psd[o],
-                    cleaned: &cleaned_psd,
-                    expected: &expected,
-                    witness_limited: &ms.witness_limited,
-                },
-                &welch_cfg,
-                n_segments_whole,
-                &left[o],
-            );
-            let variance_ratio = variance(c) / variance(y[o]);
-            if !whole_left[o] {
-                let worse: Vec<(usize, (f64, f64))> = judged
-                    .iter()
-                    .filter(|b| b.ratio > 1.0 && !b.left_raw)
-                    .map(|b| (o, (b.lo_hz, b.hi_hz)))
-                    .collect();
-                if worse.is_empty() && variance_ratio > 1.0 {
-                    new_whole.push(o);
-                }
-                new_left.extend(worse);
-            }
-            checks.push((
-                *obs,
-                BandCheck {
-                    bands: judged,
-                    variance_ratio,
-                    left_raw: whole_left[o],
-                },
-            ));
-        }
-        let changed = !(new_left.is_empty() && new_whole.is_empty());
-        for (o, band) in new_left {
-            left[o].push(band);
-        }
-        for o in new_whole {
-            whole_left[o] = true;
-        }
-        if !changed {
-            break (prediction, cleaned, checks);
-        }
-    };
+    let (prediction, cleaned, bands) = clean_never_worse(&Cleaning {
+        predictor: &predictor,
+        w: &w,
+        y: &y,
+        outputs: &outputs,
+        fs,
+        welch_cfg: &welch_cfg,
+        model_spectra: &model_spectra,
+    })?;
 
     let held: Vec<&[f64]> = w.iter().chain(&y).map(|x| &x[n_train..]).collect();
     let held_spectra = csd_matrix(&held, fs, &welch_cfg)?;
@@ -619,8 +484,277 @@ pub fn subtract(
         &cfg.readout_asd,
         report_band,
     );
-    let mut notes = vec![alignment.note.clone()];
-    notes.extend(fit.notes.iter().cloned());
+    let notes = run_notes(
+        &alignment.note,
+        &fit.notes,
+        &prediction,
+        &bands,
+        &residuals,
+        fs,
+    );
+    Ok(SubtractResult {
+        alignment,
+        segment_len,
+        n_train,
+        n_holdout: n_hold,
+        n_eff: (n_eff_train, n_eff_held),
+        fit,
+        max_delay_s,
+        witness_noise_psd: inputs.iter().copied().zip(noise_psd.clone()).collect(),
+        colocated,
+        prediction,
+        cleaned,
+        bands,
+        residuals,
+        notes,
+    })
+}
+
+/// How the overlap is cut: the Welch segment, the training and held-out stretches, the largest
+/// delay searched.
+struct SegmentPlan {
+    segment_len: usize,
+    n_train: usize,
+    n_hold: usize,
+    max_delay_s: f64,
+}
+
+impl SegmentPlan {
+    /// The plan for an overlap of `n` samples at `fs` Hz, or why the options do not fit it.
+    fn new(n: usize, fs: f64, cfg: &SubtractConfig) -> Result<SegmentPlan, SubtractError> {
+        let n_hold = (n as f64 * cfg.holdout_fraction).round() as usize;
+        let n_train = n - n_hold;
+        let segment_len = match cfg.segment_len {
+            Some(l) => l,
+            None => pow2_floor(
+                (n_train / DEFAULT_SEGMENTS_IN_TRAINING).min(n_hold / MIN_HOLDOUT_SEGMENTS),
+            )
+            .min(MAX_DEFAULT_SEGMENT),
+        };
+        let span = |m: usize| format!("{m} samples ({} s)", Num(m as f64 / fs));
+        if segment_len < MIN_SEGMENT
+            || n_train < MIN_TRAINING_SEGMENTS * segment_len
+            || n_hold < MIN_HOLDOUT_SEGMENTS * segment_len
+        {
+            let needed_seg = segment_len.max(MIN_SEGMENT);
+            let needed = (MIN_TRAINING_SEGMENTS * needed_seg) as f64 / (1.0 - cfg.holdout_fraction);
+            let needed =
+                needed.max((MIN_HOLDOUT_SEGMENTS * needed_seg) as f64 / cfg.holdout_fraction);
+            return Err(SubtractError::TooShort(format!(
+                "the records overlap for {}: with a held-out fraction of {} and a Welch segment of {} \
+                 the overlap must be at least {} (training >= {MIN_TRAINING_SEGMENTS} segments, \
+                 held-out >= {MIN_HOLDOUT_SEGMENTS}); use longer records or a shorter {}",
+                span(n),
+                cfg.holdout_fraction,
+                span(needed_seg),
+                span(needed.ceil() as usize),
+                OptionKey::NPERSEG,
+            )));
+        }
+        let segment_s = segment_len as f64 / fs;
+        let max_delay_s = match cfg.max_delay_s {
+            Some(d) if d.is_finite() && d > 0.0 && d <= MAX_DELAY_FRACTION * segment_s => d,
+            Some(d) => {
+                return Err(SubtractError::Config(format!(
+                    "{} is not allowed: must be > 0 and at most {} of the Welch segment, {} s \
+                     (longer delays need a longer {})",
+                    OptionKey::MAX_DELAY.given(format!("{} s", Num(d))),
+                    MAX_DELAY_FRACTION,
+                    Num(MAX_DELAY_FRACTION * segment_s),
+                    OptionKey::NPERSEG
+                )))
+            }
+            None => DEFAULT_MAX_DELAY_FRACTION * segment_s,
+        };
+        Ok(SegmentPlan {
+            segment_len,
+            n_train,
+            n_hold,
+            max_delay_s,
+        })
+    }
+}
+
+/// The witness noise of every input: as given, and as the co-located records estimate it (an
+/// input given both ways is refused).
+fn all_witness_noise(
+    given: &[WitnessNoise],
+    colocated: &[ColocatedEstimate],
+) -> Result<Vec<WitnessNoise>, SubtractError> {
+    let mut noise = given.to_vec();
+    for e in colocated {
+        if noise.iter().any(|x| x.input == e.noise.input) {
+            return Err(SubtractError::Config(format!(
+                "{}: the noise of {} is also estimated from the co-located records; give one \
+                 or the other",
+                OptionKey::WITNESS_NOISE.given(e.noise.input.name()),
+                e.noise.input.name()
+            )));
+        }
+        noise.push(e.noise.clone());
+    }
+    Ok(noise)
+}
+
+/// The fitted gain of every input (1 where not estimated) and the delay, less the records'
+/// sub-sample offset `fraction_s`.
+fn coupling_of(fit: &FitReport, inputs: &[Input], fraction_s: f64) -> Coupling {
+    let value = |name: &str, default: f64| {
+        fit.estimates
+            .iter()
+            .find(|e| e.name == name)
+            .map_or(default, |e| e.value)
+    };
+    Coupling {
+        gains: inputs
+            .iter()
+            .map(|i| value(&format!("gain.{}", i.name()), 1.0))
+            .collect(),
+        delay_s: value("delay_s", 0.0) - fraction_s,
+    }
+}
+
+/// What [`clean_never_worse`] works on: the predictor, the aligned witness and measured
+/// series, the Welch configuration and the model's spectra.
+struct Cleaning<'a> {
+    predictor: &'a predict::Predictor,
+    w: &'a [&'a [f64]],
+    y: &'a [&'a [f64]],
+    outputs: &'a [Observable],
+    fs: f64,
+    welch_cfg: &'a WelchConfig,
+    model_spectra: &'a [ModelSpectra],
+}
+
+/// The prediction and the cleaned record, checked band by band against the raw one before it is
+/// written: a band where the cleaned record came out worse is left unpredicted, a record whose
+/// variance would grow is left raw, until nothing changes. The residual expected of each band
+/// is the coherence limit of the whole overlap.
+#[allow(clippy::type_complexity)]
+fn clean_never_worse(
+    c: &Cleaning,
+) -> Result<
+    (
+        predict::Prediction,
+        Vec<(Observable, Vec<f64>)>,
+        Vec<(Observable, BandCheck)>,
+    ),
+    SubtractError,
+> {
+    let Cleaning {
+        predictor,
+        w,
+        y,
+        outputs,
+        fs,
+        welch_cfg,
+        model_spectra,
+    } = *c;
+    let n_in = w.len();
+    let whole: Vec<&[f64]> = w.iter().chain(y.iter()).copied().collect();
+    let whole_spectra = csd_matrix(&whole, fs, welch_cfg)?;
+    // The Welch grid of the segment length, the same as the training spectra's.
+    let freqs = &whole_spectra.freqs_hz;
+    let n_segments_whole = whole_spectra.n_segments;
+    let n_eff_whole = equivalent_averages(welch_cfg, n_segments_whole);
+    let raw_psd: Vec<Vec<f64>> = (0..outputs.len())
+        .map(|o| whole_spectra.psd(n_in + o))
+        .collect();
+    let coherence_limit: Vec<Vec<f64>> = (0..outputs.len())
+        .map(|o| residuals::coherence_limit(&whole_spectra, n_in, n_in + o, n_eff_whole))
+        .collect();
+    let mut left: Vec<Vec<(f64, f64)>> = vec![Vec::new(); outputs.len()];
+    let mut whole_left = vec![false; outputs.len()];
+    loop {
+        let mask = |o: usize, f: f64| {
+            if whole_left[o] {
+                0.0
+            } else {
+                bands::mask(&left[o], f)
+            }
+        };
+        let mut prediction = predictor.series(&mask);
+        for (o, (_, p)) in prediction.series.iter_mut().enumerate() {
+            if whole_left[o] {
+                p.iter_mut().for_each(|v| *v = 0.0);
+            }
+        }
+        let cleaned: Vec<(Observable, Vec<f64>)> = prediction
+            .series
+            .iter()
+            .zip(y.iter())
+            .map(|((o, p), m)| (*o, m.iter().zip(p).map(|(a, b)| a - b).collect()))
+            .collect();
+        let mut new_left: Vec<(usize, (f64, f64))> = Vec::new();
+        let mut new_whole: Vec<usize> = Vec::new();
+        let mut checks = Vec::with_capacity(outputs.len());
+        for (o, (obs, c)) in cleaned.iter().enumerate() {
+            let cleaned_psd = welch(c, fs, welch_cfg)?.psd;
+            let ms = &model_spectra[o];
+            let expected: Vec<f64> = (0..freqs.len())
+                .map(|k| {
+                    let c = ms.guard[k] * mask(o, freqs[k]);
+                    raw_psd[o][k] - c * (2.0 - c) * (raw_psd[o][k] - coherence_limit[o][k])
+                })
+                .collect();
+            let judged = bands::judge(
+                freqs,
+                &bands::BinSpectra {
+                    raw: &raw_psd[o],
+                    cleaned: &cleaned_psd,
+                    expected: &expected,
+                    witness_limited: &ms.witness_limited,
+                },
+                welch_cfg,
+                n_segments_whole,
+                &left[o],
+            );
+            let variance_ratio = variance(c) / variance(y[o]);
+            if !whole_left[o] {
+                let worse: Vec<(usize, (f64, f64))> = judged
+                    .iter()
+                    .filter(|b| b.ratio > 1.0 && !b.left_raw)
+                    .map(|b| (o, (b.lo_hz, b.hi_hz)))
+                    .collect();
+                if worse.is_empty() && variance_ratio > 1.0 {
+                    new_whole.push(o);
+                }
+                new_left.extend(worse);
+            }
+            checks.push((
+                *obs,
+                BandCheck {
+                    bands: judged,
+                    variance_ratio,
+                    left_raw: whole_left[o],
+                },
+            ));
+        }
+        let changed = !(new_left.is_empty() && new_whole.is_empty());
+        for (o, band) in new_left {
+            left[o].push(band);
+        }
+        for o in new_whole {
+            whole_left[o] = true;
+        }
+        if !changed {
+            return Ok((prediction, cleaned, checks));
+        }
+    }
+}
+
+/// The run's notes: the alignment's, the fit's, and where the record was not predicted, left raw,
+/// or came out below what the coherence allows.
+fn run_notes(
+    alignment_note: &str,
+    fit_notes: &[String],
+    prediction: &predict::Prediction,
+    bands: &[(Observable, BandCheck)],
+    residuals: &[residuals::ResidualSpectra],
+    fs: f64,
+) -> Vec<String> {
+    let mut notes = vec![alignment_note.to_string()];
+    notes.extend(fit_notes.iter().cloned());
     for (o, bands) in &prediction.guarded {
         if !bands.is_empty() {
             notes.push(format!(
@@ -630,7 +764,7 @@ pub fn subtract(
             ));
         }
     }
-    for (o, check) in &bands {
+    for (o, check) in bands {
         if check.left_raw {
             notes.push(format!(
                 "{}: left raw entirely: the prediction would have raised the record's variance \
@@ -653,7 +787,7 @@ pub fn subtract(
             ));
         }
     }
-    for r in &residuals {
+    for r in residuals {
         if r.band.below_coherence_bound {
             notes.push(format!(
                 "{}: the cleaned residual in the report band is more than 3 sigma below the \
@@ -664,22 +798,7 @@ pub fn subtract(
             ));
         }
     }
-    Ok(SubtractResult {
-        alignment,
-        segment_len,
-        n_train,
-        n_holdout: n_hold,
-        n_eff: (n_eff_train, n_eff_held),
-        fit,
-        max_delay_s,
-        witness_noise_psd: inputs.iter().copied().zip(noise_psd.clone()).collect(),
-        colocated,
-        prediction,
-        cleaned,
-        bands,
-        residuals,
-        notes,
-    })
+    notes
 }
 
 /// `a .. b Hz, ...`.
@@ -802,9 +921,9 @@ fn check_config(
     let f = cfg.holdout_fraction;
     if !(f > 0.0 && f <= MAX_HOLDOUT_FRACTION) {
         return Err(SubtractError::Config(format!(
-            "--holdout {} is not allowed: must be > 0 and <= {MAX_HOLDOUT_FRACTION} (the fit \
-             needs the larger part of the overlap)",
-            Num(f)
+            "{} is not allowed: must be > 0 and <= {MAX_HOLDOUT_FRACTION} (the fit needs the \
+             larger part of the overlap)",
+            OptionKey::HOLDOUT.given(Num(f))
         )));
     }
     for (i, input) in witness.inputs.iter().enumerate() {
@@ -825,37 +944,36 @@ fn check_config(
     for (input, r) in &cfg.colocated_noise_ratio {
         if !(r.is_finite() && *r > 0.0) {
             return Err(SubtractError::Config(format!(
-                "--colocated-ratio {}={}: the ratio of noise ASDs must be finite and > 0",
-                input.name(),
-                Num(*r)
+                "{}: the ratio of noise ASDs must be finite and > 0",
+                OptionKey::COLOCATED_RATIO.given(format!("{}={}", input.name(), Num(*r)))
             )));
         }
     }
     for x in &cfg.witness_noise {
         if !witness.inputs.contains(&x.input) {
             return Err(SubtractError::Config(format!(
-                "--witness-noise {}: the witness record has no input {}; it has {}",
-                x.input.name(),
+                "{}: the witness record has no input {}; it has {}",
+                OptionKey::WITNESS_NOISE.given(x.input.name()),
                 x.input.name(),
                 names(witness.inputs.iter().map(|a| a.name()))
             )));
         }
-        x.check("--witness-noise").map_err(SubtractError::Config)?;
+        x.check(&OptionKey::WITNESS_NOISE.to_string())
+            .map_err(SubtractError::Config)?;
     }
     for (o, asd) in &cfg.readout_asd {
         if !measured.channels.iter().any(|c| c.0 == *o) {
             return Err(SubtractError::Config(format!(
-                "--readout {}: the measured record has no channel {}; it has {}",
-                o.name(),
+                "{}: the measured record has no channel {}; it has {}",
+                OptionKey::READOUT.given(o.name()),
                 o.name(),
                 names(measured.channels.iter().map(|c| c.0.name()))
             )));
         }
         if !(asd.is_finite() && *asd >= 0.0) {
             return Err(SubtractError::Config(format!(
-                "--readout {}={}: the ASD ({}/sqrt(Hz)) must be finite and >= 0",
-                o.name(),
-                Num(*asd),
+                "{}: the ASD ({}/sqrt(Hz)) must be finite and >= 0",
+                OptionKey::READOUT.given(format!("{}={}", o.name(), Num(*asd))),
                 o.unit()
             )));
         }
@@ -863,18 +981,16 @@ fn check_config(
     if let Some((a, b)) = cfg.fit_band_hz {
         if !(a.is_finite() && b.is_finite() && 0.0 < a && a < b) {
             return Err(SubtractError::Config(format!(
-                "--band {}:{}: must be FLO:FHI with 0 < FLO < FHI (Hz)",
-                Num(a),
-                Num(b)
+                "{}: must be FLO:FHI with 0 < FLO < FHI (Hz)",
+                OptionKey::BAND.given(format!("{}:{}", Num(a), Num(b)))
             )));
         }
     }
     let (a, b) = cfg.report_band_hz;
     if !(a.is_finite() && b.is_finite() && 0.0 < a && a < b) {
         return Err(SubtractError::Config(format!(
-            "--report-band {}:{}: must be FLO:FHI with 0 < FLO < FHI (Hz)",
-            Num(a),
-            Num(b)
+            "{}: must be FLO:FHI with 0 < FLO < FHI (Hz)",
+            OptionKey::REPORT_BAND.given(format!("{}:{}", Num(a), Num(b)))
         )));
     }
     Ok(())

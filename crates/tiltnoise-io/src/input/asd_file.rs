@@ -10,11 +10,13 @@
 //! the quantity's unit per sqrt(Hz). Errors name the file, the line or index, the column and the
 //! value.
 
+use super::address::input_format;
 use super::csv::{parse_field, CsvFile};
 use super::h5::{self, h5err};
-use super::{frequency_refusal, InputError, InputFormat};
 use std::path::Path;
 use tiltnoise_core::error::Shown;
+use tiltnoise_core::input::require_two;
+use tiltnoise_core::input::{frequency_refusal, InputError, InputFormat};
 use tiltnoise_core::limits::ASDS;
 
 /// Frequencies (Hz) and one-sided ASD of the column read, and the column's name.
@@ -38,7 +40,7 @@ pub fn read_asd_column(
     quantity: &str,
     asd_unit: &'static str,
 ) -> Result<AsdColumn, InputError> {
-    match InputFormat::from_path(path)? {
+    match input_format(path)? {
         InputFormat::Csv => read_csv(path, quantity, asd_unit),
         InputFormat::Hdf5 => read_hdf5(path, quantity, asd_unit),
         InputFormat::Miniseed => Err(InputError::UnknownLayout {
@@ -110,7 +112,7 @@ fn read_csv(path: &Path, quantity: &str, asd_unit: &'static str) -> Result<AsdCo
         asd.push(a);
         Ok(())
     })?;
-    super::require_two(path, "column frequency_hz", freqs.len(), "frequencies")?;
+    require_two(path, "column frequency_hz", freqs.len(), "frequencies")?;
     Ok(AsdColumn {
         freqs_hz: freqs,
         asd,
@@ -172,7 +174,7 @@ fn read_hdf5(path: &Path, quantity: &str, asd_unit: &'static str) -> Result<AsdC
             format!("/{column}[{k}]")
         })?;
     }
-    super::require_two(path, "dataset /frequency_hz", freqs_hz.len(), "frequencies")?;
+    require_two(path, "dataset /frequency_hz", freqs_hz.len(), "frequencies")?;
     Ok(AsdColumn {
         freqs_hz,
         asd,

@@ -11,13 +11,15 @@
 
 use super::meta::decide_quantity;
 use super::series_units::{self, Plan, Stated};
-use super::InputError;
-use super::{resolve, MapOrigin, Motion, Resolved};
+use crate::input::spectra_checks::refuse_translation_spectra;
 use std::fs::File;
 use std::io::{BufRead, BufReader, Chain, Cursor, Read};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::csv_text::{CsvRecords, RecordError};
 use tiltnoise_core::error::{shown_list, Shown};
+use tiltnoise_core::input::InputError;
+use tiltnoise_core::input::{check_scales, AxisMap, Quantity, ReadOptions, UNITS_ALLOWED};
+use tiltnoise_core::input::{resolve, MapOrigin, Motion, Resolved};
 use tiltnoise_core::limits::{
     check_count, check_file_len, BoundedReader, Overrun, MAX_DATA_FILE_BYTES, MAX_LINE_BYTES,
     MAX_SERIES_SAMPLES,
@@ -373,15 +375,12 @@ fn declared_units(
 }
 
 /// The `# axes:` map, if any.
-fn axis_map(
-    path: &Path,
-    prelude: &Prelude,
-) -> Result<Option<(super::AxisMap, String)>, InputError> {
+fn axis_map(path: &Path, prelude: &Prelude) -> Result<Option<(AxisMap, String)>, InputError> {
     let Some(m) = prelude.meta("axes") else {
         return Ok(None);
     };
     let origin = format!("{}, line {} (# axes:)", path.display(), m.line);
-    let map = super::AxisMap::parse_from(&m.value, &origin)?;
+    let map = AxisMap::parse_from(&m.value, &origin)?;
     Ok(Some((
         map,
         format!("line {} `# axes:` of the file", m.line),
@@ -393,7 +392,7 @@ fn axis_map(
 fn map_columns(
     path: &Path,
     prelude: &Prelude,
-    opts: &super::ReadOptions,
+    opts: &ReadOptions,
     motions: &[Option<Motion>],
 ) -> Result<(Resolved, Vec<String>), InputError> {
     let file_map = axis_map(path, prelude)?;
@@ -418,7 +417,7 @@ pub(crate) struct Interpreted {
     /// The axis map resolved against the data columns (`prelude.header[1..]`).
     pub resolved: Resolved,
     /// From the explicit quantity, else the `# units:` line, else angle.
-    pub quantity: super::Quantity,
+    pub quantity: Quantity,
     /// The validated `# start_time:` value.
     pub start_time: Option<String>,
     /// Axis-map, quantity and description notes, in that order.
@@ -432,13 +431,13 @@ pub(crate) struct Interpreted {
 pub(crate) fn interpret_spectra(
     path: &Path,
     prelude: &Prelude,
-    opts: &super::ReadOptions,
+    opts: &ReadOptions,
     classify: fn(&str) -> Option<super::meta::SpectrumUnit>,
     allowed: &'static str,
 ) -> Result<Interpreted, InputError> {
     let unknown = vec![None; prelude.header.len() - 1];
     let (resolved, mut notes) = map_columns(path, prelude, opts, &unknown)?;
-    super::refuse_translation_spectra(path, &resolved)?;
+    refuse_translation_spectra(path, &resolved)?;
     let mapped: Vec<String> = resolved.channels.iter().map(|m| m.source.clone()).collect();
     let (declared, undeclared) = declared_units(path, prelude, &mapped, classify, allowed)?;
     let quantity = decide_quantity(path, opts.quantity, &declared, &undeclared, &mut notes)?;
@@ -486,7 +485,7 @@ fn stated_units(path: &Path, prelude: &Prelude) -> Result<Vec<Option<Stated>>, I
                 path: path.to_path_buf(),
                 location: location(column),
                 value: unit.to_string(),
-                allowed: tiltnoise_core::input::UNITS_ALLOWED,
+                allowed: UNITS_ALLOWED,
             }),
         }
     };
@@ -555,7 +554,7 @@ fn unit_entries<'a>(
 pub(crate) fn interpret_series(
     path: &Path,
     prelude: &Prelude,
-    opts: &super::ReadOptions,
+    opts: &ReadOptions,
 ) -> Result<InterpretedSeries, InputError> {
     let columns = &prelude.header[1..];
     let mut unit_notes = Vec::new();
@@ -570,7 +569,7 @@ pub(crate) fn interpret_series(
     let motions = series_units::motions(path, columns, &stated)?;
     let (resolved, mut notes) = map_columns(path, prelude, opts, &motions)?;
     notes.extend(unit_notes);
-    super::check_scales(path, &opts.scale, columns, "column")?;
+    check_scales(path, &opts.scale, columns, "column")?;
     let plan = series_units::plan(path, &resolved, &stated, opts, &mut notes)?;
     let start_time = start_time(path, prelude, &mut notes)?;
     if let Some(d) = prelude.meta("description") {

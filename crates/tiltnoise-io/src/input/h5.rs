@@ -1,16 +1,17 @@
 //! HDF5 helpers: opening, layout detection, typed attribute reading with precise errors.
 
 use super::start_time::{self, ISO8601_ALLOWED};
-use super::{check_sample_rate, InputError};
-use super::{resolve, MapOrigin, Resolved};
-use super::{
-    AxisMap, InputKind, ReadOptions, ACCEPTED_LAYOUTS, INPUT_SCHEMA_VERSION, SCHEMA_TILT_SERIES,
-    SCHEMA_TILT_SPECTRA,
-};
 use hdf5::types::{FixedAscii, FixedUnicode, TypeDescriptor, VarLenAscii, VarLenUnicode};
 use hdf5::{Attribute, Location, LocationType};
 use std::path::Path;
 use tiltnoise_core::error::shown_list;
+use tiltnoise_core::input::Motion;
+use tiltnoise_core::input::{check_sample_rate, InputError};
+use tiltnoise_core::input::{resolve, MapOrigin, Resolved};
+use tiltnoise_core::input::{
+    AxisMap, InputKind, ReadOptions, ACCEPTED_LAYOUTS, INPUT_SCHEMA_VERSION, SCHEMA_TILT_SERIES,
+    SCHEMA_TILT_SPECTRA,
+};
 use tiltnoise_core::limits::{
     check_count, check_memory, planned_bytes, MAX_SERIES_SAMPLES, SERIES_BYTES_PER_SAMPLE,
 };
@@ -25,7 +26,7 @@ pub(crate) fn h5err(
     move |e| InputError::Hdf5 {
         path,
         object,
-        message: crate::first_line(&e.to_string()),
+        message: crate::messages::first_line(&e.to_string()),
     }
 }
 
@@ -43,7 +44,7 @@ pub(crate) fn open(path: &Path) -> Result<hdf5::File, InputError> {
             format!(
                 "it is {}, not a regular file; an HDF5 file is read at random offsets, so \
                  copy it to a regular file first",
-                crate::file_kind(&kind)
+                crate::messages::file_kind(&kind)
             ),
         )));
     }
@@ -441,10 +442,7 @@ pub(crate) fn start_and_description(
 }
 
 /// Optional root attribute `axis_map`, parsed.
-pub(crate) fn axis_map(
-    path: &Path,
-    file: &hdf5::File,
-) -> Result<Option<super::AxisMap>, InputError> {
+pub(crate) fn axis_map(path: &Path, file: &hdf5::File) -> Result<Option<AxisMap>, InputError> {
     let Some(spec) = str_attr(
         path,
         file,
@@ -456,7 +454,7 @@ pub(crate) fn axis_map(
         return Ok(None);
     };
     let origin = format!("{}, root attribute axis_map", path.display());
-    super::AxisMap::parse_from(&spec, &origin).map(Some)
+    AxisMap::parse_from(&spec, &origin).map(Some)
 }
 
 /// Resolves the explicit axis map of `opts`, else the root attribute `axis_map` (`file_map`,
@@ -466,7 +464,7 @@ pub(crate) fn axis_map(
 pub(crate) fn resolve_axes(
     path: &Path,
     available: &[String],
-    motions: &[Option<super::Motion>],
+    motions: &[Option<Motion>],
     kind: &'static str,
     opts: &ReadOptions,
     file_map: Option<&AxisMap>,

@@ -17,12 +17,16 @@
 //! [`read_measured_input`] reads any of them; the budget turns a series into one-sided ASDs
 //! with its own Welch settings.
 
+use super::address::input_format;
 use super::csv::{decimal_resolution, parse_field, CsvFile, Prelude};
 use super::h5::{self, h5err, AttrValue};
-use super::{check_sample_rate, frequency_refusal, ChannelCtx, InputError, InputFormat};
 use std::path::Path;
 use tiltnoise_core::budget::{add_measured, series_psds, BudgetError, MeasuredPsds};
 use tiltnoise_core::error::{Num, Shown};
+use tiltnoise_core::input::require_two;
+use tiltnoise_core::input::{
+    check_sample_rate, frequency_refusal, ChannelCtx, InputError, InputFormat,
+};
 use tiltnoise_core::limits::{ASDS, SAMPLES};
 use tiltnoise_core::model::Observable;
 use tiltnoise_core::noise::BudgetReport;
@@ -55,7 +59,7 @@ pub enum MeasuredInput {
 /// time series; CSV is a spectrum when the header starts with `freq_hz`, a series when it
 /// starts with `time_s`.
 pub fn read_measured_input(path: &Path) -> Result<MeasuredInput, InputError> {
-    match InputFormat::from_path(path)? {
+    match input_format(path)? {
         InputFormat::Hdf5 => read_series_hdf5(path).map(MeasuredInput::Series),
         InputFormat::Miniseed => Err(InputError::UnknownLayout {
             path: path.to_path_buf(),
@@ -237,7 +241,7 @@ fn finish_series(
             return Err(ctx.non_finite(index, value, line));
         }
     }
-    super::require_two(path, &format!("channel {}", o0.name()), n, "samples")?;
+    require_two(path, &format!("channel {}", o0.name()), n, "samples")?;
     Ok(MeasuredSeries {
         sample_rate_hz,
         channels,
@@ -317,7 +321,7 @@ fn read_series_csv(
         Ok(())
     })?;
     let n = times.len();
-    super::require_two(path, "column time_s", n, "samples")?;
+    require_two(path, "column time_s", n, "samples")?;
     let dt = (times[n - 1] - times[0]) / (n - 1) as f64;
     for (index, &t) in times.iter().enumerate() {
         let expected = times[0] + index as f64 * dt;

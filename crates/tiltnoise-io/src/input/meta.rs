@@ -1,10 +1,10 @@
 //! Metadata shared by the readers: unit strings and the quantity decision.
 
-use super::InputError;
-use super::Quantity;
 use std::path::Path;
 use tiltnoise_core::error::{shown_list, Shown};
 use tiltnoise_core::input::normalize_unit as normalize;
+use tiltnoise_core::input::InputError;
+use tiltnoise_core::input::Quantity;
 
 /// Accepted unit strings of ASD columns/datasets, for messages.
 pub(crate) const ASD_UNITS: &str = "rad/sqrt(Hz) (angle) or rad/s/sqrt(Hz) (rate)";

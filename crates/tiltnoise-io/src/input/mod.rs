@@ -19,6 +19,7 @@
 //!   [`parse_start_time`] the instant it names, [`utc_text`] the text of an instant.
 //! * [`read_asd_column`]: the ASD of one quantity (a coloured readout, a user-named term).
 
+mod address;
 mod asd_file;
 mod csv;
 mod h5;
@@ -28,18 +29,20 @@ mod mseed;
 mod series_csv;
 mod series_units;
 mod source;
+mod spectra_checks;
 mod spectra_csv;
 mod spectra_gwpy;
 mod spectra_hdf5;
 mod start_time;
 
+pub use address::{input_format, split_hdf5_address};
 pub use asd_file::{read_asd_column, AsdColumn, GENERIC_ASD_COLUMN};
 pub use measured::{
     add_measured_file, read_measured, read_measured_input, MeasuredInput, MeasuredSeries,
     MeasuredSpectra, SCHEMA_OBSERVABLE_SERIES,
 };
 pub use source::TiltSeriesSource;
-pub use start_time::{parse_start_time, read_start_time, utc_text};
+pub use start_time::{parse_start_time, utc_text};
 pub use tiltnoise_core::input::*;
 
 use std::path::Path;
@@ -67,7 +70,7 @@ pub enum OpenedTilt {
 /// [`InputError::Extension`], [`InputError::UnknownLayout`] (naming the accepted layouts), or
 /// any validation error of the specific reader.
 pub fn open_tilt(path: &Path, opts: &ReadOptions) -> Result<OpenedTilt, InputError> {
-    match InputFormat::from_path(path)? {
+    match input_format(path)? {
         InputFormat::Csv => {
             let (file, prelude) = csv::CsvFile::open(path)?;
             match csv_kind(path, &prelude)? {
@@ -121,7 +124,7 @@ pub fn read_tilt(path: &Path, opts: &ReadOptions) -> Result<TiltInput, InputErro
 ///
 /// [`InputError::WrongKind`] if the file holds spectra; otherwise as [`read_tilt`].
 pub fn read_tilt_series(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, InputError> {
-    match InputFormat::from_path(path)? {
+    match input_format(path)? {
         InputFormat::Hdf5 => {
             let mut src = TiltSeriesSource::open(path, opts)?;
             src.read_all()
@@ -140,7 +143,7 @@ pub fn read_tilt_series(path: &Path, opts: &ReadOptions) -> Result<TiltSeries, I
 ///
 /// [`InputError::WrongKind`] if the file holds a time series; otherwise as [`read_tilt`].
 pub fn read_tilt_spectra(path: &Path, opts: &ReadOptions) -> Result<TiltSpectra, InputError> {
-    match InputFormat::from_path(path)? {
+    match input_format(path)? {
         InputFormat::Hdf5 => {
             let (file_path, object) = split_hdf5_address(path);
             let file = h5::open(&file_path)?;
@@ -166,6 +169,33 @@ pub fn read_tilt_spectra(path: &Path, opts: &ReadOptions) -> Result<TiltSpectra,
     }
 }
 
+/// The ISO 8601 time of sample 0 that the file states, if any.
+///
+/// # Errors
+///
+/// The reader's errors: an extension other than `.h5`, `.hdf5`, `.csv`, a file that cannot be
+/// opened, a `start_time` that is not a string or not ISO 8601.
+pub fn read_start_time(path: &Path) -> Result<Option<String>, InputError> {
+    match input_format(path)? {
+        InputFormat::Hdf5 => {
+            let file = h5::open(path)?;
+            h5::start_and_description(path, &file, &mut Vec::new())
+        }
+        InputFormat::Csv => {
+            let (_, prelude) = csv::CsvFile::open(path)?;
+            csv::start_time(path, &prelude, &mut Vec::new())
+        }
+        InputFormat::Miniseed => Err(InputError::UnknownLayout {
+            path: path.to_path_buf(),
+            format: "miniseed",
+            found: "a miniSEED file, whose channels are named by SEED code, not by observable"
+                .to_string(),
+            accepted: "a record of the observables as HDF5 or CSV (X, Y, Z, theta, eta, phi, \
+                       phi_a)",
+        }),
+    }
+}
+
 fn wrong_kind(path: &Path, expected: InputKind, found: InputKind) -> InputError {
     InputError::WrongKind {
         path: path.to_path_buf(),
@@ -188,49 +218,6 @@ fn csv_kind(path: &Path, prelude: &csv::Prelude) -> Result<InputKind, InputError
             ),
             accepted: ACCEPTED_LAYOUTS,
         }),
-    }
-}
-
-/// Spectra are read for the tilt axes only: a translation channel mapped from a spectrum file
-/// (an `x_t` column, or a map that asks for one) is refused rather than dropped.
-fn refuse_translation_spectra(path: &Path, resolved: &Resolved) -> Result<(), InputError> {
-    match resolved.channels.iter().find(|m| m.tilt_axis().is_none()) {
-        None => Ok(()),
-        Some(m) => Err(InputError::ChannelUnit {
-            path: path.to_path_buf(),
-            channel: m.source.clone(),
-            message: format!(
-                "feeds {}, a translation of the floor, and the file holds spectra; allowed: \
-                 spectra of the tilt axes (theta_t, eta_t, phi_t); give translations as a time \
-                 series",
-                m.input.name()
-            ),
-        }),
-    }
-}
-
-/// Scale factors apply to the samples of a time series; spectra refuse them rather than
-/// ignore them.
-fn no_scale_for_spectra(path: &Path, opts: &ReadOptions) -> Result<(), InputError> {
-    let series_only = |channel: &str, what: &str| {
-        Err(InputError::Scale {
-            path: path.to_path_buf(),
-            channel: channel.to_string(),
-            message: format!(
-                "is given {what}, but the file holds spectra; allowed: {what} for time series \
-                 only"
-            ),
-        })
-    };
-    if let Some(s) = opts.scale.first() {
-        return series_only(&s.channel, "a scale");
-    }
-    if let Some(u) = opts.units.first() {
-        return series_only(&u.channel, "a unit");
-    }
-    match opts.corrected.first().or(opts.pendulum.first()) {
-        Some(c) => series_only(c, "a sensor declaration"),
-        None => Ok(()),
     }
 }
 

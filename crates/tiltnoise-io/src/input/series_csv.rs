@@ -3,10 +3,10 @@
 
 use super::csv::{self, decimal_resolution, parse_field, CsvFile, Prelude};
 use super::series_units::{check_unstated_data, into_series, units_note};
-use super::{check_sample_rate, require_two, InputError};
-use super::{gap_note, process_channel, ChannelCtx, TiltSeries};
-use super::{GapPolicy, InputFormat, InputKind, Provenance, ReadOptions};
 use tiltnoise_core::error::Num;
+use tiltnoise_core::input::{check_sample_rate, require_two, InputError};
+use tiltnoise_core::input::{gap_note, process_channel, ChannelCtx, TiltSeries};
+use tiltnoise_core::input::{GapPolicy, InputFormat, InputKind, Provenance, ReadOptions};
 
 /// Reads the records of a CSV series whose prelude has been read (`prelude.header[0]` is
 /// `time_s`).

@@ -6,14 +6,18 @@
 //! whose unit nobody states is checked against [`tiltnoise_core::input::unstated_rms_bound`]).
 
 use super::meta::{decide_quantity, Declared};
-use super::{channel_motions, check_sensors, motion_of, scale_for, scale_note};
-use super::{ChannelUnit, GroundChannel, InputError, Motion, ParsedUnit, Quantity, ReadOptions};
-use super::{Resolved, Sensors, TranslationChannel, Unit};
 use std::path::Path;
 use tiltnoise_core::error::{shown_list, Shown};
 use tiltnoise_core::ground::GroundQuantity;
+use tiltnoise_core::input::{channel_motions, check_sensors, motion_of, scale_for, scale_note};
+use tiltnoise_core::input::{parse_unit, Mapped, Provenance, TiltSeries};
 use tiltnoise_core::input::{unstated_excess, DetrendedRms, UNITS_ALLOWED};
+use tiltnoise_core::input::{
+    ChannelUnit, GroundChannel, InputError, Motion, ParsedUnit, Quantity, ReadOptions,
+};
+use tiltnoise_core::input::{Resolved, Sensors, TranslationChannel, Unit};
 use tiltnoise_core::model::Input;
+use tiltnoise_core::option_key::OptionKey;
 
 /// A channel's unit as stated, and where.
 #[derive(Debug, Clone)]
@@ -37,7 +41,7 @@ pub(crate) struct Stated {
 impl Stated {
     /// A unit the file states at `origin`.
     pub fn in_file(text: &str, origin: String) -> Stated {
-        let parsed = tiltnoise_core::input::parse_unit(text);
+        let parsed = parse_unit(text);
         Stated {
             text: text.to_string(),
             counts: parsed == Some(ParsedUnit::Counts),
@@ -186,7 +190,7 @@ pub(crate) fn plan(
     opts: &ReadOptions,
     notes: &mut Vec<String>,
 ) -> Result<Plan, InputError> {
-    let at = |m: &super::Mapped| stated[m.index].as_ref();
+    let at = |m: &Mapped| stated[m.index].as_ref();
     for m in &resolved.channels {
         if let Some(s) = at(m).filter(|s| s.parsed.is_none()) {
             return Err(InputError::Units {
@@ -197,7 +201,7 @@ pub(crate) fn plan(
             });
         }
     }
-    let tilts: Vec<&super::Mapped> = resolved
+    let tilts: Vec<&Mapped> = resolved
         .channels
         .iter()
         .filter(|m| motion_of(m.input) == Motion::Rotation)
@@ -239,16 +243,14 @@ pub(crate) fn plan(
                             "feeds {}, a translation of the floor, and {}; allowed: a unit of \
                              length, velocity or acceleration (m, m/s, m/s^2 or a prefixed \
                              form), stated in the file (a `# units:` line, a `units` \
-                             attribute) or with the units option (--units {}=m/s^2, in Python \
-                             units={{\"{}\": \"m/s^2\"}})",
+                             attribute) or with the units option ({})",
                             m.input.name(),
                             if s.is_some_and(|s| s.counts) {
                                 "is in counts with no unit for its scaled values"
                             } else {
                                 "has no unit"
                             },
-                            m.source,
-                            m.source
+                            OptionKey::UNITS.entry(&m.source, "m/s^2")
                         ),
                     })
                 }
@@ -432,8 +434,8 @@ pub(crate) fn into_series(
     plan: &Plan,
     data: Vec<Vec<f64>>,
     sample_rate_hz: f64,
-    mut provenance: super::Provenance,
-) -> super::TiltSeries {
+    mut provenance: Provenance,
+) -> TiltSeries {
     let mut axes = Vec::new();
     let mut tilt = Vec::new();
     let mut translations = Vec::new();
@@ -452,7 +454,7 @@ pub(crate) fn into_series(
         }
     }
     provenance.quantity = plan.quantity;
-    super::TiltSeries {
+    TiltSeries {
         sample_rate_hz,
         axes,
         data: tilt,

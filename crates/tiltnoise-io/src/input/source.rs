@@ -1,14 +1,21 @@
 //! [`TiltSeriesSource`]: streaming access to an HDF5 time series of the floor's motion (schema
 //! `tiltnoise.tilt_series`), chunk by chunk, in bounded memory.
 
+use super::address::input_format;
+use super::address::split_hdf5_address;
 use super::h5::{self, h5err, AttrValue};
 use super::series_units::{self, check_unstated, into_series, Plan, Stated};
-use super::Mapped;
-use super::{check_sample_rate, require_two, InputError};
-use super::{gap_note, ChannelCtx, DetrendedRms, Gap, GapScanner, GroundChannel, TiltSeries};
-use super::{GapPolicy, InputFormat, InputKind, Provenance, Quantity, ReadOptions, SeriesSource};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::Num;
+use tiltnoise_core::input::check_scales;
+use tiltnoise_core::input::Mapped;
+use tiltnoise_core::input::{check_sample_rate, require_two, InputError};
+use tiltnoise_core::input::{
+    gap_note, ChannelCtx, DetrendedRms, Gap, GapScanner, GroundChannel, TiltSeries,
+};
+use tiltnoise_core::input::{
+    GapPolicy, InputFormat, InputKind, Provenance, Quantity, ReadOptions, SeriesSource,
+};
 use tiltnoise_core::limits::{check_count, MAX_STREAMED_SAMPLES};
 
 /// Samples per channel read at a time by the scanning pass at open (2 MiB of `f64`).
@@ -58,7 +65,7 @@ impl TiltSeriesSource {
     /// `docs/input_formats.md`); with gap interpolation, also the errors of the scanning pass
     /// (edge gaps).
     pub fn open(path: &Path, opts: &ReadOptions) -> Result<Self, InputError> {
-        let format = super::InputFormat::from_path(path)?;
+        let format = input_format(path)?;
         if format != InputFormat::Hdf5 {
             return Err(InputError::UnknownLayout {
                 path: path.to_path_buf(),
@@ -67,7 +74,7 @@ impl TiltSeriesSource {
                 accepted: "HDF5 time series (use read_tilt_series for CSV or miniSEED)",
             });
         }
-        let (file_path, object) = super::split_hdf5_address(path);
+        let (file_path, object) = split_hdf5_address(path);
         let file = h5::open(&file_path)?;
         if object.is_some() {
             return Self::from_file(&file_path, file, opts, object.as_deref());
@@ -174,7 +181,7 @@ impl TiltSeriesSource {
             }
             datasets.push(ds);
         }
-        super::check_scales(path, &opts.scale, &available, "dataset")?;
+        check_scales(path, &opts.scale, &available, "dataset")?;
         let plan = series_units::plan(path, &resolved, &stated, opts, &mut notes)?;
         let factors = plan.channels.iter().map(|p| p.factor).collect();
         let (first_name, len) = first_len.unwrap_or_default();

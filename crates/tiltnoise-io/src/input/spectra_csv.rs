@@ -3,10 +3,11 @@
 
 use super::csv::{self, parse_field, CsvFile, Prelude};
 use super::meta::{asd_unit, ASD_UNITS};
-use super::{assemble, check_csd_finite, TiltSpectra};
-use super::{frequency_refusal, require_two, InputError};
-use super::{InputFormat, InputKind, Provenance, ReadOptions};
+use crate::input::spectra_checks::no_scale_for_spectra;
 use num_complex::Complex64;
+use tiltnoise_core::input::{assemble, check_csd_finite, TiltSpectra};
+use tiltnoise_core::input::{frequency_refusal, require_two, InputError};
+use tiltnoise_core::input::{InputFormat, InputKind, Provenance, ReadOptions};
 use tiltnoise_core::limits::ASDS;
 
 /// Reads the records of a CSV spectrum whose prelude has been read (`prelude.header[0]` is
@@ -17,7 +18,7 @@ pub(crate) fn read(
     opts: &ReadOptions,
 ) -> Result<TiltSpectra, InputError> {
     let path = file.path.clone();
-    super::no_scale_for_spectra(&path, opts)?;
+    no_scale_for_spectra(&path, opts)?;
     let csv::Interpreted {
         resolved,
         quantity,

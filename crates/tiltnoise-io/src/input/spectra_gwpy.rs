@@ -7,10 +7,13 @@
 
 use super::h5::{self, h5err, AttrValue};
 use super::meta::{asd_unit, csd_unit, decide_quantity, Declared, ASD_UNITS, CSD_UNITS};
-use super::{assemble, check_csd_finite, require_two, InputError, TiltSpectra};
-use super::{frequency_refusal, InputFormat, InputKind, Mapped, Provenance, ReadOptions};
+use crate::input::spectra_checks::{no_scale_for_spectra, refuse_translation_spectra};
 use num_complex::Complex64;
 use std::path::Path;
+use tiltnoise_core::input::{assemble, check_csd_finite, require_two, InputError, TiltSpectra};
+use tiltnoise_core::input::{
+    frequency_refusal, InputFormat, InputKind, Mapped, Provenance, ReadOptions,
+};
 use tiltnoise_core::limits::{ASDS, PSDS};
 
 /// Whether the values of a dataset are amplitude or power spectral densities.
@@ -54,7 +57,7 @@ pub(crate) fn read(
     available: &[String],
     opts: &ReadOptions,
 ) -> Result<TiltSpectra, InputError> {
-    super::no_scale_for_spectra(path, opts)?;
+    no_scale_for_spectra(path, opts)?;
     let mut notes = vec!["gwpy FrequencySeries layout (attributes x0, dx in Hz)".to_string()];
     let start_time = h5::start_and_description(path, file, &mut notes)?;
     let file_map = h5::axis_map(path, file)?;
@@ -67,7 +70,7 @@ pub(crate) fn read(
         file_map.as_ref(),
         &mut notes,
     )?;
-    super::refuse_translation_spectra(path, &resolved)?;
+    refuse_translation_spectra(path, &resolved)?;
     let mut grid: Option<(String, f64, f64, usize)> = None;
     let mut values: Vec<Vec<f64>> = Vec::new();
     let mut declared = Vec::new();

@@ -5,11 +5,14 @@ use super::h5::{self, h5err, AttrValue};
 use super::meta::{
     asd_unit, csd_unit, decide_quantity, Declared, SpectrumUnit, ASD_UNITS, CSD_UNITS,
 };
-use super::{assemble, check_csd_finite, TiltSpectra, CSD_RTOL};
-use super::{frequency_refusal, require_two, InputError};
-use super::{InputFormat, InputKind, Provenance, Quantity, ReadOptions, ACCEPTED_LAYOUTS};
+use crate::input::spectra_checks::{no_scale_for_spectra, refuse_translation_spectra};
 use num_complex::Complex64;
 use std::path::Path;
+use tiltnoise_core::input::{assemble, check_csd_finite, TiltSpectra, CSD_RTOL};
+use tiltnoise_core::input::{frequency_refusal, require_two, InputError};
+use tiltnoise_core::input::{
+    InputFormat, InputKind, Provenance, Quantity, ReadOptions, ACCEPTED_LAYOUTS,
+};
 use tiltnoise_core::limits::{ASDS, PSDS};
 
 const AXES_ALLOWED: &str = "a 1-D array of strings naming the axes of the last dimension(s) of \
@@ -20,7 +23,7 @@ pub(crate) fn read(
     file: &hdf5::File,
     opts: &ReadOptions,
 ) -> Result<TiltSpectra, InputError> {
-    super::no_scale_for_spectra(path, opts)?;
+    no_scale_for_spectra(path, opts)?;
     let mut notes = Vec::new();
     let start_time = h5::start_and_description(path, file, &mut notes)?;
     let datasets = h5::root_datasets(path, file)?;
@@ -76,7 +79,7 @@ pub(crate) fn read(
         file_map.as_ref(),
         &mut notes,
     )?;
-    super::refuse_translation_spectra(path, &resolved)?;
+    refuse_translation_spectra(path, &resolved)?;
     let mapped: Vec<String> = resolved.channels.iter().map(|c| c.source.clone()).collect();
     let (declared, undeclared) = match declared {
         Some(d) => (

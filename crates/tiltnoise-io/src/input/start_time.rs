@@ -13,14 +13,12 @@
 //! Refused: impossible dates and times, and time zone names (`[Europe/Berlin]`), which would
 //! need a time zone database.
 
-use super::csv::{start_time, CsvFile};
-use super::h5;
-use super::{InputError, InputFormat};
 use jiff::fmt::temporal::{DateTimeParser, DateTimePrinter, PiecesOffset};
 use jiff::tz::Offset;
 use jiff::{civil, Timestamp, Unit};
 use std::path::Path;
 use tiltnoise_core::error::Shown;
+use tiltnoise_core::input::InputError;
 
 /// What `start_time` must look like, for messages.
 pub(crate) const ISO8601_ALLOWED: &str = "an ISO 8601 date-time string, e.g. \
@@ -106,33 +104,6 @@ pub(crate) fn checked(
             attribute,
             value: format!("`{}`", Shown(&text)),
             allowed: ISO8601_ALLOWED,
-        }),
-    }
-}
-
-/// The ISO 8601 time of sample 0 that the file states, if any.
-///
-/// # Errors
-///
-/// The reader's errors: an extension other than `.h5`, `.hdf5`, `.csv`, a file that cannot be
-/// opened, a `start_time` that is not a string or not ISO 8601.
-pub fn read_start_time(path: &Path) -> Result<Option<String>, InputError> {
-    match InputFormat::from_path(path)? {
-        InputFormat::Hdf5 => {
-            let file = h5::open(path)?;
-            h5::start_and_description(path, &file, &mut Vec::new())
-        }
-        InputFormat::Csv => {
-            let (_, prelude) = CsvFile::open(path)?;
-            start_time(path, &prelude, &mut Vec::new())
-        }
-        InputFormat::Miniseed => Err(InputError::UnknownLayout {
-            path: path.to_path_buf(),
-            format: "miniseed",
-            found: "a miniSEED file, whose channels are named by SEED code, not by observable"
-                .to_string(),
-            accepted: "a record of the observables as HDF5 or CSV (X, Y, Z, theta, eta, phi, \
-                       phi_a)",
         }),
     }
 }

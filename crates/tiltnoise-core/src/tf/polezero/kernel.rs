@@ -35,9 +35,9 @@
 //! point.
 
 use super::super::direct::{omega_sq, SINGULAR_RCOND};
-#[cfg(target_arch = "x86_64")]
-use super::lanes::Avx;
 use super::lanes::{stream_fence, Lanes, Portable, LANES};
+#[cfg(target_arch = "x86_64")]
+use super::lanes::{Avx, AvxToken};
 use crate::error::TfError;
 use crate::tf::Destination;
 use num_complex::Complex64;
@@ -398,8 +398,10 @@ pub(super) struct Kernel {
     /// `f64` values per frequency: `2 outputs x inputs` in the dense complex layout, fewer in
     /// a compact one (see [`super::super::Layout`]).
     stride: usize,
-    /// The CPU has AVX (checked at plan time): the same operations, four lanes per instruction.
-    avx: bool,
+    /// Present when the CPU has AVX (detected at plan time): the same operations, four lanes
+    /// per instruction.
+    #[cfg(target_arch = "x86_64")]
+    avx: Option<AvxToken>,
     /// Positions that more than one block adds to: a sum of finite contributions can still
     /// overflow, so these are checked once the chunk is complete.
     summed: Vec<usize>,
@@ -421,7 +423,8 @@ impl Kernel {
         Kernel {
             blocks,
             stride,
-            avx: avx_available(),
+            #[cfg(target_arch = "x86_64")]
+            avx: AvxToken::try_new(),
             summed,
         }
     }
@@ -476,18 +479,34 @@ impl Kernel {
         sink: &mut S,
     ) -> Result<(), TfError> {
         #[cfg(target_arch = "x86_64")]
-        if self.avx {
-            // SAFETY: `avx` is true only when the running CPU supports AVX (checked in `new`).
-            return unsafe { self.eval_avx(freqs_hz, chunk, sink) };
+        if let Some(token) = self.avx {
+            return self.eval_avx(token, freqs_hz, chunk, sink);
         }
         self.eval_with::<Portable, S>(freqs_hz, chunk, sink)
     }
 
+    /// The kernel in AVX registers, on the CPU `_avx` proves has them.
+    #[cfg(target_arch = "x86_64")]
+    fn eval_avx<S: Sink>(
+        &self,
+        _avx: AvxToken,
+        freqs_hz: &[f64],
+        chunk: &mut [f64],
+        sink: &mut S,
+    ) -> Result<(), TfError> {
+        // SAFETY: an `AvxToken` exists only when the running CPU has AVX.
+        unsafe { self.eval_avx_unchecked(freqs_hz, chunk, sink) }
+    }
+
     /// The kernel in AVX registers: the same operations in the same order as the portable
     /// lanes (no fused multiply-add), so the results are bit-identical.
+    ///
+    /// # Safety
+    ///
+    /// The running CPU must have AVX ([`Kernel::eval_avx`] takes the proof).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    unsafe fn eval_avx<S: Sink>(
+    unsafe fn eval_avx_unchecked<S: Sink>(
         &self,
         freqs_hz: &[f64],
         chunk: &mut [f64],
@@ -702,17 +721,6 @@ impl Sink for Planar<'_, '_> {
     }
 }
 
-fn avx_available() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use crate::model::Model;
@@ -776,9 +784,9 @@ mod tests {
     #[cfg(target_arch = "x86_64")]
     #[test]
     fn avx_and_portable_lanes_agree_bit_for_bit() {
-        if !std::arch::is_x86_feature_detected!("avx") {
+        let Some(token) = super::AvxToken::try_new() else {
             return;
-        }
+        };
         let mut damped = Params::table_i();
         for key in ["torsion_a_rad", "bouncing_b_rad"] {
             damped = damped.with_override(&format!("loss.{key}=1e-3")).unwrap();
@@ -812,8 +820,9 @@ mod tests {
                         .unwrap();
                     let mut chunk = kernel.chunk_buffer();
                     let mut sink = super::Interleaved::new(&mut avx, super::Destination::Reused);
-                    // SAFETY: the CPU has AVX (checked above).
-                    unsafe { kernel.eval_avx(&freqs, &mut chunk, &mut sink) }.unwrap();
+                    kernel
+                        .eval_avx(token, &freqs, &mut chunk, &mut sink)
+                        .unwrap();
                     for (k, (a, p)) in avx.iter().zip(&portable).enumerate() {
                         assert!(
                             a.to_bits() == p.to_bits(),
@@ -838,8 +847,9 @@ mod tests {
                         let mut sink = super::Planar(&mut planes);
                         let mut chunk = kernel.chunk_buffer();
                         if avx {
-                            // SAFETY: the CPU has AVX (checked above).
-                            unsafe { kernel.eval_avx(&freqs, &mut chunk, &mut sink) }.unwrap();
+                            kernel
+                                .eval_avx(token, &freqs, &mut chunk, &mut sink)
+                                .unwrap();
                         } else {
                             kernel
                                 .eval_with::<super::Portable, _>(&freqs, &mut chunk, &mut sink)

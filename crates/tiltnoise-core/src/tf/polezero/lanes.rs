@@ -117,7 +117,7 @@ impl Lanes for Portable {
 }
 
 #[cfg(target_arch = "x86_64")]
-pub(super) use avx::Avx;
+pub(super) use avx::{Avx, AvxToken};
 
 #[cfg(target_arch = "x86_64")]
 mod avx {
@@ -129,9 +129,21 @@ mod avx {
         _CMP_LT_OQ,
     };
 
+    /// Proof that the running CPU has AVX: a value exists only once feature detection said so
+    /// ([`AvxToken::try_new`]), and the kernel's safe AVX entry point requires one.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub(in super::super) struct AvxToken(());
+
+    impl AvxToken {
+        /// The token, if the running CPU has AVX.
+        pub(in super::super) fn try_new() -> Option<Self> {
+            std::arch::is_x86_feature_detected!("avx").then_some(AvxToken(()))
+        }
+    }
+
     /// Two AVX registers, lanes 0..4 and 4..8. Only the pole-zero kernel's AVX entry point (a
-    /// `#[target_feature(enable = "avx")]` function, called only when the CPU has AVX) makes
-    /// and uses values of this type; its methods are inlined there.
+    /// `#[target_feature(enable = "avx")]` function, reached only through an [`AvxToken`])
+    /// makes and uses values of this type; its methods are inlined there.
     #[derive(Clone, Copy)]
     pub(in super::super) struct Avx(__m256d, __m256d);
 

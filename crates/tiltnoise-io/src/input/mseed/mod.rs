@@ -17,15 +17,19 @@ mod record;
 mod steim;
 
 use super::series_units::{self, check_unstated_data, into_series, units_note, Planned, Stated};
-use super::TiltSeries;
-use super::{check_sample_rate, Provenance, Quantity, ReadOptions};
-use super::{check_scales, gap_note, process_channel, require_two, scale_for};
-use super::{resolve, ChannelCtx, ChannelUnit, InputError, MapOrigin, Mapped, Resolved};
-use super::{AxisMap, AxisMapEntry, ChannelScale, GapPolicy, InputFormat, InputKind};
 use channels::{Channel, Placed};
 use std::io::Read;
 use std::path::Path;
 use tiltnoise_core::error::{shown_list, Shown};
+use tiltnoise_core::input::TiltSeries;
+use tiltnoise_core::input::{check_sample_rate, Provenance, Quantity, ReadOptions};
+use tiltnoise_core::input::{check_scales, gap_note, process_channel, require_two, scale_for};
+use tiltnoise_core::input::{
+    resolve, ChannelCtx, ChannelUnit, InputError, MapOrigin, Mapped, Resolved,
+};
+use tiltnoise_core::input::{
+    AxisMap, AxisMapEntry, ChannelScale, GapPolicy, InputFormat, InputKind,
+};
 use tiltnoise_core::limits::{
     check_file_len, check_memory, planned_bytes, MAX_DATA_FILE_BYTES, SERIES_BYTES_PER_SAMPLE,
 };

@@ -1,0 +1,26 @@
+//! Figures written to files: drawn by `tiltnoise-plot` in the format the extension names and
+//! written through `tiltnoise-io`'s atomic writer, the same way for every front end.
+
+use std::path::Path;
+use tiltnoise_io::{write_atomic, OutputError};
+use tiltnoise_plot::{DrawError, ImageFormat};
+
+/// Draws a figure in the format named by the extension of `path` and writes it atomically.
+///
+/// # Errors
+///
+/// [`OutputError::UnknownFormat`] for an extension other than `.png`/`.svg` (nothing is drawn),
+/// [`OutputError::Write`] naming `path` for a drawing or write failure (nothing is left there).
+pub fn save_image(
+    path: &Path,
+    draw: impl FnOnce(ImageFormat) -> Result<Vec<u8>, DrawError>,
+) -> Result<(), OutputError> {
+    let format = ImageFormat::from_path(path)?;
+    let bytes = draw(format).map_err(|e| OutputError::Write {
+        path: path.to_path_buf(),
+        message: e.0,
+    })?;
+    write_atomic(path, |temp| {
+        std::fs::write(temp, &bytes).map_err(|e| e.to_string())
+    })
+}

@@ -1,0 +1,29 @@
+//! The command line's spelling of the options the libraries name in their messages
+//! ([`OptionKey`]): the flag `--segment-duration` for the key `segment_duration`, a value after a
+//! space (`--nperseg 8`), a mapping entry as `--units eta_t=urad`, a pair as `LOWER:UPPER`.
+
+use tiltnoise_core::option_key::{OptionKey, OptionStyle};
+
+/// The command line's [`OptionStyle`], installed by `main` before anything runs.
+pub struct Flags;
+
+impl OptionStyle for Flags {
+    fn option(&self, key: OptionKey) -> String {
+        match key {
+            OptionKey::DRAWN_OBSERVABLES => "--plot-observables".to_string(),
+            _ => format!("--{}", key.key().replace('_', "-")),
+        }
+    }
+
+    fn given(&self, key: OptionKey, value: &str) -> String {
+        format!("{} {value}", self.option(key))
+    }
+
+    fn entry(&self, key: OptionKey, name: &str, value: &str) -> String {
+        format!("{} {name}={value}", self.option(key))
+    }
+
+    fn pair(&self, first: &str, second: &str) -> String {
+        format!("{first}:{second}")
+    }
+}
