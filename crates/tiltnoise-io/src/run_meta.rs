@@ -1,7 +1,7 @@
 //! Provenance of a run, stored with its results in self-describing formats.
 
 /// Provenance of a run, stored alongside the results in self-describing formats (HDF5).
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct RunMeta {
     /// Version of the tool that wrote the file: [`TOOL_VERSION`].
     pub tool_version: String,

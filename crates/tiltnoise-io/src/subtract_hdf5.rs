@@ -19,7 +19,7 @@ use tiltnoise_core::input::InputMeta;
 use tiltnoise_core::subtract::{Method, SubtractResult};
 
 /// Provenance of a subtraction run.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SubtractMeta {
     /// Tool version, nominal parameters, command line, modes.
     pub run: RunMeta,

@@ -15,7 +15,7 @@ use crate::tf::{self, Request};
 pub const MAX_NOISE_REL: f64 = 1.0;
 
 /// A noise level: white, or a spectrum read log-log between its points and never beyond.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum NoiseLevel {
     /// White, one-sided ASD (unit/sqrt(Hz)).
     White(f64),
@@ -24,7 +24,7 @@ pub enum NoiseLevel {
 }
 
 /// The noise of one witness input.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct WitnessNoise {
     /// The model input the witness records.
     pub input: Input,

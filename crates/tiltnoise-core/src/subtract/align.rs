@@ -28,7 +28,7 @@ impl StartTime {
 }
 
 /// Where the two records overlap, in samples of each.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Alignment {
     /// Sample rate of both records (Hz): the tilt record's.
     pub fs_hz: f64,

@@ -20,7 +20,7 @@ pub const BANDS_PER_DECADE: f64 = 3.0;
 pub const EDGE_TAPER_FRACTION: f64 = 0.1;
 
 /// One band of one observable.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Band {
     /// Edges (Hz); the first band reaches down to DC, the last includes Nyquist.
     pub lo_hz: f64,
@@ -47,7 +47,7 @@ pub struct Band {
 }
 
 /// The check of one observable.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BandCheck {
     /// The bands, increasing.
     pub bands: Vec<Band>,

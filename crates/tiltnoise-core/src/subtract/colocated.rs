@@ -40,7 +40,7 @@ pub const GAIN_COHERENCE: f64 = 0.9;
 pub const NOISE_FLOOR_REL: f64 = 1e-6;
 
 /// How a noise level was estimated.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Method {
     /// Two instruments; the other's gain relative to the witness and its stated noise ratio.
     Huddle {
@@ -57,7 +57,7 @@ pub enum Method {
 }
 
 /// The estimated noise of one witness input.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ColocatedEstimate {
     /// The noise, as the fit and the weighting use it.
     pub noise: WitnessNoise,

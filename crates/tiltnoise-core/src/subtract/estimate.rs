@@ -122,7 +122,7 @@ pub struct FitRequest {
 }
 
 /// How an estimate came out.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Status {
     /// Fitted inside its box.
     Fitted,
@@ -144,7 +144,7 @@ impl Status {
 }
 
 /// One estimated parameter.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Estimate {
     /// `gain.<input>`, `delay_s`, a parameter-file key or `noise_scale.<input>`.
     pub name: String,
@@ -171,7 +171,7 @@ pub struct Estimate {
 }
 
 /// The outcome of the fit.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct FitReport {
     /// Every parameter asked for: the gains (record's input order), the delay, the keys, the
     /// noise scales.

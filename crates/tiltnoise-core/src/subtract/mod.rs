@@ -53,12 +53,13 @@ pub use parameters::{FREE_ENVIRONMENT_KEY, FREE_SECTIONS};
 pub use predict::{Coupling, Prediction};
 pub use residuals::{BandSummary, ResidualSpectra};
 
+use crate::cancel::{Cancel, Cancelled};
 use crate::error::{Num, TfError};
 use crate::model::{Input, Model, Observable};
 use crate::option_key::OptionKey;
 use crate::params::Params;
 use crate::spectral::confidence::equivalent_averages;
-use crate::spectral::{csd_matrix, welch, SpectralError, WelchConfig};
+use crate::spectral::{csd_matrix_cancellable, welch, SpectralError, WelchConfig};
 use nalgebra::DVector;
 use num_complex::Complex64;
 use weighting::{prediction_margin, weighting as weigh, WitnessSpectra};
@@ -136,6 +137,8 @@ pub struct SubtractConfig {
     pub readout_asd: Vec<(Observable, f64)>,
     /// Band of the residual summaries (Hz).
     pub report_band_hz: (f64, f64),
+    /// Polled between the stages and within the spectral estimates ([`crate::cancel`]).
+    pub cancel: Cancel,
 }
 
 impl Default for SubtractConfig {
@@ -150,12 +153,13 @@ impl Default for SubtractConfig {
             colocated_noise_ratio: Vec::new(),
             readout_asd: Vec::new(),
             report_band_hz: DEFAULT_REPORT_BAND_HZ,
+            cancel: Cancel::never(),
         }
     }
 }
 
 /// The outcome of [`subtract`].
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct SubtractResult {
     /// How the records were aligned.
     pub alignment: Alignment,
@@ -315,6 +319,9 @@ pub enum SubtractError {
     /// A spectral estimate failed.
     #[error(transparent)]
     Spectral(#[from] SpectralError),
+    /// The computation was cancelled ([`crate::cancel`]).
+    #[error(transparent)]
+    Cancelled(#[from] Cancelled),
 }
 
 /// The largest power of two `<= n`.
@@ -372,12 +379,13 @@ pub fn subtract(
     input_checks::check_channels(&channel_names, &w, &y)?;
     let welch_cfg = WelchConfig::new(segment_len);
     let train: Vec<&[f64]> = w.iter().chain(&y).map(|x| &x[..n_train]).collect();
-    let training_spectra = csd_matrix(&train, fs, &welch_cfg)?;
+    let training_spectra = csd_matrix_cancellable(&train, fs, &welch_cfg, &cfg.cancel)?;
     input_checks::check_spectra(&training_spectra, &channel_names, "training")?;
     let n_eff_train = equivalent_averages(&welch_cfg, training_spectra.n_segments);
     let adjacent = stats::bin_variance_factor(segment_len, 1);
     let witness_spectra = WitnessSpectra::new(&training_spectra, n_in, n_eff_train, adjacent);
     let freqs = &training_spectra.freqs_hz;
+    cfg.cancel.check()?;
     let colocated =
         colocated::estimate_all(witness, colocated, &cfg.colocated_noise_ratio, segment_len)?;
     let noise = all_witness_noise(&cfg.witness_noise, &colocated)?;
@@ -406,6 +414,7 @@ pub fn subtract(
             noise_rel,
         },
     )?;
+    cfg.cancel.check()?;
     let noise_psd: Vec<Vec<f64>> = noise_psd
         .iter()
         .zip(&fit.noise_factors)
@@ -423,8 +432,16 @@ pub fn subtract(
             })
             .collect(),
     };
-    let predictor =
-        predict::predictor(&fitted_model, fs, inputs, &w, &outputs, &coupling, &weights)?;
+    let predictor = predict::predictor(
+        &fitted_model,
+        fs,
+        inputs,
+        &w,
+        &outputs,
+        &coupling,
+        &weights,
+        &cfg.cancel,
+    )?;
     let model_spectra = model_spectra(
         &fit.params,
         inputs,
@@ -433,7 +450,7 @@ pub fn subtract(
         &witness_spectra,
         &noise_at,
     )?;
-
+    cfg.cancel.check()?;
     let (prediction, cleaned, bands) = clean_never_worse(&Cleaning {
         predictor: &predictor,
         w: &w,
@@ -442,10 +459,12 @@ pub fn subtract(
         fs,
         welch_cfg: &welch_cfg,
         model_spectra: &model_spectra,
+        cancel: &cfg.cancel,
     })?;
 
     let held: Vec<&[f64]> = w.iter().chain(&y).map(|x| &x[n_train..]).collect();
-    let held_spectra = csd_matrix(&held, fs, &welch_cfg)?;
+    cfg.cancel.check()?;
+    let held_spectra = csd_matrix_cancellable(&held, fs, &welch_cfg, &cfg.cancel)?;
     input_checks::check_spectra(&held_spectra, &channel_names, "held-out")?;
     let n_eff_held = equivalent_averages(&welch_cfg, held_spectra.n_segments);
     let psds = |series: &[(Observable, Vec<f64>)]| -> Result<Vec<Vec<f64>>, SubtractError> {
@@ -624,6 +643,7 @@ struct Cleaning<'a> {
     fs: f64,
     welch_cfg: &'a WelchConfig,
     model_spectra: &'a [ModelSpectra],
+    cancel: &'a Cancel,
 }
 
 /// The prediction and the cleaned record, checked band by band against the raw one before it is
@@ -649,10 +669,11 @@ fn clean_never_worse(
         fs,
         welch_cfg,
         model_spectra,
+        cancel,
     } = *c;
     let n_in = w.len();
     let whole: Vec<&[f64]> = w.iter().chain(y.iter()).copied().collect();
-    let whole_spectra = csd_matrix(&whole, fs, welch_cfg)?;
+    let whole_spectra = csd_matrix_cancellable(&whole, fs, welch_cfg, cancel)?;
     // The Welch grid of the segment length, the same as the training spectra's.
     let freqs = &whole_spectra.freqs_hz;
     let n_segments_whole = whole_spectra.n_segments;
@@ -666,6 +687,7 @@ fn clean_never_worse(
     let mut left: Vec<Vec<(f64, f64)>> = vec![Vec::new(); outputs.len()];
     let mut whole_left = vec![false; outputs.len()];
     loop {
+        cancel.check()?;
         let mask = |o: usize, f: f64| {
             if whole_left[o] {
                 0.0

@@ -41,6 +41,7 @@
 //! interpolation. Here both are exact.
 
 use super::SubtractError;
+use crate::cancel::Cancel;
 use crate::model::{Input, Model, Observable, Request};
 use crate::tf::plan;
 use nalgebra::DMatrix;
@@ -116,7 +117,7 @@ pub struct Predictor {
 }
 
 /// Predicted tilt parts of the observables.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Prediction {
     /// One series per requested observable, the record's length, in m or rad.
     pub series: Vec<(Observable, Vec<f64>)>,
@@ -189,14 +190,19 @@ impl Predictor {
     }
 }
 
+/// Bins of the whole record's DFT between two polls of the cancellation token: three transfer
+/// function evaluations each, a few milliseconds for all of them.
+pub const CANCEL_BINS: usize = 4096;
+
 /// The tilt parts of `outputs` predicted from the witness record `data` (one series per input
 /// of `inputs`, equal lengths >= 2, sampled at `fs_hz`) through `model` with `coupling` and the
-/// weighting `weights`.
+/// weighting `weights`, polling `cancel` every [`CANCEL_BINS`] bins.
 ///
 /// # Errors
 ///
 /// [`SubtractError::Tf`] when the transfer functions cannot be evaluated at a bin (an exact
-/// undamped resonance).
+/// undamped resonance); [`SubtractError::Cancelled`] once `cancel` is set.
+#[allow(clippy::too_many_arguments)]
 pub fn predictor(
     model: &Model,
     fs_hz: f64,
@@ -205,6 +211,7 @@ pub fn predictor(
     outputs: &[Observable],
     coupling: &Coupling,
     weights: &Weights,
+    cancel: &Cancel,
 ) -> Result<Predictor, SubtractError> {
     let n = data[0].len();
     let request = Request {
@@ -245,6 +252,9 @@ pub fn predictor(
     tf.eval_into(0.0, &mut h0)?;
     let df = fs_hz / n as f64;
     for k in 1..n_bins {
+        if k % CANCEL_BINS == 0 {
+            cancel.check()?;
+        }
         let f = k as f64 * df;
         tf.eval_into(f, &mut h)?;
         tf.eval_into(f * (1.0 + FREQ_ERROR_REL), &mut h_up)?;
@@ -341,6 +351,7 @@ pub fn predict(
         outputs,
         coupling,
         &Weights::identity(inputs.len()),
+        &Cancel::never(),
     )?;
     Ok(p.series(&|_, _| 1.0))
 }

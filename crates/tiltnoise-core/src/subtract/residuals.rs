@@ -35,7 +35,7 @@ use num_complex::Complex64;
 
 /// Spectra of one observable on the held-out stretch (one-sided PSDs, unit^2/Hz, on the Welch
 /// grid with DC).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ResidualSpectra {
     /// The observable.
     pub observable: Observable,
@@ -64,7 +64,7 @@ pub struct ResidualSpectra {
 }
 
 /// Mean PSDs over the report band, as ASDs (unit/sqrt(Hz)).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BandSummary {
     /// First and last bin frequency of the band (Hz).
     pub band_hz: (f64, f64),
