@@ -190,6 +190,8 @@ const KEYS: &[&str] = &[
     "readout",
     "term",
     "witness_noise",
+    "colocated_ratio",
+    "fit",
     "observables",
     "at",
     "at_band",

@@ -18,6 +18,8 @@ mod error;
 mod figure;
 mod given;
 pub mod subtract;
+pub mod subtract_figure;
+pub mod subtract_outputs;
 pub mod subtract_report;
 mod summary;
 

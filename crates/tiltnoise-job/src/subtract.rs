@@ -10,11 +10,12 @@ use crate::given::{witness_noise, AsdSpec, WitnessItem};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 use tiltnoise_core::cancel::{Cancel, Cancelled};
-use tiltnoise_core::error::Shown;
+use tiltnoise_core::error::{Num, Shown};
 use tiltnoise_core::input::{GroundMap, InputMeta, Provenance, Sensors, TiltSeries};
 use tiltnoise_core::model::{Input, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
-use tiltnoise_core::option_key::OptionKey;
+use tiltnoise_core::option_key::{self, OptionKey};
+use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_core::subtract::{
     subtract, MeasuredRecord, StartTime, Status, SubtractConfig, SubtractError, SubtractResult,
     WitnessNoise, WitnessRecord,
@@ -23,6 +24,9 @@ use tiltnoise_io::input::{
     parse_start_time, read_measured_input, read_tilt, utc_text, MeasuredInput, TiltInput,
 };
 use tiltnoise_io::{RunMeta, SubtractMeta};
+
+/// The model inputs a witness can record, for messages.
+const FLOOR_INPUTS: &str = "theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)";
 
 /// A subtraction to run.
 pub struct SubtractRequest<'a> {
@@ -74,6 +78,7 @@ impl SubtractRequest<'_> {
 }
 
 /// A subtraction and what its outputs are written with.
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct SubtractOutcome {
     /// The fit, the cleaned record and the residual checks.
     pub result: SubtractResult,
@@ -367,6 +372,69 @@ fn failure(f: SubtractFailure) -> JobError {
     JobError::Subtract(Box::new(f))
 }
 
+/// Refuses a band that is not finite with `0 < FLO < FHI` (Hz).
+fn check_band(option: &'static str, band: (f64, f64)) -> Result<(), JobError> {
+    let (lo, hi) = band;
+    if lo.is_finite() && hi.is_finite() && 0.0 < lo && lo < hi {
+        return Ok(());
+    }
+    Err(JobError::option(
+        option,
+        Some(&option_key::pair(
+            &Num(lo).to_string(),
+            &Num(hi).to_string(),
+        )),
+        "must be finite with 0 < FLO < FHI (Hz)".to_string(),
+    ))
+}
+
+/// The options the records are not needed for: the bands, the co-located records and their
+/// noise ratios (each a floor input once, finite and > 0), the fitted keys (each once), the
+/// readout (each observable once).
+fn check_options(req: &SubtractRequest<'_>) -> Result<(), JobError> {
+    if let Some(band) = req.band_hz {
+        check_band("band", band)?;
+    }
+    check_band("report_band", req.report_band_hz)?;
+    if req.colocated.len() > 2 {
+        return Err(failure(SubtractFailure::TooManyColocated(
+            req.colocated.len(),
+        )));
+    }
+    for &(input, r) in &req.colocated_ratio {
+        let item = format!("{}={}", input.name(), Num(r));
+        if !input.is_ground() {
+            return Err(JobError::option(
+                "colocated_ratio",
+                Some(&item),
+                format!(
+                    "`{}` is not a floor input of the model; allowed: {FLOOR_INPUTS}",
+                    input.name()
+                ),
+            ));
+        }
+        if !(r.is_finite() && r > 0.0) {
+            return Err(JobError::option(
+                "colocated_ratio",
+                Some(&item),
+                "the ratio is not allowed: must be finite and > 0".to_string(),
+            ));
+        }
+    }
+    let ratio_inputs: Vec<Input> = req.colocated_ratio.iter().map(|x| x.0).collect();
+    refuse_repeats("colocated_ratio", "input", &ratio_inputs, |i| {
+        i.name().to_string()
+    })
+    .map_err(JobError::Repeated)?;
+    if !req.colocated_ratio.is_empty() && req.colocated.len() != 1 {
+        return Err(failure(SubtractFailure::RatioNeedsOneColocated));
+    }
+    refuse_repeats("fit", "parameter key", &req.fit, |k| k.clone()).map_err(JobError::Repeated)?;
+    let readout: Vec<Observable> = req.readout_asd.iter().map(|x| x.0).collect();
+    refuse_repeats("readout", "observable", &readout, |o| o.name().to_string())
+        .map_err(JobError::Repeated)
+}
+
 fn start_of(
     option: &'static str,
     path: &Path,
@@ -437,14 +505,7 @@ pub fn run(req: SubtractRequest<'_>, cancel: &Cancel) -> Result<SubtractOutcome,
             .check()
             .map_err(|_| failure(SubtractFailure::Cancelled))
     };
-    if req.colocated.len() > 2 {
-        return Err(failure(SubtractFailure::TooManyColocated(
-            req.colocated.len(),
-        )));
-    }
-    if !req.colocated_ratio.is_empty() && req.colocated.len() != 1 {
-        return Err(failure(SubtractFailure::RatioNeedsOneColocated));
-    }
+    check_options(&req)?;
     let cfg = SubtractConfig {
         segment_len: req.nperseg,
         holdout_fraction: req.holdout,
@@ -455,6 +516,7 @@ pub fn run(req: SubtractRequest<'_>, cancel: &Cancel) -> Result<SubtractOutcome,
         colocated_noise_ratio: req.colocated_ratio.clone(),
         readout_asd: req.readout_asd.clone(),
         report_band_hz: req.report_band_hz,
+        cancel: cancel.clone(),
     };
     stage()?;
     let series = Witness::read("tilt", &req.tilt, &req)?;
@@ -513,7 +575,10 @@ pub fn run(req: SubtractRequest<'_>, cancel: &Cancel) -> Result<SubtractOutcome,
         },
         &cfg,
     )
-    .map_err(|e| failed(RunFailure::Refused(e)))?;
+    .map_err(|e| match cancel.is_cancelled() {
+        true => failure(SubtractFailure::Cancelled),
+        false => failed(RunFailure::Refused(e)),
+    })?;
     check_finite(&result).map_err(failed)?;
     stage()?;
     let skipped =
