@@ -18,6 +18,7 @@ mod report;
 mod simulate;
 mod stdout;
 mod subtract;
+mod subtract_table;
 mod tf;
 mod visibility;
 mod witness_noise;
