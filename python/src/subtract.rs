@@ -1,55 +1,36 @@
 //! `tiltnoise.subtract` (the command line's `subtract --tilt FILE --measured FILE`) and the
-//! `Subtraction` it returns: the subtract job's fit, report and cleaned record.
+//! `Subtraction` it returns: the subtract job's fit, report, cleaned record and figure, with
+//! names and units.
 
 use crate::budget::model_of;
 use crate::errors::{value_error, PyResultExt};
 use crate::inputs::Inputs;
 use crate::job_args;
+use crate::params::PyParams;
+use crate::python_side;
+use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
-use tiltnoise_core::model::Input;
+use tiltnoise_core::model::{Input, Observable};
 use tiltnoise_core::options;
-use tiltnoise_core::repeats::refuse_repeats;
-use tiltnoise_io::OutputError;
+use tiltnoise_core::subtract::{ResidualSpectra, DEFAULT_REPORT_BAND_HZ};
 use tiltnoise_job::subtract::{SubtractOutcome, SubtractRequest};
+use tiltnoise_job::subtract_outputs::SaveKind;
 
-/// The band of the residual summaries when none is given (Hz), as on the command line.
-const REPORT_BAND_HZ: (f64, f64) = (3e-3, 3e-2);
-
-/// `option=(lo, hi)`: finite with `0 < lo < hi` (Hz).
-fn band(option: &str, band: Option<(f64, f64)>) -> PyResult<Option<(f64, f64)>> {
-    match band {
-        Some((lo, hi)) if !(lo.is_finite() && hi.is_finite() && 0.0 < lo && lo < hi) => {
-            Err(value_error(format!(
-                "{option} ({lo}, {hi}): expected (FLO, FHI) in Hz with 0 < FLO < FHI, e.g. \
-                 (3e-3, 3e-2)"
-            )))
-        }
-        other => Ok(other),
-    }
-}
-
-/// `colocated_ratio`: `{input: R}`, each a floor input with a finite R > 0.
+/// `colocated_ratio`: `{input: R}` as inputs and numbers (the job checks them).
 fn parse_colocated_ratio(ratios: BTreeMap<String, f64>) -> PyResult<Vec<(Input, f64)>> {
     ratios
         .into_iter()
         .map(|(name, r)| {
-            let input = Input::from_name(&name)
-                .filter(|i| i.is_ground())
-                .ok_or_else(|| {
-                    value_error(format!(
-                        "colocated_ratio {name}=...: `{name}` is not a floor input of the model; \
-                         allowed: theta_t, eta_t, phi_t, x_t, y_t, z_t"
-                    ))
-                })?;
-            if !(r.is_finite() && r > 0.0) {
-                return Err(value_error(format!(
-                    "colocated_ratio {name}={r}: the ratio is not allowed: must be finite and > 0"
-                )));
-            }
+            let input = Input::from_name(&name).ok_or_else(|| {
+                value_error(format!(
+                    "colocated_ratio {name}=...: `{name}` is not a floor input of the model; \
+                     allowed: theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)"
+                ))
+            })?;
             Ok((input, r))
         })
         .collect()
@@ -75,7 +56,7 @@ fn parse_colocated_ratio(ratios: BTreeMap<String, f64>) -> PyResult<Vec<(Input, 
 /// ``readout``: ``{observable: ASD}``, white readout the cleaned residual is compared with.
 /// ``params``: a :class:`Params` or :class:`Model`.
 ///
-/// Returns a :class:`Subtraction`. Raises ``FileNotFoundError``/``OSError`` if a file cannot
+/// Ctrl-C stops it with ``KeyboardInterrupt``. Returns a :class:`Subtraction`. Raises ``FileNotFoundError``/``OSError`` if a file cannot
 /// be read, :class:`InputFileError` if it is not a valid record, ``ValueError`` for options or
 /// records the subtraction refuses.
 #[pyfunction]
@@ -106,9 +87,6 @@ pub fn subtract(
     params: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Subtraction> {
     let (model, params) = model_of(params)?;
-    let fit = fit.unwrap_or_default();
-    refuse_repeats("fit", "parameter key", &fit, |k| k.clone())
-        .map_err(|e| value_error(e.to_string()))?;
     let readout_asd = readout
         .unwrap_or_default()
         .into_iter()
@@ -132,9 +110,9 @@ pub fn subtract(
         colocated_ratio: parse_colocated_ratio(colocated_ratio.unwrap_or_default())?,
         witness_noise: job_args::witness_noise(witness_noise)?,
         readout_asd,
-        fit,
-        band_hz: self::band("band", band)?,
-        report_band_hz: self::band("report_band", report_band)?.unwrap_or(REPORT_BAND_HZ),
+        fit: fit.unwrap_or_default(),
+        band_hz: band,
+        report_band_hz: report_band.unwrap_or(DEFAULT_REPORT_BAND_HZ),
         nperseg,
         holdout,
         max_delay_s: max_delay,
@@ -148,17 +126,139 @@ pub fn subtract(
     Ok(Subtraction { outcome, inputs })
 }
 
-/// A subtraction: the fitted coupling (``estimates``), the report (``report``, the command
-/// line's JSON report as a dict) and the cleaned record, written by ``save``.
+/// A subtraction: the fitted coupling (``estimates``, ``fitted_params``), the tilt part
+/// predicted and removed from the measured record over the overlap (``predicted``,
+/// ``cleaned``, in ``units``), the held-out spectra (``frequency_hz``, ``asd``), the report
+/// (the command line's JSON report as a dict); ``save`` writes the command line's files and
+/// figure, ``plot`` draws the spectra with matplotlib.
 #[pyclass(module = "tiltnoise", frozen)]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub struct Subtraction {
     outcome: SubtractOutcome,
     /// The files read: no `save` may replace one.
     inputs: Inputs,
 }
 
+/// The curves of the held-out spectra, by name, as in the figure's legend.
+const CURVES: [&str; 6] = [
+    "measured",
+    "predicted",
+    "cleaned",
+    "wiener",
+    "coherence_limit",
+    "witness_limited",
+];
+
+/// The PSD of `curve` in `s` (one of [`CURVES`]).
+fn curve_psd<'a>(s: &'a ResidualSpectra, curve: &str) -> &'a [f64] {
+    match curve {
+        "measured" => &s.measured_psd,
+        "predicted" => &s.predicted_psd,
+        "cleaned" => &s.cleaned_psd,
+        "wiener" => &s.wiener_psd,
+        "coherence_limit" => &s.expected_psd,
+        _ => &s.witness_limited_psd,
+    }
+}
+
+impl Subtraction {
+    /// `{observable: array}` of `series`.
+    fn per_observable<'py>(
+        py: Python<'py>,
+        series: &[(Observable, Vec<f64>)],
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (o, x) in series {
+            d.set_item(o.name(), PyArray1::from_slice(py, x))?;
+        }
+        Ok(d)
+    }
+}
+
 #[pymethods]
 impl Subtraction {
+    /// The observables subtracted, in the measured record's order.
+    #[getter]
+    fn observables(&self) -> Vec<&'static str> {
+        self.outcome
+            .result
+            .cleaned
+            .iter()
+            .map(|(o, _)| o.name())
+            .collect()
+    }
+
+    /// ``{observable: unit}`` of the series (``m``, ``rad``); the ASDs are in unit/sqrt(Hz).
+    #[getter]
+    fn units(&self) -> BTreeMap<&'static str, &'static str> {
+        self.outcome
+            .result
+            .cleaned
+            .iter()
+            .map(|(o, _)| (o.name(), o.unit()))
+            .collect()
+    }
+
+    /// Sample rate of the overlap (Hz).
+    #[getter]
+    fn sample_rate_hz(&self) -> f64 {
+        self.outcome.result.alignment.fs_hz
+    }
+
+    /// ISO 8601 time of the first sample of the overlap, when the records state start times.
+    #[getter]
+    fn start_time(&self) -> Option<String> {
+        self.outcome.meta.start_time.clone()
+    }
+
+    /// ``{observable: measured minus predicted}`` over the overlap, in ``units``: the cleaned
+    /// record ``save("x.h5")`` writes.
+    #[getter]
+    fn cleaned<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        Self::per_observable(py, &self.outcome.result.cleaned)
+    }
+
+    /// ``{observable: predicted tilt part}`` over the overlap, in ``units``, as subtracted.
+    #[getter]
+    fn predicted<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        Self::per_observable(py, &self.outcome.result.prediction.series)
+    }
+
+    /// Frequencies (Hz) of the held-out Welch spectra, DC first.
+    #[getter]
+    fn frequency_hz<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let f = self
+            .outcome
+            .result
+            .residuals
+            .first()
+            .map_or(&[][..], |s| &s.freqs_hz);
+        PyArray1::from_slice(py, f)
+    }
+
+    /// ``{observable: {curve: one-sided ASD}}`` on the held-out stretch, in unit/sqrt(Hz), on
+    /// ``frequency_hz``: ``measured``, ``predicted`` (the tilt part), ``cleaned``, ``wiener``
+    /// (the residual of a multiple-input Wiener filter trained on the training stretch),
+    /// ``coherence_limit`` (the least any linear filter of the witness can leave) and
+    /// ``witness_limited`` (what the witness's own noise keeps from being removed): the
+    /// curves of the figure.
+    #[getter]
+    fn asd<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for s in &self.outcome.result.residuals {
+            let curves = PyDict::new(py);
+            for curve in CURVES {
+                let asd: Vec<f64> = curve_psd(s, curve)
+                    .iter()
+                    .map(|v| v.max(0.0).sqrt())
+                    .collect();
+                curves.set_item(curve, PyArray1::from_vec(py, asd))?;
+            }
+            d.set_item(s.observable.name(), curves)?;
+        }
+        Ok(d)
+    }
+
     /// The fitted parameters, each a dict with ``name``, ``value``, ``sigma`` (``None`` when the
     /// data do not constrain it), ``unit`` and ``status`` (``fitted``, ``at_bound`` or
     /// ``not_constrained``, as in the report).
@@ -177,6 +277,13 @@ impl Subtraction {
         Ok(list)
     }
 
+    /// The parameter set at the fit's solution (the fitted keys at their estimates, the others
+    /// as given).
+    #[getter]
+    fn fitted_params(&self) -> PyParams {
+        PyParams::unread(self.outcome.result.fit.params.clone())
+    }
+
     /// The report as ``subtract --format json`` prints it (``docs/subtract.md``), as a dict.
     #[getter]
     fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
@@ -190,37 +297,64 @@ impl Subtraction {
         self.outcome.input_notes.clone()
     }
 
-    /// Writes the cleaned record (``.h5``/``.hdf5``, what ``budget_from_file(measured=...)``
-    /// reads) or the report (``.json``), as the command line's ``--save`` does. Refuses to
-    /// replace an input.
+    /// The subtraction's notes (alignment, fit, bands left raw).
+    #[getter]
+    fn notes(&self) -> Vec<String> {
+        self.outcome.result.notes.clone()
+    }
+
+    /// Writes what the command line's ``--save`` writes: the cleaned record (``.h5``/``.hdf5``,
+    /// what ``budget_from_file(measured=...)`` reads), the report (``.json``) or the command
+    /// line's figure (``.png``/``.svg``, the same image as ``tiltnoise subtract --save x.png``);
+    /// atomically. Raises ``OSError`` if it cannot be written or is one of the files read,
+    /// ``ValueError`` for another extension.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
+        SaveKind::of(&path).py()?;
         self.inputs.check_save(&path)?;
-        py.detach(|| match ext.as_deref() {
-            Some("h5" | "hdf5") => {
-                tiltnoise_io::write_subtract_hdf5(&path, &self.outcome.result, &self.outcome.meta)
-            }
-            Some("json") => self.outcome.report().write(&path),
-            _ => Err(OutputError::UnknownFormat {
-                path: path.clone(),
-                allowed: ".h5, .hdf5, .json",
-            }),
-        })
-        .py()
+        py.detach(|| self.outcome.save(&path, &tiltnoise_plot::View::default()))
+            .py()
+    }
+
+    /// The held-out spectra drawn with matplotlib: one log-log panel per observable, the
+    /// curves of ``asd`` and the report band. Returns a new ``matplotlib.figure.Figure`` (of
+    /// ``matplotlib.pyplot``, so a notebook shows it). Needs matplotlib; raises ``ImportError``
+    /// saying so without it. The command line's own figure is :meth:`save` to a ``.png`` or
+    /// ``.svg`` path.
+    fn plot<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        python_side::call(slf.as_any(), "_plots", "subtraction_plot", &[])
+    }
+
+    /// The report band (Hz) of the residual summaries: ``(FLO, FHI)``, the first and last bin.
+    #[getter]
+    fn report_band_hz(&self) -> Option<(f64, f64)> {
+        self.outcome
+            .result
+            .residuals
+            .first()
+            .map(|s| s.band.band_hz)
+    }
+
+    /// Pickles as its state (see the module's pickling notes).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<crate::state::Reduced<'py>> {
+        crate::state::reduce(slf.as_any(), slf.get())
+    }
+
+    /// The object of a pickled state.
+    #[staticmethod]
+    fn _from_state(version: u32, state: &[u8]) -> PyResult<Self> {
+        crate::state::load("Subtraction", version, state)
+    }
+
+    /// Equal when every value is equal bit for bit and the same files are behind them.
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> PyResult<bool> {
+        crate::state::equal(self, other)
     }
 
     fn __repr__(&self) -> String {
         let r = &self.outcome.result;
         format!(
             "Subtraction({} of {} vs {}; {} samples at {} Hz; {} estimates)",
-            r.residuals
-                .iter()
-                .map(|s| s.observable.name())
-                .collect::<Vec<_>>()
-                .join(", "),
+            self.observables().join(", "),
             self.outcome.meta.measured_path,
             self.outcome.tilt_path,
             r.alignment.len,

@@ -16,6 +16,37 @@ def without_command_line(csv_text):
     return "".join(l for l in csv_text.splitlines(keepends=True)
                    if not l.startswith("# created_by:"))
 LAB_TILT = REPO / "tilt_data" / "lab_tilt_24h.h5"
+# The start time both records of a subtraction state.
+SUBTRACT_START = "2024-03-20T00:00:00Z"
+
+
+def write_subtract_records(directory, samples):
+    """A witness and a measured record for `subtract`, in `directory`: the first `samples` of
+    the lab tilt (HDF5, 1 Hz) and X of the pendulum driven by it through the model (circularly,
+    in the frequency domain) plus white readout noise of 1e-9 m (CSV), both stating
+    SUBTRACT_START. Returns the paths (tilt, measured)."""
+    import numpy as np
+    import tiltnoise
+    h5py = pytest.importorskip("h5py")
+    with h5py.File(LAB_TILT, "r") as f:
+        theta, eta = f["theta_t"][:samples], f["eta_t"][:samples]
+        fs = float(f.attrs["sample_rate_hz"])
+    tilt = Path(directory) / "tilt.h5"
+    with h5py.File(tilt, "w") as f:
+        f["theta_t"], f["eta_t"] = theta, eta
+        f.attrs.update(sample_rate_hz=fs, schema="tiltnoise.tilt_series", schema_version=1,
+                       start_time=SUBTRACT_START)
+    n = len(eta)
+    freqs = np.fft.rfftfreq(n, 1 / fs)
+    h = tiltnoise.Model().transfer(freqs[1:], inputs=["theta_t", "eta_t"], outputs="X")
+    spectrum = np.zeros(len(freqs), complex)
+    spectrum[1:] = h[:, 0, 0] * np.fft.rfft(theta)[1:] + h[:, 0, 1] * np.fft.rfft(eta)[1:]
+    x = np.fft.irfft(spectrum, n) + np.random.default_rng(11).normal(0, 1e-9, n)
+    measured = Path(directory) / "pendulum.csv"
+    t = np.arange(n) / fs
+    measured.write_text(f"# start_time: {SUBTRACT_START}\ntime_s,X\n"
+                        + "".join(f"{a!r},{b!r}\n" for a, b in zip(t.tolist(), x.tolist())))
+    return tilt, measured
 
 
 def _cli():

@@ -43,6 +43,27 @@ print("alive", f[1])
 
 LONG = 2**25  # samples: the most a call takes (tiltnoise_core::limits), all channels together
 
+# A subtraction of SUBTRACT_DAYS of white tilt at 1 Hz from X driven by it through the model
+# (written to CSV files before the timer starts): several seconds on two cores.
+SUBTRACT_DAYS = 12
+SUBTRACT_SETUP = f"""
+import tempfile
+n = {SUBTRACT_DAYS} * 86400
+rng = np.random.default_rng(1)
+theta, eta = 1e-8 * rng.standard_normal(n), 1e-8 * rng.standard_normal(n)
+d = tempfile.mkdtemp()
+tilt, measured = d + "/tilt.csv", d + "/x.csv"
+np.savetxt(tilt, np.column_stack([np.arange(n), theta, eta]), delimiter=",",
+           header="time_s,theta_t,eta_t", comments="")
+freqs = np.fft.rfftfreq(n, 1.0)
+h = model.transfer(freqs[1:], inputs=["theta_t", "eta_t"], outputs="X")
+spectrum = np.zeros(len(freqs), complex)
+spectrum[1:] = h[:, 0, 0] * np.fft.rfft(theta)[1:] + h[:, 0, 1] * np.fft.rfft(eta)[1:]
+x = np.fft.irfft(spectrum, n) + rng.normal(0, 1e-9, n)
+np.savetxt(measured, np.column_stack([np.arange(n), x]), delimiter=",", header="time_s,X",
+           comments="")
+"""
+
 # Single calls that each run for seconds (on two cores: Welch of 2**25 samples about 8 s, the
 # state-space evaluation of 10**6 points about 40 s), so that the signal comes mid-call. A fit
 # is not among them: it takes a tenth of a second.
@@ -66,6 +87,7 @@ CASES = {
         "f = np.logspace(-5, 2, 10**6)",
         "model.transfer(f, inputs='forces', method='statespace', threads=1)",
     ),
+    "subtract": (SUBTRACT_SETUP, "tiltnoise.subtract(tilt, measured, nperseg=4096)"),
 }
 
 

@@ -13,6 +13,7 @@ import pytest
 
 import tiltnoise
 from tiltnoise import _tiltnoise
+from conftest import write_subtract_records
 
 PROTOCOLS = range(2, pickle.HIGHEST_PROTOCOL + 1)
 
@@ -46,6 +47,12 @@ def coherence():
     return tiltnoise.coherence(tilt, measured, nperseg=1024)
 
 
+def subtraction():
+    """A subtraction of six hours of the lab tilt from X driven by it through the model."""
+    tilt, measured = write_subtract_records(tempfile.mkdtemp(), 6 * 3600)
+    return tiltnoise.subtract(tilt, measured, readout={"X": 1e-9})
+
+
 MAKERS = {
     "Params": params,
     "Model": lambda: tiltnoise.Model(params()),
@@ -55,6 +62,7 @@ MAKERS = {
     "Simulation": lambda: tiltnoise.Model().simulate(duration=2000.0, step=1.0, seed=9),
     "Budget": budget,
     "Coherence": coherence,
+    "Subtraction": subtraction,
 }
 
 
@@ -109,6 +117,15 @@ def test_unpickled_results_work_as_the_originals(tmp_path):
     f = fit()
     back = pickle.loads(pickle.dumps(f))
     assert back.params == f.params and back.chi2 == f.chi2
+    sub = subtraction()
+    back = pickle.loads(pickle.dumps(sub))
+    assert back.report == sub.report
+    for obs, x in sub.cleaned.items():
+        assert back.cleaned[obs].tobytes() == x.tobytes()
+    back.save(tmp_path / "s.h5")
+    back.save(tmp_path / "s.svg")
+    sub.save(tmp_path / "t.svg")
+    assert (tmp_path / "s.svg").read_bytes() == (tmp_path / "t.svg").read_bytes()
     m = tiltnoise.Model(params())
     back = pickle.loads(pickle.dumps(m))
     f = np.logspace(-4, 1, 50)

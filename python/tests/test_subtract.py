@@ -1,5 +1,7 @@
-"""subtract(): the command line's `subtract` from Python, with the same report and files; a
-measured record made from the tilt through the model gives back unit gains and no delay."""
+"""subtract(): the command line's `subtract` from Python, with the same report, files and
+figure; the result carries names and units, and its cleaned record is the measured one minus
+the prediction; a measured record made from the tilt through the model gives back unit gains
+and no delay."""
 
 import json
 
@@ -7,39 +9,15 @@ import numpy as np
 import pytest
 
 import tiltnoise
-from conftest import LAB_TILT
+from conftest import write_subtract_records
 
-START = "2024-03-20T00:00:00Z"
 # Six hours of the bundled record at 1 Hz: enough Welch segments for the fit, quick to run.
 SAMPLES = 6 * 3600
 
 
 @pytest.fixture(scope="module")
 def records(tmp_path_factory):
-    """The first hours of the lab tilt (HDF5) and X of the pendulum driven by it through the
-    model (circularly, in the frequency domain) plus white readout noise (CSV), both stating
-    the same start time."""
-    h5py = pytest.importorskip("h5py")
-    with h5py.File(LAB_TILT, "r") as f:
-        theta, eta = f["theta_t"][:SAMPLES], f["eta_t"][:SAMPLES]
-        fs = float(f.attrs["sample_rate_hz"])
-    d = tmp_path_factory.mktemp("subtract")
-    tilt = d / "tilt.h5"
-    with h5py.File(tilt, "w") as f:
-        f["theta_t"], f["eta_t"] = theta, eta
-        f.attrs.update(sample_rate_hz=fs, schema="tiltnoise.tilt_series", schema_version=1,
-                       start_time=START)
-    n = len(eta)
-    freqs = np.fft.rfftfreq(n, 1 / fs)
-    h = tiltnoise.Model().transfer(freqs[1:], inputs=["theta_t", "eta_t"], outputs="X")
-    spectrum = np.zeros(len(freqs), complex)
-    spectrum[1:] = h[:, 0, 0] * np.fft.rfft(theta)[1:] + h[:, 0, 1] * np.fft.rfft(eta)[1:]
-    x = np.fft.irfft(spectrum, n) + np.random.default_rng(11).normal(0, 1e-9, n)
-    measured = d / "pendulum.csv"
-    t = np.arange(n) / fs
-    measured.write_text(f"# start_time: {START}\ntime_s,X\n"
-                        + "".join(f"{a!r},{b!r}\n" for a, b in zip(t.tolist(), x.tolist())))
-    return tilt, measured
+    return write_subtract_records(tmp_path_factory.mktemp("subtract"), SAMPLES)
 
 
 @pytest.fixture(scope="module")
@@ -48,27 +26,64 @@ def result(records):
     return tiltnoise.subtract(tilt, measured, readout={"X": 1e-9})
 
 
-def test_report_and_files_equal_the_command_lines(result, records, cli, tmp_path):
+def test_report_files_and_figures_equal_the_command_lines(result, records, cli, tmp_path):
     h5py = pytest.importorskip("h5py")
     tilt, measured = records
-    report, h5 = tmp_path / "cli.json", tmp_path / "cli.h5"
+    cli_files = {ext: tmp_path / f"cli.{ext}" for ext in ("json", "h5", "png", "svg")}
+    saves = [a for p in cli_files.values() for a in ("--save", p)]
     printed = cli("subtract", "--tilt", tilt, "--measured", measured, "--readout", "X=1e-9",
-                  "--format", "json", "--save", report, "--save", h5)
+                  "--format", "json", *saves)
     assert result.report == json.loads(printed)
-    mine = tmp_path / "mine.json"
-    result.save(mine)
-    assert mine.read_bytes() == report.read_bytes()
+    for ext in ("json", "png", "svg"):
+        mine = tmp_path / f"mine.{ext}"
+        result.save(mine)
+        assert mine.read_bytes() == cli_files[ext].read_bytes(), ext
     mine = tmp_path / "mine.h5"
     result.save(mine)
-    with h5py.File(h5, "r") as a, h5py.File(mine, "r") as b:
+    with h5py.File(cli_files["h5"], "r") as a, h5py.File(mine, "r") as b:
         names = []
         a.visititems(lambda n, o: names.append(n) if isinstance(o, h5py.Dataset) else None)
-        assert "X" in names or any(n.endswith("X") for n in names), names
+        assert any(n.split("/")[-1] == "X" for n in names), names
         for name in names:
             np.testing.assert_array_equal(a[name][()], b[name][()], err_msg=name)
         for key in ("schema", "start_time", "measured_path", "input_path"):
             if key in a.attrs:
                 assert a.attrs[key] == b.attrs[key], key
+
+
+def test_names_units_and_the_cleaned_record_against_the_raw_one(result, records):
+    _, measured = records
+    assert result.observables == ["X"]
+    assert result.units == {"X": "m"}
+    assert result.sample_rate_hz == 1.0
+    assert result.start_time is not None and result.start_time.startswith("2024-03-20T00:00:00")
+    raw = np.loadtxt(measured, delimiter=",", skiprows=2)[:, 1]
+    alignment = result.report["alignment"]
+    first, n = alignment["measured_first_sample"], alignment["samples"]
+    cleaned, predicted = result.cleaned["X"], result.predicted["X"]
+    assert len(cleaned) == len(predicted) == n
+    # cleaned = measured - predicted, sample by sample: the sum gives back the raw record to
+    # the rounding of one subtraction and one addition.
+    scale = np.max(np.abs(raw))
+    np.testing.assert_allclose(cleaned + predicted, raw[first:first + n], rtol=0,
+                               atol=4 * np.finfo(float).eps * scale)
+    f = result.frequency_hz
+    assert f[0] == 0 and np.all(np.diff(f) > 0)
+    curves = result.asd["X"]
+    assert set(curves) == {"measured", "predicted", "cleaned", "wiener", "coherence_limit",
+                           "witness_limited"}
+    for name, asd in curves.items():
+        assert asd.shape == f.shape and np.all(np.isfinite(asd)) and np.all(asd >= 0), name
+    # The report's band means are the means of these PSDs over the report band.
+    lo, hi = result.report_band_hz
+    band = (f >= lo) & (f <= hi)
+    row = result.report["residuals"][0]
+    for curve, key in (("measured", "measured_asd"), ("cleaned", "cleaned_asd")):
+        np.testing.assert_allclose(np.sqrt(np.mean(curves[curve][band] ** 2)), row[key],
+                                   rtol=1e-12, err_msg=curve)
+    # Removing the tilt part leaves less in the report band.
+    assert row["cleaned_asd"] < row["measured_asd"], row
+    assert result.fitted_params.get("length.h_m") == tiltnoise.Params().get("length.h_m")
 
 
 def test_a_record_made_through_the_model_gives_unit_gains_and_no_delay(result):
@@ -107,6 +122,36 @@ def test_errors_say_what_the_command_line_says(records, cli_error, tmp_path):
     assert str(e.value) == cli_error(
         "subtract", "--tilt", tilt, "--measured", measured, *args
     ).replace("--colocated", "colocated")
+    with pytest.raises(ValueError) as e:
+        tiltnoise.subtract(tilt, measured, colocated_ratio={"eta_t": 2.0})
+    assert str(e.value) == cli_error(
+        "subtract", "--tilt", tilt, "--measured", measured, "--colocated-ratio", "eta_t=2"
+    ).replace("--colocated-ratio", "colocated_ratio").replace("--colocated", "colocated")
+
+
+def test_messages_use_keyword_spellings(records, cli_error):
+    tilt, measured = records
+    cases = [
+        (dict(band=(3e-2, 3e-3)), ["--band", "3e-2:3e-3"], "band (0.03, 0.003): "),
+        (dict(report_band=(0.0, 3e-2)), ["--report-band", "0:3e-2"], "report_band (0, 0.03): "),
+        (dict(colocated=[tilt], colocated_ratio={"F_b.x": 2.0}),
+         ["--colocated", tilt, "--colocated-ratio", "F_b.x=2"], "colocated_ratio F_b.x=2: "),
+        (dict(colocated=[tilt], colocated_ratio={"eta_t": -1.0}),
+         ["--colocated", tilt, "--colocated-ratio", "eta_t=-1"], "colocated_ratio eta_t=-1: "),
+        (dict(fit=["length.h_m", "length.h_m"]), ["--fit", "length.h_m,length.h_m"],
+         "fit: length.h_m is given twice"),
+    ]
+    for kwargs, flags, start in cases:
+        with pytest.raises(ValueError) as e:
+            tiltnoise.subtract(tilt, measured, **kwargs)
+        message = str(e.value)
+        assert message.startswith(start), (kwargs, message)
+        assert "--" not in message, message
+        flag_message = cli_error("subtract", "--tilt", tilt, "--measured", measured, *flags)
+        assert flag_message.startswith(str(flags[-2])), flag_message
+        # The same words after the option and its value.
+        assert flag_message.split(": ", 1)[1] == message.split(": ", 1)[1], (flag_message,
+                                                                             message)
 
 
 def test_save_never_replaces_an_input(result, records):
@@ -115,5 +160,17 @@ def test_save_never_replaces_an_input(result, records):
     with pytest.raises(OSError):
         result.save(tilt)
     assert tilt.read_bytes() == before
-    with pytest.raises(ValueError, match="allowed are .h5, .hdf5, .json"):
+    with pytest.raises(ValueError, match="allowed are .h5, .hdf5, .json, .png, .svg"):
         result.save(tilt.with_suffix(".txt"))
+
+
+def test_plot_draws_a_panel_per_observable(result):
+    pytest.importorskip("matplotlib")
+    import matplotlib
+    matplotlib.use("Agg")
+    fig = result.plot()
+    (ax,) = fig.axes
+    labels = [line.get_label() for line in ax.get_lines()]
+    assert {"measured", "cleaned", "predicted tilt part", "readout"} <= set(labels), labels
+    assert ax.get_xscale() == "log" and ax.get_yscale() == "log"
+    assert "m/sqrt(Hz)" in ax.get_ylabel()

@@ -1,5 +1,5 @@
 """Figures of results with matplotlib (optional): Budget.plot, Simulation.plot,
-TransferFunction.plot. The command line's own figures are written by ``save("x.png")``."""
+Subtraction.plot, TransferFunction.plot. The command line's own figures are written by ``save("x.png")``."""
 
 import numpy as np
 
@@ -36,6 +36,49 @@ def budget_plot(budget, observables=None):
         ax.legend(fontsize=8, ncol=2)
     axes[-1, 0].set_xlabel("frequency (Hz)")
     fig.suptitle("noise budget (one-sided ASD)")
+    fig.tight_layout()
+    return fig
+
+
+# The curves of Subtraction.asd as the command line's figure draws them: label, colour, style.
+_SUBTRACTION_CURVES = (
+    ("measured", "measured", "tab:blue", "-"),
+    ("predicted", "predicted tilt part", "tab:orange", "--"),
+    ("cleaned", "cleaned", "black", "-"),
+    ("wiener", "Wiener residual", "tab:green", "-."),
+    ("coherence_limit", "coherence limit", "tab:gray", ":"),
+    ("witness_limited", "witness-noise limit", "tab:purple", ":"),
+)
+
+
+def subtraction_plot(sub):
+    """One log-log panel of held-out ASDs per observable: measured, the predicted tilt part,
+    cleaned, the Wiener residual, the coherence and witness-noise limits (each drawn where it
+    is not zero everywhere), the readout and the report band."""
+    plt = _pyplot("Subtraction.plot()")
+    names = sub.observables
+    fig, axes = plt.subplots(len(names), 1, figsize=(8, 3.4 * len(names)), sharex=True,
+                             squeeze=False)
+    f = sub.frequency_hz[1:]
+    readout = {r["observable"]: r["readout_asd"] for r in sub.report["residuals"]}
+    band = sub.report_band_hz
+    for ax, o in zip(axes[:, 0], names):
+        curves = sub.asd[o]
+        for key, label, color, style in _SUBTRACTION_CURVES:
+            asd = curves[key][1:]
+            if np.any(asd > 0):
+                ax.loglog(f, asd, color=color, ls=style, lw=2.0 if key == "cleaned" else 1.2,
+                          label=label)
+        if readout.get(o):
+            ax.axhline(readout[o], color="tab:red", lw=1.0, ls="--", label="readout")
+        if band is not None:
+            for edge in band:
+                ax.axvline(edge, color="grey", lw=0.8, ls=":")
+        ax.set_ylabel(f"{o} ASD ({sub.units[o]}/sqrt(Hz))")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8, ncol=2)
+    axes[-1, 0].set_xlabel("frequency (Hz); dotted: the report band")
+    fig.suptitle("tilt subtraction, held-out stretch (one-sided ASD)")
     fig.tight_layout()
     return fig
 
