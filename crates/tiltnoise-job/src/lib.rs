@@ -18,6 +18,7 @@ mod error;
 mod figure;
 mod given;
 pub mod subtract;
+mod subtract_error;
 pub mod subtract_figure;
 pub mod subtract_outputs;
 pub mod subtract_report;

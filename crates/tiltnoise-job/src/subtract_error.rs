@@ -1,0 +1,214 @@
+//! Why a subtraction did not run, beyond the readers' and the options' errors: records that do
+//! not fit it, a result that is not finite, a cancelled run; each message names its options by
+//! key, spelled by the front end in use.
+
+use tiltnoise_core::cancel::Cancelled;
+use tiltnoise_core::error::Shown;
+use tiltnoise_core::model::Observable;
+use tiltnoise_core::option_key::OptionKey;
+use tiltnoise_core::subtract::SubtractError;
+
+/// Why a subtraction did not run, beyond the readers' and the options' errors.
+#[derive(Debug)]
+pub enum SubtractFailure {
+    /// The run was cancelled (between its stages: the subtraction itself does not poll).
+    Cancelled,
+    /// More than two co-located records.
+    TooManyColocated(usize),
+    /// A noise ratio without exactly one co-located record.
+    RatioNeedsOneColocated,
+    /// A record of the floor's motion (`option`) holds spectra.
+    WitnessSpectra {
+        /// The option.
+        option: &'static str,
+        /// The file.
+        path: String,
+    },
+    /// The measured record holds spectra.
+    MeasuredSpectra(String),
+    /// A record of the floor's motion whose channels do not map to the model's inputs.
+    Channels {
+        /// The option.
+        option: &'static str,
+        /// The file.
+        path: String,
+        /// Why.
+        problem: String,
+    },
+    /// A start time that is not ISO 8601.
+    StartTime {
+        /// The option.
+        option: &'static str,
+        /// The file.
+        path: String,
+        /// The start time as the file gives it.
+        value: String,
+    },
+    /// An observable twice in the measured record.
+    RepeatedChannel {
+        /// The file.
+        path: String,
+        /// The observable.
+        observable: Observable,
+    },
+    /// An observable asked for that the measured record lacks.
+    MissingChannel {
+        /// The file.
+        path: String,
+        /// The observable.
+        observable: Observable,
+        /// The observables it has.
+        present: Vec<Observable>,
+    },
+    /// The subtraction was refused, or its result has a number that is not finite.
+    Run {
+        /// The witness record.
+        tilt: String,
+        /// The measured record.
+        measured: String,
+        /// Why.
+        reason: RunFailure,
+    },
+}
+
+/// Why the subtraction of two readable records failed.
+#[derive(Debug)]
+pub enum RunFailure {
+    /// The subtraction refused the records or the options.
+    Refused(SubtractError),
+    /// A fitted value or its uncertainty is not finite.
+    Estimate {
+        /// The parameter.
+        name: String,
+        /// Its value.
+        value: f64,
+        /// Its uncertainty.
+        sigma: f64,
+    },
+    /// The fit's chi^2 is not finite.
+    Chi2(f64),
+    /// A band summary of the residuals is not finite.
+    Band {
+        /// Which summary.
+        what: &'static str,
+        /// The observable.
+        observable: Observable,
+        /// Its value.
+        value: f64,
+    },
+    /// A sample of the prediction or the cleaned record is not finite.
+    Sample {
+        /// The observable.
+        observable: Observable,
+        /// The sample.
+        index: usize,
+        /// Its value.
+        value: f64,
+    },
+}
+
+impl SubtractFailure {
+    /// The message, one line, with the options spelled as the front end in use does.
+    pub(crate) fn message(&self) -> String {
+        let opt = |name: &'static str| OptionKey::new(name).to_string();
+        match self {
+            SubtractFailure::Cancelled => Cancelled.to_string(),
+            SubtractFailure::TooManyColocated(n) => format!(
+                "{} is given {n} times: give one record (a huddle test with the witness) or two \
+                 (a three-cornered hat)",
+                opt("colocated")
+            ),
+            SubtractFailure::RatioNeedsOneColocated => format!(
+                "{} applies to a huddle test: give exactly one {} record (a three-cornered hat \
+                 needs no noise ratio)",
+                opt("colocated_ratio"),
+                opt("colocated")
+            ),
+            SubtractFailure::WitnessSpectra { option, path } => format!(
+                "{} {path}: holds spectra; subtract needs a time series of the floor's motion \
+                 (tilt angle or rate, and translation)",
+                opt(option)
+            ),
+            SubtractFailure::MeasuredSpectra(path) => format!(
+                "{} {path}: holds spectra; subtract needs a time series of the observables \
+                 (HDF5 as `tiltnoise simulate` writes, or CSV time_s,X,...)",
+                opt("measured")
+            ),
+            SubtractFailure::Channels {
+                option,
+                path,
+                problem,
+            } => format!("{} {path}: {problem}", opt(option)),
+            SubtractFailure::StartTime {
+                option,
+                path,
+                value,
+            } => format!(
+                "{} {path}: start time `{}` is not an ISO 8601 date-time",
+                opt(option),
+                Shown(value)
+            ),
+            SubtractFailure::RepeatedChannel { path, observable } => format!(
+                "{} {path}: channel {} appears twice; give each observable once",
+                opt("measured"),
+                observable.name()
+            ),
+            SubtractFailure::MissingChannel {
+                path,
+                observable,
+                present,
+            } => format!(
+                "{} {name}: {} {path} has no channel {name}; it has {}",
+                opt("observables"),
+                opt("measured"),
+                present
+                    .iter()
+                    .map(|o| o.name())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                name = observable.name()
+            ),
+            SubtractFailure::Run {
+                tilt,
+                measured,
+                reason,
+            } => format!(
+                "subtract {} {tilt} {} {measured}: {}",
+                opt("tilt"),
+                opt("measured"),
+                reason.message()
+            ),
+        }
+    }
+}
+
+impl RunFailure {
+    fn message(&self) -> String {
+        match self {
+            RunFailure::Refused(e) => e.to_string(),
+            RunFailure::Estimate { name, value, sigma } => format!(
+                "the fit of {name} gave {value} +/- {sigma}: not finite (the data may be \
+                 degenerate; fit fewer parameters)"
+            ),
+            RunFailure::Chi2(chi2) => format!("the fit's chi^2 is {chi2}: not finite"),
+            RunFailure::Band {
+                what,
+                observable,
+                value,
+            } => format!(
+                "the {what} ASD of {} in the report band is {value}: not finite (is the channel \
+                 constant or noiseless there? leave it out with {})",
+                observable.name(),
+                OptionKey::OBSERVABLES
+            ),
+            RunFailure::Sample {
+                observable,
+                index,
+                value,
+            } => format!(
+                "the prediction of {} at sample {index} is {value}: not finite",
+                observable.name()
+            ),
+        }
+    }
+}
