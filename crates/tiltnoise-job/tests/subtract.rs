@@ -31,6 +31,9 @@ fn request(model: &Model) -> SubtractRequest<'_> {
     }
 }
 
+/// A change of the request that makes one option wrong.
+type Change = Box<dyn Fn(&mut SubtractRequest)>;
+
 fn message(req: SubtractRequest<'_>) -> String {
     match run(req, &Cancel::never()) {
         Ok(_) => panic!("the request ran"),
@@ -41,7 +44,7 @@ fn message(req: SubtractRequest<'_>) -> String {
 #[test]
 fn options_are_refused_by_key_before_any_file_is_read() {
     let model = Model::new(&Params::table_i()).unwrap();
-    let cases: Vec<(Box<dyn Fn(&mut SubtractRequest)>, &str)> = vec![
+    let cases: Vec<(Change, &str)> = vec![
         (
             Box::new(|r| r.band_hz = Some((3e-2, 3e-3))),
             "band (0.03, 0.003): must be finite with 0 < FLO < FHI (Hz)",
