@@ -17,7 +17,10 @@ pub mod coherence;
 mod error;
 mod figure;
 mod given;
+pub mod methods;
+pub mod monte_carlo;
 mod summary;
+pub mod tf;
 
 pub use error::JobError;
 pub use figure::save_image;
