@@ -1,11 +1,16 @@
 //! The library crates keep their roles, read from their sources: no option spelling in
-//! tiltnoise-core, tiltnoise-io or tiltnoise-plot (an error names the option by its key and each
-//! front end spells it).
+//! tiltnoise-core, tiltnoise-io, tiltnoise-plot or tiltnoise-job (an error names the option by
+//! its key and each front end spells it).
 
 use std::path::{Path, PathBuf};
 
 /// The library crates, whose messages name options by key only.
-const LIBRARIES: [&str; 3] = ["tiltnoise-core", "tiltnoise-io", "tiltnoise-plot"];
+const LIBRARIES: [&str; 4] = [
+    "tiltnoise-core",
+    "tiltnoise-io",
+    "tiltnoise-plot",
+    "tiltnoise-job",
+];
 
 /// Every `.rs` file under `dir`, sorted.
 fn rust_files(dir: &Path) -> Vec<PathBuf> {
