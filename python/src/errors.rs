@@ -43,6 +43,8 @@ impl OptionStyle for Keywords {
         match key {
             OptionKey::SET => "Params.set".to_string(),
             OptionKey::DRAWN_OBSERVABLES => "observables".to_string(),
+            // The planner's reasoning is a method of its own in Python.
+            k if k.key() == "explain" => "Model.explain()".to_string(),
             _ => key.key().to_string(),
         }
     }

@@ -27,6 +27,9 @@ pub fn job_error(e: JobError) -> PyErr {
             BudgetError::Input(e) => e.into_py_err(),
             other => other.into_py_err(),
         },
+        JobError::Tf(e) => (*e).into_py_err(),
+        JobError::Freq(e) => (*e).into_py_err(),
+        JobError::MonteCarlo(e) => (*e).into_py_err(),
         _ => return value_error(message),
     };
     Python::attach(|py| PyErr::from_type(kind.get_type(py), message))

@@ -5,6 +5,7 @@ use crate::arrays;
 use crate::errors::{value_error, PyResultExt};
 use crate::grid::{self, GridBuffer};
 use crate::interrupt;
+use crate::job_args::job_error;
 use crate::params::PyParams;
 use crate::state;
 use numpy::{Complex64, PyArray1, PyArray2, PyArray3, PyArrayMethods};
@@ -14,7 +15,6 @@ use std::collections::{BTreeMap, HashMap};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
 use tiltnoise_core::cancel::Cancel;
-use tiltnoise_core::mc::{self, McConfig};
 use tiltnoise_core::model::{Coord, ForceInput, Input, Model, Observable, Request};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::options;
@@ -22,6 +22,8 @@ use tiltnoise_core::simulate::DEFAULT_MODE_ENERGY_J;
 use tiltnoise_core::tf::{
     self, eval_grid_threads_cancellable, Destination, Method, Scene, TransferFunction,
 };
+use tiltnoise_job::monte_carlo::{self, McRequest};
+use tiltnoise_job::JobError;
 
 // The defaults of `transfer`, `explain` and `simulate` are written as literals in their
 // signatures, so that Python's `inspect.signature` (and the type stubs) show the numbers; they
@@ -123,15 +125,10 @@ impl PyModel {
         if let Some(&m) = lock(&self.choices).get(&key) {
             return Ok(m);
         }
-        let scene = Scene {
-            request: request.clone(),
-            band_hz: band,
-            rel_tol,
-        };
         let model = &self.model;
         let choice = py
-            .detach(|| tf::choose(model, &scene))
-            .map_err(|e| value_error(e.to_string()))?;
+            .detach(|| tiltnoise_job::tf::choose(model, request, band, rel_tol))
+            .map_err(job_error)?;
         lock(&self.choices).insert(key, choice.method);
         Ok(choice.method)
     }
@@ -182,8 +179,8 @@ impl PyModel {
         }
         let model = &self.model;
         let plan: Arc<dyn TransferFunction> = py
-            .detach(|| tf::plan(model, request, method))
-            .map_err(|e| value_error(e.to_string()))?
+            .detach(|| tiltnoise_job::tf::plan(model, request, method))
+            .map_err(job_error)?
             .into();
         lock(&self.plans).insert(key, Arc::clone(&plan));
         Ok(plan)
@@ -306,14 +303,12 @@ fn parse_method(name: &str) -> PyResult<Option<Method>> {
         })
 }
 
-/// `rel_tol` of [`PyModel::transfer`], as the command line's `--rel-tol`.
+/// `rel_tol` of [`PyModel::transfer`], checked by the transfer-function job as the command
+/// line's `--rel-tol`.
 fn check_rel_tol(rel_tol: f64) -> PyResult<()> {
-    if rel_tol.is_finite() && rel_tol > 0.0 && rel_tol < 1.0 {
-        return Ok(());
-    }
-    Err(value_error(format!(
-        "rel_tol {rel_tol}: the tolerance must be a finite relative error in (0, 1)"
-    )))
+    tiltnoise_job::tf::rel_tol(Some(rel_tol))
+        .map(drop)
+        .map_err(job_error)
 }
 
 /// An 8x8 (or other) nalgebra matrix as a row-major NumPy array.
@@ -541,14 +536,16 @@ impl PyModel {
             outputs: parse_outputs(outputs)?,
         };
         check_rel_tol(rel_tol)?;
-        let scene = Scene {
-            rel_tol,
-            ..Scene::over_grid(request, &grid::frequencies(freq_hz, grid::GRID)?)
-        };
+        let band =
+            Scene::over_grid(request.clone(), &grid::frequencies(freq_hz, grid::GRID)?).band_hz;
         let model = &self.model;
         let choice = py
-            .detach(|| tf::choose(model, &scene))
-            .map_err(|e| value_error(e.to_string()))?;
+            .detach(|| tiltnoise_job::tf::choose(model, &request, band, rel_tol))
+            .map_err(|e| match e {
+                // Asked for the reasoning: the refusal is the answer, without a pointer here.
+                JobError::NoMethod(refusal) => value_error(refusal.to_string()),
+                other => job_error(other),
+            })?;
         Ok(choice.explain())
     }
 
@@ -618,16 +615,18 @@ impl PyModel {
         seed: u64,
         threads: usize,
     ) -> PyResult<MonteCarlo> {
-        let params = self.model.params();
-        let cancel = Cancel::new();
-        let cfg = McConfig {
+        let req = McRequest {
+            params: self.model.params(),
             samples,
             seed,
             threads,
-            cancel: cancel.clone(),
-            ..McConfig::default_for(params)
         };
-        let r = interrupt::watch(py, &cancel, || mc::run(params, &cfg, &|_| {}).py())?;
+        let cancel = Cancel::new();
+        let r = interrupt::watch(py, &cancel, || {
+            monte_carlo::run(req, &cancel, &|_| {})
+                .map(|run| run.result)
+                .map_err(job_error)
+        })?;
         Ok(MonteCarlo {
             samples: r.samples,
             rejected: r.rejected,
@@ -636,6 +635,50 @@ impl PyModel {
             mean_hz: r.mean_hz.to_vec(),
             std_hz: r.std_hz.to_vec(),
         })
+    }
+
+    /// Every evaluation method's worst error against the double-double reference and its time
+    /// per point (the command line's ``tiltnoise methods``), on ``freq_hz`` (frequencies in Hz,
+    /// positive, ascending) for the matrix of every observable from ``inputs`` (names as in
+    /// :meth:`transfer`; default the three tilt angles). Returns a dict with the keys of the
+    /// command line's JSON report: ``matrix`` (what was measured, e.g. ``7x3 tilt matrix``),
+    /// ``auto`` (the method ``method="auto"`` picks at ``target_rel_err``, or ``none (why)``),
+    /// ``target_rel_err`` and ``methods``, one dict per method with ``name``, ``max_rel_err``,
+    /// ``worst_entry``, ``worst_freq_hz``, ``ns_per_point``, ``exact_zeros`` and ``unusable``
+    /// (``None`` where a value does not apply).
+    #[pyo3(signature = (freq_hz, inputs=None))]
+    fn methods<'py>(
+        &self,
+        py: Python<'py>,
+        freq_hz: &Bound<'py, PyAny>,
+        inputs: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let req = tiltnoise_job::methods::MethodsRequest {
+            model: &self.model,
+            grid_hz: grid::frequencies(freq_hz, grid::GRID)?,
+            inputs: Some(parse_inputs(inputs)?),
+        };
+        let result = py
+            .detach(|| tiltnoise_job::methods::run(req, &Cancel::never()))
+            .map_err(job_error)?;
+        let methods = PyList::empty(py);
+        for r in &result.rows {
+            let row = PyDict::new(py);
+            row.set_item("name", r.method.name())?;
+            row.set_item("max_rel_err", r.worst.as_ref().map(|w| w.0))?;
+            row.set_item("worst_entry", r.worst.as_ref().map(|w| w.1.clone()))?;
+            row.set_item("worst_freq_hz", r.worst.as_ref().map(|w| w.2))?;
+            row.set_item("ns_per_point", r.ns_per_point)?;
+            row.set_item("exact_zeros", r.exact_zeros)?;
+            row.set_item("unusable", r.unusable.clone())?;
+            methods.append(row)?;
+        }
+        let d = PyDict::new(py);
+        d.set_item("matrix", result.matrix_label())?;
+        d.set_item("auto", result.auto_text())?;
+        d.set_item("target_rel_err", result.target_rel_err)?;
+        d.set_item("methods", methods)?;
+        Ok(d)
     }
 
     /// Constrained least-squares fit of the parameters ``free`` (dotted keys; default the

@@ -304,3 +304,31 @@ def test_the_pendulum_as_built_equals_the_command_line(cli):
         assert m.ratio == e["ratio"] and m.seen_above_ratio == e["seen_above_ratio"]
     nu6 = next(m for m in model.modes() if m.index == 6)
     assert nu6.block == "coupled" and "Z" in nu6.seen_above_ratio
+
+
+def test_auto_next_to_a_mode_says_what_to_do_in_each_spelling(model, cli_error):
+    """The planner's refusal comes from one job under both front ends, each naming its own
+    options: `--method polezero` and `--freq` on the command line, `method=polezero` and
+    `freq_hz` here."""
+    with pytest.raises(ValueError) as e:
+        model.transfer(0.415, inputs="eta_t", outputs="X")
+    assert str(e.value).endswith("(method=polezero, or another freq_hz)")
+    message = cli_error("tf", "--freq", "0.415", "--input", "eta_t", "--observables", "X")
+    assert message.endswith("(--method polezero, or another --freq)")
+    assert message.split(" (--method")[0] == str(e.value).split(" (method=")[0]
+
+
+def test_methods_equals_the_command_lines(model, cli):
+    """`Model.methods` runs the command line's `methods` job: the same matrix, pick and
+    accuracy (the times per point are measured anew)."""
+    expected = json.loads(cli("methods", "--freq", "1e-3:30:10", "--format", "json"))
+    got = model.methods(np.logspace(-3, 1, 30))
+    assert got["auto"] == expected["auto"]
+    assert got["target_rel_err"] == expected["target_rel_err"]
+    assert got["matrix"] == "7x3 tilt matrix"
+    for g, x in zip(got["methods"], expected["methods"], strict=True):
+        assert g["name"] == x["name"]
+        assert g["unusable"] == x["unusable"]
+        assert g["exact_zeros"] == x["exact_zeros"]
+    with pytest.raises(ValueError, match="freq_hz"):
+        model.methods([1e-3, 0.0])

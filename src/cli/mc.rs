@@ -1,6 +1,6 @@
-//! `tiltnoise mc`: Monte Carlo of the normal modes over the parameter errors (the error model of
-//! the parameter file, see [`tiltnoise_core::params::uncertainty`]); a table or JSON on stdout, histograms
-//! (PNG/SVG) and HDF5 with `--save`.
+//! `tiltnoise mc`: Monte Carlo of the normal modes over the parameter errors (the Monte Carlo
+//! job, [`tiltnoise_job::monte_carlo`]); a table or JSON on stdout, histograms (PNG/SVG) and
+//! HDF5 with `--save`.
 
 use super::figure_args::SizeArgs;
 use super::Run;
@@ -8,11 +8,10 @@ use anyhow::Result;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::OutputError;
-use tiltnoise_core::mc::{McConfig, McResult};
-use tiltnoise_core::model::Model;
-use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::mc::McResult;
 use tiltnoise_core::params::Params;
 use tiltnoise_io::{write_mc_hdf5, RunMeta};
+use tiltnoise_job::monte_carlo::{self, McRequest};
 
 /// Extensions `tiltnoise mc --save` accepts, for messages.
 const MC_EXTENSIONS: &str = ".h5, .hdf5, .png, .svg";
@@ -55,7 +54,9 @@ fn output_kind(path: &Path) -> Result<McOutput, OutputError> {
     }
 }
 
-/// Runs `tiltnoise mc`. Every `--save` path is checked before computing.
+/// Runs `tiltnoise mc`: the sizes checked and every `--save` path before computing, the
+/// Monte Carlo job run (with a progress bar on a terminal), the table or JSON printed and the
+/// files written.
 pub(crate) fn run_mc(params: &Params, opts: McOptions, run: &mut Run) -> Result<()> {
     use std::io::IsTerminal;
     let kinds = opts
@@ -66,99 +67,49 @@ pub(crate) fn run_mc(params: &Params, opts: McOptions, run: &mut Run) -> Result<
     let view = opts
         .figure
         .view_for(tiltnoise_plot::mc_figure::DEFAULT_SIZE)?;
-    tiltnoise_core::mc::check_size(opts.samples, opts.threads, ("--samples", "--threads"))?;
-    let saves: Vec<&Path> = opts.save.iter().map(PathBuf::as_path).collect();
-    run.check_outputs(&saves, &[])?;
-    let cfg = McConfig {
+    let req = McRequest {
+        params,
         samples: opts.samples,
         seed: opts.seed,
         threads: opts.threads,
-        cancel: run.cancel.clone(),
-        ..McConfig::default_for(params)
     };
+    monte_carlo::check(&req).map_err(super::job_error)?;
+    let saves: Vec<&Path> = opts.save.iter().map(PathBuf::as_path).collect();
+    run.check_outputs(&saves, &[])?;
     let bar = (std::io::stderr().is_terminal() && opts.samples >= 10_000)
         .then(|| indicatif::ProgressBar::new(opts.samples as u64));
-    let result = tiltnoise_core::mc::run(params, &cfg, &|done| {
+    let mc = monte_carlo::run(req, &run.cancel, &|done| {
         if let Some(b) = &bar {
             b.set_position(done as u64);
         }
-    })?;
+    })
+    .map_err(super::job_error)?;
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    let nominal: [f64; 8] = NormalModes::new(&Model::new(params)?)
-        .frequencies_hz()
-        .try_into()
-        .map_err(|v: Vec<f64>| anyhow::anyhow!("expected 8 modes, got {}", v.len()))?;
+    let (result, nominal) = (&mc.result, &mc.nominal_hz);
     if opts.json {
-        writeln!(run.out, "{}", json(&result, &nominal, opts.seed)?)?;
+        writeln!(run.out, "{}", json(result, nominal, opts.seed)?)?;
     } else {
-        write!(run.out, "{}", table(&result, &nominal, opts.seed))?;
+        write!(run.out, "{}", table(result, nominal, opts.seed))?;
     }
     if opts.save.is_empty() {
         return Ok(());
     }
     let meta = RunMeta::of_this_run(params, None);
-    let caption = caption(&result, &cfg);
+    let caption = monte_carlo::caption(&mc);
     // JSON on standard output stays parseable: the `wrote` lines go to standard error.
     run.write_outputs(opts.json, || {
         for (path, kind) in opts.save.iter().zip(kinds) {
             match kind {
-                McOutput::Hdf5 => write_mc_hdf5(path, &result, &cfg, &nominal, &meta)?,
+                McOutput::Hdf5 => write_mc_hdf5(path, result, &mc.config, nominal, &meta)?,
                 McOutput::Figure => super::output::save_image(path, |format| {
-                    tiltnoise_plot::mc_figure::mc_figure(&result, &nominal, &caption, &view, format)
+                    tiltnoise_plot::mc_figure::mc_figure(result, nominal, &caption, &view, format)
                 })?,
             }
         }
         Ok(())
     })
-}
-
-/// The figure's caption: what is marked, counts, seed and the error model, grouped by error.
-fn caption(result: &McResult, cfg: &McConfig) -> String {
-    let mut groups: Vec<(f64, &str, Vec<&str>)> = Vec::new();
-    for u in cfg.uncertainties.iter().filter(|u| u.rel_sigma > 0.0) {
-        let name = u.key.split_once('.').map_or(u.key.as_str(), |(_, n)| n);
-        let shape = u.distribution.name();
-        match groups
-            .iter_mut()
-            .find(|g| g.0 == u.rel_sigma && g.1 == shape)
-        {
-            Some(g) => g.2.push(name),
-            None => groups.push((u.rel_sigma, shape, vec![name])),
-        }
-    }
-    let model: Vec<String> = groups
-        .iter()
-        .map(|(s, shape, names)| format!("{} % {shape} on {}", s * 100.0, names.join(", ")))
-        .collect();
-    // The [asymmetry] offsets have absolute errors, in their own unit.
-    let offsets: Vec<String> = cfg
-        .uncertainties
-        .iter()
-        .filter(|u| u.abs_sigma > 0.0)
-        .map(|u| {
-            let name = u.key.split_once('.').map_or(u.key.as_str(), |(_, n)| n);
-            format!("{:e} {} on {name}", u.abs_sigma, u.distribution.name())
-        })
-        .collect();
-    let absolute = if offsets.is_empty() {
-        String::new()
-    } else {
-        format!(
-            "; absolute errors (1 std, in the key's unit): {}",
-            offsets.join("; ")
-        )
-    };
-    format!(
-        "Black dashed: nominal parameters; orange: mean; shaded: mean ± 1 std. {} draws, {} \
-         rejected as non-physical, seed {}. Relative errors (1 std): {}{absolute}; all other \
-         parameters exact.",
-        result.samples,
-        result.rejected,
-        cfg.seed,
-        model.join("; ")
-    )
 }
 
 fn json(result: &McResult, nominal: &[f64; 8], seed: u64) -> Result<String> {

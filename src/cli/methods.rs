@@ -1,5 +1,5 @@
 //! `tiltnoise methods`: every evaluation method's worst error against the double-double
-//! reference and its time per point (table, JSON, chart).
+//! reference and its time per point (table, JSON, chart), measured by the methods job.
 
 use super::args::Format;
 use super::figure_args::SizeArgs;
@@ -10,8 +10,9 @@ use clap::Args;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::freq;
-use tiltnoise_core::model::{Input, Model, Observable, Request};
+use tiltnoise_core::model::Model;
 use tiltnoise_core::params::Params;
+use tiltnoise_job::methods::{MethodsRequest, MethodsResult};
 
 /// Arguments of `tiltnoise methods`.
 #[derive(Debug, Args)]
@@ -60,7 +61,8 @@ struct MethodsJson<'a> {
     target_rel_err: f64,
 }
 
-/// Runs `tiltnoise methods`.
+/// Runs `tiltnoise methods`: the grid and inputs parsed into the methods job's request, the
+/// job run, the table or JSON printed and the chart saved.
 pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> Result<()> {
     let MethodsArgs {
         freq: spec,
@@ -70,98 +72,26 @@ pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> 
         figure,
     } = args;
     let (spec, save) = (spec.as_str(), save.as_slice());
-    use tiltnoise_core::methods::methods_table;
-    use tiltnoise_core::tf::{choose, Scene, DEFAULT_REL_TOL};
     for path in save {
         tiltnoise_plot::ImageFormat::from_path(path)?;
     }
     let view = figure.view_for(tiltnoise_plot::methods_figure::DEFAULT_SIZE)?;
     let saves: Vec<&Path> = save.iter().map(PathBuf::as_path).collect();
     run.check_outputs(&saves, &[])?;
-    let out = &mut run.out;
     let model = Model::new(params)?;
-    let grid = freq::parse_spec(spec)?;
-    let request = Request {
-        outputs: Observable::ALL.to_vec(),
-        inputs: super::tf::parse_inputs(&inputs)?,
+    let req = MethodsRequest {
+        model: &model,
+        grid_hz: freq::parse_spec(spec)?,
+        inputs: Some(super::tf::parse_inputs(&inputs)?),
     };
-    let matrix = matrix_label(&request);
-    let band = (grid[0], grid[grid.len() - 1]);
-    let auto = choose(
-        &model,
-        &Scene {
-            request: request.clone(),
-            band_hz: band,
-            rel_tol: DEFAULT_REL_TOL,
-        },
-    )
-    .map(|c| c.method.name().to_string())
-    .unwrap_or_else(|refusal| format!("none ({refusal})"));
-    let rows = methods_table(&model, &request, &grid);
+    let result = tiltnoise_job::methods::run(req, &run.cancel).map_err(super::job_error)?;
+    let out = &mut run.out;
     match format {
-        Format::Json => {
-            let methods = rows
-                .iter()
-                .map(|r| MethodJson {
-                    name: r.method.name(),
-                    max_rel_err: r.worst.as_ref().map(|w| w.0),
-                    worst_entry: r.worst.as_ref().map(|w| w.1.clone()),
-                    worst_freq_hz: r.worst.as_ref().map(|w| w.2),
-                    ns_per_point: r.ns_per_point,
-                    exact_zeros: r.exact_zeros,
-                    unusable: r.unusable.clone(),
-                })
-                .collect();
-            let json = MethodsJson {
-                auto,
-                target_rel_err: DEFAULT_REL_TOL,
-                grid: spec,
-                methods,
-            };
-            writeln!(out, "{}", serde_json::to_string_pretty(&json)?)?;
-        }
-        Format::Table => {
-            writeln!(
-                out,
-                "{matrix} on {spec} Hz ({} points; accuracy checked > 1 % from every mode)",
-                grid.len()
-            )?;
-            writeln!(
-                out,
-                "{:<9} {:>13} {:>14} {:>12} {:>12}  exact zeros",
-                "method", "max rel err", "worst entry", "at (Hz)", "ns/point"
-            )?;
-            for r in &rows {
-                match (&r.worst, r.ns_per_point) {
-                    (Some((e, entry, f)), Some(ns)) => writeln!(
-                        out,
-                        "{:<9} {:>13.2e} {:>14} {:>12.4e} {:>12.0}  {}",
-                        r.method.name(),
-                        e,
-                        entry,
-                        f,
-                        ns,
-                        if r.exact_zeros == Some(true) {
-                            "yes"
-                        } else {
-                            "no"
-                        }
-                    )?,
-                    _ => writeln!(
-                        out,
-                        "{:<9} not usable: {}",
-                        r.method.name(),
-                        r.unusable.as_deref().unwrap_or("")
-                    )?,
-                }
-            }
-            writeln!(
-                out,
-                "auto picks: {auto} (target: relative error <= {DEFAULT_REL_TOL:e})"
-            )?;
-        }
+        Format::Json => writeln!(out, "{}", json(&result, spec)?)?,
+        Format::Table => write!(out, "{}", table(&result, spec))?,
     }
-    let points: Vec<tiltnoise_plot::methods_figure::MethodPoint> = rows
+    let points: Vec<tiltnoise_plot::methods_figure::MethodPoint> = result
+        .rows
         .iter()
         .filter_map(|r| {
             Some((
@@ -171,14 +101,18 @@ pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> 
             ))
         })
         .collect();
+    let title = format!(
+        "Speed against accuracy, {}, {spec} Hz",
+        result.matrix_label()
+    );
     // JSON on standard output stays parseable: the `wrote` lines go to standard error.
     run.write_outputs(format == Format::Json, || {
         for path in save {
             save_image(path, |format| {
                 tiltnoise_plot::methods_figure::methods_figure(
                     &points,
-                    DEFAULT_REL_TOL,
-                    &format!("Speed against accuracy, {matrix}, {spec} Hz"),
+                    result.target_rel_err,
+                    &title,
                     &view,
                     format,
                 )
@@ -188,19 +122,66 @@ pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> 
     })
 }
 
-/// `7x3 tilt matrix`, `7x6 ground matrix`, or the inputs named: what the table measures.
-fn matrix_label(request: &Request) -> String {
-    let size = format!("{}x{}", request.outputs.len(), request.inputs.len());
-    let groups = [
-        ("tilt", Input::all_tilts()),
-        ("translation", Input::all_translations()),
-        ("ground", Input::all_ground()),
-    ];
-    match groups.iter().find(|(_, inputs)| *inputs == request.inputs) {
-        Some((name, _)) => format!("{size} {name} matrix"),
-        None => {
-            let names: Vec<&str> = request.inputs.iter().map(|i| i.name()).collect();
-            format!("{size} matrix from {}", names.join(", "))
+/// The JSON report (`--format json`) of the grid `spec`.
+fn json(result: &MethodsResult, spec: &str) -> Result<String> {
+    let methods = result
+        .rows
+        .iter()
+        .map(|r| MethodJson {
+            name: r.method.name(),
+            max_rel_err: r.worst.as_ref().map(|w| w.0),
+            worst_entry: r.worst.as_ref().map(|w| w.1.clone()),
+            worst_freq_hz: r.worst.as_ref().map(|w| w.2),
+            ns_per_point: r.ns_per_point,
+            exact_zeros: r.exact_zeros,
+            unusable: r.unusable.clone(),
+        })
+        .collect();
+    Ok(serde_json::to_string_pretty(&MethodsJson {
+        auto: result.auto_text(),
+        target_rel_err: result.target_rel_err,
+        grid: spec,
+        methods,
+    })?)
+}
+
+/// The table of the grid `spec`.
+fn table(result: &MethodsResult, spec: &str) -> String {
+    let mut s = format!(
+        "{} on {spec} Hz ({} points; accuracy checked > 1 % from every mode)\n",
+        result.matrix_label(),
+        result.grid_hz.len()
+    );
+    s.push_str(&format!(
+        "{:<9} {:>13} {:>14} {:>12} {:>12}  exact zeros\n",
+        "method", "max rel err", "worst entry", "at (Hz)", "ns/point"
+    ));
+    for r in &result.rows {
+        match (&r.worst, r.ns_per_point) {
+            (Some((e, entry, f)), Some(ns)) => s.push_str(&format!(
+                "{:<9} {:>13.2e} {:>14} {:>12.4e} {:>12.0}  {}\n",
+                r.method.name(),
+                e,
+                entry,
+                f,
+                ns,
+                if r.exact_zeros == Some(true) {
+                    "yes"
+                } else {
+                    "no"
+                }
+            )),
+            _ => s.push_str(&format!(
+                "{:<9} not usable: {}\n",
+                r.method.name(),
+                r.unusable.as_deref().unwrap_or("")
+            )),
         }
     }
+    s.push_str(&format!(
+        "auto picks: {} (target: relative error <= {:e})\n",
+        result.auto_text(),
+        result.target_rel_err
+    ));
+    s
 }

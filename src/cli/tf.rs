@@ -10,24 +10,25 @@
 //! `eta`, `phi`, `phi_a` (rad). Entries are complex responses per unit input: m/rad, rad/rad,
 //! m/m, rad/m, m/N, rad/(N m), ...
 
-use super::args::{scientific, MethodArg, PerArg};
+use super::args::{scientific, Format, MethodArg, PerArg};
 use super::figure_args::FigureArgs;
 use super::output::save_tf;
 use super::Run;
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::Args;
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use tiltnoise_core::freq;
-use tiltnoise_core::ground::GroundQuantity;
-use tiltnoise_core::limits::{MAX_GRID_POINTS, MAX_STREAMED_GRID_POINTS};
+use tiltnoise_core::limits::MAX_STREAMED_GRID_POINTS;
 use tiltnoise_core::model::{Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::options;
 use tiltnoise_core::params::Params;
-use tiltnoise_core::tf::planner::{choose, NoChoice, Scene, DEFAULT_REL_TOL};
-use tiltnoise_core::tf::{self, Input, Request};
-use tiltnoise_io::{read_freq_file, RunMeta};
+use tiltnoise_core::tf::planner::DEFAULT_REL_TOL;
+use tiltnoise_core::tf::{Input, Request, TransferMatrix};
+use tiltnoise_io::{OutputKind, RunMeta, TfCsvWriter, TfHdf5Writer};
+use tiltnoise_job::tf::{FreqGrid, Planned, TfRequest};
+use tiltnoise_job::JobError;
 
 /// Arguments of `tiltnoise tf`.
 #[derive(Debug, Args)]
@@ -95,6 +96,12 @@ pub struct TfArgs {
     /// Bode figure: a phase panel (degrees) beside every magnitude panel.
     #[arg(long)]
     phase: bool,
+    /// Output format on the terminal: table (default; the transfer functions as CSV rows
+    /// without --save, else the modes and the static limits) or json (the transfer functions
+    /// as one JSON document without --save, else the modes as `modes --format json` prints
+    /// them, the `wrote` lines then on standard error).
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
     #[command(flatten)]
     figure: FigureArgs,
 }
@@ -115,7 +122,7 @@ pub fn parse_observables(specs: &[String]) -> Result<Vec<Observable>> {
 fn figure_options(
     args: &TfArgs,
     request: &Request,
-    params: &Params,
+    model: &Model,
 ) -> Result<tiltnoise_plot::TfFigureOptions> {
     let observables = if !args.plot_observables.is_empty() {
         let chosen = options::parse_outputs("--plot-observables", &args.plot_observables)?;
@@ -137,7 +144,7 @@ fn figure_options(
     let options = tiltnoise_plot::TfFigureOptions {
         observables: Some(observables),
         phase: args.phase,
-        damped: !Model::new(params)?.is_undamped(),
+        damped: !model.is_undamped(),
         view: tiltnoise_plot::View::default(),
         note: None,
     };
@@ -148,116 +155,69 @@ fn figure_options(
     })
 }
 
-/// Runs `tiltnoise tf`.
+/// The request of the transfer-function job from the options.
+fn request<'a>(args: &TfArgs, model: &'a Model, request: Request) -> Result<TfRequest<'a>> {
+    let grid = match (&args.freq, &args.freq_file) {
+        (Some(spec), _) => FreqGrid::Log(freq::parse_log_spec(spec, MAX_STREAMED_GRID_POINTS)?),
+        (None, Some(path)) => FreqGrid::File(path.clone()),
+        (None, None) => FreqGrid::Default,
+    };
+    let figure = args.save.iter().find(|p| {
+        matches!(
+            OutputKind::from_path(p),
+            Ok(OutputKind::Png | OutputKind::Svg)
+        )
+    });
+    Ok(TfRequest {
+        model,
+        request,
+        grid,
+        per: args.per.quantity(),
+        method: args.method.fixed(),
+        rel_tol: Some(args.rel_tol),
+        block_freqs: args.block_freqs,
+        figure: figure.cloned(),
+    })
+}
+
+/// Runs `tiltnoise tf`: the options parsed into the job's request, the job planned (the
+/// planner's reasoning on standard error with --explain), then the grid evaluated whole for a
+/// figure, else block by block into every file (or standard output) as it is computed.
 pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()> {
-    let request = Request {
+    let request_names = Request {
         outputs: parse_observables(&args.outputs)?,
         inputs: parse_inputs(&args.inputs)?,
     };
-    if !(args.rel_tol.is_finite() && args.rel_tol > 0.0 && args.rel_tol < 1.0) {
-        bail!(
-            "--rel-tol {}: the tolerance must be a finite relative error in (0, 1)",
-            args.rel_tol
-        );
-    }
+    tiltnoise_job::tf::rel_tol(Some(args.rel_tol)).map_err(super::job_error)?;
     // Check every output before computing, so a typo costs nothing.
     for path in &args.save {
-        tiltnoise_io::OutputKind::from_path(path)?;
+        OutputKind::from_path(path)?;
     }
-    let figure = figure_options(&args, &request, params)?;
-    let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
-    let inputs: Vec<(&str, &Path)> = args
-        .freq_file
-        .iter()
-        .map(|p| ("--freq-file", p.as_path()))
-        .collect();
-    run.check_outputs(&saves, &inputs)?;
-    let block_freqs = match args.block_freqs {
-        Some(0) => bail!("--block-freqs 0: a block must hold at least 1 frequency"),
-        Some(b) => b,
-        None => TF_BLOCK_FREQS,
-    };
-    let figure_path = args.save.iter().find(|p| {
-        matches!(
-            tiltnoise_io::OutputKind::from_path(p),
-            Ok(tiltnoise_io::OutputKind::Png | tiltnoise_io::OutputKind::Svg)
-        )
-    });
-    let per = args.per.quantity();
     let model = Model::new(params)?;
-    let grid = match (&args.freq, &args.freq_file) {
-        (Some(spec), _) => Grid::Log(freq::parse_log_spec(spec, MAX_STREAMED_GRID_POINTS)?),
-        (None, Some(path)) => Grid::Points(read_freq_file(path)?),
-        (None, None) => Grid::Points(freq::default_grid(&model)),
+    let figure = figure_options(&args, &request_names, &model)?;
+    let req = request(&args, &model, request_names)?;
+    run.check_job_outputs(&args.save, req.input_files())?;
+    let has_figure = req.figure.is_some();
+    let planned = match tiltnoise_job::tf::prepare(req) {
+        Ok(planned) => planned,
+        Err(JobError::NoMethod(refusal)) if args.explain => {
+            super::note(&refusal.explain());
+            bail!("{refusal}");
+        }
+        Err(e) => return Err(super::job_error(e)),
     };
-    if let (Grid::Points(freqs), Some(path)) = (&grid, &args.freq_file) {
-        let ground = request.inputs.iter().any(|i| i.is_ground());
-        if let Some(k) = freqs.iter().position(|&f| per.to_displacement(f).is_none()) {
-            if ground {
-                bail!(
-                    "--per {q}: frequency {} of {} is 0 Hz, where a transfer function per unit \
-                     floor {q} has no value (a {q} carries no displacement at DC); use \
-                     frequencies above 0 Hz",
-                    k + 1,
-                    path.display(),
-                    q = per.name(),
-                );
-            }
-        }
+    if let (Some(choice), true) = (&planned.choice, args.explain) {
+        super::note(&choice.explain());
     }
-    if let (Some(path), Grid::Log(g)) = (figure_path, &grid) {
-        if g.len() > MAX_GRID_POINTS {
-            bail!(
-                "--save {}: a figure is drawn from at most {MAX_GRID_POINTS} frequency points \
-                 and --freq asks for {}; draw it from a smaller grid (the default grid \
-                 resolves every resonance) and write the large one to .h5 or .csv only (see \
-                 docs/limits.md)",
-                path.display(),
-                g.len()
-            );
-        }
-    }
-    let method = match args.method.fixed() {
-        Some(m) => m,
-        None => {
-            let band = grid.positive_band();
-            let scene = Scene {
-                request: request.clone(),
-                band_hz: band,
-                rel_tol: args.rel_tol,
-            };
-            let choice = match choose(&model, &scene) {
-                Ok(choice) => choice,
-                Err(refusal) if args.explain => {
-                    super::note(&refusal.explain());
-                    return Err(refusal.into());
-                }
-                Err(refusal @ NoChoice::Tolerance { .. }) => {
-                    bail!("{refusal}; run with --explain for every candidate")
-                }
-                Err(refusal @ NoChoice::NearMode { .. }) => {
-                    bail!("{refusal} (--method polezero, or another --freq)")
-                }
-                Err(refusal) => return Err(refusal.into()),
-            };
-            if args.explain {
-                super::note(&choice.explain());
-            }
-            choice.method
-        }
-    };
-    let plan = tf::plan(&model, &request, method)?;
     let modes = NormalModes::new(&model);
     let meta = RunMeta::of_this_run(params, Some(&modes));
-    if figure_path.is_none() {
-        return stream_tf(plan.as_ref(), &grid, block_freqs, &args, &model, &meta, run);
+    let json = args.format == Format::Json;
+    if !has_figure {
+        return stream_tf(&planned, &args, &model, &meta, run);
     }
-    let freqs = grid.block(0, grid.len());
-    let tf = tf::evaluate(plan.as_ref(), &freqs)
-        .and_then(|tf| per_unit(tf, per))
-        .context("evaluating the transfer functions")?;
-    write_report(&mut run.out, &model, &modes, &request)?;
-    run.write_outputs(false, || {
+    let tf = planned.whole(&run.cancel).map_err(super::job_error)?;
+    write_report(&mut run.out, &model, &modes, planned.request(), json)?;
+    run.write_outputs(json, || {
         for path in &args.save {
             save_tf(path, &tf, &meta, &figure)?;
         }
@@ -265,74 +225,22 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
     })
 }
 
-/// `tf` with the floor's motion per unit `per` (as it is when `per` is the displacement).
-fn per_unit(
-    tf: tf::TransferMatrix,
-    per: GroundQuantity,
-) -> Result<tf::TransferMatrix, tiltnoise_core::error::TfError> {
-    match per {
-        GroundQuantity::Displacement => Ok(tf),
-        _ => tf.per_ground_quantity(per),
-    }
-}
-
-/// Frequencies per block of a streamed grid: 16384 points of the largest request (7 x 15
-/// complex values) are 27 MB with the CSV text of the block.
-const TF_BLOCK_FREQS: usize = 1 << 14;
-
 /// Grids with at least this many points get a progress bar on a terminal (about 2 s).
 const TF_WORTH_A_BAR: usize = 1 << 19;
 
-/// A frequency grid: held (a file, the default grid) or computed point by point (`--freq`).
-enum Grid {
-    Points(Vec<f64>),
-    Log(freq::LogGrid),
-}
-
-impl Grid {
-    fn len(&self) -> usize {
-        match self {
-            Grid::Points(v) => v.len(),
-            Grid::Log(g) => g.len(),
-        }
-    }
-
-    fn block(&self, start: usize, len: usize) -> Vec<f64> {
-        match self {
-            Grid::Points(v) => {
-                let end = start.saturating_add(len).min(v.len());
-                v[start.min(end)..end].to_vec()
-            }
-            Grid::Log(g) => g.block(start, len),
-        }
-    }
-
-    /// The lowest and highest positive frequencies (Hz), for the planner.
-    fn positive_band(&self) -> (f64, f64) {
-        match self {
-            Grid::Log(g) => (g.lo_hz(), g.hi_hz()),
-            Grid::Points(freqs) => {
-                let positive: Vec<f64> = freqs.iter().copied().filter(|&f| f > 0.0).collect();
-                match positive.is_empty() {
-                    true => (freq::DEFAULT_F_LO_HZ, freq::DEFAULT_F_LO_HZ),
-                    false => (
-                        positive.iter().copied().fold(f64::INFINITY, f64::min),
-                        positive.iter().copied().fold(0.0, f64::max),
-                    ),
-                }
-            }
-        }
-    }
-}
-
 /// The modes table and, for tilt inputs, the static limits, for translations their limits per
-/// unit acceleration (printed when files are saved).
+/// unit acceleration (printed when files are saved); with `json`, the modes as JSON.
 fn write_report(
     out: &mut super::stdout::Out,
     model: &Model,
     modes: &NormalModes,
     request: &Request,
+    json: bool,
 ) -> Result<()> {
+    if json {
+        writeln!(out, "{}", super::report::modes_json(model, modes))?;
+        return Ok(());
+    }
     write!(out, "{}", super::report::modes_table(modes))?;
     if request.inputs.iter().any(|i| matches!(i, Input::Tilt(_))) {
         writeln!(out)?;
@@ -350,17 +258,14 @@ fn write_report(
 }
 
 /// Evaluates the grid block by block and writes each block to every HDF5 and CSV output (or
-/// as CSV to standard output without --save) before the next is computed.
+/// to standard output, as CSV or JSON, without --save) before the next is computed.
 fn stream_tf(
-    plan: &dyn tf::TransferFunction,
-    grid: &Grid,
-    block_freqs: usize,
+    planned: &Planned,
     args: &TfArgs,
     model: &Model,
     meta: &RunMeta,
     run: &mut Run,
 ) -> Result<()> {
-    use tiltnoise_io::{OutputKind, TfCsvWriter, TfHdf5Writer};
     let mut hdf5 = Vec::new();
     let mut csv = Vec::new();
     for path in &args.save {
@@ -370,7 +275,7 @@ fn stream_tf(
             OutputKind::Png | OutputKind::Svg => unreachable!("figures are drawn from memory"),
         }
     }
-    let n = grid.len();
+    let n = planned.len();
     let bar = (n >= TF_WORTH_A_BAR && std::io::stderr().is_terminal()).then(|| {
         let b = indicatif::ProgressBar::new(n as u64);
         b.set_style(
@@ -381,45 +286,48 @@ fn stream_tf(
         );
         b
     });
+    let json = args.format == Format::Json;
+    let to_stdout = args.save.is_empty();
     let mut text = String::new();
-    let mut start = 0;
-    while start < n {
-        let freqs = grid.block(start, block_freqs);
-        let block = tf::evaluate(plan, &freqs)
-            .and_then(|tf| per_unit(tf, args.per.quantity()))
-            .context("evaluating the transfer functions")?;
+    let cancel = run.cancel.clone();
+    planned.blocks(&cancel, |block, done| -> Result<()> {
         for w in &mut hdf5 {
-            w.append(&block)?;
+            w.append(block)?;
         }
         for w in &mut csv {
-            w.append(&block)?;
+            w.append(block)?;
         }
-        if args.save.is_empty() {
+        if to_stdout {
             text.clear();
-            if start == 0 {
-                text.push_str(&tiltnoise_io::tf_csv_header(&block, meta));
+            let first = done == block.freqs_hz.len();
+            match (json, first) {
+                (true, true) => text.push_str(&json_head(block, planned)),
+                (false, true) => text.push_str(&tiltnoise_io::tf_csv_header(block, meta)),
+                _ => {}
             }
-            tiltnoise_io::push_tf_csv_rows(&mut text, &block);
+            match json {
+                true => push_json_points(&mut text, block, first),
+                false => tiltnoise_io::push_tf_csv_rows(&mut text, block),
+            }
+            if json && done == n {
+                text.push_str(&json_tail(block));
+            }
             write!(run.out, "{text}")?;
         }
-        start += freqs.len();
         if let Some(b) = &bar {
-            b.set_position(start as u64);
+            b.set_position(done as u64);
         }
-    }
+        Ok(())
+    })?;
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    if args.save.is_empty() {
+    if to_stdout {
         return Ok(());
     }
-    write_report(
-        &mut run.out,
-        model,
-        &NormalModes::new(model),
-        plan.request(),
-    )?;
-    run.write_outputs(false, || {
+    let modes = NormalModes::new(model);
+    write_report(&mut run.out, model, &modes, planned.request(), json)?;
+    run.write_outputs(json, || {
         for w in hdf5 {
             w.finish()?;
         }
@@ -428,4 +336,54 @@ fn stream_tf(
         }
         Ok(())
     })
+}
+
+/// A JSON value written by serde (a number that is not finite is `null`).
+fn json_value(v: impl serde::Serialize) -> String {
+    serde_json::to_string(&v).expect("JSON of plain data")
+}
+
+/// The keys of the JSON document before its points (keys in alphabetical order, as every JSON
+/// report): `inputs`, `method`, `observables`, `per`, then `points` opened.
+fn json_head(block: &TransferMatrix, planned: &Planned) -> String {
+    let names = |v: Vec<&str>| json_value(v);
+    format!(
+        "{{\n  \"inputs\": {},\n  \"method\": {},\n  \"observables\": {},\n  \"per\": {},\n  \
+         \"points\": [",
+        names(block.inputs.iter().map(|i| i.name()).collect()),
+        json_value(planned.method().name()),
+        names(block.outputs.iter().map(|o| o.name()).collect()),
+        json_value(block.ground_quantity().name()),
+    )
+}
+
+/// One line per frequency: `{"H": [[[re, im] per input] per observable], "frequency_hz": f}`.
+fn push_json_points(s: &mut String, block: &TransferMatrix, first: bool) {
+    let (no, ni) = (block.outputs.len(), block.inputs.len());
+    for (k, &f) in block.freqs_hz.iter().enumerate() {
+        let h: Vec<Vec<[f64; 2]>> = (0..no)
+            .map(|o| {
+                (0..ni)
+                    .map(|i| {
+                        let z = block.get(k, o, i);
+                        [z.re, z.im]
+                    })
+                    .collect()
+            })
+            .collect();
+        let comma = if first && k == 0 { "" } else { "," };
+        s.push_str(&format!(
+            "{comma}\n    {{\"H\": {}, \"frequency_hz\": {}}}",
+            json_value(h),
+            json_value(f)
+        ));
+    }
+}
+
+/// The end of the JSON document: the points closed, then `units` (per observable, per input).
+fn json_tail(block: &TransferMatrix) -> String {
+    let units: Vec<Vec<String>> = (0..block.outputs.len())
+        .map(|o| (0..block.inputs.len()).map(|i| block.unit(o, i)).collect())
+        .collect();
+    format!("\n  ],\n  \"units\": {}\n}}\n", json_value(units))
 }

@@ -365,3 +365,48 @@ fn a_segment_shorter_than_the_welch_segment_names_nperseg() {
         ],
     );
 }
+
+#[test]
+fn tf_json_holds_the_numbers_of_its_csv_bit_for_bit() {
+    let args = [
+        "tf",
+        "--freq",
+        "1e-4:37:30",
+        "--input",
+        "eta_t,x_t",
+        "--observables",
+        "X,phi",
+        "--per",
+        "acceleration",
+        "--block-freqs",
+        "5",
+    ];
+    let csv = tiltnoise(&args);
+    assert!(csv.status.success(), "{}", stderr(&csv));
+    let (header, freqs, rows) = common::parse_tf_csv(&String::from_utf8(csv.stdout).unwrap());
+    let out = tiltnoise(&[&args[..], &["--format", "json"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8(out.stdout).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&text).expect("--format json is JSON");
+    assert_eq!(json["inputs"], serde_json::json!(["eta_t", "x_t"]));
+    assert_eq!(json["observables"], serde_json::json!(["X", "phi"]));
+    assert_eq!(json["per"], "acceleration");
+    assert_eq!(json["units"][0][0], "m/(rad/s^2)");
+    let points = json["points"].as_array().unwrap();
+    assert_eq!(points.len(), freqs.len());
+    assert_eq!(header[1], "X.eta_t.re");
+    for (k, p) in points.iter().enumerate() {
+        assert_eq!(p["frequency_hz"].as_f64(), Some(freqs[k]));
+        let h = &p["H"];
+        let from_json: Vec<num_complex::Complex64> = (0..2)
+            .flat_map(|o| (0..2).map(move |i| (o, i)))
+            .map(|(o, i)| {
+                num_complex::Complex64::new(
+                    h[o][i][0].as_f64().unwrap(),
+                    h[o][i][1].as_f64().unwrap(),
+                )
+            })
+            .collect();
+        assert_eq!(from_json, rows[k], "frequency {}", freqs[k]);
+    }
+}

@@ -7,12 +7,17 @@ use tiltnoise_core::budget::option_checks::{
     percentiles_error, require_segments_for_percentiles, InputKind,
 };
 use tiltnoise_core::budget::BudgetError;
+use tiltnoise_core::cancel::Cancelled;
 use tiltnoise_core::coherence::CoherenceError;
+use tiltnoise_core::error::{FreqError, TfError};
 use tiltnoise_core::error::{Num, Shown};
 use tiltnoise_core::input::InputError;
+use tiltnoise_core::mc::McError;
 use tiltnoise_core::model::Observable;
 use tiltnoise_core::option_key::{self, OptionKey};
 use tiltnoise_core::repeats::Repeated;
+use tiltnoise_core::tf::planner::NoChoice;
+use tiltnoise_core::tf::PlanError;
 
 /// Why a job did not run to its end. Options are named in snake case (`segment_duration`);
 /// [`JobError::message`] spells them as the front end does. `Display` uses the keyword
@@ -82,6 +87,19 @@ pub enum JobError {
     Coherence(Box<CoherenceError>),
     /// The subtraction's records do not fit it, or its result is not finite.
     Subtract(Box<SubtractFailure>),
+    /// `auto` found no method for the request on the grid's band.
+    NoMethod(Box<NoChoice>),
+    /// The method asked for cannot evaluate the request on this model.
+    Plan(Box<PlanError>),
+    /// The transfer functions have no value at a frequency, do not fit into memory, or the run
+    /// was cancelled.
+    Tf(Box<TfError>),
+    /// A file of frequencies cannot be read or is not valid.
+    Freq(Box<FreqError>),
+    /// The Monte Carlo cannot run (sizes, error model, every draw rejected, cancelled).
+    MonteCarlo(Box<McError>),
+    /// The run was cancelled.
+    Cancelled,
 }
 
 impl JobError {
@@ -160,6 +178,22 @@ impl JobError {
             JobError::Budget { path, source } => format!("budget of {}: {source}", Shown(path)),
             JobError::Coherence(e) => e.to_string(),
             JobError::Subtract(e) => e.message(),
+            JobError::NoMethod(refusal) => match refusal.as_ref() {
+                NoChoice::Tolerance { .. } => {
+                    format!("{refusal}; run with {} for every candidate", opt("explain"))
+                }
+                NoChoice::NearMode { .. } => format!(
+                    "{refusal} ({}, or another {})",
+                    OptionKey::new("method").given("polezero"),
+                    opt("freq_hz")
+                ),
+                NoChoice::Band(_) => refusal.to_string(),
+            },
+            JobError::Plan(e) => e.to_string(),
+            JobError::Tf(e) => format!("evaluating the transfer functions: {e}"),
+            JobError::Freq(e) => e.to_string(),
+            JobError::MonteCarlo(e) => e.to_string(),
+            JobError::Cancelled => Cancelled.to_string(),
         }
     }
 
@@ -232,6 +266,11 @@ impl std::error::Error for JobError {
             JobError::Input(e) | JobError::OptionFile { source: e, .. } => Some(e.as_ref()),
             JobError::Budget { source, .. } => Some(source.as_ref()),
             JobError::Coherence(e) => Some(e.as_ref()),
+            JobError::NoMethod(e) => Some(e.as_ref()),
+            JobError::Plan(e) => Some(e.as_ref()),
+            JobError::Tf(e) => Some(e.as_ref()),
+            JobError::Freq(e) => Some(e.as_ref()),
+            JobError::MonteCarlo(e) => Some(e.as_ref()),
             _ => None,
         }
     }

@@ -17,12 +17,15 @@ pub mod coherence;
 mod error;
 mod figure;
 mod given;
+pub mod methods;
+pub mod monte_carlo;
 pub mod subtract;
 mod subtract_error;
 pub mod subtract_figure;
 pub mod subtract_outputs;
 pub mod subtract_report;
 mod summary;
+pub mod tf;
 
 pub use error::JobError;
 pub use figure::save_image;

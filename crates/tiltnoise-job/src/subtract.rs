@@ -295,13 +295,11 @@ fn select_observables(
 /// # Errors
 ///
 /// A [`JobError`] naming the option or file that failed; `Subtract` for records the
-/// subtraction refuses, for a result that is not finite and when `cancel` was set.
+/// subtraction refuses and for a result that is not finite; `Cancelled` when `cancel` was
+/// set (the subtraction polls it between its stages, in its spectra and across the
+/// prediction's bins).
 pub fn run(req: SubtractRequest<'_>, cancel: &Cancel) -> Result<SubtractOutcome, JobError> {
-    let stage = || {
-        cancel
-            .check()
-            .map_err(|_| failure(SubtractFailure::Cancelled))
-    };
+    let stage = || cancel.check().map_err(|_| JobError::Cancelled);
     check_options(&req)?;
     let cfg = SubtractConfig {
         segment_len: req.nperseg,
@@ -373,7 +371,7 @@ pub fn run(req: SubtractRequest<'_>, cancel: &Cancel) -> Result<SubtractOutcome,
         &cfg,
     )
     .map_err(|e| match cancel.is_cancelled() {
-        true => failure(SubtractFailure::Cancelled),
+        true => JobError::Cancelled,
         false => failed(RunFailure::Refused(e)),
     })?;
     check_finite(&result).map_err(failed)?;

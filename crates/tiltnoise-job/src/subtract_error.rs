@@ -1,8 +1,7 @@
 //! Why a subtraction did not run, beyond the readers' and the options' errors: records that do
-//! not fit it, a result that is not finite, a cancelled run; each message names its options by
+//! not fit it, a result that is not finite; each message names its options by
 //! key, spelled by the front end in use.
 
-use tiltnoise_core::cancel::Cancelled;
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::Observable;
 use tiltnoise_core::option_key::OptionKey;
@@ -11,8 +10,6 @@ use tiltnoise_core::subtract::SubtractError;
 /// Why a subtraction did not run, beyond the readers' and the options' errors.
 #[derive(Debug)]
 pub enum SubtractFailure {
-    /// The run was cancelled (between its stages: the subtraction itself does not poll).
-    Cancelled,
     /// More than two co-located records.
     TooManyColocated(usize),
     /// A noise ratio without exactly one co-located record.
@@ -112,7 +109,6 @@ impl SubtractFailure {
     pub(crate) fn message(&self) -> String {
         let opt = |name: &'static str| OptionKey::new(name).to_string();
         match self {
-            SubtractFailure::Cancelled => Cancelled.to_string(),
             SubtractFailure::TooManyColocated(n) => format!(
                 "{} is given {n} times: give one record (a huddle test with the witness) or two \
                  (a three-cornered hat)",
