@@ -12,8 +12,8 @@ use std::path::{Path, PathBuf};
 use tiltnoise_core::ground::GroundQuantity;
 use tiltnoise_core::model::{Input, TiltAxis, TranslationAxis};
 use tiltnoise_io::input::{
-    read_tilt, read_tilt_series, read_tilt_spectra, AxisMap, GapPolicy, InputError, InputFormat,
-    InputKind, Quantity, ReadOptions, Sign, TiltInput, TiltSeriesSource, TiltSpectra,
+    read_tilt, read_tilt_series, read_tilt_spectra, AxisMap, FormatError, GapPolicy, InputError,
+    InputFormat, InputKind, Quantity, ReadOptions, Sign, TiltInput, TiltSeriesSource, TiltSpectra,
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -516,7 +516,10 @@ fn csv_time_column_errors_name_the_row() {
     let p = dir.path().join("t_dec.csv");
     write_text(&p, "time_s,theta_t\n0.0,1\n1.0,2\n1.0,3\n");
     let e = series_err(&p, &ReadOptions::default());
-    assert!(matches!(e, InputError::TimeNotIncreasing { .. }));
+    assert!(matches!(
+        FormatError::of(&e),
+        Some(FormatError::TimeNotIncreasing { .. })
+    ));
     err_msg(e, &p, &["line 4", "sample index 2", "time_s = 1.0 s"]);
 
     let p = dir.path().join("t_nonuni.csv");
@@ -525,7 +528,10 @@ fn csv_time_column_errors_name_the_row() {
         "# c\ntime_s,theta_t\n0.0,1\n1.0,2\n2.0,3\n3.5,4\n4.0,5\n",
     );
     let e = series_err(&p, &ReadOptions::default());
-    assert!(matches!(e, InputError::TimeNotUniform { .. }));
+    assert!(matches!(
+        FormatError::of(&e),
+        Some(FormatError::TimeNotUniform { .. })
+    ));
     err_msg(
         e,
         &p,
@@ -566,7 +572,10 @@ fn csv_structure_errors() {
     let p = dir.path().join("word.csv");
     write_text(&p, "time_s,theta_t\n0,1\n1,abc\n");
     let e = series_err(&p, &ReadOptions::default());
-    assert!(matches!(e, InputError::CsvNumber { .. }));
+    assert!(matches!(
+        FormatError::of(&e),
+        Some(FormatError::CsvNumber { .. })
+    ));
     err_msg(e, &p, &["line 3", "theta_t", "`abc`", "rad"]);
 
     let p = dir.path().join("dup.csv");
@@ -603,7 +612,10 @@ fn csv_structure_errors() {
     let p = dir.path().join("not_hdf5.h5");
     write_text(&p, "time_s,theta_t\n0,1\n1,2\n");
     let e = read_tilt(&p, &ReadOptions::default()).unwrap_err();
-    assert!(matches!(e, InputError::Hdf5 { .. }));
+    assert!(matches!(
+        FormatError::of(&e),
+        Some(FormatError::Hdf5 { .. })
+    ));
     err_msg(e, &p, &["HDF5"]);
 }
 

@@ -1,5 +1,5 @@
-//! The mass and stiffness matrices of Appendix A (eqs. (def_I) and (EM)), written once over the
-//! scalar they are evaluated in: `f64` for the model ([`crate::model`]) and double-double for
+//! The mass, stiffness and zeroth-order generalized-force matrices of Appendix A (eqs. (def_I)
+//! and (EM), and its last display), written once over the scalar they are evaluated in: `f64` for the model ([`crate::model`]) and double-double for
 //! the reference ([`crate::dd::matrices`]). The reference stays an independent check of the
 //! arithmetic (every sum and product rounded 2^-53 times more finely); the formulas, fixed by
 //! the paper, are stated here once, and `tests/it/energy_crosscheck.rs` rebuilds them from the
@@ -149,4 +149,57 @@ pub fn stiffness_elastic(p: &Params) -> [(usize, f64, f64); 4] {
         (DA, p.bouncing.kappa_a_n_per_m, lp.bouncing_a_rad),
         (DB, p.bouncing.kappa_b_n_per_m, lp.bouncing_b_rad),
     ]
+}
+
+/// Columns of the force matrix: F_a.xyz, F_b.xyz (forces at the centres of mass), M_a.xyz,
+/// M_b.xyz (torques about them).
+const FAX: usize = 0;
+const FAY: usize = 1;
+const FAZ: usize = 2;
+const FBX: usize = 3;
+const FBY: usize = 4;
+const FBZ: usize = 5;
+const MAX: usize = 6;
+const MAY: usize = 7;
+const MAZ: usize = 8;
+const MBX: usize = 9;
+const MBY: usize = 10;
+const MBZ: usize = 11;
+
+/// Zeroth-order generalized forces B (Appendix A, last display): the generalized force on each
+/// coordinate of the 12 force and torque components, columns F_a.xyz, F_b.xyz, M_a.xyz,
+/// M_b.xyz. Row h is the gradient of the body positions and rotation angles with respect to q_h
+/// at equilibrium, so B is also J^T for the kinematics behind M.
+pub fn force<S: Scalar>(p: &Params) -> [[S; 12]; 8] {
+    let l = &p.length;
+    let (d, z, z_a, z_b) = (S::of(l.d_m), S::of(l.z_m), S::of(l.z_a_m), S::of(l.z_b_m));
+    let y_a = y_a::<S>(p);
+    let (zza, zzb, one) = (z + z_a, z + z_b, S::of(1.0));
+    let rows: [(usize, &[(usize, S)]); 8] = [
+        (
+            TA,
+            &[
+                (FBY, zzb),
+                (FAY, zza),
+                (MAX, one),
+                (MBX, one),
+                (FAZ, y_a),
+                (FBZ, -d),
+            ],
+        ),
+        (EA, &[(FBX, -zzb), (FAX, -zza), (MAY, one), (MBY, one)]),
+        (PA, &[(FAX, -y_a), (FBX, d), (MAZ, one), (MBZ, one)]),
+        (DA, &[(FAZ, -one), (FBZ, -one)]),
+        (TB, &[(FBY, z_b), (MBX, one)]),
+        (EB, &[(FBX, -z_b), (MBY, one)]),
+        (PB, &[(MBZ, one)]),
+        (DB, &[(FBZ, -one)]),
+    ];
+    let mut b = [[S::ZERO; 12]; 8];
+    for (row, entries) in rows {
+        for &(col, v) in entries {
+            b[row][col] = v;
+        }
+    }
+    b
 }

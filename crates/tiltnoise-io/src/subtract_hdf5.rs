@@ -16,7 +16,7 @@ use crate::run_meta::RunMeta;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
 use tiltnoise_core::input::InputMeta;
-use tiltnoise_core::subtract::{Method, SubtractResult};
+use tiltnoise_core::subtract::{FitReport, Method, SubtractResult};
 
 /// Provenance of a subtraction run.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -59,27 +59,48 @@ pub fn write_subtract_hdf5(
 
 fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Result<()> {
     let file = hdf5::File::create(path)?;
-    let a = &r.alignment;
-    str_attr(&file, "schema", SCHEMA_OBSERVABLE_SERIES)?;
-    scalar_attr(&file, "schema_version", SCHEMA_VERSION_OBSERVABLE_SERIES)?;
-    scalar_attr(&file, "sample_rate_hz", a.fs_hz)?;
+    write_cleaned(&file, r, meta)?;
+    write_predicted(&file, r)?;
+    write_estimates(&file, &r.fit)?;
+    write_residuals(&file, r)?;
+    write_bands(&file, r)?;
+    write_witness_noise(&file, r)?;
+    write_alignment(&file, r)?;
+    write_provenance(&file, r, meta)
+}
+
+/// One-sided ASDs of the PSDs `psd` (a PSD rounded below zero counts as zero).
+fn asd(psd: &[f64]) -> Vec<f64> {
+    psd.iter().map(|p| p.max(0.0).sqrt()).collect()
+}
+
+/// The root: the observable-series attributes and the cleaned series.
+fn write_cleaned(file: &hdf5::File, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Result<()> {
+    str_attr(file, "schema", SCHEMA_OBSERVABLE_SERIES)?;
+    scalar_attr(file, "schema_version", SCHEMA_VERSION_OBSERVABLE_SERIES)?;
+    scalar_attr(file, "sample_rate_hz", r.alignment.fs_hz)?;
     if let Some(t) = &meta.start_time {
-        str_attr(&file, "start_time", t)?;
+        str_attr(file, "start_time", t)?;
     }
     str_attr(
-        &file,
+        file,
         "description",
         "measured observables minus their tilt part predicted by tiltnoise subtract",
     )?;
-    str_attr(&file, "tool_version", &meta.run.tool_version)?;
-    str_attr(&file, "created_by", &meta.run.command_line)?;
-    str_attr(&file, "parameters_toml", &meta.run.params_toml)?;
-    str_attr(&file, "fitted_parameters_toml", &r.fit.params.to_toml())?;
-    str_attr(&file, "spectral_convention", SPECTRAL_CONVENTION)?;
+    str_attr(file, "tool_version", &meta.run.tool_version)?;
+    str_attr(file, "created_by", &meta.run.command_line)?;
+    str_attr(file, "parameters_toml", &meta.run.params_toml)?;
+    str_attr(file, "fitted_parameters_toml", &r.fit.params.to_toml())?;
+    str_attr(file, "spectral_convention", SPECTRAL_CONVENTION)?;
     for (o, series) in &r.cleaned {
-        let ds = dataset(&file, o.name(), series)?;
+        let ds = dataset(file, o.name(), series)?;
         str_attr(&ds, "unit", o.unit())?;
     }
+    Ok(())
+}
+
+/// `/predicted_tilt`: the tilt part of each observable, and the bands it was not predicted in.
+fn write_predicted(file: &hdf5::File, r: &SubtractResult) -> hdf5::Result<()> {
     let g = file.create_group("predicted_tilt")?;
     str_attr(
         &g,
@@ -104,8 +125,11 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
             .with_data(&ndarray::ArrayView1::from(&bands))
             .create("not_predicted_bands_hz")?;
     }
+    Ok(())
+}
 
-    let f = &r.fit;
+/// `/estimates`: the fitted parameters, their errors and correlation, and the fit's figures.
+fn write_estimates(file: &hdf5::File, f: &FitReport) -> hdf5::Result<()> {
     let g = file.create_group("estimates")?;
     let e = &f.estimates;
     strs_attr(&g, "estimator", [ESTIMATOR])?;
@@ -187,13 +211,16 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
         )
         .create("correlation")?;
     str_attr(&d, "unit", "1")?;
+    Ok(())
+}
 
+/// `/residuals/<observable>`: the held-out spectra and their band figures.
+fn write_residuals(file: &hdf5::File, r: &SubtractResult) -> hdf5::Result<()> {
     let g = file.create_group("residuals")?;
     str_attr(&g, "spectral_convention", SPECTRAL_CONVENTION)?;
     str_attr(&g, "stretch", "held-out (the end of the overlap)")?;
     scalar_attr(&g, "segment_len", r.segment_len as u64)?;
     scalar_attr(&g, "effective_averages", r.n_eff.1)?;
-    let asd = |psd: &[f64]| -> Vec<f64> { psd.iter().map(|p| p.max(0.0).sqrt()).collect() };
     for s in &r.residuals {
         let o = s.observable;
         let h = g.create_group(o.name())?;
@@ -250,7 +277,11 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
             scalar_attr(&h, name, stored(v))?;
         }
     }
+    Ok(())
+}
 
+/// `/bands/<observable>`: the cleaned record against the raw one, per band.
+fn write_bands(file: &hdf5::File, r: &SubtractResult) -> hdf5::Result<()> {
     let g = file.create_group("bands")?;
     str_attr(
         &g,
@@ -258,7 +289,7 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
         "the cleaned record against the raw one over the whole overlap, per 1/3-decade band \
          (band means of Welch PSDs as ASDs); a band left raw had its prediction masked out",
     )?;
-    let fs = a.fs_hz;
+    let fs = r.alignment.fs_hz;
     for (o, check) in &r.bands {
         let h = g.create_group(o.name())?;
         let unit = format!("{}/sqrt(Hz)", o.unit());
@@ -302,7 +333,11 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
         scalar_attr(&h, "variance_ratio", check.variance_ratio)?;
         scalar_attr(&h, "left_raw", u8::from(check.left_raw))?;
     }
+    Ok(())
+}
 
+/// `/witness_noise`: the witness noise as used, with how it was found.
+fn write_witness_noise(file: &hdf5::File, r: &SubtractResult) -> hdf5::Result<()> {
     let g = file.create_group("witness_noise")?;
     str_attr(
         &g,
@@ -335,8 +370,13 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
             .with_data(&ndarray::ArrayView1::from(&gains))
             .create("relative_gains")?;
     }
+    Ok(())
+}
 
+/// `/alignment`: how the two records were aligned and split.
+fn write_alignment(file: &hdf5::File, r: &SubtractResult) -> hdf5::Result<()> {
     let g = file.create_group("alignment")?;
+    let a = &r.alignment;
     scalar_attr(&g, "tilt_first_sample", a.witness_first as u64)?;
     scalar_attr(&g, "measured_first_sample", a.measured_first as u64)?;
     scalar_attr(&g, "samples", a.len as u64)?;
@@ -350,7 +390,15 @@ fn write_file(path: &Path, r: &SubtractResult, meta: &SubtractMeta) -> hdf5::Res
     scalar_attr(&g, "training_samples", r.n_train as u64)?;
     scalar_attr(&g, "holdout_samples", r.n_holdout as u64)?;
     scalar_attr(&g, "max_delay_s", r.max_delay_s)?;
+    Ok(())
+}
 
+/// `/provenance`: the inputs and the run's notes.
+fn write_provenance(
+    file: &hdf5::File,
+    r: &SubtractResult,
+    meta: &SubtractMeta,
+) -> hdf5::Result<()> {
     let g = file.create_group("provenance")?;
     str_attr(&g, "tilt_path", &meta.tilt.path)?;
     str_attr(&g, "tilt_format", &meta.tilt.format)?;

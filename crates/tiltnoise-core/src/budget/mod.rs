@@ -24,7 +24,7 @@ pub use summary::{SummaryRequest, DEFAULT_BAND_FRACTION, DEFAULT_SUMMARY_FREQS_H
 use crate::cancel::{Cancel, Cancelled};
 use crate::error::TfError;
 use crate::ground::GroundQuantity;
-use crate::input::{GroundMap, InputError, SeriesSource, TiltSpectra};
+use crate::input::{GroundChannel, GroundMap, InputError, SeriesSource, TiltSpectra};
 use crate::limits::{check_memory, planned_bytes, LimitError};
 use crate::model::{Input, Model, Observable};
 use crate::noise::{
@@ -265,18 +265,26 @@ pub fn budget_from_series(
     // Polled per Welch segment, not only per chunk: a chunk of short segments of many channels
     // can take a second.
     let mut whole = WelchAccumulator::new(n_ax, fs, &cfg)?.with_cancel(opts.cancel.clone());
-    // One accumulator and one matrix buffer for every segment, emptied and reused: a month of
-    // hourly segments of six channels would otherwise map and clear 5 MB twice an hour.
-    let mut current: Option<WelchAccumulator> = None;
-    let mut segment_spectra = CrossSpectra {
-        freqs_hz: Vec::new(),
-        n_channels: n_ax,
-        data: Vec::new(),
-        n_segments: 0,
-    };
-    let mut in_segment = 0usize;
-    let mut tf_cache: Option<TransferMatrix> = None;
-    let mut segment_tilt: Vec<Vec<Vec<f32>>> = vec![Vec::new(); opts.outputs.len()];
+    let mut segments = segment_samples.map(|samples| Segments {
+        model,
+        opts,
+        map: &map,
+        inputs: &inputs,
+        term: &segment_term,
+        cfg: &cfg,
+        fs,
+        samples,
+        current: None,
+        spectra: CrossSpectra {
+            freqs_hz: Vec::new(),
+            n_channels: n_ax,
+            data: Vec::new(),
+            n_segments: 0,
+        },
+        filled: 0,
+        tf: None,
+        tilt: vec![Vec::new(); opts.outputs.len()],
+    });
 
     let mut start = 0;
     while start < n {
@@ -285,39 +293,16 @@ pub fn budget_from_series(
         let chunk = series.read_chunk(start, len)?;
         let views: Vec<&[f64]> = chunk.iter().map(Vec::as_slice).collect();
         whole.push(&views)?;
-        if let Some(seg) = segment_samples {
-            let mut offset = 0;
-            while offset < len {
-                let acc = match current.as_mut() {
-                    Some(acc) => acc,
-                    None => current.insert(
-                        WelchAccumulator::new(n_ax, fs, &cfg)?.with_cancel(opts.cancel.clone()),
-                    ),
-                };
-                let take = (seg - in_segment).min(len - offset);
-                let part: Vec<&[f64]> = views.iter().map(|c| &c[offset..offset + take]).collect();
-                acc.push(&part)?;
-                in_segment += take;
-                offset += take;
-                if in_segment == seg {
-                    opts.cancel.check()?;
-                    acc.finish_into(&mut segment_spectra)?;
-                    in_segment = 0;
-                    if tf_cache.is_none() {
-                        let grid = &segment_spectra.freqs_hz[1..];
-                        tf_cache = Some(ground_tf(model, &opts.outputs, &inputs, grid)?);
-                    }
-                    let tf = tf_cache.as_ref().expect("computed above");
-                    let psds = segment_psds(&map, tf, &mut segment_spectra, &segment_term);
-                    for (kept, psd) in segment_tilt.iter_mut().zip(psds) {
-                        kept.push(psd);
-                    }
-                }
-            }
+        if let Some(segments) = segments.as_mut() {
+            segments.push(&views, len)?;
         }
         start += len;
         progress(start as u64, n as u64);
     }
+    let (tf_cache, in_segment, segment_tilt) = match segments {
+        Some(s) => (s.tf, s.filled, s.tilt),
+        None => (None, 0, vec![Vec::new(); opts.outputs.len()]),
+    };
     let spectra = whole.finish()?;
     let (grid, csd) = map.apply(&spectra);
     let tf = match tf_cache {
@@ -333,22 +318,7 @@ pub fn budget_from_series(
         },
         &opts.readout,
     );
-    let mut notes = Vec::new();
-    if channels
-        .iter()
-        .any(|c| matches!(c.input, Input::Tilt(_)) && c.quantity == GroundQuantity::Velocity)
-    {
-        notes.push(RATE_BUDGET_NOTE.to_string());
-    }
-    notes.extend(map.notes().iter().cloned());
-    notes.extend(map.spectra_notes());
-    if in_segment > 0 {
-        notes.push(format!(
-            "the last {in_segment} samples ({:.0} s) do not fill a segment and are left out of \
-             the segment statistics (they are in the whole-record budget)",
-            in_segment as f64 / fs
-        ));
-    }
+    let notes = series_notes(&channels, &map, in_segment, fs);
     opts.cancel.check()?;
     let segment_bands = band_per_observable(
         &segment_term,
@@ -390,6 +360,97 @@ pub fn budget_from_series(
         n_segments: spectra.n_segments,
     };
     with_summary(model, report, &tilt, opts)
+}
+
+/// The notes of a budget from a record: a tilt read as a rate, the map's notes, and the
+/// `left_over` samples (at `fs` Hz) that fill no budget segment.
+fn series_notes(
+    channels: &[GroundChannel],
+    map: &GroundMap,
+    left_over: usize,
+    fs: f64,
+) -> Vec<String> {
+    let mut notes = Vec::new();
+    if channels
+        .iter()
+        .any(|c| matches!(c.input, Input::Tilt(_)) && c.quantity == GroundQuantity::Velocity)
+    {
+        notes.push(RATE_BUDGET_NOTE.to_string());
+    }
+    notes.extend(map.notes().iter().cloned());
+    notes.extend(map.spectra_notes());
+    if left_over > 0 {
+        notes.push(format!(
+            "the last {left_over} samples ({:.0} s) do not fill a segment and are left out of \
+             the segment statistics (they are in the whole-record budget)",
+            left_over as f64 / fs
+        ));
+    }
+    notes
+}
+
+/// The budget segments of a record read in chunks: each segment's Welch spectra, reduced to
+/// the tilt PSDs of the outputs as soon as the segment is complete, so that memory stays
+/// bounded.
+struct Segments<'a> {
+    model: &'a Model,
+    opts: &'a BudgetOptions,
+    map: &'a GroundMap,
+    inputs: &'a [Input],
+    /// The term of the floor's motion whose PSDs are kept.
+    term: &'a TermKind,
+    cfg: &'a WelchConfig,
+    fs: f64,
+    /// Samples per segment.
+    samples: usize,
+    /// One accumulator and one matrix buffer for every segment, emptied and reused: a month of
+    /// hourly segments of six channels would otherwise map and clear 5 MB twice an hour.
+    current: Option<WelchAccumulator>,
+    spectra: CrossSpectra,
+    /// Samples of the current segment pushed so far.
+    filled: usize,
+    /// The transfer functions on the segments' grid, computed with the first segment.
+    tf: Option<TransferMatrix>,
+    /// Per output, the PSDs of every finished segment.
+    tilt: Vec<Vec<Vec<f32>>>,
+}
+
+impl Segments<'_> {
+    /// Pushes the next `len` samples of every channel (`views`), finishing the segments they
+    /// complete.
+    fn push(&mut self, views: &[&[f64]], len: usize) -> Result<(), BudgetError> {
+        let (opts, seg) = (self.opts, self.samples);
+        let mut offset = 0;
+        while offset < len {
+            let acc = match self.current.as_mut() {
+                Some(acc) => acc,
+                None => self.current.insert(
+                    WelchAccumulator::new(self.spectra.n_channels, self.fs, self.cfg)?
+                        .with_cancel(opts.cancel.clone()),
+                ),
+            };
+            let take = (seg - self.filled).min(len - offset);
+            let part: Vec<&[f64]> = views.iter().map(|c| &c[offset..offset + take]).collect();
+            acc.push(&part)?;
+            self.filled += take;
+            offset += take;
+            if self.filled == seg {
+                opts.cancel.check()?;
+                acc.finish_into(&mut self.spectra)?;
+                self.filled = 0;
+                if self.tf.is_none() {
+                    let grid = &self.spectra.freqs_hz[1..];
+                    self.tf = Some(ground_tf(self.model, &opts.outputs, self.inputs, grid)?);
+                }
+                let tf = self.tf.as_ref().expect("computed above");
+                let psds = segment_psds(self.map, tf, &mut self.spectra, self.term);
+                for (kept, psd) in self.tilt.iter_mut().zip(psds) {
+                    kept.push(psd);
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The PSDs (f32, enough for percentile bands) of the term `term` of the floor's motion of

@@ -1,9 +1,9 @@
 //! The model's matrices in double-double, written from the paper's formulas (Appendix A,
 //! eqs. (def_I) and (EM), the zeroth-order generalized forces, section II.D and section IV.B),
 //! the apparent forces of the floor's translation, and the parameter values. It shares with
-//! `crate::model` (the `f64` model) only the formulas of M and K ([`crate::appendix`], evaluated
-//! here in double-double) and the coordinate order, which is fixed by the paper and restated
-//! here; everything else is written independently.
+//! `crate::model` (the `f64` model) only the formulas of M, K and the zeroth-order force matrix
+//! ([`crate::appendix`], evaluated here in double-double) and the coordinate order, which is
+//! fixed by the paper and restated here; everything else is written independently.
 
 use super::complex::CDd;
 use super::real::Dd;
@@ -20,20 +20,6 @@ pub const TB: usize = 4;
 pub const EB: usize = 5;
 pub const PB: usize = 6;
 pub const DB: usize = 7;
-
-/// Columns of the force matrix: F_a.xyz, F_b.xyz, M_a.xyz, M_b.xyz.
-const FAX: usize = 0;
-const FAY: usize = 1;
-const FAZ: usize = 2;
-const FBX: usize = 3;
-const FBY: usize = 4;
-const FBZ: usize = 5;
-const MAX: usize = 6;
-const MAY: usize = 7;
-const MAZ: usize = 8;
-const MBX: usize = 9;
-const MBY: usize = 10;
-const MBZ: usize = 11;
 
 /// Rows of the observation matrix: X, Y, Z, theta, eta, phi, phi_a.
 pub const OBS_X: usize = 0;
@@ -136,35 +122,33 @@ fn generalized_forces(force: &[[Dd; 12]; 8], loads: &[Dd]) -> [Dd; 8] {
 /// The closed forms of Appendix A: the symmetric pendulum (the `[asymmetry]` keys are not read;
 /// [`crate::geometry::dd_matrices`] gives the matrices of any parameter set).
 pub fn build(p: &Params) -> Matrices {
-    let (m_a, m_b) = (dd(p.mass.m_a_kg), dd(p.mass.m_b_kg));
-    let i = &p.inertia;
-    let (a11, a22, a33, a23) = (
-        dd(i.a11_kg_m2),
-        dd(i.a22_kg_m2),
-        dd(i.a33_kg_m2),
-        dd(i.a23_kg_m2),
-    );
-    let (b11, b22, b33) = (dd(i.b11_kg_m2), dd(i.b22_kg_m2), dd(i.b33_kg_m2));
-    let l = &p.length;
-    let (d, h_c, z, z_a, z_b, h) = (
-        dd(l.d_m),
-        dd(l.h_c_m),
-        dd(l.z_m),
-        dd(l.z_a_m),
-        dd(l.z_b_m),
-        dd(l.h_m),
-    );
-    let g = dd(p.environment.g_m_per_s2);
-
-    // Section II.A: the crossbar's centre of mass balances the test mass on the upper fibre.
-    let y_a = appendix::y_a::<Dd>(p);
-    let zza = z + z_a;
-    let zzb = z + z_b;
-
-    // Appendix A: M and the gravity part of K (eqs. (def_I) and (EM)), in double-double.
+    // Appendix A: M, the gravity part of K (eqs. (def_I) and (EM)) and the zeroth-order
+    // generalized forces (its last display), in double-double.
     let mass = appendix::mass::<Dd>(p);
     let kg = appendix::stiffness_gravity::<Dd>(p);
-    // ... and the fibres' elastic stiffness with structural damping k (1 + i phi).
+    let force = appendix::force::<Dd>(p);
+    let (g0, g2) = tilt_forcing(p, &kg, &force);
+    Matrices {
+        mass,
+        stiffness: stiffness(p, &kg),
+        damping: damping(p),
+        translation_g2: translation_forcing(p, &force),
+        observation: observation(p),
+        stiffness_gravity: kg,
+        force,
+        g0,
+        g2,
+    }
+}
+
+/// The complex stiffness: the gravity part `kg` plus the fibres' elastic stiffness with
+/// structural damping k (1 + i phi), plus the swing's loss.
+fn stiffness(p: &Params, kg: &[[Dd; 8]; 8]) -> [[CDd; 8]; 8] {
+    let (m_a, m_b) = (dd(p.mass.m_a_kg), dd(p.mass.m_b_kg));
+    let l = &p.length;
+    let (z, z_a, z_b) = (dd(l.z_m), dd(l.z_a_m), dd(l.z_b_m));
+    let g = dd(p.environment.g_m_per_s2);
+    let zza = z + z_a;
     let mut stiffness = kg.map(|row| row.map(CDd::real));
     let lp = &p.loss;
     for (c, k, phi) in appendix::stiffness_elastic(p) {
@@ -186,7 +170,12 @@ pub fn build(p: &Params) -> Matrices {
         stiffness[b][a] += CDd::new(Dd::ZERO, im_b);
         stiffness[b][b] += CDd::new(Dd::ZERO, im_b);
     }
-    // Viscous damping on the same coordinates (swing of fibre b on the absolute angles).
+    stiffness
+}
+
+/// Viscous damping on the same coordinates as the stiffness (swing of fibre b on the absolute
+/// angles).
+fn damping(p: &Params) -> [[Dd; 8]; 8] {
     let v = &p.viscous;
     let mut damping = [[Dd::ZERO; 8]; 8];
     for (c, coef) in [
@@ -204,39 +193,35 @@ pub fn build(p: &Params) -> Matrices {
         damping[b][a] = c_b;
         damping[b][b] = c_b;
     }
+    damping
+}
 
-    // Zeroth-order generalized forces (Appendix A, last display).
+/// Tilt forcing `(G0, G2)` (section IV.B, crate convention: t takes the floor frame to the
+/// inertial frame), columns theta_t, eta_t, phi_t.
+fn tilt_forcing(
+    p: &Params,
+    kg: &[[Dd; 8]; 8],
+    force: &[[Dd; 12]; 8],
+) -> ([[Dd; 3]; 8], [[Dd; 3]; 8]) {
+    let (m_a, m_b) = (dd(p.mass.m_a_kg), dd(p.mass.m_b_kg));
+    let i = &p.inertia;
+    let (a11, a22, a33, a23) = (
+        dd(i.a11_kg_m2),
+        dd(i.a22_kg_m2),
+        dd(i.a33_kg_m2),
+        dd(i.a23_kg_m2),
+    );
+    let (b11, b22, b33) = (dd(i.b11_kg_m2), dd(i.b22_kg_m2), dd(i.b33_kg_m2));
+    let l = &p.length;
+    let (d, z, z_a, z_b, h) = (dd(l.d_m), dd(l.z_m), dd(l.z_a_m), dd(l.z_b_m), dd(l.h_m));
+    // Section II.A: the crossbar's centre of mass balances the test mass on the upper fibre.
+    let y_a = appendix::y_a::<Dd>(p);
+    let zza = z + z_a;
+    let zzb = z + z_b;
     let one = Dd::ONE;
-    let mut force = [[Dd::ZERO; 12]; 8];
-    let rows: [(usize, Vec<(usize, Dd)>); 8] = [
-        (
-            TA,
-            vec![
-                (FBY, zzb),
-                (FAY, zza),
-                (MAX, one),
-                (MBX, one),
-                (FAZ, y_a),
-                (FBZ, -d),
-            ],
-        ),
-        (EA, vec![(FBX, -zzb), (FAX, -zza), (MAY, one), (MBY, one)]),
-        (PA, vec![(FAX, -y_a), (FBX, d), (MAZ, one), (MBZ, one)]),
-        (DA, vec![(FAZ, -one), (FBZ, -one)]),
-        (TB, vec![(FBY, z_b), (MBX, one)]),
-        (EB, vec![(FBX, -z_b), (MBY, one)]),
-        (PB, vec![(MBZ, one)]),
-        (DB, vec![(FBZ, -one)]),
-    ];
-    for (row, entries) in rows {
-        for (col, v) in entries {
-            force[row][col] = v;
-        }
-    }
 
-    // Tilt forcing (section IV.B, crate convention: t takes the floor frame to the inertial
-    // frame). G0: the potential is evaluated at theta_a - theta_t, eta_a - eta_t, so the tilt
-    // columns are K_gravity's theta_a and eta_a columns; phi_t does not enter the potential.
+    // G0: the potential is evaluated at theta_a - theta_t, eta_a - eta_t, so the tilt columns
+    // are K_gravity's theta_a and eta_a columns; phi_t does not enter the potential.
     let mut g0 = [[Dd::ZERO; 3]; 8];
     for r in 0..8 {
         g0[r][0] = kg[r][TA];
@@ -270,11 +255,16 @@ pub fn build(p: &Params) -> Matrices {
         ];
         let loads: Vec<Dd> = [fa, fb, ma, mb].concat();
         // Q per unit t''; a harmonic tilt has t'' = -w^2 t, so G2 = -Q.
-        for (r, q) in generalized_forces(&force, &loads).into_iter().enumerate() {
+        for (r, q) in generalized_forces(force, &loads).into_iter().enumerate() {
             g2[r][axis] = -q;
         }
     }
+    (g0, g2)
+}
 
+/// Floor-translation forcing per unit `w^2` displacement (columns x_t, y_t, z_t).
+fn translation_forcing(p: &Params, force: &[[Dd; 12]; 8]) -> [[Dd; 3]; 8] {
+    let (m_a, m_b) = (dd(p.mass.m_a_kg), dd(p.mass.m_b_kg));
     // Floor translation: the frame accelerates by u'' without turning, so each body feels
     // -m u'' at its centre of mass and no torque. Q per unit u''; u'' = -w^2 u, so G2 = -Q.
     let mut translation_g2 = [[Dd::ZERO; 3]; 8];
@@ -282,7 +272,7 @@ pub fn build(p: &Params) -> Matrices {
         let mut loads = [Dd::ZERO; 12];
         loads[axis] = -m_a;
         loads[3 + axis] = -m_b;
-        for (r, q) in generalized_forces(&force, &loads).into_iter().enumerate() {
+        for (r, q) in generalized_forces(force, &loads).into_iter().enumerate() {
             translation_g2[r][axis] = -q;
         }
     }
@@ -292,8 +282,14 @@ pub fn build(p: &Params) -> Matrices {
     // few DD_EPS of m_b d there; the balance is exact by definition.
     translation_g2[PA][0] = Dd::ZERO;
     translation_g2[TA][2] = Dd::ZERO;
+    translation_g2
+}
 
-    // Observation rows (section II.D).
+/// Observation matrix C (section II.D), rows X, Y, Z, theta, eta, phi, phi_a.
+fn observation(p: &Params) -> [[Dd; 8]; 7] {
+    let l = &p.length;
+    let (d, h_c, z, z_b) = (dd(l.d_m), dd(l.h_c_m), dd(l.z_m), dd(l.z_b_m));
+    let one = Dd::ONE;
     let lever = z + z_b + h_c;
     let lower = h_c + z_b;
     let mut observation = [[Dd::ZERO; 8]; 7];
@@ -312,16 +308,5 @@ pub fn build(p: &Params) -> Matrices {
     observation[OBS_PHI][PA] = one;
     observation[OBS_PHI][PB] = one;
     observation[OBS_PHI_A][PA] = one;
-
-    Matrices {
-        mass,
-        stiffness_gravity: kg,
-        stiffness,
-        damping,
-        force,
-        g0,
-        g2,
-        translation_g2,
-        observation,
-    }
+    observation
 }

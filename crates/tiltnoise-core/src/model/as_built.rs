@@ -32,7 +32,7 @@ impl RestLinear {
         let derived = matrices::derived(p);
         let mass = matrices::mass(p);
         let (stiffness_gravity, _) = matrices::stiffness(p);
-        let force = matrices::force_matrix(p, &derived);
+        let force = matrices::force_matrix(p);
         let tilt = tilt::TiltForcing::new(p, &derived, &force, &stiffness_gravity);
         let translation = translation::TranslationForcing::new(p, &force);
         RestLinear {

@@ -1,6 +1,6 @@
 //! Mass, stiffness, generalized-force and observation matrices from Appendix A of the paper, in
-//! `f64`: M and K are [`crate::appendix`]'s formulas (shared with the double-double reference),
-//! the others written here. `tests/it/energy_crosscheck.rs` rebuilds every matrix from the
+//! `f64`: M, K and the force matrix are [`crate::appendix`]'s formulas (shared with the
+//! double-double reference), the others written here. `tests/it/energy_crosscheck.rs` rebuilds every matrix from the
 //! energies of section II and checks this entry by entry.
 
 use super::{Coord, Derived, ForceMatrix, Mat8, ObservationMatrix};
@@ -42,54 +42,11 @@ pub(super) fn stiffness(p: &Params) -> (Mat8, Mat8) {
     (kg, ke)
 }
 
-/// Zeroth-order generalized forces (Appendix A, last display), columns F_a.xyz, F_b.xyz,
-/// M_a.xyz, M_b.xyz. Row h is the gradient of the body positions and rotation angles with
-/// respect to q_h at equilibrium, so this matrix is also J^T for the kinematics behind M.
-pub(super) fn force_matrix(p: &Params, dv: &Derived) -> ForceMatrix {
-    let l = &p.length;
-    let (d, z, z_a, z_b, y_a) = (l.d_m, l.z_m, l.z_a_m, l.z_b_m, dv.y_a_m);
-    const FAX: usize = 0;
-    const FAY: usize = 1;
-    const FAZ: usize = 2;
-    const FBX: usize = 3;
-    const FBY: usize = 4;
-    const FBZ: usize = 5;
-    const MAX: usize = 6;
-    const MAY: usize = 7;
-    const MAZ: usize = 8;
-    const MBX: usize = 9;
-    const MBY: usize = 10;
-    const MBZ: usize = 11;
-    let mut b = ForceMatrix::zeros();
-    let rows: [(Coord, &[(usize, f64)]); 8] = [
-        (
-            ThetaA,
-            &[
-                (FBY, z + z_b),
-                (FAY, z + z_a),
-                (MAX, 1.0),
-                (MBX, 1.0),
-                (FAZ, y_a),
-                (FBZ, -d),
-            ],
-        ),
-        (
-            EtaA,
-            &[(FBX, -(z + z_b)), (FAX, -(z + z_a)), (MAY, 1.0), (MBY, 1.0)],
-        ),
-        (PhiA, &[(FAX, -y_a), (FBX, d), (MAZ, 1.0), (MBZ, 1.0)]),
-        (DeltaA, &[(FAZ, -1.0), (FBZ, -1.0)]),
-        (ThetaB, &[(FBY, z_b), (MBX, 1.0)]),
-        (EtaB, &[(FBX, -z_b), (MBY, 1.0)]),
-        (PhiB, &[(MBZ, 1.0)]),
-        (DeltaB, &[(FBZ, -1.0)]),
-    ];
-    for (coord, entries) in rows {
-        for &(col, v) in entries {
-            b[(at(coord), col)] = v;
-        }
-    }
-    b
+/// Zeroth-order generalized forces B ([`appendix::force`]), columns F_a.xyz, F_b.xyz, M_a.xyz,
+/// M_b.xyz.
+pub(super) fn force_matrix(p: &Params) -> ForceMatrix {
+    let b = appendix::force::<f64>(p);
+    ForceMatrix::from_fn(|r, c| b[r][c])
 }
 
 /// Observation matrix (section II.D): X, Y, Z of the cube centre, theta, eta, phi of the test

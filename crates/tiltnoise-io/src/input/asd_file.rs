@@ -12,6 +12,7 @@
 
 use super::address::input_format;
 use super::csv::{parse_field, CsvFile};
+use super::format_error::FormatError;
 use super::h5::{self, h5err};
 use std::path::Path;
 use tiltnoise_core::error::Shown;
@@ -55,10 +56,12 @@ pub fn read_asd_column(
 
 fn read_csv(path: &Path, quantity: &str, asd_unit: &'static str) -> Result<AsdColumn, InputError> {
     let (mut file, prelude) = CsvFile::open(path)?;
-    let csv_err = |line: usize, message: String| InputError::Csv {
-        path: path.to_path_buf(),
-        line,
-        message,
+    let csv_err = |line: usize, message: String| {
+        InputError::from(FormatError::Csv {
+            path: path.to_path_buf(),
+            line,
+            message,
+        })
     };
     let header = &prelude.header;
     if !super::csv::is_frequency_column(header.first()) {

@@ -9,6 +9,7 @@
 //! file is refused before reading), lines of at most [`MAX_LINE_BYTES`], and at most
 //! [`MAX_SERIES_SAMPLES`] records.
 
+use super::format_error::FormatError;
 use super::meta::decide_quantity;
 use super::series_units::{self, Plan, Stated};
 use crate::input::spectra_checks::refuse_translation_spectra;
@@ -85,11 +86,11 @@ struct Lines<'a> {
 
 impl Lines<'_> {
     fn err(&self, line: usize, message: String) -> InputError {
-        InputError::Csv {
+        InputError::from(FormatError::Csv {
             path: self.path.to_path_buf(),
             line,
             message,
-        }
+        })
     }
 
     /// Reads the next line into `self.buf`; `false` at end of file.
@@ -140,16 +141,16 @@ fn io_error(path: &Path, reason: std::io::Error) -> InputError {
 fn record_error(path: &Path, e: RecordError) -> InputError {
     match e {
         RecordError::Io(reason) => io_error(path, reason),
-        RecordError::NotUtf8 { line } => InputError::Csv {
+        RecordError::NotUtf8 { line } => InputError::from(FormatError::Csv {
             path: path.to_path_buf(),
             line,
             message: NOT_UTF8.to_string(),
-        },
-        e @ RecordError::OpenQuote { line } => InputError::Csv {
+        }),
+        e @ RecordError::OpenQuote { line } => InputError::from(FormatError::Csv {
             path: path.to_path_buf(),
             line,
             message: e.to_string(),
-        },
+        }),
     }
 }
 
@@ -173,12 +174,15 @@ impl CsvFile {
             line_no: 0,
             buf: String::new(),
         };
-        let no_header = |line: usize| InputError::Csv {
-            path: path.to_path_buf(),
-            line,
-            message: "no header line; allowed: optional `#` comment lines, then a header such as \
+        let no_header = |line: usize| {
+            InputError::from(FormatError::Csv {
+                path: path.to_path_buf(),
+                line,
+                message:
+                    "no header line; allowed: optional `#` comment lines, then a header such as \
                  time_s,theta_t,eta_t or frequency_hz,theta_t,eta_t, then data rows"
-                .to_string(),
+                        .to_string(),
+            })
         };
         let mut meta: Vec<MetaLine> = Vec::new();
         loop {
@@ -224,10 +228,12 @@ impl CsvFile {
             Ok(None) => return Err(no_header(header_line)),
             Err(e) => return Err(record_error(path, e)),
         };
-        let header_err = |message: String| InputError::Csv {
-            path: path.to_path_buf(),
-            line: header_line,
-            message,
+        let header_err = |message: String| {
+            InputError::from(FormatError::Csv {
+                path: path.to_path_buf(),
+                line: header_line,
+                message,
+            })
         };
         for (i, name) in header.iter().enumerate() {
             if name.is_empty() {
@@ -286,7 +292,7 @@ impl CsvFile {
                 max_records,
             )?;
             if fields.len() != n_fields {
-                return Err(InputError::Csv {
+                return Err(FormatError::Csv {
                     path: self.path.clone(),
                     line,
                     message: format!(
@@ -294,7 +300,8 @@ impl CsvFile {
                          per header column",
                         fields.len()
                     ),
-                });
+                }
+                .into());
             }
             f(line, &fields)?;
         }
@@ -513,7 +520,7 @@ fn unit_entries<'a>(
     let mut entries: Vec<(&str, &str)> = Vec::new();
     for item in m.value.split(',') {
         let Some((name, unit)) = item.split_once('=') else {
-            return Err(InputError::Csv {
+            return Err(FormatError::Csv {
                 path: path.to_path_buf(),
                 line: m.line,
                 message: format!(
@@ -521,12 +528,13 @@ fn unit_entries<'a>(
                      (e.g. `# units: rad/s`) or COLUMN=UNIT entries separated by commas",
                     Shown(item.trim())
                 ),
-            });
+            }
+            .into());
         };
         let (name, unit) = (name.trim(), unit.trim());
         let repeated = entries.iter().any(|(n, _)| *n == name);
         if !prelude.header[1..].iter().any(|h| h == name) || repeated {
-            return Err(InputError::Csv {
+            return Err(FormatError::Csv {
                 path: path.to_path_buf(),
                 line: m.line,
                 message: format!(
@@ -540,7 +548,8 @@ fn unit_entries<'a>(
                     },
                     shown_list(&prelude.header[1..])
                 ),
-            });
+            }
+            .into());
         }
         entries.push((name, unit));
     }

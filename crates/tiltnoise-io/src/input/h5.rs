@@ -1,5 +1,6 @@
 //! HDF5 helpers: opening, layout detection, typed attribute reading with precise errors.
 
+use super::format_error::FormatError;
 use super::start_time::{self, ISO8601_ALLOWED};
 use hdf5::types::{FixedAscii, FixedUnicode, TypeDescriptor, VarLenAscii, VarLenUnicode};
 use hdf5::{Attribute, Location, LocationType};
@@ -16,17 +17,19 @@ use tiltnoise_core::limits::{
     check_count, check_memory, planned_bytes, MAX_SERIES_SAMPLES, SERIES_BYTES_PER_SAMPLE,
 };
 
-/// Maps an HDF5 error to [`InputError::Hdf5`] naming `object`.
+/// Maps an HDF5 error to [`FormatError::Hdf5`] naming `object`.
 pub(crate) fn h5err(
     path: &Path,
     object: impl Into<String>,
 ) -> impl FnOnce(hdf5::Error) -> InputError {
     let path = path.to_path_buf();
     let object = object.into();
-    move |e| InputError::Hdf5 {
-        path,
-        object,
-        message: crate::messages::first_line(&e.to_string()),
+    move |e| {
+        InputError::from(FormatError::Hdf5 {
+            path,
+            object,
+            message: crate::messages::first_line(&e.to_string()),
+        })
     }
 }
 
@@ -158,11 +161,11 @@ fn text(path: &Path, what: &str, bytes: Vec<u8>) -> Result<String, InputError> {
     String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let byte = e.as_bytes()[at];
-        InputError::InvalidText {
+        InputError::from(FormatError::InvalidText {
             path: path.to_path_buf(),
             object: what.to_string(),
             detail: format!("byte 0x{byte:02x} at offset {at} is not valid UTF-8"),
-        }
+        })
     })
 }
 

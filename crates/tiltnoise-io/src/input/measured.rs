@@ -19,6 +19,7 @@
 
 use super::address::input_format;
 use super::csv::{decimal_resolution, parse_field, CsvFile, Prelude};
+use super::format_error::FormatError;
 use super::h5::{self, h5err, AttrValue};
 use std::path::Path;
 use tiltnoise_core::budget::{add_measured, series_psds, BudgetError, MeasuredPsds};
@@ -255,10 +256,12 @@ fn read_series_csv(
     header: &[String],
     header_line: usize,
 ) -> Result<MeasuredSeries, InputError> {
-    let csv_err = |line: usize, message: String| InputError::Csv {
-        path: path.to_path_buf(),
-        line,
-        message,
+    let csv_err = |line: usize, message: String| {
+        InputError::from(FormatError::Csv {
+            path: path.to_path_buf(),
+            line,
+            message,
+        })
     };
     let mut observables = Vec::new();
     for name in &header[1..] {
@@ -302,13 +305,14 @@ fn read_series_csv(
         }
         if let Some(&previous) = times.last() {
             if t <= previous {
-                return Err(InputError::TimeNotIncreasing {
+                return Err(FormatError::TimeNotIncreasing {
                     path: path.to_path_buf(),
                     line,
                     index: times.len(),
                     value: t,
                     previous,
-                });
+                }
+                .into());
             }
         }
         times.push(t);
@@ -328,7 +332,7 @@ fn read_series_csv(
         // The printed precision of the two times involved, plus rounding of the grid itself.
         let tolerance = resolution[index].max(resolution[0]) + 4.0 * f64::EPSILON * t.abs();
         if (t - expected).abs() > tolerance {
-            return Err(InputError::TimeNotUniform {
+            return Err(FormatError::TimeNotUniform {
                 path: path.to_path_buf(),
                 line: lines[index],
                 index,
@@ -338,7 +342,8 @@ fn read_series_csv(
                 tolerance,
                 relative: tolerance / dt,
                 dt,
-            });
+            }
+            .into());
         }
     }
     let rate = check_sample_rate(
@@ -374,10 +379,12 @@ fn read_spectra_csv(
     mut file: CsvFile,
     prelude: &Prelude,
 ) -> Result<MeasuredSpectra, InputError> {
-    let csv_err = |line: usize, message: String| InputError::Csv {
-        path: path.to_path_buf(),
-        line,
-        message,
+    let csv_err = |line: usize, message: String| {
+        InputError::from(FormatError::Csv {
+            path: path.to_path_buf(),
+            line,
+            message,
+        })
     };
     if !super::csv::is_frequency_column(prelude.header.first()) {
         return Err(csv_err(

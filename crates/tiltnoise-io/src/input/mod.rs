@@ -22,6 +22,7 @@
 mod address;
 mod asd_file;
 mod csv;
+mod format_error;
 mod h5;
 mod measured;
 mod meta;
@@ -37,6 +38,7 @@ mod start_time;
 
 pub use address::{input_format, split_hdf5_address};
 pub use asd_file::{read_asd_column, AsdColumn, GENERIC_ASD_COLUMN};
+pub use format_error::FormatError;
 pub use measured::{
     add_measured_file, read_measured, read_measured_input, MeasuredInput, MeasuredSeries,
     MeasuredSpectra, SCHEMA_OBSERVABLE_SERIES,

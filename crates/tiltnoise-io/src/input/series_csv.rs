@@ -2,6 +2,7 @@
 //! metadata lines.
 
 use super::csv::{self, decimal_resolution, parse_field, CsvFile, Prelude};
+use super::format_error::FormatError;
 use super::series_units::{check_unstated_data, into_series, units_note};
 use tiltnoise_core::error::Num;
 use tiltnoise_core::input::{check_sample_rate, require_two, InputError};
@@ -32,25 +33,27 @@ pub(crate) fn read(
         let t = match parse_field(fields[0]) {
             Ok(Some(t)) if t.is_finite() => t,
             _ => {
-                return Err(InputError::CsvNumber {
+                return Err(FormatError::CsvNumber {
                     path: path.clone(),
                     line,
                     column: "time_s".to_string(),
                     text: fields[0].to_string(),
                     unit: "s",
                     empty_allowed: false,
-                })
+                }
+                .into())
             }
         };
         if let Some(&previous) = times.last() {
             if t <= previous {
-                return Err(InputError::TimeNotIncreasing {
+                return Err(FormatError::TimeNotIncreasing {
                     path: path.clone(),
                     line,
                     index,
                     value: t,
                     previous,
-                });
+                }
+                .into());
             }
         }
         times.push(t);
@@ -68,14 +71,15 @@ pub(crate) fn read(
                 Ok(Some(v)) => v,
                 Ok(None) => f64::NAN,
                 Err(()) => {
-                    return Err(InputError::CsvNumber {
+                    return Err(FormatError::CsvNumber {
                         path: path.clone(),
                         line,
                         column: m.source.clone(),
                         text: text.to_string(),
                         unit,
                         empty_allowed: true,
-                    })
+                    }
+                    .into())
                 }
             };
             if !raw.is_finite() && opts.gaps == GapPolicy::Reject {
@@ -168,7 +172,7 @@ fn check_uniform(
         let deviation = (t - expected).abs();
         let tolerance = 0.5 * res + 0.5 * res_ends + 4.0 * f64::EPSILON * t_max;
         if deviation > tolerance {
-            return Err(InputError::TimeNotUniform {
+            return Err(FormatError::TimeNotUniform {
                 path: path.to_path_buf(),
                 line: lines[i],
                 index: i,
@@ -178,7 +182,8 @@ fn check_uniform(
                 tolerance,
                 relative: tolerance / dt,
                 dt,
-            });
+            }
+            .into());
         }
     }
     Ok(dt)

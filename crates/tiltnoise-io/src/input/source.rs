@@ -354,7 +354,7 @@ impl TiltSeriesSource {
     ///
     /// [`InputError::ChunkOutOfRange`] if `start + len > self.len()`;
     /// [`InputError::NonFinite`] naming the absolute sample index (gaps rejected);
-    /// [`InputError::Hdf5`] on a read failure.
+    /// [`InputError::Format`] (the HDF5 library's failure) on a read failure.
     pub fn read_chunk(&mut self, start: usize, len: usize) -> Result<Vec<Vec<f64>>, InputError> {
         if start.checked_add(len).is_none_or(|end| end > self.len) {
             return Err(InputError::ChunkOutOfRange {

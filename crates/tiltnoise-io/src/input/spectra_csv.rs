@@ -2,6 +2,7 @@
 //! rad/sqrt(Hz), axes uncorrelated.
 
 use super::csv::{self, parse_field, CsvFile, Prelude};
+use super::format_error::FormatError;
 use super::meta::{asd_unit, ASD_UNITS};
 use crate::input::spectra_checks::no_scale_for_spectra;
 use num_complex::Complex64;
@@ -37,14 +38,15 @@ pub(crate) fn read(
         let f = match parse_field(fields[0]) {
             Ok(Some(f)) => f,
             _ => {
-                return Err(InputError::CsvNumber {
+                return Err(FormatError::CsvNumber {
                     path: path.clone(),
                     line,
                     column: prelude.header[0].clone(),
                     text: fields[0].to_string(),
                     unit: "Hz",
                     empty_allowed: false,
-                })
+                }
+                .into())
             }
         };
         if let Some(allowed) = frequency_refusal(f, freqs.last().copied()) {
@@ -61,14 +63,15 @@ pub(crate) fn read(
             let v = match parse_field(text) {
                 Ok(Some(v)) => v,
                 _ => {
-                    return Err(InputError::CsvNumber {
+                    return Err(FormatError::CsvNumber {
                         path: path.clone(),
                         line,
                         column: m.source.clone(),
                         text: text.to_string(),
                         unit,
                         empty_allowed: false,
-                    })
+                    }
+                    .into())
                 }
             };
             if !ASDS.admits(v) {

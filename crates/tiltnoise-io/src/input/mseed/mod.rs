@@ -16,6 +16,7 @@ mod channels;
 mod record;
 mod steim;
 
+use super::format_error::FormatError;
 use super::series_units::{self, check_unstated_data, into_series, units_note, Planned, Stated};
 use channels::{Channel, Placed};
 use std::io::Read;
@@ -38,11 +39,11 @@ use tiltnoise_core::limits::{
 const DATA_FILE: &str = "a miniSEED input";
 
 fn fault(path: &Path, record: Option<(usize, u64)>, message: String) -> InputError {
-    InputError::Miniseed {
+    InputError::from(FormatError::Miniseed {
         path: path.to_path_buf(),
         record,
         message,
-    }
+    })
 }
 
 /// Reads the file whole, at most [`MAX_DATA_FILE_BYTES`].
