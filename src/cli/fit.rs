@@ -8,11 +8,13 @@ use anyhow::Result;
 use clap::{Args, ValueEnum};
 use serde::Serialize;
 use std::collections::BTreeMap;
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::OutputError;
-use tiltnoise_core::fit::{self, Bound, FitConfig, FitResult, Measured, SigmaSource, Visibilities};
+use tiltnoise_core::fit::{Bound, FitResult, SigmaSource};
 use tiltnoise_core::params::Params;
-use tiltnoise_io::{read_measured_modes, read_visibilities, write_atomic, write_fit_hdf5};
+use tiltnoise_io::{write_atomic, write_fit_hdf5};
+use tiltnoise_job::fit::{FitOutcome, FitRequest};
 
 /// Arguments of `tiltnoise fit`.
 #[derive(Debug, Args)]
@@ -57,52 +59,27 @@ enum FitFormat {
     Json,
 }
 
-/// Runs `tiltnoise fit`.
+/// Runs `tiltnoise fit`: the options into the fit job's request, the job run, the report
+/// printed and the files written.
 pub(crate) fn run_fit(params: &Params, args: FitArgs, run: &mut Run) -> Result<()> {
     for path in &args.save {
         save_kind(path)?;
     }
-    let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
-    let inputs: Vec<(&str, &Path)> = args
-        .measured
-        .iter()
-        .map(|p| ("--measured-modes", p.as_path()))
-        .chain(
-            args.visibility
-                .iter()
-                .map(|p| ("--visibility", p.as_path())),
-        )
-        .collect();
-    run.check_outputs(&saves, &inputs)?;
-    // Visibilities without a frequency file are fitted alone: Table II's frequencies belong to
-    // the paper's pendulum, not to the one whose record gave the visibilities.
-    let measured = match (&args.measured, &args.visibility) {
-        (Some(path), _) => read_measured_modes(path)?,
-        (None, None) => Measured::table_ii(),
-        (None, Some(_)) => Measured {
-            modes: Vec::new(),
-            origin: "no frequency file".into(),
-        },
-    };
-    let visibilities = match &args.visibility {
-        Some(path) => read_visibilities(path)?,
-        None => Visibilities::none(),
-    };
-    let config = FitConfig {
-        free: args
-            .free
-            .clone()
-            .map(|keys| keys.into_iter().map(|k| k.trim().to_string()).collect())
-            .unwrap_or_else(|| FitConfig::default().free),
+    let req = FitRequest {
+        params,
+        measured: args.measured.clone(),
+        visibility: args.visibility.clone(),
+        free: args.free.clone(),
         bound_sigmas: args.bound_sigmas,
         prior: args.prior,
-        cancel: run.cancel.clone(),
     };
-    let result = fit::fit_with_visibilities(params, &measured, &visibilities, &config)?;
-    let json = fit_json(&result, &measured.origin);
+    run.check_job_outputs(&args.save, req.input_files())?;
+    let FitOutcome { result, origin } =
+        tiltnoise_job::fit::run(req, &run.cancel).map_err(super::job_error)?;
+    let json = fit_json(&result, &origin);
     match args.format {
         FitFormat::Json => writeln!(run.out, "{}", serde_json::to_string_pretty(&json)?)?,
-        FitFormat::Table => write!(run.out, "{}", fit_table(&result, &measured.origin))?,
+        FitFormat::Table => write!(run.out, "{}", fit_table(&result, &origin))?,
     }
     // JSON on standard output stays parseable: the `wrote` lines go to standard error.
     run.write_outputs(args.format == FitFormat::Json, || {
@@ -116,7 +93,7 @@ pub(crate) fn run_fit(params: &Params, args: FitArgs, run: &mut Run) -> Result<(
                 }
                 SaveKind::Hdf5 => {
                     let meta = tiltnoise_io::RunMeta::of_this_run(params, None);
-                    write_fit_hdf5(path, &result, &measured.origin, &meta)?
+                    write_fit_hdf5(path, &result, &origin, &meta)?
                 }
             }
         }
@@ -297,10 +274,20 @@ struct WeakJson<'a> {
     singular_value: f64,
 }
 
-/// The terminal report.
+/// The terminal report: the fit's header, the parameters, the modes and visibilities, the
+/// correlations, the start and the weak directions.
 fn fit_table(r: &FitResult, origin: &str) -> String {
-    use std::fmt::Write;
     let mut s = String::new();
+    header(&mut s, r, origin);
+    parameters(&mut s, r);
+    residuals(&mut s, r);
+    correlations(&mut s, r);
+    legend(&mut s, r);
+    s
+}
+
+/// What was fitted to what, and how the solver ended.
+fn header(s: &mut String, r: &FitResult, origin: &str) {
     let box_kind = match r.config.prior {
         true => "box + Gaussian prior",
         false => "box",
@@ -332,6 +319,10 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
         r.projected_gradient
     );
     let _ = writeln!(s);
+}
+
+/// The table of the free parameters.
+fn parameters(s: &mut String, r: &FitResult) {
     let _ = writeln!(
         s,
         "{:<26} {:>12} {:>12} {:>11} {:>11} {:>6} {:>6}  unit",
@@ -355,6 +346,10 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
         );
     }
     let _ = writeln!(s);
+}
+
+/// The tables of the modes and of the visibilities: measured, nominal, fitted, residual.
+fn residuals(s: &mut String, r: &FitResult) {
     if !r.modes.is_empty() {
         let _ = writeln!(
             s,
@@ -375,31 +370,36 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
             m.residual_sigmas()
         );
     }
-    if !r.visibilities.is_empty() {
-        let _ = writeln!(s);
+    if r.visibilities.is_empty() {
+        return;
+    }
+    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
+        "{:<5} {:<13} {:>13} {:>11} {:>13} {:>13} {:>10}",
+        "mode", "ratio", "measured", "sigma", "nominal", "fitted", "resid/sig"
+    );
+    for v in &r.visibilities {
         let _ = writeln!(
             s,
-            "{:<5} {:<13} {:>13} {:>11} {:>13} {:>13} {:>10}",
-            "mode", "ratio", "measured", "sigma", "nominal", "fitted", "resid/sig"
+            "nu_{:<2} {:<13} {:>13.5e} {:>11.2e} {:>13.5e} {:>13.5e} {:>10.2}",
+            v.measured.mode,
+            format!(
+                "{}/{}",
+                v.measured.observable.name(),
+                v.measured.reference.name()
+            ),
+            v.measured.ratio,
+            v.measured.sigma,
+            v.nominal,
+            v.fitted,
+            v.residual_sigmas()
         );
-        for v in &r.visibilities {
-            let _ = writeln!(
-                s,
-                "nu_{:<2} {:<13} {:>13.5e} {:>11.2e} {:>13.5e} {:>13.5e} {:>10.2}",
-                v.measured.mode,
-                format!(
-                    "{}/{}",
-                    v.measured.observable.name(),
-                    v.measured.reference.name()
-                ),
-                v.measured.ratio,
-                v.measured.sigma,
-                v.nominal,
-                v.fitted,
-                v.residual_sigmas()
-            );
-        }
     }
+}
+
+/// The correlation matrix, and where the fit started when away from the nominal point.
+fn correlations(s: &mut String, r: &FitResult) {
     if r.params.len() > 1 {
         let _ = writeln!(s);
         let _ = writeln!(s, "correlations (linearized covariance; - on a bound):");
@@ -414,18 +414,14 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
             let _ = writeln!(s, "{:<26} {}", p.key, row.join(" "));
         }
     }
-    if r.start
+    let start: Vec<String> = r
+        .params
         .iter()
-        .zip(&r.params)
-        .any(|(s0, p)| *s0 != p.nominal)
-    {
-        let start: Vec<String> = r
-            .params
-            .iter()
-            .zip(&r.start)
-            .filter(|(p, s0)| **s0 != p.nominal)
-            .map(|(p, s0)| format!("{} = {s0:e}", p.key))
-            .collect();
+        .zip(&r.start)
+        .filter(|(p, s0)| **s0 != p.nominal)
+        .map(|(p, s0)| format!("{} = {s0:e}", p.key))
+        .collect();
+    if !start.is_empty() {
         let _ = writeln!(s);
         let _ = writeln!(
             s,
@@ -433,6 +429,10 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
             start.join(", ")
         );
     }
+}
+
+/// What `bound` and `poor` mean, and the weak directions.
+fn legend(s: &mut String, r: &FitResult) {
     let _ = writeln!(s);
     let _ = writeln!(
         s,
@@ -444,41 +444,37 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
         "poor: the data alone determine it no better than its error bar (data sigma >= prior \
          sigma)."
     );
-    match r.weak_directions.is_empty() {
-        true => {
-            let _ = writeln!(
-                s,
-                "No weak direction: every singular value of the weighted Jacobian is >= 1 \
-                 (smallest {:.3e}).",
-                r.singular_values.last().copied().unwrap_or(f64::NAN)
-            );
-        }
-        false => {
-            for w in &r.weak_directions {
-                let mut comps: Vec<&(String, f64)> = w.direction.iter().collect();
-                comps.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
-                let text: Vec<String> = comps
-                    .iter()
-                    .filter(|(_, c)| c.abs() >= 0.1)
-                    .map(|(k, c)| format!("{c:+.2} {k}"))
-                    .collect();
-                let _ = writeln!(
-                    s,
-                    "weak direction (singular value {:.3e} < 1, known to {:.2} error bars): {}",
-                    w.singular_value,
-                    1.0 / w.singular_value,
-                    text.join(" ")
-                );
-            }
-        }
+    if r.weak_directions.is_empty() {
+        let _ = writeln!(
+            s,
+            "No weak direction: every singular value of the weighted Jacobian is >= 1 \
+             (smallest {:.3e}).",
+            r.singular_values.last().copied().unwrap_or(f64::NAN)
+        );
     }
-    s
+    for w in &r.weak_directions {
+        let mut comps: Vec<&(String, f64)> = w.direction.iter().collect();
+        comps.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+        let text: Vec<String> = comps
+            .iter()
+            .filter(|(_, c)| c.abs() >= 0.1)
+            .map(|(k, c)| format!("{c:+.2} {k}"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "weak direction (singular value {:.3e} < 1, known to {:.2} error bars): {}",
+            w.singular_value,
+            1.0 / w.singular_value,
+            text.join(" ")
+        );
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::cli::report::assert_keys_sorted;
+    use tiltnoise_core::fit::{self, FitConfig, Measured};
 
     #[test]
     fn json_lists_keys_alphabetically() {

@@ -387,6 +387,7 @@ fn commands_that_print_a_summary_take_format() {
             "fit",
             "mc",
             "methods",
+            "simulate",
         ]
         .contains(&command.as_str())
         {

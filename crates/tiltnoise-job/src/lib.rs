@@ -16,8 +16,11 @@ pub mod budget;
 pub mod coherence;
 mod error;
 mod figure;
+pub mod fit;
 mod given;
+pub mod simulate;
 mod summary;
+pub mod visibility;
 
 pub use error::JobError;
 pub use figure::save_image;
