@@ -2,6 +2,10 @@
 //! measured column) to the constrained least-squares fit of chosen parameters within their
 //! error bars ([`tiltnoise_core::fit`]).
 
+mod json;
+
+pub use json::{check_save_path, save};
+
 use crate::error::JobError;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::cancel::Cancel;
