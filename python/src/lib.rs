@@ -22,6 +22,7 @@ mod python_side;
 mod simulate;
 mod spectral;
 mod state;
+mod visibility;
 
 use pyo3::prelude::*;
 
@@ -70,11 +71,13 @@ fn tiltnoise_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<simulate::Simulation>()?;
     m.add_class::<budget::Budget>()?;
     m.add_class::<coherence::Coherence>()?;
+    m.add_class::<visibility::Visibilities>()?;
     m.add_function(wrap_pyfunction!(spectral::welch, m)?)?;
     m.add_function(wrap_pyfunction!(spectral::csd, m)?)?;
     m.add_function(wrap_pyfunction!(budget::budget, m)?)?;
     m.add_function(wrap_pyfunction!(budget::budget_from_file, m)?)?;
     m.add_function(wrap_pyfunction!(coherence::coherence, m)?)?;
+    m.add_function(wrap_pyfunction!(visibility::visibility, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
     Ok(())
 }

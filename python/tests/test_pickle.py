@@ -46,6 +46,13 @@ def coherence():
     return tiltnoise.coherence(tilt, measured, nperseg=1024)
 
 
+def visibilities():
+    """The visibilities of a short free motion written for them."""
+    path = Path(tempfile.mkdtemp()) / "free.h5"
+    tiltnoise.Model().simulate(duration=4000.0, step=0.5, seed=2).save(path)
+    return tiltnoise.visibility(path)
+
+
 MAKERS = {
     "Params": params,
     "Model": lambda: tiltnoise.Model(params()),
@@ -55,6 +62,7 @@ MAKERS = {
     "Simulation": lambda: tiltnoise.Model().simulate(duration=2000.0, step=1.0, seed=9),
     "Budget": budget,
     "Coherence": coherence,
+    "Visibilities": visibilities,
 }
 
 

@@ -18,8 +18,8 @@ amplitudes for ``exp(+i w t)``; the tilt ``(theta_t, eta_t, phi_t)`` is the rota
 the floor frame to the inertial frame, so ``X -> -eta_t (Z + Z_b + h_c)`` as ``f -> 0``.
 
 Results carry their frequencies, names and units: ``to_gwpy()`` and ``to_pandas()`` convert
-them (gwpy and pandas are optional), ``plot()`` draws them with matplotlib, and a budget's
-``save("b.png")`` writes the command line's figure. Every object pickles (multiprocessing,
+them (gwpy and pandas are optional), ``plot()`` draws them with matplotlib, and ``save("x.png")`` of a budget, a simulation or
+a coherence writes the command line's figure. Every object pickles (multiprocessing,
 joblib). Ctrl-C stops any long call with ``KeyboardInterrupt``.
 
 Errors are ``ValueError`` (parameters, names, options), ``OSError`` subclasses for files that
@@ -37,6 +37,7 @@ from ._tiltnoise import (
     MonteCarlo,
     Params,
     Simulation,
+    Visibilities,
     __version__,
     budget,
     budget_from_file,
@@ -44,6 +45,7 @@ from ._tiltnoise import (
     csd,
     hdf5_version,
     welch,
+    visibility,
 )
 from ._transfer import TransferFunction
 
@@ -58,6 +60,7 @@ __all__ = [
     "Params",
     "Simulation",
     "TransferFunction",
+    "Visibilities",
     "__version__",
     "budget",
     "budget_from_file",
@@ -65,4 +68,5 @@ __all__ = [
     "csd",
     "hdf5_version",
     "welch",
+    "visibility",
 ]
