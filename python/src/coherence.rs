@@ -272,24 +272,34 @@ impl Coherence {
     }
 
     /// Writes the report as the command line's ``--save`` does: ``.h5``/``.hdf5`` (schema
-    /// ``tiltnoise.coherence``, with the parameters and the records' provenance) or ``.csv``;
-    /// atomically. Raises ``OSError`` if it cannot be written or is one of the files read,
-    /// ``ValueError`` for another extension.
+    /// ``tiltnoise.coherence``, with the parameters and the records' provenance), ``.csv``,
+    /// or the command line's figure as ``.png`` or ``.svg`` (per observable, the coherence
+    /// with each axis against the noise threshold and the measured transfer functions with
+    /// their confidence band beside the model's: the same image as ``tiltnoise coherence
+    /// --save x.png`` for the same records); atomically. Raises ``OSError`` if it cannot be
+    /// written or is one of the files read, ``ValueError`` for another extension.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        let kind = OutputKind::from_path(&path).py()?;
+        OutputKind::from_path(&path).py()?;
         self.inputs.check_save(&path)?;
         let meta = self.run_meta();
-        py.detach(|| match kind {
-            OutputKind::Hdf5 => {
-                tiltnoise_io::write_coherence_hdf5(&path, &self.report, &meta, &self.records)
-            }
-            OutputKind::Csv => tiltnoise_io::write_coherence_csv(&path, &self.report, &meta),
-            OutputKind::Png | OutputKind::Svg => Err(tiltnoise_io::OutputError::UnknownFormat {
-                path: path.clone(),
-                allowed: ".h5, .hdf5, .csv",
-            }),
+        let result = CoherenceResult {
+            report: self.report.clone(),
+            inputs: self.records.clone(),
+        };
+        py.detach(|| {
+            tiltnoise_job::coherence::save(&path, &result, &meta, &tiltnoise_plot::View::default())
         })
         .py()
+    }
+
+    /// The report drawn with matplotlib: per observable, the ordinary coherence with each
+    /// axis and the multiple coherence against their noise thresholds, and the magnitude of
+    /// each measured transfer function with its confidence band beside the model's, log-log.
+    /// Returns a new ``matplotlib.figure.Figure`` (of ``matplotlib.pyplot``). Needs
+    /// matplotlib; raises ``ImportError`` saying so without it. The command line's own figure
+    /// is :meth:`save` to a ``.png`` or ``.svg`` path.
+    fn plot<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        crate::python_side::call(slf.as_any(), "_plots", "coherence_plot", &[])
     }
 
     /// Pickles as its state (see the module's pickling notes).

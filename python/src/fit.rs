@@ -1,41 +1,19 @@
 //! `Model.fit`: the constrained least-squares fit of chosen parameters to measured mode
 //! frequencies (the command line's `tiltnoise fit`).
 
-use crate::errors::{value_error, InputFileError};
+use crate::errors::{value_error, PyResultExt};
+use crate::inputs::Inputs;
 use crate::interrupt;
+use crate::job_args::job_error;
 use crate::params::PyParams;
 use crate::state;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
-use tiltnoise_core::fit::{
-    self, FitConfig, FitError, FitResult, Measured, SigmaSource, Visibilities,
-};
+use tiltnoise_core::fit::{FitResult, SigmaSource};
 use tiltnoise_core::params::Params;
-use tiltnoise_core::repeats::refuse_repeats;
-
-/// The measured modes: Table II's measured column, or a CSV file (`mode,frequency_hz[,sigma_hz]`).
-fn measured(path: Option<PathBuf>) -> PyResult<Measured> {
-    match path {
-        None => Ok(Measured::table_ii()),
-        Some(p) => tiltnoise_io::read_measured_modes(&p).map_err(|e| match e {
-            FitError::Measured { .. } => InputFileError::new_err(e.to_string()),
-            other => value_error(other.to_string()),
-        }),
-    }
-}
-
-/// The measured visibilities: a CSV file (`mode,observable,reference,ratio[,sigma]`), or none.
-fn visibilities(path: Option<PathBuf>) -> PyResult<Visibilities> {
-    match path {
-        None => Ok(Visibilities::none()),
-        Some(p) => tiltnoise_io::read_visibilities(&p).map_err(|e| match e {
-            FitError::Visibility { .. } => InputFileError::new_err(e.to_string()),
-            other => value_error(other.to_string()),
-        }),
-    }
-}
+use tiltnoise_job::fit::{FitOutcome, FitRequest};
 
 /// What `Model.fit` measures against: the frequency file, or Table II's measured column; with
 /// visibilities and no frequency file, no frequency at all (Table II belongs to the paper's
@@ -47,40 +25,36 @@ pub struct FitInputs {
     pub visibility: Option<PathBuf>,
 }
 
-/// Runs the fit of `params` (`Model.fit`).
+/// Runs the fit job on `params` (`Model.fit`).
 pub fn run(
     py: Python<'_>,
     params: &Params,
+    params_file: Option<&std::path::Path>,
     free: Option<Vec<String>>,
     inputs: FitInputs,
     bound_sigmas: f64,
     prior: bool,
 ) -> PyResult<Fit> {
-    let measured = match (&inputs.measured, &inputs.visibility) {
-        (None, Some(_)) => Measured {
-            modes: Vec::new(),
-            origin: "no frequency file".into(),
-        },
-        _ => measured(inputs.measured)?,
-    };
-    let visibilities = visibilities(inputs.visibility)?;
-    if let Some(keys) = &free {
-        refuse_repeats("free", "parameter key", keys, String::clone)
-            .map_err(|e| value_error(e.to_string()))?;
-    }
-    let config = FitConfig {
-        free: free.unwrap_or_else(|| FitConfig::default().free),
+    let files = Inputs::of_params(params_file)
+        .with("measured", inputs.measured.as_deref())
+        .with("visibility", inputs.visibility.as_deref());
+    let req = FitRequest {
+        params,
+        measured: inputs.measured,
+        visibility: inputs.visibility,
+        free,
         bound_sigmas,
         prior,
-        cancel: Cancel::new(),
     };
-    let result = interrupt::watch(py, &config.cancel, || {
-        fit::fit_with_visibilities(params, &measured, &visibilities, &config)
-            .map_err(|e| value_error(e.to_string()))
+    let cancel = Cancel::new();
+    let FitOutcome { result, origin } = interrupt::watch(py, &cancel, || {
+        tiltnoise_job::fit::run(req, &cancel).map_err(job_error)
     })?;
     Ok(Fit {
         result,
-        origin: measured.origin,
+        origin,
+        nominal: params.clone(),
+        inputs: files,
     })
 }
 
@@ -94,6 +68,20 @@ pub fn run(
 pub struct Fit {
     result: FitResult,
     origin: String,
+    /// The nominal parameters (the saved files' run metadata).
+    nominal: Params,
+    /// The files read: no `save` may replace one.
+    inputs: Inputs,
+}
+
+impl Fit {
+    /// The fit as the job returned it.
+    fn outcome(&self) -> FitOutcome {
+        FitOutcome {
+            result: self.result.clone(),
+            origin: self.origin.clone(),
+        }
+    }
 }
 
 #[pymethods]
@@ -260,6 +248,27 @@ impl Fit {
     #[getter]
     fn measured_origin(&self) -> &str {
         &self.origin
+    }
+
+    /// The report as the command line's ``fit --format json`` prints it (keys in alphabetical
+    /// order, non-finite numbers as ``null``).
+    fn to_json(&self) -> PyResult<String> {
+        self.outcome()
+            .json()
+            .map_err(|e| value_error(e.to_string()))
+    }
+
+    /// Writes the fit as the command line's ``fit --save`` does: ``.json`` (the report of
+    /// :meth:`to_json`) or ``.h5``/``.hdf5`` (schema ``tiltnoise.fit``); atomically. Raises
+    /// ``OSError`` if it cannot be written or is one of the files read, ``ValueError`` for
+    /// another extension.
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        tiltnoise_job::fit::check_save_path(&path).py()?;
+        self.inputs.check_save(&path)?;
+        let meta = tiltnoise_io::RunMeta::of_this_run(&self.nominal, None);
+        let fit = self.outcome();
+        py.detach(|| tiltnoise_job::fit::save(&path, &fit, &meta))
+            .py()
     }
 
     /// Pickles as its state (see the module's pickling notes).

@@ -3,17 +3,19 @@
 //! The job (`tiltnoise_job`) reads the files and checks everything against the budget, as it
 //! does for the command line.
 
-use crate::errors::{value_error, IntoPyErr, PyResultExt};
+use crate::errors::{value_error, InputFileError, IntoPyErr, PyResultExt};
 use crate::model::names;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
 use tiltnoise_core::budget::BudgetError;
+use tiltnoise_core::fit::FitError;
 use tiltnoise_core::input::{parse_scales, parse_units, AxisMap};
 use tiltnoise_core::model::{Input, Observable};
 use tiltnoise_core::noise::UserSource;
 use tiltnoise_core::options::{self, observable_names};
 use tiltnoise_core::repeats::refuse_repeats;
+use tiltnoise_core::simulate::SimError;
 use tiltnoise_job::budget::ReadRequest;
 use tiltnoise_job::{AsdSpec, JobError, ReadoutItem, TermItem, WitnessItem};
 
@@ -30,6 +32,23 @@ pub fn job_error(e: JobError) -> PyErr {
         JobError::Tf(e) => (*e).into_py_err(),
         JobError::Freq(e) => (*e).into_py_err(),
         JobError::MonteCarlo(e) => (*e).into_py_err(),
+        JobError::FitFile(e) => match *e {
+            FitError::Measured { .. } | FitError::Visibility { .. } => {
+                return InputFileError::new_err(message)
+            }
+            _ => return value_error(message),
+        },
+        JobError::Fit(e) => match *e {
+            FitError::TooLarge(e) => e.into_py_err(),
+            _ => return value_error(message),
+        },
+        JobError::Simulate(e) => match *e {
+            SimError::TooLarge(e) => e.into_py_err(),
+            _ => return value_error(message),
+        },
+        JobError::Refused(e) => (*e).into_py_err(),
+        JobError::Spectral(e) => (*e).into_py_err(),
+        JobError::Output(e) => (*e).into_py_err(),
         _ => return value_error(message),
     };
     Python::attach(|py| PyErr::from_type(kind.get_type(py), message))

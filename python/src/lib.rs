@@ -23,6 +23,7 @@ mod simulate;
 mod spectral;
 mod state;
 mod subtract;
+mod visibility;
 
 use pyo3::prelude::*;
 
@@ -72,12 +73,14 @@ fn tiltnoise_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<budget::Budget>()?;
     m.add_class::<coherence::Coherence>()?;
     m.add_class::<subtract::Subtraction>()?;
+    m.add_class::<visibility::Visibilities>()?;
     m.add_function(wrap_pyfunction!(spectral::welch, m)?)?;
     m.add_function(wrap_pyfunction!(spectral::csd, m)?)?;
     m.add_function(wrap_pyfunction!(budget::budget, m)?)?;
     m.add_function(wrap_pyfunction!(budget::budget_from_file, m)?)?;
     m.add_function(wrap_pyfunction!(coherence::coherence, m)?)?;
     m.add_function(wrap_pyfunction!(subtract::subtract, m)?)?;
+    m.add_function(wrap_pyfunction!(visibility::visibility, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
     Ok(())
 }

@@ -703,7 +703,15 @@ impl PyModel {
             measured,
             visibility,
         };
-        crate::fit::run(py, self.model.params(), free, inputs, bound_sigmas, prior)
+        crate::fit::run(
+            py,
+            self.model.params(),
+            self.params_file.as_deref(),
+            free,
+            inputs,
+            bound_sigmas,
+            prior,
+        )
     }
 
     /// Free motion of the undamped model (the command line's ``tiltnoise simulate``): exact

@@ -4,8 +4,8 @@
 use crate::errors::{value_error, PyResultExt};
 use crate::inputs::Inputs;
 use crate::interrupt;
+use crate::job_args::job_error;
 use crate::python_side;
-use crate::spectral::welch_cancellable;
 use crate::state;
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -14,17 +14,15 @@ use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::model::{Coord, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
-use tiltnoise_core::noise::Readout;
 use tiltnoise_core::options;
 use tiltnoise_core::params::Params;
-use tiltnoise_core::simulate::resonance::check_resonances;
 use tiltnoise_core::simulate::{
-    check_sampling, describe_run, initial_state, parse_coordinates, record_description,
-    set_coordinate, simulate_with_progress, Excitation, InitialState, ModalPropagator, SimConfig,
-    SimError, Simulation as CoreSimulation,
+    parse_coordinates, record_description, set_coordinate, Excitation, InitialState,
+    Simulation as CoreSimulation,
 };
-use tiltnoise_core::spectral::WelchConfig;
 use tiltnoise_io::{OutputKind, RunMeta, SeriesAsd, SimulationMeta};
+use tiltnoise_job::simulate::{asd_figure_data, save, Keep, RecordOutputs, SimulateRequest};
+use tiltnoise_plot::View;
 
 /// The options of `Model.simulate`, as given.
 pub struct SimulateArgs<'a, 'py> {
@@ -92,18 +90,14 @@ fn excitation(args: &SimulateArgs<'_, '_>) -> PyResult<Excitation> {
     }
 }
 
-/// Runs the simulation of `model` (`Model.simulate`).
+/// Runs the simulate job on `model`, the whole record kept (`Model.simulate`).
 pub fn run(
     py: Python<'_>,
     model: &Model,
     params_file: Option<&std::path::Path>,
     args: SimulateArgs<'_, '_>,
 ) -> PyResult<Simulation> {
-    if !model.is_undamped() {
-        return Err(value_error(SimError::Damped.to_string()));
-    }
-    let (_, nperseg) = check_sampling(args.duration, args.step, args.nperseg).py()?;
-    let mut items = Vec::new();
+    let mut readout = Vec::new();
     if let Some(d) = args.readout {
         for (name, value) in d.iter() {
             let name: String = name
@@ -112,64 +106,48 @@ pub fn run(
             let asd: f64 = value
                 .extract()
                 .map_err(|_| value_error(format!("readout {name}: the ASD must be a number")))?;
-            items.push(options::readout_item("readout", &name, asd).py()?);
+            readout.push(options::readout_item("readout", &name, asd).py()?);
         }
     }
-    let mut readout = options::apply_readout("readout", Readout::default(), &items, None)
-        .py()?
-        .asd;
-    readout.sort_by_key(|(o, _)| o.index());
-    let (init, init_source) = initial_state(model, &excitation(&args)?).py()?;
-    let cfg = SimConfig {
-        dt_s: args.step,
+    let req = SimulateRequest {
+        model,
         duration_s: args.duration,
-        readout_asd: readout.clone(),
+        step_s: args.step,
+        excitation: excitation(&args)?,
+        readout,
         seed: args.seed,
-        cancel: Cancel::new(),
+        nperseg: args.nperseg,
+        chunk_samples: None,
+        keep: Keep {
+            record: true,
+            ..Keep::default()
+        },
     };
-    let wcfg = WelchConfig::new(nperseg);
-    let (sim, asd, check, modes) = interrupt::watch(py, &cfg.cancel, || -> PyResult<_> {
-        let sim = simulate_with_progress(model, &init, &cfg, &mut |_, _| {})
-            .map_err(|e| value_error(e.to_string()))?;
-        let fs = sim.fs_hz();
-        let mut psds = Vec::new();
-        for (o, x) in &sim.observables {
-            psds.push((*o, welch_cancellable(x, fs, &wcfg, &cfg.cancel).py()?));
-        }
-        let modes = NormalModes::new(model);
-        let prop =
-            ModalPropagator::new(model, &init, cfg.dt_s).map_err(|e| value_error(e.to_string()))?;
-        let (u0, v0) = prop.initial_modal_state();
-        let amplitude: [f64; 8] = std::array::from_fn(|k| u0[k].hypot(v0[k]));
-        let check = check_resonances(&modes, &amplitude, &psds, fs, nperseg, &readout);
-        let asd = SeriesAsd {
-            freqs_hz: psds[0].1.freqs_hz.clone(),
-            asd: psds.iter().map(|(o, p)| (*o, p.asd())).collect(),
-            segment_len: nperseg,
-            overlap: wcfg.overlap,
-            averaging: "mean".to_string(),
-            n_segments: psds[0].1.n_segments,
-        };
-        let modes: Vec<(usize, f64)> = modes
+    let cancel = Cancel::new();
+    let r = interrupt::watch(py, &cancel, || {
+        tiltnoise_job::simulate::run(req, &cancel, &mut |_, _| {}).map_err(job_error)
+    })?;
+    let sim = r
+        .record
+        .ok_or_else(|| value_error("the simulation kept no record"))?;
+    Ok(Simulation {
+        sim,
+        asd: r.asd,
+        init: r.init,
+        init_source: r.init_source,
+        readout: r.readout,
+        seed: r.seed,
+        duration_s: r.duration_s,
+        description: r.description,
+        check_table: r.check.table(),
+        check_agrees: r.check.all_agree(),
+        params: model.params().clone(),
+        modes: r
+            .modes
             .modes
             .iter()
             .map(|m| (m.index, m.frequency_hz))
-            .collect();
-        Ok((sim, asd, (check.table(), check.all_agree()), modes))
-    })?;
-    Ok(Simulation {
-        description: describe_run(&sim, &init_source, &readout, args.seed),
-        sim,
-        asd,
-        init,
-        init_source,
-        readout,
-        seed: args.seed,
-        duration_s: args.duration,
-        check_table: check.0,
-        check_agrees: check.1,
-        params: model.params().clone(),
-        modes,
+            .collect(),
         inputs: Inputs::of_params(params_file),
     })
 }
@@ -352,37 +330,40 @@ impl Simulation {
 
     /// Writes the run as the command line's ``simulate --save`` does, atomically: ``.h5`` /
     /// ``.hdf5`` (the series, the ASDs and the run's provenance; schema
-    /// ``tiltnoise.observable_series``, readable by ``budget(measured=...)``) or ``.csv``
-    /// (the ASDs, ``freq_hz,X,...``). Raises ``OSError`` if it cannot be written or is the
-    /// parameter file of the model, ``ValueError`` for another extension.
+    /// ``tiltnoise.observable_series``, readable by ``budget(measured=...)``), ``.csv``
+    /// (the ASDs, ``freq_hz,X,...``), or the command line's figure of the ASDs as ``.png`` or
+    /// ``.svg`` (the same image as ``tiltnoise simulate --save x.png`` for the same run).
+    /// Raises ``OSError`` if it cannot be written or is the parameter file of the model,
+    /// ``ValueError`` for another extension.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        let kind = OutputKind::from_path(&path).py()?;
+        OutputKind::from_path(&path).py()?;
         self.inputs.check_save(&path)?;
         let run = RunMeta {
             modes: self.modes.clone(),
             ..RunMeta::of_this_run(&self.params, None)
         };
-        py.detach(|| match kind {
-            OutputKind::Hdf5 => {
-                let meta = SimulationMeta {
-                    run: run.clone(),
-                    description: record_description(&self.description),
-                    start_time: None,
-                    seed: self.seed,
-                    init: self.init,
-                    init_source: self.init_source.clone(),
-                    readout_asd: self.readout.clone(),
-                    duration_s: self.duration_s,
-                };
-                tiltnoise_io::write_observable_series_hdf5(&path, &self.sim, &self.asd, &meta)
-            }
-            OutputKind::Csv => {
-                tiltnoise_io::write_asd_csv(&path, &self.asd.freqs_hz, &self.asd.asd, &run)
-            }
-            OutputKind::Png | OutputKind::Svg => Err(tiltnoise_io::OutputError::UnknownFormat {
-                path: path.clone(),
-                allowed: ".h5, .hdf5, .csv (figures: plot the arrays with matplotlib)",
-            }),
+        let model = Model::new(&self.params).py()?;
+        py.detach(|| {
+            let meta = SimulationMeta {
+                run: run.clone(),
+                description: record_description(&self.description),
+                start_time: None,
+                seed: self.seed,
+                init: self.init,
+                init_source: self.init_source.clone(),
+                readout_asd: self.readout.clone(),
+                duration_s: self.duration_s,
+            };
+            let modes = NormalModes::new(&model);
+            let fs = self.sim.fs_hz();
+            let figure = asd_figure_data(&self.asd, &self.readout, &modes, fs, &self.description);
+            let outputs = RecordOutputs {
+                record: Some((&self.sim, &meta)),
+                asd: &self.asd,
+                run: &run,
+                figure: &figure,
+            };
+            save(&path, &outputs, &View::default())
         })
         .py()
     }

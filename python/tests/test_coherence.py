@@ -53,6 +53,25 @@ def test_files_equal_the_command_lines(result, measured, cli, tmp_path):
                 assert a.attrs[key] == b.attrs[key], key
 
 
+@pytest.mark.parametrize("ext", ["png", "svg"])
+def test_the_figure_is_the_command_lines(result, measured, cli, tmp_path, ext):
+    theirs, mine = tmp_path / f"cli.{ext}", tmp_path / f"mine.{ext}"
+    cli("coherence", "--tilt", LAB_TILT, "--measured", measured, "--nperseg", 4096,
+        "--fit-band", "1e-3:0.1", "--save", theirs)
+    result.save(mine)
+    assert mine.read_bytes() == theirs.read_bytes()
+
+
+def test_plot_draws_every_observable(result):
+    pytest.importorskip("matplotlib")
+    import matplotlib
+    matplotlib.use("Agg")
+    fig = result.plot()
+    assert len(fig.axes) == 2 * len(result.observables)
+    labels = {line.get_label() for ax in fig.axes for line in ax.get_lines()}
+    assert {"multiple", "eta_t measured", "eta_t model"} <= labels
+
+
 def test_a_record_made_through_the_model_gives_the_model_back(result):
     assert result.observables == ["X"] and result.axes == ["theta_t", "eta_t"]
     assert result.units == {"X": "m/rad"}

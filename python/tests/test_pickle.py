@@ -51,6 +51,11 @@ def subtraction():
     """A subtraction of six hours of the lab tilt from X driven by it through the model."""
     tilt, measured = write_subtract_records(tempfile.mkdtemp(), 6 * 3600)
     return tiltnoise.subtract(tilt, measured, readout={"X": 1e-9})
+def visibilities():
+    """The visibilities of a short free motion written for them."""
+    path = Path(tempfile.mkdtemp()) / "free.h5"
+    tiltnoise.Model().simulate(duration=4000.0, step=0.5, seed=2).save(path)
+    return tiltnoise.visibility(path)
 
 
 MAKERS = {
@@ -63,6 +68,7 @@ MAKERS = {
     "Budget": budget,
     "Coherence": coherence,
     "Subtraction": subtraction,
+    "Visibilities": visibilities,
 }
 
 

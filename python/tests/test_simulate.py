@@ -36,6 +36,14 @@ def test_simulation_equals_the_command_lines_files(kick, cli, tmp_path):
             np.testing.assert_array_equal(b[name][()], x, err_msg=name)
 
 
+@pytest.mark.parametrize("ext", ["png", "svg"])
+def test_the_figure_is_the_command_lines(kick, cli, tmp_path, ext):
+    theirs, mine = tmp_path / f"cli.{ext}", tmp_path / f"mine.{ext}"
+    cli("simulate", "--duration", 3600, "--kick-x", 1e-6, "--seed", 3, "--save", theirs)
+    kick.save(mine)
+    assert mine.read_bytes() == theirs.read_bytes()
+
+
 def test_kick_starts_at_rest_at_the_displacement(kick):
     x = kick.observables["X"]
     assert kick.n_samples == 36_000 and len(x) == 36_000 and kick.dt_s == 0.1
@@ -73,4 +81,4 @@ def test_simulate_errors():
     with pytest.raises(ValueError, match=r"init: phi_b is given twice"):
         model.simulate(100, init="phi_b=1,phi_b=2")
     with pytest.raises(ValueError, match="unknown extension"):
-        model.simulate(100, init={"phi_b": 1e-3}).save("sim.png")
+        model.simulate(100, init={"phi_b": 1e-3}).save("sim.json")

@@ -18,8 +18,8 @@ amplitudes for ``exp(+i w t)``; the tilt ``(theta_t, eta_t, phi_t)`` is the rota
 the floor frame to the inertial frame, so ``X -> -eta_t (Z + Z_b + h_c)`` as ``f -> 0``.
 
 Results carry their frequencies, names and units: ``to_gwpy()`` and ``to_pandas()`` convert
-them (gwpy and pandas are optional), ``plot()`` draws them with matplotlib, and a budget's
-``save("b.png")`` writes the command line's figure. Every object pickles (multiprocessing,
+them (gwpy and pandas are optional), ``plot()`` draws them with matplotlib, and ``save("x.png")`` of a budget, a simulation or
+a coherence writes the command line's figure. Every object pickles (multiprocessing,
 joblib). Ctrl-C stops any long call with ``KeyboardInterrupt``.
 
 Errors are ``ValueError`` (parameters, names, options), ``OSError`` subclasses for files that
@@ -38,6 +38,7 @@ from ._tiltnoise import (
     Params,
     Simulation,
     Subtraction,
+    Visibilities,
     __version__,
     budget,
     budget_from_file,
@@ -46,6 +47,7 @@ from ._tiltnoise import (
     hdf5_version,
     subtract,
     welch,
+    visibility,
 )
 from ._transfer import TransferFunction
 
@@ -61,6 +63,7 @@ __all__ = [
     "Simulation",
     "Subtraction",
     "TransferFunction",
+    "Visibilities",
     "__version__",
     "budget",
     "budget_from_file",
@@ -69,4 +72,5 @@ __all__ = [
     "hdf5_version",
     "subtract",
     "welch",
+    "visibility",
 ]

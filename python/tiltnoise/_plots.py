@@ -1,5 +1,5 @@
 """Figures of results with matplotlib (optional): Budget.plot, Simulation.plot,
-Subtraction.plot, TransferFunction.plot. The command line's own figures are written by ``save("x.png")``."""
+Subtraction.plot, TransferFunction.plot, Coherence.plot. The command line's own figures are written by ``save("x.png")``."""
 
 import numpy as np
 
@@ -123,5 +123,43 @@ def transfer_plot(tf):
     phase.set_yticks(range(-180, 181, 90))
     phase.grid(True, which="both", alpha=0.3)
     phase.set_xlabel("frequency (Hz)")
+    fig.tight_layout()
+    return fig
+
+
+def coherence_plot(coh):
+    """Per observable, two panels: the ordinary coherence with each axis and the multiple
+    coherence against their noise thresholds; |H| measured (with its confidence band) and the
+    model's, log-log."""
+    plt = _pyplot("Coherence.plot()")
+    names = list(coh.observables)
+    fig, axes = plt.subplots(len(names), 2, figsize=(12, 3.6 * len(names)), sharex=True,
+                             squeeze=False)
+    f = coh.frequency_hz
+    gamma, multiple = coh.coherence, coh.multiple_coherence
+    measured, radius, model = coh.transfer, coh.transfer_radius, coh.model
+    for (left, right), o in zip(axes, names):
+        for a in coh.axes:
+            (line,) = left.semilogx(f, gamma[o][a], lw=1.0, label=f"{a}")
+            h, r = np.abs(measured[o][a]), radius[o][a]
+            right.loglog(f, h, lw=1.0, color=line.get_color(), label=f"{a} measured")
+            lower = np.where(h - r > 0, h - r, np.nan)
+            right.fill_between(f, lower, h + r, color=line.get_color(), alpha=0.2, lw=0)
+            m = np.abs(model[o][a])
+            if np.any(m > 0):
+                right.loglog(f, m, lw=1.4, ls="--", color=line.get_color(), label=f"{a} model")
+        left.semilogx(f, multiple[o], color="black", lw=1.4, label="multiple")
+        left.axhline(coh.coherence_threshold, color="grey", ls=":", lw=0.9,
+                     label=f"threshold ({coh.confidence:.0%})")
+        left.axhline(coh.multiple_coherence_threshold, color="black", ls=":", lw=0.9)
+        left.set_ylim(0, 1)
+        left.set_ylabel(f"{o}: coherence")
+        right.set_ylabel(f"|H| ({coh.units[o]})")
+        for ax in (left, right):
+            ax.grid(True, which="both", alpha=0.3)
+            ax.legend(fontsize=7, ncol=2)
+    for ax in axes[-1]:
+        ax.set_xlabel("frequency (Hz)")
+    fig.suptitle("coherence with the tilt axes and measured transfer functions")
     fig.tight_layout()
     return fig

@@ -222,7 +222,7 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     run.check_job_outputs(&args.save, req.input_files())?;
     let mut bar = None;
     let result = tiltnoise_job::budget::run(req, &run.cancel, &mut |done, total| {
-        bar.get_or_insert_with(|| progress_bar(total))
+        bar.get_or_insert_with(|| progress_bar(total, WORTH_A_BAR))
             .as_ref()
             .map_or((), |b| b.set_position(done))
     });
@@ -252,10 +252,13 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     })
 }
 
-/// A progress bar on stderr when it is a terminal and the input is long enough to wait for.
-fn progress_bar(total: u64) -> Option<indicatif::ProgressBar> {
-    const WORTH_A_BAR: u64 = 1 << 22;
-    if total < WORTH_A_BAR || !std::io::stderr().is_terminal() {
+/// Samples of a budget's input worth a progress bar.
+const WORTH_A_BAR: u64 = 1 << 22;
+
+/// A progress bar on stderr when it is a terminal and the work (`total` samples) is long
+/// enough to wait for (`worth_a_bar` samples or more).
+pub(super) fn progress_bar(total: u64, worth_a_bar: u64) -> Option<indicatif::ProgressBar> {
+    if total < worth_a_bar || !std::io::stderr().is_terminal() {
         return None;
     }
     let bar = indicatif::ProgressBar::new(total);

@@ -4,7 +4,6 @@
 
 use super::args::{tilt_read_options, Format};
 use super::figure_args::FigureArgs;
-use super::output::save_coherence;
 use super::tf::parse_observables;
 use super::Run;
 use anyhow::{anyhow, Result};
@@ -126,28 +125,24 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
         fit_band_hz: args.fit_band.as_deref().map(parse_fit_band).transpose()?,
     };
     run.check_job_outputs(&args.save, req.input_files())?;
-    let CoherenceResult { report, inputs } =
-        tiltnoise_job::coherence::run(req, &run.cancel).map_err(super::job_error)?;
+    let result = tiltnoise_job::coherence::run(req, &run.cancel).map_err(super::job_error)?;
+    let CoherenceResult { report, inputs } = &result;
     match args.format {
         Format::Table => {
             for note in &inputs.tilt.notes {
                 writeln!(run.out, "input: {note}")?;
             }
-            write!(run.out, "{}", summary(&report))?;
+            write!(run.out, "{}", summary(report))?;
         }
         Format::Json => {
-            let json = summary_json(&report, &inputs.tilt.notes);
+            let json = summary_json(report, &inputs.tilt.notes);
             writeln!(run.out, "{}", serde_json::to_string_pretty(&json)?)?;
         }
     }
     let meta = RunMeta::of_this_run(params, Some(&NormalModes::new(&model)));
-    let names = (
-        args.tilt.display().to_string(),
-        args.measured.display().to_string(),
-    );
     run.write_outputs(args.format == Format::Json, || {
         for out in &args.save {
-            save_coherence(out, &report, &meta, &inputs, &names, &view)?;
+            tiltnoise_job::coherence::save(out, &result, &meta, &view)?;
         }
         Ok(())
     })

@@ -1,18 +1,15 @@
-//! `tiltnoise fit`: the command line of the constrained least-squares fit of parameters to
-//! measured mode frequencies and visibilities ([`tiltnoise_core::fit`]): argument parsing, the
-//! table and JSON reports and the `--save` writers (.json, .h5; written atomically, checked
-//! before the fit runs).
+//! `tiltnoise fit`: the command line of the fit job ([`tiltnoise_job::fit`]): argument
+//! parsing, the request, the terminal table, and the job's JSON report and files (.json, .h5;
+//! checked before the fit runs).
 
 use super::Run;
 use anyhow::Result;
 use clap::{Args, ValueEnum};
-use serde::Serialize;
-use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-use tiltnoise_core::error::OutputError;
-use tiltnoise_core::fit::{self, Bound, FitConfig, FitResult, Measured, SigmaSource, Visibilities};
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use tiltnoise_core::fit::{Bound, FitResult};
 use tiltnoise_core::params::Params;
-use tiltnoise_io::{read_measured_modes, read_visibilities, write_atomic, write_fit_hdf5};
+use tiltnoise_job::fit::FitRequest;
 
 /// Arguments of `tiltnoise fit`.
 #[derive(Debug, Args)]
@@ -57,250 +54,50 @@ enum FitFormat {
     Json,
 }
 
-/// Runs `tiltnoise fit`.
+/// Runs `tiltnoise fit`: the options into the fit job's request, the job run, the report
+/// printed and the files written.
 pub(crate) fn run_fit(params: &Params, args: FitArgs, run: &mut Run) -> Result<()> {
     for path in &args.save {
-        save_kind(path)?;
+        tiltnoise_job::fit::check_save_path(path)?;
     }
-    let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
-    let inputs: Vec<(&str, &Path)> = args
-        .measured
-        .iter()
-        .map(|p| ("--measured-modes", p.as_path()))
-        .chain(
-            args.visibility
-                .iter()
-                .map(|p| ("--visibility", p.as_path())),
-        )
-        .collect();
-    run.check_outputs(&saves, &inputs)?;
-    // Visibilities without a frequency file are fitted alone: Table II's frequencies belong to
-    // the paper's pendulum, not to the one whose record gave the visibilities.
-    let measured = match (&args.measured, &args.visibility) {
-        (Some(path), _) => read_measured_modes(path)?,
-        (None, None) => Measured::table_ii(),
-        (None, Some(_)) => Measured {
-            modes: Vec::new(),
-            origin: "no frequency file".into(),
-        },
-    };
-    let visibilities = match &args.visibility {
-        Some(path) => read_visibilities(path)?,
-        None => Visibilities::none(),
-    };
-    let config = FitConfig {
-        free: args
-            .free
-            .clone()
-            .map(|keys| keys.into_iter().map(|k| k.trim().to_string()).collect())
-            .unwrap_or_else(|| FitConfig::default().free),
+    let req = FitRequest {
+        params,
+        measured: args.measured.clone(),
+        visibility: args.visibility.clone(),
+        free: args.free.clone(),
         bound_sigmas: args.bound_sigmas,
         prior: args.prior,
-        cancel: run.cancel.clone(),
     };
-    let result = fit::fit_with_visibilities(params, &measured, &visibilities, &config)?;
-    let json = fit_json(&result, &measured.origin);
+    run.check_job_outputs(&args.save, req.input_files())?;
+    let fit = tiltnoise_job::fit::run(req, &run.cancel).map_err(super::job_error)?;
     match args.format {
-        FitFormat::Json => writeln!(run.out, "{}", serde_json::to_string_pretty(&json)?)?,
-        FitFormat::Table => write!(run.out, "{}", fit_table(&result, &measured.origin))?,
+        FitFormat::Json => writeln!(run.out, "{}", fit.json()?)?,
+        FitFormat::Table => write!(run.out, "{}", fit_table(&fit.result, &fit.origin))?,
     }
+    let meta = tiltnoise_io::RunMeta::of_this_run(params, None);
     // JSON on standard output stays parseable: the `wrote` lines go to standard error.
     run.write_outputs(args.format == FitFormat::Json, || {
         for path in &args.save {
-            match save_kind(path)? {
-                SaveKind::Json => {
-                    let text = serde_json::to_string_pretty(&json)? + "\n";
-                    write_atomic(path, |tmp| {
-                        std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
-                    })?
-                }
-                SaveKind::Hdf5 => {
-                    let meta = tiltnoise_io::RunMeta::of_this_run(params, None);
-                    write_fit_hdf5(path, &result, &measured.origin, &meta)?
-                }
-            }
+            tiltnoise_job::fit::save(path, &fit, &meta)?;
         }
         Ok(())
     })
 }
 
-enum SaveKind {
-    Json,
-    Hdf5,
-}
-
-fn save_kind(path: &Path) -> Result<SaveKind, OutputError> {
-    match path.extension().and_then(|e| e.to_str()) {
-        Some("json") => Ok(SaveKind::Json),
-        Some("h5" | "hdf5") => Ok(SaveKind::Hdf5),
-        _ => Err(OutputError::UnknownFormat {
-            path: path.to_path_buf(),
-            allowed: ".json, .h5, .hdf5",
-        }),
-    }
-}
-
-fn sigma_source(s: SigmaSource) -> &'static str {
-    match s {
-        SigmaSource::File => "file",
-        SigmaSource::Digits => "digits",
-    }
-}
-
-fn bound_name(b: Option<Bound>) -> &'static str {
-    b.map_or("", Bound::name)
-}
-
-/// The JSON report (also the content of a saved .json file). Non-finite numbers are written
-/// as `null` (JSON has no infinity).
-fn fit_json<'a>(r: &'a FitResult, origin: &'a str) -> FitJson<'a> {
-    FitJson {
-        bound_sigmas: r.config.bound_sigmas,
-        chi2: r.chi2,
-        chi2_nominal: r.chi2_nominal,
-        correlation: &r.correlation,
-        dof: r.dof,
-        evaluations: r.evaluations,
-        fitted_params_toml: r.fitted_params.to_toml(),
-        iterations: r.iterations,
-        measured_origin: origin,
-        modes: r
-            .modes
-            .iter()
-            .map(|m| ModeJson {
-                fitted_hz: m.fitted_hz,
-                index: m.measured.mode,
-                measured_hz: m.measured.frequency_hz,
-                nominal_hz: m.nominal_hz,
-                residual_hz: m.residual_hz(),
-                residual_sigmas: m.residual_sigmas(),
-                sigma_hz: m.measured.sigma_hz,
-                sigma_source: sigma_source(m.measured.sigma_source),
-            })
-            .collect(),
-        parameters: r
-            .params
-            .iter()
-            .zip(&r.start)
-            .map(|(p, &start)| ParamJson {
-                at_bound: p.at_bound.map(Bound::name),
-                data_sigma_rel: p.data_sigma_rel,
-                fitted: p.fitted,
-                fitted_sigma: p.fitted_sigma,
-                key: &p.key,
-                nominal: p.nominal,
-                poorly_constrained: p.poorly_constrained,
-                prior_sigma: p.prior_sigma,
-                start,
-                unit: &p.unit,
-            })
-            .collect(),
-        prior: r.config.prior,
-        prior_term: r.prior_term,
-        projected_gradient: r.projected_gradient,
-        singular_values: &r.singular_values,
-        stop: r.stop.describe(),
-        visibilities: r
-            .visibilities
-            .iter()
-            .map(|v| VisibilityJson {
-                fitted: v.fitted,
-                measured: v.measured.ratio,
-                mode: v.measured.mode,
-                nominal: v.nominal,
-                observable: v.measured.observable.name(),
-                reference: v.measured.reference.name(),
-                residual_sigmas: v.residual_sigmas(),
-                sigma: v.measured.sigma,
-                sigma_source: sigma_source(v.measured.sigma_source),
-            })
-            .collect(),
-        weak_directions: r
-            .weak_directions
-            .iter()
-            .map(|w| WeakJson {
-                direction: w.direction.iter().map(|(k, c)| (k.as_str(), *c)).collect(),
-                singular_value: w.singular_value,
-            })
-            .collect(),
-    }
-}
-
-// Keys in alphabetical order, as the report has always listed them: fields declared in that
-// order, maps as BTreeMaps.
-
-#[derive(Serialize)]
-struct FitJson<'a> {
-    bound_sigmas: f64,
-    chi2: f64,
-    chi2_nominal: f64,
-    /// Correlation matrix of the parameters (their order); null on a bound.
-    correlation: &'a [Vec<f64>],
-    dof: usize,
-    evaluations: usize,
-    fitted_params_toml: String,
-    iterations: usize,
-    measured_origin: &'a str,
-    modes: Vec<ModeJson>,
-    parameters: Vec<ParamJson<'a>>,
-    prior: bool,
-    prior_term: f64,
-    projected_gradient: f64,
-    singular_values: &'a [f64],
-    stop: &'static str,
-    visibilities: Vec<VisibilityJson>,
-    weak_directions: Vec<WeakJson<'a>>,
-}
-
-#[derive(Serialize)]
-struct VisibilityJson {
-    fitted: f64,
-    measured: f64,
-    mode: usize,
-    nominal: f64,
-    observable: &'static str,
-    reference: &'static str,
-    residual_sigmas: f64,
-    sigma: f64,
-    sigma_source: &'static str,
-}
-
-#[derive(Serialize)]
-struct ModeJson {
-    fitted_hz: f64,
-    index: usize,
-    measured_hz: f64,
-    nominal_hz: f64,
-    residual_hz: f64,
-    residual_sigmas: f64,
-    sigma_hz: f64,
-    sigma_source: &'static str,
-}
-
-#[derive(Serialize)]
-struct ParamJson<'a> {
-    at_bound: Option<&'static str>,
-    data_sigma_rel: f64,
-    fitted: f64,
-    fitted_sigma: Option<f64>,
-    key: &'a str,
-    nominal: f64,
-    poorly_constrained: bool,
-    prior_sigma: f64,
-    start: f64,
-    unit: &'a str,
-}
-
-#[derive(Serialize)]
-struct WeakJson<'a> {
-    direction: BTreeMap<&'a str, f64>,
-    singular_value: f64,
-}
-
-/// The terminal report.
+/// The terminal report: the fit's header, the parameters, the modes and visibilities, the
+/// correlations, the start and the weak directions.
 fn fit_table(r: &FitResult, origin: &str) -> String {
-    use std::fmt::Write;
     let mut s = String::new();
+    header(&mut s, r, origin);
+    parameters(&mut s, r);
+    residuals(&mut s, r);
+    correlations(&mut s, r);
+    legend(&mut s, r);
+    s
+}
+
+/// What was fitted to what, and how the solver ended.
+fn header(s: &mut String, r: &FitResult, origin: &str) {
     let box_kind = match r.config.prior {
         true => "box + Gaussian prior",
         false => "box",
@@ -332,6 +129,10 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
         r.projected_gradient
     );
     let _ = writeln!(s);
+}
+
+/// The table of the free parameters.
+fn parameters(s: &mut String, r: &FitResult) {
     let _ = writeln!(
         s,
         "{:<26} {:>12} {:>12} {:>11} {:>11} {:>6} {:>6}  unit",
@@ -349,12 +150,16 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
             p.fitted,
             sigma,
             p.prior_sigma,
-            bound_name(p.at_bound),
+            p.at_bound.map_or("", Bound::name),
             if p.poorly_constrained { "yes" } else { "" },
             p.unit
         );
     }
     let _ = writeln!(s);
+}
+
+/// The tables of the modes and of the visibilities: measured, nominal, fitted, residual.
+fn residuals(s: &mut String, r: &FitResult) {
     if !r.modes.is_empty() {
         let _ = writeln!(
             s,
@@ -375,31 +180,36 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
             m.residual_sigmas()
         );
     }
-    if !r.visibilities.is_empty() {
-        let _ = writeln!(s);
+    if r.visibilities.is_empty() {
+        return;
+    }
+    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
+        "{:<5} {:<13} {:>13} {:>11} {:>13} {:>13} {:>10}",
+        "mode", "ratio", "measured", "sigma", "nominal", "fitted", "resid/sig"
+    );
+    for v in &r.visibilities {
         let _ = writeln!(
             s,
-            "{:<5} {:<13} {:>13} {:>11} {:>13} {:>13} {:>10}",
-            "mode", "ratio", "measured", "sigma", "nominal", "fitted", "resid/sig"
+            "nu_{:<2} {:<13} {:>13.5e} {:>11.2e} {:>13.5e} {:>13.5e} {:>10.2}",
+            v.measured.mode,
+            format!(
+                "{}/{}",
+                v.measured.observable.name(),
+                v.measured.reference.name()
+            ),
+            v.measured.ratio,
+            v.measured.sigma,
+            v.nominal,
+            v.fitted,
+            v.residual_sigmas()
         );
-        for v in &r.visibilities {
-            let _ = writeln!(
-                s,
-                "nu_{:<2} {:<13} {:>13.5e} {:>11.2e} {:>13.5e} {:>13.5e} {:>10.2}",
-                v.measured.mode,
-                format!(
-                    "{}/{}",
-                    v.measured.observable.name(),
-                    v.measured.reference.name()
-                ),
-                v.measured.ratio,
-                v.measured.sigma,
-                v.nominal,
-                v.fitted,
-                v.residual_sigmas()
-            );
-        }
     }
+}
+
+/// The correlation matrix, and where the fit started when away from the nominal point.
+fn correlations(s: &mut String, r: &FitResult) {
     if r.params.len() > 1 {
         let _ = writeln!(s);
         let _ = writeln!(s, "correlations (linearized covariance; - on a bound):");
@@ -414,18 +224,14 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
             let _ = writeln!(s, "{:<26} {}", p.key, row.join(" "));
         }
     }
-    if r.start
+    let start: Vec<String> = r
+        .params
         .iter()
-        .zip(&r.params)
-        .any(|(s0, p)| *s0 != p.nominal)
-    {
-        let start: Vec<String> = r
-            .params
-            .iter()
-            .zip(&r.start)
-            .filter(|(p, s0)| **s0 != p.nominal)
-            .map(|(p, s0)| format!("{} = {s0:e}", p.key))
-            .collect();
+        .zip(&r.start)
+        .filter(|(p, s0)| **s0 != p.nominal)
+        .map(|(p, s0)| format!("{} = {s0:e}", p.key))
+        .collect();
+    if !start.is_empty() {
         let _ = writeln!(s);
         let _ = writeln!(
             s,
@@ -433,6 +239,10 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
             start.join(", ")
         );
     }
+}
+
+/// What `bound` and `poor` mean, and the weak directions.
+fn legend(s: &mut String, r: &FitResult) {
     let _ = writeln!(s);
     let _ = writeln!(
         s,
@@ -444,47 +254,51 @@ fn fit_table(r: &FitResult, origin: &str) -> String {
         "poor: the data alone determine it no better than its error bar (data sigma >= prior \
          sigma)."
     );
-    match r.weak_directions.is_empty() {
-        true => {
-            let _ = writeln!(
-                s,
-                "No weak direction: every singular value of the weighted Jacobian is >= 1 \
-                 (smallest {:.3e}).",
-                r.singular_values.last().copied().unwrap_or(f64::NAN)
-            );
-        }
-        false => {
-            for w in &r.weak_directions {
-                let mut comps: Vec<&(String, f64)> = w.direction.iter().collect();
-                comps.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
-                let text: Vec<String> = comps
-                    .iter()
-                    .filter(|(_, c)| c.abs() >= 0.1)
-                    .map(|(k, c)| format!("{c:+.2} {k}"))
-                    .collect();
-                let _ = writeln!(
-                    s,
-                    "weak direction (singular value {:.3e} < 1, known to {:.2} error bars): {}",
-                    w.singular_value,
-                    1.0 / w.singular_value,
-                    text.join(" ")
-                );
-            }
-        }
+    if r.weak_directions.is_empty() {
+        let _ = writeln!(
+            s,
+            "No weak direction: every singular value of the weighted Jacobian is >= 1 \
+             (smallest {:.3e}).",
+            r.singular_values.last().copied().unwrap_or(f64::NAN)
+        );
     }
-    s
+    for w in &r.weak_directions {
+        let mut comps: Vec<&(String, f64)> = w.direction.iter().collect();
+        comps.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+        let text: Vec<String> = comps
+            .iter()
+            .filter(|(_, c)| c.abs() >= 0.1)
+            .map(|(k, c)| format!("{c:+.2} {k}"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "weak direction (singular value {:.3e} < 1, known to {:.2} error bars): {}",
+            w.singular_value,
+            1.0 / w.singular_value,
+            text.join(" ")
+        );
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::cli::report::assert_keys_sorted;
+    use tiltnoise_job::fit::FitOutcome;
 
     #[test]
     fn json_lists_keys_alphabetically() {
-        let measured = Measured::table_ii();
-        let result = fit::fit(&Params::table_i(), &measured, &FitConfig::default()).unwrap();
-        let text = serde_json::to_string_pretty(&fit_json(&result, &measured.origin)).unwrap();
+        let req = FitRequest {
+            params: &Params::table_i(),
+            measured: None,
+            visibility: None,
+            free: None,
+            bound_sigmas: 1.0,
+            prior: false,
+        };
+        let fit: FitOutcome =
+            tiltnoise_job::fit::run(req, &tiltnoise_job::Cancel::never()).unwrap();
+        let text = fit.json().unwrap();
         let value = assert_keys_sorted(&text);
         assert_eq!(value["measured_origin"], "embedded Table II");
     }

@@ -2,16 +2,12 @@
 //! `tiltnoise-plot` and written by the job layer's [`save_image`], which Python uses too.
 
 use std::path::Path;
-use tiltnoise_core::coherence::CoherenceReport;
 use tiltnoise_core::error::OutputError;
 use tiltnoise_core::input::InputMeta;
 use tiltnoise_core::noise::BudgetReport;
 use tiltnoise_core::tf::TransferMatrix;
-use tiltnoise_io::{
-    write_budget_csv, write_budget_hdf5, write_coherence_csv, write_coherence_hdf5, write_tf_csv,
-    write_tf_hdf5,
-};
-use tiltnoise_io::{CoherenceInputs, OutputKind, RunMeta};
+use tiltnoise_io::{write_budget_csv, write_budget_hdf5, write_tf_csv, write_tf_hdf5};
+use tiltnoise_io::{OutputKind, RunMeta};
 
 pub use tiltnoise_job::save_image;
 
@@ -63,38 +59,6 @@ pub fn save_budget(
             };
             save_image(path, |format| {
                 tiltnoise_plot::budget_figure_with(report, format, &options)
-            })
-        }
-    }
-}
-
-/// Saves a coherence report in the format named by the extension of `path`: HDF5 (with `meta`
-/// and `inputs`), CSV, or a PNG/SVG figure titled with the `(tilt, measured)` file names.
-///
-/// # Errors
-///
-/// [`OutputError::UnknownFormat`] for an unsupported extension (nothing is written), or the
-/// writer's [`OutputError::Write`].
-pub fn save_coherence(
-    path: &Path,
-    report: &CoherenceReport,
-    meta: &RunMeta,
-    inputs: &CoherenceInputs,
-    (tilt, measured): &(String, String),
-    view: &tiltnoise_plot::View,
-) -> Result<(), OutputError> {
-    match OutputKind::from_path(path)? {
-        OutputKind::Hdf5 => write_coherence_hdf5(path, report, meta, inputs),
-        OutputKind::Csv => write_coherence_csv(path, report, meta),
-        OutputKind::Png | OutputKind::Svg => {
-            let options = tiltnoise_plot::CoherenceFigureOptions {
-                tilt_name: tilt.clone(),
-                measured_name: measured.clone(),
-                view: view.clone(),
-                ..tiltnoise_plot::CoherenceFigureOptions::default()
-            };
-            save_image(path, |format| {
-                tiltnoise_plot::coherence_figure(report, format, &options)
             })
         }
     }

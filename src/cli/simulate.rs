@@ -3,42 +3,30 @@
 //! and the outputs (HDF5 series + ASDs, CSV ASDs, Figure 3, Figures 4/5). Owns the progress
 //! bar (only when stderr is a terminal and the run is long). Documented in `docs/simulate.md`.
 
-use super::args::scientific;
+use super::args::{scientific, Format};
+use super::budget::progress_bar;
 use super::figure_args::FigureArgs;
 use super::output::save_image;
 use super::Run;
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::Args;
 use std::fmt::Write as _;
-use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
-use tiltnoise_core::error::Num;
-use tiltnoise_core::limits::{check_memory, planned_bytes, STREAMED_WELCH_BYTES_PER_SAMPLE};
+use std::path::PathBuf;
 use tiltnoise_core::model::{Model, Observable};
-use tiltnoise_core::modes::NormalModes;
-use tiltnoise_core::noise::Readout;
-use tiltnoise_core::options;
 use tiltnoise_core::params::Params;
-use tiltnoise_core::simulate::resonance::check_resonances;
-use tiltnoise_core::simulate::stream::{
-    check_streamed_samples, FreeMotion, MinMaxEnvelope, SimChunk,
-};
 use tiltnoise_core::simulate::{
-    self, aliased_frequency_hz, default_sim_nperseg, parse_coordinates, Excitation, InitialState,
-    ModalPropagator, SimConfig, DEFAULT_MODE_ENERGY_J,
+    aliased_frequency_hz, parse_coordinates, readout_text, Excitation, DEFAULT_MODE_ENERGY_J,
 };
-use tiltnoise_core::spectral::{Psd, WelchAccumulator, WelchConfig};
-use tiltnoise_io::{
-    ObservableSeriesWriter, OutputKind, RunMeta, SeriesAsd, SimulationMeta, SERIES_CHUNK_SAMPLES,
+use tiltnoise_io::{OutputKind, RunMeta};
+use tiltnoise_job::simulate::{
+    asd_figure_data, save, Keep, RecordOutputs, SimulateRequest, SimulateResult,
 };
-use tiltnoise_plot::simulate_figure::{
-    asd_figure, time_series_figure, ModeMark, SimAsdData, TimePanel, TimeSeriesData, ASD_SIZE,
-};
+use tiltnoise_plot::simulate_figure::{time_series_figure, ASD_SIZE};
 
 mod driven;
 
 /// Runs with at least this many samples get a progress bar on a terminal (about 2 s of work).
-const WORTH_A_BAR: usize = 1 << 23;
+const WORTH_A_BAR: u64 = 1 << 23;
 
 /// Options of `tiltnoise simulate`.
 #[derive(Debug, Args)]
@@ -165,26 +153,27 @@ pub(crate) struct SimulateArgs {
         requires = "tilt"
     )]
     drive_delay: Option<f64>,
+    /// Output format on the terminal: table (default) or json (the summary and the resonance
+    /// check; `wrote` lines then go to standard error).
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
     #[command(flatten)]
     figure: FigureArgs,
 }
 
-/// `--readout OBS=ASD` items over the default (the paper's 9 nm/sqrt(Hz) on X; 0 removes
-/// one), each observable once, in observable order.
+/// `--readout OBS=ASD` items, in order (the job applies them over the default: the paper's
+/// 9 nm/sqrt(Hz) on X; 0 removes one).
 fn parse_readout(items: &[String]) -> Result<Vec<(Observable, f64)>> {
-    let items = items
+    items
         .iter()
         .map(|item| super::args::parse_readout_item(item))
-        .collect::<Result<Vec<_>>>()?;
-    let mut readout = options::apply_readout("--readout", Readout::default(), &items, None)?.asd;
-    readout.sort_by_key(|(o, _)| o.index());
-    Ok(readout)
+        .collect()
 }
 
-/// The run's initial state and a description of where it came from: the kick, the given
-/// coordinates and rates, or equal energy in every mode.
-fn initial_state(model: &Model, args: &SimulateArgs) -> Result<(InitialState, String)> {
-    let excitation = if let Some(x_m) = args.kick_x {
+/// The excitation asked for: the kick, the given coordinates and rates, or equal energy in
+/// every mode.
+fn excitation(args: &SimulateArgs) -> Result<Excitation> {
+    Ok(if let Some(x_m) = args.kick_x {
         Excitation::KickX { x_m }
     } else if !args.init.is_empty() || !args.init_rate.is_empty() {
         let (mut q, mut qdot) = ([0.0; 8], [0.0; 8]);
@@ -195,25 +184,11 @@ fn initial_state(model: &Model, args: &SimulateArgs) -> Result<(InitialState, St
         Excitation::EqualEnergy {
             energy_j: args.mode_energy,
         }
-    };
-    Ok(simulate::initial_state(model, &excitation)?)
+    })
 }
 
-/// Runs `tiltnoise simulate`.
-pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -> Result<()> {
-    let model = Model::new(params)?;
-    if !model.is_undamped() {
-        bail!(
-            "tiltnoise simulate supports only the undamped model (exact modal propagation of \
-             free motion); the parameters have non-zero loss angles in [loss]: set every \
-             loss.*_rad to 0, e.g. with --set"
-        );
-    }
-    let view = args.figure.view_for(ASD_SIZE)?;
-    if let Some(path) = &args.tilt {
-        return driven::run(params, &model, &args, path, run);
-    }
-    let c = &args.channels;
+/// Refuses the options that describe the channels of a record, which free motion has not.
+fn refuse_channel_options(c: &super::args::ChannelArgs) -> Result<()> {
     if let Some(option) = [
         ("--units", c.units.is_empty()),
         ("--corrected", c.corrected.is_empty()),
@@ -224,254 +199,91 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
     {
         bail!("{option} describes the channels of a record and applies with --tilt FILE only");
     }
-    if !(args.step.is_finite() && args.step > 0.0) {
-        bail!(
-            "--step {}: the sampling step (s) must be finite and > 0",
-            args.step
-        );
+    Ok(())
+}
+
+/// Runs `tiltnoise simulate`: free motion, or with `--tilt` the driven simulation
+/// ([`driven`]). The options into the simulate job's request, the job run (a progress bar on
+/// a terminal), the summary and the resonance check printed and the files written.
+pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -> Result<()> {
+    let model = Model::new(params)?;
+    let view = args.figure.view_for(ASD_SIZE)?;
+    if let Some(path) = &args.tilt {
+        return driven::run(&model, &args, path, &view, run);
     }
-    if !(args.duration.is_finite() && args.duration > 0.0) {
-        bail!(
-            "--duration {}: the duration (s) must be finite and > 0",
-            args.duration
-        );
-    }
-    let n_f = (args.duration / args.step * (1.0 + 1e-9)).floor();
-    if n_f < 2.0 {
-        bail!(
-            "--duration {} s at --step {} s gives {n_f} sample(s): at least 2 are needed",
-            args.duration,
-            args.step
-        );
-    }
-    check_streamed_samples(
-        || {
-            format!(
-                "--duration {} s at --step {} s",
-                Num(args.duration),
-                Num(args.step)
-            )
-        },
-        n_f,
-    )?;
-    let n = n_f as usize;
-    let nperseg = args.nperseg.unwrap_or_else(|| default_sim_nperseg(n));
-    if nperseg < 16 {
-        bail!("--nperseg {nperseg}: the Welch segment must have at least 16 samples");
-    }
-    if nperseg > n {
-        bail!(
-            "--duration {} s at --step {} s gives {n} samples, shorter than one Welch segment \
-             (--nperseg {nperseg} = {} s): lengthen --duration or lower --nperseg",
-            Num(args.duration),
-            Num(args.step),
-            Num(nperseg as f64 * args.step)
-        );
-    }
-    check_memory(
-        || format!("--nperseg {nperseg}: Welch segments of the 7 observables"),
-        planned_bytes(nperseg, 7 * STREAMED_WELCH_BYTES_PER_SAMPLE),
-    )?;
+    refuse_channel_options(&args.channels)?;
     for path in &args.save {
         OutputKind::from_path(path)?;
     }
     for path in &args.save_time {
         tiltnoise_plot::ImageFormat::from_path(path)?;
     }
-    let hdf5_paths: Vec<&PathBuf> = args
+    let hdf5: Vec<PathBuf> = args
         .save
         .iter()
         .filter(|p| matches!(OutputKind::from_path(p), Ok(OutputKind::Hdf5)))
+        .cloned()
         .collect();
-    if args.with_coordinates && hdf5_paths.is_empty() {
+    if args.with_coordinates && hdf5.is_empty() {
         bail!("--with-coordinates: the coordinates go to an HDF5 file; add --save FILE.h5");
     }
-    let chunk_samples = match args.chunk_samples {
-        Some(0) => bail!("--chunk-samples 0: a chunk must hold at least 1 sample"),
-        Some(c) => c,
-        None => SERIES_CHUNK_SAMPLES,
-    };
-    let saves: Vec<&Path> = args
-        .save
-        .iter()
-        .chain(&args.save_time)
-        .map(PathBuf::as_path)
-        .collect();
-    run.check_outputs(&saves, &[])?;
-    let readout = parse_readout(&args.readout)?;
-    let (init, init_source) = initial_state(&model, &args)?;
-    let cfg = SimConfig {
-        dt_s: args.step,
+    let outputs: Vec<PathBuf> = args.save.iter().chain(&args.save_time).cloned().collect();
+    run.check_job_outputs(&outputs, Vec::new())?;
+    let req = SimulateRequest {
+        model: &model,
         duration_s: args.duration,
-        readout_asd: readout.clone(),
+        step_s: args.step,
+        excitation: excitation(&args)?,
+        readout: parse_readout(&args.readout)?,
         seed: args.seed,
-        cancel: run.cancel.clone(),
+        nperseg: args.nperseg,
+        chunk_samples: args.chunk_samples,
+        keep: Keep {
+            record: false,
+            hdf5,
+            hdf5_coordinates: args.with_coordinates,
+            time_figure: !args.save_time.is_empty(),
+        },
     };
-    let mut motion = FreeMotion::new(&model, &init, &cfg, args.with_coordinates)?;
-    let dt_s = motion.dt_s();
-    let fs = 1.0 / dt_s;
-    let wcfg = WelchConfig::new(nperseg);
-    let modes = NormalModes::new(&model);
-    let meta = RunMeta::of_this_run(params, Some(&modes));
-    let run_caption = format!(
-        "{n} samples at {dt_s} s ({} s), exact modal propagation of the undamped model; initial \
-         state: {init_source}; readout: {}; seed {}.",
-        n as f64 * dt_s,
-        readout_text(&readout),
-        args.seed
-    );
-    let smeta = SimulationMeta {
-        run: meta.clone(),
-        description: format!(
-            "SIMULATED free motion of the double torsion pendulum model (not a measurement). \
-             {run_caption}"
-        ),
-        start_time: None,
-        seed: args.seed,
-        init,
-        init_source: init_source.clone(),
-        readout_asd: readout.clone(),
-        duration_s: args.duration,
-    };
-
-    // The record streams through the HDF5 writers, the Welch accumulators and the pieces the
-    // time-series figure needs; it is never held whole.
-    let mut writers = hdf5_paths
-        .iter()
-        .map(|p| ObservableSeriesWriter::create(p, dt_s, &smeta, args.with_coordinates))
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut accumulators = Observable::ALL
-        .iter()
-        .map(|_| WelchAccumulator::new(1, fs, &wcfg))
-        .collect::<Result<Vec<_>, _>>()?;
-    let want_time = !args.save_time.is_empty();
-    let mut phi = want_time.then(|| MinMaxEnvelope::new(n, TIME_FIGURE_BLOCKS));
-    let n_x = x_samples_shown(&modes, dt_s, n);
-    let mut x_start = Vec::new();
-    let bar = (n >= WORTH_A_BAR && std::io::stderr().is_terminal()).then(|| {
-        let b = indicatif::ProgressBar::new(n as u64);
-        b.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{spinner} {wide_bar} {pos}/{len} samples ({percent}%, eta {eta})",
-            )
-            .expect("valid template"),
-        );
-        b
+    let mut bar = None;
+    let result = tiltnoise_job::simulate::run(req, &run.cancel, &mut |done, total| {
+        bar.get_or_insert_with(|| progress_bar(total, WORTH_A_BAR))
+            .as_ref()
+            .map_or((), |b| b.set_position(done))
     });
-    let mut chunk = SimChunk::default();
-    while {
-        cfg.cancel.check()?;
-        motion.next_chunk(chunk_samples, &mut chunk)
-    } {
-        for w in &mut writers {
-            w.append(&chunk)?;
-        }
-        for (acc, x) in accumulators.iter_mut().zip(&chunk.observables) {
-            acc.push(&[x])?;
-        }
-        if let Some(e) = &mut phi {
-            e.push(chunk.observable(Observable::Phi));
-        }
-        if want_time && x_start.len() < n_x {
-            let x = chunk.observable(Observable::X);
-            x_start.extend_from_slice(&x[..x.len().min(n_x - x_start.len())]);
-        }
-        if let Some(b) = &bar {
-            b.set_position(motion.samples_done() as u64);
-        }
-    }
-    if let Some(b) = bar {
+    if let Some(Some(b)) = bar {
         b.finish_and_clear();
     }
-
-    let mut psds = Vec::with_capacity(7);
-    for (o, acc) in Observable::ALL.into_iter().zip(accumulators) {
-        let m = acc.finish()?;
-        psds.push((
-            o,
-            Psd {
-                psd: m.psd(0),
-                freqs_hz: m.freqs_hz,
-                n_segments: m.n_segments,
-            },
-        ));
+    let mut result = result.map_err(super::job_error)?;
+    let json = args.format == Format::Json;
+    match json {
+        true => writeln!(
+            run.out,
+            "{}",
+            serde_json::to_string_pretty(&summary_json(&result))?
+        )?,
+        false => write!(run.out, "{}{}", summary(&result), result.check.table())?,
     }
-    let prop = ModalPropagator::new(&model, &init, cfg.dt_s)?;
-    let (u0, v0) = prop.initial_modal_state();
-    let amplitude: [f64; 8] = std::array::from_fn(|k| u0[k].hypot(v0[k]));
-    let check = check_resonances(&modes, &amplitude, &psds, fs, nperseg, &readout);
-
-    write!(
-        run.out,
-        "{}",
-        summary(
-            (n, dt_s),
-            &modes,
-            &init_source,
-            &readout,
-            args.seed,
-            &wcfg,
-            psds[0].1.n_segments
-        )
-    )?;
-    write!(run.out, "{}", check.table())?;
-
-    let freqs_hz = psds[0].1.freqs_hz.clone();
-    let asd: Vec<(Observable, Vec<f64>)> = psds.iter().map(|(o, p)| (*o, p.asd())).collect();
-    let caption = vec![
-        run_caption,
-        format!(
-            "One-sided Welch ASDs: periodic Hann, {} samples per segment, 50 % overlap, {} \
-             segments, mean. Modes above Nyquist ({} Hz) are marked at their aliases.",
-            nperseg,
-            psds[0].1.n_segments,
-            fs / 2.0
-        ),
-    ];
-    let series_asd = SeriesAsd {
-        freqs_hz: freqs_hz.clone(),
-        asd: asd.clone(),
-        segment_len: nperseg,
-        overlap: wcfg.overlap,
-        averaging: "mean".to_string(),
-        n_segments: psds[0].1.n_segments,
-    };
-    let time_data = phi.map(|phi| {
-        let (values, spacing) = phi.finish();
-        time_series_data((values, spacing * dt_s), (x_start, dt_s), &init_source)
-    });
-    run.write_outputs(false, || {
-        for writer in writers {
-            writer.finish(&series_asd)?;
-        }
+    let meta = RunMeta::of_this_run(params, Some(&result.modes));
+    let figure = asd_figure_data(
+        &result.asd,
+        &result.readout,
+        &result.modes,
+        result.fs_hz(),
+        &result.description,
+    );
+    run.write_outputs(json, || {
+        result.finish_records()?;
+        let outputs = RecordOutputs {
+            record: None,
+            asd: &result.asd,
+            run: &meta,
+            figure: &figure,
+        };
         for path in &args.save {
-            match OutputKind::from_path(path)? {
-                OutputKind::Hdf5 => {}
-                OutputKind::Csv => tiltnoise_io::write_asd_csv(path, &freqs_hz, &asd, &meta)
-                    .with_context(|| format!("writing {}", path.display()))?,
-                OutputKind::Png | OutputKind::Svg => {
-                    let data = SimAsdData {
-                        freqs_hz: freqs_hz.clone(),
-                        asd: asd.clone(),
-                        readout_asd: readout.clone(),
-                        modes: modes
-                            .modes
-                            .iter()
-                            .enumerate()
-                            .map(|(k, m)| ModeMark {
-                                index: m.index,
-                                frequency_hz: m.frequency_hz,
-                                apparent_frequency_hz: aliased_frequency_hz(m.frequency_hz, fs),
-                                seen_by: modes.observables_seeing(k),
-                            })
-                            .collect(),
-                        caption: caption.clone(),
-                    };
-                    save_image(path, |format| asd_figure(&data, &view, format))?;
-                }
-            }
+            save(path, &outputs, &view)?;
         }
-        if let Some(data) = &time_data {
+        if let Some(data) = &result.time_figure {
             for path in &args.save_time {
                 save_image(path, |format| time_series_figure(data, &view, format))?;
             }
@@ -480,19 +292,10 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
     })
 }
 
-/// The readout as the summary and the files describe it (the library's wording).
-pub(crate) use tiltnoise_core::simulate::readout_text;
-
-fn summary(
-    (n, dt_s): (usize, f64),
-    modes: &NormalModes,
-    init_source: &str,
-    readout: &[(Observable, f64)],
-    seed: u64,
-    wcfg: &WelchConfig,
-    n_segments: usize,
-) -> String {
-    let fs = 1.0 / dt_s;
+/// The run, the spectra and the modes as the terminal shows them (the resonance check
+/// follows).
+fn summary(r: &SimulateResult) -> String {
+    let (n, dt_s, fs) = (r.n_samples, r.dt_s, r.fs_hz());
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -502,30 +305,33 @@ fn summary(
         n as f64 * dt_s,
         fs / 2.0
     );
-    let _ = writeln!(s, "initial state: {init_source}");
+    let _ = writeln!(s, "initial state: {}", r.init_source);
     let _ = writeln!(
         s,
-        "readout (white, one-sided ASD): {}; seed {seed}",
-        readout_text(readout)
+        "readout (white, one-sided ASD): {}; seed {}",
+        readout_text(&r.readout),
+        r.seed
     );
+    let a = &r.asd;
     let _ = writeln!(
         s,
         "ASDs: one-sided Welch, periodic Hann, {} samples per segment ({} s, df = {:.3e} Hz), \
          overlap {}, {} segments, mean",
-        wcfg.segment_len,
-        wcfg.segment_len as f64 / fs,
-        fs / wcfg.segment_len as f64,
-        wcfg.overlap,
-        n_segments
+        a.segment_len,
+        a.segment_len as f64 / fs,
+        fs / a.segment_len as f64,
+        a.overlap,
+        a.n_segments
     );
-    for (k, m) in modes.modes.iter().enumerate() {
+    for (k, m) in r.modes.modes.iter().enumerate() {
         let apparent = aliased_frequency_hz(m.frequency_hz, fs);
         let alias = if apparent != m.frequency_hz {
             format!(" (above Nyquist: appears at {apparent:.4e} Hz)")
         } else {
             String::new()
         };
-        let seen: Vec<&str> = modes
+        let seen: Vec<&str> = r
+            .modes
             .observables_seeing(k)
             .iter()
             .map(|o| o.name())
@@ -541,44 +347,74 @@ fn summary(
     s
 }
 
-/// Points of the whole-run panel of the time-series figure: the minimum and maximum of at most
-/// this many blocks of samples (the figure shows 4000 columns).
-const TIME_FIGURE_BLOCKS: usize = 1 << 15;
-
-/// Samples of X in the second panel of the time-series figure: the first quarter of the nu_1
-/// period (a fraction of a torsion period, to show the swinging oscillations).
-fn x_samples_shown(modes: &NormalModes, dt_s: f64, n: usize) -> usize {
-    let quarter_s = 0.25 / modes.modes[0].frequency_hz;
-    ((quarter_s / dt_s).ceil() as usize).clamp(2, n)
-}
-
-/// Figures 4 and 5: phi over the whole run (`(values, spacing in s)`: the series, or its
-/// min/max envelope for a long run), X over the first quarter of the nu_1 period.
-fn time_series_data(
-    (phi, phi_dt_s): (Vec<f64>, f64),
-    (x, dt_s): (Vec<f64>, f64),
-    init_source: &str,
-) -> TimeSeriesData {
-    TimeSeriesData {
-        title: format!("Simulated free motion ({init_source})"),
-        panels: vec![
-            TimePanel {
-                title: "φ: test-mass torsion, whole run (cf. Figure 4)".to_string(),
-                observable: Observable::Phi,
-                dt_s: phi_dt_s,
-                t0_s: 0.0,
-                values: phi,
-            },
-            TimePanel {
-                title: format!(
-                    "X: test-mass displacement, first {:.0} s = 1/4 of the ν1 period (cf. Figure 5)",
-                    x.len() as f64 * dt_s
-                ),
-                observable: Observable::X,
-                dt_s,
-                t0_s: 0.0,
-                values: x,
-            },
-        ],
-    }
+/// The summary as JSON (`--format json`): the numbers of the table, unrounded, and the
+/// resonance check per channel and mode.
+fn summary_json(r: &SimulateResult) -> serde_json::Value {
+    use serde_json::json;
+    let fs = r.fs_hz();
+    let modes: Vec<serde_json::Value> = r
+        .modes
+        .modes
+        .iter()
+        .enumerate()
+        .map(|(k, m)| {
+            let seen: Vec<&str> = r
+                .modes
+                .observables_seeing(k)
+                .iter()
+                .map(|o| o.name())
+                .collect();
+            json!({
+                "index": m.index,
+                "frequency_hz": m.frequency_hz,
+                "apparent_frequency_hz": aliased_frequency_hz(m.frequency_hz, fs),
+                "seen_by": seen,
+            })
+        })
+        .collect();
+    let channels: Vec<serde_json::Value> = r
+        .check
+        .channels
+        .iter()
+        .map(|c| {
+            let modes: Vec<serde_json::Value> = c
+                .modes
+                .iter()
+                .map(|m| {
+                    json!({
+                        "mode": m.mode_index,
+                        "spectrum": m.spectrum.name(),
+                        "table_seen": m.table_seen,
+                        "agrees": m.agrees(),
+                    })
+                })
+                .collect();
+            json!({ "observable": c.observable.name(), "readout_asd": c.readout_asd, "modes": modes })
+        })
+        .collect();
+    let readout: serde_json::Map<String, serde_json::Value> = r
+        .readout
+        .iter()
+        .map(|(o, a)| (o.name().to_string(), json!(a)))
+        .collect();
+    json!({
+        "samples": r.n_samples,
+        "dt_s": r.dt_s,
+        "duration_s": r.n_samples as f64 * r.dt_s,
+        "nyquist_hz": fs / 2.0,
+        "initial_state": r.init_source,
+        "readout_asd": readout,
+        "seed": r.seed,
+        "welch": {
+            "segment_len": r.asd.segment_len,
+            "overlap": r.asd.overlap,
+            "n_segments": r.asd.n_segments,
+        },
+        "modes": modes,
+        "resonance_check": {
+            "all_agree": r.check.all_agree(),
+            "tested": r.check.n_tested(),
+            "channels": channels,
+        },
+    })
 }

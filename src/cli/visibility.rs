@@ -4,13 +4,11 @@
 use super::Run;
 use anyhow::{bail, Result};
 use clap::Args;
-use std::path::{Path, PathBuf};
-use tiltnoise_core::fit::peaks::{self, RecordVisibilities, MIN_SNR};
+use std::path::PathBuf;
 use tiltnoise_core::model::Model;
-use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
-use tiltnoise_io::input::{read_measured_input, MeasuredInput};
 use tiltnoise_io::write_atomic;
+use tiltnoise_job::visibility::{VisibilityRequest, VisibilityResult};
 
 /// Arguments of `tiltnoise visibility`.
 #[derive(Debug, Args)]
@@ -35,7 +33,8 @@ enum VisibilityFormat {
     Csv,
 }
 
-/// Runs `tiltnoise visibility`.
+/// Runs `tiltnoise visibility`: the visibility job run on `--measured`, the table or the CSV
+/// printed and the CSV saved.
 pub(crate) fn run_visibility(params: &Params, args: VisibilityArgs, run: &mut Run) -> Result<()> {
     if let Some(path) = &args.save {
         if path.extension().and_then(|e| e.to_str()) != Some("csv") {
@@ -45,47 +44,16 @@ pub(crate) fn run_visibility(params: &Params, args: VisibilityArgs, run: &mut Ru
             );
         }
     }
-    let saves: Vec<&Path> = args.save.iter().map(PathBuf::as_path).collect();
-    run.check_outputs(&saves, &[("--measured", args.record.as_path())])?;
-    let series = match read_measured_input(&args.record)? {
-        MeasuredInput::Series(s) => s,
-        MeasuredInput::Spectra(_) => bail!(
-            "--measured {}: holds spectra; the visibilities need the time series (header time_s, \
-             or HDF5)",
-            args.record.display()
-        ),
-    };
     let model = Model::new(params)?;
-    let modes = NormalModes::new(&model);
-    let expected: [f64; 8] = std::array::from_fn(|k| {
-        modes
-            .modes
-            .iter()
-            .find(|m| m.index == k + 1)
-            .map_or(f64::NAN, |m| m.frequency_hz)
-    });
-    let origin = args.record.display().to_string();
-    let measured = peaks::measure(
-        &series.channels,
-        series.sample_rate_hz,
-        &expected,
-        &origin,
-        &run.cancel,
-    )?;
-    let comment = [
-        format!("mode visibilities measured from {origin} by tiltnoise visibility"),
-        format!(
-            "Hann-windowed peaks of each mode near the model's frequency; reference: the \
-             strongest channel of each unit with SNR >= {MIN_SNR}; sigma: first-order error from \
-             the local noise"
-        ),
-    ];
-    let text = measured.visibilities.to_csv(&comment);
+    let req = VisibilityRequest {
+        model: &model,
+        measured: args.record.clone(),
+    };
+    run.check_job_outputs(args.save.as_slice(), req.input_files())?;
+    let result = tiltnoise_job::visibility::run(req, &run.cancel).map_err(super::job_error)?;
+    let text = result.csv();
     match args.format {
-        VisibilityFormat::Table => {
-            let names: Vec<&str> = series.channels.iter().map(|(o, _)| o.name()).collect();
-            write!(run.out, "{}", table(&measured, &names))?;
-        }
+        VisibilityFormat::Table => write!(run.out, "{}", table(&result))?,
         VisibilityFormat::Csv => write!(run.out, "{text}")?,
     }
     let Some(path) = &args.save else {
@@ -99,8 +67,11 @@ pub(crate) fn run_visibility(params: &Params, args: VisibilityArgs, run: &mut Ru
     })
 }
 
-fn table(m: &RecordVisibilities, channels: &[&str]) -> String {
+/// The peaks and the ratios, as the terminal shows them.
+fn table(result: &VisibilityResult) -> String {
     use std::fmt::Write;
+    let m = &result.measured;
+    let channels: Vec<&str> = result.channels.iter().map(|o| o.name()).collect();
     let mut s = String::new();
     let _ = writeln!(
         s,

@@ -424,14 +424,13 @@ fn saved_files_hold_the_report_exactly() {
         measured_path: "m".into(),
         measured_start_time: None,
     };
-    let names = ("t".to_string(), "m".to_string());
+    let result = tiltnoise_job::coherence::CoherenceResult { report, inputs };
+    let report = &result.report;
     for path in [&h5, &csv] {
-        crate::output::save_coherence(
+        tiltnoise_job::coherence::save(
             path,
-            &report,
+            &result,
             &RunMeta::default(),
-            &inputs,
-            &names,
             &tiltnoise_plot::View::default(),
         )
         .unwrap();
@@ -470,12 +469,10 @@ fn saved_files_hold_the_report_exactly() {
     assert_eq!(back, want);
     // A figure drawn from the same report.
     let png = dir.path().join("r.png");
-    crate::output::save_coherence(
+    tiltnoise_job::coherence::save(
         &png,
-        &report,
+        &result,
         &RunMeta::default(),
-        &inputs,
-        &names,
         &tiltnoise_plot::View::default(),
     )
     .unwrap();

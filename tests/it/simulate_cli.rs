@@ -206,3 +206,43 @@ fn bad_input_exits_2_names_the_option_and_writes_nothing() {
     );
     assert!(listing(dir.path()).is_empty());
 }
+
+#[test]
+fn json_holds_the_numbers_of_the_table() {
+    let run = |format: &str| {
+        let out = tiltnoise(&["simulate", "--duration", "3600", "--format", format]);
+        assert!(out.status.success(), "{}", common::stderr(&out));
+        stdout(&out)
+    };
+    let (table, json) = (run("table"), run("json"));
+    let json: serde_json::Value = serde_json::from_str(&json).expect("--format json is JSON");
+    assert_eq!(json["samples"], 36_000);
+    assert!(
+        table.starts_with("free motion: 36000 samples at dt = 0.1 s"),
+        "{table}"
+    );
+    let check = &json["resonance_check"];
+    let pairs = check["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|c| c["modes"].as_array().unwrap().clone())
+        .collect::<Vec<_>>();
+    let agree = pairs.iter().filter(|m| m["agrees"] == true).count();
+    let tested = pairs.iter().filter(|m| !m["agrees"].is_null()).count();
+    assert_eq!(check["tested"], tested);
+    assert!(
+        table.contains(&format!(
+            "{agree} of {tested} testable (channel, mode) pairs agree"
+        )),
+        "{table}"
+    );
+    for m in json["modes"].as_array().unwrap() {
+        let line = format!(
+            "  nu_{} {:>11.4e} Hz",
+            m["index"],
+            m["frequency_hz"].as_f64().unwrap()
+        );
+        assert!(table.contains(&line), "{line} in {table}");
+    }
+}

@@ -388,6 +388,7 @@ fn commands_that_print_a_summary_take_format() {
             "mc",
             "methods",
             "tf",
+            "simulate",
         ]
         .contains(&command.as_str())
         {

@@ -12,7 +12,9 @@ use tiltnoise_core::model::{Model, Observable, TiltAxis};
 use tiltnoise_io::input::{
     parse_start_time, read_measured_input, read_start_time, read_tilt_series, MeasuredInput,
 };
-use tiltnoise_io::CoherenceInputs;
+use tiltnoise_io::{
+    write_coherence_csv, write_coherence_hdf5, CoherenceInputs, OutputError, OutputKind, RunMeta,
+};
 
 /// A coherence analysis to run.
 pub struct CoherenceRequest<'a> {
@@ -150,4 +152,37 @@ pub fn run(req: CoherenceRequest<'_>, cancel: &Cancel) -> Result<CoherenceResult
             measured_start_time: measured_start,
         },
     })
+}
+
+/// Saves a coherence report in the format named by the extension of `path`: HDF5 (schema
+/// `tiltnoise.coherence`, with `meta` and the records' provenance), CSV, or the PNG/SVG figure
+/// titled with the records' names and drawn with `view`; atomically, the same for every front
+/// end.
+///
+/// # Errors
+///
+/// [`OutputError::UnknownFormat`] for another extension (nothing is written), or the writer's
+/// [`OutputError::Write`] naming `path`.
+pub fn save(
+    path: &std::path::Path,
+    result: &CoherenceResult,
+    meta: &RunMeta,
+    view: &tiltnoise_plot::View,
+) -> Result<(), OutputError> {
+    let (report, inputs) = (&result.report, &result.inputs);
+    match OutputKind::from_path(path)? {
+        OutputKind::Hdf5 => write_coherence_hdf5(path, report, meta, inputs),
+        OutputKind::Csv => write_coherence_csv(path, report, meta),
+        OutputKind::Png | OutputKind::Svg => {
+            let options = tiltnoise_plot::CoherenceFigureOptions {
+                tilt_name: inputs.tilt.path.clone(),
+                measured_name: inputs.measured_path.clone(),
+                view: view.clone(),
+                ..tiltnoise_plot::CoherenceFigureOptions::default()
+            };
+            crate::save_image(path, |format| {
+                tiltnoise_plot::coherence_figure(report, format, &options)
+            })
+        }
+    }
 }

@@ -9,13 +9,18 @@ use tiltnoise_core::budget::option_checks::{
 use tiltnoise_core::budget::BudgetError;
 use tiltnoise_core::cancel::Cancelled;
 use tiltnoise_core::coherence::CoherenceError;
+use tiltnoise_core::error::OutputError;
 use tiltnoise_core::error::{FreqError, TfError};
 use tiltnoise_core::error::{Num, Shown};
+use tiltnoise_core::fit::FitError;
 use tiltnoise_core::input::InputError;
 use tiltnoise_core::mc::McError;
 use tiltnoise_core::model::Observable;
 use tiltnoise_core::option_key::{self, OptionKey};
+use tiltnoise_core::options::OptionError;
 use tiltnoise_core::repeats::Repeated;
+use tiltnoise_core::simulate::SimError;
+use tiltnoise_core::spectral::SpectralError;
 use tiltnoise_core::tf::planner::NoChoice;
 use tiltnoise_core::tf::PlanError;
 
@@ -100,6 +105,19 @@ pub enum JobError {
     MonteCarlo(Box<McError>),
     /// The run was cancelled.
     Cancelled,
+    /// An option's value the library refused (its message names the option).
+    Refused(Box<OptionError>),
+    /// A simulation that cannot run as asked (or was cancelled).
+    Simulate(Box<SimError>),
+    /// A fit, or a measurement of visibilities, that failed (a file it reads names itself).
+    Fit(Box<FitError>),
+    /// A file of measured frequencies or visibilities that cannot be read or is not valid
+    /// (the error names it).
+    FitFile(Box<FitError>),
+    /// The spectra of a simulated record.
+    Spectral(Box<SpectralError>),
+    /// An output the job writes while it runs (a record streamed to its file).
+    Output(Box<OutputError>),
 }
 
 impl JobError {
@@ -194,6 +212,11 @@ impl JobError {
             JobError::Freq(e) => e.to_string(),
             JobError::MonteCarlo(e) => e.to_string(),
             JobError::Cancelled => Cancelled.to_string(),
+            JobError::Refused(e) => e.to_string(),
+            JobError::Simulate(e) => e.to_string(),
+            JobError::Fit(e) | JobError::FitFile(e) => e.to_string(),
+            JobError::Spectral(e) => e.to_string(),
+            JobError::Output(e) => e.to_string(),
         }
     }
 
@@ -245,6 +268,8 @@ const KEYS: &[&str] = &[
     "save",
     "set",
     "params",
+    "free",
+    "drive_gain",
 ];
 
 /// `name` as the front end in use spells it (itself when it is not a known key).
@@ -271,6 +296,11 @@ impl std::error::Error for JobError {
             JobError::Tf(e) => Some(e.as_ref()),
             JobError::Freq(e) => Some(e.as_ref()),
             JobError::MonteCarlo(e) => Some(e.as_ref()),
+            JobError::Refused(e) => Some(e.as_ref()),
+            JobError::Simulate(e) => Some(e.as_ref()),
+            JobError::Fit(e) | JobError::FitFile(e) => Some(e.as_ref()),
+            JobError::Spectral(e) => Some(e.as_ref()),
+            JobError::Output(e) => Some(e.as_ref()),
             _ => None,
         }
     }
@@ -279,6 +309,30 @@ impl std::error::Error for JobError {
 impl From<InputError> for JobError {
     fn from(e: InputError) -> JobError {
         JobError::Input(Box::new(e))
+    }
+}
+
+macro_rules! from_boxed {
+    ($($ty:ident => $variant:ident),*) => {$(
+        impl From<$ty> for JobError {
+            fn from(e: $ty) -> JobError {
+                JobError::$variant(Box::new(e))
+            }
+        }
+    )*};
+}
+
+from_boxed!(
+    OptionError => Refused,
+    SimError => Simulate,
+    FitError => Fit,
+    SpectralError => Spectral,
+    OutputError => Output
+);
+
+impl From<tiltnoise_core::limits::LimitError> for JobError {
+    fn from(e: tiltnoise_core::limits::LimitError) -> JobError {
+        JobError::Simulate(Box::new(SimError::TooLarge(e)))
     }
 }
 

@@ -66,7 +66,7 @@ pub const MIN_SAMPLES: usize = 64;
 const PADDING: usize = 2;
 
 /// One mode's peak in the record.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ModePeak {
     /// Label of the mode (nu_k).
     pub mode: usize,
@@ -79,7 +79,7 @@ pub struct ModePeak {
 }
 
 /// The visibilities of a record and the peaks they were read from.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RecordVisibilities {
     /// The ratios (origin: the record's name).
     pub visibilities: Visibilities,

@@ -51,7 +51,7 @@ pub struct MeasuredVisibility {
 }
 
 /// A set of measured visibilities, sorted by (mode, observable, reference).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Visibilities {
     /// The ratios.
     pub items: Vec<MeasuredVisibility>,

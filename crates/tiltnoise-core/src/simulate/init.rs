@@ -4,9 +4,7 @@
 //! given coordinates and rates, or equal energy in every mode), with messages that name the
 //! option as the caller spells it ([`OptionKey`]).
 
-use super::{
-    check_initial_state, check_samples, equal_energy_init, kick_x, InitialState, Simulation,
-};
+use super::{check_initial_state, check_samples, equal_energy_init, kick_x, InitialState};
 use crate::error::{Num, Shown};
 use crate::limits::MIN_SAMPLE;
 use crate::model::{Coord, Model, Observable};
@@ -237,12 +235,14 @@ pub const MAX_DEFAULT_SIM_NPERSEG: usize = 1 << 18;
 
 /// The number of samples of `duration_s` at `step_s` and the Welch segment (`nperseg`, or
 /// [`default_sim_nperseg`]), checked: a finite positive step and duration, at least two
-/// samples and not more than the limits allow, a segment of at least [`MIN_SIM_NPERSEG`]
-/// samples that fits into the record.
+/// samples and not more than the limits allow (those of a record held whole, or, when
+/// `streamed`, of one that streams chunk by chunk: [`super::stream::check_streamed_samples`]),
+/// a segment of at least [`MIN_SIM_NPERSEG`] samples that fits into the record.
 pub fn check_sampling(
     duration_s: f64,
     step_s: f64,
     nperseg: Option<usize>,
+    streamed: bool,
 ) -> Result<(usize, usize), OptionError> {
     let (step, duration) = (OptionKey::STEP, OptionKey::DURATION);
     if !(step_s.is_finite() && step_s > 0.0) {
@@ -262,16 +262,17 @@ pub fn check_sampling(
              are needed"
         )));
     }
-    check_samples(
-        || {
-            format!(
-                "{duration} {} s at {step} {} s",
-                Num(duration_s),
-                Num(step_s)
-            )
-        },
-        n_f,
-    )?;
+    let what = || {
+        format!(
+            "{duration} {} s at {step} {} s",
+            Num(duration_s),
+            Num(step_s)
+        )
+    };
+    match streamed {
+        true => super::stream::check_streamed_samples(what, n_f)?,
+        false => check_samples(what, n_f)?,
+    }
     let n = n_f as usize;
     let seg = nperseg.unwrap_or_else(|| default_sim_nperseg(n));
     let option = OptionKey::NPERSEG;
@@ -308,17 +309,15 @@ pub fn readout_text(readout: &[(Observable, f64)]) -> String {
 /// One sentence on a run: samples, step, initial state, readout and seed (the caption of its
 /// figures and the description of its files).
 pub fn describe_run(
-    sim: &Simulation,
+    (n_samples, dt_s): (usize, f64),
     init_source: &str,
     readout: &[(Observable, f64)],
     seed: u64,
 ) -> String {
     format!(
-        "{} samples at {} s ({} s), exact modal propagation of the undamped model; initial \
-         state: {init_source}; readout: {}; seed {seed}.",
-        sim.len(),
-        sim.dt_s,
-        sim.len() as f64 * sim.dt_s,
+        "{n_samples} samples at {dt_s} s ({} s), exact modal propagation of the undamped \
+         model; initial state: {init_source}; readout: {}; seed {seed}.",
+        n_samples as f64 * dt_s,
         readout_text(readout),
     )
 }
@@ -394,7 +393,7 @@ mod tests {
     #[test]
     fn sampling_is_checked() {
         assert_eq!(
-            check_sampling(43_200.0, 0.1, None).unwrap(),
+            check_sampling(43_200.0, 0.1, None, false).unwrap(),
             (432_000, 1 << 17)
         );
         let cases = [
@@ -424,9 +423,12 @@ mod tests {
             ),
         ];
         for (d, s, n, want) in cases {
-            assert_eq!(check_sampling(d, s, n).unwrap_err().to_string(), want);
+            assert_eq!(
+                check_sampling(d, s, n, false).unwrap_err().to_string(),
+                want
+            );
         }
-        let e = check_sampling(10.0, 0.1, Some(128)).unwrap_err();
+        let e = check_sampling(10.0, 0.1, Some(128), false).unwrap_err();
         assert_eq!(
             e.to_string(),
             "duration 10 s at step 0.1 s gives 100 samples, shorter than one Welch segment \
