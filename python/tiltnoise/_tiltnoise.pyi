@@ -311,6 +311,7 @@ class Subtraction:
     def __reduce__(self) -> Tuple[Any, Tuple[int, bytes]]: ...
     @staticmethod
     def _from_state(version: int, state: bytes) -> Subtraction: ...
+
 @final
 class Visibilities:
     @property

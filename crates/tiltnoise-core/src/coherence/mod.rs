@@ -45,7 +45,8 @@ use crate::spectral::confidence::{
     tf_sigma,
 };
 use crate::spectral::{
-    coherence, csd_matrix_cancellable, multiple_input, SpectralError, WelchConfig,
+    coherence, csd_matrix_cancellable, multiple_input, CrossSpectra, MultipleInput, SpectralError,
+    WelchConfig,
 };
 use crate::tf::{self, Scene};
 use num_complex::Complex64;
@@ -265,62 +266,14 @@ pub fn coherence_from_series(
             OptionKey::NPERSEG
         )));
     }
-    let mut channels: Vec<&[f64]> = tilt
-        .channels
-        .iter()
-        .map(|(_, x)| &x[alignment.start_a..alignment.start_a + n])
-        .collect();
-    channels.extend(
-        measured
-            .channels
-            .iter()
-            .map(|(_, x)| &x[alignment.start_b..alignment.start_b + n]),
-    );
-    let names: Vec<String> = tilt
-        .channels
-        .iter()
-        .map(|(a, _)| format!("{} of {}", a.name(), tilt.name))
-        .chain(
-            measured
-                .channels
-                .iter()
-                .map(|(o, _)| format!("{} of {}", o.name(), measured.name)),
-        )
-        .collect();
-    // A constant channel has no power above DC; its Welch estimate would be rounding noise.
-    for (x, name) in channels.iter().zip(&names) {
-        if let Some(&first) = x.first().filter(|&&v| x.iter().all(|&w| w == v)) {
-            let what = match first == 0.0 {
-                true => "zero at every sample".to_string(),
-                false => format!("constant ({})", Num(first)),
-            };
-            return Err(CoherenceError::Config(format!(
-                "{name} is {what} over the common stretch: it has no power above DC to \
-                 analyse; leave it out"
-            )));
-        }
-    }
+    let (channels, names) = common_stretch(tilt, measured, &alignment);
+    check_not_constant(&channels, &names)?;
     let mut spectra = csd_matrix_cancellable(&channels, fs, &cfg, &opts.cancel)?;
     if opts.tilt_quantity == crate::input::Quantity::Rate {
         let rates: Vec<usize> = (0..tilt.channels.len()).collect();
         crate::input::rate::rate_channels_to_angle(&mut spectra, &rates);
     }
-
-    for (c, name) in names.iter().enumerate() {
-        let psd = spectra.psd(c);
-        if psd.iter().any(|p| !p.is_finite()) {
-            return Err(CoherenceError::Config(format!(
-                "the power spectrum of {name} overflows f64: its samples are far too large for \
-                 its unit (check the file's units)"
-            )));
-        }
-        if psd[1..].iter().all(|&p| p == 0.0) {
-            return Err(CoherenceError::Config(format!(
-                "{name} has no power at any frequency above DC (the series is constant): it \
-                 cannot be analysed; leave it out"
-            )));
-        }
-    }
+    check_spectra(&spectra, &names)?;
     let inputs: Vec<usize> = (0..q).collect();
     let outputs: Vec<usize> = (q..q + measured.channels.len()).collect();
     let mimo = multiple_input(&spectra, &inputs, &outputs)?;
@@ -343,94 +296,31 @@ pub fn coherence_from_series(
     }
     let level = opts.confidence;
     let alpha = 1.0 - level;
-    // Remove the phase of a sub-sample offset between the grids: exp(-i w r).
-    let r = alignment.residual_offset_s;
-    let unshift =
-        |k: usize| Complex64::from_polar(1.0, -2.0 * std::f64::consts::PI * freqs_hz[k] * r);
     let (model_tf, model_smoothed) =
         model_tf(model, &measured.channels, &axes, &freqs_hz, cfg.segment_len)?;
-    let correlation = bin_correlation(cfg.segment_len);
     let mc_threshold = coherence_threshold(n_d, q, alpha);
     let mut notes = alignment.notes.clone();
-    let mut observables = Vec::new();
-    for (o, (obs, _)) in measured.channels.iter().enumerate() {
-        let y = q + o;
-        let at = |k: usize| k + 1;
-        let mc: Vec<f64> = (0..nf)
-            .map(|k| mimo.multiple_coherence_at(at(k), o))
-            .collect();
-        let (mc_lo, mc_hi) = intervals(&mc, n_d, q, level);
-        let residual_psd: Vec<f64> = (0..nf).map(|k| mimo.residual_psd_at(at(k), o)).collect();
-        let mut per_axis = Vec::new();
-        for (i, &axis) in axes.iter().enumerate() {
-            let coh = coherence(&spectra, i, y)[1..].to_vec();
-            let (coh_lo, coh_hi) = intervals(&coh, n_d, 1, level);
-            let tf: Vec<Complex64> = (0..nf)
-                .map(|k| mimo.tf_at(at(k), o, i) * unshift(k))
-                .collect();
-            let radius: Vec<f64> = (0..nf)
-                .map(|k| {
-                    let (nn, inv) = (residual_psd[k], mimo.inverse_diagonal_at(at(k), i));
-                    tf_radius(nn, inv, n_d, q, level)
-                })
-                .collect();
-            let sigma: Vec<f64> = (0..nf)
-                .map(|k| tf_sigma(residual_psd[k], mimo.inverse_diagonal_at(at(k), i), n_d, q))
-                .collect();
-            let model_entry: Vec<Complex64> = (0..nf).map(|k| model_tf.get(k, o, i)).collect();
-            let smoothed = &model_smoothed[o * q + i];
-            let model_resolved: Vec<bool> = (0..nf)
-                .map(|k| (smoothed[k] - model_entry[k]).norm() <= RESOLUTION_FRACTION * sigma[k])
-                .collect();
-            let unresolved = (0..nf)
-                .filter(|&k| estimable[k] && !model_resolved[k])
-                .count();
-            if unresolved > 0 {
-                notes.push(format!(
-                    "{}/{}: {unresolved} of {nf} bins are left out of the measured/model fit: \
-                     the model varies across the Welch resolution there by more than {} of the \
-                     bin's standard error (resonances, the lowest bins)",
-                    obs.name(),
-                    axis.name(),
-                    RESOLUTION_FRACTION
-                ));
-            }
-            // Every estimable bin of the band, whatever its coherence: selecting bins by their
-            // estimated coherence would select underestimated residuals, and so errors.
-            let usable: Vec<bool> = (0..nf)
-                .map(|k| {
-                    estimable[k]
-                        && model_resolved[k]
-                        && opts
-                            .fit_band_hz
-                            .is_none_or(|(lo, hi)| (lo..=hi).contains(&freqs_hz[k]))
-                })
-                .collect();
-            let agreement =
-                fit_agreement(&freqs_hz, &tf, &sigma, &model_entry, &usable, correlation);
-            per_axis.push(AxisEstimate {
-                axis,
-                coherence: coh,
-                coherence_lower: coh_lo,
-                coherence_upper: coh_hi,
-                tf,
-                tf_radius: radius,
-                tf_sigma: sigma,
-                model: model_entry,
-                model_resolved,
-                agreement,
-            });
-        }
-        observables.push(ObservableEstimate {
-            observable: *obs,
-            psd: spectra.psd(y)[1..].to_vec(),
-            multiple_coherence: mc,
-            multiple_coherence_lower: mc_lo,
-            multiple_coherence_upper: mc_hi,
-            residual_psd,
-            axes: per_axis,
-        });
-    }
+    let estimation = Estimation {
+        spectra: &spectra,
+        mimo: &mimo,
+        q,
+        nf,
+        n_d,
+        level,
+        freqs_hz: &freqs_hz,
+        estimable: &estimable,
+        residual_offset_s: alignment.residual_offset_s,
+        model_tf: &model_tf,
+        model_smoothed: &model_smoothed,
+        correlation: bin_correlation(cfg.segment_len),
+        fit_band_hz: opts.fit_band_hz,
+    };
+    let observables = measured
+        .channels
+        .iter()
+        .enumerate()
+        .map(|(o, (obs, _))| estimation.observable(o, *obs, &axes, &mut notes))
+        .collect();
     let missing = estimable.iter().filter(|&&e| !e).count();
     if missing > 0 {
         let first = estimable.iter().position(|&e| !e).unwrap_or(0);
@@ -464,6 +354,221 @@ pub fn coherence_from_series(
         fit_band_hz: opts.fit_band_hz,
         notes,
     })
+}
+
+/// The channels over the common stretch (the tilt axes, then the measured observables), with
+/// the names that messages give them.
+fn common_stretch<'a>(
+    tilt: &Record<'a, TiltAxis>,
+    measured: &Record<'a, Observable>,
+    alignment: &Alignment,
+) -> (Vec<&'a [f64]>, Vec<String>) {
+    let n = alignment.len;
+    let mut channels: Vec<&[f64]> = tilt
+        .channels
+        .iter()
+        .map(|(_, x)| &x[alignment.start_a..alignment.start_a + n])
+        .collect();
+    channels.extend(
+        measured
+            .channels
+            .iter()
+            .map(|(_, x)| &x[alignment.start_b..alignment.start_b + n]),
+    );
+    let names: Vec<String> = tilt
+        .channels
+        .iter()
+        .map(|(a, _)| format!("{} of {}", a.name(), tilt.name))
+        .chain(
+            measured
+                .channels
+                .iter()
+                .map(|(o, _)| format!("{} of {}", o.name(), measured.name)),
+        )
+        .collect();
+    (channels, names)
+}
+
+/// A constant channel has no power above DC; its Welch estimate would be rounding noise.
+fn check_not_constant(channels: &[&[f64]], names: &[String]) -> Result<(), CoherenceError> {
+    for (x, name) in channels.iter().zip(names) {
+        if let Some(&first) = x.first().filter(|&&v| x.iter().all(|&w| w == v)) {
+            let what = match first == 0.0 {
+                true => "zero at every sample".to_string(),
+                false => format!("constant ({})", Num(first)),
+            };
+            return Err(CoherenceError::Config(format!(
+                "{name} is {what} over the common stretch: it has no power above DC to \
+                 analyse; leave it out"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Every channel's power spectrum finite and not zero above DC.
+fn check_spectra(spectra: &CrossSpectra, names: &[String]) -> Result<(), CoherenceError> {
+    for (c, name) in names.iter().enumerate() {
+        let psd = spectra.psd(c);
+        if psd.iter().any(|p| !p.is_finite()) {
+            return Err(CoherenceError::Config(format!(
+                "the power spectrum of {name} overflows f64: its samples are far too large for \
+                 its unit (check the file's units)"
+            )));
+        }
+        if psd[1..].iter().all(|&p| p == 0.0) {
+            return Err(CoherenceError::Config(format!(
+                "{name} has no power at any frequency above DC (the series is constant): it \
+                 cannot be analysed; leave it out"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// What every observable's estimate reads, on bins 1.. (DC left out): the spectra (tilt axes
+/// first, `q` of them) and their multiple-input solution, the model, the statistics.
+struct Estimation<'a> {
+    spectra: &'a CrossSpectra,
+    mimo: &'a MultipleInput,
+    q: usize,
+    nf: usize,
+    n_d: f64,
+    level: f64,
+    freqs_hz: &'a [f64],
+    estimable: &'a [bool],
+    residual_offset_s: f64,
+    model_tf: &'a tf::TransferMatrix,
+    model_smoothed: &'a [Vec<Complex64>],
+    correlation: [f64; 3],
+    fit_band_hz: Option<(f64, f64)>,
+}
+
+impl Estimation<'_> {
+    /// The Welch bin of entry `k` (DC left out).
+    fn at(k: usize) -> usize {
+        k + 1
+    }
+
+    /// Removes the phase of a sub-sample offset between the grids: exp(-i w r).
+    fn unshift(&self, k: usize) -> Complex64 {
+        Complex64::from_polar(
+            1.0,
+            -2.0 * std::f64::consts::PI * self.freqs_hz[k] * self.residual_offset_s,
+        )
+    }
+
+    /// Measured observable `o` against every tilt axis.
+    fn observable(
+        &self,
+        o: usize,
+        obs: Observable,
+        axes: &[TiltAxis],
+        notes: &mut Vec<String>,
+    ) -> ObservableEstimate {
+        let (mimo, nf, q) = (self.mimo, self.nf, self.q);
+        let y = q + o;
+        let mc: Vec<f64> = (0..nf)
+            .map(|k| mimo.multiple_coherence_at(Self::at(k), o))
+            .collect();
+        let (mc_lo, mc_hi) = intervals(&mc, self.n_d, q, self.level);
+        let residual_psd: Vec<f64> = (0..nf)
+            .map(|k| mimo.residual_psd_at(Self::at(k), o))
+            .collect();
+        let per_axis = axes
+            .iter()
+            .enumerate()
+            .map(|(i, &axis)| self.axis(o, obs, i, axis, &residual_psd, notes))
+            .collect();
+        ObservableEstimate {
+            observable: obs,
+            psd: self.spectra.psd(y)[1..].to_vec(),
+            multiple_coherence: mc,
+            multiple_coherence_lower: mc_lo,
+            multiple_coherence_upper: mc_hi,
+            residual_psd,
+            axes: per_axis,
+        }
+    }
+
+    /// Measured observable `o` against tilt axis `i`, and its agreement with the model.
+    fn axis(
+        &self,
+        o: usize,
+        obs: Observable,
+        i: usize,
+        axis: TiltAxis,
+        residual_psd: &[f64],
+        notes: &mut Vec<String>,
+    ) -> AxisEstimate {
+        let (mimo, nf, q, n_d, level) = (self.mimo, self.nf, self.q, self.n_d, self.level);
+        let (freqs_hz, estimable) = (self.freqs_hz, self.estimable);
+        let at = Self::at;
+        let y = q + o;
+        let coh = coherence(self.spectra, i, y)[1..].to_vec();
+        let (coh_lo, coh_hi) = intervals(&coh, n_d, 1, level);
+        let tf: Vec<Complex64> = (0..nf)
+            .map(|k| mimo.tf_at(at(k), o, i) * self.unshift(k))
+            .collect();
+        let radius: Vec<f64> = (0..nf)
+            .map(|k| {
+                let (nn, inv) = (residual_psd[k], mimo.inverse_diagonal_at(at(k), i));
+                tf_radius(nn, inv, n_d, q, level)
+            })
+            .collect();
+        let sigma: Vec<f64> = (0..nf)
+            .map(|k| tf_sigma(residual_psd[k], mimo.inverse_diagonal_at(at(k), i), n_d, q))
+            .collect();
+        let model_entry: Vec<Complex64> = (0..nf).map(|k| self.model_tf.get(k, o, i)).collect();
+        let smoothed = &self.model_smoothed[o * q + i];
+        let model_resolved: Vec<bool> = (0..nf)
+            .map(|k| (smoothed[k] - model_entry[k]).norm() <= RESOLUTION_FRACTION * sigma[k])
+            .collect();
+        let unresolved = (0..nf)
+            .filter(|&k| estimable[k] && !model_resolved[k])
+            .count();
+        if unresolved > 0 {
+            notes.push(format!(
+                "{}/{}: {unresolved} of {nf} bins are left out of the measured/model fit: \
+                 the model varies across the Welch resolution there by more than {} of the \
+                 bin's standard error (resonances, the lowest bins)",
+                obs.name(),
+                axis.name(),
+                RESOLUTION_FRACTION
+            ));
+        }
+        // Every estimable bin of the band, whatever its coherence: selecting bins by their
+        // estimated coherence would select underestimated residuals, and so errors.
+        let usable: Vec<bool> = (0..nf)
+            .map(|k| {
+                estimable[k]
+                    && model_resolved[k]
+                    && self
+                        .fit_band_hz
+                        .is_none_or(|(lo, hi)| (lo..=hi).contains(&freqs_hz[k]))
+            })
+            .collect();
+        let agreement = fit_agreement(
+            freqs_hz,
+            &tf,
+            &sigma,
+            &model_entry,
+            &usable,
+            self.correlation,
+        );
+        AxisEstimate {
+            axis,
+            coherence: coh,
+            coherence_lower: coh_lo,
+            coherence_upper: coh_hi,
+            tf,
+            tf_radius: radius,
+            tf_sigma: sigma,
+            model: model_entry,
+            model_resolved,
+            agreement,
+        }
+    }
 }
 
 /// At least one channel, all of the same length, every sample finite.

@@ -421,146 +421,37 @@ pub fn fit_with_visibilities(
     let vis = &visibilities.items;
     let free = check_config(params, (measured.modes.len(), vis.len()), config)?;
     let n = config.bound_sigmas;
-    let keys: Vec<String> = free.iter().map(|f| f.key.clone()).collect();
-    let m = measured.modes.len();
-    let data_rows = m + vis.len();
-    let ranks: Vec<usize> = measured.modes.iter().map(|x| x.mode - 1).collect();
-    let at = |u: &DVector<f64>| -> Result<Params, FitError> {
-        free.iter()
-            .zip(u.iter())
-            .try_fold(params.clone(), |p, (f, &ui)| {
-                jacobian::with_value(&p, &f.key, f.nominal + ui * f.sigma)
-            })
+    let problem = Problem {
+        params,
+        measured,
+        vis,
+        keys: free.iter().map(|f| f.key.clone()).collect(),
+        free: &free,
+        ranks: measured.modes.iter().map(|x| x.mode - 1).collect(),
+        data_rows: measured.modes.len() + vis.len(),
+        config,
     };
-    // Frequency rows, visibility rows, then (with the prior) one row u_j per parameter.
-    // Once cancelled every evaluation fails, which the minimizer takes as rejected steps
-    // until its damping runs out (a few dozen cheap rounds); the check after it returns.
-    let residuals = |u: &DVector<f64>| -> Result<Evaluation, FitError> {
-        config.cancel.check()?;
-        let e = jacobian::evaluate(&at(u)?, &keys, vis)?;
-        let rows = data_rows + if config.prior { free.len() } else { 0 };
-        let mut r = DVector::zeros(rows);
-        let mut jac = DMatrix::zeros(rows, free.len());
-        for (i, (x, &k)) in measured.modes.iter().zip(&ranks).enumerate() {
-            r[i] = (e.frequencies_hz[k] - x.frequency_hz) / x.sigma_hz;
-            for (j, f) in free.iter().enumerate() {
-                jac[(i, j)] = e.frequency_jacobian[(k, j)] * f.sigma / x.sigma_hz;
-            }
-        }
-        for (i, v) in vis.iter().enumerate() {
-            r[m + i] = (e.ratios[i] - v.ratio) / v.sigma;
-            for (j, f) in free.iter().enumerate() {
-                jac[(m + i, j)] = e.ratio_jacobian[(i, j)] * f.sigma / v.sigma;
-            }
-        }
-        if config.prior {
-            for j in 0..free.len() {
-                r[data_rows + j] = u[j];
-                jac[(data_rows + j, j)] = 1.0;
-            }
-        }
-        Ok((r, jac, e.frequencies_hz, e.ratios))
-    };
-    let nominal = at(&DVector::zeros(free.len()))?;
+    let data_rows = problem.data_rows;
+    let ranks = &problem.ranks;
+    let nominal = problem.at(&DVector::zeros(free.len()))?;
     let nominal_model = crate::model::Model::new(&nominal).map_err(FitError::Params)?;
     let nominal_freqs = jacobian::evaluate(&nominal, &[], &[])?.frequencies_hz;
     let nominal_ratios = nominal_ratios(&nominal_model, vis);
-    let chi2_nominal = measured
-        .modes
-        .iter()
-        .zip(&ranks)
-        .map(|(x, &k)| ((nominal_freqs[k] - x.frequency_hz) / x.sigma_hz).powi(2))
-        .chain(
-            vis.iter()
-                .zip(&nominal_ratios)
-                .map(|(v, r)| ((r - v.ratio) / v.sigma).powi(2)),
-        )
-        .sum::<f64>();
-    let opts = lm::LmOptions {
-        gtol: GTOL,
-        max_iterations: MAX_ITERATIONS,
-    };
-    let mut best: Option<(lm::LmOutcome, DVector<f64>)> = None;
-    let mut evaluations = 0;
-    for u0 in starts(&free, n) {
-        let out = lm::minimize(u0.clone(), n, &opts, |u| {
-            residuals(u).map(|(r, j, _, _)| (r, j))
-        })?;
-        config.cancel.check()?;
-        evaluations += out.evaluations;
-        if best
-            .as_ref()
-            .is_none_or(|(b, _)| out.r.norm_squared() < b.r.norm_squared())
-        {
-            best = Some((out, u0));
-        }
-    }
-    let (out, u_start) = best.expect("at least one start");
-    let fitted_params = at(&out.u)?;
-    let (_, _, fitted_freqs, fitted_ratios) = residuals(&out.u)?;
+    let chi2_nominal = problem.chi2(&nominal_freqs, &nominal_ratios);
+    let (out, u_start, evaluations) = problem.best_of_starts(n)?;
+    let fitted_params = problem.at(&out.u)?;
+    let (_, _, fitted_freqs, fitted_ratios) = problem.residuals(&out.u)?;
 
     let data_jac = out.jac.rows(0, data_rows).into_owned();
-    let data_sigma_rel = diag_of_inverse(&data_jac);
-    let at_bound: Vec<Option<Bound>> = out
-        .u
-        .iter()
-        .map(|&ui| match ui {
-            x if x >= n => Some(Bound::Upper),
-            x if x <= -n => Some(Bound::Lower),
-            _ => None,
-        })
-        .collect();
-    let inside: Vec<usize> = (0..free.len()).filter(|&j| at_bound[j].is_none()).collect();
-    let covariance = covariance(&out.jac.select_columns(&inside));
-    let mut correlation = vec![vec![f64::NAN; free.len()]; free.len()];
-    for (a, &i) in inside.iter().enumerate() {
-        for (b, &j) in inside.iter().enumerate() {
-            correlation[i][j] =
-                covariance[(a, b)] / (covariance[(a, a)] * covariance[(b, b)]).sqrt();
-        }
-    }
-    let params_out = free
-        .iter()
-        .enumerate()
-        .map(|(j, f)| FittedParam {
-            key: f.key.clone(),
-            unit: f.unit.clone(),
-            nominal: f.nominal,
-            fitted: f.nominal + out.u[j] * f.sigma,
-            prior_sigma: f.sigma,
-            fitted_sigma: inside
-                .iter()
-                .position(|&i| i == j)
-                .map(|pos| covariance[(pos, pos)].sqrt() * f.sigma),
-            at_bound: at_bound[j],
-            data_sigma_rel: data_sigma_rel[j],
-            poorly_constrained: data_sigma_rel[j] >= 1.0,
-        })
-        .collect();
-    let svd = data_jac.clone().svd(false, true);
-    let v_t = svd.v_t.expect("requested");
-    let mut order: Vec<usize> = (0..svd.singular_values.len()).collect();
-    order.sort_by(|&a, &b| svd.singular_values[b].total_cmp(&svd.singular_values[a]));
-    let singular_values: Vec<f64> = order.iter().map(|&i| svd.singular_values[i]).collect();
-    let weak_directions = order
-        .iter()
-        .filter(|&&i| svd.singular_values[i] < 1.0)
-        .map(|&i| WeakDirection {
-            singular_value: svd.singular_values[i],
-            direction: keys
-                .iter()
-                .enumerate()
-                .map(|(j, k)| (k.clone(), v_t[(i, j)]))
-                .collect(),
-        })
-        .collect();
+    let (params_out, correlation) = uncertainties(&free, &out, &data_jac, n);
+    let (singular_values, weak_directions) = weak_directions(&data_jac, &problem.keys);
     let chi2 = out.r.rows(0, data_rows).norm_squared();
     Ok(FitResult {
         params: params_out,
         modes: measured
             .modes
             .iter()
-            .zip(&ranks)
+            .zip(ranks)
             .map(|(x, &k)| ModeFit {
                 measured: x.clone(),
                 nominal_hz: nominal_freqs[k],
@@ -602,6 +493,177 @@ pub fn fit_with_visibilities(
         projected_gradient: out.projected_gradient,
         config: config.clone(),
     })
+}
+
+/// The least-squares problem in the scaled variables `u` (module docs).
+struct Problem<'a> {
+    params: &'a Params,
+    measured: &'a Measured,
+    vis: &'a [MeasuredVisibility],
+    free: &'a [Free],
+    keys: Vec<String>,
+    /// Per measured mode, its index among the model's eight.
+    ranks: Vec<usize>,
+    /// Frequency rows, then visibility rows.
+    data_rows: usize,
+    config: &'a FitConfig,
+}
+
+impl Problem<'_> {
+    /// The parameter set at `u`.
+    fn at(&self, u: &DVector<f64>) -> Result<Params, FitError> {
+        self.free
+            .iter()
+            .zip(u.iter())
+            .try_fold(self.params.clone(), |p, (f, &ui)| {
+                jacobian::with_value(&p, &f.key, f.nominal + ui * f.sigma)
+            })
+    }
+
+    /// Frequency rows, visibility rows, then (with the prior) one row u_j per parameter.
+    /// Once cancelled every evaluation fails, which the minimizer takes as rejected steps
+    /// until its damping runs out (a few dozen cheap rounds); the check after it returns.
+    fn residuals(&self, u: &DVector<f64>) -> Result<Evaluation, FitError> {
+        let (free, vis, data_rows, config) = (self.free, self.vis, self.data_rows, self.config);
+        let m = self.measured.modes.len();
+        config.cancel.check()?;
+        let e = jacobian::evaluate(&self.at(u)?, &self.keys, vis)?;
+        let rows = data_rows + if config.prior { free.len() } else { 0 };
+        let mut r = DVector::zeros(rows);
+        let mut jac = DMatrix::zeros(rows, free.len());
+        for (i, (x, &k)) in self.measured.modes.iter().zip(&self.ranks).enumerate() {
+            r[i] = (e.frequencies_hz[k] - x.frequency_hz) / x.sigma_hz;
+            for (j, f) in free.iter().enumerate() {
+                jac[(i, j)] = e.frequency_jacobian[(k, j)] * f.sigma / x.sigma_hz;
+            }
+        }
+        for (i, v) in vis.iter().enumerate() {
+            r[m + i] = (e.ratios[i] - v.ratio) / v.sigma;
+            for (j, f) in free.iter().enumerate() {
+                jac[(m + i, j)] = e.ratio_jacobian[(i, j)] * f.sigma / v.sigma;
+            }
+        }
+        if config.prior {
+            for j in 0..free.len() {
+                r[data_rows + j] = u[j];
+                jac[(data_rows + j, j)] = 1.0;
+            }
+        }
+        Ok((r, jac, e.frequencies_hz, e.ratios))
+    }
+
+    /// `chi^2` of the data at the model frequencies `freqs` and visibilities `ratios`.
+    fn chi2(&self, freqs: &[f64; 8], ratios: &[f64]) -> f64 {
+        self.measured
+            .modes
+            .iter()
+            .zip(&self.ranks)
+            .map(|(x, &k)| ((freqs[k] - x.frequency_hz) / x.sigma_hz).powi(2))
+            .chain(
+                self.vis
+                    .iter()
+                    .zip(ratios)
+                    .map(|(v, r)| ((r - v.ratio) / v.sigma).powi(2)),
+            )
+            .sum::<f64>()
+    }
+
+    /// The best solution over every start within `n` prior sigmas, its start, and the
+    /// evaluations spent over all starts.
+    fn best_of_starts(&self, n: f64) -> Result<(lm::LmOutcome, DVector<f64>, usize), FitError> {
+        let opts = lm::LmOptions {
+            gtol: GTOL,
+            max_iterations: MAX_ITERATIONS,
+        };
+        let mut best: Option<(lm::LmOutcome, DVector<f64>)> = None;
+        let mut evaluations = 0;
+        for u0 in starts(self.free, n) {
+            let out = lm::minimize(u0.clone(), n, &opts, |u| {
+                self.residuals(u).map(|(r, j, _, _)| (r, j))
+            })?;
+            self.config.cancel.check()?;
+            evaluations += out.evaluations;
+            if best
+                .as_ref()
+                .is_none_or(|(b, _)| out.r.norm_squared() < b.r.norm_squared())
+            {
+                best = Some((out, u0));
+            }
+        }
+        let (out, u_start) = best.expect("at least one start");
+        Ok((out, u_start, evaluations))
+    }
+}
+
+/// The fitted parameters with their uncertainties (those on the box have none), and the
+/// correlation matrix (NaN in the rows and columns of those on the box).
+fn uncertainties(
+    free: &[Free],
+    out: &lm::LmOutcome,
+    data_jac: &DMatrix<f64>,
+    n: f64,
+) -> (Vec<FittedParam>, Vec<Vec<f64>>) {
+    let data_sigma_rel = diag_of_inverse(data_jac);
+    let at_bound: Vec<Option<Bound>> = out
+        .u
+        .iter()
+        .map(|&ui| match ui {
+            x if x >= n => Some(Bound::Upper),
+            x if x <= -n => Some(Bound::Lower),
+            _ => None,
+        })
+        .collect();
+    let inside: Vec<usize> = (0..free.len()).filter(|&j| at_bound[j].is_none()).collect();
+    let covariance = covariance(&out.jac.select_columns(&inside));
+    let mut correlation = vec![vec![f64::NAN; free.len()]; free.len()];
+    for (a, &i) in inside.iter().enumerate() {
+        for (b, &j) in inside.iter().enumerate() {
+            correlation[i][j] =
+                covariance[(a, b)] / (covariance[(a, a)] * covariance[(b, b)]).sqrt();
+        }
+    }
+    let params_out = free
+        .iter()
+        .enumerate()
+        .map(|(j, f)| FittedParam {
+            key: f.key.clone(),
+            unit: f.unit.clone(),
+            nominal: f.nominal,
+            fitted: f.nominal + out.u[j] * f.sigma,
+            prior_sigma: f.sigma,
+            fitted_sigma: inside
+                .iter()
+                .position(|&i| i == j)
+                .map(|pos| covariance[(pos, pos)].sqrt() * f.sigma),
+            at_bound: at_bound[j],
+            data_sigma_rel: data_sigma_rel[j],
+            poorly_constrained: data_sigma_rel[j] >= 1.0,
+        })
+        .collect();
+    (params_out, correlation)
+}
+
+/// The data Jacobian's singular values, largest first, and the directions along those below 1
+/// (combinations of the parameters the data know less well than the prior).
+fn weak_directions(data_jac: &DMatrix<f64>, keys: &[String]) -> (Vec<f64>, Vec<WeakDirection>) {
+    let svd = data_jac.clone().svd(false, true);
+    let v_t = svd.v_t.expect("requested");
+    let mut order: Vec<usize> = (0..svd.singular_values.len()).collect();
+    order.sort_by(|&a, &b| svd.singular_values[b].total_cmp(&svd.singular_values[a]));
+    let singular_values: Vec<f64> = order.iter().map(|&i| svd.singular_values[i]).collect();
+    let weak_directions = order
+        .iter()
+        .filter(|&&i| svd.singular_values[i] < 1.0)
+        .map(|&i| WeakDirection {
+            singular_value: svd.singular_values[i],
+            direction: keys
+                .iter()
+                .enumerate()
+                .map(|(j, k)| (k.clone(), v_t[(i, j)]))
+                .collect(),
+        })
+        .collect();
+    (singular_values, weak_directions)
 }
 
 /// The model's visibilities at the nominal parameters, NaN where the reference does not see

@@ -108,131 +108,29 @@ pub fn measure(
         origin: origin.to_string(),
         message,
     };
-    let n = channels.first().map_or(0, |(_, x)| x.len());
-    if n < MIN_SAMPLES {
-        return Err(fail(format!(
-            "{n} samples; a record of at least {MIN_SAMPLES} is needed"
-        )));
-    }
-    if let Some((o, x)) = channels.iter().find(|(_, x)| x.len() != n) {
-        return Err(fail(format!(
-            "channel {} has {} samples, the first {n}",
-            o.name(),
-            x.len()
-        )));
-    }
-    if let Some((o, _)) = channels
-        .iter()
-        .find(|(_, x)| x.iter().any(|v| !v.is_finite()))
-    {
-        return Err(fail(format!(
-            "channel {} has a non-finite sample; fill or cut the gap first",
-            o.name()
-        )));
-    }
-    if !(fs_hz.is_finite() && fs_hz > 0.0) {
-        return Err(fail(format!(
-            "sample rate {fs_hz} Hz; must be finite and > 0"
-        )));
-    }
-    let windowed: Vec<Vec<f64>> = channels.iter().map(|(_, x)| hann_windowed(x)).collect();
-    let spectra: Vec<Vec<f64>> = windowed.iter().map(|y| padded_power(y)).collect();
-    let padded_df = fs_hz / (PADDING * n) as f64;
-    let resolution = fs_hz / n as f64;
+    let n = checked_length(channels, fs_hz).map_err(fail)?;
+    let record = Record::new(channels, fs_hz, expected_hz, n);
     let mut order: Vec<usize> = (0..8).collect();
     order.sort_by(|&a, &b| expected_hz[a].total_cmp(&expected_hz[b]));
     let mut items = Vec::new();
     let mut peaks = Vec::new();
     let mut skipped = Vec::new();
     let mut candidates: Vec<(usize, f64)> = Vec::new();
-    // Where each mode appears in the sampled record: above fs/2 it aliases (the bounce modes
-    // of a record sampled at a few Hz), and is left out of the noise estimates there too.
-    let aliased: [f64; 8] = std::array::from_fn(|k| {
-        let r = expected_hz[k].rem_euclid(fs_hz);
-        r.min(fs_hz - r)
-    });
     for (rank, &k) in order.iter().enumerate() {
         cancel.check()?;
-        let f_k = expected_hz[k];
-        if f_k >= 0.5 * fs_hz {
-            skipped.push((
-                k + 1,
-                format!(
-                    "above the Nyquist frequency {:.6e} Hz of the record (aliased to {:.6e} Hz)",
-                    0.5 * fs_hz,
-                    aliased[k]
-                ),
-            ));
-            continue;
+        match record.locate_peak(expected_hz, &order, rank) {
+            Ok(f_peak) => candidates.push((k, f_peak)),
+            Err(why) => skipped.push((k + 1, why)),
         }
-        let below = rank.checked_sub(1).map(|r| expected_hz[order[r]]);
-        let above = order.get(rank + 1).map(|&j| expected_hz[j]);
-        let lo = below
-            .map_or(0.0, |b| (b * f_k).sqrt())
-            .max(f_k * (1.0 - SEARCH_FRACTION));
-        let hi = above
-            .map_or(f64::INFINITY, |a| (a * f_k).sqrt())
-            .min(f_k * (1.0 + SEARCH_FRACTION))
-            .min(0.5 * fs_hz);
-        if (hi - lo) < MIN_BINS * resolution {
-            skipped.push((
-                k + 1,
-                format!(
-                    "not resolved: the search interval {lo:.6e}..{hi:.6e} Hz spans {:.1} bins of \
-                     1/T = {resolution:.3e} Hz (at least {MIN_BINS} needed: a longer record)",
-                    (hi - lo) / resolution
-                ),
-            ));
-            continue;
-        }
-        let noise: Vec<f64> = spectra
-            .iter()
-            .map(|p| noise_power(p, padded_df, f_k, &aliased, resolution, fs_hz))
-            .collect();
-        if noise.iter().any(|&v| v.is_nan() || v <= 0.0) {
-            skipped.push((
-                k + 1,
-                "no noise-only bins within an octave of it to estimate the noise from".into(),
-            ));
-            continue;
-        }
-        let score = |f: f64| -> f64 {
-            windowed
-                .iter()
-                .zip(&noise)
-                .map(|(y, v)| dft(y, f / fs_hz).norm_sqr() / v)
-                .sum()
-        };
-        let (b_lo, b_hi) = (
-            (lo / padded_df).ceil() as usize,
-            ((hi / padded_df).floor() as usize).min(spectra[0].len() - 1),
-        );
-        let best_bin = (b_lo..=b_hi)
-            .max_by(|&a, &b| {
-                let s = |i: usize| {
-                    spectra
-                        .iter()
-                        .zip(&noise)
-                        .map(|(p, v)| p[i] / v)
-                        .sum::<f64>()
-                };
-                s(a).total_cmp(&s(b))
-            })
-            .expect("a non-empty interval");
-        let f_peak = golden_max(
-            score,
-            (best_bin as f64 - 1.0) * padded_df,
-            (best_bin as f64 + 1.0) * padded_df,
-        );
-        candidates.push((k, f_peak));
     }
     // Every channel's complex amplitude of every mode at once, free of the other modes'
     // leakage (module docs).
     let nus: Vec<f64> = candidates.iter().map(|(_, f)| f / fs_hz).collect();
-    let solve = joint_amplitudes(&windowed, &nus, n);
+    let solve = joint_amplitudes(&record.windowed, &nus, n);
     // The noise once the peaks are gone: the strong modes' side lobes would otherwise count as
     // noise near them (the torsion modes' in every channel at a few mHz).
-    let residual_spectra: Vec<Vec<f64>> = windowed
+    let residual_spectra: Vec<Vec<f64>> = record
+        .windowed
         .iter()
         .zip(&solve)
         .map(|(y, a)| padded_power(&without_sinusoids(y, &nus, a)))
@@ -241,7 +139,7 @@ pub fn measure(
         cancel.check()?;
         let noise: Vec<f64> = residual_spectra
             .iter()
-            .map(|p| noise_power(p, padded_df, expected_hz[k], &aliased, resolution, fs_hz))
+            .map(|p| record.noise_power(p, expected_hz[k]))
             .collect();
         let amplitude: Vec<Complex64> = solve.iter().map(|a| a[j]).collect();
         let snr: Vec<f64> = amplitude
@@ -249,44 +147,13 @@ pub fn measure(
             .zip(&noise)
             .map(|(a, v)| a.norm() / v.sqrt())
             .collect();
-        let mut found = false;
-        for group in [
-            &[Observable::X, Observable::Y, Observable::Z][..],
-            &[
-                Observable::Theta,
-                Observable::Eta,
-                Observable::Phi,
-                Observable::PhiA,
-            ],
-        ] {
-            let members: Vec<usize> = (0..channels.len())
-                .filter(|&c| group.contains(&channels[c].0))
-                .collect();
-            let Some(&r) = members
-                .iter()
-                .max_by(|&&a, &&b| amplitude[a].norm().total_cmp(&amplitude[b].norm()))
-            else {
-                continue;
-            };
-            if snr[r] < MIN_SNR {
-                continue;
-            }
-            found = true;
-            let a_r = amplitude[r];
-            for &c in members.iter().filter(|&&c| c != r) {
-                let rho = (amplitude[c] * a_r.conj()).re / a_r.norm_sqr();
-                let sigma = ((noise[c] + rho * rho * noise[r]) / (2.0 * a_r.norm_sqr())).sqrt();
-                items.push(MeasuredVisibility {
-                    mode: k + 1,
-                    observable: channels[c].0,
-                    reference: channels[r].0,
-                    ratio: rho,
-                    sigma,
-                    sigma_source: SigmaSource::File,
-                });
-            }
-        }
-        if found {
+        let peak = Peak {
+            mode: k + 1,
+            amplitude: &amplitude,
+            noise: &noise,
+            snr: &snr,
+        };
+        if peak.push_ratios(channels, &mut items) {
             peaks.push(ModePeak {
                 mode: k + 1,
                 expected_hz: expected_hz[k],
@@ -326,6 +193,215 @@ pub fn measure(
         peaks,
         skipped,
     })
+}
+
+/// The channels' common length, or what is wrong with the record.
+fn checked_length(channels: &[(Observable, Vec<f64>)], fs_hz: f64) -> Result<usize, String> {
+    let n = channels.first().map_or(0, |(_, x)| x.len());
+    if n < MIN_SAMPLES {
+        return Err(format!(
+            "{n} samples; a record of at least {MIN_SAMPLES} is needed"
+        ));
+    }
+    if let Some((o, x)) = channels.iter().find(|(_, x)| x.len() != n) {
+        return Err(format!(
+            "channel {} has {} samples, the first {n}",
+            o.name(),
+            x.len()
+        ));
+    }
+    if let Some((o, _)) = channels
+        .iter()
+        .find(|(_, x)| x.iter().any(|v| !v.is_finite()))
+    {
+        return Err(format!(
+            "channel {} has a non-finite sample; fill or cut the gap first",
+            o.name()
+        ));
+    }
+    if !(fs_hz.is_finite() && fs_hz > 0.0) {
+        return Err(format!("sample rate {fs_hz} Hz; must be finite and > 0"));
+    }
+    Ok(n)
+}
+
+/// The windowed channels of a record and their padded power spectra.
+struct Record {
+    windowed: Vec<Vec<f64>>,
+    spectra: Vec<Vec<f64>>,
+    fs_hz: f64,
+    padded_df: f64,
+    resolution: f64,
+    /// Where each mode appears in the sampled record: above fs/2 it aliases (the bounce modes
+    /// of a record sampled at a few Hz), and is left out of the noise estimates there too.
+    aliased: [f64; 8],
+}
+
+impl Record {
+    fn new(
+        channels: &[(Observable, Vec<f64>)],
+        fs_hz: f64,
+        expected_hz: &[f64; 8],
+        n: usize,
+    ) -> Self {
+        let windowed: Vec<Vec<f64>> = channels.iter().map(|(_, x)| hann_windowed(x)).collect();
+        let spectra: Vec<Vec<f64>> = windowed.iter().map(|y| padded_power(y)).collect();
+        let aliased: [f64; 8] = std::array::from_fn(|k| {
+            let r = expected_hz[k].rem_euclid(fs_hz);
+            r.min(fs_hz - r)
+        });
+        Self {
+            windowed,
+            spectra,
+            fs_hz,
+            padded_df: fs_hz / (PADDING * n) as f64,
+            resolution: fs_hz / n as f64,
+            aliased,
+        }
+    }
+
+    /// [`noise_power`] of spectrum `p` near `f_k`.
+    fn noise_power(&self, p: &[f64], f_k: f64) -> f64 {
+        noise_power(
+            p,
+            self.padded_df,
+            f_k,
+            &self.aliased,
+            self.resolution,
+            self.fs_hz,
+        )
+    }
+
+    /// The peak frequency (Hz) of mode `order[rank]` (module docs), or why it is skipped.
+    fn locate_peak(
+        &self,
+        expected_hz: &[f64; 8],
+        order: &[usize],
+        rank: usize,
+    ) -> Result<f64, String> {
+        let (fs_hz, padded_df, resolution) = (self.fs_hz, self.padded_df, self.resolution);
+        let k = order[rank];
+        let f_k = expected_hz[k];
+        if f_k >= 0.5 * fs_hz {
+            return Err(format!(
+                "above the Nyquist frequency {:.6e} Hz of the record (aliased to {:.6e} Hz)",
+                0.5 * fs_hz,
+                self.aliased[k]
+            ));
+        }
+        let below = rank.checked_sub(1).map(|r| expected_hz[order[r]]);
+        let above = order.get(rank + 1).map(|&j| expected_hz[j]);
+        let lo = below
+            .map_or(0.0, |b| (b * f_k).sqrt())
+            .max(f_k * (1.0 - SEARCH_FRACTION));
+        let hi = above
+            .map_or(f64::INFINITY, |a| (a * f_k).sqrt())
+            .min(f_k * (1.0 + SEARCH_FRACTION))
+            .min(0.5 * fs_hz);
+        if (hi - lo) < MIN_BINS * resolution {
+            return Err(format!(
+                "not resolved: the search interval {lo:.6e}..{hi:.6e} Hz spans {:.1} bins of \
+                 1/T = {resolution:.3e} Hz (at least {MIN_BINS} needed: a longer record)",
+                (hi - lo) / resolution
+            ));
+        }
+        let noise: Vec<f64> = self
+            .spectra
+            .iter()
+            .map(|p| self.noise_power(p, f_k))
+            .collect();
+        if noise.iter().any(|&v| v.is_nan() || v <= 0.0) {
+            return Err(
+                "no noise-only bins within an octave of it to estimate the noise from".into(),
+            );
+        }
+        let score = |f: f64| -> f64 {
+            self.windowed
+                .iter()
+                .zip(&noise)
+                .map(|(y, v)| dft(y, f / fs_hz).norm_sqr() / v)
+                .sum()
+        };
+        let (b_lo, b_hi) = (
+            (lo / padded_df).ceil() as usize,
+            ((hi / padded_df).floor() as usize).min(self.spectra[0].len() - 1),
+        );
+        let best_bin = (b_lo..=b_hi)
+            .max_by(|&a, &b| {
+                let s = |i: usize| {
+                    self.spectra
+                        .iter()
+                        .zip(&noise)
+                        .map(|(p, v)| p[i] / v)
+                        .sum::<f64>()
+                };
+                s(a).total_cmp(&s(b))
+            })
+            .expect("a non-empty interval");
+        Ok(golden_max(
+            score,
+            (best_bin as f64 - 1.0) * padded_df,
+            (best_bin as f64 + 1.0) * padded_df,
+        ))
+    }
+}
+
+/// One mode's joint amplitudes in every channel, with the channels' noise at it.
+struct Peak<'a> {
+    mode: usize,
+    amplitude: &'a [Complex64],
+    noise: &'a [f64],
+    snr: &'a [f64],
+}
+
+impl Peak<'_> {
+    /// Pushes the ratios of every unit group whose reference is seen well enough; whether any
+    /// group was.
+    fn push_ratios(
+        &self,
+        channels: &[(Observable, Vec<f64>)],
+        items: &mut Vec<MeasuredVisibility>,
+    ) -> bool {
+        let (amplitude, noise, snr) = (self.amplitude, self.noise, self.snr);
+        let mut found = false;
+        for group in [
+            &[Observable::X, Observable::Y, Observable::Z][..],
+            &[
+                Observable::Theta,
+                Observable::Eta,
+                Observable::Phi,
+                Observable::PhiA,
+            ],
+        ] {
+            let members: Vec<usize> = (0..channels.len())
+                .filter(|&c| group.contains(&channels[c].0))
+                .collect();
+            let Some(&r) = members
+                .iter()
+                .max_by(|&&a, &&b| amplitude[a].norm().total_cmp(&amplitude[b].norm()))
+            else {
+                continue;
+            };
+            if snr[r] < MIN_SNR {
+                continue;
+            }
+            found = true;
+            let a_r = amplitude[r];
+            for &c in members.iter().filter(|&&c| c != r) {
+                let rho = (amplitude[c] * a_r.conj()).re / a_r.norm_sqr();
+                let sigma = ((noise[c] + rho * rho * noise[r]) / (2.0 * a_r.norm_sqr())).sqrt();
+                items.push(MeasuredVisibility {
+                    mode: self.mode,
+                    observable: channels[c].0,
+                    reference: channels[r].0,
+                    ratio: rho,
+                    sigma,
+                    sigma_source: SigmaSource::File,
+                });
+            }
+        }
+        found
+    }
 }
 
 /// `(x - mean) w` with the symmetric Hann window `w_n = sin^2(pi n / (N - 1))`.

@@ -102,18 +102,6 @@ impl Visibilities {
             }
         };
         let n_columns = columns.len();
-        let observable = |n: usize, what: &str, cell: &str| {
-            Observable::from_name(cell).ok_or_else(|| {
-                fail(
-                    Some(n),
-                    format!(
-                        "{what} `{}` is not an observable; allowed: {}",
-                        Shown(cell),
-                        Observable::ALL.map(Observable::name).join(", ")
-                    ),
-                )
-            })
-        };
         let mut items: Vec<MeasuredVisibility> = Vec::new();
         while let Some((n, cells)) = next(&mut records)? {
             if cells.len() != n_columns {
@@ -126,102 +114,21 @@ impl Visibilities {
                     ),
                 ));
             }
-            let mode: usize = cells[0]
-                .parse()
-                .ok()
-                .filter(|m| (1..=8).contains(m))
-                .ok_or_else(|| {
-                    fail(
-                        Some(n),
-                        format!(
-                            "mode `{}` is not allowed: must be an integer 1..8 (nu_k)",
-                            Shown(&cells[0])
-                        ),
-                    )
-                })?;
-            let obs = observable(n, "observable", &cells[1])?;
-            let reference = observable(n, "reference", &cells[2])?;
-            if obs == reference {
+            let v = parse_row(&cells, with_sigma).map_err(|m| fail(Some(n), m))?;
+            if items.iter().any(|w| {
+                w.mode == v.mode && w.observable == v.observable && w.reference == v.reference
+            }) {
                 return Err(fail(
                     Some(n),
                     format!(
-                        "observable and reference are both `{}`: a ratio to itself is 1 and \
-                         measures nothing",
-                        obs.name()
+                        "nu_{} {}/{} is listed twice; give each ratio once",
+                        v.mode,
+                        v.observable.name(),
+                        v.reference.name()
                     ),
                 ));
             }
-            let ratio = cells[3]
-                .parse::<f64>()
-                .ok()
-                .filter(|r| r.is_finite() && r.abs() <= MAX_RATIO)
-                .ok_or_else(|| {
-                    fail(
-                        Some(n),
-                        format!(
-                            "ratio `{}` of nu_{mode} {}/{} is not allowed: must be a finite \
-                             number of either sign, |ratio| <= {MAX_RATIO:e}",
-                            Shown(&cells[3]),
-                            obs.name(),
-                            reference.name()
-                        ),
-                    )
-                })?;
-            let (sigma, sigma_source) = match with_sigma && !cells[4].is_empty() {
-                true => (
-                    cells[4]
-                        .parse::<f64>()
-                        .ok()
-                        .filter(|s| s.is_finite() && *s > 0.0)
-                        .ok_or_else(|| {
-                            fail(
-                                Some(n),
-                                format!(
-                                    "sigma `{}` of nu_{mode} {}/{} is not allowed: must be \
-                                     finite and > 0 (or empty: half the last digit of ratio)",
-                                    Shown(&cells[4]),
-                                    obs.name(),
-                                    reference.name()
-                                ),
-                            )
-                        })?,
-                    SigmaSource::File,
-                ),
-                false => (half_last_digit(&cells[3]), SigmaSource::Digits),
-            };
-            if !(sigma.is_finite() && sigma > 0.0) {
-                return Err(fail(
-                    Some(n),
-                    format!(
-                        "the sigma of nu_{mode} {}/{} from the digits of `{}` is {sigma:e}: give \
-                         a sigma column",
-                        obs.name(),
-                        reference.name(),
-                        Shown(&cells[3])
-                    ),
-                ));
-            }
-            if items
-                .iter()
-                .any(|v| v.mode == mode && v.observable == obs && v.reference == reference)
-            {
-                return Err(fail(
-                    Some(n),
-                    format!(
-                        "nu_{mode} {}/{} is listed twice; give each ratio once",
-                        obs.name(),
-                        reference.name()
-                    ),
-                ));
-            }
-            items.push(MeasuredVisibility {
-                mode,
-                observable: obs,
-                reference,
-                ratio,
-                sigma,
-                sigma_source,
-            });
+            items.push(v);
         }
         if items.is_empty() {
             return Err(fail(
@@ -252,6 +159,89 @@ impl Visibilities {
         }
         s
     }
+}
+
+/// One data row (as many cells as the header), or what is wrong with it.
+fn parse_row(cells: &[String], with_sigma: bool) -> Result<MeasuredVisibility, String> {
+    let mode: usize = cells[0]
+        .parse()
+        .ok()
+        .filter(|m| (1..=8).contains(m))
+        .ok_or_else(|| {
+            format!(
+                "mode `{}` is not allowed: must be an integer 1..8 (nu_k)",
+                Shown(&cells[0])
+            )
+        })?;
+    let obs = observable("observable", &cells[1])?;
+    let reference = observable("reference", &cells[2])?;
+    if obs == reference {
+        return Err(format!(
+            "observable and reference are both `{}`: a ratio to itself is 1 and \
+             measures nothing",
+            obs.name()
+        ));
+    }
+    let ratio = cells[3]
+        .parse::<f64>()
+        .ok()
+        .filter(|r| r.is_finite() && r.abs() <= MAX_RATIO)
+        .ok_or_else(|| {
+            format!(
+                "ratio `{}` of nu_{mode} {}/{} is not allowed: must be a finite \
+                 number of either sign, |ratio| <= {MAX_RATIO:e}",
+                Shown(&cells[3]),
+                obs.name(),
+                reference.name()
+            )
+        })?;
+    let (sigma, sigma_source) = match with_sigma && !cells[4].is_empty() {
+        true => (
+            cells[4]
+                .parse::<f64>()
+                .ok()
+                .filter(|s| s.is_finite() && *s > 0.0)
+                .ok_or_else(|| {
+                    format!(
+                        "sigma `{}` of nu_{mode} {}/{} is not allowed: must be \
+                         finite and > 0 (or empty: half the last digit of ratio)",
+                        Shown(&cells[4]),
+                        obs.name(),
+                        reference.name()
+                    )
+                })?,
+            SigmaSource::File,
+        ),
+        false => (half_last_digit(&cells[3]), SigmaSource::Digits),
+    };
+    if !(sigma.is_finite() && sigma > 0.0) {
+        return Err(format!(
+            "the sigma of nu_{mode} {}/{} from the digits of `{}` is {sigma:e}: give \
+             a sigma column",
+            obs.name(),
+            reference.name(),
+            Shown(&cells[3])
+        ));
+    }
+    Ok(MeasuredVisibility {
+        mode,
+        observable: obs,
+        reference,
+        ratio,
+        sigma,
+        sigma_source,
+    })
+}
+
+/// The observable named in a cell of column `what`.
+fn observable(what: &str, cell: &str) -> Result<Observable, String> {
+    Observable::from_name(cell).ok_or_else(|| {
+        format!(
+            "{what} `{}` is not an observable; allowed: {}",
+            Shown(cell),
+            Observable::ALL.map(Observable::name).join(", ")
+        )
+    })
 }
 
 /// Position in `modes.modes` of the mode labelled `nu_label`.

@@ -10,6 +10,7 @@ use crate::error::{shown_within, ParamError, Shown, SHOWN_MAX_CHARS};
 use serde::{Deserialize, Serialize};
 
 pub mod asymmetry;
+mod fields;
 pub mod uncertainty;
 pub use asymmetry::Asymmetry;
 pub use uncertainty::UncertaintyTable;
@@ -363,214 +364,20 @@ impl Params {
 
     /// Every parameter with its key, unit, symbol and allowed range, in file order.
     pub fn fields(&self) -> Vec<Field> {
-        use Allowed::*;
-        let f = |key, value, unit, symbol, allowed| Field {
-            key,
-            value,
-            unit,
-            symbol,
-            allowed,
-        };
-        let (m, i, t, b, l) = (
-            &self.mass,
-            &self.inertia,
-            &self.torsion,
-            &self.bouncing,
-            &self.length,
-        );
-        let mut fields = vec![
-            f("mass.m_a_kg", m.m_a_kg, "kg", "m_a", Positive),
-            f("mass.m_b_kg", m.m_b_kg, "kg", "m_b", Positive),
-            f(
-                "inertia.a11_kg_m2",
-                i.a11_kg_m2,
-                "kg m^2",
-                "I^a_11",
-                Positive,
-            ),
-            f(
-                "inertia.a22_kg_m2",
-                i.a22_kg_m2,
-                "kg m^2",
-                "I^a_22",
-                Positive,
-            ),
-            f(
-                "inertia.a33_kg_m2",
-                i.a33_kg_m2,
-                "kg m^2",
-                "I^a_33",
-                Positive,
-            ),
-            f("inertia.a23_kg_m2", i.a23_kg_m2, "kg m^2", "I^a_23", Finite),
-            f(
-                "inertia.b11_kg_m2",
-                i.b11_kg_m2,
-                "kg m^2",
-                "I^b_11",
-                Positive,
-            ),
-            f(
-                "inertia.b22_kg_m2",
-                i.b22_kg_m2,
-                "kg m^2",
-                "I^b_22",
-                Positive,
-            ),
-            f(
-                "inertia.b33_kg_m2",
-                i.b33_kg_m2,
-                "kg m^2",
-                "I^b_33",
-                Positive,
-            ),
-            f(
-                "torsion.k_a_n_m_per_rad",
-                t.k_a_n_m_per_rad,
-                "N m/rad",
-                "k_a",
-                Positive,
-            ),
-            f(
-                "torsion.k_b_n_m_per_rad",
-                t.k_b_n_m_per_rad,
-                "N m/rad",
-                "k_b",
-                Positive,
-            ),
-            f(
-                "bouncing.kappa_a_n_per_m",
-                b.kappa_a_n_per_m,
-                "N/m",
-                "kappa_e,a",
-                Positive,
-            ),
-            f(
-                "bouncing.kappa_b_n_per_m",
-                b.kappa_b_n_per_m,
-                "N/m",
-                "kappa_e,b",
-                Positive,
-            ),
-            f("length.d_m", l.d_m, "m", "d", Length),
-            f("length.h_c_m", l.h_c_m, "m", "h_c", LengthOrZero),
-            f("length.z_m", l.z_m, "m", "Z", Length),
-            f("length.z_a_m", l.z_a_m, "m", "Z_a", Length),
-            f("length.z_b_m", l.z_b_m, "m", "Z_b", Length),
-            f("length.h_m", l.h_m, "m", "h (assumption)", Length),
-            f(
-                "environment.g_m_per_s2",
-                self.environment.g_m_per_s2,
-                "m/s^2",
-                "g (assumption)",
-                Positive,
-            ),
-            f(
-                "environment.temperature_k",
-                self.environment.temperature_k,
-                "K",
-                "T (assumption)",
-                Positive,
-            ),
-            f(
-                "loss.torsion_a_rad",
-                self.loss.torsion_a_rad,
-                "rad",
-                "phi_torsion,a",
-                LossAngle,
-            ),
-            f(
-                "loss.torsion_b_rad",
-                self.loss.torsion_b_rad,
-                "rad",
-                "phi_torsion,b",
-                LossAngle,
-            ),
-            f(
-                "loss.bouncing_a_rad",
-                self.loss.bouncing_a_rad,
-                "rad",
-                "phi_bouncing,a",
-                LossAngle,
-            ),
-            f(
-                "loss.bouncing_b_rad",
-                self.loss.bouncing_b_rad,
-                "rad",
-                "phi_bouncing,b",
-                LossAngle,
-            ),
-            f(
-                "loss.bending_a_rad",
-                self.loss.bending_a_rad,
-                "rad",
-                "phi_fibre,a (swing: / D_a)",
-                LossAngle,
-            ),
-            f(
-                "loss.bending_b_rad",
-                self.loss.bending_b_rad,
-                "rad",
-                "phi_fibre,b (swing: / D_b)",
-                LossAngle,
-            ),
-            f(
-                "loss.dilution_a",
-                self.loss.dilution_a,
-                "1",
-                "D_a",
-                AtLeastOne,
-            ),
-            f(
-                "loss.dilution_b",
-                self.loss.dilution_b,
-                "1",
-                "D_b",
-                AtLeastOne,
-            ),
-            f(
-                "viscous.torsion_a_n_m_s_per_rad",
-                self.viscous.torsion_a_n_m_s_per_rad,
-                "N m s/rad",
-                "c_torsion,a",
-                NonNegative,
-            ),
-            f(
-                "viscous.torsion_b_n_m_s_per_rad",
-                self.viscous.torsion_b_n_m_s_per_rad,
-                "N m s/rad",
-                "c_torsion,b",
-                NonNegative,
-            ),
-            f(
-                "viscous.bouncing_a_n_s_per_m",
-                self.viscous.bouncing_a_n_s_per_m,
-                "N s/m",
-                "c_bouncing,a",
-                NonNegative,
-            ),
-            f(
-                "viscous.bouncing_b_n_s_per_m",
-                self.viscous.bouncing_b_n_s_per_m,
-                "N s/m",
-                "c_bouncing,b",
-                NonNegative,
-            ),
-            f(
-                "viscous.swing_a_n_m_s_per_rad",
-                self.viscous.swing_a_n_m_s_per_rad,
-                "N m s/rad",
-                "c_swing,a",
-                NonNegative,
-            ),
-            f(
-                "viscous.swing_b_n_m_s_per_rad",
-                self.viscous.swing_b_n_m_s_per_rad,
-                "N m s/rad",
-                "c_swing,b",
-                NonNegative,
-            ),
-        ];
+        let mut fields = self.mass.fields();
+        fields.extend(self.inertia.fields());
+        fields.extend(self.torsion.fields());
+        fields.extend(self.bouncing.fields());
+        fields.extend(self.length.fields());
+        fields.extend(self.environment.fields());
+        fields.extend(self.loss.fields());
+        fields.extend(self.viscous.fields());
+        fields.extend(self.asymmetry_fields());
+        fields
+    }
+
+    /// The limits of the asymmetry offsets, which scale with the lengths.
+    fn asymmetry_fields(&self) -> Vec<Field> {
         let symbols = [
             "crossbar centre of mass, x offset",
             "crossbar centre of mass, y offset",
@@ -583,13 +390,20 @@ impl Params {
             "readout axes, rotation about z",
         ];
         let l = &self.length;
+        let mut fields = Vec::new();
         for (limit, symbol) in self
             .asymmetry
             .limits(l.d_m, l.z_a_m, l.z_b_m)
             .into_iter()
             .zip(symbols)
         {
-            fields.push(f(limit.key, limit.value, limit.unit, symbol, Offset));
+            fields.push(Field {
+                key: limit.key,
+                value: limit.value,
+                unit: limit.unit,
+                symbol,
+                allowed: Allowed::Offset,
+            });
         }
         fields
     }

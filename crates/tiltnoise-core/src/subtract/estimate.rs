@@ -243,135 +243,25 @@ pub fn fit(
     let params = candidates(base, inputs, req, dt)?;
     let mut notes = Vec::new();
 
-    let noise_at = |k: usize| -> Vec<f64> { req.noise_psd.iter().map(|m| m[k]).collect() };
-    let adjacent = super::stats::bin_variance_factor(training.segment_len, 1);
-    let coherent_top = coherent_top(spectra, n_in, outputs.len(), n_eff, adjacent);
-    if coherent_top.is_none() && req.band_hz.is_none() {
-        return Err(SubtractError::NotCoherent);
-    }
-    let (band, grid_bins) = band_bins(&spectra.freqs_hz, req.band_hz, coherent_top)?;
-    if let (Some(top), Some((_, hi))) = (coherent_top, req.band_hz) {
-        if hi > top {
-            notes.push(format!(
-                "the fit band reaches {hi:e} Hz, above {top:e} Hz, where the witness stops being \
-                 coherent with the observables: bins there carry no information on the coupling \
-                 and depend on the stated witness noise"
-            ));
-        }
-    }
+    let FitBand {
+        band,
+        grid_bins,
+        coherent_top,
+    } = fit_band(training, n_in, outputs.len(), req, &mut notes)?;
     let freqs: Vec<f64> = grid_bins.iter().map(|&k| spectra.freqs_hz[k]).collect();
     let request = Request {
         outputs: outputs.to_vec(),
         inputs: inputs.to_vec(),
     };
-    let h0 = transfer(base, &request, &freqs)?;
-    let shifted = |sign: f64| -> Vec<f64> {
-        freqs
-            .iter()
-            .map(|f| f * (1.0 + sign * super::predict::FREQ_ERROR_REL))
-            .collect()
-    };
-    let h_up = transfer(base, &request, &shifted(1.0))?;
-    let h_down = transfer(base, &request, &shifted(-1.0))?;
-    let block = outputs.len() * n_in;
-    let n_ch = spectra.n_channels;
-    let mut singular = 0;
-    let grid: Vec<Option<GridBin>> = grid_bins
-        .iter()
-        .map(|&k| {
-            let m = spectra.matrix(k);
-            let sww = DMatrix::from_fn(n_in, n_in, |a, b| m[a * n_ch + b]);
-            let sbar = training.witness.smoothed[k].clone();
-            let usable = regular(&sbar) && regular(&sww);
-            if !usable {
-                singular += 1;
-            }
-            usable.then(|| GridBin {
-                sww,
-                sbar,
-                noise: noise_at(k),
-            })
-        })
-        .collect();
-    if singular > 0 {
-        notes.push(format!(
-            "{singular} bin(s) of the band left out where the witnesses' spectral matrix is \
-             numerically singular (dependent or dead witness channels)"
-        ));
-    }
-    let mut bins: Vec<(usize, Vec<Bin>)> = Vec::new();
-    let mut counts = Vec::new();
-    for (o, &obs) in outputs.iter().enumerate() {
-        let yc = n_in + o;
-        let row = |h: &[Complex64], g: usize| -> Vec<Complex64> {
-            h[g * block + o * n_in..][..n_in].to_vec()
-        };
-        if (0..freqs.len()).all(|g| row(&h0, g).iter().all(|z| z.norm() == 0.0)) {
-            notes.push(format!(
-                "{}: not driven by the witness inputs (its transfer functions from them are \
-                 exactly 0); left out of the fit",
-                obs.name()
-            ));
-            counts.push((obs, 0));
-            continue;
-        }
-        let mut list = Vec::new();
-        let mut sensitive = 0;
-        for (g, &k) in grid_bins.iter().enumerate() {
-            let Some(gb) = &grid[g] else { continue };
-            let sens = super::predict::sensitivity(&row(&h0, g), &row(&h_up, g), &row(&h_down, g));
-            if sens.is_nan() || sens >= FIT_SENSITIVITY {
-                sensitive += 1;
-                continue;
-            }
-            let m = spectra.matrix(k);
-            let s = DVector::from_fn(n_in, |a, _| m[a * n_ch + yc]);
-            let syy = m[yc * n_ch + yc].re;
-            if syy <= 0.0 {
-                continue;
-            }
-            // Model-free first weights: the coherence residual, unbiased for n_eff averages.
-            let coh = coherence_residual(syy, &s, &gb.sww).unwrap_or(syy);
-            let n_fac = if n_eff > n_in as f64 {
-                n_eff / (n_eff - n_in as f64)
-            } else {
-                1.0
-            };
-            let see = (coh * n_fac).clamp(S_EE_FLOOR * syy, syy.max(S_EE_FLOOR * syy));
-            list.push(Bin {
-                grid: g,
-                s,
-                syy,
-                see,
-                whitener: whitener(&gb.sbar, see, n_eff, None),
-            });
-        }
-        if sensitive > 0 {
-            notes.push(format!(
-                "{}: {sensitive} bin(s) of the band left out where a 1 % error of the model's \
-                 frequencies changes the transfer function by 1 % or more (resonances)",
-                obs.name()
-            ));
-        }
-        counts.push((obs, list.len()));
-        if !list.is_empty() {
-            bins.push((o, list));
-        }
-    }
+    let model = ModelRows::new(base, &request, &freqs)?;
+    let grid = witness_grid(training, &grid_bins, n_in, req, &mut notes);
+    let ObservableBins { bins, counts } = observable_bins(
+        training, outputs, &grid_bins, &grid, &model, n_in, &mut notes,
+    );
     if bins.is_empty() {
         return Err(SubtractError::NoFitBins { band_hz: band });
     }
-    let witness_bias = (0..n_in)
-        .map(|a| {
-            let mut r: Vec<f64> = bins
-                .iter()
-                .flat_map(|(_, b)| b.iter())
-                .filter_map(|b| grid[b.grid].as_ref())
-                .map(|g| g.noise[a] / g.sbar[(a, a)].re)
-                .collect();
-            median(&mut r)
-        })
-        .collect();
+    let witness_bias = witness_bias(&grid, &bins, n_in);
     let mut problem = Problem {
         base,
         request,
@@ -385,61 +275,23 @@ pub fn fit(
         fraction_s,
     };
     let mut theta: Vec<f64> = problem.params.iter().map(|p| p.nominal).collect();
-    scan_delay(&problem, &h0, &mut theta, &mut notes);
+    scan_delay(&problem, &model.h0, &mut theta, &mut notes);
     problem.reweight(&theta)?;
 
     let all: Vec<usize> = (0..problem.params.len()).collect();
-    let opts = LmOptions {
-        gtol: LM_GTOL,
-        max_iterations: LM_MAX_ITERATIONS,
-    };
-    let mut iterations = 0;
-    let mut stop = Stop::Gradient;
-    let mut free = constrained(&mut problem, &theta, &all)?;
-    for pass in 0..2 {
-        for &j in &all {
-            if !free.contains(&j) {
-                theta[j] = problem.params[j].nominal;
-            }
-        }
-        if !free.is_empty() {
-            let u0 = DVector::from_iterator(
-                free.len(),
-                free.iter().map(|&j| {
-                    (theta[j] - problem.params[j].nominal) / problem.params[j].half_width
-                }),
-            );
-            let base_theta = theta.clone();
-            let to_theta = |u: &DVector<f64>| -> Vec<f64> {
-                let mut t = base_theta.clone();
-                for (jj, &j) in free.iter().enumerate() {
-                    t[j] = problem.params[j].nominal + u[jj] * problem.params[j].half_width;
-                }
-                t
-            };
-            // The instruments, fixed for the pass at its starting point; the estimate solves
-            // Z^T r = 0, i.e. minimizes |(Z^T Z)^-1/2 Z^T r|^2 (exactly identified).
-            let z = problem.evaluate(&theta, &free)?.inst;
-            let project = projector(&z);
-            let out = lm::minimize(u0, 1.0, &opts, |u| {
-                let e = problem.evaluate(&to_theta(u), &free)?;
-                Ok::<_, SubtractError>((&project * e.r, &project * e.jac))
-            })?;
-            theta = to_theta(&out.u);
-            iterations += out.iterations;
-            stop = out.stop;
-        }
-        if pass == 0 {
-            problem.reweight(&theta)?;
-            free = constrained(&mut problem, &theta, &free)?;
-        }
-    }
-    if stop == Stop::MaxIterations {
+    let solution = solve_two_passes(&mut problem, theta, &all)?;
+    if solution.stop == Stop::MaxIterations {
         notes.push(format!(
             "the fit stopped at its iteration limit ({LM_MAX_ITERATIONS}) without converging: \
              the estimates are not at a minimum (fit fewer parameters, or a narrower band)"
         ));
     }
+    let Solution {
+        theta,
+        free,
+        iterations,
+        stop,
+    } = solution;
     let at_solution = problem.evaluate(&theta, &free)?;
     let chi2 = at_solution.r.norm_squared();
     let dof = at_solution.r.len().saturating_sub(free.len()).max(1);
@@ -491,6 +343,304 @@ pub fn fit(
         stop,
         witness_bias,
         notes,
+    })
+}
+
+/// The band of the fit and its bins on the Welch grid.
+struct FitBand {
+    band: (f64, f64),
+    grid_bins: Vec<usize>,
+    coherent_top: Option<f64>,
+}
+
+/// The band asked for, or the one where the witness is coherent with some observable; a note
+/// when the band asked for reaches above the coherent one.
+fn fit_band(
+    training: &Training,
+    n_in: usize,
+    n_out: usize,
+    req: &FitRequest,
+    notes: &mut Vec<String>,
+) -> Result<FitBand, SubtractError> {
+    let spectra = training.spectra;
+    let adjacent = super::stats::bin_variance_factor(training.segment_len, 1);
+    let coherent_top = coherent_top(spectra, n_in, n_out, training.n_eff, adjacent);
+    if coherent_top.is_none() && req.band_hz.is_none() {
+        return Err(SubtractError::NotCoherent);
+    }
+    let (band, grid_bins) = band_bins(&spectra.freqs_hz, req.band_hz, coherent_top)?;
+    if let (Some(top), Some((_, hi))) = (coherent_top, req.band_hz) {
+        if hi > top {
+            notes.push(format!(
+                "the fit band reaches {hi:e} Hz, above {top:e} Hz, where the witness stops being \
+                 coherent with the observables: bins there carry no information on the coupling \
+                 and depend on the stated witness noise"
+            ));
+        }
+    }
+    Ok(FitBand {
+        band,
+        grid_bins,
+        coherent_top,
+    })
+}
+
+/// The nominal model's transfer functions on the fit grid, and with its frequencies shifted
+/// by `±FREQ_ERROR_REL` (to find the bins too close to a resonance).
+struct ModelRows {
+    h0: Vec<Complex64>,
+    h_up: Vec<Complex64>,
+    h_down: Vec<Complex64>,
+    /// Transfer functions per grid frequency (`outputs × inputs`).
+    block: usize,
+    n_in: usize,
+}
+
+impl ModelRows {
+    fn new(base: &Params, request: &Request, freqs: &[f64]) -> Result<Self, SubtractError> {
+        let h0 = transfer(base, request, freqs)?;
+        let shifted = |sign: f64| -> Vec<f64> {
+            freqs
+                .iter()
+                .map(|f| f * (1.0 + sign * super::predict::FREQ_ERROR_REL))
+                .collect()
+        };
+        let h_up = transfer(base, request, &shifted(1.0))?;
+        let h_down = transfer(base, request, &shifted(-1.0))?;
+        let n_in = request.inputs.len();
+        Ok(Self {
+            h0,
+            h_up,
+            h_down,
+            block: request.outputs.len() * n_in,
+            n_in,
+        })
+    }
+
+    /// The transfer functions from every input to observable `o` at grid frequency `g`.
+    fn row(&self, h: &[Complex64], o: usize, g: usize) -> Vec<Complex64> {
+        h[g * self.block + o * self.n_in..][..self.n_in].to_vec()
+    }
+}
+
+/// The witnesses' spectral matrices per fit bin (`None` where singular, with a note).
+fn witness_grid(
+    training: &Training,
+    grid_bins: &[usize],
+    n_in: usize,
+    req: &FitRequest,
+    notes: &mut Vec<String>,
+) -> Vec<Option<GridBin>> {
+    let spectra = training.spectra;
+    let n_ch = spectra.n_channels;
+    let noise_at = |k: usize| -> Vec<f64> { req.noise_psd.iter().map(|m| m[k]).collect() };
+    let mut singular = 0;
+    let grid: Vec<Option<GridBin>> = grid_bins
+        .iter()
+        .map(|&k| {
+            let m = spectra.matrix(k);
+            let sww = DMatrix::from_fn(n_in, n_in, |a, b| m[a * n_ch + b]);
+            let sbar = training.witness.smoothed[k].clone();
+            let usable = regular(&sbar) && regular(&sww);
+            if !usable {
+                singular += 1;
+            }
+            usable.then(|| GridBin {
+                sww,
+                sbar,
+                noise: noise_at(k),
+            })
+        })
+        .collect();
+    if singular > 0 {
+        notes.push(format!(
+            "{singular} bin(s) of the band left out where the witnesses' spectral matrix is \
+             numerically singular (dependent or dead witness channels)"
+        ));
+    }
+    grid
+}
+
+/// The bins of the fit.
+struct ObservableBins {
+    /// Per observable driven by the witnesses (its index in the outputs), its usable bins with
+    /// model-free first weights.
+    bins: Vec<(usize, Vec<Bin>)>,
+    /// Bins per observable (0 for one left out).
+    counts: Vec<(Observable, usize)>,
+}
+
+/// Each observable's usable bins, with notes on those left out.
+fn observable_bins(
+    training: &Training,
+    outputs: &[Observable],
+    grid_bins: &[usize],
+    grid: &[Option<GridBin>],
+    model: &ModelRows,
+    n_in: usize,
+    notes: &mut Vec<String>,
+) -> ObservableBins {
+    let mut bins: Vec<(usize, Vec<Bin>)> = Vec::new();
+    let mut counts = Vec::new();
+    for (o, &obs) in outputs.iter().enumerate() {
+        if (0..grid_bins.len()).all(|g| model.row(&model.h0, o, g).iter().all(|z| z.norm() == 0.0))
+        {
+            notes.push(format!(
+                "{}: not driven by the witness inputs (its transfer functions from them are \
+                 exactly 0); left out of the fit",
+                obs.name()
+            ));
+            counts.push((obs, 0));
+            continue;
+        }
+        let (list, sensitive) = bins_of_observable(training, o, grid_bins, grid, model, n_in);
+        if sensitive > 0 {
+            notes.push(format!(
+                "{}: {sensitive} bin(s) of the band left out where a 1 % error of the model's \
+                 frequencies changes the transfer function by 1 % or more (resonances)",
+                obs.name()
+            ));
+        }
+        counts.push((obs, list.len()));
+        if !list.is_empty() {
+            bins.push((o, list));
+        }
+    }
+    ObservableBins { bins, counts }
+}
+
+/// The usable bins of observable `o`, and how many were left out near a resonance.
+fn bins_of_observable(
+    training: &Training,
+    o: usize,
+    grid_bins: &[usize],
+    grid: &[Option<GridBin>],
+    model: &ModelRows,
+    n_in: usize,
+) -> (Vec<Bin>, usize) {
+    let spectra = training.spectra;
+    let n_eff = training.n_eff;
+    let n_ch = spectra.n_channels;
+    let yc = n_in + o;
+    let mut list = Vec::new();
+    let mut sensitive = 0;
+    for (g, &k) in grid_bins.iter().enumerate() {
+        let Some(gb) = &grid[g] else { continue };
+        let sens = super::predict::sensitivity(
+            &model.row(&model.h0, o, g),
+            &model.row(&model.h_up, o, g),
+            &model.row(&model.h_down, o, g),
+        );
+        if sens.is_nan() || sens >= FIT_SENSITIVITY {
+            sensitive += 1;
+            continue;
+        }
+        let m = spectra.matrix(k);
+        let s = DVector::from_fn(n_in, |a, _| m[a * n_ch + yc]);
+        let syy = m[yc * n_ch + yc].re;
+        if syy <= 0.0 {
+            continue;
+        }
+        // Model-free first weights: the coherence residual, unbiased for n_eff averages.
+        let coh = coherence_residual(syy, &s, &gb.sww).unwrap_or(syy);
+        let n_fac = if n_eff > n_in as f64 {
+            n_eff / (n_eff - n_in as f64)
+        } else {
+            1.0
+        };
+        let see = (coh * n_fac).clamp(S_EE_FLOOR * syy, syy.max(S_EE_FLOOR * syy));
+        list.push(Bin {
+            grid: g,
+            s,
+            syy,
+            see,
+            whitener: whitener(&gb.sbar, see, n_eff, None),
+        });
+    }
+    (list, sensitive)
+}
+
+/// Median over the fit bins of `S_mm / S_ww` per input.
+fn witness_bias(grid: &[Option<GridBin>], bins: &[(usize, Vec<Bin>)], n_in: usize) -> Vec<f64> {
+    (0..n_in)
+        .map(|a| {
+            let mut r: Vec<f64> = bins
+                .iter()
+                .flat_map(|(_, b)| b.iter())
+                .filter_map(|b| grid[b.grid].as_ref())
+                .map(|g| g.noise[a] / g.sbar[(a, a)].re)
+                .collect();
+            median(&mut r)
+        })
+        .collect()
+}
+
+/// Where the solver ended.
+struct Solution {
+    theta: Vec<f64>,
+    /// The parameters left free (the others at their nominal values).
+    free: Vec<usize>,
+    iterations: usize,
+    stop: Stop,
+}
+
+/// Two passes of the solver: the second after reweighting at the first's solution and fixing
+/// what the data then leave unconstrained.
+fn solve_two_passes(
+    problem: &mut Problem,
+    mut theta: Vec<f64>,
+    all: &[usize],
+) -> Result<Solution, SubtractError> {
+    let opts = LmOptions {
+        gtol: LM_GTOL,
+        max_iterations: LM_MAX_ITERATIONS,
+    };
+    let mut iterations = 0;
+    let mut stop = Stop::Gradient;
+    let mut free = constrained(problem, &theta, all)?;
+    for pass in 0..2 {
+        for &j in all {
+            if !free.contains(&j) {
+                theta[j] = problem.params[j].nominal;
+            }
+        }
+        if !free.is_empty() {
+            let u0 = DVector::from_iterator(
+                free.len(),
+                free.iter().map(|&j| {
+                    (theta[j] - problem.params[j].nominal) / problem.params[j].half_width
+                }),
+            );
+            let base_theta = theta.clone();
+            let to_theta = |u: &DVector<f64>| -> Vec<f64> {
+                let mut t = base_theta.clone();
+                for (jj, &j) in free.iter().enumerate() {
+                    t[j] = problem.params[j].nominal + u[jj] * problem.params[j].half_width;
+                }
+                t
+            };
+            // The instruments, fixed for the pass at its starting point; the estimate solves
+            // Z^T r = 0, i.e. minimizes |(Z^T Z)^-1/2 Z^T r|^2 (exactly identified).
+            let z = problem.evaluate(&theta, &free)?.inst;
+            let project = projector(&z);
+            let out = lm::minimize(u0, 1.0, &opts, |u| {
+                let e = problem.evaluate(&to_theta(u), &free)?;
+                Ok::<_, SubtractError>((&project * e.r, &project * e.jac))
+            })?;
+            theta = to_theta(&out.u);
+            iterations += out.iterations;
+            stop = out.stop;
+        }
+        if pass == 0 {
+            problem.reweight(&theta)?;
+            free = constrained(problem, &theta, &free)?;
+        }
+    }
+    Ok(Solution {
+        theta,
+        free,
+        iterations,
+        stop,
     })
 }
 

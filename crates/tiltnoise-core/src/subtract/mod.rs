@@ -364,16 +364,7 @@ pub fn subtract(
     } = SegmentPlan::new(n, fs, cfg)?;
     let inputs = witness.inputs;
     let n_in = inputs.len();
-    let w: Vec<&[f64]> = witness
-        .data
-        .iter()
-        .map(|x| &x[alignment.witness_first..alignment.witness_first + n])
-        .collect();
-    let y: Vec<&[f64]> = measured
-        .channels
-        .iter()
-        .map(|(_, x)| &x[alignment.measured_first..alignment.measured_first + n])
-        .collect();
+    let (w, y) = overlap(witness, measured, &alignment);
     let outputs: Vec<Observable> = measured.channels.iter().map(|c| c.0).collect();
     let channel_names = input_checks::channel_names(inputs, &outputs);
     input_checks::check_channels(&channel_names, &w, &y)?;
@@ -388,12 +379,7 @@ pub fn subtract(
     cfg.cancel.check()?;
     let colocated =
         colocated::estimate_all(witness, colocated, &cfg.colocated_noise_ratio, segment_len)?;
-    let noise = all_witness_noise(&cfg.witness_noise, &colocated)?;
-    let noise_psd = noise_on_grid(inputs, &noise, freqs)?;
-    let noise_rel: Vec<f64> = inputs
-        .iter()
-        .map(|i| noise.iter().find(|x| x.input == *i).map_or(0.0, |x| x.rel))
-        .collect();
+    let (noise_psd, noise_rel) = witness_noise(inputs, &cfg.witness_noise, &colocated, freqs)?;
     let fit = estimate::fit(
         params,
         inputs,
@@ -423,15 +409,7 @@ pub fn subtract(
     let noise_at = |k: usize| -> Vec<f64> { noise_psd.iter().map(|m| m[k]).collect() };
     let coupling = coupling_of(&fit, inputs, alignment.fraction_s);
     let fitted_model = Model::new(&fit.params).map_err(|e| SubtractError::Params(e.to_string()))?;
-    let weights = predict::Weights {
-        freqs_hz: freqs[1..].to_vec(),
-        at: (1..freqs.len())
-            .map(|k| {
-                let margin = prediction_margin(witness_spectra.dof[k]);
-                weigh(&witness_spectra.smoothed[k], &noise_at(k), margin).at
-            })
-            .collect(),
-    };
+    let weights = prediction_weights(&witness_spectra, freqs, &noise_at);
     let predictor = predict::predictor(
         &fitted_model,
         fs,
@@ -467,28 +445,11 @@ pub fn subtract(
     let held_spectra = csd_matrix_cancellable(&held, fs, &welch_cfg, &cfg.cancel)?;
     input_checks::check_spectra(&held_spectra, &channel_names, "held-out")?;
     let n_eff_held = equivalent_averages(&welch_cfg, held_spectra.n_segments);
-    let psds = |series: &[(Observable, Vec<f64>)]| -> Result<Vec<Vec<f64>>, SubtractError> {
-        series
-            .iter()
-            .map(|(_, x)| Ok(welch(&x[n_train..], fs, &welch_cfg)?.psd))
-            .collect()
-    };
-    let predicted_psd = psds(&prediction.series)?;
-    let cleaned_psd = psds(&cleaned)?;
+    let predicted_psd = held_out_psds(&prediction.series, n_train, fs, &welch_cfg)?;
+    let cleaned_psd = held_out_psds(&cleaned, n_train, fs, &welch_cfg)?;
     let wiener = residuals::Wiener::train(&training_spectra, n_in, outputs.len(), n_eff_train);
     let report_band = cfg.report_band_hz;
-    let grid = &held_spectra.freqs_hz;
-    if grid
-        .iter()
-        .skip(1)
-        .all(|&f| f < report_band.0 || f > report_band.1)
-    {
-        return Err(SubtractError::Band {
-            what: "report".into(),
-            band_hz: report_band,
-            grid_hz: (grid[1], grid[grid.len() - 1]),
-        });
-    }
+    check_report_band(&held_spectra.freqs_hz, report_band)?;
     let residuals = residuals::evaluate(
         &wiener,
         &residuals::HeldOut {
@@ -527,6 +488,89 @@ pub fn subtract(
         residuals,
         notes,
     })
+}
+
+/// The witness and measured series over their overlap.
+fn overlap<'a>(
+    witness: &WitnessRecord<'a>,
+    measured: &MeasuredRecord<'a>,
+    alignment: &Alignment,
+) -> (Vec<&'a [f64]>, Vec<&'a [f64]>) {
+    let n = alignment.len;
+    let w: Vec<&[f64]> = witness
+        .data
+        .iter()
+        .map(|x| &x[alignment.witness_first..alignment.witness_first + n])
+        .collect();
+    let y: Vec<&[f64]> = measured
+        .channels
+        .iter()
+        .map(|(_, x)| &x[alignment.measured_first..alignment.measured_first + n])
+        .collect();
+    (w, y)
+}
+
+/// Per input, its noise PSD on the Welch grid `freqs` (given, or from the colocated
+/// witnesses) and the stated relative uncertainty of its level (0 when none was stated).
+fn witness_noise(
+    inputs: &[Input],
+    given: &[WitnessNoise],
+    colocated: &[ColocatedEstimate],
+    freqs: &[f64],
+) -> Result<(Vec<Vec<f64>>, Vec<f64>), SubtractError> {
+    let noise = all_witness_noise(given, colocated)?;
+    let noise_psd = noise_on_grid(inputs, &noise, freqs)?;
+    let noise_rel: Vec<f64> = inputs
+        .iter()
+        .map(|i| noise.iter().find(|x| x.input == *i).map_or(0.0, |x| x.rel))
+        .collect();
+    Ok((noise_psd, noise_rel))
+}
+
+/// The prediction's weighting of the witnesses at every Welch bin but DC.
+fn prediction_weights(
+    witness_spectra: &WitnessSpectra,
+    freqs: &[f64],
+    noise_at: &dyn Fn(usize) -> Vec<f64>,
+) -> predict::Weights {
+    predict::Weights {
+        freqs_hz: freqs[1..].to_vec(),
+        at: (1..freqs.len())
+            .map(|k| {
+                let margin = prediction_margin(witness_spectra.dof[k]);
+                weigh(&witness_spectra.smoothed[k], &noise_at(k), margin).at
+            })
+            .collect(),
+    }
+}
+
+/// The Welch PSD of every series over the held-out stretch (from sample `n_train`).
+fn held_out_psds(
+    series: &[(Observable, Vec<f64>)],
+    n_train: usize,
+    fs: f64,
+    welch_cfg: &WelchConfig,
+) -> Result<Vec<Vec<f64>>, SubtractError> {
+    series
+        .iter()
+        .map(|(_, x)| Ok(welch(&x[n_train..], fs, welch_cfg)?.psd))
+        .collect()
+}
+
+/// Some bin of the held-out grid (DC left out) lies in the report band.
+fn check_report_band(grid: &[f64], report_band: (f64, f64)) -> Result<(), SubtractError> {
+    if grid
+        .iter()
+        .skip(1)
+        .all(|&f| f < report_band.0 || f > report_band.1)
+    {
+        return Err(SubtractError::Band {
+            what: "report".into(),
+            band_hz: report_band,
+            grid_hz: (grid[1], grid[grid.len() - 1]),
+        });
+    }
+    Ok(())
 }
 
 /// How the overlap is cut: the Welch segment, the training and held-out stretches, the largest

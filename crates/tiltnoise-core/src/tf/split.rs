@@ -243,6 +243,212 @@ impl Form {
     }
 }
 
+/// The block-local index of coordinate `c`, if the block has it.
+fn local(idx: &[usize; 4], c: Coord) -> Option<usize> {
+    idx.iter().position(|&i| i == c.index())
+}
+
+/// The generalized force of force input `f` on the block.
+fn force_q(model: &Model, idx: &[usize; 4], f: ForceInput) -> Vector4<f64> {
+    Vector4::from_fn(|r, _| model.force_matrix()[(idx[r], f.index())])
+}
+
+/// The forcing `g2` of floor translation `a` on the block.
+fn translation_q(model: &Model, idx: &[usize; 4], a: TranslationAxis) -> Vector4<f64> {
+    Vector4::from_fn(|r, _| model.translation_forcing().g2[(idx[r], a.index())])
+}
+
+/// One block's matrices and observation rows, in the model's coordinates (`_q`) and in
+/// absolute test-mass angles, from which each input's two forms are built.
+struct BlockParts<'a> {
+    model: &'a Model,
+    idx: [usize; 4],
+    t: Absolute,
+    mass_q: Matrix4<f64>,
+    stiffness_q: Matrix4<Complex64>,
+    damping_q: Matrix4<f64>,
+    /// `M_u = T^-T M T^-1`.
+    mass: Matrix4<f64>,
+    /// `K_u = T^-T K_c T^-1`.
+    stiffness: Matrix4<Complex64>,
+    /// `C_u = T^-T C T^-1`, when there is viscous damping.
+    damping: Option<Matrix4<f64>>,
+    /// Outputs that read the block: row in the request, `C` row.
+    obs_q: Vec<(usize, RowVector4<f64>)>,
+    /// The same with the `C_u` row.
+    outputs: Vec<(usize, RowVector4<f64>)>,
+}
+
+impl<'a> BlockParts<'a> {
+    fn new(
+        model: &'a Model,
+        block: Block,
+        idx: [usize; 4],
+        obs_q: Vec<(usize, RowVector4<f64>)>,
+    ) -> Self {
+        let t = Absolute::new(block);
+        let mass_q = Model::block_of(model.mass(), block);
+        let k = model.stiffness_complex();
+        let stiffness_q = Matrix4::from_fn(|r, c| k[(idx[r], idx[c])]);
+        let mass = t.congruence(&mass_q);
+        let stiffness = t.congruence(&stiffness_q);
+        let damping_q = Model::block_of(model.damping(), block);
+        let damping = model.has_viscous().then(|| t.congruence(&damping_q));
+        let outputs: Vec<(usize, RowVector4<f64>)> = obs_q
+            .iter()
+            .map(|(row, c)| (*row, t.observation(c)))
+            .collect();
+        BlockParts {
+            model,
+            idx,
+            t,
+            mass_q,
+            stiffness_q,
+            damping_q,
+            mass,
+            stiffness,
+            damping,
+            obs_q,
+            outputs,
+        }
+    }
+
+    /// Per tilt column `a`: T^-T i Im(K_c) e_a (the loss term).
+    fn loss_column(&self, a: usize) -> Vector4<Complex64> {
+        self.t.force(
+            &self
+                .stiffness_q
+                .column(a)
+                .map(|z| Complex64::new(0.0, z.im)),
+        )
+    }
+
+    /// Per tilt column `a`: T^-T C e_a (the viscous term).
+    fn viscous_column(&self, a: usize) -> Vector4<f64> {
+        self.t.force(&self.damping_q.column(a).into_owned())
+    }
+
+    /// Column `j` of the block's observation rows.
+    fn observed_column(&self, j: usize) -> Vec<f64> {
+        self.obs_q.iter().map(|(_, c)| c[j]).collect()
+    }
+
+    /// `C_u y0` for a static displacement `y0`, or zero without viscous damping.
+    fn damped(&self, y0: &Vector4<f64>) -> Vector4<f64> {
+        match &self.damping {
+            Some(c) => c * y0,
+            None => Vector4::zeros(),
+        }
+    }
+
+    /// The low- and high-frequency forms of `input`.
+    fn forms(&self, input: Input) -> (Form, Form) {
+        match input {
+            Input::Force(f) => {
+                let form = Form::new(
+                    vec![0.0; self.outputs.len()],
+                    self.t
+                        .force(&force_q(self.model, &self.idx, f))
+                        .map(Complex64::from),
+                    1.0,
+                    false,
+                );
+                (form.clone(), form)
+            }
+            Input::Translation(a) => self.translation_forms(a),
+            Input::Tilt(axis @ (TiltAxis::ThetaT | TiltAxis::EtaT)) => {
+                self.suspension_tilt_forms(axis)
+            }
+            Input::Tilt(axis) => self.rotation_tilt_forms(axis),
+        }
+    }
+
+    fn translation_forms(&self, a: TranslationAxis) -> (Form, Form) {
+        let g = self.t.force(&translation_q(self.model, &self.idx, a));
+        let y0 = self
+            .mass
+            .lu()
+            .solve(&g)
+            .expect("M is positive definite (checked by Model::new)");
+        let high_offset = self.outputs.iter().map(|(_, c)| -c.dot(&y0.transpose()));
+        let c_y0 = self.damped(&y0);
+        (
+            Form::new(
+                vec![0.0; self.outputs.len()],
+                g.map(Complex64::from),
+                1.0,
+                true,
+            ),
+            Form::new(
+                high_offset.collect(),
+                self.stiffness * y0.map(Complex64::from),
+                1.0,
+                false,
+            )
+            .with_damping(Vector4::zeros(), c_y0),
+        )
+    }
+
+    /// A tilt about a horizontal axis, which also moves the suspension point.
+    fn suspension_tilt_forms(&self, axis: TiltAxis) -> (Form, Form) {
+        let p = self.model.params();
+        let (m_a, m_b) = (p.mass.m_a_kg, p.mass.m_b_kg);
+        let l = &p.length;
+        let a = local(&self.idx, tilt_coord(axis)).expect("filtered above");
+        let b = local(&self.idx, partner(tilt_coord(axis)))
+            .expect("theta_b, eta_b share the block of theta_a, eta_a");
+        // Suspension-point translation h per radian, in absolute angles.
+        let mut r_u = Vector4::zeros();
+        r_u[a] = l.h_m * (m_a * (l.z_m + l.z_a_m) + m_b * l.z_m);
+        r_u[b] = l.h_m * (m_b * l.z_b_m);
+        let y0 = self
+            .mass
+            .lu()
+            .solve(&r_u)
+            .expect("M is positive definite (checked by Model::new)");
+        let static_part = self.observed_column(a);
+        let high_offset = static_part
+            .iter()
+            .zip(&self.outputs)
+            .map(|(s, (_, c))| s - c.dot(&y0.transpose()))
+            .collect();
+        let (loss, visc) = (-self.loss_column(a), -self.viscous_column(a));
+        let c_y0 = self.damped(&y0);
+        (
+            Form::new(static_part, r_u.map(Complex64::from), 1.0, true).with_damping(loss, visc),
+            Form::new(
+                high_offset,
+                self.stiffness * y0.map(Complex64::from),
+                1.0,
+                false,
+            )
+            .with_damping(loss, visc + c_y0),
+        )
+    }
+
+    /// A tilt about the vertical axis.
+    fn rotation_tilt_forms(&self, axis: TiltAxis) -> (Form, Form) {
+        let a = local(&self.idx, tilt_coord(axis)).expect("filtered above");
+        (
+            Form::new(
+                vec![0.0; self.outputs.len()],
+                self.t
+                    .force(&self.mass_q.column(a).into_owned())
+                    .map(Complex64::from),
+                -1.0,
+                true,
+            ),
+            Form::new(
+                self.observed_column(a),
+                self.t.force(&self.stiffness_q.column(a).into_owned()),
+                -1.0,
+                false,
+            )
+            .with_damping(Vector4::zeros(), -self.viscous_column(a)),
+        )
+    }
+}
+
 impl AbsoluteBlock {
     fn new(
         model: &Model,
@@ -251,20 +457,14 @@ impl AbsoluteBlock {
         request: &Request,
     ) -> Option<AbsoluteBlock> {
         let idx = block.coords().map(Coord::index);
-        let local = |c: Coord| idx.iter().position(|&i| i == c.index());
-        let force_q =
-            |f: ForceInput| Vector4::from_fn(|r, _| model.force_matrix()[(idx[r], f.index())]);
-        let translation_q = |a: TranslationAxis| {
-            Vector4::from_fn(|r, _| model.translation_forcing().g2[(idx[r], a.index())])
-        };
         let inputs: Vec<(usize, Input)> = request
             .inputs
             .iter()
             .enumerate()
             .filter(|&(_, &input)| match input {
-                Input::Tilt(axis) => local(tilt_coord(axis)).is_some(),
-                Input::Translation(a) => translation_q(a).iter().any(|&v| v != 0.0),
-                Input::Force(f) => force_q(f).iter().any(|&v| v != 0.0),
+                Input::Tilt(axis) => local(&idx, tilt_coord(axis)).is_some(),
+                Input::Translation(a) => translation_q(model, &idx, a).iter().any(|&v| v != 0.0),
+                Input::Force(f) => force_q(model, &idx, f).iter().any(|&v| v != 0.0),
             })
             .map(|(col, &input)| (col, input))
             .collect();
@@ -284,112 +484,11 @@ impl AbsoluteBlock {
         if inputs.is_empty() || obs_q.is_empty() {
             return None;
         }
-        let t = Absolute::new(block);
-        let mass_q = Model::block_of(model.mass(), block);
-        let k = model.stiffness_complex();
-        let stiffness_q = Matrix4::from_fn(|r, c| k[(idx[r], idx[c])]);
-        let mass = t.congruence(&mass_q);
-        let stiffness = t.congruence(&stiffness_q);
-        let damping_q = Model::block_of(model.damping(), block);
-        let damping = model.has_viscous().then(|| t.congruence(&damping_q));
-        // Per tilt column `a`: T^-T i Im(K_c) e_a and T^-T C e_a (the damping terms).
-        let loss_column = |a: usize| -> Vector4<Complex64> {
-            t.force(&stiffness_q.column(a).map(|z| Complex64::new(0.0, z.im)))
-        };
-        let viscous_column =
-            |a: usize| -> Vector4<f64> { t.force(&damping_q.column(a).into_owned()) };
-        let outputs: Vec<(usize, RowVector4<f64>)> = obs_q
-            .iter()
-            .map(|(row, c)| (*row, t.observation(c)))
-            .collect();
-        let observed_column = |j: usize| -> Vec<f64> { obs_q.iter().map(|(_, c)| c[j]).collect() };
-        let p = model.params();
-        let (m_a, m_b) = (p.mass.m_a_kg, p.mass.m_b_kg);
-        let l = &p.length;
+        let parts = BlockParts::new(model, block, idx, obs_q);
         let columns = inputs
             .into_iter()
             .map(|(col, input)| {
-                let (low, high) = match input {
-                    Input::Force(f) => {
-                        let form = Form::new(
-                            vec![0.0; outputs.len()],
-                            t.force(&force_q(f)).map(Complex64::from),
-                            1.0,
-                            false,
-                        );
-                        (form.clone(), form)
-                    }
-                    Input::Translation(a) => {
-                        let g = t.force(&translation_q(a));
-                        let y0 = mass
-                            .lu()
-                            .solve(&g)
-                            .expect("M is positive definite (checked by Model::new)");
-                        let high_offset = outputs.iter().map(|(_, c)| -c.dot(&y0.transpose()));
-                        let c_y0 = match &damping {
-                            Some(c) => c * y0,
-                            None => Vector4::zeros(),
-                        };
-                        (
-                            Form::new(vec![0.0; outputs.len()], g.map(Complex64::from), 1.0, true),
-                            Form::new(
-                                high_offset.collect(),
-                                stiffness * y0.map(Complex64::from),
-                                1.0,
-                                false,
-                            )
-                            .with_damping(Vector4::zeros(), c_y0),
-                        )
-                    }
-                    Input::Tilt(axis @ (TiltAxis::ThetaT | TiltAxis::EtaT)) => {
-                        let a = local(tilt_coord(axis)).expect("filtered above");
-                        let b = local(partner(tilt_coord(axis)))
-                            .expect("theta_b, eta_b share the block of theta_a, eta_a");
-                        // Suspension-point translation h per radian, in absolute angles.
-                        let mut r_u = Vector4::zeros();
-                        r_u[a] = l.h_m * (m_a * (l.z_m + l.z_a_m) + m_b * l.z_m);
-                        r_u[b] = l.h_m * (m_b * l.z_b_m);
-                        let y0 = mass
-                            .lu()
-                            .solve(&r_u)
-                            .expect("M is positive definite (checked by Model::new)");
-                        let static_part = observed_column(a);
-                        let high_offset = static_part
-                            .iter()
-                            .zip(&outputs)
-                            .map(|(s, (_, c))| s - c.dot(&y0.transpose()))
-                            .collect();
-                        let (loss, visc) = (-loss_column(a), -viscous_column(a));
-                        let c_y0 = match &damping {
-                            Some(c) => c * y0,
-                            None => Vector4::zeros(),
-                        };
-                        (
-                            Form::new(static_part, r_u.map(Complex64::from), 1.0, true)
-                                .with_damping(loss, visc),
-                            Form::new(high_offset, stiffness * y0.map(Complex64::from), 1.0, false)
-                                .with_damping(loss, visc + c_y0),
-                        )
-                    }
-                    Input::Tilt(axis) => {
-                        let a = local(tilt_coord(axis)).expect("filtered above");
-                        (
-                            Form::new(
-                                vec![0.0; outputs.len()],
-                                t.force(&mass_q.column(a).into_owned()).map(Complex64::from),
-                                -1.0,
-                                true,
-                            ),
-                            Form::new(
-                                observed_column(a),
-                                t.force(&stiffness_q.column(a).into_owned()),
-                                -1.0,
-                                false,
-                            )
-                            .with_damping(Vector4::zeros(), -viscous_column(a)),
-                        )
-                    }
-                };
+                let (low, high) = parts.forms(input);
                 Column { col, low, high }
             })
             .collect();
@@ -402,11 +501,11 @@ impl AbsoluteBlock {
         let lo = eigenvalues.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = eigenvalues.iter().copied().fold(0.0, f64::max);
         Some(AbsoluteBlock {
-            stiffness,
-            mass,
-            damping,
+            stiffness: parts.stiffness,
+            mass: parts.mass,
+            damping: parts.damping,
             crossover_w2: (lo * hi).sqrt(),
-            outputs,
+            outputs: parts.outputs,
             columns,
         })
     }
