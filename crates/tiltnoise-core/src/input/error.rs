@@ -77,19 +77,6 @@ pub enum InputError {
         found: &'static str,
     },
 
-    /// A required HDF5 attribute is absent.
-    #[error("input file {path}: required attribute `{attribute}` of {object} is missing; expected {expected}")]
-    MissingAttribute {
-        /// The file.
-        path: PathBuf,
-        /// The object that should carry it, e.g. `/` (root) or `dataset /E`.
-        object: String,
-        /// The attribute name.
-        attribute: &'static str,
-        /// What it should hold, with unit.
-        expected: &'static str,
-    },
-
     /// An HDF5 attribute (or CSV metadata key) with a value or type that is not allowed.
     #[error(
         "input file {path}: attribute `{attribute}` of {} = {} is not allowed: must be {allowed}",
@@ -107,34 +94,6 @@ pub enum InputError {
         value: String,
         /// What is allowed, with unit.
         allowed: &'static str,
-    },
-
-    /// A required HDF5 dataset is absent.
-    #[error("input file {path}: required dataset `{dataset}` is missing; expected {expected}")]
-    MissingDataset {
-        /// The file.
-        path: PathBuf,
-        /// The dataset path, e.g. `/frequency_hz`.
-        dataset: String,
-        /// What it should hold.
-        expected: String,
-    },
-
-    /// An HDF5 dataset of the wrong type or shape.
-    #[error(
-        "input file {path}: dataset `{}` has {}; allowed: {allowed}",
-        Shown(.dataset),
-        Shown(.found)
-    )]
-    BadDataset {
-        /// The file.
-        path: PathBuf,
-        /// The dataset path.
-        dataset: String,
-        /// Its type or shape.
-        found: String,
-        /// What is allowed.
-        allowed: String,
     },
 
     /// A NaN or infinite sample while gaps are rejected.
@@ -512,27 +471,6 @@ pub enum InputError {
         unit: &'static str,
         /// Whether the value is a PSD (else an ASD).
         power: bool,
-    },
-
-    /// A cross-spectral density matrix that is not Hermitian positive semidefinite within
-    /// tolerance, or has non-finite entries.
-    #[error("input file {path}: /csd[{index}, {i}, {j}] at {freq_hz:?} Hz ({pair}): {problem}")]
-    Csd {
-        /// The file.
-        path: PathBuf,
-        /// Frequency index.
-        index: usize,
-        /// Frequency (Hz).
-        freq_hz: f64,
-        /// Row.
-        i: usize,
-        /// Column.
-        j: usize,
-        /// The axis names of the row and column, e.g. `theta_t, eta_t`.
-        pair: String,
-        /// What is wrong, with the values and their unit, and what is allowed, with the
-        /// tolerance.
-        problem: String,
     },
 
     /// A `--scale CHANNEL=FACTOR` that names no channel of the file, or a channel in counts

@@ -129,18 +129,19 @@ fn read_hdf5(path: &Path, quantity: &str, asd_unit: &'static str) -> Result<AsdC
     let column = [quantity, GENERIC_ASD_COLUMN]
         .into_iter()
         .find(|n| names.iter().any(|x| x == n))
-        .ok_or_else(|| InputError::MissingDataset {
+        .ok_or_else(|| FormatError::MissingDataset {
             path: path.to_path_buf(),
             dataset: format!("/{} (or /{GENERIC_ASD_COLUMN})", Shown(quantity)),
             expected: format!("the one-sided ASD of {} in {asd_unit}", Shown(quantity)),
         })?
         .to_string();
     if !names.iter().any(|n| n == "frequency_hz") {
-        return Err(InputError::MissingDataset {
+        return Err(FormatError::MissingDataset {
             path: path.to_path_buf(),
             dataset: "/frequency_hz".to_string(),
             expected: "the frequencies (Hz) of the ASD".to_string(),
-        });
+        }
+        .into());
     }
     let read = |name: &str| -> Result<Vec<f64>, InputError> {
         let object = format!("dataset /{name}");
@@ -148,12 +149,13 @@ fn read_hdf5(path: &Path, quantity: &str, asd_unit: &'static str) -> Result<AsdC
         let (float, dtype) = h5::is_float(&ds).map_err(h5err(path, object.clone()))?;
         let shape = ds.shape();
         if shape.len() != 1 || !float {
-            return Err(InputError::BadDataset {
+            return Err(FormatError::BadDataset {
                 path: path.to_path_buf(),
                 dataset: format!("/{name}"),
                 found: format!("type {dtype} and shape {shape:?}"),
                 allowed: "a 1-D float64 (or float32) dataset, one value per frequency".into(),
-            });
+            }
+            .into());
         }
         h5::check_whole_read(path, &format!("/{name}"), shape[0], 2, "frequencies")?;
         ds.read_raw::<f64>().map_err(h5err(path, object))

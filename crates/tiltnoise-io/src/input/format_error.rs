@@ -136,6 +136,68 @@ pub enum FormatError {
         /// What is wrong and what is allowed.
         message: String,
     },
+
+    /// A required HDF5 attribute is absent.
+    #[error("input file {path}: required attribute `{attribute}` of {object} is missing; expected {expected}")]
+    MissingAttribute {
+        /// The file.
+        path: PathBuf,
+        /// The object that should carry it, e.g. `/` (root) or `dataset /E`.
+        object: String,
+        /// The attribute name.
+        attribute: &'static str,
+        /// What it should hold, with unit.
+        expected: &'static str,
+    },
+
+    /// A required HDF5 dataset is absent.
+    #[error("input file {path}: required dataset `{dataset}` is missing; expected {expected}")]
+    MissingDataset {
+        /// The file.
+        path: PathBuf,
+        /// The dataset path, e.g. `/frequency_hz`.
+        dataset: String,
+        /// What it should hold.
+        expected: String,
+    },
+
+    /// An HDF5 dataset of the wrong type or shape.
+    #[error(
+        "input file {path}: dataset `{}` has {}; allowed: {allowed}",
+        Shown(.dataset),
+        Shown(.found)
+    )]
+    BadDataset {
+        /// The file.
+        path: PathBuf,
+        /// The dataset path.
+        dataset: String,
+        /// Its type or shape.
+        found: String,
+        /// What is allowed.
+        allowed: String,
+    },
+
+    /// A cross-spectral density matrix that is not Hermitian positive semidefinite within
+    /// tolerance, or has non-finite entries.
+    #[error("input file {path}: /csd[{index}, {i}, {j}] at {freq_hz:?} Hz ({pair}): {problem}")]
+    Csd {
+        /// The file.
+        path: PathBuf,
+        /// Frequency index.
+        index: usize,
+        /// Frequency (Hz).
+        freq_hz: f64,
+        /// Row.
+        i: usize,
+        /// Column.
+        j: usize,
+        /// The axis names of the row and column, e.g. `theta_t, eta_t`.
+        pair: String,
+        /// What is wrong, with the values and their unit, and what is allowed, with the
+        /// tolerance.
+        problem: String,
+    },
 }
 
 impl FormatError {

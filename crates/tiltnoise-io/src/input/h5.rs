@@ -71,7 +71,7 @@ pub(crate) fn check_storage(
     if have >= need {
         return Ok(());
     }
-    Err(InputError::BadDataset {
+    Err(FormatError::BadDataset {
         path: path.to_path_buf(),
         dataset: dataset.to_string(),
         found: format!(
@@ -81,7 +81,8 @@ pub(crate) fn check_storage(
         allowed: "storage for every entry (this dataset is truncated, damaged or was never \
                   written)"
             .to_string(),
-    })
+    }
+    .into())
 }
 
 /// Refuses to read `channels` datasets of `len` samples (or frequencies) each into memory when
@@ -256,12 +257,13 @@ pub(crate) fn str_attr(
 pub(crate) fn sample_rate_hz(path: &Path, file: &hdf5::File) -> Result<f64, InputError> {
     const RATE_ALLOWED: &str = "the sample rate in Hz: a finite number > 0";
     match attr(path, file, "/", "sample_rate_hz")? {
-        None => Err(InputError::MissingAttribute {
+        None => Err(FormatError::MissingAttribute {
             path: path.to_path_buf(),
             object: "/".to_string(),
             attribute: "sample_rate_hz",
             expected: RATE_ALLOWED,
-        }),
+        }
+        .into()),
         Some(AttrValue::Num(v)) if v.is_finite() && v > 0.0 => {
             check_sample_rate(path, || "attribute sample_rate_hz of /".to_string(), v)
         }
@@ -536,14 +538,15 @@ pub(crate) fn locate(
                 (parent.to_string(), Some(name.to_string()))
             }
             _ => {
-                return Err(InputError::MissingDataset {
+                return Err(FormatError::MissingDataset {
                     path: path.to_path_buf(),
                     dataset: o.to_string(),
                     expected: format!(
                         "a group or a dataset of the file; datasets: {}",
                         shown_list(&all_datasets(file))
                     ),
-                })
+                }
+                .into())
             }
         },
     };

@@ -163,12 +163,13 @@ fn read_series_hdf5(path: &Path) -> Result<MeasuredSeries, InputError> {
         let (float, dtype) = h5::is_float(&ds).map_err(h5err(path, object.clone()))?;
         let shape = ds.shape();
         if shape.len() != 1 || !float {
-            return Err(InputError::BadDataset {
+            return Err(FormatError::BadDataset {
                 path: path.to_path_buf(),
                 dataset: format!("/{name}"),
                 found: format!("type {dtype} and shape {shape:?}"),
                 allowed: "a 1-D float64 (or float32) dataset, one sample per entry".to_string(),
-            });
+            }
+            .into());
         }
         h5::check_storage(path, &ds, &format!("/{name}"))?;
         match h5::unit_attr(path, &ds, &object)? {
@@ -207,13 +208,14 @@ fn finish_series(
     lines: Option<&[usize]>,
 ) -> Result<MeasuredSeries, InputError> {
     if channels.is_empty() {
-        return Err(InputError::MissingDataset {
+        return Err(FormatError::MissingDataset {
             path: path.to_path_buf(),
             dataset: "X (or Y, Z, theta, eta, phi, phi_a)".to_string(),
             expected: "at least one observable series (1-D float dataset or CSV column named \
                        after the observable)"
                 .to_string(),
-        });
+        }
+        .into());
     }
     channels.sort_by_key(|(o, _)| o.index());
     let (o0, n) = (channels[0].0, channels[0].1.len());

@@ -3,6 +3,7 @@
 
 use super::address::input_format;
 use super::address::split_hdf5_address;
+use super::format_error::FormatError;
 use super::h5::{self, h5err, AttrValue};
 use super::series_units::{self, check_unstated, into_series, Plan, Stated};
 use std::path::{Path, PathBuf};
@@ -60,7 +61,7 @@ impl TiltSeriesSource {
     /// # Errors
     ///
     /// [`InputError::Extension`] unless the extension is `.h5`/`.hdf5`;
-    /// [`InputError::WrongKind`] for spectra; [`InputError::MissingAttribute`] without a root
+    /// [`InputError::WrongKind`] for spectra; [`FormatError::MissingAttribute`] without a root
     /// attribute `sample_rate_hz`; any validation error of the layout (see
     /// `docs/input_formats.md`); with gap interpolation, also the errors of the scanning pass
     /// (edge gaps).
@@ -158,12 +159,13 @@ impl TiltSeriesSource {
             let (float, dtype) =
                 h5::is_float(&ds).map_err(h5err(path, format!("dataset {name}")))?;
             if shape.len() != 1 || !float {
-                return Err(InputError::BadDataset {
+                return Err(FormatError::BadDataset {
                     path: path.to_path_buf(),
                     dataset: name,
                     found: format!("type {dtype} and shape {shape:?}"),
                     allowed: "a 1-D float64 (or float32) dataset, one sample per entry".to_string(),
-                });
+                }
+                .into());
             }
             h5::check_storage(path, &ds, &name)?;
             match &first_len {
@@ -464,12 +466,13 @@ fn gwpy_rate(
         let dx = match h5::attr(path, &ds, &object, "dx")? {
             Some(h5::AttrValue::Num(v)) if v.is_finite() && v > 0.0 => v,
             None => {
-                return Err(InputError::MissingAttribute {
+                return Err(FormatError::MissingAttribute {
                     path: path.to_path_buf(),
                     object,
                     attribute: "dx",
                     expected: DX,
-                })
+                }
+                .into())
             }
             Some(other) => {
                 return Err(InputError::BadAttribute {

@@ -5,6 +5,7 @@
 //! taken as uncorrelated (off-diagonal CSD 0); bins at `f <= 0` (gwpy's spectra start at DC)
 //! are dropped.
 
+use super::format_error::FormatError;
 use super::h5::{self, h5err, AttrValue};
 use super::meta::{asd_unit, csd_unit, decide_quantity, Declared, ASD_UNITS, CSD_UNITS};
 use crate::input::spectra_checks::{no_scale_for_spectra, refuse_translation_spectra};
@@ -32,12 +33,13 @@ fn num_attr(
 ) -> Result<f64, InputError> {
     match h5::attr(path, ds, object, name)? {
         Some(AttrValue::Num(v)) if v.is_finite() => Ok(v),
-        None => Err(InputError::MissingAttribute {
+        None => Err(FormatError::MissingAttribute {
             path: path.to_path_buf(),
             object: object.to_string(),
             attribute: name,
             expected: allowed,
-        }),
+        }
+        .into()),
         Some(other) => Err(InputError::BadAttribute {
             path: path.to_path_buf(),
             object: object.to_string(),
@@ -84,12 +86,13 @@ pub(crate) fn read(
             .map_err(h5err(path, object.clone()))?;
         let (float, dtype) = h5::is_float(&ds).map_err(h5err(path, object.clone()))?;
         if ds.shape().len() != 1 || !float {
-            return Err(InputError::BadDataset {
+            return Err(FormatError::BadDataset {
                 path: path.to_path_buf(),
                 dataset: name,
                 found: format!("type {dtype} and shape {:?}", ds.shape()),
                 allowed: "a 1-D float dataset, one value per frequency".to_string(),
-            });
+            }
+            .into());
         }
         h5::check_storage(path, &ds, &name)?;
         let len = ds.shape()[0];

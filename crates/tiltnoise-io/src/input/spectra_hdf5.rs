@@ -1,6 +1,7 @@
 //! Tilt spectra from HDF5 (schema `tiltnoise.tilt_spectra`): `/frequency_hz` and either `/asd`
 //! `[n, n_axes]` or `/csd` `[n, n_axes, n_axes]` (complex), root attribute `axes`.
 
+use super::format_error::FormatError;
 use super::h5::{self, h5err, AttrValue};
 use super::meta::{
     asd_unit, csd_unit, decide_quantity, Declared, SpectrumUnit, ASD_UNITS, CSD_UNITS,
@@ -30,12 +31,13 @@ pub(crate) fn read(
     let has = |n: &str| datasets.iter().any(|d| d == n);
 
     if !has("frequency_hz") {
-        return Err(InputError::MissingDataset {
+        return Err(FormatError::MissingDataset {
             path: path.to_path_buf(),
             dataset: "/frequency_hz".to_string(),
             expected: "a 1-D float64 dataset of frequencies in Hz, > 0, strictly increasing"
                 .to_string(),
-        });
+        }
+        .into());
     }
     let freqs = frequencies(path, file)?;
     match (has("asd"), has("csd")) {
@@ -48,13 +50,14 @@ pub(crate) fn read(
             })
         }
         (false, false) => {
-            return Err(InputError::MissingDataset {
+            return Err(FormatError::MissingDataset {
                 path: path.to_path_buf(),
                 dataset: "/asd or /csd".to_string(),
                 expected: "/asd float64 [n_freq, n_axes] (rad/sqrt(Hz)) or /csd complex128 \
                            [n_freq, n_axes, n_axes] (rad^2/Hz)"
                     .to_string(),
-            })
+            }
+            .into())
         }
         _ => {}
     }
@@ -127,12 +130,13 @@ fn frequencies(path: &Path, file: &hdf5::File) -> Result<Vec<f64>, InputError> {
         .map_err(h5err(path, "dataset /frequency_hz"))?;
     let (float, dtype) = h5::is_float(&fds).map_err(h5err(path, "dataset /frequency_hz"))?;
     if fds.ndim() != 1 || !float {
-        return Err(InputError::BadDataset {
+        return Err(FormatError::BadDataset {
             path: path.to_path_buf(),
             dataset: "/frequency_hz".to_string(),
             found: format!("type {dtype} and shape {:?}", fds.shape()),
             allowed: "a 1-D float64 dataset (Hz)".to_string(),
-        });
+        }
+        .into());
     }
     h5::check_storage(path, &fds, "/frequency_hz")?;
     // The values: one CSD matrix of up to 3 x 3 complex (2 x 9 `f64`) per frequency.
@@ -160,12 +164,13 @@ fn frequencies(path: &Path, file: &hdf5::File) -> Result<Vec<f64>, InputError> {
 fn axis_names(path: &Path, file: &hdf5::File) -> Result<Vec<String>, InputError> {
     let names = match h5::attr(path, file, "/", "axes")? {
         None => {
-            return Err(InputError::MissingAttribute {
+            return Err(FormatError::MissingAttribute {
                 path: path.to_path_buf(),
                 object: "/".to_string(),
                 attribute: "axes",
                 expected: AXES_ALLOWED,
-            })
+            }
+            .into())
         }
         Some(AttrValue::Str(s)) => vec![s],
         Some(AttrValue::StrList(v)) => v,
@@ -265,12 +270,13 @@ fn open_values(
     let ds = file.dataset(kind.name).map_err(h5err(path, &object))?;
     let (right_type, dtype) = (kind.is_type)(&ds).map_err(h5err(path, &object))?;
     if ds.shape() != shape || !right_type {
-        return Err(InputError::BadDataset {
+        return Err(FormatError::BadDataset {
             path: path.to_path_buf(),
             dataset: format!("/{}", kind.name),
             found: format!("type {dtype} and shape {:?}", ds.shape()),
             allowed,
-        });
+        }
+        .into());
     }
     h5::check_storage(path, &ds, &format!("/{}", kind.name))?;
     let declared = units(path, &ds, kind.name, kind.classify, kind.units_allowed)?;
@@ -344,14 +350,17 @@ fn read_csd(
         .map_err(h5err(path, "dataset /csd"))?;
     for (k, &f) in freqs.iter().enumerate() {
         let at = |i: usize, j: usize| src[(k * m + i) * m + j];
-        let err = |i: usize, j: usize, detail: String, allowed: String| InputError::Csd {
-            path: path.to_path_buf(),
-            index: k,
-            freq_hz: f,
-            i,
-            j,
-            pair: format!("{}, {}", names[i], names[j]),
-            problem: format!("{detail} ({unit}); allowed: {allowed}"),
+        let err = |i: usize, j: usize, detail: String, allowed: String| {
+            FormatError::Csd {
+                path: path.to_path_buf(),
+                index: k,
+                freq_hz: f,
+                i,
+                j,
+                pair: format!("{}, {}", names[i], names[j]),
+                problem: format!("{detail} ({unit}); allowed: {allowed}"),
+            }
+            .into()
         };
         for i in 0..m {
             for j in 0..m {
