@@ -11,6 +11,10 @@ impl OptionStyle for Flags {
     fn option(&self, key: OptionKey) -> String {
         match key {
             OptionKey::DRAWN_OBSERVABLES => "--plot-observables".to_string(),
+            // The inputs and observables of a transfer function (`inputs`, `outputs` in
+            // Python).
+            OptionKey::INPUTS => "--input".to_string(),
+            OptionKey::OUTPUTS => "--observables".to_string(),
             // The grid of a model evaluation, `freq_hz` in Python.
             k if k.key() == "freq_hz" => "--freq".to_string(),
             _ => format!("--{}", key.key().replace('_', "-")),

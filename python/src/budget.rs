@@ -28,6 +28,7 @@ use tiltnoise_core::input::{
 use tiltnoise_core::model::{Input, Model, Observable};
 use tiltnoise_core::noise::equivalent::referred_terms;
 use tiltnoise_core::noise::{BudgetReport, SpectralSource};
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_io::RunMeta;
@@ -217,7 +218,7 @@ fn tilt_channels(
         .iter()
         .map(|n| ground_input(n))
         .collect::<PyResult<Vec<_>>>()?;
-    refuse_repeats("axes", "input", &axes, |a| a.name().to_string())
+    refuse_repeats(OptionKey::AXES, "input", &axes, |a| a.name().to_string())
         .map_err(|e| value_error(e.to_string()))?;
     let rows = arrays::rows("tilt", tilt, SERIES)?;
     if rows.len() != axes.len() {
@@ -252,7 +253,7 @@ fn describe_arrays(
 ) -> PyResult<Described> {
     let quantity: Quantity = quantity.parse().map_err(value_error)?;
     let items: Vec<String> = units.iter().map(|(k, u)| format!("{k}={u}")).collect();
-    let units = parse_units("units", &items).map_err(value_error)?;
+    let units = parse_units(OptionKey::UNITS, &items).py()?;
     let inputs: Vec<Input> = channels.iter().map(|(i, _)| *i).collect();
     for u in &units {
         if !inputs.iter().any(|i| i.name() == u.channel) {
@@ -269,8 +270,8 @@ fn describe_arrays(
     }
     let mut sensors = Sensors::default();
     for (option, names, motion) in [
-        ("corrected", &corrected, Motion::Translation),
-        ("pendulum_tiltmeter", &pendulum, Motion::Rotation),
+        (OptionKey::CORRECTED, &corrected, Motion::Translation),
+        (OptionKey::PENDULUM_TILTMETER, &pendulum, Motion::Rotation),
     ] {
         refuse_repeats(option, "input", names, |n| n.clone())
             .map_err(|e| value_error(e.to_string()))?;

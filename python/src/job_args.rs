@@ -13,6 +13,7 @@ use tiltnoise_core::fit::FitError;
 use tiltnoise_core::input::{parse_scales, parse_units, AxisMap};
 use tiltnoise_core::model::{Input, Observable};
 use tiltnoise_core::noise::UserSource;
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::options::{self, observable_names};
 use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_core::simulate::SimError;
@@ -74,7 +75,7 @@ pub fn read_request(
             .map_err(|e| value_error(e.to_string()))?,
         quantity: quantity.map(str::parse).transpose().map_err(value_error)?,
         gaps: gaps.map(str::parse).transpose().map_err(value_error)?,
-        scale: parse_scales("scale", &scale).map_err(value_error)?,
+        scale: parse_scales(OptionKey::SCALE, &scale).py()?,
         ..ReadRequest::default()
     })
 }
@@ -91,7 +92,7 @@ pub fn file_read_request(
     gaps: Option<&str>,
     scale: Option<std::collections::BTreeMap<String, f64>>,
 ) -> PyResult<ReadRequest> {
-    let names_once = |option: &str, names: Option<Vec<String>>| -> PyResult<Vec<String>> {
+    let names_once = |option: OptionKey, names: Option<Vec<String>>| -> PyResult<Vec<String>> {
         let names = names.unwrap_or_default();
         refuse_repeats(option, "channel", &names, |n| n.clone())
             .map_err(|e| value_error(e.to_string()))?;
@@ -99,16 +100,16 @@ pub fn file_read_request(
     };
     Ok(ReadRequest {
         units: parse_units(
-            "units",
+            OptionKey::UNITS,
             &units
                 .unwrap_or_default()
                 .iter()
                 .map(|(c, u)| format!("{c}={u}"))
                 .collect::<Vec<_>>(),
         )
-        .map_err(value_error)?,
-        corrected: names_once("corrected", corrected)?,
-        pendulum_tiltmeter: names_once("pendulum_tiltmeter", pendulum_tiltmeter)?,
+        .py()?,
+        corrected: names_once(OptionKey::CORRECTED, corrected)?,
+        pendulum_tiltmeter: names_once(OptionKey::PENDULUM_TILTMETER, pendulum_tiltmeter)?,
         ..read_request(axes, quantity, gaps, scale)?
     })
 }
@@ -118,7 +119,7 @@ pub fn observables(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<Observ
     let Some(arg) = arg else {
         return Ok(None);
     };
-    options::parse_outputs("observables", &names("observables", arg)?)
+    options::parse_outputs(OptionKey::OBSERVABLES, &names("observables", arg)?)
         .py()
         .map(Some)
 }
@@ -162,7 +163,7 @@ pub fn readout(arg: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<ReadoutItem>> {
                 "readout {name}: expected an ASD (a number) or an ASD file (a path)"
             ))
         })?;
-        let (observable, asd) = options::readout_item("readout", &name, asd).py()?;
+        let (observable, asd) = options::readout_item(OptionKey::READOUT, &name, asd).py()?;
         items.push(ReadoutItem {
             observable,
             asd: AsdSpec::White(asd),

@@ -17,6 +17,7 @@ use std::time::{Duration, Instant};
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::model::{Coord, ForceInput, Input, Model, Observable, Request};
 use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::options;
 use tiltnoise_core::simulate::DEFAULT_MODE_ENERGY_J;
 use tiltnoise_core::tf::{
@@ -272,7 +273,7 @@ pub(crate) fn names(what: &str, arg: &Bound<'_, PyAny>) -> PyResult<Vec<String>>
 fn parse_inputs(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Input>> {
     match arg {
         None => Ok(Input::all_tilts()),
-        Some(arg) => options::parse_inputs("inputs", &names("inputs", arg)?).py(),
+        Some(arg) => options::parse_inputs(OptionKey::INPUTS, &names("inputs", arg)?).py(),
     }
 }
 
@@ -281,7 +282,7 @@ fn parse_inputs(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Input>> {
 fn parse_outputs(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Observable>> {
     match arg {
         None => Ok(Observable::ALL.to_vec()),
-        Some(arg) => options::parse_outputs("outputs", &names("outputs", arg)?).py(),
+        Some(arg) => options::parse_outputs(OptionKey::OUTPUTS, &names("outputs", arg)?).py(),
     }
 }
 

@@ -14,6 +14,7 @@ use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::model::{Coord, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::options;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::simulate::{
@@ -40,7 +41,7 @@ pub struct SimulateArgs<'a, 'py> {
 /// Coordinates from a dict `{coordinate: value}` or a `str` `"theta_a=1e-5,phi_b=0.01"` (the
 /// command line's syntax) into `out`.
 fn coordinates(
-    option: &str,
+    option: OptionKey,
     arg: Option<&Bound<'_, PyAny>>,
     rate: bool,
     out: &mut [f64; 8],
@@ -80,8 +81,8 @@ fn excitation(args: &SimulateArgs<'_, '_>) -> PyResult<Excitation> {
         Some(x_m) => Ok(Excitation::KickX { x_m }),
         None if given => {
             let (mut q, mut qdot) = ([0.0; 8], [0.0; 8]);
-            coordinates("init", args.init, false, &mut q)?;
-            coordinates("init_rate", args.init_rate, true, &mut qdot)?;
+            coordinates(OptionKey::INIT, args.init, false, &mut q)?;
+            coordinates(OptionKey::INIT_RATE, args.init_rate, true, &mut qdot)?;
             Ok(Excitation::Given { q, qdot })
         }
         None => Ok(Excitation::EqualEnergy {
@@ -106,7 +107,7 @@ pub fn run(
             let asd: f64 = value
                 .extract()
                 .map_err(|_| value_error(format!("readout {name}: the ASD must be a number")))?;
-            readout.push(options::readout_item("readout", &name, asd).py()?);
+            readout.push(options::readout_item(OptionKey::READOUT, &name, asd).py()?);
         }
     }
     let req = SimulateRequest {

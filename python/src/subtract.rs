@@ -15,6 +15,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::model::{Input, Observable};
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::options;
 use tiltnoise_core::subtract::{ResidualSpectra, DEFAULT_REPORT_BAND_HZ};
 use tiltnoise_job::subtract::{SubtractOutcome, SubtractRequest};
@@ -90,7 +91,7 @@ pub fn subtract(
     let readout_asd = readout
         .unwrap_or_default()
         .into_iter()
-        .map(|(name, asd)| options::readout_item("readout", &name, asd).py())
+        .map(|(name, asd)| options::readout_item(OptionKey::READOUT, &name, asd).py())
         .collect::<PyResult<Vec<_>>>()?;
     let req = SubtractRequest {
         model: &model,

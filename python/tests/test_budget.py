@@ -249,3 +249,13 @@ def test_units_are_checked_for_arrays():
     with pytest.raises(ValueError, match=r"urad.*units=\{\"eta_t\""):
         tiltnoise.budget({"eta_t": x}, 1.0)
     tiltnoise.budget({"eta_t": x}, 1.0, units={"eta_t": "urad"})
+
+
+def test_an_item_error_names_the_option_as_a_keyword():
+    # The library's error names the option by its key; the command line spells it `--units`
+    # (tests/it), Python as the keyword.
+    x = np.random.default_rng(4).standard_normal(4096) * 1e-9
+    with pytest.raises(ValueError, match=r"^units: unit `furlong` of channel `eta_t`"):
+        tiltnoise.budget({"eta_t": x}, 1.0, units={"eta_t": "furlong"})
+    with pytest.raises(ValueError, match=r"^scale: factor `0\.0` of channel `E` is not allowed"):
+        tiltnoise.budget_from_file(LAB_TILT, scale={"E": 0.0})

@@ -6,6 +6,7 @@ use clap::{Args, ValueEnum};
 use tiltnoise_core::ground::GroundQuantity;
 use tiltnoise_core::input::{parse_scales, parse_units};
 use tiltnoise_core::model::Observable;
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::repeats::{list_entries, refuse_repeats};
 use tiltnoise_core::tf::Method;
 use tiltnoise_io::input::{AxisMap, ReadOptions};
@@ -102,7 +103,7 @@ pub fn scientific(x: f64) -> String {
 /// readout noise, one-sided ASD in the observable's unit/sqrt(Hz), finite and >= 0.
 pub fn parse_readout_item(item: &str) -> Result<(Observable, f64)> {
     Ok(tiltnoise_core::options::parse_readout_item(
-        "--readout",
+        OptionKey::READOUT,
         item,
     )?)
 }
@@ -130,7 +131,7 @@ pub struct ChannelArgs {
 }
 
 /// The channel names of a repeatable, comma-separated option, each once.
-fn channel_names(option: &str, items: &[String]) -> Result<Vec<String>> {
+fn channel_names(option: OptionKey, items: &[String]) -> Result<Vec<String>> {
     let names = list_entries(items);
     refuse_repeats(option, "channel", &names, |n| n.to_string())?;
     Ok(names.into_iter().map(str::to_string).collect())
@@ -157,10 +158,10 @@ pub fn read_options(
             .unwrap_or("reject")
             .parse()
             .map_err(|e: String| anyhow!("--gaps: {e}"))?,
-        scale: parse_scales("--scale", scale).map_err(|e| anyhow!(e))?,
-        units: parse_units("--units", &channels.units).map_err(|e| anyhow!(e))?,
-        corrected: channel_names("--corrected", &channels.corrected)?,
-        pendulum: channel_names("--pendulum-tiltmeter", &channels.pendulum_tiltmeter)?,
+        scale: parse_scales(OptionKey::SCALE, scale)?,
+        units: parse_units(OptionKey::UNITS, &channels.units)?,
+        corrected: channel_names(OptionKey::CORRECTED, &channels.corrected)?,
+        pendulum: channel_names(OptionKey::PENDULUM_TILTMETER, &channels.pendulum_tiltmeter)?,
     })
 }
 

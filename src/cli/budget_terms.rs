@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::{Input, Observable};
 use tiltnoise_core::noise::UserSource;
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::options;
 use tiltnoise_core::repeats::refuse_repeated_keys;
 use tiltnoise_job::{AsdSpec, ReadoutItem, TermItem};
@@ -19,13 +20,13 @@ const INPUTS: &str =
 
 /// `--observables X,phi,...`: known names, each once.
 pub fn parse_observables(text: &str) -> Result<Vec<Observable>> {
-    Ok(options::parse_outputs("--observables", &[text])?)
+    Ok(options::parse_outputs(OptionKey::OBSERVABLES, &[text])?)
 }
 
 /// `--readout OBS=ASD` (white, in the observable's unit/sqrt(Hz); 0 removes it) or
 /// `--readout OBS=FILE` (coloured, a `.csv`, `.h5` or `.hdf5` ASD file), each observable once.
 pub fn parse_readout(items: &[String]) -> Result<Vec<ReadoutItem>> {
-    refuse_repeated_keys("--readout", "observable", items)?;
+    refuse_repeated_keys(OptionKey::READOUT, "observable", items)?;
     items
         .iter()
         .map(|item| {
@@ -62,7 +63,7 @@ pub fn parse_readout(items: &[String]) -> Result<Vec<ReadoutItem>> {
 /// observable's ASD) or an input of the model (its ASD, propagated through the transfer
 /// functions), FILE a CSV or HDF5 ASD file.
 pub fn parse_terms(items: &[String]) -> Result<Vec<TermItem>> {
-    refuse_repeated_keys("--term", "term name", items)?;
+    refuse_repeated_keys(OptionKey::TERM, "term name", items)?;
     items
         .iter()
         .map(|item| {

@@ -32,6 +32,7 @@ use std::path::{Path, PathBuf};
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::model::Model;
 use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::repeats::refuse_repeated_keys;
 use tiltnoise_io::Staging;
@@ -128,7 +129,7 @@ impl ParamArgs {
             Some(path) => tiltnoise_io::read_params(path)?,
             None => Params::table_i(),
         };
-        refuse_repeated_keys("--set", "parameter key", &self.set)?;
+        refuse_repeated_keys(OptionKey::SET, "parameter key", &self.set)?;
         for assignment in &self.set {
             params = params.with_override(assignment)?;
         }
@@ -168,12 +169,7 @@ impl Run {
         let outputs: Vec<&Path> = outputs.iter().map(PathBuf::as_path).collect();
         let flags: Vec<(String, &Path)> = files
             .into_iter()
-            .map(|(option, path)| {
-                (
-                    tiltnoise_core::option_key::OptionKey::new(option).to_string(),
-                    path,
-                )
-            })
+            .map(|(option, path)| (OptionKey::new(option).to_string(), path))
             .collect();
         let inputs: Vec<(&str, &Path)> = flags.iter().map(|(o, p)| (o.as_str(), *p)).collect();
         self.check_outputs(&outputs, &inputs)

@@ -13,6 +13,7 @@ use clap::Args;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use tiltnoise_core::model::{Model, Observable};
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::simulate::{
     aliased_frequency_hz, parse_coordinates, readout_text, Excitation, DEFAULT_MODE_ENERGY_J,
@@ -177,8 +178,8 @@ fn excitation(args: &SimulateArgs) -> Result<Excitation> {
         Excitation::KickX { x_m }
     } else if !args.init.is_empty() || !args.init_rate.is_empty() {
         let (mut q, mut qdot) = ([0.0; 8], [0.0; 8]);
-        parse_coordinates("--init", &args.init, false, &mut q)?;
-        parse_coordinates("--init-rate", &args.init_rate, true, &mut qdot)?;
+        parse_coordinates(OptionKey::INIT, &args.init, false, &mut q)?;
+        parse_coordinates(OptionKey::INIT_RATE, &args.init_rate, true, &mut qdot)?;
         Excitation::Given { q, qdot }
     } else {
         Excitation::EqualEnergy {

@@ -14,6 +14,7 @@ use clap::Args;
 use std::path::PathBuf;
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::{Input, Model};
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::options;
 use tiltnoise_core::params::Params;
 use tiltnoise_job::budget::ReadRequest;
@@ -188,7 +189,10 @@ fn request<'a>(args: &SubtractArgs, model: &'a Model) -> Result<SubtractRequest<
         measured: args.measured.clone(),
         observables: match args.observables.is_empty() {
             true => None,
-            false => Some(options::parse_outputs("--observables", &args.observables)?),
+            false => Some(options::parse_outputs(
+                OptionKey::OBSERVABLES,
+                &args.observables,
+            )?),
         },
         colocated: args.colocated.clone(),
         colocated_ratio: parse_colocated_ratio(&args.colocated_ratio)?,
@@ -198,7 +202,7 @@ fn request<'a>(args: &SubtractArgs, model: &'a Model) -> Result<SubtractRequest<
             .iter()
             .map(|item| parse_readout_item(item))
             .collect::<Result<_>>()?,
-        fit: options::split_names("--fit", &args.fit)?
+        fit: options::split_names(OptionKey::FIT, &args.fit)?
             .into_iter()
             .map(str::to_string)
             .collect(),

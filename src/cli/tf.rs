@@ -22,6 +22,7 @@ use tiltnoise_core::freq;
 use tiltnoise_core::limits::MAX_STREAMED_GRID_POINTS;
 use tiltnoise_core::model::{Model, Observable};
 use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::options;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::tf::planner::DEFAULT_REL_TOL;
@@ -108,12 +109,12 @@ pub struct TfArgs {
 
 /// Parses `--input` values (see [`TfArgs`]); empty means the three tilt angles.
 pub fn parse_inputs(specs: &[String]) -> Result<Vec<Input>> {
-    Ok(options::parse_inputs("--input", specs)?)
+    Ok(options::parse_inputs(OptionKey::INPUTS, specs)?)
 }
 
 /// Parses `--observables` values (see [`TfArgs`]); empty means all seven observables.
 pub fn parse_observables(specs: &[String]) -> Result<Vec<Observable>> {
-    Ok(options::parse_outputs("--observables", specs)?)
+    Ok(options::parse_outputs(OptionKey::OUTPUTS, specs)?)
 }
 
 /// The figure's options: panels from `--plot-observables` (each one of the computed
@@ -125,7 +126,7 @@ fn figure_options(
     model: &Model,
 ) -> Result<tiltnoise_plot::TfFigureOptions> {
     let observables = if !args.plot_observables.is_empty() {
-        let chosen = options::parse_outputs("--plot-observables", &args.plot_observables)?;
+        let chosen = options::parse_outputs(OptionKey::DRAWN_OBSERVABLES, &args.plot_observables)?;
         if let Some(o) = chosen.iter().find(|o| !request.outputs.contains(o)) {
             let have: Vec<&str> = request.outputs.iter().map(|o| o.name()).collect();
             bail!(

@@ -8,6 +8,7 @@ use anyhow::{anyhow, Result};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::Input;
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::repeats::refuse_repeated_keys;
 use tiltnoise_job::{AsdSpec, WitnessItem};
 
@@ -21,7 +22,7 @@ pub fn is_floor_input(input: Input) -> bool {
 
 /// Parses every `--witness-noise` item into the job's items, each input once.
 pub fn parse_witness_items(items: &[String]) -> Result<Vec<WitnessItem>> {
-    refuse_repeated_keys("--witness-noise", "input", items)?;
+    refuse_repeated_keys(OptionKey::WITNESS_NOISE, "input", items)?;
     items
         .iter()
         .map(|item| {

@@ -1,6 +1,7 @@
 //! The library crates keep their roles, read from their sources: no option spelling in
 //! tiltnoise-core, tiltnoise-io, tiltnoise-plot or tiltnoise-job (an error names the option by
-//! its key and each front end spells it).
+//! its key and each front end spells it), and no core function takes an option's name as text
+//! to put into its messages (it takes an `OptionKey`).
 
 use std::path::{Path, PathBuf};
 
@@ -137,6 +138,49 @@ fn libraries_spell_no_option() {
         found.is_empty(),
         "{} string literals in the library crates spell an option as a flag; name it by its \
          key (tiltnoise_core::option_key::OptionKey) and let the front end spell it:\n{}",
+        found.len(),
+        found.join("\n")
+    );
+}
+
+/// Whether the code `line` (comments left out) declares an option's name as text: a parameter
+/// or field `option` or `flag` of type `&str`, `&'static str` or `String`.
+fn takes_an_option_name_as_text(line: &str) -> bool {
+    let code: String = line
+        .split("//")
+        .next()
+        .unwrap_or("")
+        .chars()
+        .filter(|c| !c.is_whitespace())
+        .collect();
+    ["option", "flag"].iter().any(|name| {
+        ["&str", "&'staticstr", "String"]
+            .iter()
+            .any(|ty| code.contains(&format!("{name}:{ty}")))
+    })
+}
+
+#[test]
+fn core_takes_option_keys_not_names() {
+    assert!(takes_an_option_name_as_text("    option: &str,"));
+    assert!(takes_an_option_name_as_text("fn f(flag: &'static str) {"));
+    assert!(takes_an_option_name_as_text("        option: String,"));
+    assert!(!takes_an_option_name_as_text("    option: OptionKey,"));
+    assert!(!takes_an_option_name_as_text("/// option: &str is refused"));
+    let src = Path::new(crate::REPO_ROOT).join("crates/tiltnoise-core/src");
+    let mut found = Vec::new();
+    for file in rust_files(&src) {
+        let text = std::fs::read_to_string(&file).unwrap();
+        for (i, line) in text.lines().enumerate() {
+            if takes_an_option_name_as_text(line) {
+                found.push(format!("{}:{}: {}", file.display(), i + 1, line.trim()));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "{} declarations in tiltnoise-core take an option's name as text; take an \
+         OptionKey (tiltnoise_core::option_key), which the front end spells:\n{}",
         found.len(),
         found.join("\n")
     );

@@ -142,6 +142,23 @@ fn scale_on_the_command_line() {
     );
 }
 
+/// The library's error about an item of an option names the option by its key, spelled by the
+/// front end: the flag here, the keyword in Python (`units: unit ...`, python/tests).
+#[test]
+fn an_item_error_names_the_option_as_a_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = csv(dir.path(), "E=counts, N=rad");
+    let p = path.to_str().unwrap();
+    assert_fails(
+        &["budget", "--tilt", p, "--units", "E=furlong"],
+        &["--units: unit `furlong` of channel `E`"],
+    );
+    assert_fails(
+        &["budget", "--tilt", p, "--scale", "E=0"],
+        &["--scale: factor `0` of channel `E` is not allowed"],
+    );
+}
+
 fn gwpy(name: &str) -> std::path::PathBuf {
     crate::common::repo("tests/fixtures/input/gwpy").join(name)
 }

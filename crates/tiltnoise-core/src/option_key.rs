@@ -52,14 +52,28 @@ impl OptionKey {
     pub const SEGMENT_DURATION: Self = Self("segment_duration");
     /// The percentiles of a per-segment band.
     pub const PERCENTILES: Self = Self("percentiles");
+    /// The inputs of a transfer-function request (tilt angles, translations, forces).
+    pub const INPUTS: Self = Self("inputs");
+    /// The observables of a transfer-function request.
+    pub const OUTPUTS: Self = Self("outputs");
     /// The observables a command computes.
     pub const OBSERVABLES: Self = Self("observables");
     /// The tilt axes read from a record.
     pub const AXES: Self = Self("axes");
     /// The units of a record's channels.
     pub const UNITS: Self = Self("units");
+    /// Translation channels whose tilt part is removed already.
+    pub const CORRECTED: Self = Self("corrected");
+    /// Tilt channels read by a pendulum tiltmeter.
+    pub const PENDULUM_TILTMETER: Self = Self("pendulum_tiltmeter");
+    /// The factors a record's channels are multiplied by (counts to physical units).
+    pub const SCALE: Self = Self("scale");
     /// The white readout noise of an observable.
     pub const READOUT: Self = Self("readout");
+    /// A user noise term of a budget.
+    pub const TERM: Self = Self("term");
+    /// The frequencies a budget is reported at (Hz).
+    pub const AT: Self = Self("at");
     /// The free parameters of a fit.
     pub const FREE: Self = Self("free");
     /// The half-width of a fit's box, in error bars.
@@ -68,6 +82,8 @@ impl OptionKey {
     pub const INIT: Self = Self("init");
     /// The initial rates of a simulation.
     pub const INIT_RATE: Self = Self("init_rate");
+    /// The gain of a drive of a simulation, by input.
+    pub const DRIVE_GAIN: Self = Self("drive_gain");
     /// The kick test's static displacement of X (m).
     pub const KICK_X: Self = Self("kick_x");
     /// The energy per mode of an equal-energy start (J).

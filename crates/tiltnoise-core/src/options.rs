@@ -1,14 +1,14 @@
 //! Names and options as a user gives them, parsed and checked once for every front end: the
 //! command line (`--input F_b.x,M_b.z`, `--readout X=9e-9`) and the Python package
 //! (`inputs=["F_b.x", "M_b.z"]`, `readout={"X": 9e-9}`) call these functions and so say the
-//! same thing about the same mistake. A message starts with the option as the caller spells it
-//! (the `option` argument; options the library names itself are [`crate::option_key::OptionKey`]s),
-//! then the value given and what is allowed.
+//! same thing about the same mistake. A message starts with the option, an [`OptionKey`] the
+//! front end in use spells (`--readout`, `readout`), then the value given and what is allowed.
 
 use crate::error::{Num, Shown};
 use crate::limits::{LimitError, ASDS};
 use crate::model::{ForceInput, Input, Observable};
 use crate::noise::Readout;
+use crate::option_key::OptionKey;
 use crate::repeats::{refuse_repeats, Repeated};
 
 /// A name or option value that is not allowed; the message names the option, the value and
@@ -18,8 +18,8 @@ pub enum OptionError {
     /// An empty name in a comma-separated list.
     #[error("{option} \"{}\": empty name in the list (names are separated by single commas)", Shown(.spec))]
     EmptyName {
-        /// The option, as spelled by the caller.
-        option: String,
+        /// The option.
+        option: OptionKey,
         /// The list given.
         spec: String,
     },
@@ -27,7 +27,7 @@ pub enum OptionError {
     #[error("{option}: unknown input \"{}\"; allowed: {}", Shown(.name), input_names())]
     UnknownInput {
         /// The option.
-        option: String,
+        option: OptionKey,
         /// The name given.
         name: String,
     },
@@ -35,7 +35,7 @@ pub enum OptionError {
     #[error("{option}: unknown observable \"{}\"; allowed: {}", Shown(.name), observable_names())]
     UnknownObservable {
         /// The option.
-        option: String,
+        option: OptionKey,
         /// The name given.
         name: String,
     },
@@ -46,7 +46,7 @@ pub enum OptionError {
     #[error("{option} {}: expected OBS=ASD, e.g. X=9e-9", Shown(.item))]
     ReadoutSyntax {
         /// The option.
-        option: String,
+        option: OptionKey,
         /// The item given.
         item: String,
     },
@@ -54,7 +54,7 @@ pub enum OptionError {
     #[error("{option} {}: unknown observable `{}`; allowed: {}", Shown(.item), Shown(.name), observable_names())]
     ReadoutObservable {
         /// The option.
-        option: String,
+        option: OptionKey,
         /// The item given.
         item: String,
         /// The observable's name given.
@@ -64,7 +64,7 @@ pub enum OptionError {
     #[error("{option} {}: `{}` is not a number", Shown(.item), Shown(.value))]
     NotANumber {
         /// The option.
-        option: String,
+        option: OptionKey,
         /// The item given.
         item: String,
         /// The value's text.
@@ -80,7 +80,7 @@ pub enum OptionError {
     )]
     ReadoutAsd {
         /// The option.
-        option: String,
+        option: OptionKey,
         /// The item given.
         item: String,
         /// The ASD given.
@@ -92,11 +92,20 @@ pub enum OptionError {
     #[error("{option} {name}=...: {name} is not budgeted; allowed: {allowed}")]
     NotBudgeted {
         /// The option.
-        option: String,
+        option: OptionKey,
         /// The observable.
         name: &'static str,
         /// The budgeted observables, comma-separated.
         allowed: String,
+    },
+    /// An item of a `KEY=VALUE` option that does not parse (the message says what is
+    /// expected).
+    #[error("{option}: {message}")]
+    Item {
+        /// The option.
+        option: OptionKey,
+        /// What is wrong with the item and what is allowed.
+        message: String,
     },
     /// An option that does not fit the others or the input, or a value out of its range (the
     /// message says why and what to do instead).
@@ -125,17 +134,17 @@ pub fn observable_names() -> String {
 
 /// The names of `specs` (each a comma-separated list, as a repeated option gives them),
 /// trimmed; an empty name is refused.
-pub fn split_names<'a, S: AsRef<str>>(
-    option: &str,
-    specs: &'a [S],
-) -> Result<Vec<&'a str>, OptionError> {
+pub fn split_names<S: AsRef<str>>(
+    option: OptionKey,
+    specs: &[S],
+) -> Result<Vec<&str>, OptionError> {
     let mut names = Vec::new();
     for spec in specs {
         let spec = spec.as_ref();
         for name in spec.split(',').map(str::trim) {
             if name.is_empty() {
                 return Err(OptionError::EmptyName {
-                    option: option.to_string(),
+                    option,
                     spec: spec.to_string(),
                 });
             }
@@ -149,7 +158,10 @@ pub fn split_names<'a, S: AsRef<str>>(
 /// floor translations (`x_t`, `y_t`, `z_t`), force and torque components (`F_a.x` .. `M_b.z`)
 /// and the groups `tilt`, `translation`, `ground` (tilt and translation) and `forces`, in the
 /// order given, each once; no name means the three tilt angles.
-pub fn parse_inputs<S: AsRef<str>>(option: &str, specs: &[S]) -> Result<Vec<Input>, OptionError> {
+pub fn parse_inputs<S: AsRef<str>>(
+    option: OptionKey,
+    specs: &[S],
+) -> Result<Vec<Input>, OptionError> {
     if specs.is_empty() {
         return Ok(Input::all_tilts());
     }
@@ -162,7 +174,7 @@ pub fn parse_inputs<S: AsRef<str>>(option: &str, specs: &[S]) -> Result<Vec<Inpu
             "forces" => inputs.extend(ForceInput::ALL.into_iter().map(Input::Force)),
             _ => inputs.push(
                 Input::from_name(name).ok_or_else(|| OptionError::UnknownInput {
-                    option: option.to_string(),
+                    option,
                     name: name.to_string(),
                 })?,
             ),
@@ -175,7 +187,7 @@ pub fn parse_inputs<S: AsRef<str>>(option: &str, specs: &[S]) -> Result<Vec<Inpu
 /// The observables named by `specs` ([`split_names`]), in the order given, each once; no name
 /// means all seven.
 pub fn parse_outputs<S: AsRef<str>>(
-    option: &str,
+    option: OptionKey,
     specs: &[S],
 ) -> Result<Vec<Observable>, OptionError> {
     if specs.is_empty() {
@@ -185,7 +197,7 @@ pub fn parse_outputs<S: AsRef<str>>(
         .into_iter()
         .map(|name| {
             Observable::from_name(name).ok_or_else(|| OptionError::UnknownObservable {
-                option: option.to_string(),
+                option,
                 name: name.to_string(),
             })
         })
@@ -196,15 +208,15 @@ pub fn parse_outputs<S: AsRef<str>>(
 
 /// One readout item `OBS=ASD` as the command line gives it: the observable and its white
 /// readout noise, one-sided ASD in the observable's unit/sqrt(Hz), finite and >= 0.
-pub fn parse_readout_item(option: &str, item: &str) -> Result<(Observable, f64), OptionError> {
+pub fn parse_readout_item(option: OptionKey, item: &str) -> Result<(Observable, f64), OptionError> {
     let (name, value) = item
         .split_once('=')
         .ok_or_else(|| OptionError::ReadoutSyntax {
-            option: option.to_string(),
+            option,
             item: item.to_string(),
         })?;
     let asd: Result<f64, OptionError> = value.trim().parse().map_err(|_| OptionError::NotANumber {
-        option: option.to_string(),
+        option,
         item: item.to_string(),
         value: value.to_string(),
     });
@@ -215,29 +227,37 @@ pub fn parse_readout_item(option: &str, item: &str) -> Result<(Observable, f64),
 
 /// One readout item given as a name and a number (a keyword argument's dict entry), checked
 /// as [`parse_readout_item`] checks `NAME=ASD`.
-pub fn readout_item(option: &str, name: &str, asd: f64) -> Result<(Observable, f64), OptionError> {
+pub fn readout_item(
+    option: OptionKey,
+    name: &str,
+    asd: f64,
+) -> Result<(Observable, f64), OptionError> {
     let item = format!("{name}={}", Num(asd));
     let o = readout_observable(option, &item, name)?;
     check_readout_asd(option, &item, o, asd)
 }
 
-fn readout_observable(option: &str, item: &str, name: &str) -> Result<Observable, OptionError> {
+fn readout_observable(
+    option: OptionKey,
+    item: &str,
+    name: &str,
+) -> Result<Observable, OptionError> {
     Observable::from_name(name).ok_or_else(|| OptionError::ReadoutObservable {
-        option: option.to_string(),
+        option,
         item: item.to_string(),
         name: name.to_string(),
     })
 }
 
 fn check_readout_asd(
-    option: &str,
+    option: OptionKey,
     item: &str,
     o: Observable,
     asd: f64,
 ) -> Result<(Observable, f64), OptionError> {
     if !ASDS.admits(asd) {
         return Err(OptionError::ReadoutAsd {
-            option: option.to_string(),
+            option,
             item: item.to_string(),
             asd,
             unit: o.unit(),
@@ -250,7 +270,7 @@ fn check_readout_asd(
 /// the paper's 9e-9 m/sqrt(Hz) on X), 0 removes it. An observable given twice is refused; with
 /// `budgeted`, so is an observable outside it.
 pub fn apply_readout(
-    option: &str,
+    option: OptionKey,
     mut readout: Readout,
     items: &[(Observable, f64)],
     budgeted: Option<&[Observable]>,
@@ -262,7 +282,7 @@ pub fn apply_readout(
             if !budgeted.contains(&o) {
                 let allowed: Vec<&str> = budgeted.iter().map(|o| o.name()).collect();
                 return Err(OptionError::NotBudgeted {
-                    option: option.to_string(),
+                    option,
                     name: o.name(),
                     allowed: allowed.join(", "),
                 });
@@ -282,43 +302,53 @@ mod tests {
 
     #[test]
     fn inputs_parse_lists_groups_and_repeats() {
-        let got = parse_inputs("inputs", &["F_b.x, M_b.z", "theta_t"]).unwrap();
+        let got = parse_inputs(OptionKey::INPUTS, &["F_b.x, M_b.z", "theta_t"]).unwrap();
         let names: Vec<&str> = got.iter().map(|i| i.name()).collect();
         assert_eq!(names, ["F_b.x", "M_b.z", "theta_t"]);
         assert_eq!(
-            parse_inputs::<&str>("inputs", &[]).unwrap(),
+            parse_inputs::<&str>(OptionKey::INPUTS, &[]).unwrap(),
             Input::all_tilts()
         );
-        assert_eq!(parse_inputs("inputs", &["forces"]).unwrap().len(), 12);
-        assert_eq!(parse_inputs("inputs", &["tilt,forces"]).unwrap().len(), 15);
         assert_eq!(
-            parse_inputs("inputs", &["translation"]).unwrap(),
+            parse_inputs(OptionKey::INPUTS, &["forces"]).unwrap().len(),
+            12
+        );
+        assert_eq!(
+            parse_inputs(OptionKey::INPUTS, &["tilt,forces"])
+                .unwrap()
+                .len(),
+            15
+        );
+        assert_eq!(
+            parse_inputs(OptionKey::INPUTS, &["translation"]).unwrap(),
             Input::all_translations()
         );
-        let ground = parse_inputs("inputs", &["ground"]).unwrap();
+        let ground = parse_inputs(OptionKey::INPUTS, &["ground"]).unwrap();
         let names: Vec<&str> = ground.iter().map(|i| i.name()).collect();
         assert_eq!(names, ["theta_t", "eta_t", "phi_t", "x_t", "y_t", "z_t"]);
-        let e = parse_inputs("inputs", &["ground,y_t"]).unwrap_err();
+        let e = parse_inputs(OptionKey::INPUTS, &["ground,y_t"]).unwrap_err();
         assert!(e.to_string().contains("y_t is given twice"), "{e}");
     }
 
     #[test]
     fn bad_input_names_are_refused_with_the_allowed_list() {
-        let e = parse_inputs("inputs", &["F_c.x"]).unwrap_err().to_string();
+        let e = parse_inputs(OptionKey::INPUTS, &["F_c.x"])
+            .unwrap_err()
+            .to_string();
         assert!(
             e.starts_with("inputs: unknown input \"F_c.x\"")
                 && e.contains("M_b.z")
                 && e.contains("theta_t"),
             "{e}"
         );
-        let e = parse_inputs("inputs", &["F_b.x,F_b.x"]).unwrap_err();
+        let e = parse_inputs(OptionKey::INPUTS, &["F_b.x,F_b.x"]).unwrap_err();
         assert_eq!(
             e.to_string(),
             "inputs: F_b.x is given twice; name each input once"
         );
-        let e = parse_inputs("inputs", &["tilt,eta_t"]).unwrap_err();
+        let e = parse_inputs(OptionKey::INPUTS, &["tilt,eta_t"]).unwrap_err();
         assert!(e.to_string().contains("eta_t is given twice"), "{e}");
-        let e = parse_inputs("inputs", &["F_b.x,,M_b.z"]).unwrap_err();
+        let e = parse_inputs(OptionKey::INPUTS, &["F_b.x,,M_b.z"]).unwrap_err();
         assert_eq!(
             e.to_string(),
             "inputs \"F_b.x,,M_b.z\": empty name in the list (names are separated by single \
@@ -328,18 +358,20 @@ mod tests {
 
     #[test]
     fn outputs_parse_and_refuse_unknown_names() {
-        let got = parse_outputs("outputs", &["phi,X"]).unwrap();
+        let got = parse_outputs(OptionKey::OUTPUTS, &["phi,X"]).unwrap();
         assert_eq!(got, [Observable::Phi, Observable::X]);
         assert_eq!(
-            parse_outputs::<&str>("outputs", &[]).unwrap(),
+            parse_outputs::<&str>(OptionKey::OUTPUTS, &[]).unwrap(),
             Observable::ALL.to_vec()
         );
-        let e = parse_outputs("outputs", &["x"]).unwrap_err().to_string();
+        let e = parse_outputs(OptionKey::OUTPUTS, &["x"])
+            .unwrap_err()
+            .to_string();
         assert_eq!(
             e,
             "outputs: unknown observable \"x\"; allowed: X, Y, Z, theta, eta, phi, phi_a"
         );
-        let e = parse_outputs("outputs", &["X", "X"])
+        let e = parse_outputs(OptionKey::OUTPUTS, &["X", "X"])
             .unwrap_err()
             .to_string();
         assert_eq!(e, "outputs: X is given twice; name each observable once");
@@ -348,11 +380,11 @@ mod tests {
     #[test]
     fn readout_items_as_text_and_as_keywords() {
         assert_eq!(
-            parse_readout_item("readout", "phi = 1e-9").unwrap(),
+            parse_readout_item(OptionKey::READOUT, "phi = 1e-9").unwrap(),
             (Observable::Phi, 1e-9)
         );
         assert_eq!(
-            readout_item("readout", "phi", 1e-9).unwrap(),
+            readout_item(OptionKey::READOUT, "phi", 1e-9).unwrap(),
             (Observable::Phi, 1e-9)
         );
         let cases = [
@@ -370,12 +402,14 @@ mod tests {
         ];
         for (item, want) in cases {
             assert_eq!(
-                parse_readout_item("readout", item).unwrap_err().to_string(),
+                parse_readout_item(OptionKey::READOUT, item)
+                    .unwrap_err()
+                    .to_string(),
                 want
             );
         }
         assert_eq!(
-            readout_item("readout", "phi", f64::NAN)
+            readout_item(OptionKey::READOUT, "phi", f64::NAN)
                 .unwrap_err()
                 .to_string(),
             "readout phi=NaN: ASD NaN rad/sqrt(Hz) is not allowed: must be 0 or a value from \
@@ -387,7 +421,7 @@ mod tests {
     fn readout_items_replace_remove_and_are_checked_against_the_budget() {
         let budgeted = [Observable::X, Observable::Phi];
         let r = apply_readout(
-            "readout",
+            OptionKey::READOUT,
             Readout::default(),
             &[(Observable::Phi, 1e-9), (Observable::X, 0.0)],
             Some(&budgeted),
@@ -395,7 +429,7 @@ mod tests {
         .unwrap();
         assert_eq!(r.asd, [(Observable::Phi, 1e-9)]);
         let e = apply_readout(
-            "readout",
+            OptionKey::READOUT,
             Readout::default(),
             &[(Observable::Theta, 1e-9)],
             Some(&budgeted),
@@ -406,14 +440,14 @@ mod tests {
             "readout theta=...: theta is not budgeted; allowed: X, phi"
         );
         let r = apply_readout(
-            "readout",
+            OptionKey::READOUT,
             Readout::default(),
             &[(Observable::Theta, 1e-9)],
             None,
         );
         assert_eq!(r.unwrap().asd.len(), 2);
         let e = apply_readout(
-            "readout",
+            OptionKey::READOUT,
             Readout::default(),
             &[(Observable::X, 1e-9), (Observable::X, 2e-9)],
             None,

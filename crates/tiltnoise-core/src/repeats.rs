@@ -6,14 +6,16 @@
 //! rather than resolved (first or last wins), because a user who repeats a key has made a
 //! mistake the program cannot correct.
 //!
-//! Depends on nothing else in the crate.
+//! Depends on nothing else in the crate but [`crate::option_key`], which names the option.
+
+use crate::option_key::OptionKey;
 
 /// A key or name given twice in one option.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("{option}: {name} is given twice; name each {what} once")]
 pub struct Repeated {
-    /// The option, as the caller spells it (`--readout`, `readout`).
-    pub option: String,
+    /// The option, shown as the front end in use spells it (`--readout`, `readout`).
+    pub option: OptionKey,
     /// The key or name, as the user gave it (the first spelling, for names with aliases).
     pub name: String,
     /// What a key is, singular: `observable`, `channel`, `parameter key`, `frequency`.
@@ -25,16 +27,19 @@ pub struct Repeated {
 /// caller's parsing (trimmed text, or the typed value: `X` and ` X ` are one observable).
 ///
 /// ```
+/// use tiltnoise_core::option_key::OptionKey;
 /// use tiltnoise_core::repeats::refuse_repeats;
-/// assert!(refuse_repeats("--observables", "observable", &["X", "phi"], |k| k.to_string()).is_ok());
-/// let e = refuse_repeats("--readout", "observable", &["X", "phi", "X"], |k| k.to_string());
+/// let (observables, readout) = (OptionKey::OBSERVABLES, OptionKey::READOUT);
+/// assert!(refuse_repeats(observables, "observable", &["X", "phi"], |k| k.to_string()).is_ok());
+/// let e = refuse_repeats(readout, "observable", &["X", "phi", "X"], |k| k.to_string());
+/// // Without a front end's style installed, the key is shown as itself.
 /// assert_eq!(
 ///     e.unwrap_err().to_string(),
-///     "--readout: X is given twice; name each observable once"
+///     "readout: X is given twice; name each observable once"
 /// );
 /// ```
 pub fn refuse_repeats<K: PartialEq>(
-    option: &str,
+    option: OptionKey,
     what: &'static str,
     keys: &[K],
     name: impl Fn(&K) -> String,
@@ -45,7 +50,7 @@ pub fn refuse_repeats<K: PartialEq>(
         .find(|(i, k)| keys[..*i].contains(k))
     {
         Some((_, k)) => Err(Repeated {
-            option: option.to_string(),
+            option,
             name: name(k),
             what,
         }),
@@ -57,7 +62,7 @@ pub fn refuse_repeats<K: PartialEq>(
 /// one by one: `--readout X=1e-9 --readout X=2e-9`, `--init theta_a=1,theta_a=2` (after
 /// [`list_entries`]).
 pub fn refuse_repeated_keys<S: AsRef<str>>(
-    option: &str,
+    option: OptionKey,
     what: &'static str,
     items: &[S],
 ) -> Result<(), Repeated> {
@@ -94,20 +99,23 @@ mod tests {
     fn the_first_repeat_is_named_with_its_option() {
         let keys = keys_of(&["length.h_m=1", " mass.m_a_kg = 2", "length.h_m =3"]);
         assert_eq!(keys, ["length.h_m", "mass.m_a_kg", "length.h_m"]);
-        let e = refuse_repeats("set", "parameter key", &keys, |k| k.to_string()).unwrap_err();
+        let e =
+            refuse_repeats(OptionKey::SET, "parameter key", &keys, |k| k.to_string()).unwrap_err();
         assert_eq!(
             e.to_string(),
             "set: length.h_m is given twice; name each parameter key once"
         );
         // Typed keys: equal values are one key however they were written.
-        let e =
-            refuse_repeats("at", "frequency", &[1e-3, 2e-3, 0.001], |f| f.to_string()).unwrap_err();
+        let e = refuse_repeats(OptionKey::AT, "frequency", &[1e-3, 2e-3, 0.001], |f| {
+            f.to_string()
+        })
+        .unwrap_err();
         assert_eq!(e.name, "0.001");
-        assert!(refuse_repeats::<f64>("at", "frequency", &[], |f| f.to_string()).is_ok());
+        assert!(refuse_repeats::<f64>(OptionKey::AT, "frequency", &[], |f| f.to_string()).is_ok());
         assert_eq!(keys_of(&["no-equals"]), ["no-equals"]);
         let entries = list_entries(&["theta_a=1, phi_b=2,", "theta_a=3"]);
         assert_eq!(entries, ["theta_a=1", "phi_b=2", "theta_a=3"]);
-        let e = refuse_repeated_keys("init", "coordinate", &entries).unwrap_err();
+        let e = refuse_repeated_keys(OptionKey::INIT, "coordinate", &entries).unwrap_err();
         assert_eq!(
             e.to_string(),
             "init: theta_a is given twice; name each coordinate once"

@@ -19,6 +19,7 @@ use tiltnoise_core::input::{
 };
 use tiltnoise_core::model::{Model, Observable};
 use tiltnoise_core::noise::BudgetReport;
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_core::spectral::Averaging;
 use tiltnoise_io::input::{add_measured_file, open_tilt, OpenedTilt};
@@ -185,7 +186,7 @@ fn summary(at_hz: Option<&[f64]>, at_band: Option<f64>) -> Result<SummaryRequest
         ..SummaryRequest::default()
     };
     if let Some(f) = at_hz {
-        refuse_repeats("at", "frequency", f, |f| Num(*f).to_string())
+        refuse_repeats(OptionKey::AT, "frequency", f, |f| Num(*f).to_string())
             .map_err(JobError::Repeated)?;
         req.strict = true;
         req.freqs_hz = f.to_vec();

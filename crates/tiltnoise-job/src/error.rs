@@ -79,7 +79,7 @@ pub enum JobError {
         /// The upper percentile given.
         upper: f64,
     },
-    /// A key given twice (`Repeated::option` in snake case).
+    /// A key given twice.
     Repeated(Repeated),
     /// The computation on the input `path` failed.
     Budget {
@@ -188,11 +188,7 @@ impl JobError {
                 let given = option_key::pair(&Num(*lower).to_string(), &Num(*upper).to_string());
                 percentiles_error(&given).to_string()
             }
-            JobError::Repeated(r) => Repeated {
-                option: spelled(&r.option),
-                ..r.clone()
-            }
-            .to_string(),
+            JobError::Repeated(r) => r.to_string(),
             JobError::Budget { path, source } => format!("budget of {}: {source}", Shown(path)),
             JobError::Coherence(e) => e.to_string(),
             JobError::Subtract(e) => e.message(),
@@ -237,46 +233,6 @@ impl JobError {
             problem,
         }
     }
-}
-
-/// The options a job refuses repeated items of, by key: how [`spelled`] finds the
-/// [`OptionKey`] of a name carried as a `String`.
-const KEYS: &[&str] = &[
-    "tilt",
-    "measured",
-    "readout",
-    "term",
-    "witness_noise",
-    "colocated_ratio",
-    "fit",
-    "observables",
-    "at",
-    "at_band",
-    "nperseg",
-    "overlap",
-    "average",
-    "segment_duration",
-    "percentiles",
-    "freq",
-    "gaps",
-    "scale",
-    "units",
-    "corrected",
-    "pendulum_tiltmeter",
-    "axes",
-    "quantity",
-    "save",
-    "set",
-    "params",
-    "free",
-    "drive_gain",
-];
-
-/// `name` as the front end in use spells it (itself when it is not a known key).
-fn spelled(name: &str) -> String {
-    KEYS.iter()
-        .find(|k| **k == name)
-        .map_or_else(|| name.to_string(), |k| OptionKey::new(k).to_string())
 }
 
 impl fmt::Display for JobError {

@@ -14,7 +14,7 @@ use tiltnoise_core::error::Num;
 use tiltnoise_core::input::{GroundMap, InputMeta, Provenance, Sensors, TiltSeries};
 use tiltnoise_core::model::{Input, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
-use tiltnoise_core::option_key;
+use tiltnoise_core::option_key::{self, OptionKey};
 use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_core::subtract::{
     subtract, MeasuredRecord, StartTime, Status, SubtractConfig, SubtractResult, WitnessNoise,
@@ -219,17 +219,20 @@ fn check_options(req: &SubtractRequest<'_>) -> Result<(), JobError> {
         }
     }
     let ratio_inputs: Vec<Input> = req.colocated_ratio.iter().map(|x| x.0).collect();
-    refuse_repeats("colocated_ratio", "input", &ratio_inputs, |i| {
+    refuse_repeats(OptionKey::COLOCATED_RATIO, "input", &ratio_inputs, |i| {
         i.name().to_string()
     })
     .map_err(JobError::Repeated)?;
     if !req.colocated_ratio.is_empty() && req.colocated.len() != 1 {
         return Err(failure(SubtractFailure::RatioNeedsOneColocated));
     }
-    refuse_repeats("fit", "parameter key", &req.fit, |k| k.clone()).map_err(JobError::Repeated)?;
+    refuse_repeats(OptionKey::FIT, "parameter key", &req.fit, |k| k.clone())
+        .map_err(JobError::Repeated)?;
     let readout: Vec<Observable> = req.readout_asd.iter().map(|x| x.0).collect();
-    refuse_repeats("readout", "observable", &readout, |o| o.name().to_string())
-        .map_err(JobError::Repeated)
+    refuse_repeats(OptionKey::READOUT, "observable", &readout, |o| {
+        o.name().to_string()
+    })
+    .map_err(JobError::Repeated)
 }
 
 fn start_of(

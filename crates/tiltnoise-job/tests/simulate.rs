@@ -6,6 +6,7 @@
 use tiltnoise_core::fit::peaks;
 use tiltnoise_core::model::{Model, Observable};
 use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::simulate::{
     equal_energy_init, simulate, Excitation, SimConfig, DEFAULT_MODE_ENERGY_J,
@@ -224,7 +225,7 @@ fn a_fit_refuses_a_key_given_twice_and_fits_visibilities_alone() {
         )
     };
     match fit(&["mass.m_b_kg", " mass.m_b_kg"], None) {
-        Err(JobError::Repeated(r)) => assert_eq!(r.option, "free"),
+        Err(JobError::Repeated(r)) => assert_eq!(r.option, OptionKey::FREE),
         other => panic!("a repeated key: {:?}", other.map(|o| o.origin)),
     }
     let table_ii = fit(&["mass.m_b_kg"], None).unwrap();

@@ -9,6 +9,7 @@ use anyhow::{anyhow, Result};
 use std::path::Path;
 use tiltnoise_core::error::{Num, Shown};
 use tiltnoise_core::model::Model;
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::repeats::{list_entries, refuse_repeated_keys};
 use tiltnoise_io::{OutputKind, RunMeta};
 use tiltnoise_job::budget::ReadRequest;
@@ -20,7 +21,7 @@ use tiltnoise_plot::View;
 /// against the record).
 fn parse_gains(items: &[String]) -> Result<Vec<(String, f64)>> {
     let entries = list_entries(items);
-    refuse_repeated_keys("--drive-gain", "input", &entries)?;
+    refuse_repeated_keys(OptionKey::DRIVE_GAIN, "input", &entries)?;
     entries
         .into_iter()
         .map(|entry| {

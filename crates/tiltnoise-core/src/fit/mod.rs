@@ -746,7 +746,7 @@ fn check_config(
         return Err(FitError::NoFree);
     }
     refuse_repeats(
-        &OptionKey::FREE.to_string(),
+        OptionKey::FREE,
         "parameter key",
         &config.free,
         String::clone,

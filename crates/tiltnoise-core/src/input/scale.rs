@@ -4,6 +4,8 @@
 
 use super::error::InputError;
 use crate::error::{shown_list, Shown};
+use crate::option_key::OptionKey;
+use crate::options::OptionError;
 use crate::repeats::{refuse_repeated_keys, refuse_repeats};
 use std::fmt;
 use std::path::Path;
@@ -59,17 +61,24 @@ impl fmt::Display for ChannelScale {
     }
 }
 
-/// The `CHANNEL=FACTOR` items of the option `option` (`--scale`, `scale`), each channel once.
+/// The `CHANNEL=FACTOR` items of the option `option` ([`OptionKey::SCALE`]), each channel once.
 ///
 /// # Errors
 ///
-/// The message (without the option) of the first item that does not parse, or of a channel
-/// given twice.
-pub fn parse_scales<S: AsRef<str>>(option: &str, items: &[S]) -> Result<Vec<ChannelScale>, String> {
-    refuse_repeated_keys(option, "channel", items).map_err(|e| e.to_string())?;
+/// [`OptionError::Item`] for the first item that does not parse, [`OptionError::Repeated`] for
+/// a channel given twice.
+pub fn parse_scales<S: AsRef<str>>(
+    option: OptionKey,
+    items: &[S],
+) -> Result<Vec<ChannelScale>, OptionError> {
+    refuse_repeated_keys(option, "channel", items)?;
     items
         .iter()
-        .map(|s| s.as_ref().parse().map_err(|e| format!("{option}: {e}")))
+        .map(|s| {
+            s.as_ref()
+                .parse()
+                .map_err(|message| OptionError::Item { option, message })
+        })
         .collect()
 }
 
@@ -90,7 +99,7 @@ pub fn check_scales(
     kind: &'static str,
 ) -> Result<(), InputError> {
     let channels: Vec<&str> = scales.iter().map(|s| s.channel.as_str()).collect();
-    refuse_repeats("scale", "channel", &channels, |c| c.to_string()).map_err(|e| {
+    refuse_repeats(OptionKey::SCALE, "channel", &channels, |c| c.to_string()).map_err(|e| {
         InputError::Scale {
             path: path.to_path_buf(),
             channel: e.name,

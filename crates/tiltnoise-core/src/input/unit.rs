@@ -11,6 +11,8 @@
 use super::Quantity;
 use crate::error::Shown;
 use crate::ground::GroundQuantity;
+use crate::option_key::OptionKey;
+use crate::options::OptionError;
 use crate::repeats::refuse_repeated_keys;
 use std::fmt;
 use std::str::FromStr;
@@ -244,17 +246,24 @@ impl fmt::Display for ChannelUnit {
     }
 }
 
-/// The `CHANNEL=UNIT` items of the option `option` (`--units`, `units`), each channel once.
+/// The `CHANNEL=UNIT` items of the option `option` ([`OptionKey::UNITS`]), each channel once.
 ///
 /// # Errors
 ///
-/// The message (with the option) of the first item that does not parse, or of a channel given
-/// twice.
-pub fn parse_units<S: AsRef<str>>(option: &str, items: &[S]) -> Result<Vec<ChannelUnit>, String> {
-    refuse_repeated_keys(option, "channel", items).map_err(|e| e.to_string())?;
+/// [`OptionError::Item`] for the first item that does not parse, [`OptionError::Repeated`] for
+/// a channel given twice.
+pub fn parse_units<S: AsRef<str>>(
+    option: OptionKey,
+    items: &[S],
+) -> Result<Vec<ChannelUnit>, OptionError> {
+    refuse_repeated_keys(option, "channel", items)?;
     items
         .iter()
-        .map(|s| s.as_ref().parse().map_err(|e| format!("{option}: {e}")))
+        .map(|s| {
+            s.as_ref()
+                .parse()
+                .map_err(|message| OptionError::Item { option, message })
+        })
         .collect()
 }
 
@@ -425,12 +434,17 @@ mod tests {
     #[test]
     fn channel_units_are_parsed_once_per_channel() {
         let items = ["LHE=m/s^2", " LJE = rad/s"];
-        let u = parse_units("units", &items).unwrap();
+        let u = parse_units(OptionKey::UNITS, &items).unwrap();
         assert_eq!(u[1].channel, "LJE");
         assert_eq!(u[1].unit.si(), "rad/s");
-        let e = parse_units("units", &["LHE=m/s^2", "LHE=m/s"]).unwrap_err();
-        assert_eq!(e, "units: LHE is given twice; name each channel once");
-        let e = parse_units("units", &["LJE=rad/s^2"]).unwrap_err();
+        let e = parse_units(OptionKey::UNITS, &["LHE=m/s^2", "LHE=m/s"]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "units: LHE is given twice; name each channel once"
+        );
+        let e = parse_units(OptionKey::UNITS, &["LJE=rad/s^2"])
+            .unwrap_err()
+            .to_string();
         assert!(
             e.starts_with("units: unit `rad/s^2` of channel `LJE`"),
             "{e}"

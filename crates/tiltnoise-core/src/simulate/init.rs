@@ -43,7 +43,7 @@ pub enum Excitation {
 /// `option`, whose item `item` is shown in messages; refuses an unknown name and a value that
 /// is not finite.
 pub fn set_coordinate(
-    option: &str,
+    option: OptionKey,
     item: &str,
     name: &str,
     value: f64,
@@ -66,7 +66,7 @@ pub fn set_coordinate(
 }
 
 /// The coordinate named `name` (crate names: `theta_a` .. `delta_b`).
-fn coordinate(option: &str, item: &str, name: &str) -> Result<Coord, OptionError> {
+fn coordinate(option: OptionKey, item: &str, name: &str) -> Result<Coord, OptionError> {
     Coord::ALL
         .into_iter()
         .find(|c| c.name() == name)
@@ -84,7 +84,7 @@ fn coordinate(option: &str, item: &str, name: &str) -> Result<Coord, OptionError
 /// Parses `COORD=VALUE,...` lists (the command line's repeatable `--init`, `--init-rate`)
 /// into `out`, SI units; unlisted coordinates keep their value.
 pub fn parse_coordinates<S: AsRef<str>>(
-    option: &str,
+    option: OptionKey,
     items: &[S],
     rate: bool,
     out: &mut [f64; 8],
@@ -335,7 +335,13 @@ mod tests {
     #[test]
     fn coordinates_parse_and_are_refused_by_name() {
         let mut q = [0.0; 8];
-        parse_coordinates("init", &["theta_a=1e-5, phi_b=0.01", ""], false, &mut q).unwrap();
+        parse_coordinates(
+            OptionKey::INIT,
+            &["theta_a=1e-5, phi_b=0.01", ""],
+            false,
+            &mut q,
+        )
+        .unwrap();
         assert_eq!((q[0], q[6]), (1e-5, 0.01));
         let mut q = [0.0; 8];
         let cases = [
@@ -346,10 +352,11 @@ mod tests {
             ("phi_b=1,phi_b=2", "init: phi_b is given twice; name each coordinate once"),
         ];
         for (item, want) in cases {
-            let e = parse_coordinates("init", &[item], false, &mut q).unwrap_err();
+            let e = parse_coordinates(OptionKey::INIT, &[item], false, &mut q).unwrap_err();
             assert_eq!(e.to_string(), want);
         }
-        let e = parse_coordinates("init_rate", &["delta_b=nan"], true, &mut q).unwrap_err();
+        let e =
+            parse_coordinates(OptionKey::INIT_RATE, &["delta_b=nan"], true, &mut q).unwrap_err();
         assert_eq!(
             e.to_string(),
             "init_rate delta_b=nan: NaN m/s is not allowed: must be finite"

@@ -10,6 +10,7 @@ use crate::error::JobError;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::fit::{self, FitConfig, FitError, FitResult, Measured, Visibilities};
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::repeats::refuse_repeats;
 
@@ -82,7 +83,7 @@ pub fn run(req: FitRequest<'_>, cancel: &Cancel) -> Result<FitOutcome, JobError>
     let free = match req.free {
         Some(keys) => {
             let keys: Vec<String> = keys.iter().map(|k| k.trim().to_string()).collect();
-            refuse_repeats("free", "parameter key", &keys, String::clone)
+            refuse_repeats(OptionKey::FREE, "parameter key", &keys, String::clone)
                 .map_err(JobError::Repeated)?;
             keys
         }

@@ -134,8 +134,8 @@ impl SimulateResult {
 /// The readout of `items` over the default (9e-9 m/sqrt(Hz) on X), each observable once, in
 /// observable order.
 fn readout(items: &[(Observable, f64)]) -> Result<Vec<(Observable, f64)>, OptionError> {
-    let option = OptionKey::READOUT.to_string();
-    let mut readout = options::apply_readout(&option, Readout::default(), items, None)?.asd;
+    let mut readout =
+        options::apply_readout(OptionKey::READOUT, Readout::default(), items, None)?.asd;
     readout.sort_by_key(|(o, _)| o.index());
     Ok(readout)
 }
