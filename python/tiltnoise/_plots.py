@@ -176,6 +176,11 @@ def monte_carlo_plot(mc):
         ax.axvline(mc.nominal_hz[k], color="black", ls="--", label="nominal")
         ax.axvline(mc.mean_hz[k], color="tab:orange", label="mean")
         ax.set_xlabel(f"nu_{k + 1} (Hz)")
+        if k % 2 == 0:
+            ax.set_ylabel("draws")
+        # The low modes' frequencies in mHz would crowd their tick labels: few, scientific.
+        ax.locator_params(axis="x", nbins=5)
+        ax.ticklabel_format(axis="x", style="sci", scilimits=(-2, 3))
         ax.grid(True, alpha=0.3)
     axes[0, 0].legend(fontsize=8)
     fig.suptitle(f"Monte Carlo of the normal modes: {mc.samples} draws, "
