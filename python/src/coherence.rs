@@ -292,6 +292,27 @@ impl Coherence {
         .py()
     }
 
+    /// ``{"coherence": {observable: {axis: FrequencySeries}}, "multiple_coherence":
+    /// {observable: FrequencySeries}, "transfer": {observable: {axis: FrequencySeries}},
+    /// "transfer_radius": ..., "model": ..., "psd": {observable: FrequencySeries}}``: the
+    /// attributes of the same names as ``gwpy.frequencyseries.FrequencySeries`` on
+    /// ``frequency_hz``, named ``"OBS.AXIS.coherence"``, ``"OBS.psd"``, ..., with their
+    /// units (coherences dimensionless, transfer functions complex in ``units``, PSDs in
+    /// unit**2/Hz). Needs gwpy (``pip install gwpy``); raises ``ImportError`` saying so
+    /// without it.
+    fn to_gwpy<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        crate::python_side::call(slf.as_any(), "_convert", "coherence_to_gwpy", &[])
+    }
+
+    /// The report as a ``pandas.DataFrame`` indexed by ``frequency_hz``, one column per
+    /// ``"OBS.psd"``, ``"OBS.multiple_coherence"`` and ``"OBS.AXIS.coherence"``,
+    /// ``"OBS.AXIS.transfer"`` (complex), ``"OBS.AXIS.transfer_radius"``,
+    /// ``"OBS.AXIS.model"`` (complex), the unit of each column in ``df.attrs["units"]``.
+    /// Needs pandas (``pip install pandas``); raises ``ImportError`` saying so without it.
+    fn to_pandas<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        crate::python_side::call(slf.as_any(), "_convert", "coherence_to_pandas", &[])
+    }
+
     /// The report drawn with matplotlib: per observable, the ordinary coherence with each
     /// axis and the multiple coherence against their noise thresholds, and the magnitude of
     /// each measured transfer function with its confidence band beside the model's, log-log.

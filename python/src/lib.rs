@@ -17,6 +17,7 @@ mod inputs;
 mod interrupt;
 mod job_args;
 mod model;
+mod monte_carlo;
 mod params;
 mod python_side;
 mod simulate;
@@ -67,7 +68,7 @@ fn tiltnoise_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<params::PyParams>()?;
     m.add_class::<model::PyModel>()?;
     m.add_class::<model::Mode>()?;
-    m.add_class::<model::MonteCarlo>()?;
+    m.add_class::<monte_carlo::MonteCarlo>()?;
     m.add_class::<fit::Fit>()?;
     m.add_class::<simulate::Simulation>()?;
     m.add_class::<budget::Budget>()?;

@@ -23,7 +23,6 @@ use tiltnoise_core::simulate::DEFAULT_MODE_ENERGY_J;
 use tiltnoise_core::tf::{
     self, eval_grid_threads_cancellable, Destination, Method, Scene, TransferFunction,
 };
-use tiltnoise_job::monte_carlo::{self, McRequest};
 use tiltnoise_job::JobError;
 
 // The defaults of `transfer`, `explain` and `simulate` are written as literals in their
@@ -615,27 +614,8 @@ impl PyModel {
         samples: usize,
         seed: u64,
         threads: usize,
-    ) -> PyResult<MonteCarlo> {
-        let req = McRequest {
-            params: self.model.params(),
-            samples,
-            seed,
-            threads,
-        };
-        let cancel = Cancel::new();
-        let r = interrupt::watch(py, &cancel, || {
-            monte_carlo::run(req, &cancel, &|_| {})
-                .map(|run| run.result)
-                .map_err(job_error)
-        })?;
-        Ok(MonteCarlo {
-            samples: r.samples,
-            rejected: r.rejected,
-            freqs_hz: r.freqs_hz,
-            sample_index: r.sample_index,
-            mean_hz: r.mean_hz.to_vec(),
-            std_hz: r.std_hz.to_vec(),
-        })
+    ) -> PyResult<crate::monte_carlo::MonteCarlo> {
+        crate::monte_carlo::run(py, self.params(), samples, seed, threads)
     }
 
     /// Every evaluation method's worst error against the double-double reference and its time
@@ -858,67 +838,6 @@ impl Mode {
             self.quality_factor,
             dominant.join(", "),
             self.seen_by.join(" ")
-        )
-    }
-}
-
-/// The result of :meth:`Model.monte_carlo`.
-#[pyclass(module = "tiltnoise", frozen)]
-#[derive(serde::Serialize, serde::Deserialize)]
-pub struct MonteCarlo {
-    /// Draws made (accepted + rejected).
-    #[pyo3(get)]
-    samples: usize,
-    /// Draws rejected as non-physical.
-    #[pyo3(get)]
-    rejected: usize,
-    freqs_hz: Vec<[f64; 8]>,
-    sample_index: Vec<usize>,
-    /// Mean frequency per mode (Hz).
-    #[pyo3(get)]
-    mean_hz: Vec<f64>,
-    /// Standard deviation (n - 1) per mode (Hz).
-    #[pyo3(get)]
-    std_hz: Vec<f64>,
-}
-
-#[pymethods]
-impl MonteCarlo {
-    /// Mode frequencies (Hz) of every accepted draw, ``[n_accepted, 8]``, each row ascending
-    /// (read-only).
-    #[getter]
-    fn freqs_hz<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let flat: Vec<f64> = self.freqs_hz.iter().flatten().copied().collect();
-        let a = PyArray1::from_vec(py, flat).reshape([self.freqs_hz.len(), 8])?;
-        arrays::read_only(a)
-    }
-
-    /// 0-based draw number of each row of ``freqs_hz`` (read-only).
-    #[getter]
-    fn sample_index<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<usize>>> {
-        arrays::read_only(PyArray1::from_slice(py, &self.sample_index))
-    }
-
-    /// Pickles as its state (see the module's pickling notes).
-    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<state::Reduced<'py>> {
-        state::reduce(slf.as_any(), slf.get())
-    }
-
-    /// The object of a pickled state.
-    #[staticmethod]
-    fn _from_state(version: u32, state: &[u8]) -> PyResult<Self> {
-        state::load("MonteCarlo", version, state)
-    }
-
-    /// Equal when every value is equal bit for bit and the same files are behind them.
-    fn __eq__(&self, other: &Bound<'_, PyAny>) -> PyResult<bool> {
-        state::equal(self, other)
-    }
-
-    fn __repr__(&self) -> String {
-        format!(
-            "MonteCarlo({} draws, {} rejected; mean_hz={:?}, std_hz={:?})",
-            self.samples, self.rejected, self.mean_hz, self.std_hz
         )
     }
 }

@@ -325,6 +325,25 @@ impl Subtraction {
         python_side::call(slf.as_any(), "_plots", "subtraction_plot", &[])
     }
 
+    /// ``{"cleaned": gwpy.timeseries.TimeSeriesDict, "predicted": TimeSeriesDict, "asd":
+    /// {observable: {curve: gwpy.frequencyseries.FrequencySeries}}}``: the series over the
+    /// overlap (``t0`` its start as GPS time when the records state one, else 0; ``dt`` one
+    /// over ``sample_rate_hz``) and the held-out ASDs, each named ``"OBS.cleaned"``,
+    /// ``"OBS.predicted"``, ``"OBS.CURVE"`` with its unit. Needs gwpy (``pip install gwpy``);
+    /// raises ``ImportError`` saying so without it.
+    fn to_gwpy<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        python_side::call(slf.as_any(), "_convert", "subtraction_to_gwpy", &[])
+    }
+
+    /// ``{"cleaned": DataFrame, "predicted": DataFrame}`` indexed by ``time_s`` (from the
+    /// overlap's start), one column per observable, and ``"asd"``: a DataFrame indexed by
+    /// ``frequency_hz``, one column per ``"OBS.CURVE"``; units in each frame's
+    /// ``attrs["units"]``. Needs pandas (``pip install pandas``); raises ``ImportError``
+    /// saying so without it.
+    fn to_pandas<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        python_side::call(slf.as_any(), "_convert", "subtraction_to_pandas", &[])
+    }
+
     /// The report band (Hz) of the residual summaries: ``(FLO, FHI)``, the first and last bin.
     #[getter]
     fn report_band_hz(&self) -> Option<(f64, f64)> {

@@ -1,6 +1,8 @@
 """coherence(): the command line's `coherence` from Python, with the same numbers and files;
 a measured record made from the tilt through the model gives back the model."""
 
+import sys
+
 import numpy as np
 import pytest
 
@@ -105,3 +107,34 @@ def test_errors_say_what_the_command_line_says(measured, cli_error, tmp_path):
                                      "--fit-band", "0.1:0.01").replace("--fit-band", "fit_band")
     with pytest.raises(OSError):
         tiltnoise.coherence(LAB_TILT, measured).save(measured.with_suffix(".csv"))
+
+
+def test_to_gwpy_and_pandas_hold_the_values_with_names_and_units(result):
+    pytest.importorskip("gwpy")
+    pd = pytest.importorskip("pandas")
+    g = result.to_gwpy()
+    c = g["coherence"]["X"]["eta_t"]
+    assert c.value.tobytes() == result.coherence["X"]["eta_t"].tobytes()
+    assert c.name == "X.eta_t.coherence" and c.unit.to_string() == ""
+    np.testing.assert_allclose(c.frequencies.value, result.frequency_hz, rtol=1e-12, atol=0)
+    t = g["transfer"]["X"]["theta_t"]
+    assert t.value.tobytes() == result.transfer["X"]["theta_t"].tobytes()
+    assert t.unit.to_string() == "m / rad"
+    assert g["psd"]["X"].unit.to_string() == "m2 / Hz"
+    assert g["multiple_coherence"]["X"].value.tobytes() == result.multiple_coherence["X"].tobytes()
+    df = result.to_pandas()
+    assert isinstance(df, pd.DataFrame) and df.index.name == "frequency_hz"
+    assert df["X.eta_t.model"].to_numpy().tobytes() == result.model["X"]["eta_t"].tobytes()
+    assert df["X.psd"].to_numpy().tobytes() == result.psd["X"].tobytes()
+    assert df.attrs["units"]["X.theta_t.transfer"] == "m/rad"
+    assert df.attrs["units"]["X.psd"] == "m^2/Hz"
+    assert df.attrs["units"]["frequency_hz"] == "Hz"
+
+
+@pytest.mark.parametrize("method, package", [("to_pandas", "pandas"), ("to_gwpy", "gwpy")])
+def test_conversions_without_their_package_say_how_to_get_it(result, monkeypatch, method,
+                                                             package):
+    for m in (package, f"{package}.frequencyseries", f"{package}.timeseries"):
+        monkeypatch.setitem(sys.modules, m, None)
+    with pytest.raises(ImportError, match=f"pip install {package}"):
+        getattr(result, method)()

@@ -4,6 +4,7 @@ the prediction; a measured record made from the tilt through the model gives bac
 and no delay."""
 
 import json
+import sys
 
 import numpy as np
 import pytest
@@ -174,3 +175,44 @@ def test_plot_draws_a_panel_per_observable(result):
     assert {"measured", "cleaned", "predicted tilt part", "readout"} <= set(labels), labels
     assert ax.get_xscale() == "log" and ax.get_yscale() == "log"
     assert "m/sqrt(Hz)" in ax.get_ylabel()
+
+
+def test_to_gwpy_and_pandas_hold_the_series_and_spectra_with_names_and_units(result):
+    gwpy = pytest.importorskip("gwpy")
+    pd = pytest.importorskip("pandas")
+    from gwpy.time import to_gps
+
+    g = result.to_gwpy()
+    assert set(g) == {"cleaned", "predicted", "asd"}
+    for kind, series in (("cleaned", result.cleaned), ("predicted", result.predicted)):
+        d = g[kind]
+        assert isinstance(d, gwpy.timeseries.TimeSeriesDict) and list(d) == result.observables
+        x = d["X"]
+        assert x.value.tobytes() == series["X"].tobytes()
+        assert x.name == f"X.{kind}" and str(x.unit) == "m"
+        assert x.dt.value == 1.0 / result.sample_rate_hz
+        assert x.t0.value == float(to_gps(result.start_time))
+    a = g["asd"]["X"]["cleaned"]
+    assert a.value.tobytes() == result.asd["X"]["cleaned"].tobytes()
+    assert a.name == "X.cleaned" and a.unit.to_string() == "m / Hz(1/2)"
+    np.testing.assert_allclose(a.frequencies.value, result.frequency_hz, rtol=1e-12, atol=0)
+    frames = result.to_pandas()
+    cleaned = frames["cleaned"]
+    assert isinstance(cleaned, pd.DataFrame) and cleaned.index.name == "time_s"
+    assert cleaned["X"].to_numpy().tobytes() == result.cleaned["X"].tobytes()
+    assert cleaned.index[1] - cleaned.index[0] == 1.0 / result.sample_rate_hz
+    assert frames["predicted"]["X"].to_numpy().tobytes() == result.predicted["X"].tobytes()
+    asd = frames["asd"]
+    assert asd.index.name == "frequency_hz"
+    assert asd["X.wiener"].to_numpy().tobytes() == result.asd["X"]["wiener"].tobytes()
+    assert asd.attrs["units"]["X.measured"] == "m/sqrt(Hz)"
+    assert cleaned.attrs["units"] == {"X": "m", "time_s": "s"}
+
+
+@pytest.mark.parametrize("method, package", [("to_pandas", "pandas"), ("to_gwpy", "gwpy")])
+def test_conversions_without_their_package_say_how_to_get_it(result, monkeypatch, method,
+                                                             package):
+    for m in (package, f"{package}.frequencyseries", f"{package}.timeseries"):
+        monkeypatch.setitem(sys.modules, m, None)
+    with pytest.raises(ImportError, match=f"pip install {package}"):
+        getattr(result, method)()

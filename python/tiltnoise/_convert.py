@@ -157,3 +157,105 @@ def transfer_to_pandas(tf):
     df.attrs["units"] = {f"{o}/{i}": u for (o, i), u in tf.units.items()}
     df.attrs["units"]["frequency_hz"] = "Hz"
     return df
+
+
+def _gps(start_time):
+    """GPS seconds of an ISO 8601 start time (gwpy's reading), 0 when the records state none."""
+    if start_time is None:
+        return 0.0
+    from gwpy.time import to_gps
+
+    return float(to_gps(start_time))
+
+
+def subtraction_to_gwpy(sub):
+    """Cleaned and predicted series as TimeSeriesDicts, held-out ASDs as FrequencySeries
+    (Subtraction.to_gwpy)."""
+    gwpy = _need("gwpy", "Subtraction.to_gwpy()")
+    t0, dt = _gps(sub.start_time), 1.0 / sub.sample_rate_hz
+    out = {}
+    for kind, series in (("cleaned", sub.cleaned), ("predicted", sub.predicted)):
+        out[kind] = gwpy.timeseries.TimeSeriesDict(
+            (obs, gwpy.timeseries.TimeSeries(x, t0=t0, dt=dt, unit=sub.units[obs],
+                                             name=f"{obs}.{kind}"))
+            for obs, x in series.items()
+        )
+    where = _where(sub.frequency_hz)
+    out["asd"] = {
+        obs: {
+            curve: gwpy.frequencyseries.FrequencySeries(
+                a, unit=astropy_unit(f"{sub.units[obs]}/sqrt(Hz)"), name=f"{obs}.{curve}",
+                **where
+            )
+            for curve, a in curves.items()
+        }
+        for obs, curves in sub.asd.items()
+    }
+    return out
+
+
+def subtraction_to_pandas(sub):
+    """Cleaned and predicted series and the held-out ASDs as DataFrames
+    (Subtraction.to_pandas)."""
+    pd = _need("pandas", "Subtraction.to_pandas()")
+    out = {}
+    for kind, series in (("cleaned", sub.cleaned), ("predicted", sub.predicted)):
+        n = len(next(iter(series.values()))) if series else 0
+        df = pd.DataFrame(dict(series),
+                          index=pd.Index(np.arange(n) / sub.sample_rate_hz, name="time_s"))
+        df.attrs["units"] = dict(sub.units, time_s="s")
+        out[kind] = df
+    cols = {f"{obs}.{curve}": a for obs, curves in sub.asd.items() for curve, a in curves.items()}
+    asd = pd.DataFrame(cols, index=pd.Index(sub.frequency_hz, name="frequency_hz"))
+    asd.attrs["units"] = {f"{obs}.{curve}": f"{sub.units[obs]}/sqrt(Hz)"
+                          for obs, curves in sub.asd.items() for curve in curves}
+    asd.attrs["units"]["frequency_hz"] = "Hz"
+    out["asd"] = asd
+    return out
+
+
+def _coherence_columns(coh):
+    """``[(key, observable, axis or None, name, values, unit)]`` of a coherence report: per
+    observable its PSD and multiple coherence, then per axis the coherence, the measured
+    transfer function, its confidence radius and the model's."""
+    units = _units(coh.observables)
+    per_axis = (("coherence", coh.coherence, ""), ("transfer", coh.transfer, "tf"),
+                ("transfer_radius", coh.transfer_radius, "tf"), ("model", coh.model, "tf"))
+    out = []
+    for obs in coh.observables:
+        out.append(("psd", obs, None, f"{obs}.psd", coh.psd[obs], f"{units[obs]}^2/Hz"))
+        out.append(("multiple_coherence", obs, None, f"{obs}.multiple_coherence",
+                    coh.multiple_coherence[obs], ""))
+        for key, values, unit in per_axis:
+            for axis, v in values[obs].items():
+                out.append((key, obs, axis, f"{obs}.{axis}.{key}", v,
+                            coh.units[obs] if unit == "tf" else ""))
+    return out
+
+
+def coherence_to_gwpy(coh):
+    """The coherence report as FrequencySeries (Coherence.to_gwpy)."""
+    gwpy = _need("gwpy", "Coherence.to_gwpy()")
+    where = _where(coh.frequency_hz)
+    out = {"coherence": {}, "multiple_coherence": {}, "transfer": {}, "transfer_radius": {},
+           "model": {}, "psd": {}}
+    for key, obs, axis, name, values, unit in _coherence_columns(coh):
+        series = gwpy.frequencyseries.FrequencySeries(
+            values, unit=astropy_unit(unit).replace("^2", "**2"), name=name, **where
+        )
+        if axis is None:
+            out[key][obs] = series
+        else:
+            out[key].setdefault(obs, {})[axis] = series
+    return out
+
+
+def coherence_to_pandas(coh):
+    """The coherence report as a DataFrame indexed by frequency_hz (Coherence.to_pandas)."""
+    pd = _need("pandas", "Coherence.to_pandas()")
+    columns = _coherence_columns(coh)
+    df = pd.DataFrame({name: np.array(v) for _, _, _, name, v, _ in columns},
+                      index=pd.Index(np.array(coh.frequency_hz), name="frequency_hz"))
+    df.attrs["units"] = {name: unit for _, _, _, name, _, unit in columns}
+    df.attrs["units"]["frequency_hz"] = "Hz"
+    return df

@@ -1,5 +1,5 @@
 """Figures of results with matplotlib (optional): Budget.plot, Simulation.plot,
-Subtraction.plot, TransferFunction.plot, Coherence.plot. The command line's own figures are written by ``save("x.png")``."""
+Subtraction.plot, TransferFunction.plot, Coherence.plot, MonteCarlo.plot. The command line's own figures are written by ``save("x.png")``."""
 
 import numpy as np
 
@@ -161,5 +161,29 @@ def coherence_plot(coh):
     for ax in axes[-1]:
         ax.set_xlabel("frequency (Hz)")
     fig.suptitle("coherence with the tilt axes and measured transfer functions")
+    fig.tight_layout()
+    return fig
+
+
+def monte_carlo_plot(mc):
+    """One histogram per mode of the accepted draws, the nominal frequency dashed black and
+    the mean orange, as the command line's figure marks them."""
+    plt = _pyplot("MonteCarlo.plot()")
+    fig, axes = plt.subplots(4, 2, figsize=(9, 10), squeeze=False)
+    f = mc.freqs_hz
+    for k, ax in enumerate(axes.flat):
+        ax.hist(f[:, k], bins=40, color="tab:blue", alpha=0.7)
+        ax.axvline(mc.nominal_hz[k], color="black", ls="--", label="nominal")
+        ax.axvline(mc.mean_hz[k], color="tab:orange", label="mean")
+        ax.set_xlabel(f"nu_{k + 1} (Hz)")
+        if k % 2 == 0:
+            ax.set_ylabel("draws")
+        # The low modes' frequencies in mHz would crowd their tick labels: few, scientific.
+        ax.locator_params(axis="x", nbins=5)
+        ax.ticklabel_format(axis="x", style="sci", scilimits=(-2, 3))
+        ax.grid(True, alpha=0.3)
+    axes[0, 0].legend(fontsize=8)
+    fig.suptitle(f"Monte Carlo of the normal modes: {mc.samples} draws, "
+                 f"{mc.rejected} rejected, seed {mc.seed}")
     fig.tight_layout()
     return fig

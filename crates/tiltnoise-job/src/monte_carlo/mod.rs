@@ -1,6 +1,10 @@
 //! The Monte Carlo job: the normal modes over the parameter errors (the error model of the
 //! parameter file, see [`tiltnoise_core::params::uncertainty`]), with the nominal modes beside
-//! them.
+//! them; its report and files ([`summary_json`], [`save`]), the same for every front end.
+
+mod outputs;
+
+pub use outputs::{caption, check_save_path, save, summary_json};
 
 use crate::error::JobError;
 use tiltnoise_core::cancel::Cancel;
@@ -48,6 +52,18 @@ pub fn check(req: &McRequest<'_>) -> Result<(), JobError> {
         .map_err(|e| JobError::MonteCarlo(Box::new(e.into())))
 }
 
+/// The configuration `req` runs with: the error model of its parameters, polling `cancel`.
+/// A front end that keeps a result without its configuration rebuilds it with this.
+pub fn config(req: &McRequest<'_>, cancel: &Cancel) -> McConfig {
+    McConfig {
+        samples: req.samples,
+        seed: req.seed,
+        threads: req.threads,
+        cancel: cancel.clone(),
+        ..McConfig::default_for(req.params)
+    }
+}
+
 /// Runs the Monte Carlo; `progress` is called from the workers with the draws done so far.
 ///
 /// # Errors
@@ -60,13 +76,7 @@ pub fn run(
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<McRun, JobError> {
     check(&req)?;
-    let config = McConfig {
-        samples: req.samples,
-        seed: req.seed,
-        threads: req.threads,
-        cancel: cancel.clone(),
-        ..McConfig::default_for(req.params)
-    };
+    let config = config(&req, cancel);
     let mc_error = |e: mc::McError| JobError::MonteCarlo(Box::new(e));
     let result = mc::run(req.params, &config, progress).map_err(mc_error)?;
     let model = Model::new(req.params).map_err(|e| mc_error(e.into()))?;
@@ -78,53 +88,4 @@ pub fn run(
         config,
         nominal_hz,
     })
-}
-
-/// The histograms' caption: what is marked, counts, seed and the error model, grouped by
-/// error.
-pub fn caption(run: &McRun) -> String {
-    let (result, cfg) = (&run.result, &run.config);
-    let mut groups: Vec<(f64, &str, Vec<&str>)> = Vec::new();
-    for u in cfg.uncertainties.iter().filter(|u| u.rel_sigma > 0.0) {
-        let name = u.key.split_once('.').map_or(u.key.as_str(), |(_, n)| n);
-        let shape = u.distribution.name();
-        match groups
-            .iter_mut()
-            .find(|g| g.0 == u.rel_sigma && g.1 == shape)
-        {
-            Some(g) => g.2.push(name),
-            None => groups.push((u.rel_sigma, shape, vec![name])),
-        }
-    }
-    let model: Vec<String> = groups
-        .iter()
-        .map(|(s, shape, names)| format!("{} % {shape} on {}", s * 100.0, names.join(", ")))
-        .collect();
-    // The [asymmetry] offsets have absolute errors, in their own unit.
-    let offsets: Vec<String> = cfg
-        .uncertainties
-        .iter()
-        .filter(|u| u.abs_sigma > 0.0)
-        .map(|u| {
-            let name = u.key.split_once('.').map_or(u.key.as_str(), |(_, n)| n);
-            format!("{:e} {} on {name}", u.abs_sigma, u.distribution.name())
-        })
-        .collect();
-    let absolute = if offsets.is_empty() {
-        String::new()
-    } else {
-        format!(
-            "; absolute errors (1 std, in the key's unit): {}",
-            offsets.join("; ")
-        )
-    };
-    format!(
-        "Black dashed: nominal parameters; orange: mean; shaded: mean ± 1 std. {} draws, {} \
-         rejected as non-physical, seed {}. Relative errors (1 std): {}{absolute}; all other \
-         parameters exact.",
-        result.samples,
-        result.rejected,
-        cfg.seed,
-        model.join("; ")
-    )
 }
