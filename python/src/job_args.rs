@@ -4,9 +4,8 @@
 //! does for the command line.
 
 use crate::errors::{value_error, InputFileError, IntoPyErr, PyResultExt};
-use crate::model::names;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyString};
 use std::path::PathBuf;
 use tiltnoise_core::budget::BudgetError;
 use tiltnoise_core::fit::FitError;
@@ -252,6 +251,23 @@ pub fn witness_noise(arg: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<WitnessIte
             })?),
         };
         items.push(WitnessItem { input, asd, rel });
+    }
+    Ok(items)
+}
+
+/// Names from a `str` (comma-separated, as on the command line) or a sequence of `str`.
+pub(crate) fn names(what: &str, arg: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
+    let items: Vec<String> = if let Ok(s) = arg.cast::<PyString>() {
+        vec![s.to_cow()?.into_owned()]
+    } else {
+        arg.extract::<Vec<String>>()
+            .map_err(|_| value_error(format!("{what}: expected a str or a sequence of str")))?
+    };
+    if items.is_empty() {
+        return Err(value_error(format!(
+            "{what}: an empty sequence names nothing; give one or more names, or None for the \
+             default"
+        )));
     }
     Ok(items)
 }

@@ -5,12 +5,12 @@ use crate::arrays;
 use crate::errors::{value_error, PyResultExt};
 use crate::grid::{self, GridBuffer};
 use crate::interrupt;
-use crate::job_args::job_error;
+use crate::job_args::{job_error, names};
 use crate::params::PyParams;
 use crate::state;
 use numpy::{Complex64, PyArray1, PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList, PyString};
+use pyo3::types::{PyDict, PyList};
 use std::collections::{BTreeMap, HashMap};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
@@ -248,23 +248,6 @@ fn names_of(observables: &[Observable]) -> Vec<String> {
 /// A band and a tolerance as a cache key.
 fn scene_bits(band: (f64, f64), rel_tol: f64) -> [u64; 3] {
     [band.0.to_bits(), band.1.to_bits(), rel_tol.to_bits()]
-}
-
-/// Names from a `str` (comma-separated, as on the command line) or a sequence of `str`.
-pub(crate) fn names(what: &str, arg: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
-    let items: Vec<String> = if let Ok(s) = arg.cast::<PyString>() {
-        vec![s.to_cow()?.into_owned()]
-    } else {
-        arg.extract::<Vec<String>>()
-            .map_err(|_| value_error(format!("{what}: expected a str or a sequence of str")))?
-    };
-    if items.is_empty() {
-        return Err(value_error(format!(
-            "{what}: an empty sequence names nothing; give one or more names, or None for the \
-             default"
-        )));
-    }
-    Ok(items)
 }
 
 /// `inputs` of [`PyModel::transfer`]: names as on the command line's `--input`; `None`: the
