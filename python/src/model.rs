@@ -481,7 +481,7 @@ impl PyModel {
     /// :meth:`transfer`'s.
     #[pyo3(signature = (freq_hz, inputs=None, outputs=None, method="auto", rel_tol=1e-9))]
     fn transfer_function<'py>(
-        &self,
+        slf: &Bound<'py, Self>,
         py: Python<'py>,
         freq_hz: &Bound<'py, PyAny>,
         inputs: Option<&Bound<'py, PyAny>>,
@@ -489,7 +489,9 @@ impl PyModel {
         method: &str,
         rel_tol: f64,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let h = self.transfer(py, freq_hz, inputs, outputs, method, rel_tol, None, None)?;
+        let h = slf
+            .get()
+            .transfer(py, freq_hz, inputs, outputs, method, rel_tol, None, None)?;
         let freqs = PyArray1::from_vec(py, grid::frequencies(freq_hz, grid::GRID)?);
         let (ins, outs) = (parse_inputs(inputs)?, parse_outputs(outputs)?);
         let names_units = |n: Vec<(&'static str, &'static str)>| n.into_iter().unzip();
@@ -499,7 +501,67 @@ impl PyModel {
             names_units(outs.iter().map(|o| (o.name(), o.unit())).collect());
         py.import("tiltnoise._transfer")?
             .getattr("TransferFunction")?
-            .call1((freqs, h, in_names, out_names, in_units, out_units, method))
+            .call1((freqs, h, in_names, out_names, in_units, out_units, method))?
+            .call_method1("_of", (slf, rel_tol, outputs.is_some()))
+    }
+
+    /// Writes the transfer functions of :meth:`transfer` with these arguments as the command
+    /// line's ``tf --save`` does (:meth:`TransferFunction.save` calls it): ``drawn``, the
+    /// observables of the figure (each one computed); ``phase``, a phase panel beside each
+    /// magnitude panel.
+    #[pyo3(signature = (path, freq_hz, inputs, outputs, method, rel_tol, drawn, phase))]
+    #[allow(clippy::too_many_arguments)]
+    fn _save_transfer(
+        &self,
+        py: Python<'_>,
+        path: std::path::PathBuf,
+        freq_hz: &Bound<'_, PyAny>,
+        inputs: Option<&Bound<'_, PyAny>>,
+        outputs: Option<&Bound<'_, PyAny>>,
+        method: &str,
+        rel_tol: f64,
+        drawn: Vec<String>,
+        phase: bool,
+    ) -> PyResult<()> {
+        tiltnoise_io::OutputKind::from_path(&path).py()?;
+        crate::inputs::Inputs::of_params(self.params_file.as_deref()).check_save(&path)?;
+        let request = Request {
+            inputs: parse_inputs(inputs)?,
+            outputs: parse_outputs(outputs)?,
+        };
+        let drawn = options::parse_outputs(OptionKey::DRAWN_OBSERVABLES, &drawn).py()?;
+        if let Some(o) = drawn.iter().find(|o| !request.outputs.contains(o)) {
+            return Err(value_error(format!(
+                "observables: {} is not among the computed observables ({})",
+                o.name(),
+                request
+                    .outputs
+                    .iter()
+                    .map(|o| o.name())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )));
+        }
+        let model = &self.model;
+        let req = tiltnoise_job::tf::TfRequest {
+            model,
+            request,
+            grid: tiltnoise_job::tf::FreqGrid::Points(grid::frequencies(freq_hz, grid::GRID)?),
+            per: tiltnoise_core::ground::GroundQuantity::Displacement,
+            method: parse_method(method)?,
+            rel_tol: Some(rel_tol),
+            block_freqs: None,
+            figure: None,
+        };
+        let figure = tiltnoise_job::tf::figure_options(model, drawn, phase);
+        let meta =
+            tiltnoise_io::RunMeta::of_this_run(model.params(), Some(&NormalModes::new(model)));
+        let tf = py
+            .detach(|| tiltnoise_job::tf::run(req, &Cancel::never()))
+            .map_err(job_error)?
+            .tf;
+        py.detach(|| tiltnoise_job::tf::save(&path, &tf, &meta, &figure))
+            .py()
     }
 
     /// Which method ``method="auto"`` picks for this request and grid, and why: every
@@ -643,6 +705,33 @@ impl PyModel {
         d.set_item("target_rel_err", result.target_rel_err)?;
         d.set_item("methods", methods)?;
         Ok(d)
+    }
+
+    /// Runs :meth:`methods` and writes its chart, time per point against worst error, as the
+    /// command line's ``methods --save`` does: ``.png`` or ``.svg`` (the command line's chart
+    /// for the same grid and inputs, drawn by the same code; the measured times, and so the
+    /// points' places, differ from run to run), atomically. Raises
+    /// ``ValueError`` for another extension, ``OSError`` if it cannot be written or is the
+    /// parameter file.
+    #[pyo3(signature = (path, freq_hz, inputs=None))]
+    fn save_methods(
+        &self,
+        py: Python<'_>,
+        path: std::path::PathBuf,
+        freq_hz: &Bound<'_, PyAny>,
+        inputs: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        tiltnoise_plot::ImageFormat::from_path(&path).py()?;
+        crate::inputs::Inputs::of_params(self.params_file.as_deref()).check_save(&path)?;
+        let req = tiltnoise_job::methods::MethodsRequest {
+            model: &self.model,
+            grid_hz: grid::frequencies(freq_hz, grid::GRID)?,
+            inputs: Some(parse_inputs(inputs)?),
+        };
+        py.detach(|| {
+            let result = tiltnoise_job::methods::run(req, &Cancel::never()).map_err(job_error)?;
+            tiltnoise_job::methods::save(&path, &result, &tiltnoise_plot::View::default()).py()
+        })
     }
 
     /// Constrained least-squares fit of the parameters ``free`` (dotted keys; default the

@@ -219,6 +219,20 @@ class Model:
     def matrices(self) -> dict[str, Any]: ...
     def monte_carlo(self, samples: int = 10000, seed: int = 1, threads: int = 0) -> MonteCarlo: ...
     def methods(self, freq_hz: _Freqs, inputs: Optional[_Names] = None) -> dict[str, Any]: ...
+    def _save_transfer(
+        self,
+        path: _Path,
+        freq_hz: _Freqs,
+        inputs: Optional[_Names],
+        outputs: Optional[_Names],
+        method: str,
+        rel_tol: float,
+        drawn: Sequence[str],
+        phase: bool,
+    ) -> None: ...
+    def save_methods(
+        self, path: _Path, freq_hz: _Freqs, inputs: Optional[_Names] = None
+    ) -> None: ...
     def fit(
         self,
         free: Optional[Sequence[str]] = None,

@@ -28,21 +28,57 @@ class TransferFunction:
     """
 
     __slots__ = ("freq_hz", "values", "inputs", "outputs", "input_units", "output_units",
-                 "method")
+                 "method", "_model", "_rel_tol", "_outputs_given")
 
     def __init__(self, freq_hz, values, inputs, outputs, input_units, output_units,
-                 method="auto"):
+                 method="auto", model=None, rel_tol=1e-9, outputs_given=True):
         self.freq_hz = _fixed(np.atleast_1d(freq_hz), np.float64)
         self.values = _fixed(values, np.complex128)
         self.inputs, self.outputs = tuple(inputs), tuple(outputs)
         self.input_units, self.output_units = tuple(input_units), tuple(output_units)
         self.method = method
+        # The request, for `save`: the model, the tolerance of `auto`, and whether the
+        # observables were named (if not, the figure is the paper's Figure 5).
+        self._model, self._rel_tol, self._outputs_given = model, rel_tol, outputs_given
         shape = (len(self.freq_hz), len(self.outputs), len(self.inputs))
         if self.values.shape != shape or len(self.input_units) != len(self.inputs) or len(
                 self.output_units) != len(self.outputs):
             raise ValueError(
                 f"values: shape {self.values.shape} does not fit (n_freq, n_outputs, n_inputs) "
                 f"= {shape}, or the units do not fit the names")
+
+    def _of(self, model, rel_tol, outputs_given):
+        """This transfer function, with the request :meth:`save` runs again."""
+        self._model, self._rel_tol, self._outputs_given = model, rel_tol, outputs_given
+        return self
+
+    def save(self, path, observables=None, phase=False):
+        """Writes the transfer functions as the command line's ``tf --save`` does for the same
+        request, atomically: ``.h5``/``.hdf5`` (schema ``tiltnoise.tf``, with the parameters and
+        modes), ``.csv``, or the figure (``|H|`` per observable, one panel per kind of input)
+        as ``.png`` or ``.svg``. ``observables``: the observables the figure draws, each one of
+        :attr:`outputs` (the command line's ``--plot-observables``; default every output, or
+        ``X``, ``phi``, ``phi_a`` as the paper's Figure 5 when the outputs were not named);
+        ``phase``: a phase panel (degrees) beside each magnitude panel (``--phase``). The
+        values are computed again by :meth:`Model.transfer_function`'s request through the
+        command line's code. Raises ``ValueError`` for another extension or a drawn observable
+        not computed, ``OSError`` if it cannot be written or is the parameter file, and
+        ``TypeError`` for a transfer function built by hand (without its model). The figure's
+        caption names the option that chooses its panels as Python spells it
+        (``observables``), so a figure that leaves computed observables out differs from the
+        command line's in that word only."""
+        if self._model is None:
+            raise TypeError("save: this TransferFunction has no model; make it with "
+                            "Model.transfer_function")
+        if observables is None:
+            drawn = self.outputs if self._outputs_given else ("X", "phi", "phi_a")
+        elif isinstance(observables, str):
+            drawn = [o for o in observables.split(",") if o]
+        else:
+            drawn = observables
+        outputs = list(self.outputs) if self._outputs_given else None
+        self._model._save_transfer(path, self.freq_hz, list(self.inputs), outputs, self.method,
+                                   self._rel_tol, list(drawn), phase)
 
     @property
     def units(self):
@@ -85,7 +121,8 @@ class TransferFunction:
 
     def __reduce__(self):
         return (TransferFunction, (self.freq_hz, self.values, self.inputs, self.outputs,
-                                   self.input_units, self.output_units, self.method))
+                                   self.input_units, self.output_units, self.method,
+                                   self._model, self._rel_tol, self._outputs_given))
 
     def __repr__(self):
         f = self.freq_hz

@@ -3,7 +3,6 @@
 
 use super::args::Format;
 use super::figure_args::SizeArgs;
-use super::output::save_image;
 use super::Run;
 use anyhow::Result;
 use clap::Args;
@@ -90,33 +89,10 @@ pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> 
         Format::Json => writeln!(out, "{}", json(&result, spec)?)?,
         Format::Table => write!(out, "{}", table(&result, spec))?,
     }
-    let points: Vec<tiltnoise_plot::methods_figure::MethodPoint> = result
-        .rows
-        .iter()
-        .filter_map(|r| {
-            Some((
-                r.method.name().to_string(),
-                r.ns_per_point?,
-                r.worst.as_ref()?.0,
-            ))
-        })
-        .collect();
-    let title = format!(
-        "Speed against accuracy, {}, {spec} Hz",
-        result.matrix_label()
-    );
     // JSON on standard output stays parseable: the `wrote` lines go to standard error.
     run.write_outputs(format == Format::Json, || {
         for path in save {
-            save_image(path, |format| {
-                tiltnoise_plot::methods_figure::methods_figure(
-                    &points,
-                    result.target_rel_err,
-                    &title,
-                    &view,
-                    format,
-                )
-            })?;
+            tiltnoise_job::methods::save(path, &result, &view)?;
         }
         Ok(())
     })

@@ -5,33 +5,10 @@ use std::path::Path;
 use tiltnoise_core::error::OutputError;
 use tiltnoise_core::input::InputMeta;
 use tiltnoise_core::noise::BudgetReport;
-use tiltnoise_core::tf::TransferMatrix;
-use tiltnoise_io::{write_budget_csv, write_budget_hdf5, write_tf_csv, write_tf_hdf5};
+use tiltnoise_io::{write_budget_csv, write_budget_hdf5};
 use tiltnoise_io::{OutputKind, RunMeta};
 
 pub use tiltnoise_job::save_image;
-
-/// Saves a transfer matrix in the format named by the extension of `path`: HDF5 (with
-/// `meta`), CSV (`meta` is not stored), or a PNG/SVG figure.
-///
-/// # Errors
-///
-/// [`OutputError::UnknownFormat`] for an unsupported extension (nothing is written), or the
-/// writer's [`OutputError::Write`].
-pub fn save_tf(
-    path: &Path,
-    tf: &TransferMatrix,
-    meta: &RunMeta,
-    figure: &tiltnoise_plot::TfFigureOptions,
-) -> Result<(), OutputError> {
-    match OutputKind::from_path(path)? {
-        OutputKind::Hdf5 => write_tf_hdf5(path, tf, meta),
-        OutputKind::Csv => write_tf_csv(path, tf, meta),
-        OutputKind::Png | OutputKind::Svg => save_image(path, |format| {
-            tiltnoise_plot::tf_figure_with(tf, format, figure)
-        }),
-    }
-}
 
 /// Saves a noise budget in the format named by the extension of `path`: HDF5 (with `meta` and
 /// `input`), CSV (ASDs only; identically-zero columns left out unless `keep_zero_columns`), or a PNG/SVG figure drawn with `figure` and the input named in

@@ -12,7 +12,6 @@
 
 use super::args::{scientific, Format, MethodArg, PerArg};
 use super::figure_args::FigureArgs;
-use super::output::save_tf;
 use super::Run;
 use anyhow::{bail, Result};
 use clap::Args;
@@ -140,15 +139,9 @@ fn figure_options(
     } else if !args.outputs.is_empty() {
         request.outputs.clone()
     } else {
-        vec![Observable::X, Observable::Phi, Observable::PhiA]
+        tiltnoise_job::tf::FIGURE5_OBSERVABLES.to_vec()
     };
-    let options = tiltnoise_plot::TfFigureOptions {
-        observables: Some(observables),
-        phase: args.phase,
-        damped: !model.is_undamped(),
-        view: tiltnoise_plot::View::default(),
-        note: None,
-    };
+    let options = tiltnoise_job::tf::figure_options(model, observables, args.phase);
     let size = tiltnoise_plot::tf_figure::default_size(&options, &request.inputs);
     Ok(tiltnoise_plot::TfFigureOptions {
         view: args.figure.view_for(size)?,
@@ -220,7 +213,7 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
     write_report(&mut run.out, &model, &modes, planned.request(), json)?;
     run.write_outputs(json, || {
         for path in &args.save {
-            save_tf(path, &tf, &meta, &figure)?;
+            tiltnoise_job::tf::save(path, &tf, &meta, &figure)?;
         }
         Ok(())
     })

@@ -3,7 +3,6 @@
 
 use crate::common;
 
-use crate::output::save_tf;
 use common::{listing, str_attr, strs_attr, strs_dataset};
 use num_complex::Complex64;
 use std::path::Path;
@@ -12,6 +11,7 @@ use tiltnoise_core::model::Model;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::tf::{evaluate, plan, Method, Request, TransferMatrix};
 use tiltnoise_io::{write_atomic, write_tf_csv, write_tf_hdf5, OutputKind, RunMeta, TOOL_VERSION};
+use tiltnoise_job::tf::save as save_tf;
 
 fn freqs() -> Vec<f64> {
     // 0 Hz, then log-spaced 1e-4 .. 10 Hz (irrational-looking values), then a few exact ones.

@@ -2,11 +2,15 @@
 //! and its time per point, for a matrix of the model on a grid, with the method `auto` picks.
 
 use crate::error::JobError;
+use std::path::Path;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::methods::{methods_table, MethodRow};
 use tiltnoise_core::model::{Input, Model, Observable, Request};
 use tiltnoise_core::tf::planner::{NoChoice, DEFAULT_REL_TOL};
 use tiltnoise_core::tf::Method;
+use tiltnoise_io::OutputError;
+use tiltnoise_plot::methods_figure::{methods_figure, MethodPoint};
+use tiltnoise_plot::View;
 
 /// A comparison of the methods to run.
 pub struct MethodsRequest<'a> {
@@ -49,6 +53,15 @@ impl MethodsResult {
                 format!("{size} matrix from {}", names.join(", "))
             }
         }
+    }
+
+    /// The grid as the chart's title names it: `400 points, 1e-5 to 1e2 Hz`.
+    pub fn grid_label(&self) -> String {
+        let (lo, hi) = match (self.grid_hz.first(), self.grid_hz.last()) {
+            (Some(lo), Some(hi)) => (*lo, *hi),
+            _ => (f64::NAN, f64::NAN),
+        };
+        format!("{} points, {lo:e} to {hi:e} Hz", self.grid_hz.len())
     }
 
     /// `auto`'s pick as the table and the JSON name it: the method, or `none (why)`.
@@ -101,5 +114,35 @@ pub fn run(req: MethodsRequest<'_>, cancel: &Cancel) -> Result<MethodsResult, Jo
         rows,
         auto,
         target_rel_err: DEFAULT_REL_TOL,
+    })
+}
+
+/// Saves the chart of a comparison (time per point against worst error, one point per usable
+/// method, the target error marked) as `.png` or `.svg`, drawn with `view`; atomically, the
+/// same for every front end.
+///
+/// # Errors
+///
+/// [`OutputError::UnknownFormat`] for another extension (nothing is written), or
+/// [`OutputError::Write`] naming `path`.
+pub fn save(path: &Path, result: &MethodsResult, view: &View) -> Result<(), OutputError> {
+    let points: Vec<MethodPoint> = result
+        .rows
+        .iter()
+        .filter_map(|r| {
+            Some((
+                r.method.name().to_string(),
+                r.ns_per_point?,
+                r.worst.as_ref()?.0,
+            ))
+        })
+        .collect();
+    let title = format!(
+        "Speed against accuracy, {}, {}",
+        result.matrix_label(),
+        result.grid_label()
+    );
+    crate::save_image(path, |format| {
+        methods_figure(&points, result.target_rel_err, &title, view, format)
     })
 }

@@ -4,15 +4,17 @@
 //! to the transfer matrix, whole or block by block in memory that does not grow with the grid.
 
 use crate::error::{shown_path, JobError};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::freq::{self, LogGrid};
 use tiltnoise_core::ground::GroundQuantity;
 use tiltnoise_core::limits::MAX_GRID_POINTS;
+use tiltnoise_core::model::Observable;
 use tiltnoise_core::model::{Model, Request};
 use tiltnoise_core::tf::planner::{Choice, Scene, DEFAULT_REL_TOL};
 use tiltnoise_core::tf::{self, Method, TransferFunction, TransferMatrix};
-use tiltnoise_io::read_freq_file;
+use tiltnoise_io::{read_freq_file, write_tf_csv, write_tf_hdf5, OutputError, OutputKind, RunMeta};
+use tiltnoise_plot::TfFigureOptions;
 
 /// Frequencies per block of a streamed grid: 16384 points of the largest request (7 x 15
 /// complex values) are 27 MB with the CSV text of the block.
@@ -356,4 +358,43 @@ pub fn run(req: TfRequest<'_>, cancel: &Cancel) -> Result<TfResult, JobError> {
         tf,
         choice: planned.choice,
     })
+}
+
+/// The observables a figure draws when none are chosen: those of the paper's Figure 5.
+pub const FIGURE5_OBSERVABLES: [Observable; 3] = [Observable::X, Observable::Phi, Observable::PhiA];
+
+/// The figure of a matrix of `model`: a row of panels per observable of `drawn` (each one
+/// computed), a phase panel beside each with `phase`, the caption saying whether the model is
+/// damped, in the default view.
+pub fn figure_options(model: &Model, drawn: Vec<Observable>, phase: bool) -> TfFigureOptions {
+    TfFigureOptions {
+        observables: Some(drawn),
+        phase,
+        damped: !model.is_undamped(),
+        view: tiltnoise_plot::View::default(),
+        note: None,
+    }
+}
+
+/// Saves a transfer matrix in the format named by the extension of `path`: HDF5 (schema
+/// `tiltnoise.tf`, with `meta`), CSV, or the PNG/SVG figure drawn with `figure`; atomically,
+/// the same for every front end.
+///
+/// # Errors
+///
+/// [`OutputError::UnknownFormat`] for another extension (nothing is written), or the writer's
+/// [`OutputError::Write`] naming `path`.
+pub fn save(
+    path: &Path,
+    tf: &TransferMatrix,
+    meta: &RunMeta,
+    figure: &TfFigureOptions,
+) -> Result<(), OutputError> {
+    match OutputKind::from_path(path)? {
+        OutputKind::Hdf5 => write_tf_hdf5(path, tf, meta),
+        OutputKind::Csv => write_tf_csv(path, tf, meta),
+        OutputKind::Png | OutputKind::Svg => crate::save_image(path, |format| {
+            tiltnoise_plot::tf_figure_with(tf, format, figure)
+        }),
+    }
 }
