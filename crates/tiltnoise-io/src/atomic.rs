@@ -23,6 +23,9 @@ use tiltnoise_core::error::OutputError;
 /// The longest file name most file systems accept (bytes).
 pub(crate) const NAME_MAX: usize = 255;
 
+/// How long [`remove_temporaries_for_exit`] waits before removing the temporary files again.
+const RECREATE_GRACE: std::time::Duration = std::time::Duration::from_millis(100);
+
 /// Temporary files that exist right now, for [`remove_temporaries_for_exit`].
 static LIVE_TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
@@ -341,12 +344,24 @@ impl Drop for Staging {
 /// line's interrupt handler). The registry stays locked afterwards, so that no temporary file
 /// can appear any more: a writer that tries to create one waits for the process to end.
 /// Safe to call from any thread: a writer holds the lock only for a moment.
+///
+/// A registered path can still be created again by a writer already past the registry: the
+/// HDF5 library creates its file over the (registered) temporary one, so a `File::create`
+/// running on another thread at the moment of the removal leaves a fresh file behind. The
+/// files are therefore removed a second time after [`RECREATE_GRACE`], long enough for such a
+/// create to have finished.
 pub fn remove_temporaries_for_exit() -> usize {
     let live = LIVE_TEMPORARIES
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner);
     for p in live.iter() {
         let _ = std::fs::remove_file(p);
+    }
+    if !live.is_empty() {
+        std::thread::sleep(RECREATE_GRACE);
+        for p in live.iter() {
+            let _ = std::fs::remove_file(p);
+        }
     }
     let removed = live.len();
     std::mem::forget(live);
