@@ -348,7 +348,7 @@ impl Drop for Staging {
 /// A registered path can still be created again by a writer already past the registry: the
 /// HDF5 library creates its file over the (registered) temporary one, so a `File::create`
 /// running on another thread at the moment of the removal leaves a fresh file behind. The
-/// files are therefore removed a second time after [`RECREATE_GRACE`], long enough for such a
+/// files are therefore removed a second time after a pause (100 ms), long enough for such a
 /// create to have finished.
 pub fn remove_temporaries_for_exit() -> usize {
     let live = LIVE_TEMPORARIES
