@@ -155,9 +155,10 @@ with h5py.File(path("measured_h5_bytes", "observables.h5"), "w") as f:
     f.create_dataset("time_s", data=np.arange(16) / 4.0)
 
 
-# tilt_h5_bytes/known_hangs: inputs on which the HDF5 library itself never returns, kept for
-# the bug reports and not replayed (docs/robustness.md). Here: series_angle.h5 with the size of
-# its global heap's free-space object set to 0; decoding the heap then never advances.
+# tilt_h5_bytes/regressions: series_angle.h5 with the size of its global heap's free-space
+# object set to 0. Unpatched HDF5 decodes that heap forever; the vendored library refuses it
+# (vendor/README.md), and the test a_global_heap_with_an_empty_free_space_object_is_refused
+# replays it under a time bound.
 def zero_free_space(src, dst):
     import struct
     data = bytearray(open(src, "rb").read())
@@ -175,7 +176,7 @@ def zero_free_space(src, dst):
 
 
 zero_free_space(path("tilt_h5_bytes", "series_angle.h5"),
-                path("tilt_h5_bytes/known_hangs", "global_heap_free_space_of_size_0.h5"))
+                path("tilt_h5_bytes/regressions", "global_heap_free_space_of_size_0.h5"))
 
 # miniSEED: the synthetic fixtures of the reader (written with ObsPy by
 # tests/fixtures/input/miniseed/make_miniseed_fixtures.py).

@@ -278,10 +278,6 @@ fn read_miniseed(path: &Path) {
 
 /// Every HDF5 reader: the tilt readers, streaming against in-memory, the measured series.
 fn read_hdf5_any(path: &Path) {
-    let bytes = std::fs::read(path).expect("the input file was just written");
-    if global_heap_hangs_hdf5(&bytes) {
-        return;
-    }
     read_tilt_any(path);
     if strict() {
         for opts in option_sets() {
@@ -413,40 +409,4 @@ fn apply_overrides(path: &Path) {
         }
     }
     check_round_trip(&p);
-}
-
-/// Whether `bytes` hold a global heap collection (signature `GCOL`: where variable-length
-/// strings live) that HDF5 2.0.0 decodes forever. Its decoder (`H5HG__cache_heap_deserialize`)
-/// advances by the size of each object, and the free-space object (index 0) has no header of
-/// its own: one of size 0 never advances. That is a bug of the C library (reported upstream,
-/// see `docs/robustness.md`) which no reader can stop, so such inputs are skipped; every
-/// collection of the file is walked as HDF5 walks it (8-byte lengths).
-pub fn global_heap_hangs_hdf5(bytes: &[u8]) -> bool {
-    const OBJECT_HEADER: usize = 16;
-    let word = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().expect("8 bytes"));
-    let mut from = 0;
-    while let Some(at) = bytes[from..].windows(4).position(|w| w == b"GCOL") {
-        let base = from + at;
-        from = base + 1;
-        if base + 16 > bytes.len() {
-            break;
-        }
-        let size = usize::try_from(word(base + 8)).unwrap_or(usize::MAX);
-        let end = base.saturating_add(size).min(bytes.len());
-        let mut p = base + 16;
-        while p + OBJECT_HEADER <= end {
-            let index = u16::from_le_bytes([bytes[p], bytes[p + 1]]);
-            let len = word(p + 8);
-            let need = match index {
-                0 if len == 0 => return true,
-                0 => len,
-                _ => len.div_ceil(8).saturating_mul(8).saturating_add(16),
-            };
-            match usize::try_from(need).ok().and_then(|n| p.checked_add(n)) {
-                Some(next) => p = next,
-                None => break,
-            }
-        }
-    }
-    false
 }
