@@ -241,3 +241,22 @@ fn budget_reads_miniseed_from_the_command_line() {
         &["XX.TILT.00.BJE", "digitizer counts (Steim-2)"],
     );
 }
+
+/// Channels whose samples fall between each other's: the message names the channel off the
+/// grid and the one that sets it (the one starting last), each with its own start time.
+#[test]
+fn channels_off_each_others_grid_are_both_named() {
+    let path = fixture("off_grid.mseed");
+    let opts = ReadOptions {
+        axis_map: Some(AxisMap::parse("theta_t=-BJE,eta_t=-BJN").unwrap()),
+        quantity: Some(Quantity::Rate),
+        ..ReadOptions::default()
+    };
+    let e = read_tilt_series(&path, &opts).unwrap_err().to_string();
+    assert!(
+        e.contains("channel XX.TILT.00.BJE starts at 2018-01-23T09:31:42")
+            && e.contains("and XX.TILT.00.BJN at 2018-01-23T09:31:42.05"),
+        "{e}"
+    );
+    assert!(e.contains("not on one time grid"), "{e}");
+}

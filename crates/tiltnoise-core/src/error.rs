@@ -272,7 +272,7 @@ pub enum TfError {
     /// A transfer function per unit velocity or acceleration of the floor asked for where it has
     /// no value from the one per unit displacement (0 Hz, see [`crate::ground`]).
     #[error(
-        "a transfer function per unit floor {quantity} has no value at {} Hz (a {quantity} \
+        "a transfer function per unit floor {quantity} has no value at {} Hz (a floor {quantity} \
          carries no displacement there): use frequencies above 0 Hz",
         Num(*.freq_hz)
     )]

@@ -340,7 +340,7 @@ fn refuse_zero_for_per(
         "per",
         Some(q),
         format!(
-            "{at} is 0 Hz, where a transfer function per unit floor {q} has no value (a {q} \
+            "{at} is 0 Hz, where a transfer function per unit floor {q} has no value (a floor {q} \
              carries no displacement at DC); use frequencies above 0 Hz"
         ),
     ))

@@ -208,10 +208,9 @@ pub enum UncertaintyError {
     },
     /// An entry that is not `{ rel_sigma = ..., distribution = ... }`.
     #[error(
-        "[uncertainty]: entry `{key}`: {message}; expected e.g. \
-         `\"{key}\" = {{ rel_sigma = 0.03, distribution = \"gaussian\" }}` (an [asymmetry] \
-         key takes `sigma`, absolute in its unit)",
-        key = Shown(.key)
+        "[uncertainty]: entry `{key}`: {message}; expected e.g. {example}",
+        key = Shown(.key),
+        example = EntryExample(.key)
     )]
     Malformed {
         /// The key of the entry.
@@ -219,6 +218,29 @@ pub enum UncertaintyError {
         /// What is wrong.
         message: String,
     },
+}
+
+/// An example entry for `key` in a message: `sigma` (absolute) for an [asymmetry] key,
+/// `rel_sigma` for every other.
+struct EntryExample<'a>(&'a str);
+
+impl std::fmt::Display for EntryExample<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let key = Shown(self.0);
+        if is_absolute_key(self.0) {
+            write!(
+                f,
+                "`\"{key}\" = {{ sigma = 1e-4, distribution = \"gaussian\" }}` (an [asymmetry] \
+                 key's sigma is absolute, in the key's unit)"
+            )
+        } else {
+            write!(
+                f,
+                "`\"{key}\" = {{ rel_sigma = 0.03, distribution = \"gaussian\" }}` (relative; an \
+                 [asymmetry] key takes an absolute `sigma`)"
+            )
+        }
+    }
 }
 
 /// The `[uncertainty]` table of a parameter file: the entries that override
@@ -620,11 +642,21 @@ mod tests {
         for (entry, needles) in [
             (
                 "\"asymmetry.tm_com_x_m\" = { rel_sigma = 0.1 }",
-                &["asymmetry.tm_com_x_m", "rel_sigma", "allowed fields: sigma"][..],
+                &[
+                    "asymmetry.tm_com_x_m",
+                    "rel_sigma",
+                    "allowed fields: sigma",
+                    "expected e.g. `\"asymmetry.tm_com_x_m\" = { sigma = 1e-4",
+                ][..],
             ),
             (
                 "\"mass.m_a_kg\" = { sigma = 0.1 }",
-                &["mass.m_a_kg", "sigma", "allowed fields: rel_sigma"],
+                &[
+                    "mass.m_a_kg",
+                    "sigma",
+                    "allowed fields: rel_sigma",
+                    "expected e.g. `\"mass.m_a_kg\" = { rel_sigma = 0.03",
+                ],
             ),
             (
                 "\"asymmetry.sensor_rot_z_rad\" = { sigma = -1e-3 }",
@@ -635,6 +667,14 @@ mod tests {
             for n in needles {
                 assert!(e.contains(n), "`{n}` missing in: {e}");
             }
+            // The example is of the key's own kind: never the field the entry was refused for.
+            let refused_example = if entry.contains("asymmetry.") {
+                "{ rel_sigma = "
+            } else {
+                "{ sigma = "
+            };
+            let example = e.split("expected e.g.").nth(1).unwrap_or("");
+            assert!(!example.contains(refused_example), "{e}");
         }
     }
 

@@ -115,6 +115,18 @@ pub(crate) fn merge_given(
                 mine
             }
             Some(s) if s.unit() == Some(g.unit) => s,
+            Some(s) if s.origin == GIVEN => {
+                return Err(InputError::ChannelUnit {
+                    path: path.to_path_buf(),
+                    channel: g.channel.clone(),
+                    message: format!(
+                        "is given the units `{}` and `{}` by {GIVEN}; allowed: one unit per \
+                         channel",
+                        Shown(&s.text),
+                        Shown(&g.text)
+                    ),
+                })
+            }
             Some(s) => {
                 return Err(InputError::ChannelUnit {
                     path: path.to_path_buf(),

@@ -356,7 +356,13 @@ fn common_span(
             ));
         }
     }
-    let start_ns = chans.iter().map(|c| c.start_ns).max().unwrap_or(0);
+    // The common record starts with the channel that starts last: every other channel is
+    // judged against it (and named with it when its samples fall between its grid's).
+    let latest = chans
+        .iter()
+        .max_by_key(|c| c.start_ns)
+        .expect("at least one mapped channel");
+    let start_ns = latest.start_ns;
     let tolerance = chans
         .iter()
         .map(|c| c.time_resolution_ns)
@@ -375,8 +381,8 @@ fn common_span(
                      grid ({rate} Hz); allowed: channels sampled at the same instants",
                     ch.id,
                     ch.time(0),
-                    first.id,
-                    first.time(0)
+                    latest.id,
+                    latest.time(0)
                 ),
             ));
         }
