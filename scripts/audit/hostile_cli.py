@@ -51,7 +51,8 @@ non-finite  exit 0, but a number written to stdout or to a new or changed file i
             `"quality_factor": "inf"`), NaN in the `measured`/`residual` terms of a budget
             (documented as NaN outside the band the measured file covers; also the note
             "(NaN outside)"), and NaN in a fit's `fitted_sigma` (documented for a parameter on
-            a bound).
+            a bound). A case may name JSON keys whose `null` counts as non-finite
+            (`null_keys`) and restrict the evidence to named values (`nonfinite_only`).
 leftover    after a failing run, any file or directory in the scratch directory that was not
             there before; after any run, a new temporary-looking name (`*.tmp`, `.tmpXXXXXX`,
             or the atomic writer's `.<name>.XXXXXX[.<ext>]`).
@@ -61,11 +62,13 @@ exit!=2     controlled failure with an exit code other than 2 (cases that sent a
             exempt: any status is acceptable after SIGINT/SIGTERM/SIGHUP).
 accepted    the case must be refused (documented error, destroys its input, or output that
             could not be written) and the run exited 0.
+ignored     as accepted, for a case whose option names an input the run does not have (an
+            `ignored option`; counted with accepted bad in the compact table).
 refused     the case must succeed (a valid but unusual input) and the run failed in a
             controlled way.
 
 The single `classification` of a record is its most severe flag in the order crash, abort/oom,
-panic, hang, non-finite, leftover, accepted, refused, multi-line, silent, exit!=2; otherwise
+panic, hang, non-finite, leftover, accepted, ignored, refused, multi-line, silent, exit!=2; otherwise
 `error` (controlled failure, exit 2, one line) or `ok` (exit 0).
 
 Categories

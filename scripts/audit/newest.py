@@ -8,6 +8,7 @@ Imported by hostile_cli.py, which runs the cases; the pair of records comes from
 """
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -16,7 +17,7 @@ import h5py
 import numpy as np
 
 import surfaces
-from case_kit import C, chain, copy_setup, write
+from case_kit import SHORT_TIMEOUT, C, chain, copy_setup, write
 
 SIX = "six.h5"
 FREE = "free.h5"
@@ -271,7 +272,12 @@ def cases_visibility(inputs: Path) -> list:
     cases = []
     cases.append(C(cat, "fit --visibility (the measured file)", ["fit", "--visibility", _in(VIS)],
                    must_succeed=True))
-    rows = [("sigma 1e-310", "1,phi_a,phi,0.6458,1e-310", False, r"1e-310|sigma"),
+    eta = next((line for line in vis_lines() if line.startswith("1,eta,phi,")),
+               "1,eta,phi,-6.7e-7,1e-14").split(",")
+    rows = [("sigma 1e-310 (nu_1 eta/phi, its ratio kept)", ",".join(eta[:4] + ["1e-310"]),
+             False, r"1e-310|sigma"),
+            ("sigma 1e-310 (nu_1 phi_a/phi, ratio 1e-4 off)", "1,phi_a,phi,0.6458,1e-310",
+             False, r"1e-310|sigma"),
             ("sigma 0", "1,phi_a,phi,0.6458,0", True, r"sigma"),
             ("sigma NaN", "1,phi_a,phi,0.6458,nan", True, r"sigma"),
             ("sigma -1", "1,phi_a,phi,0.6458,-1", True, r"sigma"),
@@ -287,10 +293,10 @@ def cases_visibility(inputs: Path) -> list:
             ("a missing field", "1,phi_a,phi", True, r"line"),
             ("an extra field", "1,phi_a,phi,0.6,1e-3,7", True, r"line")]
     for label, row, bad, culprit in rows:
-        path = vis_variant(label.replace(" ", "_"), row)
+        path = vis_variant(re.sub(r"[^A-Za-z0-9]+", "_", label), row)
         cases.append(C(cat, f"fit --visibility with a row of {label}",
                        ["fit", "--visibility", str(path)], must_fail=bad, culprit=culprit,
-                       culprit_if_fails=culprit is not None))
+                       culprit_if_fails=culprit is not None, timeout=SHORT_TIMEOUT))
     cases.append(C(cat, "fit --visibility an empty file",
                    ["fit", "--visibility", str(write(_IN["dir"] / "vis_empty.csv", ""))],
                    must_fail=True, culprit=r"vis_empty"))
