@@ -387,13 +387,14 @@ def cases_python_newest(inputs: Path) -> list:
     cat = "python (newest)"
     cases = []
     # `public(obj)`: the object's public attributes, so that py_case.py checks their numbers.
-    pre = ("import numpy as np, tiltnoise as tn\n"
-           "def public(o):\n"
-           "    return {k: getattr(o, k) for k in dir(o)\n"
-           "            if not k.startswith('_') and not callable(getattr(o, k))}\n")
+    pre = "import numpy as np, tiltnoise as tn\n"
+    helper = ("def public(o):\n"
+              "    return {k: getattr(o, k) for k in dir(o)\n"
+              "            if not k.startswith('_') and not callable(getattr(o, k))}\n")
 
     def py(label, code, setup=None, **kw):
-        cases.append(C(cat, label, [], python=pre + code, setup=setup, **kw))
+        code = pre + (helper if "public(" in code else "") + code
+        cases.append(C(cat, label, [], python=code, setup=setup, **kw))
 
     for inp in ("translation", "ground"):
         for f in TF_FREQS:
