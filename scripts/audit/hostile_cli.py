@@ -68,7 +68,8 @@ refused     the case must succeed (a valid but unusual input) and the run failed
             controlled way.
 
 The single `classification` of a record is its most severe flag in the order crash, abort/oom,
-panic, hang, non-finite, leftover, accepted, ignored, refused, multi-line, silent, exit!=2; otherwise
+panic, hang, non-finite, leftover, accepted, ignored, refused, multi-line, silent, exit!=2;
+otherwise
 `error` (controlled failure, exit 2, one line) or `ok` (exit 0).
 
 Categories

@@ -36,8 +36,8 @@ SIX_AXES = ["--axes", "theta_t=-E,eta_t=-N,phi_t=-Z,x_t=HE,y_t=HN,z_t=HZ"]
 
 def newest_inputs(inputs: Path, first_bin: str) -> None:
     """The six-component record, two co-located records (the pair's tilt plus 10 % of its
-    own noise), one with theta_t only, a 12 h free-motion record at 0.5 s, its visibility file and the
-    parameter file, all made once (the record and file by the first binary)."""
+    own noise), one with theta_t only, a 12 h free-motion record at 0.5 s, its visibility file
+    and the parameter file, all made once (the record and file by the first binary)."""
     d = inputs / "newest"
     d.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(9)
