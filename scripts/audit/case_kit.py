@@ -60,6 +60,16 @@ class Case:
     serial: bool = False
     culprit: str | None = None  # regex the one-line error must match (what it must name)
     python: str | None = None  # a Python snippet run by py_case.py instead of the binary
+    # The culprit is also wanted when a case that may fail or succeed fails (e.g. a value that
+    # may be refused but must then be named).
+    culprit_if_fails: bool = False
+    # A must_fail case whose option names something the run does not have: exit 0 counts as
+    # `ignored option` (an accepted bad input) rather than `accepted bad`.
+    ignored_option: bool = False
+    # Regex of JSON keys whose `null` values (stdout, written .json) count as non-finite.
+    null_keys: str | None = None
+    # Regex: only non-finite evidence matching it counts (outputs with documented NaN elsewhere).
+    nonfinite_only: str | None = None
 
 
 def C(cat, name, args, **kw) -> Case:

@@ -51,7 +51,8 @@ non-finite  exit 0, but a number written to stdout or to a new or changed file i
             `"quality_factor": "inf"`), NaN in the `measured`/`residual` terms of a budget
             (documented as NaN outside the band the measured file covers; also the note
             "(NaN outside)"), and NaN in a fit's `fitted_sigma` (documented for a parameter on
-            a bound).
+            a bound). A case may name JSON keys whose `null` counts as non-finite
+            (`null_keys`) and restrict the evidence to named values (`nonfinite_only`).
 leftover    after a failing run, any file or directory in the scratch directory that was not
             there before; after any run, a new temporary-looking name (`*.tmp`, `.tmpXXXXXX`,
             or the atomic writer's `.<name>.XXXXXX[.<ext>]`).
@@ -61,11 +62,14 @@ exit!=2     controlled failure with an exit code other than 2 (cases that sent a
             exempt: any status is acceptable after SIGINT/SIGTERM/SIGHUP).
 accepted    the case must be refused (documented error, destroys its input, or output that
             could not be written) and the run exited 0.
+ignored     as accepted, for a case whose option names an input the run does not have (an
+            `ignored option`; counted with accepted bad in the compact table).
 refused     the case must succeed (a valid but unusual input) and the run failed in a
             controlled way.
 
 The single `classification` of a record is its most severe flag in the order crash, abort/oom,
-panic, hang, non-finite, leftover, accepted, refused, multi-line, silent, exit!=2; otherwise
+panic, hang, non-finite, leftover, accepted, ignored, refused, multi-line, silent, exit!=2;
+otherwise
 `error` (controlled failure, exit 2, one line) or `ok` (exit 0).
 
 Categories
@@ -113,6 +117,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+import newest
 import surfaces
 from case_kit import (DAMPED, LAB_H5, PETERSON, QUICK_TIMEOUT, REPO, SHORT_TIMEOUT, ArgFromFile,
                       Case, Ctx, C, copy_setup, fifo_setup, h5_measured, h5_series, h5_spectra,
@@ -128,29 +133,30 @@ H5_SCAN_CAP = 50_000_000  # elements per file
 ARTIFACT_CAP = 4 << 20
 
 CATEGORIES = ["parameters", "tilt inputs", "frequency options", "outputs", "miniseed",
-              "gwpy addressing", "coherence/subtract pairs", "option edges", "python", "process",
-              "fuzz"]
+              "gwpy addressing", "coherence/subtract pairs", "option edges", "python",
+              *newest.CATEGORIES, "process", "fuzz"]
 # The categories of the surfaces added after the first audit (surfaces.py); they need the valid
 # pair of records made by the first binary.
 NEW_SURFACES = ["miniseed", "gwpy addressing", "coherence/subtract pairs", "option edges",
-                "python"]
+                "python", *newest.CATEGORIES]
 FLAGS = ["crash", "abort_oom", "panic", "hang", "overwrote", "nonfinite", "leftover", "accepted",
-         "refused", "unclear", "multiline", "silent", "exit_not_2"]
+         "ignored", "refused", "unclear", "multiline", "silent", "exit_not_2"]
 FLAG_TITLES = {
     "crash": "crash", "abort_oom": "abort/oom", "panic": "panic", "hang": "hang",
     "overwrote": "overwrote input", "nonfinite": "non-finite", "leftover": "leftover files",
-    "accepted": "accepted bad", "refused": "refused valid", "unclear": "unclear err",
+    "accepted": "accepted bad", "ignored": "ignored option", "refused": "refused valid",
+    "unclear": "unclear err",
     "multiline": "multi-line err", "silent": "silent fail", "exit_not_2": "exit!=2",
 }
 TABLE_FLAGS = ["crash", "abort_oom", "panic", "overwrote", "nonfinite", "leftover", "unclear",
-               "multiline", "exit_not_2", "hang", "silent", "accepted", "refused"]
+               "multiline", "exit_not_2", "hang", "silent", "accepted", "ignored", "refused"]
 # The defect kinds of the compact table: flags summed per kind.
 KINDS = {
     "crashes": ["crash", "abort_oom", "panic", "hang"],
     "overwritten inputs": ["overwrote"],
     "silent non-finite": ["nonfinite"],
     "unclear errors": ["unclear", "multiline", "silent", "exit_not_2"],
-    "accepted bad": ["accepted"],
+    "accepted bad": ["accepted", "ignored"],
     "other (leftover, refused valid)": ["leftover", "refused"],
 }
 PY_CASE = str(Path(__file__).resolve().parent / "py_case.py")
@@ -1668,6 +1674,21 @@ def scan_h5_file(path: Path) -> list[str]:
     return [e for e in ev if "scan stopped" not in e]
 
 
+def null_evidence(stdout_head: bytes, root: Path, rels: list[str], keys: str) -> list[str]:
+    """`null` values of the JSON keys matching `keys` on stdout or in a written .json file."""
+    pat = re.compile(r'"(' + keys + r')"\s*:\s*(null|\[[^\]]*\bnull\b[^\]]*\])')
+    texts = [("stdout", stdout_head.decode("utf-8", "replace"))]
+    for rel in rels:
+        p = root / rel
+        if p.suffix.lower() == ".json" and p.is_file():
+            texts.append((p.name, p.read_text(errors="replace")[:TEXT_SCAN_CAP]))
+    ev = []
+    for where, text in texts:
+        for m in pat.finditer(text):
+            ev.append(f"{where}: {m.group(0)[:120]}")
+    return ev[:5]
+
+
 def scan_outputs(root: Path, rels: list[str]) -> list[str]:
     ev = []
     for rel in rels:
@@ -1876,6 +1897,11 @@ def execute(case: Case, binary: str, workroot: Path, keep_scratch: bool,
     if rc == 0:
         ev = out_scan.evidence if out_scan and case.stdout == "pipe" else []
         ev = ev + scan_outputs(cdir, new + changed)
+        if case.nonfinite_only:
+            ev = [e for e in ev if re.search(case.nonfinite_only, e)]
+        if case.null_keys:
+            ev = ev + null_evidence(bytes(out_scan.head) if out_scan else b"", cdir,
+                                    new + changed, case.null_keys)
         if ev:
             flags.append("nonfinite")
             rec["nonfinite_evidence"] = ev[:5]
@@ -1891,7 +1917,7 @@ def execute(case: Case, binary: str, workroot: Path, keep_scratch: bool,
         flags.append("leftover")
         rec["left_behind"] = new[:10]
     if case.must_fail and rc == 0:
-        flags.append("accepted")
+        flags.append("ignored" if case.ignored_option else "accepted")
     if case.must_succeed and controlled:
         flags.append("refused")
     if controlled and stderr_text is not None:
@@ -1903,7 +1929,8 @@ def execute(case: Case, binary: str, workroot: Path, keep_scratch: bool,
             flags.append("silent")
     if controlled and rc != 2 and not case.sig:
         flags.append("exit_not_2")
-    if (case.culprit and controlled and case.must_fail and stderr_text is not None
+    if (case.culprit and controlled and (case.must_fail or case.culprit_if_fails)
+            and stderr_text is not None
             and not re.search(case.culprit, stderr_text, re.S)):
         flags.append("unclear")
     order = FLAGS
@@ -2140,6 +2167,11 @@ def main(argv=None) -> int:
                            ("python", surfaces.cases_python)]:
             if cat in only:
                 cases += build(inputs)
+        if only & set(newest.CATEGORIES):
+            newest.newest_inputs(inputs, binaries[0])
+            for cat, build in newest.CATEGORIES.items():
+                if cat in only:
+                    cases += build(inputs)
         if "process" in only:
             cases += surfaces.cases_process_new()
     if "process" in only:
