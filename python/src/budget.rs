@@ -1,6 +1,7 @@
 //! `tiltnoise.budget` (arrays) and `tiltnoise.budget_from_file` (the command line's `budget
 //! --tilt FILE`), and the `Budget` they return.
 
+use crate::args;
 use crate::arrays::{self, check_size, series};
 use crate::errors::{value_error, PyResultExt};
 use crate::inputs::Inputs;
@@ -212,7 +213,7 @@ fn tilt_channels(
             .split(',')
             .map(|n| n.trim().to_string())
             .collect(),
-        Err(_) => axes.extract()?,
+        Err(_) => crate::args::strings("axes", Some(axes))?.unwrap_or_default(),
     };
     let axes = names
         .iter()
@@ -454,23 +455,31 @@ pub fn budget(
     axes: Option<&Bound<'_, PyAny>>,
     quantity: &str,
     units: Option<std::collections::BTreeMap<String, String>>,
-    corrected: Option<Vec<String>>,
-    pendulum_tiltmeter: Option<Vec<String>>,
+    corrected: Option<&Bound<'_, PyAny>>,
+    pendulum_tiltmeter: Option<&Bound<'_, PyAny>>,
     gaps: &str,
     params: Option<&Bound<'_, PyAny>>,
     nperseg: Option<usize>,
     overlap: Option<f64>,
     average: Option<&str>,
     segment_duration: Option<f64>,
-    percentiles: Option<(f64, f64)>,
+    percentiles: Option<&Bound<'_, PyAny>>,
     observables: Option<&Bound<'_, PyAny>>,
     readout: Option<&Bound<'_, PyDict>>,
     term: Option<&Bound<'_, PyDict>>,
     witness_noise: Option<&Bound<'_, PyDict>>,
     measured: Option<PathBuf>,
-    at: Option<Vec<f64>>,
+    at: Option<&Bound<'_, PyAny>>,
     at_band: Option<f64>,
 ) -> PyResult<Budget> {
+    let corrected = args::strings("corrected", corrected)?;
+    let pendulum_tiltmeter = args::strings("pendulum_tiltmeter", pendulum_tiltmeter)?;
+    let percentiles = args::pair(
+        "percentiles",
+        percentiles,
+        "(LOWER, UPPER) with 0 <= LOWER < UPPER <= 100",
+    )?;
+    let at = args::numbers("at", at)?;
     let (model, params) = model_of(params)?;
     let gaps: GapPolicy = gaps.parse().map_err(value_error)?;
     check_fs(fs)?;
@@ -608,15 +617,15 @@ pub fn budget_from_file(
     axes: Option<&str>,
     quantity: Option<&str>,
     units: Option<std::collections::BTreeMap<String, String>>,
-    corrected: Option<Vec<String>>,
-    pendulum_tiltmeter: Option<Vec<String>>,
+    corrected: Option<&Bound<'_, PyAny>>,
+    pendulum_tiltmeter: Option<&Bound<'_, PyAny>>,
     gaps: Option<&str>,
     params: Option<&Bound<'_, PyAny>>,
     nperseg: Option<usize>,
     overlap: Option<f64>,
     average: Option<&str>,
     segment_duration: Option<f64>,
-    percentiles: Option<(f64, f64)>,
+    percentiles: Option<&Bound<'_, PyAny>>,
     observables: Option<&Bound<'_, PyAny>>,
     readout: Option<&Bound<'_, PyDict>>,
     term: Option<&Bound<'_, PyDict>>,
@@ -624,9 +633,17 @@ pub fn budget_from_file(
     freq: Option<&Bound<'_, PyAny>>,
     measured: Option<PathBuf>,
     scale: Option<std::collections::BTreeMap<String, f64>>,
-    at: Option<Vec<f64>>,
+    at: Option<&Bound<'_, PyAny>>,
     at_band: Option<f64>,
 ) -> PyResult<Budget> {
+    let corrected = args::strings("corrected", corrected)?;
+    let pendulum_tiltmeter = args::strings("pendulum_tiltmeter", pendulum_tiltmeter)?;
+    let percentiles = args::pair(
+        "percentiles",
+        percentiles,
+        "(LOWER, UPPER) with 0 <= LOWER < UPPER <= 100",
+    )?;
+    let at = args::numbers("at", at)?;
     let (model, params) = model_of(params)?;
     let read = job_args::file_read_request(
         axes,
@@ -1078,8 +1095,9 @@ impl Budget {
     #[pyo3(signature = (observables=None))]
     fn plot<'py>(
         slf: &Bound<'py, Self>,
-        observables: Option<Vec<String>>,
+        observables: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
+        let observables = crate::args::names("observables", observables)?;
         let observables = observables.into_pyobject(slf.py())?.into_any();
         python_side::call(slf.as_any(), "_plots", "budget_plot", &[observables])
     }

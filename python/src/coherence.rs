@@ -1,6 +1,7 @@
 //! `tiltnoise.coherence` (the command line's `coherence --tilt FILE --measured FILE`) and the
 //! `Coherence` it returns: the coherence job's report with names and units.
 
+use crate::args;
 use crate::budget::model_of;
 use crate::errors::PyResultExt;
 use crate::inputs::Inputs;
@@ -46,9 +47,10 @@ pub fn coherence(
     nperseg: Option<usize>,
     overlap: Option<f64>,
     confidence: Option<f64>,
-    fit_band: Option<(f64, f64)>,
+    fit_band: Option<&Bound<'_, PyAny>>,
     params: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Coherence> {
+    let fit_band = args::pair("fit_band", fit_band, "(FLO, FHI) in Hz, 0 < FLO < FHI")?;
     let (model, params) = model_of(params)?;
     let observables = job_args::observables(observables)?;
     let req = CoherenceRequest {

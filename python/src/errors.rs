@@ -66,7 +66,7 @@ impl OptionStyle for Keywords {
 }
 
 /// The `OSError` subclass for an operating-system failure to open or read a file.
-fn os_error(kind: ErrorKind, message: String) -> PyErr {
+pub fn os_error(kind: ErrorKind, message: String) -> PyErr {
     match kind {
         ErrorKind::NotFound => PyFileNotFoundError::new_err(message),
         ErrorKind::PermissionDenied => PyPermissionError::new_err(message),

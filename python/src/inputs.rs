@@ -5,6 +5,7 @@
 use crate::errors::PyResultExt;
 use pyo3::PyResult;
 use std::path::{Path, PathBuf};
+use tiltnoise_io::OutputError;
 
 /// The input files of a result, each with the argument that named it (`path`, `measured`,
 /// `Params.from_toml`), for the message.
@@ -38,13 +39,43 @@ impl Inputs {
     }
 
     /// Refuses to save to `path` when it is one of the inputs, or when it cannot be written
-    /// (its directory is missing or not writable): `OSError` naming the path and the rule.
+    /// (its directory is missing or not writable): `OSError` naming the path and the rule,
+    /// the input as what it is to the reader (`the tilt input tilt.h5`).
     pub fn check_save(&self, path: &Path) -> PyResult<()> {
-        let inputs: Vec<(&str, &Path)> = self
+        let inputs: Vec<(String, &Path)> = self
             .0
             .iter()
-            .map(|(a, p)| (a.as_str(), p.as_path()))
+            .map(|(a, p)| (described(a), p.as_path()))
             .collect();
-        tiltnoise_io::check_outputs(&[path], &inputs).py()
+        let labelled: Vec<(&str, &Path)> = inputs.iter().map(|(a, p)| (a.as_str(), *p)).collect();
+        match tiltnoise_io::check_outputs(&[path], &labelled) {
+            Err(OutputError::Refused { path, rule }) => {
+                // The library's rule reads `the file OPTION PATH reads` (the command line's
+                // spelling, `the file --tilt tilt.h5 reads`): said here without the option.
+                let rule = inputs
+                    .iter()
+                    .map(|(what, input)| {
+                        (
+                            format!("the file {what} {} reads", input.display()),
+                            format!("the {what} {}", input.display()),
+                        )
+                    })
+                    .find(|(said, _)| rule.contains(said.as_str()))
+                    .map(|(said, meant)| rule.replacen(&said, &meant, 1))
+                    .unwrap_or(rule);
+                Err(OutputError::Refused { path, rule }).py()
+            }
+            other => other.py(),
+        }
+    }
+}
+
+/// The input named by the argument `arg`, as a reader says it: `tilt input`, `measured
+/// input`, `parameter file (Params.from_toml)`, `colocated input`.
+fn described(arg: &str) -> String {
+    match arg {
+        "path" | "tilt" => "tilt input".to_string(),
+        "Params.from_toml" => "parameter file (Params.from_toml)".to_string(),
+        other => format!("{other} input"),
     }
 }

@@ -5,7 +5,7 @@
 
 use crate::errors::{value_error, InputFileError, IntoPyErr, PyResultExt};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString};
+use pyo3::types::PyDict;
 use std::path::PathBuf;
 use tiltnoise_core::budget::BudgetError;
 use tiltnoise_core::fit::FitError;
@@ -118,7 +118,8 @@ pub fn observables(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<Observ
     let Some(arg) = arg else {
         return Ok(None);
     };
-    options::parse_outputs(OptionKey::OBSERVABLES, &names("observables", arg)?)
+    let names = crate::args::names("observables", Some(arg))?.unwrap_or_default();
+    options::parse_outputs(OptionKey::OBSERVABLES, &names)
         .py()
         .map(Some)
 }
@@ -251,23 +252,6 @@ pub fn witness_noise(arg: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<WitnessIte
             })?),
         };
         items.push(WitnessItem { input, asd, rel });
-    }
-    Ok(items)
-}
-
-/// Names from a `str` (comma-separated, as on the command line) or a sequence of `str`.
-pub(crate) fn names(what: &str, arg: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
-    let items: Vec<String> = if let Ok(s) = arg.cast::<PyString>() {
-        vec![s.to_cow()?.into_owned()]
-    } else {
-        arg.extract::<Vec<String>>()
-            .map_err(|_| value_error(format!("{what}: expected a str or a sequence of str")))?
-    };
-    if items.is_empty() {
-        return Err(value_error(format!(
-            "{what}: an empty sequence names nothing; give one or more names, or None for the \
-             default"
-        )));
     }
     Ok(items)
 }

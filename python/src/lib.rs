@@ -7,6 +7,7 @@
 //! on the command line, NumPy arrays), the library's typed errors into Python exceptions with
 //! the command line's messages (module `errors`), and releases the GIL around every computation.
 
+mod args;
 mod arrays;
 mod budget;
 mod coherence;

@@ -5,7 +5,7 @@ use crate::arrays;
 use crate::errors::{value_error, PyResultExt};
 use crate::grid::{self, GridBuffer};
 use crate::interrupt;
-use crate::job_args::{job_error, names};
+use crate::job_args::job_error;
 use crate::params::PyParams;
 use crate::state;
 use numpy::{Complex64, PyArray1, PyArray2, PyArray3, PyArrayMethods};
@@ -255,7 +255,11 @@ fn scene_bits(band: (f64, f64), rel_tol: f64) -> [u64; 3] {
 fn parse_inputs(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Input>> {
     match arg {
         None => Ok(Input::all_tilts()),
-        Some(arg) => options::parse_inputs(OptionKey::INPUTS, &names("inputs", arg)?).py(),
+        Some(arg) => options::parse_inputs(
+            OptionKey::INPUTS,
+            &crate::args::names("inputs", Some(arg))?.unwrap_or_default(),
+        )
+        .py(),
     }
 }
 
@@ -264,7 +268,11 @@ fn parse_inputs(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Input>> {
 fn parse_outputs(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Observable>> {
     match arg {
         None => Ok(Observable::ALL.to_vec()),
-        Some(arg) => options::parse_outputs(OptionKey::OUTPUTS, &names("outputs", arg)?).py(),
+        Some(arg) => options::parse_outputs(
+            OptionKey::OUTPUTS,
+            &crate::args::names("outputs", Some(arg))?.unwrap_or_default(),
+        )
+        .py(),
     }
 }
 
@@ -746,12 +754,13 @@ impl PyModel {
     fn fit(
         &self,
         py: Python<'_>,
-        free: Option<Vec<String>>,
+        free: Option<&Bound<'_, PyAny>>,
         measured: Option<std::path::PathBuf>,
         bound_sigmas: f64,
         prior: bool,
         visibility: Option<std::path::PathBuf>,
     ) -> PyResult<crate::fit::Fit> {
+        let free = crate::args::strings("free", free)?;
         let inputs = crate::fit::FitInputs {
             measured,
             visibility,

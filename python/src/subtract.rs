@@ -2,6 +2,7 @@
 //! `Subtraction` it returns: the subtract job's fit, report, cleaned record and figure, with
 //! names and units.
 
+use crate::args;
 use crate::budget::model_of;
 use crate::errors::{value_error, PyResultExt};
 use crate::inputs::Inputs;
@@ -67,14 +68,14 @@ pub fn subtract(
     py: Python<'_>,
     tilt: PathBuf,
     measured: PathBuf,
-    fit: Option<Vec<String>>,
-    band: Option<(f64, f64)>,
-    report_band: Option<(f64, f64)>,
+    fit: Option<&Bound<'_, PyAny>>,
+    band: Option<&Bound<'_, PyAny>>,
+    report_band: Option<&Bound<'_, PyAny>>,
     nperseg: Option<usize>,
     holdout: f64,
     max_delay: Option<f64>,
     witness_noise: Option<&Bound<'_, PyDict>>,
-    colocated: Option<Vec<PathBuf>>,
+    colocated: Option<&Bound<'_, PyAny>>,
     colocated_ratio: Option<BTreeMap<String, f64>>,
     readout: Option<BTreeMap<String, f64>>,
     observables: Option<&Bound<'_, PyAny>>,
@@ -83,10 +84,20 @@ pub fn subtract(
     gaps: Option<&str>,
     scale: Option<BTreeMap<String, f64>>,
     units: Option<BTreeMap<String, String>>,
-    corrected: Option<Vec<String>>,
-    pendulum_tiltmeter: Option<Vec<String>>,
+    corrected: Option<&Bound<'_, PyAny>>,
+    pendulum_tiltmeter: Option<&Bound<'_, PyAny>>,
     params: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Subtraction> {
+    let fit = args::strings("fit", fit)?;
+    let band = args::pair("band", band, "(FLO, FHI) in Hz, 0 < FLO < FHI")?;
+    let report_band = args::pair(
+        "report_band",
+        report_band,
+        "(FLO, FHI) in Hz, 0 < FLO < FHI",
+    )?;
+    let colocated = args::paths("colocated", colocated)?;
+    let corrected = args::strings("corrected", corrected)?;
+    let pendulum_tiltmeter = args::strings("pendulum_tiltmeter", pendulum_tiltmeter)?;
     let (model, params) = model_of(params)?;
     let readout_asd = readout
         .unwrap_or_default()
