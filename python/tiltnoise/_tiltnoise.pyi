@@ -235,7 +235,7 @@ class Model:
     ) -> None: ...
     def fit(
         self,
-        free: Optional[Sequence[str]] = None,
+        free: Optional[_Names] = None,
         measured: Optional[_Path] = None,
         bound_sigmas: float = 1.0,
         prior: bool = False,
@@ -401,7 +401,7 @@ class Budget:
     def save(self, path: _Path, *, keep_zero_columns: bool = False) -> None: ...
     def to_gwpy(self) -> dict[str, dict[str, Any]]: ...
     def to_pandas(self) -> Any: ...
-    def plot(self, observables: Optional[Sequence[str]] = None) -> Any: ...
+    def plot(self, observables: Optional[_Names] = None) -> Any: ...
     def __reduce__(self) -> Tuple[Any, Tuple[int, bytes]]: ...
     @staticmethod
     def _from_state(version: int, state: bytes) -> Budget: ...
@@ -433,8 +433,8 @@ def budget(
     axes: Optional[_Names] = None,
     quantity: Literal["angle", "rate"] = "angle",
     units: Optional[Mapping[str, str]] = None,
-    corrected: Optional[Sequence[str]] = None,
-    pendulum_tiltmeter: Optional[Sequence[str]] = None,
+    corrected: Optional[_Names] = None,
+    pendulum_tiltmeter: Optional[_Names] = None,
     gaps: Literal["reject", "interpolate"] = "reject",
     params: Union[Params, Model, None] = None,
     nperseg: Optional[int] = None,
@@ -447,7 +447,7 @@ def budget(
     term: Optional[Mapping[str, Tuple[str, _Path]]] = None,
     witness_noise: Optional[Mapping[str, Union[float, _Path, Tuple[Union[float, _Path], float]]]] = None,
     measured: Optional[_Path] = None,
-    at: Optional[Sequence[float]] = None,
+    at: Union[float, Sequence[float], None] = None,
     at_band: Optional[float] = None,
 ) -> Budget: ...
 def budget_from_file(
@@ -456,8 +456,8 @@ def budget_from_file(
     axes: Optional[str] = None,
     quantity: Optional[Literal["angle", "rate"]] = None,
     units: Optional[Mapping[str, str]] = None,
-    corrected: Optional[Sequence[str]] = None,
-    pendulum_tiltmeter: Optional[Sequence[str]] = None,
+    corrected: Optional[_Names] = None,
+    pendulum_tiltmeter: Optional[_Names] = None,
     gaps: Optional[Literal["reject", "interpolate"]] = None,
     params: Union[Params, Model, None] = None,
     nperseg: Optional[int] = None,
@@ -472,7 +472,7 @@ def budget_from_file(
     freq: Union[str, npt.ArrayLike, None] = None,
     measured: Optional[_Path] = None,
     scale: Optional[Mapping[str, float]] = None,
-    at: Optional[Sequence[float]] = None,
+    at: Union[float, Sequence[float], None] = None,
     at_band: Optional[float] = None,
 ) -> Budget: ...
 def coherence(
@@ -494,14 +494,14 @@ def subtract(
     tilt: _Path,
     measured: _Path,
     *,
-    fit: Optional[Sequence[str]] = None,
+    fit: Optional[_Names] = None,
     band: Optional[Tuple[float, float]] = None,
     report_band: Optional[Tuple[float, float]] = None,
     nperseg: Optional[int] = None,
     holdout: float = 0.25,
     max_delay: Optional[float] = None,
     witness_noise: Optional[Mapping[str, Union[float, _Path, Tuple[Union[float, _Path], float]]]] = None,
-    colocated: Optional[Sequence[_Path]] = None,
+    colocated: Union[_Path, Sequence[_Path], None] = None,
     colocated_ratio: Optional[Mapping[str, float]] = None,
     readout: Optional[Mapping[str, float]] = None,
     observables: Optional[_Names] = None,
@@ -510,8 +510,8 @@ def subtract(
     gaps: Optional[Literal["reject", "interpolate"]] = None,
     scale: Optional[Mapping[str, float]] = None,
     units: Optional[Mapping[str, str]] = None,
-    corrected: Optional[Sequence[str]] = None,
-    pendulum_tiltmeter: Optional[Sequence[str]] = None,
+    corrected: Optional[_Names] = None,
+    pendulum_tiltmeter: Optional[_Names] = None,
     params: Union[Params, Model, None] = None,
 ) -> Subtraction: ...
 def visibility(
