@@ -290,7 +290,7 @@ def test_a_save_never_replaces_an_input(tmp_path):
     (tmp_path / "p.csv").write_text(tn.Params().to_toml())
     sim = tn.Model(tn.Params.from_toml(str(tmp_path / "p.csv")).set("length.h_m", 1.0))
     run = sim.simulate(1000.0)
-    with pytest.raises(OSError, match=r"Params.from_toml .*p\.csv"):
+    with pytest.raises(OSError, match=r"the parameter file \(Params.from_toml\) .*p\.csv"):
         run.save(tmp_path / "p.csv")
     run.save(tmp_path / "sim.h5")
 
