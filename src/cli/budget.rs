@@ -179,6 +179,7 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
     for path in &args.save {
         OutputKind::from_path(path)?;
     }
+    args.figure.refuse_without_figure(&args.save)?;
     let figure = tiltnoise_plot::BudgetFigureOptions {
         view: args
             .figure

@@ -96,6 +96,7 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
     for path in &args.save {
         OutputKind::from_path(path)?;
     }
+    args.figure.refuse_without_figure(&args.save)?;
     let view = args.figure.view_for(COHERENCE_SIZE)?;
     let model = Model::new(params)?;
     let o = tilt_read_options(

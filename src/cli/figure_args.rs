@@ -6,6 +6,7 @@
 use super::args::range_parts;
 use anyhow::{bail, Result};
 use clap::Args;
+use std::path::PathBuf;
 use tiltnoise_core::error::Shown;
 use tiltnoise_plot::View;
 
@@ -77,7 +78,58 @@ impl SizeArgs {
     }
 }
 
+impl SizeArgs {
+    /// The options given, by their flags.
+    fn given(&self) -> Vec<&'static str> {
+        [
+            ("--size", self.size.is_some()),
+            ("--dpi", self.dpi.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(flag, set)| set.then_some(flag))
+        .collect()
+    }
+
+    /// Refuses these options when no output of `outputs` is a figure: they would be ignored.
+    pub fn refuse_without_figure(&self, outputs: &[PathBuf]) -> Result<()> {
+        refuse_without_figure(&self.given(), outputs)
+    }
+}
+
+/// Refuses the figure options `given` (their flags) when none of `outputs` is a figure
+/// (`.png`, `.svg`): an option that would change nothing is an error, never ignored.
+pub fn refuse_without_figure(given: &[&str], outputs: &[PathBuf]) -> Result<()> {
+    let figure = outputs
+        .iter()
+        .any(|p| tiltnoise_plot::ImageFormat::from_path(p).is_ok());
+    match given.first() {
+        Some(flag) if !figure => bail!(
+            "{flag} applies to the figures, and no figure is saved: add --save FILE.png (or \
+             .svg), or leave {flag} out"
+        ),
+        _ => Ok(()),
+    }
+}
+
 impl FigureArgs {
+    /// The options given, by their flags.
+    pub fn given(&self) -> Vec<&'static str> {
+        let mut flags: Vec<&'static str> = [
+            ("--xlim", self.xlim.is_some()),
+            ("--ylim", self.ylim.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(flag, set)| set.then_some(flag))
+        .collect();
+        flags.extend(self.size.given());
+        flags
+    }
+
+    /// Refuses these options when no output of `outputs` is a figure: they would be ignored.
+    pub fn refuse_without_figure(&self, outputs: &[PathBuf]) -> Result<()> {
+        refuse_without_figure(&self.given(), outputs)
+    }
+
     /// The validated view: [`SizeArgs::view_for`] and the axis limits.
     ///
     /// # Errors

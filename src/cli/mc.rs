@@ -35,6 +35,7 @@ pub(crate) fn run_mc(params: &Params, opts: McOptions, run: &mut Run) -> Result<
     for path in &opts.save {
         monte_carlo::check_save_path(path)?;
     }
+    opts.figure.refuse_without_figure(&opts.save)?;
     let view = opts
         .figure
         .view_for(tiltnoise_plot::mc_figure::DEFAULT_SIZE)?;

@@ -74,6 +74,7 @@ pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> 
     for path in save {
         tiltnoise_plot::ImageFormat::from_path(path)?;
     }
+    figure.refuse_without_figure(save)?;
     let view = figure.view_for(tiltnoise_plot::methods_figure::DEFAULT_SIZE)?;
     let saves: Vec<&Path> = save.iter().map(PathBuf::as_path).collect();
     run.check_outputs(&saves, &[])?;

@@ -67,7 +67,7 @@ pub(crate) struct SimulateArgs {
     kick_x: Option<f64>,
     /// Energy per mode (J) of the default excitation (no --init, --init-rate, --kick-x).
     #[arg(long, value_name = "JOULES", default_value = scientific(DEFAULT_MODE_ENERGY_J),
-          allow_negative_numbers = true)]
+          allow_negative_numbers = true, conflicts_with_all = ["init", "init_rate", "kick_x"])]
     mode_energy: f64,
     /// White readout noise OBS=ASD in the observable's unit/sqrt(Hz) (repeatable; default
     /// X=9e-9 m/sqrt(Hz) from the paper, angles noiseless; OBS=0 removes it).
@@ -208,6 +208,8 @@ fn refuse_channel_options(c: &super::args::ChannelArgs) -> Result<()> {
 /// a terminal), the summary and the resonance check printed and the files written.
 pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -> Result<()> {
     let model = Model::new(params)?;
+    let figures: Vec<PathBuf> = args.save.iter().chain(&args.save_time).cloned().collect();
+    args.figure.refuse_without_figure(&figures)?;
     let view = args.figure.view_for(ASD_SIZE)?;
     if let Some(path) = &args.tilt {
         return driven::run(&model, &args, path, &view, run);

@@ -224,6 +224,7 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
     for path in &args.save {
         SaveKind::of(path)?;
     }
+    args.figure.refuse_without_figure(&args.save)?;
     let view = args.figure.view_for(FIGURE_SIZE)?;
     let model = Model::new(params)?;
     let req = request(&args, &model)?;

@@ -124,6 +124,14 @@ fn figure_options(
     request: &Request,
     model: &Model,
 ) -> Result<tiltnoise_plot::TfFigureOptions> {
+    let mut given = args.figure.given();
+    if !args.plot_observables.is_empty() {
+        given.insert(0, "--plot-observables");
+    }
+    if args.phase {
+        given.insert(0, "--phase");
+    }
+    super::figure_args::refuse_without_figure(&given, &args.save)?;
     let observables = if !args.plot_observables.is_empty() {
         let chosen = options::parse_outputs(OptionKey::DRAWN_OBSERVABLES, &args.plot_observables)?;
         if let Some(o) = chosen.iter().find(|o| !request.outputs.contains(o)) {

@@ -12,6 +12,7 @@ use std::time::Duration;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::error::Num;
 use tiltnoise_core::input::{GroundMap, InputMeta, Provenance, Sensors, TiltSeries};
+use tiltnoise_core::limits::NOISE_RATIOS;
 use tiltnoise_core::model::{Input, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::option_key::{self, OptionKey};
@@ -210,11 +211,15 @@ fn check_options(req: &SubtractRequest<'_>) -> Result<(), JobError> {
                 ),
             ));
         }
-        if !(r.is_finite() && r > 0.0) {
+        if !NOISE_RATIOS.admits(r) {
             return Err(JobError::option(
                 "colocated_ratio",
                 Some(&item),
-                "the ratio is not allowed: must be finite and > 0".to_string(),
+                format!(
+                    "the ratio of noise ASDs is not allowed: must be {} (beyond it the \
+                     huddle's estimate no longer depends on it; see docs/subtract.md)",
+                    NOISE_RATIOS.allowed("")
+                ),
             ));
         }
     }
@@ -233,6 +238,37 @@ fn check_options(req: &SubtractRequest<'_>) -> Result<(), JobError> {
         o.name().to_string()
     })
     .map_err(JobError::Repeated)
+}
+
+/// Refuses a noise ratio of an input that the witness or the (one) co-located record does
+/// not record: it would estimate nothing.
+fn check_ratio_inputs(
+    req: &SubtractRequest<'_>,
+    witness: &Witness,
+    colocated: &[Witness],
+) -> Result<(), JobError> {
+    let records = std::iter::once(("tilt", &req.tilt, witness)).chain(
+        colocated
+            .iter()
+            .zip(&req.colocated)
+            .map(|(w, p)| ("colocated", p, w)),
+    );
+    for (option, path, record) in records {
+        if let Some(&(input, r)) = req
+            .colocated_ratio
+            .iter()
+            .find(|(i, _)| !record.inputs.contains(i))
+        {
+            return Err(failure(SubtractFailure::RatioUnrecorded {
+                item: format!("{}={}", input.name(), Num(r)),
+                input: input.name().to_string(),
+                option,
+                path: shown_path(path),
+                present: record.inputs.iter().map(|i| i.name().to_string()).collect(),
+            }));
+        }
+    }
+    Ok(())
 }
 
 fn start_of(
@@ -323,6 +359,7 @@ pub fn run(req: SubtractRequest<'_>, cancel: &Cancel) -> Result<SubtractOutcome,
         .iter()
         .map(|p| Witness::read("colocated", p, &req))
         .collect::<Result<Vec<_>, _>>()?;
+    check_ratio_inputs(&req, &series, &colocated_series)?;
     stage()?;
     let measured = match read_measured_input(&req.measured)? {
         MeasuredInput::Series(m) => m,
@@ -439,6 +476,7 @@ fn check_finite(r: &SubtractResult) -> Result<(), RunFailure> {
             });
         }
     }
+    check_derived_finite(r)?;
     for (o, x) in r.cleaned.iter().chain(&r.prediction.series) {
         if let Some((index, &value)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
             return Err(RunFailure::Sample {
@@ -447,6 +485,97 @@ fn check_finite(r: &SubtractResult) -> Result<(), RunFailure> {
                 value,
             });
         }
+    }
+    Ok(())
+}
+
+/// The first value of `values` that is not finite, as a [`RunFailure::Value`] naming `what`
+/// and the index (`bin` of a spectrum, `band` of a band check).
+fn first_nonfinite(what: impl Fn(usize) -> String, values: &[f64]) -> Result<(), RunFailure> {
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(k) => Err(RunFailure::Value {
+            what: what(k),
+            value: values[k],
+        }),
+        None => Ok(()),
+    }
+}
+
+/// The numbers of the result besides the fit and the records: the co-located estimates (the
+/// relative gains and the stated uncertainty), the witness noise used, the band checks and
+/// the held-out spectra.
+fn check_derived_finite(r: &SubtractResult) -> Result<(), RunFailure> {
+    use tiltnoise_core::subtract::colocated::Method;
+    for e in &r.colocated {
+        let input = e.noise.input.name();
+        let gains = match &e.method {
+            Method::Huddle { relative_gain, .. } => vec![*relative_gain],
+            Method::ThreeCorneredHat { relative_gains } => relative_gains.to_vec(),
+        };
+        first_nonfinite(
+            |k| format!("relative gain of co-located record {} of {input}", k + 1),
+            &gains,
+        )?;
+        first_nonfinite(
+            |_| format!("relative uncertainty of the co-located noise estimate of {input}"),
+            &[e.noise.rel],
+        )?;
+    }
+    for (input, psd) in &r.witness_noise_psd {
+        first_nonfinite(
+            |k| format!("witness noise PSD of {} at bin {k}", input.name()),
+            psd,
+        )?;
+    }
+    for (o, check) in &r.bands {
+        let o = o.name();
+        first_nonfinite(
+            |_| format!("cleaned / raw variance of {o}"),
+            &[check.variance_ratio],
+        )?;
+        for (j, b) in check.bands.iter().enumerate() {
+            first_nonfinite(
+                |_| format!("band check of {o} (band {j} from {} Hz)", Num(b.lo_hz)),
+                &[
+                    b.raw_psd,
+                    b.expected_psd,
+                    b.cleaned_psd,
+                    b.witness_limited_psd,
+                    b.ratio,
+                    b.sigma,
+                    b.limit,
+                ],
+            )?;
+        }
+    }
+    for s in &r.residuals {
+        let o = s.observable.name();
+        let spectra = [
+            ("measured", &s.measured_psd),
+            ("predicted", &s.predicted_psd),
+            ("cleaned", &s.cleaned_psd),
+            ("Wiener residual", &s.wiener_psd),
+            ("coherence-limit", &s.expected_psd),
+            ("witness-limited", &s.witness_limited_psd),
+        ];
+        for (name, psd) in spectra {
+            first_nonfinite(|k| format!("held-out {name} PSD of {o} at bin {k}"), psd)?;
+        }
+        for (input, psd) in s.witness_limited_by_input.iter().enumerate() {
+            first_nonfinite(
+                |k| {
+                    format!(
+                        "witness-limited PSD of {o} by input {} at bin {k}",
+                        input + 1
+                    )
+                },
+                psd,
+            )?;
+        }
+        first_nonfinite(
+            |_| format!("Wiener training excess of {o}"),
+            &[s.wiener_training_excess],
+        )?;
     }
     Ok(())
 }

@@ -14,6 +14,19 @@ pub enum SubtractFailure {
     TooManyColocated(usize),
     /// A noise ratio without exactly one co-located record.
     RatioNeedsOneColocated,
+    /// A noise ratio for an input that the witness or the co-located record does not record.
+    RatioUnrecorded {
+        /// The ratio's input and value, as given (`x_t=1`).
+        item: String,
+        /// The input.
+        input: String,
+        /// The option of the record that lacks it (`tilt` or `colocated`).
+        option: &'static str,
+        /// The record.
+        path: String,
+        /// The inputs the record has.
+        present: Vec<String>,
+    },
     /// A record of the floor's motion (`option`) holds spectra.
     WitnessSpectra {
         /// The option.
@@ -93,6 +106,14 @@ pub enum RunFailure {
         /// Its value.
         value: f64,
     },
+    /// Another number of the result (a relative gain, a noise or residual spectrum, a band
+    /// check) is not finite.
+    Value {
+        /// What it is, with the observable or input and the bin.
+        what: String,
+        /// Its value.
+        value: f64,
+    },
     /// A sample of the prediction or the cleaned record is not finite.
     Sample {
         /// The observable.
@@ -119,6 +140,19 @@ impl SubtractFailure {
                  needs no noise ratio)",
                 opt("colocated_ratio"),
                 opt("colocated")
+            ),
+            SubtractFailure::RatioUnrecorded {
+                item,
+                input,
+                option,
+                path,
+                present,
+            } => format!(
+                "{} {item}: {} {path} has no input {input}; it has {} (the ratio applies to an \
+                 input that the witness and the co-located record both record)",
+                opt("colocated_ratio"),
+                opt(option),
+                present.join(", ")
             ),
             SubtractFailure::WitnessSpectra { option, path } => format!(
                 "{} {path}: holds spectra; subtract needs a time series of the floor's motion \
@@ -197,6 +231,9 @@ impl RunFailure {
                 observable.name(),
                 OptionKey::OBSERVABLES
             ),
+            RunFailure::Value { what, value } => {
+                format!("the {what} is {value}: not finite; nothing was written")
+            }
             RunFailure::Sample {
                 observable,
                 index,

@@ -6,7 +6,8 @@
 //! others (`A = J^T J` restricted to them; Marquardt's scaling, so the step does not depend on
 //! the units of `u`), projects `u + d` onto the box and accepts it if the cost decreases, or
 //! stays equal to rounding while the projected gradient falls (`lambda / 3`), otherwise
-//! retries with `4 lambda`. It stops when the projected gradient
+//! retries with `4 lambda` (also when the step is not finite, or the residuals are not
+//! finite there, which `eval` reports as an error). It stops when the projected gradient
 //! `|u - clamp(u - g)|_inf` is at most `gtol` (first-order optimality on the box), or when
 //! `lambda` exceeds [`LAMBDA_MAX`] (no decreasing step exists at working precision). There is
 //! deliberately no small-step test: with a large `lambda` the accepted steps are small long
@@ -140,6 +141,12 @@ pub fn minimize<E>(
             trial[i] += s;
         }
         let trial = clamp(&trial);
+        // A step that is not finite (the damped system of a Jacobian near overflow) is
+        // rejected like one that raises the cost, never evaluated.
+        if trial.iter().any(|x| !x.is_finite()) {
+            lambda *= 4.0;
+            continue;
+        }
         evaluations += 1;
         match eval(&trial) {
             Ok((r_new, jac_new)) if better(&trial, &r_new, &jac_new) => {
@@ -204,5 +211,29 @@ mod tests {
                 assert!((out.u[1] - want).abs() <= 1e-12, "{} vs {want}", out.u[1]);
             }
         }
+    }
+
+    /// Normal equations that overflow (a Jacobian of 1e200) and trial points where the
+    /// residuals do not exist: every such step is rejected, and the iteration ends within its
+    /// bound, at the (finite) starting point.
+    #[test]
+    fn overflowing_steps_are_rejected_and_the_iteration_ends() {
+        let opts = LmOptions {
+            gtol: 1e-13,
+            max_iterations: 50,
+        };
+        let out = minimize(DVector::from_element(1, 0.5), 1.0, &opts, |u| {
+            if u[0] != 0.5 {
+                return Err(());
+            }
+            Ok((
+                DVector::from_element(1, 1e200),
+                DMatrix::from_element(1, 1, 1e200),
+            ))
+        })
+        .unwrap();
+        assert!(out.iterations <= opts.max_iterations);
+        assert_eq!(out.u[0], 0.5);
+        assert!(matches!(out.stop, Stop::NoDecrease | Stop::MaxIterations));
     }
 }

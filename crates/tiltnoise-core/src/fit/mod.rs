@@ -94,6 +94,11 @@ pub const MAX_SIGN_STARTS: usize = 16;
 /// the matrix dimension, the usual numerical-rank threshold.
 pub const RANK_TOL: f64 = 16.0 * f64::EPSILON;
 
+/// Most sweeps of the SVD of a Jacobian (of at most a few dozen rows by eight columns, whose
+/// bidiagonal QR converges in about two sweeps per singular value): a bound, so that an SVD
+/// that does not converge is an error, never a loop without end.
+pub const SVD_MAX_ITERATIONS: usize = 1000;
+
 /// What to fit and how.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FitConfig {
@@ -362,6 +367,21 @@ pub enum FitError {
     /// The nominal or a derived parameter set is not physical.
     #[error(transparent)]
     Params(ParamError),
+    /// A number the fit derived (a fitted value, a sigma, a correlation, chi^2, ...) is not
+    /// finite; nothing is printed or written ([`check_finite`]).
+    #[error(
+        "fit: the {quantity} is {}: not finite, so nothing is printed or written (the data \
+         may not determine it, or the error bars span too many orders of magnitude; fit fewer \
+         parameters with {})",
+        crate::num_text::Num(*.value),
+        OptionKey::FREE
+    )]
+    NotFinite {
+        /// What it is (with the parameter, mode or row).
+        quantity: String,
+        /// Its value.
+        value: f64,
+    },
 }
 
 /// Weighted residuals, their Jacobian in `u`, the eight model frequencies (Hz) and the model's
@@ -443,10 +463,10 @@ pub fn fit_with_visibilities(
     let (_, _, fitted_freqs, fitted_ratios) = problem.residuals(&out.u)?;
 
     let data_jac = out.jac.rows(0, data_rows).into_owned();
-    let (params_out, correlation) = uncertainties(&free, &out, &data_jac, n);
-    let (singular_values, weak_directions) = weak_directions(&data_jac, &problem.keys);
+    let (params_out, correlation) = uncertainties(&free, &out, &data_jac, n)?;
+    let (singular_values, weak_directions) = weak_directions(&data_jac, &problem.keys)?;
     let chi2 = out.r.rows(0, data_rows).norm_squared();
-    Ok(FitResult {
+    let result = FitResult {
         params: params_out,
         modes: measured
             .modes
@@ -492,7 +512,112 @@ pub fn fit_with_visibilities(
         stop: out.stop,
         projected_gradient: out.projected_gradient,
         config: config.clone(),
-    })
+    };
+    check_finite(&result)?;
+    Ok(result)
+}
+
+/// The first value of `values` that is not finite, as [`FitError::NotFinite`] naming
+/// `quantity(index)`.
+fn first_nonfinite<'a>(
+    quantity: impl Fn(usize) -> String,
+    values: impl IntoIterator<Item = &'a f64>,
+) -> Result<(), FitError> {
+    match values.into_iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        Some((k, &value)) => Err(FitError::NotFinite {
+            quantity: quantity(k),
+            value,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Every number of a fit that is printed or written is finite, or the fit is refused naming
+/// it ([`FitError::NotFinite`]). The only exceptions are the documented markers of "not
+/// available": the sigma (`None`) and the correlations (NaN) of a parameter on a bound, and
+/// the nominal model visibility (NaN) where the model's mode has no component in the reference,
+/// which makes `chi2_nominal` NaN (never infinite). Every way out of a fit that returns a
+/// result passes here.
+pub fn check_finite(r: &FitResult) -> Result<(), FitError> {
+    for p in &r.params {
+        let key = &p.key;
+        first_nonfinite(
+            |k| {
+                let what = [
+                    "nominal value",
+                    "fitted value",
+                    "prior sigma",
+                    "data-only sigma",
+                ];
+                format!("{} of {key}", what[k])
+            },
+            &[p.nominal, p.fitted, p.prior_sigma, p.data_sigma_rel],
+        )?;
+        first_nonfinite(|_| format!("fitted sigma of {key}"), p.fitted_sigma.iter())?;
+    }
+    for (i, row) in r.correlation.iter().enumerate() {
+        if r.params[i].at_bound.is_some() {
+            continue;
+        }
+        for (j, &c) in row.iter().enumerate() {
+            if r.params[j].at_bound.is_none() && !c.is_finite() {
+                return Err(FitError::NotFinite {
+                    quantity: format!("correlation of {} and {}", r.params[i].key, r.params[j].key),
+                    value: c,
+                });
+            }
+        }
+    }
+    for m in &r.modes {
+        first_nonfinite(
+            |k| {
+                let what = ["nominal", "fitted"][k];
+                format!("{what} frequency of nu_{}", m.measured.mode)
+            },
+            &[m.nominal_hz, m.fitted_hz],
+        )?;
+    }
+    for v in &r.visibilities {
+        let m = &v.measured;
+        let name = format!(
+            "visibility nu_{} {}/{}",
+            m.mode,
+            m.observable.name(),
+            m.reference.name()
+        );
+        first_nonfinite(|_| format!("fitted {name}"), [&v.fitted])?;
+        if v.nominal.is_infinite() {
+            return Err(FitError::NotFinite {
+                quantity: format!("nominal {name}"),
+                value: v.nominal,
+            });
+        }
+    }
+    if r.chi2_nominal.is_infinite() {
+        return Err(FitError::NotFinite {
+            quantity: "chi^2 at the nominal parameters".into(),
+            value: r.chi2_nominal,
+        });
+    }
+    first_nonfinite(
+        |k| ["chi^2", "prior term", "projected gradient"][k].to_string(),
+        &[r.chi2, r.prior_term, r.projected_gradient],
+    )?;
+    first_nonfinite(
+        |k| format!("starting value of {}", r.params[k].key),
+        &r.start,
+    )?;
+    first_nonfinite(
+        |k| format!("singular value {} of the data Jacobian", k + 1),
+        &r.singular_values,
+    )?;
+    for w in &r.weak_directions {
+        first_nonfinite(
+            |k| format!("weak direction's component along {}", w.direction[k].0),
+            w.direction.iter().map(|(_, c)| c),
+        )?;
+    }
+    Ok(())
 }
 
 /// The least-squares problem in the scaled variables `u` (module docs).
@@ -549,7 +674,42 @@ impl Problem<'_> {
                 jac[(data_rows + j, j)] = 1.0;
             }
         }
+        // A residual or a derivative that is not finite is refused here: at the start it is
+        // the fit's error, at a trial step the minimizer rejects the step.
+        if let Some(i) =
+            (0..rows).find(|&i| !r[i].is_finite() || jac.row(i).iter().any(|x| !x.is_finite()))
+        {
+            let (what, value) = match r[i].is_finite() {
+                true => (
+                    "derivative",
+                    jac.row(i).iter().copied().find(|x| !x.is_finite()),
+                ),
+                false => ("residual", Some(r[i])),
+            };
+            return Err(FitError::NotFinite {
+                quantity: format!("{what} of {}", self.row_name(i)),
+                value: value.unwrap_or(f64::NAN),
+            });
+        }
         Ok((r, jac, e.frequencies_hz, e.ratios))
+    }
+
+    /// What row `i` of the residuals is, for messages.
+    fn row_name(&self, i: usize) -> String {
+        let m = self.measured.modes.len();
+        if i < m {
+            format!("the frequency of nu_{}", self.measured.modes[i].mode)
+        } else if i < self.data_rows {
+            let v = &self.vis[i - m];
+            format!(
+                "the visibility nu_{} {}/{}",
+                v.mode,
+                v.observable.name(),
+                v.reference.name()
+            )
+        } else {
+            format!("the prior of {}", self.free[i - self.data_rows].key)
+        }
     }
 
     /// `chi^2` of the data at the model frequencies `freqs` and visibilities `ratios`.
@@ -602,8 +762,8 @@ fn uncertainties(
     out: &lm::LmOutcome,
     data_jac: &DMatrix<f64>,
     n: f64,
-) -> (Vec<FittedParam>, Vec<Vec<f64>>) {
-    let data_sigma_rel = diag_of_inverse(data_jac);
+) -> Result<(Vec<FittedParam>, Vec<Vec<f64>>), FitError> {
+    let data_sigma_rel = diag_of_inverse(data_jac)?;
     let at_bound: Vec<Option<Bound>> = out
         .u
         .iter()
@@ -614,7 +774,7 @@ fn uncertainties(
         })
         .collect();
     let inside: Vec<usize> = (0..free.len()).filter(|&j| at_bound[j].is_none()).collect();
-    let covariance = covariance(&out.jac.select_columns(&inside));
+    let covariance = covariance(&out.jac.select_columns(&inside))?;
     let mut correlation = vec![vec![f64::NAN; free.len()]; free.len()];
     for (a, &i) in inside.iter().enumerate() {
         for (b, &j) in inside.iter().enumerate() {
@@ -640,13 +800,37 @@ fn uncertainties(
             poorly_constrained: data_sigma_rel[j] >= 1.0,
         })
         .collect();
-    (params_out, correlation)
+    Ok((params_out, correlation))
+}
+
+/// The SVD of `jac` (its right singular vectors only), or [`FitError::NotFinite`] when it does
+/// not converge within [`SVD_MAX_ITERATIONS`] sweeps (a Jacobian that is not finite).
+fn svd_of(
+    jac: &DMatrix<f64>,
+) -> Result<nalgebra::linalg::SVD<f64, nalgebra::Dyn, nalgebra::Dyn>, FitError> {
+    if let Some(&value) = jac.iter().find(|x| !x.is_finite()) {
+        return Err(FitError::NotFinite {
+            quantity: "weighted Jacobian".into(),
+            value,
+        });
+    }
+    jac.clone()
+        .try_svd(false, true, f64::EPSILON, SVD_MAX_ITERATIONS)
+        .ok_or_else(|| FitError::NotFinite {
+            quantity: format!(
+                "SVD of the weighted Jacobian (not converged in {SVD_MAX_ITERATIONS} sweeps)"
+            ),
+            value: f64::NAN,
+        })
 }
 
 /// The data Jacobian's singular values, largest first, and the directions along those below 1
 /// (combinations of the parameters the data know less well than the prior).
-fn weak_directions(data_jac: &DMatrix<f64>, keys: &[String]) -> (Vec<f64>, Vec<WeakDirection>) {
-    let svd = data_jac.clone().svd(false, true);
+fn weak_directions(
+    data_jac: &DMatrix<f64>,
+    keys: &[String],
+) -> Result<(Vec<f64>, Vec<WeakDirection>), FitError> {
+    let svd = svd_of(data_jac)?;
     let v_t = svd.v_t.expect("requested");
     let mut order: Vec<usize> = (0..svd.singular_values.len()).collect();
     order.sort_by(|&a, &b| svd.singular_values[b].total_cmp(&svd.singular_values[a]));
@@ -663,7 +847,7 @@ fn weak_directions(data_jac: &DMatrix<f64>, keys: &[String]) -> (Vec<f64>, Vec<W
                 .collect(),
         })
         .collect();
-    (singular_values, weak_directions)
+    Ok((singular_values, weak_directions))
 }
 
 /// The model's visibilities at the nominal parameters, NaN where the reference does not see
@@ -680,15 +864,15 @@ fn nominal_ratios(model: &crate::model::Model, vis: &[MeasuredVisibility]) -> Ve
 
 /// `(J^T J)^-1` through the SVD of `J` (the pseudo-inverse: directions along a numerically zero
 /// singular value, see [`RANK_TOL`], get an infinite variance).
-fn covariance(jac: &DMatrix<f64>) -> DMatrix<f64> {
+fn covariance(jac: &DMatrix<f64>) -> Result<DMatrix<f64>, FitError> {
     let cols = jac.ncols();
     if cols == 0 {
-        return DMatrix::zeros(0, 0);
+        return Ok(DMatrix::zeros(0, 0));
     }
-    let svd = jac.clone().svd(false, true);
+    let svd = svd_of(jac)?;
     let v_t = svd.v_t.expect("requested");
     let s_max = svd.singular_values.max();
-    DMatrix::from_fn(cols, cols, |a, b| {
+    Ok(DMatrix::from_fn(cols, cols, |a, b| {
         let mut c = 0.0;
         for (i, &s) in svd.singular_values.iter().enumerate() {
             let (va, vb) = (v_t[(i, a)], v_t[(i, b)]);
@@ -701,20 +885,20 @@ fn covariance(jac: &DMatrix<f64>) -> DMatrix<f64> {
             c += va * vb / (s * s);
         }
         c
-    })
+    }))
 }
 
 /// `sqrt(diag((J^T J)^-1))` through the SVD of `J`; a parameter with a component along a
 /// numerically zero singular value gets an infinite value.
-fn diag_of_inverse(jac: &DMatrix<f64>) -> Vec<f64> {
+fn diag_of_inverse(jac: &DMatrix<f64>) -> Result<Vec<f64>, FitError> {
     let cols = jac.ncols();
     if cols == 0 {
-        return Vec::new();
+        return Ok(Vec::new());
     }
-    let svd = jac.clone().svd(false, true);
+    let svd = svd_of(jac)?;
     let v_t = svd.v_t.expect("requested");
     let s_max = svd.singular_values.max();
-    (0..cols)
+    Ok((0..cols)
         .map(|j| {
             let mut var = 0.0;
             for (i, &s) in svd.singular_values.iter().enumerate() {
@@ -729,7 +913,7 @@ fn diag_of_inverse(jac: &DMatrix<f64>) -> Vec<f64> {
             }
             var.sqrt()
         })
-        .collect()
+        .collect())
 }
 
 /// Checks the configuration against the parameters and the measurements.

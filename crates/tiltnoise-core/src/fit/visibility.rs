@@ -15,15 +15,19 @@
 //! `X, Y, Z, theta, eta, phi, phi_a`; `ratio` is finite, of either sign, with magnitude at most
 //! [`MAX_RATIO`] (unit: the observable's per the reference's, m/m, rad/rad, m/rad or rad/m);
 //! `sigma`, when present and not empty, is the one-standard-deviation error of the ratio
-//! (finite and > 0). When it is absent the sigma is half a unit of the last printed digit of
+//! (from 1e-40 to 2e6, [`crate::limits::VISIBILITY_SIGMA_RANGE`]). When it is absent the sigma is half a unit of the last printed digit of
 //! `ratio`. Each (mode, observable, reference) at most once.
 
 use super::measured::{half_last_digit, SigmaSource};
 use super::FitError;
 use crate::csv_text::{line_text, CsvRecords};
 use crate::error::Shown;
+use crate::limits::VISIBILITY_SIGMAS;
 use crate::model::{Mat8, Observable, ObservationMatrix};
 use crate::modes::NormalModes;
+
+// The largest error of a ratio spans the whole range of ratios (limits::VISIBILITY_SIGMA_RANGE).
+const _: () = assert!(crate::limits::VISIBILITY_SIGMA_RANGE.1 == 2.0 * MAX_RATIO);
 
 /// The largest magnitude of a measured ratio: a mode a million times stronger in one channel
 /// than in its reference is not measured against that reference (choose the stronger channel
@@ -200,27 +204,29 @@ fn parse_row(cells: &[String], with_sigma: bool) -> Result<MeasuredVisibility, S
             cells[4]
                 .parse::<f64>()
                 .ok()
-                .filter(|s| s.is_finite() && *s > 0.0)
+                .filter(|s| VISIBILITY_SIGMAS.admits(*s))
                 .ok_or_else(|| {
                     format!(
-                        "sigma `{}` of nu_{mode} {}/{} is not allowed: must be \
-                         finite and > 0 (or empty: half the last digit of ratio)",
+                        "sigma `{}` of nu_{mode} {}/{} is not allowed: must be {} (or \
+                         empty: half the last digit of ratio)",
                         Shown(&cells[4]),
                         obs.name(),
-                        reference.name()
+                        reference.name(),
+                        VISIBILITY_SIGMAS.allowed("")
                     )
                 })?,
             SigmaSource::File,
         ),
         false => (half_last_digit(&cells[3]), SigmaSource::Digits),
     };
-    if !(sigma.is_finite() && sigma > 0.0) {
+    if !VISIBILITY_SIGMAS.admits(sigma) {
         return Err(format!(
-            "the sigma of nu_{mode} {}/{} from the digits of `{}` is {sigma:e}: give \
-             a sigma column",
+            "the sigma of nu_{mode} {}/{} from the digits of `{}` is {sigma:e}, not {}: \
+             give a sigma column",
             obs.name(),
             reference.name(),
-            Shown(&cells[3])
+            Shown(&cells[3]),
+            VISIBILITY_SIGMAS.allowed("")
         ));
     }
     Ok(MeasuredVisibility {
@@ -316,6 +322,10 @@ mod tests {
             ("6,Y,X,2e6,0.01\n", "ratio `2e6`"),
             ("6,Y,X,0.1,-1\n", "sigma `-1`"),
             ("6,Y,X,0.1,0\n", "sigma `0`"),
+            ("6,Y,X,0.1,1e-310\n", "sigma `1e-310`"),
+            ("6,Y,X,0.1,9e-41\n", "from 1e-40 to 2e6"),
+            ("6,Y,X,0.1,3e6\n", "sigma `3e6`"),
+            ("6,Y,X,1e-300,\n", "from the digits of `1e-300`"),
             ("6,Y,X,0.1\n", "has 4 fields"),
             ("6,Y,X,0.1,0.01\n6,Y,X,0.2,0.01\n", "listed twice"),
             ("", "no visibility"),

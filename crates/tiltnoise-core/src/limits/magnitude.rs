@@ -66,6 +66,40 @@ pub const MIN_SPECTRUM_FREQUENCY_HZ: f64 = 1e-9;
 /// tiltmeter off by six orders of magnitude either way is a wrong unit, not a calibration.
 pub const GAIN_RANGE: (f64, f64) = (1e-6, 1e6);
 
+/// Smallest and largest ratio `r` of a co-located instrument's noise ASD to the witness's
+/// (`subtract --colocated-ratio`, a huddle test). The witness's noise is estimated as
+/// `N_1 = PSD(x_1 - x_2 / g) / (1 + r^2 / g^2)`, floored at `1e-6` of the witness's PSD
+/// (`subtract::colocated::NOISE_FLOOR_REL`); the relative gain `g` of two instruments
+/// recording the same motion in the same unit is near 1. Where the two are coherent enough
+/// for the gain (coherence >= 0.9) the difference's PSD is below a ninth of the witness's, so
+/// for `r / |g| >= 1e3 = 1 / sqrt(1e-6)` the estimate is the floor whatever the records hold
+/// (the witness's noise is hidden under the other's); and for `r / |g| <= 1e-3` the share
+/// `1 + r^2 / g^2` differs from 1 by less than the floor: the estimate is that of a noiseless
+/// co-located instrument. A ratio outside tells nothing the bounds do not, and is a PSD ratio
+/// given for an ASD ratio, or a unit slip.
+pub const NOISE_RATIO_RANGE: (f64, f64) = (1e-3, 1e3);
+
+/// Smallest and largest nonzero absolute error bar of an `[asymmetry]` offset in a parameter
+/// file's `[uncertainty]` table (`sigma`, in m or rad; 0 keeps the offset exact). An offset
+/// displaces a position of the model, whose bodies are at least 1 mm long: below
+/// `f64::EPSILON x 1 mm = 2.2e-19 m` (and `2.2e-16 rad` of a rotation) the error bar is below
+/// the rounding of the positions it moves, and the fit's scaled variable `(p - p0) / sigma`
+/// and its covariance `sigma^2 (J^T J)^-1` lose their meaning (and, at `1e-310`, their
+/// finiteness). Above it: an offset is bounded by a tenth of its body (bodies below 10 m) or
+/// 0.1 rad ([`crate::params::Asymmetry::limits`]), so a sigma above 1 puts every Monte Carlo
+/// draw and both edges of the fit's box outside the bound.
+pub const OFFSET_SIGMA_RANGE: (f64, f64) = (1e-20, 1.0);
+
+/// Smallest and largest error `sigma` of a measured visibility (`fit --visibility`, the ratio
+/// of a mode's components in two observables, `|ratio| <= 1e6`,
+/// `fit::visibility::MAX_RATIO`). Above `2e6`, the whole range of ratios, a row measures
+/// nothing. Below `1e-40` nothing is measured either (a ratio of two amplitudes each at least
+/// [`MIN_SAMPLE`] in magnitude); within the range a residual `(model - ratio) / sigma` is at
+/// most `2e46` for a model ratio within the same range, its square `4e92`, and `chi^2` over
+/// a file's rows and the normal equations of the fit (error bars of at most 1,
+/// [`OFFSET_SIGMA_RANGE`]) stay finite with a margin of 10^200.
+pub const VISIBILITY_SIGMA_RANGE: (f64, f64) = (1e-40, 2e6);
+
 /// Longest Welch segment the bounds above are derived for.
 const MAX_SEGMENT: f64 = super::MAX_STREAMED_SAMPLES as f64;
 
@@ -89,6 +123,13 @@ const _: () = {
     let bottom = MIN_ASD * MIN_ASD / (high * high);
     assert!(top * top * 1e8 < f64::MAX / 1e40);
     assert!(bottom * bottom > f64::MIN_POSITIVE * 1e40);
+    // An offset's smallest error bar is below the rounding of a 1 mm position.
+    assert!(OFFSET_SIGMA_RANGE.0 < f64::EPSILON * 1e-3);
+    // The largest residual of a visibility, squared, summed over a file's rows (at most one
+    // per two bytes) and multiplied by the squared largest error bar, stays finite.
+    let residual = 2.0 * 1e6 / VISIBILITY_SIGMA_RANGE.0;
+    let rows = (super::MAX_SETTINGS_FILE_BYTES / 2) as f64;
+    assert!(residual * residual * rows * OFFSET_SIGMA_RANGE.1 < f64::MAX / 1e200);
     // PSDS are the squares of ASDS, to the rounding of the products.
     let eps = 4.0 * f64::EPSILON;
     let (lo, hi) = (
@@ -160,6 +201,30 @@ pub const GAINS: Magnitudes = Magnitudes {
     largest: GAIN_RANGE.1,
     signed: true,
     zero: true,
+};
+
+/// Ratios of two co-located instruments' noise ASDs ([`NOISE_RATIO_RANGE`]).
+pub const NOISE_RATIOS: Magnitudes = Magnitudes {
+    smallest: NOISE_RATIO_RANGE.0,
+    largest: NOISE_RATIO_RANGE.1,
+    signed: false,
+    zero: false,
+};
+
+/// Absolute error bars of `[asymmetry]` offsets ([`OFFSET_SIGMA_RANGE`]); 0 (exact) allowed.
+pub const OFFSET_SIGMAS: Magnitudes = Magnitudes {
+    smallest: OFFSET_SIGMA_RANGE.0,
+    largest: OFFSET_SIGMA_RANGE.1,
+    signed: false,
+    zero: true,
+};
+
+/// Errors of measured visibilities ([`VISIBILITY_SIGMA_RANGE`]).
+pub const VISIBILITY_SIGMAS: Magnitudes = Magnitudes {
+    smallest: VISIBILITY_SIGMA_RANGE.0,
+    largest: VISIBILITY_SIGMA_RANGE.1,
+    signed: false,
+    zero: false,
 };
 
 impl Magnitudes {

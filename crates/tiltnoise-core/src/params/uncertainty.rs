@@ -167,8 +167,9 @@ pub enum UncertaintyError {
     },
     /// An absolute sigma that is negative or not finite.
     #[error(
-        "[uncertainty]: sigma of `{key}` = {sigma} is not allowed: must be finite and >= 0 \
-         (absolute, in the key's unit)"
+        "[uncertainty]: sigma of `{key}` = {sigma:e} is not allowed: must be {} (absolute, in \
+         the key's unit; see docs/limits.md)",
+        crate::limits::OFFSET_SIGMAS.allowed("")
     )]
     InvalidAbsSigma {
         /// The parameter.
@@ -287,7 +288,7 @@ pub fn check(list: &[Uncertainty], keys: &[&str]) -> Result<(), UncertaintyError
         if list[..i].iter().any(|v| v.key == u.key) {
             return Err(UncertaintyError::DuplicateKey { key: u.key.clone() });
         }
-        if !(u.abs_sigma.is_finite() && u.abs_sigma >= 0.0) {
+        if !crate::limits::OFFSET_SIGMAS.admits(u.abs_sigma) {
             return Err(UncertaintyError::InvalidAbsSigma {
                 key: u.key.clone(),
                 sigma: u.abs_sigma,
@@ -660,7 +661,27 @@ mod tests {
             ),
             (
                 "\"asymmetry.sensor_rot_z_rad\" = { sigma = -1e-3 }",
-                &["asymmetry.sensor_rot_z_rad", "-0.001", ">= 0"],
+                &[
+                    "asymmetry.sensor_rot_z_rad",
+                    "-1e-3",
+                    "0 or a value from 1e-20 to 1e0",
+                ],
+            ),
+            (
+                "\"asymmetry.tm_com_x_m\" = { sigma = 1e-310 }",
+                &[
+                    "asymmetry.tm_com_x_m",
+                    "1e-310",
+                    "0 or a value from 1e-20 to 1e0",
+                ],
+            ),
+            (
+                "\"asymmetry.tm_com_x_m\" = { sigma = 2 }",
+                &[
+                    "asymmetry.tm_com_x_m",
+                    "= 2e0",
+                    "0 or a value from 1e-20 to 1e0",
+                ],
             ),
         ] {
             let e = with_table(&format!("\n[uncertainty]\n{entry}\n")).unwrap_err();

@@ -39,6 +39,36 @@ pub const GAIN_COHERENCE: f64 = 0.9;
 /// Floor of the estimated noise PSD, relative to the witness's PSD.
 pub const NOISE_FLOOR_REL: f64 = 1e-6;
 
+// The range of the noise ratio is derived from the floor (limits::NOISE_RATIO_RANGE): its
+// largest value squared is the reciprocal of the floor, its smallest the reciprocal of the
+// largest.
+const _: () = {
+    let (lo, hi) = crate::limits::NOISE_RATIO_RANGE;
+    let floor = hi * hi * NOISE_FLOOR_REL;
+    assert!(floor > 1.0 - 1e-12 && floor < 1.0 + 1e-12);
+    assert!(lo * hi > 1.0 - 1e-12 && lo * hi < 1.0 + 1e-12);
+};
+
+/// The magnitude of the relative gain `g` of a huddle in one bin: the positive root of
+/// `a g^2 + (r^2 s11 - s22) g - r^2 a = 0` (module docs; `a = |S_12| > 0`, `s11`, `s22` the
+/// two PSDs, `r` the noise ratio), computed without cancellation or overflow: for `r <= 1`
+/// the root of the larger magnitude is formed without a difference of nearly equal terms
+/// (`2 r^2 a / (b + hypot(b, 2 r a))` when `b >= 0`, `(hypot(b, 2 r a) - b) / (2 a)` when
+/// not), and for `r > 1` the equation is that of `1 / g` with `s11` and `s22` swapped and
+/// `1 / r` (substitute `g = 1 / h` and divide by `r^2`), so `r^2` never exceeds 1.
+pub fn huddle_gain(s11: f64, s22: f64, a: f64, r: f64) -> f64 {
+    if r > 1.0 {
+        return 1.0 / huddle_gain(s22, s11, a, 1.0 / r);
+    }
+    let b = r * r * s11 - s22;
+    let h = b.hypot(2.0 * r * a);
+    if b >= 0.0 {
+        2.0 * r * r * a / (b + h)
+    } else {
+        (h - b) / (2.0 * a)
+    }
+}
+
 /// How a noise level was estimated.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Method {
@@ -107,15 +137,11 @@ pub fn estimate(
     }
     let (gains, method) = match others.len() {
         1 => {
-            let r2 = noise_ratio * noise_ratio;
             let mut g: Vec<f64> = bins
                 .iter()
                 .map(|&k| {
                     let (s11, s22, s12) = (m.get(k, 0, 0).re, m.get(k, 1, 1).re, m.get(k, 0, 1));
-                    let a = s12.norm();
-                    let b = r2 * s11 - s22;
-                    let root = (-b + (b * b + 4.0 * r2 * a * a).sqrt()) / (2.0 * a);
-                    root * s12.re.signum()
+                    huddle_gain(s11, s22, s12.norm(), noise_ratio) * s12.re.signum()
                 })
                 .collect();
             let g = median(&mut g);
@@ -342,6 +368,41 @@ mod tests {
                 t.iter().map(|v| g * v + s * r.gaussian()).collect()
             })
             .collect()
+    }
+
+    /// The huddle's gain against the quadratic's root in double-double arithmetic (the
+    /// textbook formula, whose cancellation costs about 1e-12 relative at the ends of the
+    /// ratio's range: far below double-double's 1e-32), over the whole range of ratios and
+    /// of PSDs: finite, positive, within a few eps of the reference, and between the two
+    /// regression gains `a / s11` and `s22 / a`.
+    #[test]
+    fn huddle_gain_is_the_root_without_cancellation_over_the_whole_range() {
+        use crate::dd::Dd;
+        let (lo, hi) = crate::limits::NOISE_RATIO_RANGE;
+        let ratios = [lo, 3e-3, 0.1, 0.9, 1.0, 1.1, 10.0, 333.0, hi];
+        let psds = crate::limits::PSDS;
+        for scale in [psds.smallest, 1e-20, 1.0, 1e30, psds.largest] {
+            // Coherence 0.95 and 0.9 between records of gains 1 and 1.3 and 0.7.
+            for (s11, s22, coherence) in [(1.0, 1.69, 0.95), (1.0, 0.49, 0.9), (2.0, 2.0, 1.0)] {
+                let (s11, s22) = (s11 * scale, s22 * scale);
+                let a = (coherence * s11 * s22).sqrt();
+                for r in ratios {
+                    let g = huddle_gain(s11, s22, a, r);
+                    let (ad, rd) = (Dd::from(a), Dd::from(r));
+                    let r2 = rd * rd;
+                    let b = r2 * s11 - Dd::from(s22);
+                    let disc = b * b + r2 * ad * ad * 4.0;
+                    let want = ((disc.sqrt() - b) / (ad * 2.0)).to_f64();
+                    assert!(
+                        g.is_finite() && g > 0.0 && (g / want - 1.0).abs() <= 8.0 * f64::EPSILON,
+                        "s11 {s11:e}, s22 {s22:e}, r {r}: {g:e} vs {want:e}"
+                    );
+                    let (low, high) = (a / s11, s22 / a);
+                    assert!(g >= low * (1.0 - 4.0 * f64::EPSILON), "{g} < {low}");
+                    assert!(g <= high * (1.0 + 4.0 * f64::EPSILON), "{g} > {high}");
+                }
+            }
+        }
     }
 
     #[test]

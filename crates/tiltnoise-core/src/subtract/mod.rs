@@ -1008,10 +1008,11 @@ fn check_config(
         }
     }
     for (input, r) in &cfg.colocated_noise_ratio {
-        if !(r.is_finite() && *r > 0.0) {
+        if !crate::limits::NOISE_RATIOS.admits(*r) {
             return Err(SubtractError::Config(format!(
-                "{}: the ratio of noise ASDs must be finite and > 0",
-                OptionKey::COLOCATED_RATIO.given(format!("{}={}", input.name(), Num(*r)))
+                "{}: the ratio of noise ASDs is not allowed: must be {}",
+                OptionKey::COLOCATED_RATIO.given(format!("{}={}", input.name(), Num(*r))),
+                crate::limits::NOISE_RATIOS.allowed("")
             )));
         }
     }

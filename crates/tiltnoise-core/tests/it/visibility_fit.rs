@@ -147,3 +147,83 @@ fn offset_fit_starts_away_from_the_symmetric_point() {
             <= 1e-15 * PRIOR_SIGMA_M
     );
 }
+
+/// The finiteness of a fit, one class: a fit of model-made visibilities gives only finite
+/// numbers (`check_finite` passes); a derived number made non-finite (a sigma, a correlation
+/// of parameters inside the box, chi^2) is refused naming it; and rows whose errors sit at the
+/// ends of their range, one of them far off its model value, make a fit that ends (with finite
+/// numbers or a refusal naming what is not finite), never one that loops.
+#[test]
+fn every_derived_number_of_a_fit_is_finite_or_refused_by_name() {
+    use tiltnoise_core::fit::visibility::model_ratio;
+    use tiltnoise_core::fit::{FitError, MeasuredVisibility, SigmaSource};
+    use tiltnoise_core::limits::VISIBILITY_SIGMA_RANGE;
+    let params = nominal();
+    let truth = params
+        .with_override(&format!("asymmetry.tm_com_x_m={TRUTH_M:e}"))
+        .unwrap();
+    let model = Model::new(&truth).unwrap();
+    let modes = NormalModes::new(&model);
+    let row = |mode, observable, reference, sigma: f64, off: f64| {
+        let mut v = MeasuredVisibility {
+            mode,
+            observable,
+            reference,
+            ratio: 0.0,
+            sigma,
+            sigma_source: SigmaSource::File,
+        };
+        v.ratio = model_ratio(&modes, model.observation(), &v, &[]).unwrap().0 + off;
+        v
+    };
+    let vis = |rows: Vec<MeasuredVisibility>| Visibilities {
+        items: rows,
+        origin: "synthetic".into(),
+    };
+    let measured = Measured {
+        modes: Vec::new(),
+        origin: "none".into(),
+    };
+    let config = FitConfig {
+        free: vec!["asymmetry.tm_com_x_m".into()],
+        bound_sigmas: 3.0,
+        ..FitConfig::default()
+    };
+    let good = vis(vec![
+        row(6, Observable::Z, Observable::X, 1e-6, 0.0),
+        row(2, Observable::Y, Observable::X, 1e-6, 0.0),
+    ]);
+    let result = fit::fit_with_visibilities(&params, &measured, &good, &config).unwrap();
+    fit::check_finite(&result).unwrap();
+    assert!(result.params[0].fitted_sigma.unwrap().is_finite());
+    let refused = |r: &fit::FitResult, needle: &str| match fit::check_finite(r) {
+        Err(FitError::NotFinite { quantity, .. }) => {
+            assert!(
+                quantity.contains(needle),
+                "{quantity} does not name {needle}"
+            )
+        }
+        other => panic!("{needle}: not refused: {other:?}"),
+    };
+    let mut r = result.clone();
+    r.params[0].fitted_sigma = Some(f64::INFINITY);
+    refused(&r, "fitted sigma of asymmetry.tm_com_x_m");
+    let mut r = result.clone();
+    r.correlation[0][0] = f64::NAN;
+    refused(&r, "correlation of asymmetry.tm_com_x_m");
+    let mut r = result.clone();
+    r.chi2 = f64::INFINITY;
+    refused(&r, "chi^2");
+    // The ends of the error's range, one row a 1e-4 off its model value.
+    for sigma in [VISIBILITY_SIGMA_RANGE.0, VISIBILITY_SIGMA_RANGE.1] {
+        let extreme = vis(vec![
+            row(6, Observable::Z, Observable::X, sigma, 1e-4),
+            row(2, Observable::Y, Observable::X, 1e-6, 0.0),
+        ]);
+        match fit::fit_with_visibilities(&params, &measured, &extreme, &config) {
+            Ok(r) => fit::check_finite(&r).unwrap(),
+            Err(FitError::NotFinite { quantity, .. }) => assert!(!quantity.is_empty()),
+            Err(e) => panic!("sigma {sigma:e}: {e}"),
+        }
+    }
+}
