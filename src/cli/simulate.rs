@@ -127,15 +127,14 @@ pub(crate) struct SimulateArgs {
     /// Units and sensors of the record's channels (with --tilt).
     #[command(flatten)]
     channels: super::args::ChannelArgs,
-    /// Fine steps per record sample of the driven propagation (with --tilt).
+    /// Fine steps per record sample of the driven propagation (with --tilt; default 10).
     #[arg(
         long,
         value_name = "N",
-        default_value_t = 10,
         allow_negative_numbers = true,
         requires = "tilt"
     )]
-    oversample: usize,
+    oversample: Option<usize>,
     /// The pendulum sees GAIN times the record's channel of an input, INPUT=GAIN,... (with
     /// --tilt; default 1; e.g. eta_t=0.97, x_t=1.02): a sensor's calibration error.
     #[arg(
@@ -188,17 +187,36 @@ fn excitation(args: &SimulateArgs) -> Result<Excitation> {
     })
 }
 
-/// Refuses the options that describe the channels of a record, which free motion has not.
-fn refuse_channel_options(c: &super::args::ChannelArgs) -> Result<()> {
+/// Refuses the options that describe the channels of a record or how it drives the
+/// pendulum, which free motion has not.
+fn refuse_record_options(args: &SimulateArgs) -> Result<()> {
+    let c = &args.channels;
     if let Some(option) = [
-        ("--units", c.units.is_empty()),
-        ("--corrected", c.corrected.is_empty()),
-        ("--pendulum-tiltmeter", c.pendulum_tiltmeter.is_empty()),
+        ("--units", !c.units.is_empty()),
+        ("--corrected", !c.corrected.is_empty()),
+        ("--pendulum-tiltmeter", !c.pendulum_tiltmeter.is_empty()),
+        ("--axes", args.axes.is_some()),
+        ("--quantity", args.quantity.is_some()),
+        ("--gaps", args.gaps.is_some()),
+        ("--scale", !args.scale.is_empty()),
     ]
     .into_iter()
-    .find_map(|(option, empty)| (!empty).then_some(option))
+    .find_map(|(option, given)| given.then_some(option))
     {
         bail!("{option} describes the channels of a record and applies with --tilt FILE only");
+    }
+    if let Some(option) = [
+        ("--oversample", args.oversample.is_some()),
+        ("--drive-gain", !args.drive_gain.is_empty()),
+        ("--drive-delay", args.drive_delay.is_some()),
+    ]
+    .into_iter()
+    .find_map(|(option, given)| given.then_some(option))
+    {
+        bail!(
+            "{option} applies to a simulation driven by a record (--tilt FILE); free motion \
+             has no record"
+        );
     }
     Ok(())
 }
@@ -214,7 +232,7 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
     if let Some(path) = &args.tilt {
         return driven::run(&model, &args, path, &view, run);
     }
-    refuse_channel_options(&args.channels)?;
+    refuse_record_options(&args)?;
     for path in &args.save {
         OutputKind::from_path(path)?;
     }

@@ -5,7 +5,10 @@
 //! spectrum frequencies have their ranges; `subtract` names a dead channel; and an output never
 //! replaces an input, whatever its spelling (an HDF5 address included).
 
-use crate::common::{assert_fails, disable_hdf5_file_locking, listing, repo, stderr, tiltnoise};
+use crate::common::{
+    assert_fails, assert_fails_without_output, disable_hdf5_file_locking, listing, repo, stderr,
+    tiltnoise,
+};
 use ndarray::Array1;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::model::TiltAxis;
@@ -400,4 +403,144 @@ fn no_command_saves_onto_an_input_given_as_an_hdf5_address() {
         "an input was overwritten"
     );
     assert_eq!(listing(d), entries, "files were left behind");
+}
+
+/// The newest outputs, one class: what `subtract` with a co-located record and `fit` with
+/// visibilities print and store is finite, or the input that would make it infinite is refused
+/// where it enters (the huddle's noise ratio, an offset's error bar, a visibility's error),
+/// naming the option or file, key or line, the value and the range, with nothing written. At
+/// the ends of the ratio's range the relative gain is finite and near 1, in the JSON and in
+/// the HDF5 file.
+#[test]
+fn newest_outputs_are_finite_or_their_inputs_refused_where_they_enter() {
+    disable_hdf5_file_locking();
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let lab_path = lab();
+    let lab = lab_path.display().to_string();
+    let meas = d.join("meas.h5").display().to_string();
+    let out = tiltnoise(&[
+        "simulate",
+        "--tilt",
+        &lab,
+        "--oversample",
+        "2",
+        "--save",
+        &meas,
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let co = copy_edited(&lab_path, d, "co.h5", "eta_t", |x| {
+        let mut rng = tiltnoise_core::rng::Rng::stream(5, 0);
+        let sd = (x.iter().map(|v| v * v).sum::<f64>() / x.len() as f64).sqrt();
+        x.iter_mut().for_each(|v| *v += 0.1 * sd * rng.gaussian());
+    });
+    let co = co.display().to_string();
+    let (lo, hi) = tiltnoise_core::limits::NOISE_RATIO_RANGE;
+    for r in [lo, 1.0, hi] {
+        let save = d.join(format!("s_{r}.h5"));
+        let ratio = format!("eta_t={r:e}");
+        let out = tiltnoise(&[
+            "subtract",
+            "--tilt",
+            &lab,
+            "--measured",
+            &meas,
+            "--colocated",
+            &co,
+            "--colocated-ratio",
+            &ratio,
+            "--format",
+            "json",
+            "--save",
+            save.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{r}: {}", stderr(&out));
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let eta = json["witness_noise"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|w| w["input"] == "eta_t")
+            .unwrap();
+        let g = eta["relative_gains"][0].as_f64().expect("a finite gain");
+        assert!((g - 1.0).abs() < 0.1, "ratio {r}: gain {g}");
+        let file = hdf5::File::open(&save).unwrap();
+        for name in file.member_names().unwrap() {
+            if let Ok(ds) = file.dataset(&name) {
+                if let Ok(v) = ds.read_raw::<f64>() {
+                    assert!(v.iter().all(|x| x.is_finite()), "{r}: /{name}");
+                }
+            }
+        }
+    }
+    let before = listing(d);
+    for r in ["1e150", "1e300", "9.9e-4", "0", "nan"] {
+        let ratio = format!("eta_t={r}");
+        assert_fails(
+            &[
+                "subtract",
+                "--tilt",
+                &lab,
+                "--measured",
+                &meas,
+                "--colocated",
+                &co,
+                "--colocated-ratio",
+                &ratio,
+                "--save",
+                &d.join("never.h5").display().to_string(),
+            ],
+            &["--colocated-ratio eta_t=", "must be from 1e-3 to 1e3"],
+        );
+    }
+    assert_eq!(listing(d), before, "a refused run wrote something");
+    // fit: an offset's error bar and a visibility's error outside their ranges.
+    let params = d.join("p.toml");
+    let table = String::from_utf8(tiltnoise(&["params"]).stdout).unwrap();
+    let vis = d.join("vis.csv");
+    std::fs::write(
+        &vis,
+        "mode,observable,reference,ratio,sigma\n1,phi_a,phi,0.6458,1e-8\n6,Z,X,1e-3,1e-310\n",
+    )
+    .unwrap();
+    let vis = vis.display().to_string();
+    for sigma in ["1e-310", "1e-21", "2"] {
+        std::fs::write(
+            &params,
+            format!("{table}\n[uncertainty]\n\"asymmetry.tm_com_x_m\" = {{ sigma = {sigma} }}\n"),
+        )
+        .unwrap();
+        assert_fails_without_output(
+            &[
+                "--params",
+                params.to_str().unwrap(),
+                "fit",
+                "--free",
+                "asymmetry.tm_com_x_m",
+                "--save",
+                &d.join("never.json").display().to_string(),
+            ],
+            d,
+            &[
+                "p.toml",
+                "sigma of `asymmetry.tm_com_x_m`",
+                "from 1e-20 to 1e0",
+            ],
+        );
+    }
+    assert_fails_without_output(
+        &[
+            "fit",
+            "--visibility",
+            &vis,
+            "--save",
+            &d.join("never.json").display().to_string(),
+        ],
+        d,
+        &[
+            "vis.csv, line 3",
+            "sigma `1e-310` of nu_6 Z/X",
+            "from 1e-40 to 2e6",
+        ],
+    );
 }

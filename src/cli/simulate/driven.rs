@@ -12,6 +12,9 @@ use tiltnoise_core::model::Model;
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::repeats::{list_entries, refuse_repeated_keys};
 use tiltnoise_io::{OutputKind, RunMeta};
+
+/// Fine steps per record sample of the driven propagation when `--oversample` is not given.
+const DEFAULT_OVERSAMPLE: usize = 10;
 use tiltnoise_job::budget::ReadRequest;
 use tiltnoise_job::simulate::driven::{DrivenRequest, DrivenResult};
 use tiltnoise_job::simulate::{asd_figure_data, save, RecordOutputs};
@@ -59,7 +62,7 @@ fn request<'a>(model: &'a Model, args: &SimulateArgs, path: &Path) -> Result<Dri
             gaps: Some(o.gaps),
             scale: o.scale,
         },
-        oversample: args.oversample,
+        oversample: args.oversample.unwrap_or(DEFAULT_OVERSAMPLE),
         drive_gain: parse_gains(&args.drive_gain)?,
         drive_delay_s: args.drive_delay,
         readout: parse_readout(&args.readout)?,
