@@ -40,7 +40,7 @@ def test_noise_ratio_out_of_its_range_or_for_an_unrecorded_input_is_refused(reco
         tiltnoise.subtract(tilt, measured, colocated=[co], colocated_ratio={"x_t": 1.0})
     for r in (1e-3, 1e3):
         s = tiltnoise.subtract(tilt, measured, colocated=[co], colocated_ratio={"eta_t": r})
-        gains = [g for w in s.report()["witness_noise"] for g in (w.get("relative_gains") or [])]
+        gains = [g for w in s.report["witness_noise"] for g in (w.get("relative_gains") or [])]
         assert gains and all(math.isfinite(g) and abs(g - 1) < 0.1 for g in gains), gains
 
 
