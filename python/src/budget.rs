@@ -643,14 +643,7 @@ pub fn budget_from_file(
     let channels_of = job_args::ChannelLists::of(corrected, pendulum_tiltmeter)?;
     let at = args::numbers("at", at)?;
     let (model, params) = model_of(params)?;
-    let read = job_args::file_read_request(
-        axes.as_deref(),
-        quantity.as_deref(),
-        units,
-        channels_of,
-        gaps.as_deref(),
-        scale,
-    )?;
+    let read = job_args::file_read_request(axes, quantity, units, channels_of, gaps, scale)?;
     let freq_hz = match freq {
         None => None,
         Some(f) => Some(match f.cast::<PyString>() {

@@ -56,7 +56,7 @@ pub fn coherence(
     let req = CoherenceRequest {
         model: &model,
         tilt,
-        read: job_args::read_request(axes.as_deref(), quantity.as_deref(), gaps.as_deref(), scale)?,
+        read: job_args::read_request(axes, quantity, gaps, scale)?,
         measured,
         observables,
         nperseg,

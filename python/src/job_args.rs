@@ -60,9 +60,9 @@ pub fn job_error(e: JobError) -> PyErr {
 /// How to read a record of the floor's motion from `axes` (the axis map), `quantity`,
 /// `gaps` and `scale` (`{channel: factor}`), as the command line's options of the same names.
 pub fn read_request(
-    axes: Option<&str>,
-    quantity: Option<&str>,
-    gaps: Option<&str>,
+    axes: Option<String>,
+    quantity: Option<String>,
+    gaps: Option<String>,
     scale: Option<std::collections::BTreeMap<String, f64>>,
 ) -> PyResult<ReadRequest> {
     let scale: Vec<String> = scale
@@ -72,11 +72,20 @@ pub fn read_request(
         .collect();
     Ok(ReadRequest {
         axis_map: axes
+            .as_deref()
             .map(AxisMap::parse)
             .transpose()
             .map_err(|e| value_error(e.to_string()))?,
-        quantity: quantity.map(str::parse).transpose().map_err(value_error)?,
-        gaps: gaps.map(str::parse).transpose().map_err(value_error)?,
+        quantity: quantity
+            .as_deref()
+            .map(str::parse)
+            .transpose()
+            .map_err(value_error)?,
+        gaps: gaps
+            .as_deref()
+            .map(str::parse)
+            .transpose()
+            .map_err(value_error)?,
         scale: parse_scales(OptionKey::SCALE, &scale).py()?,
         ..ReadRequest::default()
     })
@@ -109,11 +118,11 @@ impl ChannelLists {
 /// How to read a record of the floor's motion from a file: [`read_request`]'s options and
 /// `units` (`{channel: unit}`), and the [`ChannelLists`], each channel once.
 pub fn file_read_request(
-    axes: Option<&str>,
-    quantity: Option<&str>,
+    axes: Option<String>,
+    quantity: Option<String>,
     units: Option<std::collections::BTreeMap<String, String>>,
     channels_of: ChannelLists,
-    gaps: Option<&str>,
+    gaps: Option<String>,
     scale: Option<std::collections::BTreeMap<String, f64>>,
 ) -> PyResult<ReadRequest> {
     let names_once = |option: OptionKey, names: Vec<String>| -> PyResult<Vec<String>> {

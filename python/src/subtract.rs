@@ -102,14 +102,7 @@ pub fn subtract(
     let req = SubtractRequest {
         model: &model,
         tilt,
-        read: job_args::file_read_request(
-            axes.as_deref(),
-            quantity.as_deref(),
-            units,
-            channels_of,
-            gaps.as_deref(),
-            scale,
-        )?,
+        read: job_args::file_read_request(axes, quantity, units, channels_of, gaps, scale)?,
         measured,
         observables: job_args::observables(observables)?,
         colocated: colocated.unwrap_or_default(),
