@@ -1,7 +1,7 @@
 //! `tiltnoise.budget` (arrays) and `tiltnoise.budget_from_file` (the command line's `budget
 //! --tilt FILE`), and the `Budget` they return.
 
-use crate::args;
+use crate::args::{self, kw};
 use crate::arrays::{self, check_size, series};
 use crate::errors::{value_error, PyResultExt};
 use crate::inputs::Inputs;
@@ -94,7 +94,9 @@ pub(crate) fn model_of(params: Option<&Bound<'_, PyAny>>) -> PyResult<(Arc<Model
     }
     let params = p
         .cast::<PyParams>()
-        .map_err(|_| value_error("params: expected a tiltnoise.Params or a tiltnoise.Model"))?
+        .map_err(|_| {
+            args::type_error("params", p, "a tiltnoise.Params, a tiltnoise.Model or None")
+        })?
         .get()
         .clone();
     Ok((Arc::new(Model::new(&params.inner).py()?), params))
@@ -106,14 +108,18 @@ fn welch(
     overlap: Option<f64>,
     average: Option<&str>,
     segment_duration: Option<f64>,
-    percentiles: Option<(f64, f64)>,
+    percentiles: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<WelchRequest> {
     Ok(WelchRequest {
         nperseg,
         overlap,
         averaging: average.map(averaging).transpose()?,
         segment_duration_s: segment_duration,
-        percentiles,
+        percentiles: args::pair(
+            "percentiles",
+            percentiles,
+            "(LOWER, UPPER) with 0 <= LOWER < UPPER <= 100",
+        )?,
     })
 }
 
@@ -186,10 +192,7 @@ fn tilt_channels(
             ));
         }
         let mut given = Vec::new();
-        for (k, v) in d.iter() {
-            let name: String = k.extract().map_err(|_| {
-                value_error("tilt: the keys must be input names (str), theta_t .. z_t")
-            })?;
+        for (name, v) in args::entries("tilt", d, "a dict {input: array}, input theta_t .. z_t")? {
             let axis = ground_input(&name)?;
             let array = v.cast::<PyUntypedArray>().ok().map(|a| a.len());
             given.push((axis, name, v, array));
@@ -249,8 +252,7 @@ fn describe_arrays(
     channels: &[(Input, Vec<f64>)],
     quantity: &str,
     units: std::collections::BTreeMap<String, String>,
-    corrected: Vec<String>,
-    pendulum: Vec<String>,
+    channels_of: job_args::ChannelLists,
 ) -> PyResult<Described> {
     let quantity: Quantity = quantity.parse().map_err(value_error)?;
     let items: Vec<String> = units.iter().map(|(k, u)| format!("{k}={u}")).collect();
@@ -271,8 +273,16 @@ fn describe_arrays(
     }
     let mut sensors = Sensors::default();
     for (option, names, motion) in [
-        (OptionKey::CORRECTED, &corrected, Motion::Translation),
-        (OptionKey::PENDULUM_TILTMETER, &pendulum, Motion::Rotation),
+        (
+            OptionKey::CORRECTED,
+            &channels_of.corrected,
+            Motion::Translation,
+        ),
+        (
+            OptionKey::PENDULUM_TILTMETER,
+            &channels_of.pendulum_tiltmeter,
+            Motion::Rotation,
+        ),
     ] {
         refuse_repeats(option, "input", names, |n| n.clone())
             .map_err(|e| value_error(e.to_string()))?;
@@ -446,39 +456,33 @@ fn check_unstated_array(name: &str, quantity: Quantity, data: &[f64], fs: f64) -
 ///
 /// Returns a :class:`Budget`. Raises ``ValueError`` for options or data that do not fit.
 #[pyfunction]
-#[pyo3(signature = (tilt, fs, *, axes=None, quantity="angle", units=None, corrected=None, pendulum_tiltmeter=None, gaps="reject", params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, observables=None, readout=None, term=None, witness_noise=None, measured=None, at=None, at_band=None))]
+#[pyo3(signature = (tilt, fs, *, axes=None, quantity=String::from("angle"), units=None, corrected=None, pendulum_tiltmeter=None, gaps=String::from("reject"), params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, observables=None, readout=None, term=None, witness_noise=None, measured=None, at=None, at_band=None), text_signature = "(tilt, fs, *, axes=None, quantity='angle', units=None, corrected=None, pendulum_tiltmeter=None, gaps='reject', params=None, nperseg=None, overlap=None, average=None, segment_duration=None, percentiles=None, observables=None, readout=None, term=None, witness_noise=None, measured=None, at=None, at_band=None)")]
 #[allow(clippy::too_many_arguments)]
 pub fn budget(
     py: Python<'_>,
     tilt: &Bound<'_, PyAny>,
-    fs: f64,
+    #[pyo3(from_py_with = kw::fs)] fs: f64,
     axes: Option<&Bound<'_, PyAny>>,
-    quantity: &str,
-    units: Option<std::collections::BTreeMap<String, String>>,
+    #[pyo3(from_py_with = kw::quantity)] quantity: String,
+    #[pyo3(from_py_with = kw::units)] units: Option<std::collections::BTreeMap<String, String>>,
     corrected: Option<&Bound<'_, PyAny>>,
     pendulum_tiltmeter: Option<&Bound<'_, PyAny>>,
-    gaps: &str,
+    #[pyo3(from_py_with = kw::gaps)] gaps: String,
     params: Option<&Bound<'_, PyAny>>,
-    nperseg: Option<usize>,
-    overlap: Option<f64>,
-    average: Option<&str>,
-    segment_duration: Option<f64>,
+    #[pyo3(from_py_with = kw::nperseg)] nperseg: Option<usize>,
+    #[pyo3(from_py_with = kw::overlap)] overlap: Option<f64>,
+    #[pyo3(from_py_with = kw::average)] average: Option<String>,
+    #[pyo3(from_py_with = kw::segment_duration)] segment_duration: Option<f64>,
     percentiles: Option<&Bound<'_, PyAny>>,
     observables: Option<&Bound<'_, PyAny>>,
-    readout: Option<&Bound<'_, PyDict>>,
-    term: Option<&Bound<'_, PyDict>>,
-    witness_noise: Option<&Bound<'_, PyDict>>,
-    measured: Option<PathBuf>,
+    #[pyo3(from_py_with = kw::readout)] readout: Option<Bound<'_, PyDict>>,
+    #[pyo3(from_py_with = kw::term)] term: Option<Bound<'_, PyDict>>,
+    #[pyo3(from_py_with = kw::witness_noise)] witness_noise: Option<Bound<'_, PyDict>>,
+    #[pyo3(from_py_with = kw::measured)] measured: Option<PathBuf>,
     at: Option<&Bound<'_, PyAny>>,
-    at_band: Option<f64>,
+    #[pyo3(from_py_with = kw::at_band)] at_band: Option<f64>,
 ) -> PyResult<Budget> {
-    let corrected = args::strings("corrected", corrected)?;
-    let pendulum_tiltmeter = args::strings("pendulum_tiltmeter", pendulum_tiltmeter)?;
-    let percentiles = args::pair(
-        "percentiles",
-        percentiles,
-        "(LOWER, UPPER) with 0 <= LOWER < UPPER <= 100",
-    )?;
+    let channels_of = job_args::ChannelLists::of(corrected, pendulum_tiltmeter)?;
     let at = args::numbers("at", at)?;
     let (model, params) = model_of(params)?;
     let gaps: GapPolicy = gaps.parse().map_err(value_error)?;
@@ -490,13 +494,7 @@ pub fn budget(
             "tilt: no input given; give at least one of theta_t, eta_t, phi_t, x_t, y_t, z_t",
         ));
     }
-    let described = describe_arrays(
-        &channels,
-        quantity,
-        units.unwrap_or_default(),
-        corrected.unwrap_or_default(),
-        pendulum_tiltmeter.unwrap_or_default(),
-    )?;
+    let described = describe_arrays(&channels, &quantity, units.unwrap_or_default(), channels_of)?;
     for w in channels.windows(2) {
         if w[0].1.len() != w[1].1.len() {
             return Err(value_error(format!(
@@ -508,11 +506,17 @@ pub fn budget(
             )));
         }
     }
-    let welch = welch(nperseg, overlap, average, segment_duration, percentiles)?;
+    let welch = welch(
+        nperseg,
+        overlap,
+        average.as_deref(),
+        segment_duration,
+        percentiles,
+    )?;
     let observables = job_args::observables(observables)?;
-    let readout = job_args::readout(readout)?;
-    let terms = job_args::terms(term)?;
-    let witness_noise = job_args::witness_noise(witness_noise)?;
+    let readout = job_args::readout(readout.as_ref())?;
+    let terms = job_args::terms(term.as_ref())?;
+    let witness_noise = job_args::witness_noise(witness_noise.as_ref())?;
     let axis_map = described
         .channels
         .iter()
@@ -578,7 +582,7 @@ pub fn budget(
             at_band,
         };
         let inputs = Inputs::of_params(params.file.as_deref())
-            .with_all(job_args::python_names(req.input_files()));
+            .with_all(job_args::python_names(req.input_files(), &[]));
         let result = tiltnoise_job::budget::run(req, &cancel, &mut |_, _| {});
         Ok((result.map_err(job_args::job_error)?, inputs))
     })?;
@@ -613,47 +617,33 @@ pub fn budget(
 #[allow(clippy::too_many_arguments)]
 pub fn budget_from_file(
     py: Python<'_>,
-    path: PathBuf,
-    axes: Option<&str>,
-    quantity: Option<&str>,
-    units: Option<std::collections::BTreeMap<String, String>>,
+    #[pyo3(from_py_with = kw::path)] path: PathBuf,
+    #[pyo3(from_py_with = kw::axes)] axes: Option<String>,
+    #[pyo3(from_py_with = kw::quantity)] quantity: Option<String>,
+    #[pyo3(from_py_with = kw::units)] units: Option<std::collections::BTreeMap<String, String>>,
     corrected: Option<&Bound<'_, PyAny>>,
     pendulum_tiltmeter: Option<&Bound<'_, PyAny>>,
-    gaps: Option<&str>,
+    #[pyo3(from_py_with = kw::gaps)] gaps: Option<String>,
     params: Option<&Bound<'_, PyAny>>,
-    nperseg: Option<usize>,
-    overlap: Option<f64>,
-    average: Option<&str>,
-    segment_duration: Option<f64>,
+    #[pyo3(from_py_with = kw::nperseg)] nperseg: Option<usize>,
+    #[pyo3(from_py_with = kw::overlap)] overlap: Option<f64>,
+    #[pyo3(from_py_with = kw::average)] average: Option<String>,
+    #[pyo3(from_py_with = kw::segment_duration)] segment_duration: Option<f64>,
     percentiles: Option<&Bound<'_, PyAny>>,
     observables: Option<&Bound<'_, PyAny>>,
-    readout: Option<&Bound<'_, PyDict>>,
-    term: Option<&Bound<'_, PyDict>>,
-    witness_noise: Option<&Bound<'_, PyDict>>,
+    #[pyo3(from_py_with = kw::readout)] readout: Option<Bound<'_, PyDict>>,
+    #[pyo3(from_py_with = kw::term)] term: Option<Bound<'_, PyDict>>,
+    #[pyo3(from_py_with = kw::witness_noise)] witness_noise: Option<Bound<'_, PyDict>>,
     freq: Option<&Bound<'_, PyAny>>,
-    measured: Option<PathBuf>,
-    scale: Option<std::collections::BTreeMap<String, f64>>,
+    #[pyo3(from_py_with = kw::measured)] measured: Option<PathBuf>,
+    #[pyo3(from_py_with = kw::scale)] scale: Option<std::collections::BTreeMap<String, f64>>,
     at: Option<&Bound<'_, PyAny>>,
-    at_band: Option<f64>,
+    #[pyo3(from_py_with = kw::at_band)] at_band: Option<f64>,
 ) -> PyResult<Budget> {
-    let corrected = args::strings("corrected", corrected)?;
-    let pendulum_tiltmeter = args::strings("pendulum_tiltmeter", pendulum_tiltmeter)?;
-    let percentiles = args::pair(
-        "percentiles",
-        percentiles,
-        "(LOWER, UPPER) with 0 <= LOWER < UPPER <= 100",
-    )?;
+    let channels_of = job_args::ChannelLists::of(corrected, pendulum_tiltmeter)?;
     let at = args::numbers("at", at)?;
     let (model, params) = model_of(params)?;
-    let read = job_args::file_read_request(
-        axes,
-        quantity,
-        units,
-        corrected,
-        pendulum_tiltmeter,
-        gaps,
-        scale,
-    )?;
+    let read = job_args::file_read_request(axes, quantity, units, channels_of, gaps, scale)?;
     let freq_hz = match freq {
         None => None,
         Some(f) => Some(match f.cast::<PyString>() {
@@ -664,18 +654,26 @@ pub fn budget_from_file(
     let req = BudgetRequest {
         model: &model,
         tilt: TiltSource::File { path, read },
-        welch: welch(nperseg, overlap, average, segment_duration, percentiles)?,
+        welch: welch(
+            nperseg,
+            overlap,
+            average.as_deref(),
+            segment_duration,
+            percentiles,
+        )?,
         freq_hz,
         observables: job_args::observables(observables)?,
-        readout: job_args::readout(readout)?,
-        terms: job_args::terms(term)?,
-        witness_noise: job_args::witness_noise(witness_noise)?,
+        readout: job_args::readout(readout.as_ref())?,
+        terms: job_args::terms(term.as_ref())?,
+        witness_noise: job_args::witness_noise(witness_noise.as_ref())?,
         measured,
         at_hz: at,
         at_band,
     };
-    let inputs = Inputs::of_params(params.file.as_deref())
-        .with_all(job_args::python_names(req.input_files()));
+    let inputs = Inputs::of_params(params.file.as_deref()).with_all(job_args::python_names(
+        req.input_files(),
+        &[("tilt", "path")],
+    ));
     let cancel = Cancel::new();
     let BudgetResult { report, input } = interrupt::watch(py, &cancel, || {
         tiltnoise_job::budget::run(req, &cancel, &mut |_, _| {}).map_err(job_args::job_error)
@@ -851,25 +849,25 @@ impl Budget {
     }
 
     /// One-sided PSD of a term (or ``"total"``) of an observable, (unit)**2/Hz.
-    #[pyo3(signature = (observable, term="total"))]
+    #[pyo3(signature = (observable, term=String::from("total")), text_signature = "($self, observable, term='total')")]
     fn psd<'py>(
         &self,
         py: Python<'py>,
-        observable: &str,
-        term: &str,
+        #[pyo3(from_py_with = kw::observable)] observable: String,
+        #[pyo3(from_py_with = kw::term)] term: String,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        Ok(PyArray1::from_vec(py, self.psd_of(observable, term)?))
+        Ok(PyArray1::from_vec(py, self.psd_of(&observable, &term)?))
     }
 
     /// ASD of a term (or ``"total"``) of an observable, unit/sqrt(Hz).
-    #[pyo3(signature = (observable, term="total"))]
+    #[pyo3(signature = (observable, term=String::from("total")), text_signature = "($self, observable, term='total')")]
     fn asd<'py>(
         &self,
         py: Python<'py>,
-        observable: &str,
-        term: &str,
+        #[pyo3(from_py_with = kw::observable)] observable: String,
+        #[pyo3(from_py_with = kw::term)] term: String,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        Ok(asd(py, &self.psd_of(observable, term)?))
+        Ok(asd(py, &self.psd_of(&observable, &term)?))
     }
 
     /// For a damped model, ``{observable: {"input", "unit", "quantity", "response_abs",
@@ -1033,7 +1031,10 @@ impl Budget {
     /// columns ``OBS.TERM``; ``docs/schemas.md``): columns that are zero at every frequency
     /// are left out and named in a ``# note:`` line unless ``keep_zero_columns``.
     #[pyo3(signature = (*, keep_zero_columns=false))]
-    fn to_csv(&self, keep_zero_columns: bool) -> PyResult<String> {
+    fn to_csv(
+        &self,
+        #[pyo3(from_py_with = kw::keep_zero_columns)] keep_zero_columns: bool,
+    ) -> PyResult<String> {
         tiltnoise_io::budget_csv_string(&self.report, &self.run_meta(), keep_zero_columns)
             .map_err(value_error)
     }
@@ -1047,7 +1048,12 @@ impl Budget {
     /// parameter file; compared as files, whatever the spelling), ``ValueError`` for another
     /// extension. ``keep_zero_columns``: as ``to_csv``.
     #[pyo3(signature = (path, *, keep_zero_columns=false))]
-    fn save(&self, py: Python<'_>, path: PathBuf, keep_zero_columns: bool) -> PyResult<()> {
+    fn save(
+        &self,
+        py: Python<'_>,
+        #[pyo3(from_py_with = kw::path)] path: PathBuf,
+        #[pyo3(from_py_with = kw::keep_zero_columns)] keep_zero_columns: bool,
+    ) -> PyResult<()> {
         use tiltnoise_io::OutputKind;
         let kind = OutputKind::from_path(&path).py()?;
         self.inputs.check_save(&path)?;

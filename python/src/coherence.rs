@@ -1,7 +1,7 @@
 //! `tiltnoise.coherence` (the command line's `coherence --tilt FILE --measured FILE`) and the
 //! `Coherence` it returns: the coherence job's report with names and units.
 
-use crate::args;
+use crate::args::{self, kw};
 use crate::budget::model_of;
 use crate::errors::PyResultExt;
 use crate::inputs::Inputs;
@@ -37,20 +37,20 @@ use tiltnoise_job::coherence::{CoherenceRequest, CoherenceResult};
 #[allow(clippy::too_many_arguments)]
 pub fn coherence(
     py: Python<'_>,
-    tilt: PathBuf,
-    measured: PathBuf,
-    axes: Option<&str>,
-    quantity: Option<&str>,
-    gaps: Option<&str>,
-    scale: Option<std::collections::BTreeMap<String, f64>>,
+    #[pyo3(from_py_with = kw::tilt)] tilt: PathBuf,
+    #[pyo3(from_py_with = kw::measured)] measured: PathBuf,
+    #[pyo3(from_py_with = kw::axes)] axes: Option<String>,
+    #[pyo3(from_py_with = kw::quantity)] quantity: Option<String>,
+    #[pyo3(from_py_with = kw::gaps)] gaps: Option<String>,
+    #[pyo3(from_py_with = kw::scale)] scale: Option<std::collections::BTreeMap<String, f64>>,
     observables: Option<&Bound<'_, PyAny>>,
-    nperseg: Option<usize>,
-    overlap: Option<f64>,
-    confidence: Option<f64>,
+    #[pyo3(from_py_with = kw::nperseg)] nperseg: Option<usize>,
+    #[pyo3(from_py_with = kw::overlap)] overlap: Option<f64>,
+    #[pyo3(from_py_with = kw::confidence)] confidence: Option<f64>,
     fit_band: Option<&Bound<'_, PyAny>>,
     params: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Coherence> {
-    let fit_band = args::pair("fit_band", fit_band, "(FLO, FHI) in Hz, 0 < FLO < FHI")?;
+    let fit_band = args::band("fit_band", fit_band)?;
     let (model, params) = model_of(params)?;
     let observables = job_args::observables(observables)?;
     let req = CoherenceRequest {
@@ -65,7 +65,7 @@ pub fn coherence(
         fit_band_hz: fit_band,
     };
     let inputs = Inputs::of_params(params.file.as_deref())
-        .with_all(job_args::python_names(req.input_files()));
+        .with_all(job_args::python_names(req.input_files(), &[]));
     let cancel = Cancel::new();
     let CoherenceResult {
         report,
@@ -280,7 +280,7 @@ impl Coherence {
     /// their confidence band beside the model's: the same image as ``tiltnoise coherence
     /// --save x.png`` for the same records); atomically. Raises ``OSError`` if it cannot be
     /// written or is one of the files read, ``ValueError`` for another extension.
-    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+    fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
         OutputKind::from_path(&path).py()?;
         self.inputs.check_save(&path)?;
         let meta = self.run_meta();

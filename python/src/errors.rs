@@ -1,9 +1,10 @@
 //! The library's typed errors as Python exceptions, with the command line's messages.
 //!
 //! * A file that cannot be opened or read: `FileNotFoundError`, `PermissionError`,
-//!   `IsADirectoryError` or `OSError`, by what the operating system said.
+//!   `IsADirectoryError` or `OSError`, by what the operating system said, whichever call and
+//!   keyword named it (the libraries' errors keep the reason whole for this).
 //! * A file that was read but is not valid (layout, attributes, values, a parameter file's
-//!   TOML): [`InputFileError`], a subclass of `OSError`.
+//!   TOML, a text file that is not UTF-8): [`InputFileError`], a subclass of `OSError`.
 //! * A request whose memory the machine does not have (`tiltnoise_core::limits`: more than
 //!   half of what is available, under the process's address-space limit too): `MemoryError`.
 //! * Everything else the caller can fix (a parameter out of range, an unknown name, an option
@@ -75,6 +76,16 @@ pub fn os_error(kind: ErrorKind, message: String) -> PyErr {
     }
 }
 
+/// The exception for a file that could not be read, `reason` what reading it said: the
+/// `OSError` subclass of an operating-system failure ([`os_error`]), [`InputFileError`] for a
+/// text file that is not UTF-8 (read, but not valid).
+pub fn read_error(reason: &std::io::Error, message: String) -> PyErr {
+    match reason.kind() {
+        ErrorKind::InvalidData => InputFileError::new_err(message),
+        kind => os_error(kind, message),
+    }
+}
+
 /// Conversion of a library error into the Python exception of its kind (see the module docs).
 pub trait IntoPyErr {
     /// The exception, carrying the error's message.
@@ -94,7 +105,7 @@ impl IntoPyErr for ParamError {
     fn into_py_err(self) -> PyErr {
         let message = self.to_string();
         match self {
-            ParamError::Read { reason, .. } => os_error(reason.kind(), message),
+            ParamError::Read { reason, .. } => read_error(&reason, message),
             ParamError::TooLarge(e) => e.into_py_err(),
             _ => PyValueError::new_err(message),
         }
@@ -105,7 +116,7 @@ impl IntoPyErr for InputError {
     fn into_py_err(self) -> PyErr {
         let message = self.to_string();
         match self {
-            InputError::Io { reason, .. } => os_error(reason.kind(), message),
+            InputError::Io { reason, .. } => read_error(&reason, message),
             // A path whose extension names no supported format: the argument is wrong, not
             // the file (which is not opened).
             InputError::Extension { .. } => PyValueError::new_err(message),

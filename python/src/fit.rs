@@ -1,7 +1,8 @@
 //! `Model.fit`: the constrained least-squares fit of chosen parameters to measured mode
 //! frequencies (the command line's `tiltnoise fit`).
 
-use crate::errors::{os_error, value_error, PyResultExt};
+use crate::args::kw;
+use crate::errors::{value_error, PyResultExt};
 use crate::inputs::Inputs;
 use crate::interrupt;
 use crate::job_args::job_error;
@@ -14,7 +15,6 @@ use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::fit::{FitResult, SigmaSource};
 use tiltnoise_core::params::Params;
 use tiltnoise_job::fit::{FitOutcome, FitRequest};
-use tiltnoise_job::JobError;
 
 /// What `Model.fit` measures against: the frequency file, or Table II's measured column; with
 /// visibilities and no frequency file, no frequency at all (Table II belongs to the paper's
@@ -39,12 +39,6 @@ pub fn run(
     let files = Inputs::of_params(params_file)
         .with("measured", inputs.measured.as_deref())
         .with("visibility", inputs.visibility.as_deref());
-    let given: Vec<PathBuf> = inputs
-        .measured
-        .iter()
-        .chain(&inputs.visibility)
-        .cloned()
-        .collect();
     let req = FitRequest {
         params,
         measured: inputs.measured,
@@ -55,7 +49,7 @@ pub fn run(
     };
     let cancel = Cancel::new();
     let FitOutcome { result, origin } = interrupt::watch(py, &cancel, || {
-        tiltnoise_job::fit::run(req, &cancel).map_err(|e| file_error(e, &given))
+        tiltnoise_job::fit::run(req, &cancel).map_err(job_error)
     })?;
     Ok(Fit {
         result,
@@ -63,23 +57,6 @@ pub fn run(
         nominal: params.clone(),
         inputs: files,
     })
-}
-
-/// The fit job's error as its exception; a file of `given` that cannot be opened (the job's
-/// error keeps only the reason's text) as the `OSError` of the reason, `FileNotFoundError`
-/// for a missing file, as for every other call's input files.
-fn file_error(e: JobError, given: &[PathBuf]) -> PyErr {
-    if matches!(e, JobError::FitFile(_)) {
-        let unreadable = given.iter().find_map(|p| match std::fs::File::open(p) {
-            Err(reason) => Some(reason.kind()),
-            Ok(_) if p.is_dir() => Some(std::io::ErrorKind::IsADirectory),
-            Ok(_) => None,
-        });
-        if let Some(kind) = unreadable {
-            return os_error(kind, e.message());
-        }
-    }
-    job_error(e)
 }
 
 /// The result of :meth:`Model.fit` (the command line's ``fit --format json``, by the same
@@ -286,7 +263,7 @@ impl Fit {
     /// :meth:`to_json`) or ``.h5``/``.hdf5`` (schema ``tiltnoise.fit``); atomically. Raises
     /// ``OSError`` if it cannot be written or is one of the files read, ``ValueError`` for
     /// another extension.
-    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+    fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
         tiltnoise_job::fit::check_save_path(&path).py()?;
         self.inputs.check_save(&path)?;
         let meta = tiltnoise_io::RunMeta::of_this_run(&self.nominal, None);

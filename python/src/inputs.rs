@@ -7,8 +7,8 @@ use pyo3::PyResult;
 use std::path::{Path, PathBuf};
 use tiltnoise_io::OutputError;
 
-/// The input files of a result, each with the argument that named it (`path`, `measured`,
-/// `Params.from_toml`), for the message.
+/// The input files of a result, each with the keyword that named it in its call (`path`,
+/// `tilt`, `measured`, `Params.from_toml`), for the message.
 #[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub struct Inputs(Vec<(String, PathBuf)>);
 
@@ -40,7 +40,7 @@ impl Inputs {
 
     /// Refuses to save to `path` when it is one of the inputs, or when it cannot be written
     /// (its directory is missing or not writable): `OSError` naming the path and the rule,
-    /// the input as what it is to the reader (`the tilt input tilt.h5`).
+    /// the input as what it is to the reader and its keyword (`the tilt input (tilt=) tilt.h5`).
     pub fn check_save(&self, path: &Path) -> PyResult<()> {
         let inputs: Vec<(String, &Path)> = self
             .0
@@ -70,12 +70,13 @@ impl Inputs {
     }
 }
 
-/// The input named by the argument `arg`, as a reader says it: `tilt input`, `measured
-/// input`, `parameter file (Params.from_toml)`, `colocated input`.
+/// The input named by the argument `arg`, as a reader says it: what it is and the keyword
+/// that named it (`tilt input (path=)`, `tilt input (tilt=)`, `measured input (measured=)`,
+/// `parameter file (Params.from_toml)`).
 fn described(arg: &str) -> String {
     match arg {
-        "path" | "tilt" => "tilt input".to_string(),
         "Params.from_toml" => "parameter file (Params.from_toml)".to_string(),
-        other => format!("{other} input"),
+        "path" => "tilt input (path=)".to_string(),
+        other => format!("{} input ({other}=)", other.replace('_', " ")),
     }
 }

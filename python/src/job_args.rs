@@ -3,10 +3,11 @@
 //! The job (`tiltnoise_job`) reads the files and checks everything against the budget, as it
 //! does for the command line.
 
-use crate::errors::{value_error, InputFileError, IntoPyErr, PyResultExt};
+use crate::args;
+use crate::errors::{read_error, value_error, InputFileError, IntoPyErr, PyResultExt};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use std::path::PathBuf;
+
 use tiltnoise_core::budget::BudgetError;
 use tiltnoise_core::fit::FitError;
 use tiltnoise_core::input::{parse_scales, parse_units, AxisMap};
@@ -33,9 +34,11 @@ pub fn job_error(e: JobError) -> PyErr {
         JobError::Freq(e) => (*e).into_py_err(),
         JobError::MonteCarlo(e) => (*e).into_py_err(),
         JobError::FitFile(e) => match *e {
+            FitError::Read { reason, .. } => return read_error(&reason, message),
             FitError::Measured { .. } | FitError::Visibility { .. } => {
                 return InputFileError::new_err(message)
             }
+            FitError::TooLarge(e) => e.into_py_err(),
             _ => return value_error(message),
         },
         JobError::Fit(e) => match *e {
@@ -57,9 +60,9 @@ pub fn job_error(e: JobError) -> PyErr {
 /// How to read a record of the floor's motion from `axes` (the axis map), `quantity`,
 /// `gaps` and `scale` (`{channel: factor}`), as the command line's options of the same names.
 pub fn read_request(
-    axes: Option<&str>,
-    quantity: Option<&str>,
-    gaps: Option<&str>,
+    axes: Option<String>,
+    quantity: Option<String>,
+    gaps: Option<String>,
     scale: Option<std::collections::BTreeMap<String, f64>>,
 ) -> PyResult<ReadRequest> {
     let scale: Vec<String> = scale
@@ -69,30 +72,60 @@ pub fn read_request(
         .collect();
     Ok(ReadRequest {
         axis_map: axes
+            .as_deref()
             .map(AxisMap::parse)
             .transpose()
             .map_err(|e| value_error(e.to_string()))?,
-        quantity: quantity.map(str::parse).transpose().map_err(value_error)?,
-        gaps: gaps.map(str::parse).transpose().map_err(value_error)?,
+        quantity: quantity
+            .as_deref()
+            .map(str::parse)
+            .transpose()
+            .map_err(value_error)?,
+        gaps: gaps
+            .as_deref()
+            .map(str::parse)
+            .transpose()
+            .map_err(value_error)?,
         scale: parse_scales(OptionKey::SCALE, &scale).py()?,
         ..ReadRequest::default()
     })
 }
 
+/// The channel lists of a record of the floor's motion: the translation channels `corrected`
+/// already and the tilt channels read by a `pendulum_tiltmeter` (each a `str` or a sequence of
+/// them, [`crate::args::strings`]; none by default).
+pub struct ChannelLists {
+    /// `corrected=`.
+    pub corrected: Vec<String>,
+    /// `pendulum_tiltmeter=`.
+    pub pendulum_tiltmeter: Vec<String>,
+}
+
+impl ChannelLists {
+    /// The lists of the keywords `corrected` and `pendulum_tiltmeter`.
+    pub fn of(
+        corrected: Option<&Bound<'_, PyAny>>,
+        pendulum_tiltmeter: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<ChannelLists> {
+        Ok(ChannelLists {
+            corrected: args::strings("corrected", corrected)?.unwrap_or_default(),
+            pendulum_tiltmeter: args::strings("pendulum_tiltmeter", pendulum_tiltmeter)?
+                .unwrap_or_default(),
+        })
+    }
+}
+
 /// How to read a record of the floor's motion from a file: [`read_request`]'s options and
-/// `units` (`{channel: unit}`), the translation channels `corrected` already and the tilt
-/// channels read by a `pendulum_tiltmeter`, each channel once.
+/// `units` (`{channel: unit}`), and the [`ChannelLists`], each channel once.
 pub fn file_read_request(
-    axes: Option<&str>,
-    quantity: Option<&str>,
+    axes: Option<String>,
+    quantity: Option<String>,
     units: Option<std::collections::BTreeMap<String, String>>,
-    corrected: Option<Vec<String>>,
-    pendulum_tiltmeter: Option<Vec<String>>,
-    gaps: Option<&str>,
+    channels_of: ChannelLists,
+    gaps: Option<String>,
     scale: Option<std::collections::BTreeMap<String, f64>>,
 ) -> PyResult<ReadRequest> {
-    let names_once = |option: OptionKey, names: Option<Vec<String>>| -> PyResult<Vec<String>> {
-        let names = names.unwrap_or_default();
+    let names_once = |option: OptionKey, names: Vec<String>| -> PyResult<Vec<String>> {
         refuse_repeats(option, "channel", &names, |n| n.clone())
             .map_err(|e| value_error(e.to_string()))?;
         Ok(names)
@@ -107,8 +140,11 @@ pub fn file_read_request(
                 .collect::<Vec<_>>(),
         )
         .py()?,
-        corrected: names_once(OptionKey::CORRECTED, corrected)?,
-        pendulum_tiltmeter: names_once(OptionKey::PENDULUM_TILTMETER, pendulum_tiltmeter)?,
+        corrected: names_once(OptionKey::CORRECTED, channels_of.corrected)?,
+        pendulum_tiltmeter: names_once(
+            OptionKey::PENDULUM_TILTMETER,
+            channels_of.pendulum_tiltmeter,
+        )?,
         ..read_request(axes, quantity, gaps, scale)?
     })
 }
@@ -118,20 +154,10 @@ pub fn observables(arg: Option<&Bound<'_, PyAny>>) -> PyResult<Option<Vec<Observ
     let Some(arg) = arg else {
         return Ok(None);
     };
-    let names = crate::args::names("observables", Some(arg))?.unwrap_or_default();
+    let names = args::names("observables", Some(arg))?.unwrap_or_default();
     options::parse_outputs(OptionKey::OBSERVABLES, &names)
         .py()
         .map(Some)
-}
-
-/// A path given as `str` or `os.PathLike`, or `None` for anything else.
-fn path_of(value: &Bound<'_, PyAny>) -> Option<PathBuf> {
-    if value.is_instance_of::<pyo3::types::PyFloat>()
-        || value.is_instance_of::<pyo3::types::PyInt>()
-    {
-        return None;
-    }
-    value.extract::<PathBuf>().ok()
 }
 
 /// `readout`: `{observable: ASD}` (white, unit/sqrt(Hz); 0 removes it) or `{observable:
@@ -140,12 +166,10 @@ pub fn readout(arg: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<ReadoutItem>> {
     let Some(d) = arg else {
         return Ok(Vec::new());
     };
+    const EXPECTED: &str = "a dict {observable: ASD (a number) or ASD file (a path)}";
     let mut items = Vec::new();
-    for (name, value) in d.iter() {
-        let name: String = name
-            .extract()
-            .map_err(|_| value_error("readout: the keys must be observable names (str)"))?;
-        if let Some(path) = path_of(&value) {
+    for (name, value) in args::entries("readout", d, EXPECTED)? {
+        if let Some(path) = args::path_of(&value) {
             let observable = Observable::from_name(&name).ok_or_else(|| {
                 value_error(format!(
                     "readout {name}=...: unknown observable `{name}`; allowed: {}",
@@ -158,11 +182,8 @@ pub fn readout(arg: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<ReadoutItem>> {
             });
             continue;
         }
-        let asd: f64 = value.extract().map_err(|_| {
-            value_error(format!(
-                "readout {name}: expected an ASD (a number) or an ASD file (a path)"
-            ))
-        })?;
+        let asd = args::number_of(&value)
+            .ok_or_else(|| args::entry_error("readout", d, EXPECTED, &name, &value))?;
         let (observable, asd) = options::readout_item(OptionKey::READOUT, &name, asd).py()?;
         items.push(ReadoutItem {
             observable,
@@ -177,16 +198,17 @@ pub fn terms(arg: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<TermItem>> {
     let Some(d) = arg else {
         return Ok(Vec::new());
     };
+    const EXPECTED: &str =
+        "a dict {name: (source, path)}, e.g. {\"mag\": (\"phi\", \"phi_mag.csv\")}";
     let mut items = Vec::new();
-    for (name, value) in d.iter() {
-        let name: String = name
-            .extract()
-            .map_err(|_| value_error("term: the keys must be term names (str)"))?;
-        let (source, file): (String, PathBuf) = value.extract().map_err(|_| {
-            value_error(format!(
-                "term[{name:?}]: expected (source, path), e.g. (\"phi\", \"phi_mag.csv\")"
-            ))
-        })?;
+    for (name, value) in args::entries("term", d, EXPECTED)? {
+        let pair = value
+            .extract::<(Bound<'_, PyAny>, Bound<'_, PyAny>)>()
+            .ok()
+            .and_then(|(s, f)| Some((s.extract::<String>().ok()?, args::path_of(&f)?)));
+        let Some((source, file)) = pair else {
+            return Err(args::entry_error("term", d, EXPECTED, &name, &value));
+        };
         let source = match (Observable::from_name(&source), Input::from_name(&source)) {
             (Some(o), _) => UserSource::Observable(o),
             (None, Some(i)) => UserSource::Input(i),
@@ -204,17 +226,20 @@ pub fn terms(arg: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<TermItem>> {
     Ok(items)
 }
 
-/// The argument that names each of the job's input files in Python (`files` from
-/// `BudgetRequest::input_files`), for the rule that no `save` replaces one.
+/// The keyword that names each of the job's input files in the Python call (`files` from the
+/// request's `input_files`, by the command line's option names), for the rule that no `save`
+/// replaces one: `renamed` lists the options whose keyword differs in this call (the tilt
+/// file is `path=` in `budget_from_file`, `tilt=` in `subtract` and `coherence`).
 pub fn python_names<'a>(
     files: Vec<(&'static str, &'a std::path::Path)>,
+    renamed: &'static [(&'static str, &'static str)],
 ) -> impl Iterator<Item = (&'static str, &'a std::path::Path)> {
-    files.into_iter().map(|(option, path)| {
-        let arg = match option {
-            "tilt" => "path",
-            other => other,
-        };
-        (arg, path)
+    files.into_iter().map(move |(option, path)| {
+        let keyword = renamed
+            .iter()
+            .find(|(o, _)| *o == option)
+            .map_or(option, |(_, k)| *k);
+        (keyword, path)
     })
 }
 
@@ -225,11 +250,10 @@ pub fn witness_noise(arg: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<WitnessIte
     let Some(d) = arg else {
         return Ok(Vec::new());
     };
+    const EXPECTED: &str = "a dict {input: ASD (a number) or ASD file (a path), or either \
+                            with its relative uncertainty as (value, rel)}";
     let mut items = Vec::new();
-    for (name, value) in d.iter() {
-        let name: String = name
-            .extract()
-            .map_err(|_| value_error("witness_noise: the keys must be input names (str)"))?;
+    for (name, value) in args::entries("witness_noise", d, EXPECTED)? {
         let input = Input::from_name(&name)
             .filter(|i| i.is_ground())
             .ok_or_else(|| {
@@ -238,18 +262,33 @@ pub fn witness_noise(arg: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<WitnessIte
                      allowed: theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)"
                 ))
             })?;
-        let (level, rel) = match value.extract::<(Bound<'_, PyAny>, f64)>() {
-            Ok((level, rel)) => (level, rel),
-            Err(_) => (value, 0.0),
+        let (level, rel) = match value.extract::<(Bound<'_, PyAny>, Bound<'_, PyAny>)>() {
+            Ok((level, rel)) => match args::number_of(&rel) {
+                Some(rel) => (level, rel),
+                None => {
+                    return Err(args::entry_error(
+                        "witness_noise",
+                        d,
+                        EXPECTED,
+                        &name,
+                        &value,
+                    ))
+                }
+            },
+            Err(_) => (value.clone(), 0.0),
         };
-        let asd = match path_of(&level) {
-            Some(path) => AsdSpec::File(path),
-            None => AsdSpec::White(level.extract().map_err(|_| {
-                value_error(format!(
-                    "witness_noise {name}: expected an ASD (a number) or an ASD file (a path), \
-                     or either with its relative uncertainty as (value, rel)"
+        let asd = match (args::path_of(&level), args::number_of(&level)) {
+            (Some(path), _) => AsdSpec::File(path),
+            (None, Some(asd)) => AsdSpec::White(asd),
+            (None, None) => {
+                return Err(args::entry_error(
+                    "witness_noise",
+                    d,
+                    EXPECTED,
+                    &name,
+                    &value,
                 ))
-            })?),
+            }
         };
         items.push(WitnessItem { input, asd, rel });
     }

@@ -1,6 +1,7 @@
 //! `tiltnoise.Model`: normal modes, transfer functions (the command line's `modes` and `tf`),
 //! the model's matrices and the Monte Carlo of the modes (`mc`).
 
+use crate::args::kw;
 use crate::arrays;
 use crate::errors::{value_error, PyResultExt};
 use crate::grid::{self, GridBuffer};
@@ -317,8 +318,8 @@ fn matrix<'py, R: nalgebra::Dim, C: nalgebra::Dim, S: nalgebra::RawStorage<f64, 
 impl PyModel {
     #[new]
     #[pyo3(signature = (params=None))]
-    fn new(params: Option<PyRef<'_, PyParams>>) -> PyResult<Self> {
-        PyModel::build(params.as_deref())
+    fn new(#[pyo3(from_py_with = kw::params)] params: Option<PyParams>) -> PyResult<Self> {
+        PyModel::build(params.as_ref())
     }
 
     /// The parameters the model was built from.
@@ -402,7 +403,7 @@ impl PyModel {
     /// name the method (``method="polezero"`` is what it picks for the tilt matrix of Table I).
     /// Raises ``ValueError`` for an unknown name, a frequency that is
     /// negative or not finite, or one on an undamped resonance.
-    #[pyo3(signature = (freq_hz, inputs=None, outputs=None, method="auto", rel_tol=1e-9, threads=None, out=None))]
+    #[pyo3(signature = (freq_hz, inputs=None, outputs=None, method=String::from("auto"), rel_tol=1e-9, threads=None, out=None), text_signature = "($self, freq_hz, inputs=None, outputs=None, method='auto', rel_tol=1e-9, threads=None, out=None)")]
     #[allow(clippy::too_many_arguments)]
     #[allow(unsafe_code, reason = "a new NumPy array filled in place")]
     fn transfer<'py>(
@@ -411,16 +412,16 @@ impl PyModel {
         freq_hz: &Bound<'py, PyAny>,
         inputs: Option<&Bound<'py, PyAny>>,
         outputs: Option<&Bound<'py, PyAny>>,
-        method: &str,
-        rel_tol: f64,
-        threads: Option<usize>,
+        #[pyo3(from_py_with = kw::method)] method: String,
+        #[pyo3(from_py_with = kw::rel_tol)] rel_tol: f64,
+        #[pyo3(from_py_with = kw::threads)] threads: Option<usize>,
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyArray3<Complex64>>> {
         let request = Request {
             inputs: parse_inputs(inputs)?,
             outputs: parse_outputs(outputs)?,
         };
-        let asked = parse_method(method)?;
+        let asked = parse_method(&method)?;
         check_rel_tol(rel_tol)?;
         // The grid's copy, and the result unless it goes into `out`: 16 bytes an entry.
         let entries = (request.outputs.len() * request.inputs.len()) as u64;
@@ -487,19 +488,26 @@ impl PyModel {
     /// frequencies, the names and the units of every input and output, convertible to gwpy
     /// (``to_gwpy()``) and pandas (``to_pandas()``), drawn by ``plot()``. The arguments are
     /// :meth:`transfer`'s.
-    #[pyo3(signature = (freq_hz, inputs=None, outputs=None, method="auto", rel_tol=1e-9))]
+    #[pyo3(signature = (freq_hz, inputs=None, outputs=None, method=String::from("auto"), rel_tol=1e-9), text_signature = "($self, freq_hz, inputs=None, outputs=None, method='auto', rel_tol=1e-9)")]
     fn transfer_function<'py>(
         slf: &Bound<'py, Self>,
         py: Python<'py>,
         freq_hz: &Bound<'py, PyAny>,
         inputs: Option<&Bound<'py, PyAny>>,
         outputs: Option<&Bound<'py, PyAny>>,
-        method: &str,
-        rel_tol: f64,
+        #[pyo3(from_py_with = kw::method)] method: String,
+        #[pyo3(from_py_with = kw::rel_tol)] rel_tol: f64,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let h = slf
-            .get()
-            .transfer(py, freq_hz, inputs, outputs, method, rel_tol, None, None)?;
+        let h = slf.get().transfer(
+            py,
+            freq_hz,
+            inputs,
+            outputs,
+            method.clone(),
+            rel_tol,
+            None,
+            None,
+        )?;
         let freqs = PyArray1::from_vec(py, grid::frequencies(freq_hz, grid::GRID)?);
         let (ins, outs) = (parse_inputs(inputs)?, parse_outputs(outputs)?);
         let names_units = |n: Vec<(&'static str, &'static str)>| n.into_iter().unzip();
@@ -522,14 +530,14 @@ impl PyModel {
     fn _save_transfer(
         &self,
         py: Python<'_>,
-        path: std::path::PathBuf,
+        #[pyo3(from_py_with = kw::path)] path: std::path::PathBuf,
         freq_hz: &Bound<'_, PyAny>,
         inputs: Option<&Bound<'_, PyAny>>,
         outputs: Option<&Bound<'_, PyAny>>,
         method: &str,
         rel_tol: f64,
         drawn: Vec<String>,
-        phase: bool,
+        #[pyo3(from_py_with = kw::phase)] phase: bool,
     ) -> PyResult<()> {
         tiltnoise_io::OutputKind::from_path(&path).py()?;
         crate::inputs::Inputs::of_params(self.params_file.as_deref()).check_save(&path)?;
@@ -582,7 +590,7 @@ impl PyModel {
         freq_hz: &Bound<'_, PyAny>,
         inputs: Option<&Bound<'_, PyAny>>,
         outputs: Option<&Bound<'_, PyAny>>,
-        rel_tol: f64,
+        #[pyo3(from_py_with = kw::rel_tol)] rel_tol: f64,
     ) -> PyResult<String> {
         let request = Request {
             inputs: parse_inputs(inputs)?,
@@ -664,9 +672,9 @@ impl PyModel {
     fn monte_carlo(
         &self,
         py: Python<'_>,
-        samples: usize,
-        seed: u64,
-        threads: usize,
+        #[pyo3(from_py_with = kw::samples)] samples: usize,
+        #[pyo3(from_py_with = kw::seed)] seed: u64,
+        #[pyo3(from_py_with = kw::threads)] threads: usize,
     ) -> PyResult<crate::monte_carlo::MonteCarlo> {
         crate::monte_carlo::run(py, self.params(), samples, seed, threads)
     }
@@ -725,7 +733,7 @@ impl PyModel {
     fn save_methods(
         &self,
         py: Python<'_>,
-        path: std::path::PathBuf,
+        #[pyo3(from_py_with = kw::path)] path: std::path::PathBuf,
         freq_hz: &Bound<'_, PyAny>,
         inputs: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
@@ -755,10 +763,10 @@ impl PyModel {
         &self,
         py: Python<'_>,
         free: Option<&Bound<'_, PyAny>>,
-        measured: Option<std::path::PathBuf>,
-        bound_sigmas: f64,
-        prior: bool,
-        visibility: Option<std::path::PathBuf>,
+        #[pyo3(from_py_with = kw::measured)] measured: Option<std::path::PathBuf>,
+        #[pyo3(from_py_with = kw::bound_sigmas)] bound_sigmas: f64,
+        #[pyo3(from_py_with = kw::prior)] prior: bool,
+        #[pyo3(from_py_with = kw::visibility)] visibility: Option<std::path::PathBuf>,
     ) -> PyResult<crate::fit::Fit> {
         let free = crate::args::strings("free", free)?;
         let inputs = crate::fit::FitInputs {
@@ -796,15 +804,15 @@ impl PyModel {
     fn simulate(
         &self,
         py: Python<'_>,
-        duration: f64,
-        step: f64,
+        #[pyo3(from_py_with = kw::duration)] duration: f64,
+        #[pyo3(from_py_with = kw::step)] step: f64,
         init: Option<&Bound<'_, PyAny>>,
         init_rate: Option<&Bound<'_, PyAny>>,
-        kick_x: Option<f64>,
-        mode_energy: f64,
-        readout: Option<&Bound<'_, PyDict>>,
-        seed: u64,
-        nperseg: Option<usize>,
+        #[pyo3(from_py_with = kw::kick_x)] kick_x: Option<f64>,
+        #[pyo3(from_py_with = kw::mode_energy)] mode_energy: f64,
+        #[pyo3(from_py_with = kw::readout)] readout: Option<Vec<(String, f64)>>,
+        #[pyo3(from_py_with = kw::seed)] seed: u64,
+        #[pyo3(from_py_with = kw::nperseg)] nperseg: Option<usize>,
     ) -> PyResult<crate::simulate::Simulation> {
         let args = crate::simulate::SimulateArgs {
             duration,

@@ -1,6 +1,7 @@
 //! `Model.monte_carlo` (the command line's `tiltnoise mc`) and the `MonteCarlo` it returns:
 //! the Monte Carlo job's draws with the nominal modes, its JSON report and its files.
 
+use crate::args::kw;
 use crate::arrays;
 use crate::errors::PyResultExt;
 use crate::inputs::Inputs;
@@ -152,7 +153,7 @@ impl MonteCarlo {
     /// ``.svg`` (the same image as ``tiltnoise mc --save x.png`` for the same draws). Raises
     /// ``OSError`` if it cannot be written or is the parameter file, ``ValueError`` for
     /// another extension.
-    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+    fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
         monte_carlo::check_save_path(&path).py()?;
         Inputs::of_params(self.params.file.as_deref()).check_save(&path)?;
         let meta = RunMeta::of_this_run(&self.params.inner, None);

@@ -1,7 +1,8 @@
 //! `tiltnoise.Params`: a validated, immutable parameter set (the command line's `--params FILE`
 //! and `--set KEY=VALUE`).
 
-use crate::errors::{value_error, InputFileError, IntoPyErr, PyResultExt};
+use crate::args::kw;
+use crate::errors::{InputFileError, IntoPyErr, PyResultExt};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple};
 use std::path::PathBuf;
@@ -56,7 +57,13 @@ fn toml_source(arg: &Bound<'_, PyAny>) -> PyResult<Result<PathBuf, String>> {
             Ok(PathBuf::from(s.as_ref()))
         });
     }
-    Ok(Ok(arg.extract::<PathBuf>()?))
+    crate::args::path_of(arg).map(Ok).ok_or_else(|| {
+        crate::args::type_error(
+            "source",
+            arg,
+            "a path (str or os.PathLike) or TOML text (str)",
+        )
+    })
 }
 
 #[pymethods]
@@ -106,25 +113,26 @@ impl PyParams {
     /// ``key`` is a dotted key such as ``"length.h_m"``, ``value`` in the key's SI unit.
     /// Raises ``ValueError`` naming the key for an unknown key or a value outside the allowed
     /// range. ``self`` is not changed.
-    fn set(&self, key: &str, value: f64) -> PyResult<Self> {
+    fn set(
+        &self,
+        #[pyo3(from_py_with = kw::key)] key: String,
+        #[pyo3(from_py_with = kw::value)] value: f64,
+    ) -> PyResult<Self> {
         Ok(PyParams {
-            inner: self.inner.with_override(&assignment(key, value)).py()?,
+            inner: self.inner.with_override(&assignment(&key, value)).py()?,
             file: self.file.clone(),
         })
     }
 
     /// A new parameter set with several values changed, e.g.
     /// ``p.update({"length.h_m": 1.5, "loss.torsion_b_rad": 1e-3})``; each as :meth:`set`.
-    fn update(&self, values: &Bound<'_, PyDict>) -> PyResult<Self> {
+    fn update(
+        &self,
+        #[pyo3(from_py_with = kw::values)] values: Vec<(String, f64)>,
+    ) -> PyResult<Self> {
         let mut inner = self.inner.clone();
-        for (key, value) in values.iter() {
-            let key: String = key.extract()?;
-            let value: f64 = value.extract().map_err(|_| {
-                value_error(format!(
-                    "{key}: the value must be a number (SI unit of the key)"
-                ))
-            })?;
-            inner = inner.with_override(&assignment(&key, value)).py()?;
+        for (key, value) in &values {
+            inner = inner.with_override(&assignment(key, *value)).py()?;
         }
         Ok(PyParams {
             inner,
@@ -133,7 +141,7 @@ impl PyParams {
     }
 
     /// The value of one key, e.g. ``p.get("length.h_m")`` (m). ``KeyError`` for an unknown key.
-    fn get(&self, key: &str) -> PyResult<f64> {
+    fn get(&self, #[pyo3(from_py_with = kw::key)] key: String) -> PyResult<f64> {
         self.inner
             .fields()
             .iter()

@@ -1,6 +1,7 @@
 //! `Model.simulate`: free motion of the undamped model, its one-sided Welch ASDs and the
 //! resonance check (the command line's `tiltnoise simulate`), and the `Simulation` it returns.
 
+use crate::args::kw;
 use crate::errors::{value_error, PyResultExt};
 use crate::inputs::Inputs;
 use crate::interrupt;
@@ -33,7 +34,7 @@ pub struct SimulateArgs<'a, 'py> {
     pub init_rate: Option<&'a Bound<'py, PyAny>>,
     pub kick_x: Option<f64>,
     pub mode_energy: f64,
-    pub readout: Option<&'a Bound<'py, PyDict>>,
+    pub readout: Option<Vec<(String, f64)>>,
     pub seed: u64,
     pub nperseg: Option<usize>,
 }
@@ -52,18 +53,10 @@ fn coordinates(
     if let Ok(text) = arg.cast::<PyString>() {
         return parse_coordinates(option, &[text.to_cow()?], rate, out).py();
     }
-    let d = arg.cast::<PyDict>().map_err(|_| {
-        value_error(format!(
-            "{option}: expected a dict {{coordinate: value}} or a str \"theta_a=1e-5,phi_b=0.01\""
-        ))
-    })?;
-    for (name, value) in d.iter() {
-        let name: String = name
-            .extract()
-            .map_err(|_| value_error(format!("{option}: the keys must be coordinate names")))?;
-        let value: f64 = value
-            .extract()
-            .map_err(|_| value_error(format!("{option} {name}: the value must be a number")))?;
+    let kw = option.to_string();
+    let values: Vec<(String, f64)> =
+        crate::args::dict_of(&kw, arg, " or a str \"theta_a=1e-5,phi_b=0.01\"")?;
+    for (name, value) in values {
         let item = format!("{name}={value}");
         set_coordinate(option, &item, &name, value, rate, out).py()?;
     }
@@ -98,18 +91,12 @@ pub fn run(
     params_file: Option<&std::path::Path>,
     args: SimulateArgs<'_, '_>,
 ) -> PyResult<Simulation> {
-    let mut readout = Vec::new();
-    if let Some(d) = args.readout {
-        for (name, value) in d.iter() {
-            let name: String = name
-                .extract()
-                .map_err(|_| value_error("readout: the keys must be observable names (str)"))?;
-            let asd: f64 = value
-                .extract()
-                .map_err(|_| value_error(format!("readout {name}: the ASD must be a number")))?;
-            readout.push(options::readout_item(OptionKey::READOUT, &name, asd).py()?);
-        }
-    }
+    let readout = args
+        .readout
+        .iter()
+        .flatten()
+        .map(|(name, asd)| options::readout_item(OptionKey::READOUT, name, *asd).py())
+        .collect::<PyResult<Vec<_>>>()?;
     let req = SimulateRequest {
         model,
         duration_s: args.duration,
@@ -336,7 +323,7 @@ impl Simulation {
     /// ``.svg`` (the same image as ``tiltnoise simulate --save x.png`` for the same run).
     /// Raises ``OSError`` if it cannot be written or is the parameter file of the model,
     /// ``ValueError`` for another extension.
-    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+    fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
         OutputKind::from_path(&path).py()?;
         self.inputs.check_save(&path)?;
         let run = RunMeta {

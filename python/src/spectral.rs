@@ -2,6 +2,7 @@
 //! the scaling of `scipy.signal.welch` and `scipy.signal.csd` (periodic Hann window, one-sided
 //! density).
 
+use crate::args::kw;
 use crate::arrays::{self, Size};
 use crate::errors::{value_error, PyResultExt};
 use crate::interrupt;
@@ -74,12 +75,14 @@ pub fn averaging(average: &str) -> PyResult<Averaging> {
     }
 }
 
-/// The Welch configuration of scipy's arguments.
+/// The Welch configuration of scipy's arguments (`detrend` `None`: `"constant"`), the
+/// sample rate `fs` checked.
 fn config(
+    fs: f64,
     window: &str,
     nperseg: usize,
     noverlap: Option<usize>,
-    detrend: &Bound<'_, PyAny>,
+    detrend: Option<&Bound<'_, PyAny>>,
     average: &str,
 ) -> PyResult<WelchConfig> {
     if window != "hann" {
@@ -88,7 +91,22 @@ fn config(
              window, \"hann\" (scipy's default)"
         )));
     }
-    let detrend = match detrend.extract::<String>() {
+    let detrend = match detrend {
+        None => Detrend::Constant,
+        Some(d) => detrend_of(d)?,
+    };
+    let cfg = WelchConfig::new(nperseg)
+        .with_overlap(noverlap.unwrap_or(nperseg / 2))
+        .with_averaging(averaging(average)?)
+        .with_detrend(detrend);
+    cfg.validate().py()?;
+    check_fs(fs)?;
+    Ok(cfg)
+}
+
+/// `detrend`: `"constant"` or `False`.
+fn detrend_of(detrend: &Bound<'_, PyAny>) -> PyResult<Detrend> {
+    Ok(match detrend.extract::<String>() {
         Ok(s) if s == "constant" => Detrend::Constant,
         _ if detrend.is_instance_of::<pyo3::types::PyBool>() && !detrend.is_truthy()? => {
             Detrend::None
@@ -98,13 +116,7 @@ fn config(
                 "detrend {detrend} is not allowed: must be \"constant\" (scipy's default) or False"
             )))
         }
-    };
-    let cfg = WelchConfig::new(nperseg)
-        .with_overlap(noverlap.unwrap_or(nperseg / 2))
-        .with_averaging(averaging(average)?)
-        .with_detrend(detrend);
-    cfg.validate().py()?;
-    Ok(cfg)
+    })
 }
 
 /// One-sided power spectral density of ``x`` by Welch's method, as
@@ -118,27 +130,19 @@ fn config(
 /// instead of shortening the segment. ``average`` is ``"mean"`` or ``"median"`` (with
 /// scipy's bias correction); ``detrend`` is ``"constant"`` or ``False``.
 #[pyfunction]
-#[pyo3(signature = (x, fs=1.0, window="hann", nperseg=256, noverlap=None, detrend=None, average="mean"))]
+#[pyo3(signature = (x, fs=1.0, window=String::from("hann"), nperseg=256, noverlap=None, detrend=None, average=String::from("mean")), text_signature = "(x, fs=1.0, window='hann', nperseg=256, noverlap=None, detrend=None, average='mean')")]
 #[allow(clippy::too_many_arguments)]
 pub fn welch<'py>(
     py: Python<'py>,
     x: &Bound<'py, PyAny>,
-    fs: f64,
-    window: &str,
-    nperseg: usize,
-    noverlap: Option<usize>,
+    #[pyo3(from_py_with = kw::fs)] fs: f64,
+    #[pyo3(from_py_with = kw::window)] window: String,
+    #[pyo3(from_py_with = kw::nperseg)] nperseg: usize,
+    #[pyo3(from_py_with = kw::noverlap)] noverlap: Option<usize>,
     detrend: Option<&Bound<'py, PyAny>>,
-    average: &str,
+    #[pyo3(from_py_with = kw::average)] average: String,
 ) -> Spectrum<'py, f64> {
-    let constant = pyo3::types::PyString::new(py, "constant").into_any();
-    let cfg = config(
-        window,
-        nperseg,
-        noverlap,
-        detrend.unwrap_or(&constant),
-        average,
-    )?;
-    check_fs(fs)?;
+    let cfg = config(fs, &window, nperseg, noverlap, detrend, &average)?;
     let x = checked_series("x", x)?;
     let cancel = Cancel::new();
     let long = x.len() >= WATCHED_SAMPLES;
@@ -159,28 +163,20 @@ pub fn welch<'py>(
 /// ``tau``, ``angle(Pxy) = -2 pi f tau``. ``x`` and ``y`` must have the same length (scipy
 /// zero-pads the shorter one).
 #[pyfunction]
-#[pyo3(signature = (x, y, fs=1.0, window="hann", nperseg=256, noverlap=None, detrend=None, average="mean"))]
+#[pyo3(signature = (x, y, fs=1.0, window=String::from("hann"), nperseg=256, noverlap=None, detrend=None, average=String::from("mean")), text_signature = "(x, y, fs=1.0, window='hann', nperseg=256, noverlap=None, detrend=None, average='mean')")]
 #[allow(clippy::too_many_arguments)]
 pub fn csd<'py>(
     py: Python<'py>,
     x: &Bound<'py, PyAny>,
     y: &Bound<'py, PyAny>,
-    fs: f64,
-    window: &str,
-    nperseg: usize,
-    noverlap: Option<usize>,
+    #[pyo3(from_py_with = kw::fs)] fs: f64,
+    #[pyo3(from_py_with = kw::window)] window: String,
+    #[pyo3(from_py_with = kw::nperseg)] nperseg: usize,
+    #[pyo3(from_py_with = kw::noverlap)] noverlap: Option<usize>,
     detrend: Option<&Bound<'py, PyAny>>,
-    average: &str,
+    #[pyo3(from_py_with = kw::average)] average: String,
 ) -> Spectrum<'py, Complex64> {
-    let constant = pyo3::types::PyString::new(py, "constant").into_any();
-    let cfg = config(
-        window,
-        nperseg,
-        noverlap,
-        detrend.unwrap_or(&constant),
-        average,
-    )?;
-    check_fs(fs)?;
+    let cfg = config(fs, &window, nperseg, noverlap, detrend, &average)?;
     let (x, y) = (checked_series("x", x)?, checked_series("y", y)?);
     let cancel = Cancel::new();
     let long = x.len() >= WATCHED_SAMPLES;

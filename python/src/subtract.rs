@@ -2,7 +2,7 @@
 //! `Subtraction` it returns: the subtract job's fit, report, cleaned record and figure, with
 //! names and units.
 
-use crate::args;
+use crate::args::{self, kw};
 use crate::budget::model_of;
 use crate::errors::{value_error, PyResultExt};
 use crate::inputs::Inputs;
@@ -66,38 +66,33 @@ fn parse_colocated_ratio(ratios: BTreeMap<String, f64>) -> PyResult<Vec<(Input, 
 #[allow(clippy::too_many_arguments)]
 pub fn subtract(
     py: Python<'_>,
-    tilt: PathBuf,
-    measured: PathBuf,
+    #[pyo3(from_py_with = kw::tilt)] tilt: PathBuf,
+    #[pyo3(from_py_with = kw::measured)] measured: PathBuf,
     fit: Option<&Bound<'_, PyAny>>,
     band: Option<&Bound<'_, PyAny>>,
     report_band: Option<&Bound<'_, PyAny>>,
-    nperseg: Option<usize>,
-    holdout: f64,
-    max_delay: Option<f64>,
-    witness_noise: Option<&Bound<'_, PyDict>>,
+    #[pyo3(from_py_with = kw::nperseg)] nperseg: Option<usize>,
+    #[pyo3(from_py_with = kw::holdout)] holdout: f64,
+    #[pyo3(from_py_with = kw::max_delay)] max_delay: Option<f64>,
+    #[pyo3(from_py_with = kw::witness_noise)] witness_noise: Option<Bound<'_, PyDict>>,
     colocated: Option<&Bound<'_, PyAny>>,
-    colocated_ratio: Option<BTreeMap<String, f64>>,
-    readout: Option<BTreeMap<String, f64>>,
+    #[pyo3(from_py_with = kw::colocated_ratio)] colocated_ratio: Option<BTreeMap<String, f64>>,
+    #[pyo3(from_py_with = kw::readout)] readout: Option<BTreeMap<String, f64>>,
     observables: Option<&Bound<'_, PyAny>>,
-    axes: Option<&str>,
-    quantity: Option<&str>,
-    gaps: Option<&str>,
-    scale: Option<BTreeMap<String, f64>>,
-    units: Option<BTreeMap<String, String>>,
+    #[pyo3(from_py_with = kw::axes)] axes: Option<String>,
+    #[pyo3(from_py_with = kw::quantity)] quantity: Option<String>,
+    #[pyo3(from_py_with = kw::gaps)] gaps: Option<String>,
+    #[pyo3(from_py_with = kw::scale)] scale: Option<BTreeMap<String, f64>>,
+    #[pyo3(from_py_with = kw::units)] units: Option<BTreeMap<String, String>>,
     corrected: Option<&Bound<'_, PyAny>>,
     pendulum_tiltmeter: Option<&Bound<'_, PyAny>>,
     params: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Subtraction> {
     let fit = args::strings("fit", fit)?;
-    let band = args::pair("band", band, "(FLO, FHI) in Hz, 0 < FLO < FHI")?;
-    let report_band = args::pair(
-        "report_band",
-        report_band,
-        "(FLO, FHI) in Hz, 0 < FLO < FHI",
-    )?;
+    let band = args::band("band", band)?;
+    let report_band = args::band("report_band", report_band)?;
     let colocated = args::paths("colocated", colocated)?;
-    let corrected = args::strings("corrected", corrected)?;
-    let pendulum_tiltmeter = args::strings("pendulum_tiltmeter", pendulum_tiltmeter)?;
+    let channels_of = job_args::ChannelLists::of(corrected, pendulum_tiltmeter)?;
     let (model, params) = model_of(params)?;
     let readout_asd = readout
         .unwrap_or_default()
@@ -107,20 +102,12 @@ pub fn subtract(
     let req = SubtractRequest {
         model: &model,
         tilt,
-        read: job_args::file_read_request(
-            axes,
-            quantity,
-            units,
-            corrected,
-            pendulum_tiltmeter,
-            gaps,
-            scale,
-        )?,
+        read: job_args::file_read_request(axes, quantity, units, channels_of, gaps, scale)?,
         measured,
         observables: job_args::observables(observables)?,
         colocated: colocated.unwrap_or_default(),
         colocated_ratio: parse_colocated_ratio(colocated_ratio.unwrap_or_default())?,
-        witness_noise: job_args::witness_noise(witness_noise)?,
+        witness_noise: job_args::witness_noise(witness_noise.as_ref())?,
         readout_asd,
         fit: fit.unwrap_or_default(),
         band_hz: band,
@@ -130,7 +117,7 @@ pub fn subtract(
         max_delay_s: max_delay,
     };
     let inputs = Inputs::of_params(params.file.as_deref())
-        .with_all(job_args::python_names(req.input_files()));
+        .with_all(job_args::python_names(req.input_files(), &[]));
     let cancel = Cancel::new();
     let outcome = crate::interrupt::watch(py, &cancel, || {
         tiltnoise_job::subtract::run(req, &cancel).map_err(job_args::job_error)
@@ -320,7 +307,7 @@ impl Subtraction {
     /// line's figure (``.png``/``.svg``, the same image as ``tiltnoise subtract --save x.png``);
     /// atomically. Raises ``OSError`` if it cannot be written or is one of the files read,
     /// ``ValueError`` for another extension.
-    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+    fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
         SaveKind::of(&path).py()?;
         self.inputs.check_save(&path)?;
         py.detach(|| self.outcome.save(&path, &tiltnoise_plot::View::default()))

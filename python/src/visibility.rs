@@ -1,6 +1,7 @@
 //! `tiltnoise.visibility` (the command line's `visibility --measured FILE`) and the
 //! `Visibilities` it returns: the visibility job's peaks and ratios with names and units.
 
+use crate::args::kw;
 use crate::budget::model_of;
 use crate::errors::PyResultExt;
 use crate::inputs::Inputs;
@@ -30,7 +31,7 @@ use tiltnoise_job::visibility::{VisibilityRequest, VisibilityResult};
 #[pyo3(signature = (measured, *, params=None))]
 pub fn visibility(
     py: Python<'_>,
-    measured: PathBuf,
+    #[pyo3(from_py_with = kw::measured)] measured: PathBuf,
     params: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Visibilities> {
     let (model, params) = model_of(params)?;
@@ -125,7 +126,7 @@ impl Visibilities {
 
     /// Writes :meth:`to_csv` to ``path`` (``.csv``), atomically. Raises ``OSError`` if it
     /// cannot be written or is one of the files read, ``ValueError`` for another extension.
-    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+    fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
         if path.extension().and_then(|e| e.to_str()) != Some("csv") {
             return Err(OutputError::UnknownFormat {
                 path,

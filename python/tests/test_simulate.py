@@ -76,7 +76,7 @@ def test_simulate_errors():
         tiltnoise.Model(tiltnoise.Params().set("loss.torsion_b_rad", 1e-3)).simulate(100)
     with pytest.raises(ValueError, match="either kick_x or init/init_rate"):
         model.simulate(100, kick_x=1e-6, init={"phi_b": 1e-3})
-    with pytest.raises(ValueError, match="init: expected a dict"):
+    with pytest.raises(TypeError, match=r"^init=\[1, 2\]: expected a dict"):
         model.simulate(100, init=[1, 2])
     with pytest.raises(ValueError, match=r"init: phi_b is given twice"):
         model.simulate(100, init="phi_b=1,phi_b=2")

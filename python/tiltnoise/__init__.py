@@ -44,9 +44,11 @@ and ``report`` hold the command line's JSON reports; ``to_gwpy()`` and ``to_pand
 spectra, transfer functions and series (gwpy, pandas and matplotlib are optional). Every object
 pickles (multiprocessing, joblib). Ctrl-C stops any long call with ``KeyboardInterrupt``.
 
-Errors are ``ValueError`` (parameters, names, options), ``OSError`` subclasses for files that
-cannot be read (``FileNotFoundError``, ...) and :class:`InputFileError` (an ``OSError``) for
-files that are read but not valid.
+Errors are ``TypeError`` for an argument of the wrong type (``KW=VALUE: expected WHAT, got
+TYPE``; a single ``str`` or path is a one-item list), ``ValueError`` (parameters, names,
+options, values out of range), ``OSError`` subclasses for files that cannot be read
+(``FileNotFoundError``, ``IsADirectoryError``, ``PermissionError``, in every call) and
+:class:`InputFileError` (an ``OSError``) for files that are read but not valid.
 """
 
 from ._tiltnoise import (

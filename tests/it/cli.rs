@@ -366,6 +366,21 @@ fn a_segment_shorter_than_the_welch_segment_names_nperseg() {
     );
 }
 
+/// A segment duration that is not a positive number is refused naming the option.
+#[test]
+fn a_segment_duration_that_is_not_positive_names_the_option() {
+    let lab = concat!(env!("CARGO_MANIFEST_DIR"), "/tilt_data/lab_tilt_24h.h5");
+    for (given, shown) in [("nan", "NaN"), ("0", "0"), ("-60", "-60")] {
+        assert_fails(
+            &["budget", "--tilt", lab, "--segment-duration", given],
+            &[
+                &format!("--segment-duration {shown} is not allowed"),
+                "a positive number of seconds",
+            ],
+        );
+    }
+}
+
 #[test]
 fn tf_json_holds_the_numbers_of_its_csv_bit_for_bit() {
     let args = [

@@ -11,7 +11,8 @@ use tiltnoise_core::limits::MAX_SETTINGS_FILE_BYTES;
 ///
 /// # Errors
 ///
-/// [`FitError::Measured`] naming the file (and line) when it cannot be read or is malformed;
+/// [`FitError::Read`] naming the file when it cannot be read, [`FitError::Measured`] naming
+/// it (and the line) when it is malformed;
 /// [`FitError::TooLarge`] for a file over [`MAX_SETTINGS_FILE_BYTES`] (a device or pipe is
 /// read no further) or a line over [`tiltnoise_core::limits::MAX_LINE_BYTES`].
 pub fn read_measured_modes(path: &Path) -> Result<Measured, FitError> {
@@ -24,9 +25,10 @@ pub fn read_measured_modes(path: &Path) -> Result<Measured, FitError> {
         "a measured-frequency file",
     )
     .map_err(|e| match e {
-        TextFileError::Io(e) => FitError::Measured {
+        TextFileError::Io(reason) => FitError::Read {
+            what: "measured frequencies",
             origin: origin.clone(),
-            message: e.to_string(),
+            reason,
         },
         TextFileError::TooLarge(e) => FitError::TooLarge(e),
     })?;
@@ -38,7 +40,8 @@ pub fn read_measured_modes(path: &Path) -> Result<Measured, FitError> {
 ///
 /// # Errors
 ///
-/// [`FitError::Visibility`] naming the file (and line) when it cannot be read or is malformed;
+/// [`FitError::Read`] naming the file when it cannot be read, [`FitError::Visibility`] naming
+/// it (and the line) when it is malformed;
 /// [`FitError::TooLarge`] as [`read_measured_modes`].
 pub fn read_visibilities(path: &Path) -> Result<Visibilities, FitError> {
     let origin = path.display().to_string();
@@ -46,9 +49,10 @@ pub fn read_visibilities(path: &Path) -> Result<Visibilities, FitError> {
     let text =
         read_text_file(path, MAX_SETTINGS_FILE_BYTES, &name, "a visibility file").map_err(|e| {
             match e {
-                TextFileError::Io(e) => FitError::Visibility {
+                TextFileError::Io(reason) => FitError::Read {
+                    what: "visibilities",
                     origin: origin.clone(),
-                    message: e.to_string(),
+                    reason,
                 },
                 TextFileError::TooLarge(e) => FitError::TooLarge(e),
             }

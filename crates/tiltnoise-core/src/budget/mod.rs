@@ -208,15 +208,22 @@ fn segment_samples(
     Ok(match opts.segment_duration_s {
         None => None,
         Some(d) => {
+            if !(d.is_finite() && d > 0.0) {
+                return Err(BudgetError::Config(format!(
+                    "{} is not allowed: the segment duration must be a positive number of \
+                     seconds",
+                    crate::option_key::OptionKey::SEGMENT_DURATION.given(crate::error::Num(d))
+                )));
+            }
             let s = (d * fs).round();
-            if !(d.is_finite() && s >= seg_len as f64) {
+            if s < seg_len as f64 {
                 return Err(BudgetError::Config(format!(
                     "segment duration {} s is not allowed: must hold at least one Welch segment \
                      ({seg_len} samples = {} s at {fs} Hz); shorten the Welch segment (nperseg) \
                      to at most {} samples, or lengthen the segment duration",
                     crate::error::Num(d),
                     seg_len as f64 / fs,
-                    if s.is_finite() { s.max(0.0) } else { 0.0 }
+                    s.max(0.0)
                 )));
             }
             if s > n as f64 {

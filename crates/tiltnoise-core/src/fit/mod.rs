@@ -273,6 +273,17 @@ pub enum FitError {
     /// Cancelled through [`FitConfig::cancel`].
     #[error(transparent)]
     Cancelled(#[from] Cancelled),
+    /// A measured-frequency or visibility file that cannot be opened or read (its reason
+    /// kept whole, so that a missing file stays a missing file to the caller).
+    #[error("{what} {origin}: {reason}")]
+    Read {
+        /// What the file holds: `measured frequencies` or `visibilities`.
+        what: &'static str,
+        /// The file, as given.
+        origin: String,
+        /// What the operating system said.
+        reason: std::io::Error,
+    },
     /// A malformed visibility file, or a visibility the model cannot form.
     #[error("visibilities {origin}: {message}")]
     Visibility {
