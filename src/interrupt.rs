@@ -1,14 +1,16 @@
 //! SIGINT, SIGTERM and SIGHUP (unless SIGHUP is ignored, as under `nohup`) end the run: the
 //! handler sets the run's [`Cancel`] token (so that the computation stops where it polls it),
-//! removes the temporary files of the outputs being written
-//! ([`tiltnoise_io::remove_temporaries_for_exit`]), prints one line naming the signal and ends
-//! the process with exit code 2, at once, whatever the main thread is doing.
+//! removes the staging directory of every output being written or staged
+//! ([`tiltnoise_io::remove_staging_for_exit`], which keeps any from being created afterwards),
+//! prints one line naming the signal and ends the process with exit code 2, at once, whatever
+//! the main thread is doing. An output is only ever created inside a staging directory that
+//! exists and is registered, so nothing is left, however far a writer had got.
 
 use tiltnoise_core::cancel::Cancel;
 
 /// Starts the handler (a thread of signal-hook's iterator) and returns the token it sets. Call
 /// it once, early in `main`. On platforms without POSIX signals the token is never set.
-pub(crate) fn install() -> Cancel {
+pub fn install() -> Cancel {
     let cancel = Cancel::new();
     #[cfg(unix)]
     unix::install(&cancel);
@@ -18,7 +20,7 @@ pub(crate) fn install() -> Cancel {
 /// For the main thread when the run failed because the token was set: the handler is ending
 /// the process and prints the run's one line, so this thread waits for that instead of
 /// printing a second one.
-pub(crate) fn wait_for_the_handler() -> ! {
+pub fn wait_for_the_handler() -> ! {
     loop {
         std::thread::park();
     }
@@ -49,7 +51,7 @@ mod unix {
                 return;
             };
             cancel.cancel();
-            let removed = tiltnoise_io::remove_temporaries_for_exit();
+            let cleanup = tiltnoise_io::remove_staging_for_exit();
             let name = match signal {
                 SIGINT => "SIGINT",
                 SIGHUP => "SIGHUP",
@@ -57,15 +59,34 @@ mod unix {
             };
             // Not eprintln!: a panic on a closed standard error would end this thread before
             // the process.
-            let _ = writeln!(
-                std::io::stderr(),
-                "tiltnoise: error: interrupted by {name}; {removed} temporary file(s) removed, \
-                 no output written"
-            );
+            let _ = writeln!(std::io::stderr(), "{}", message(name, &cleanup));
             // `_exit`: no atexit handlers, whose clean-up (the HDF5 library's) would race with a
             // write in progress on another thread.
             signal_hook::low_level::exit(2);
         });
+    }
+
+    /// The one line the handler prints.
+    fn message(signal: &str, cleanup: &tiltnoise_io::ExitCleanup) -> String {
+        let mut line = format!(
+            "tiltnoise: error: interrupted by {signal}; {} staged output(s) removed",
+            cleanup.removed
+        );
+        match cleanup.committed {
+            0 => line.push_str(", no output written"),
+            n => line.push_str(&format!(", {n} output(s) written before")),
+        }
+        if let Some((dir, why)) = cleanup.left.first() {
+            line.push_str(&format!(
+                "; could not remove {} ({why}){}",
+                dir.display(),
+                match cleanup.left.len() {
+                    1 => String::new(),
+                    n => format!(" and {} more", n - 1),
+                }
+            ));
+        }
+        line
     }
 
     /// Whether `signal`'s disposition is "ignore" (inherited from the parent, as `nohup` sets

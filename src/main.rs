@@ -1,12 +1,11 @@
 //! The `tiltnoise` binary: parse, run, map errors to exit code 2 with a one-line message.
 
-mod interrupt;
 mod option_style;
 
 use clap::error::ErrorKind;
 use clap::{CommandFactory, FromArgMatches};
 use std::process::ExitCode;
-use tiltnoise::cli;
+use tiltnoise::{cli, interrupt};
 use tiltnoise_core::error::shown_within;
 
 /// The longest error line printed (characters); values inside it are already cut to 200.
@@ -15,7 +14,7 @@ const MAX_ERROR_CHARS: usize = 2000;
 fn main() -> ExitCode {
     // Before any message: the libraries' errors name options as flags (`--nperseg`).
     tiltnoise_core::option_key::install_style(&option_style::Flags);
-    // First: SIGINT, SIGTERM and SIGHUP cancel the run, remove the temporary files of the
+    // First: SIGINT, SIGTERM and SIGHUP cancel the run, remove the staging directories of the
     // outputs being written, print one line and end the process with exit code 2.
     let cancel = interrupt::install();
     // `--version` names the HDF5 library linked in (bundled, static).

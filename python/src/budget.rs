@@ -32,7 +32,7 @@ use tiltnoise_core::noise::{BudgetReport, SpectralSource};
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::repeats::refuse_repeats;
-use tiltnoise_io::RunMeta;
+use tiltnoise_io::{RunMeta, Staging};
 use tiltnoise_job::budget::{BudgetRequest, BudgetResult, TiltSource, WelchRequest};
 
 /// A record of the floor's motion handed over as arrays: one channel per input, in canonical
@@ -1058,22 +1058,28 @@ impl Budget {
         let kind = OutputKind::from_path(&path).py()?;
         self.inputs.check_save(&path)?;
         let meta = self.run_meta();
-        py.detach(|| match kind {
-            OutputKind::Hdf5 => {
-                tiltnoise_io::write_budget_hdf5(&path, &self.report, &meta, &self.input)
-            }
-            OutputKind::Csv => {
-                tiltnoise_io::write_budget_csv(&path, &self.report, &meta, keep_zero_columns)
-            }
-            OutputKind::Png | OutputKind::Svg => {
-                let options = tiltnoise_plot::BudgetFigureOptions {
-                    input: Some(self.input.clone()),
-                    ..tiltnoise_plot::BudgetFigureOptions::default()
-                };
-                tiltnoise_job::save_image(&path, |format| {
-                    tiltnoise_plot::budget_figure_with(&self.report, format, &options)
-                })
-            }
+        py.detach(|| {
+            Staging::committed(|stage| match kind {
+                OutputKind::Hdf5 => {
+                    tiltnoise_io::write_budget_hdf5(stage, &path, &self.report, &meta, &self.input)
+                }
+                OutputKind::Csv => tiltnoise_io::write_budget_csv(
+                    stage,
+                    &path,
+                    &self.report,
+                    &meta,
+                    keep_zero_columns,
+                ),
+                OutputKind::Png | OutputKind::Svg => {
+                    let options = tiltnoise_plot::BudgetFigureOptions {
+                        input: Some(self.input.clone()),
+                        ..tiltnoise_plot::BudgetFigureOptions::default()
+                    };
+                    tiltnoise_job::save_image(stage, &path, |format| {
+                        tiltnoise_plot::budget_figure_with(&self.report, format, &options)
+                    })
+                }
+            })
         })
         .py()
     }

@@ -13,7 +13,7 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::coherence::CoherenceReport;
-use tiltnoise_io::{CoherenceInputs, OutputKind, RunMeta};
+use tiltnoise_io::{CoherenceInputs, OutputKind, RunMeta, Staging};
 use tiltnoise_job::coherence::{CoherenceRequest, CoherenceResult};
 
 /// Coherence of measured observables with the tilt axes, and their measured transfer
@@ -289,7 +289,10 @@ impl Coherence {
             inputs: self.records.clone(),
         };
         py.detach(|| {
-            tiltnoise_job::coherence::save(&path, &result, &meta, &tiltnoise_plot::View::default())
+            Staging::committed(|stage| {
+                let view = tiltnoise_plot::View::default();
+                tiltnoise_job::coherence::save(stage, &path, &result, &meta, &view)
+            })
         })
         .py()
     }

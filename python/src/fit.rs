@@ -14,6 +14,7 @@ use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::fit::{FitResult, SigmaSource};
 use tiltnoise_core::params::Params;
+use tiltnoise_io::Staging;
 use tiltnoise_job::fit::{FitOutcome, FitRequest};
 
 /// What `Model.fit` measures against: the frequency file, or Table II's measured column; with
@@ -268,8 +269,10 @@ impl Fit {
         self.inputs.check_save(&path)?;
         let meta = tiltnoise_io::RunMeta::of_this_run(&self.nominal, None);
         let fit = self.outcome();
-        py.detach(|| tiltnoise_job::fit::save(&path, &fit, &meta))
-            .py()
+        py.detach(|| {
+            Staging::committed(|stage| tiltnoise_job::fit::save(stage, &path, &fit, &meta))
+        })
+        .py()
     }
 
     /// Pickles as its state (see the module's pickling notes).

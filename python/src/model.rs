@@ -24,6 +24,7 @@ use tiltnoise_core::simulate::DEFAULT_MODE_ENERGY_J;
 use tiltnoise_core::tf::{
     self, eval_grid_threads_cancellable, Destination, Method, Scene, TransferFunction,
 };
+use tiltnoise_io::Staging;
 use tiltnoise_job::JobError;
 
 // The defaults of `transfer`, `explain` and `simulate` are written as literals in their
@@ -576,8 +577,10 @@ impl PyModel {
             .detach(|| tiltnoise_job::tf::run(req, &Cancel::never()))
             .map_err(job_error)?
             .tf;
-        py.detach(|| tiltnoise_job::tf::save(&path, &tf, &meta, &figure))
-            .py()
+        py.detach(|| {
+            Staging::committed(|stage| tiltnoise_job::tf::save(stage, &path, &tf, &meta, &figure))
+        })
+        .py()
     }
 
     /// Which method ``method="auto"`` picks for this request and grid, and why: every
@@ -746,7 +749,9 @@ impl PyModel {
         };
         py.detach(|| {
             let result = tiltnoise_job::methods::run(req, &Cancel::never()).map_err(job_error)?;
-            tiltnoise_job::methods::save(&path, &result, &tiltnoise_plot::View::default()).py()
+            let view = tiltnoise_plot::View::default();
+            Staging::committed(|stage| tiltnoise_job::methods::save(stage, &path, &result, &view))
+                .py()
         })
     }
 

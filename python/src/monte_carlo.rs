@@ -15,7 +15,7 @@ use pyo3::prelude::*;
 use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::mc::McResult;
-use tiltnoise_io::RunMeta;
+use tiltnoise_io::{RunMeta, Staging};
 use tiltnoise_job::monte_carlo::{self, McRequest, McRun};
 
 /// Runs the Monte Carlo job for `params` with Ctrl-C honoured.
@@ -158,8 +158,11 @@ impl MonteCarlo {
         Inputs::of_params(self.params.file.as_deref()).check_save(&path)?;
         let meta = RunMeta::of_this_run(&self.params.inner, None);
         let run = self.job_run();
-        py.detach(|| monte_carlo::save(&path, &run, &meta, &tiltnoise_plot::View::default()))
-            .py()
+        let view = tiltnoise_plot::View::default();
+        py.detach(|| {
+            Staging::committed(|stage| monte_carlo::save(stage, &path, &run, &meta, &view))
+        })
+        .py()
     }
 
     /// The draws drawn with matplotlib: one histogram per mode, the nominal frequency and the

@@ -22,7 +22,7 @@ use tiltnoise_core::simulate::{
     parse_coordinates, record_description, set_coordinate, Excitation, InitialState,
     Simulation as CoreSimulation,
 };
-use tiltnoise_io::{OutputKind, RunMeta, SeriesAsd, SimulationMeta};
+use tiltnoise_io::{OutputKind, RunMeta, SeriesAsd, SimulationMeta, Staging};
 use tiltnoise_job::simulate::{asd_figure_data, save, Keep, RecordOutputs, SimulateRequest};
 use tiltnoise_plot::View;
 
@@ -351,7 +351,7 @@ impl Simulation {
                 run: &run,
                 figure: &figure,
             };
-            save(&path, &outputs, &View::default())
+            Staging::committed(|stage| save(stage, &path, &outputs, &View::default()))
         })
         .py()
     }

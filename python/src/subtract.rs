@@ -19,6 +19,7 @@ use tiltnoise_core::model::{Input, Observable};
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::options;
 use tiltnoise_core::subtract::{ResidualSpectra, DEFAULT_REPORT_BAND_HZ};
+use tiltnoise_io::Staging;
 use tiltnoise_job::subtract::{SubtractOutcome, SubtractRequest};
 use tiltnoise_job::subtract_outputs::SaveKind;
 
@@ -310,7 +311,8 @@ impl Subtraction {
     fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
         SaveKind::of(&path).py()?;
         self.inputs.check_save(&path)?;
-        py.detach(|| self.outcome.save(&path, &tiltnoise_plot::View::default()))
+        let view = tiltnoise_plot::View::default();
+        py.detach(|| Staging::committed(|stage| self.outcome.save(stage, &path, &view)))
             .py()
     }
 

@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
-use tiltnoise_io::{write_atomic, OutputError};
+use tiltnoise_io::{OutputError, Staging};
 use tiltnoise_job::visibility::{VisibilityRequest, VisibilityResult};
 
 /// Mode visibilities measured from a recorded free motion (the command line's ``tiltnoise
@@ -137,8 +137,10 @@ impl Visibilities {
         self.inputs.check_save(&path)?;
         let text = self.result.csv();
         py.detach(|| {
-            write_atomic(&path, |tmp| {
-                std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
+            Staging::committed(|stage| {
+                stage.write(&path, |tmp| {
+                    std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
+                })
             })
         })
         .py()

@@ -55,7 +55,7 @@ non-finite  exit 0, but a number written to stdout or to a new or changed file i
             (`null_keys`) and restrict the evidence to named values (`nonfinite_only`).
 leftover    after a failing run, any file or directory in the scratch directory that was not
             there before; after any run, a new temporary-looking name (`*.tmp`, `.tmpXXXXXX`,
-            or the atomic writer's `.<name>.XXXXXX[.<ext>]`).
+            the staging directory `.<name>.XXXXXX.tmp`, or the former `.<name>.XXXXXX[.<ext>]`).
 multi-line  controlled failure whose stderr has more than one line.
 silent      controlled failure with nothing on stderr.
 exit!=2     controlled failure with an exit code other than 2 (cases that sent a signal are

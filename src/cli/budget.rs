@@ -245,9 +245,17 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
         write!(run.out, "{}", super::budget_summary::table(&report))?;
     }
     let meta = RunMeta::of_this_run(params, Some(&NormalModes::new(&model)));
-    run.write_outputs(json, || {
+    run.write_outputs(json, |stage| {
         for out in &args.save {
-            save_budget(out, &report, &meta, &input, &figure, args.keep_zero_columns)?;
+            save_budget(
+                stage,
+                out,
+                &report,
+                &meta,
+                &input,
+                &figure,
+                args.keep_zero_columns,
+            )?;
         }
         Ok(())
     })

@@ -141,9 +141,9 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
         }
     }
     let meta = RunMeta::of_this_run(params, Some(&NormalModes::new(&model)));
-    run.write_outputs(args.format == Format::Json, || {
+    run.write_outputs(args.format == Format::Json, |stage| {
         for out in &args.save {
-            tiltnoise_job::coherence::save(out, &result, &meta, &view)?;
+            tiltnoise_job::coherence::save(stage, out, &result, &meta, &view)?;
         }
         Ok(())
     })

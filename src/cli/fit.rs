@@ -76,9 +76,9 @@ pub(crate) fn run_fit(params: &Params, args: FitArgs, run: &mut Run) -> Result<(
     }
     let meta = tiltnoise_io::RunMeta::of_this_run(params, None);
     // JSON on standard output stays parseable: the `wrote` lines go to standard error.
-    run.write_outputs(args.format == FitFormat::Json, || {
+    run.write_outputs(args.format == FitFormat::Json, |stage| {
         for path in &args.save {
-            tiltnoise_job::fit::save(path, &fit, &meta)?;
+            tiltnoise_job::fit::save(stage, path, &fit, &meta)?;
         }
         Ok(())
     })

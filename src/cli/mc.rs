@@ -69,9 +69,9 @@ pub(crate) fn run_mc(params: &Params, opts: McOptions, run: &mut Run) -> Result<
     }
     let meta = RunMeta::of_this_run(params, None);
     // JSON on standard output stays parseable: the `wrote` lines go to standard error.
-    run.write_outputs(opts.json, || {
+    run.write_outputs(opts.json, |stage| {
         for path in &opts.save {
-            monte_carlo::save(path, &mc, &meta, &view)?;
+            monte_carlo::save(stage, path, &mc, &meta, &view)?;
         }
         Ok(())
     })

@@ -91,9 +91,9 @@ pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> 
         Format::Table => write!(out, "{}", table(&result, spec))?,
     }
     // JSON on standard output stays parseable: the `wrote` lines go to standard error.
-    run.write_outputs(format == Format::Json, || {
+    run.write_outputs(format == Format::Json, |stage| {
         for path in save {
-            tiltnoise_job::methods::save(path, &result, &view)?;
+            tiltnoise_job::methods::save(stage, path, &result, &view)?;
         }
         Ok(())
     })

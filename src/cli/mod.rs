@@ -175,18 +175,19 @@ impl Run {
         self.check_outputs(&outputs, &inputs)
     }
 
-    /// Writes every output of the run all or none: `write` saves them (each through
-    /// `tiltnoise_io::write_atomic`), and they appear only once all are written and standard
+    /// Writes every output of the run all or none: `write` saves them, each as one of the
+    /// outputs of the run's [`Staging`], and they appear only once all are written and standard
     /// output has taken everything printed before (so a run whose standard output fails
     /// leaves none). Then one `wrote PATH` line per output, on standard error when
-    /// `report_on_stderr` (standard output carries JSON).
+    /// `report_on_stderr` (standard output carries JSON). Writers created before (streamed
+    /// outputs) are finished into the same `Staging` by `write`.
     pub(crate) fn write_outputs(
         &mut self,
         report_on_stderr: bool,
-        write: impl FnOnce() -> Result<()>,
+        write: impl FnOnce(&Staging) -> Result<()>,
     ) -> Result<()> {
-        let stage = Staging::begin();
-        write()?;
+        let stage = Staging::new();
+        write(&stage)?;
         self.out.flush()?;
         for path in stage.commit()? {
             match report_on_stderr {

@@ -293,8 +293,8 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
         result.fs_hz(),
         &result.description,
     );
-    run.write_outputs(json, || {
-        result.finish_records()?;
+    run.write_outputs(json, |stage| {
+        result.finish_records(stage)?;
         let outputs = RecordOutputs {
             record: None,
             asd: &result.asd,
@@ -302,11 +302,13 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
             figure: &figure,
         };
         for path in &args.save {
-            save(path, &outputs, &view)?;
+            save(stage, path, &outputs, &view)?;
         }
         if let Some(data) = &result.time_figure {
             for path in &args.save_time {
-                save_image(path, |format| time_series_figure(data, &view, format))?;
+                save_image(stage, path, |format| {
+                    time_series_figure(data, &view, format)
+                })?;
             }
         }
         Ok(())

@@ -240,9 +240,9 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
         Format::Json => writeln!(run.out, "{}", outcome.report().to_json())?,
         Format::Table => write!(run.out, "{}", report_table(&outcome.result))?,
     }
-    run.write_outputs(args.format == Format::Json, || {
+    run.write_outputs(args.format == Format::Json, |stage| {
         for path in &args.save {
-            outcome.save(path, &view)?;
+            outcome.save(stage, path, &view)?;
         }
         Ok(())
     })

@@ -219,9 +219,9 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
     }
     let tf = planned.whole(&run.cancel).map_err(super::job_error)?;
     write_report(&mut run.out, &model, &modes, planned.request(), json)?;
-    run.write_outputs(json, || {
+    run.write_outputs(json, |stage| {
         for path in &args.save {
-            tiltnoise_job::tf::save(path, &tf, &meta, &figure)?;
+            tiltnoise_job::tf::save(stage, path, &tf, &meta, &figure)?;
         }
         Ok(())
     })
@@ -329,12 +329,12 @@ fn stream_tf(
     }
     let modes = NormalModes::new(model);
     write_report(&mut run.out, model, &modes, planned.request(), json)?;
-    run.write_outputs(json, || {
+    run.write_outputs(json, |stage| {
         for w in hdf5 {
-            w.finish()?;
+            w.finish(stage)?;
         }
         for w in csv {
-            w.finish()?;
+            w.finish(stage)?;
         }
         Ok(())
     })

@@ -7,7 +7,6 @@ use clap::Args;
 use std::path::PathBuf;
 use tiltnoise_core::model::Model;
 use tiltnoise_core::params::Params;
-use tiltnoise_io::write_atomic;
 use tiltnoise_job::visibility::{VisibilityRequest, VisibilityResult};
 
 /// Arguments of `tiltnoise visibility`.
@@ -59,8 +58,8 @@ pub(crate) fn run_visibility(params: &Params, args: VisibilityArgs, run: &mut Ru
     let Some(path) = &args.save else {
         return Ok(());
     };
-    run.write_outputs(args.format == VisibilityFormat::Csv, || {
-        write_atomic(path, |tmp| {
+    run.write_outputs(args.format == VisibilityFormat::Csv, |stage| {
+        stage.write(path, |tmp| {
             std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
         })?;
         Ok(())

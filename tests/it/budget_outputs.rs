@@ -148,14 +148,17 @@ fn hdf5_round_trip_is_bit_exact_and_self_describing() {
     let report = synthetic_report();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("budget.h5");
-    save_budget(
-        &path,
-        &report,
-        &meta(),
-        &input_meta(),
-        &Default::default(),
-        true,
-    )
+    tiltnoise_io::Staging::committed(|s| {
+        save_budget(
+            s,
+            &path,
+            &report,
+            &meta(),
+            &input_meta(),
+            &Default::default(),
+            true,
+        )
+    })
     .unwrap();
     assert_eq!(listing(dir.path()), vec![path.clone()], "no temporary file");
 
@@ -266,7 +269,8 @@ fn hdf5_for_spectra_input_without_segments() {
     report.notes.clear();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("b.hdf5");
-    write_budget_hdf5(&path, &report, &meta(), &input).unwrap();
+    tiltnoise_io::Staging::committed(|s| write_budget_hdf5(s, &path, &report, &meta(), &input))
+        .unwrap();
     let file = hdf5::File::open(&path).unwrap();
     assert_eq!(str_attr(&file, "source"), "spectra");
     let band = file.attr("data_band_hz").unwrap().read_1d::<f64>().unwrap();
@@ -282,14 +286,17 @@ fn csv_header_and_values_round_trip() {
     let report = synthetic_report();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("budget.csv");
-    save_budget(
-        &path,
-        &report,
-        &meta(),
-        &input_meta(),
-        &Default::default(),
-        true,
-    )
+    tiltnoise_io::Staging::committed(|s| {
+        save_budget(
+            s,
+            &path,
+            &report,
+            &meta(),
+            &input_meta(),
+            &Default::default(),
+            true,
+        )
+    })
     .unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
     assert_eq!(text, budget_csv_string(&report, &meta(), true).unwrap());
@@ -439,14 +446,17 @@ fn inconsistent_report_is_rejected_and_leaves_nothing() {
     let dir = tempfile::tempdir().unwrap();
     for name in ["b.h5", "b.csv", "b.png", "b.svg"] {
         let path = dir.path().join(name);
-        let err = save_budget(
-            &path,
-            &report,
-            &meta(),
-            &input_meta(),
-            &Default::default(),
-            true,
-        )
+        let err = tiltnoise_io::Staging::committed(|s| {
+            save_budget(
+                s,
+                &path,
+                &report,
+                &meta(),
+                &input_meta(),
+                &Default::default(),
+                true,
+            )
+        })
         .unwrap_err();
         let text = err.to_string();
         assert!(text.contains("phi.tilt") && text.contains(name), "{text}");
@@ -460,23 +470,29 @@ fn figures_are_written() {
     let dir = tempfile::tempdir().unwrap();
     let png = dir.path().join("budget.png");
     let svg = dir.path().join("budget.svg");
-    save_budget(
-        &png,
-        &report,
-        &meta(),
-        &input_meta(),
-        &Default::default(),
-        true,
-    )
+    tiltnoise_io::Staging::committed(|s| {
+        save_budget(
+            s,
+            &png,
+            &report,
+            &meta(),
+            &input_meta(),
+            &Default::default(),
+            true,
+        )
+    })
     .unwrap();
-    save_budget(
-        &svg,
-        &report,
-        &meta(),
-        &input_meta(),
-        &Default::default(),
-        true,
-    )
+    tiltnoise_io::Staging::committed(|s| {
+        save_budget(
+            s,
+            &svg,
+            &report,
+            &meta(),
+            &input_meta(),
+            &Default::default(),
+            true,
+        )
+    })
     .unwrap();
     let bytes = std::fs::read(&png).unwrap();
     assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
@@ -510,14 +526,17 @@ fn missing_directory_is_an_error_naming_the_path() {
     let dir = tempfile::tempdir().unwrap();
     for name in ["b.h5", "b.hdf5", "b.csv", "b.png", "b.svg"] {
         let path = dir.path().join("no-such-dir").join(name);
-        let err = save_budget(
-            &path,
-            &report,
-            &meta(),
-            &input_meta(),
-            &Default::default(),
-            true,
-        )
+        let err = tiltnoise_io::Staging::committed(|s| {
+            save_budget(
+                s,
+                &path,
+                &report,
+                &meta(),
+                &input_meta(),
+                &Default::default(),
+                true,
+            )
+        })
         .unwrap_err();
         match &err {
             OutputError::Write { path: p, .. } => assert_eq!(p, &path),
@@ -536,14 +555,17 @@ fn missing_directory_is_an_error_naming_the_path() {
 fn unknown_extension_is_rejected_before_writing() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("b.pdf");
-    let err = save_budget(
-        &path,
-        &synthetic_report(),
-        &meta(),
-        &input_meta(),
-        &Default::default(),
-        true,
-    )
+    let err = tiltnoise_io::Staging::committed(|s| {
+        save_budget(
+            s,
+            &path,
+            &synthetic_report(),
+            &meta(),
+            &input_meta(),
+            &Default::default(),
+            true,
+        )
+    })
     .unwrap_err();
     assert!(matches!(err, OutputError::UnknownFormat { .. }), "{err:?}");
     assert!(listing(dir.path()).is_empty());
@@ -656,12 +678,19 @@ fn realistic_budget_renders() {
     let out = preview_dir();
     for ext in ["png", "svg"] {
         let name = format!("budget_spectra.{ext}");
-        save_image(&dir.path().join(&name), |format| {
-            budget_figure(&spectra, format)
+        tiltnoise_io::Staging::committed(|s| {
+            save_image(s, &dir.path().join(&name), |format| {
+                budget_figure(&spectra, format)
+            })
         })
         .unwrap();
         if let Some(out) = &out {
-            save_image(&out.join(&name), |format| budget_figure(&spectra, format)).unwrap();
+            tiltnoise_io::Staging::committed(|s| {
+                save_image(s, &out.join(&name), |format| {
+                    budget_figure(&spectra, format)
+                })
+            })
+            .unwrap();
         }
     }
     let text = std::fs::read_to_string(dir.path().join("budget_spectra.svg")).unwrap();
@@ -670,17 +699,31 @@ fn realistic_budget_renders() {
     for (stem, r) in [("budget", &report), ("budget_measured", &measured)] {
         for ext in ["png", "svg", "h5", "csv"] {
             let path = dir.path().join(format!("{stem}.{ext}"));
-            save_budget(&path, r, &meta(), &input_meta(), &Default::default(), true).unwrap();
-            assert!(std::fs::metadata(&path).unwrap().len() > 1000);
-            if let Some(out) = &out {
+            tiltnoise_io::Staging::committed(|s| {
                 save_budget(
-                    &out.join(format!("{stem}.{ext}")),
+                    s,
+                    &path,
                     r,
                     &meta(),
                     &input_meta(),
                     &Default::default(),
                     true,
                 )
+            })
+            .unwrap();
+            assert!(std::fs::metadata(&path).unwrap().len() > 1000);
+            if let Some(out) = &out {
+                tiltnoise_io::Staging::committed(|s| {
+                    save_budget(
+                        s,
+                        &out.join(format!("{stem}.{ext}")),
+                        r,
+                        &meta(),
+                        &input_meta(),
+                        &Default::default(),
+                        true,
+                    )
+                })
                 .unwrap();
             }
         }

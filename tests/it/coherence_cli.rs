@@ -427,12 +427,15 @@ fn saved_files_hold_the_report_exactly() {
     let result = tiltnoise_job::coherence::CoherenceResult { report, inputs };
     let report = &result.report;
     for path in [&h5, &csv] {
-        tiltnoise_job::coherence::save(
-            path,
-            &result,
-            &RunMeta::default(),
-            &tiltnoise_plot::View::default(),
-        )
+        tiltnoise_io::Staging::committed(|s| {
+            tiltnoise_job::coherence::save(
+                s,
+                path,
+                &result,
+                &RunMeta::default(),
+                &tiltnoise_plot::View::default(),
+            )
+        })
         .unwrap();
     }
     let file = hdf5::File::open(&h5).unwrap();
@@ -469,12 +472,15 @@ fn saved_files_hold_the_report_exactly() {
     assert_eq!(back, want);
     // A figure drawn from the same report.
     let png = dir.path().join("r.png");
-    tiltnoise_job::coherence::save(
-        &png,
-        &result,
-        &RunMeta::default(),
-        &tiltnoise_plot::View::default(),
-    )
+    tiltnoise_io::Staging::committed(|s| {
+        tiltnoise_job::coherence::save(
+            s,
+            &png,
+            &result,
+            &RunMeta::default(),
+            &tiltnoise_plot::View::default(),
+        )
+    })
     .unwrap();
     assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
 }

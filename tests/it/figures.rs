@@ -23,7 +23,10 @@ fn missing_directory_is_an_error_and_leaves_nothing() {
     let dir = tempfile::tempdir().unwrap();
     for name in ["fig.png", "fig.svg"] {
         let path = dir.path().join("no-such-dir").join(name);
-        let err = save_image(&path, |format| tf_figure(&tf, format)).unwrap_err();
+        let err = tiltnoise_io::Staging::committed(|s| {
+            save_image(s, &path, |format| tf_figure(&tf, format))
+        })
+        .unwrap_err();
         match &err {
             OutputError::Write { path: p, .. } => assert_eq!(p, &path),
             other => panic!("unexpected error {other:?}"),
@@ -39,7 +42,9 @@ fn unknown_extension_is_rejected_before_drawing() {
     let dir = tempfile::tempdir().unwrap();
     for name in ["fig.pdf", "fig"] {
         let path = dir.path().join(name);
-        let err = save_image(&path, |_| panic!("{name}: drawn")).unwrap_err();
+        let err =
+            tiltnoise_io::Staging::committed(|s| save_image(s, &path, |_| panic!("{name}: drawn")))
+                .unwrap_err();
         assert!(matches!(err, OutputError::UnknownFormat { .. }), "{err:?}");
         assert!(!path.exists());
     }
@@ -51,7 +56,10 @@ fn drawing_error_leaves_existing_target_untouched() {
     for name in ["old.png", "old.svg"] {
         let path = dir.path().join(name);
         std::fs::write(&path, b"previous").unwrap();
-        let err = save_image(&path, |_| Err(DrawError("deliberate".to_string()))).unwrap_err();
+        let err = tiltnoise_io::Staging::committed(|s| {
+            save_image(s, &path, |_| Err(DrawError("deliberate".to_string())))
+        })
+        .unwrap_err();
         assert!(err.to_string().contains("deliberate"), "{err}");
         assert!(err.to_string().contains(name), "{err}");
         assert_eq!(std::fs::read(&path).unwrap(), b"previous");
@@ -68,7 +76,8 @@ fn overwrite_replaces_target() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("fig.svg");
     std::fs::write(&path, b"previous").unwrap();
-    save_image(&path, |format| tf_figure(&tf, format)).unwrap();
+    tiltnoise_io::Staging::committed(|s| save_image(s, &path, |format| tf_figure(&tf, format)))
+        .unwrap();
     assert!(std::fs::read_to_string(&path).unwrap().starts_with("<svg"));
     assert_eq!(listing(dir.path()), vec![path]);
 }

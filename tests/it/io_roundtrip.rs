@@ -10,7 +10,7 @@ use tiltnoise_core::error::OutputError;
 use tiltnoise_core::model::Model;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::tf::{evaluate, plan, Method, Request, TransferMatrix};
-use tiltnoise_io::{write_atomic, write_tf_csv, write_tf_hdf5, OutputKind, RunMeta, TOOL_VERSION};
+use tiltnoise_io::{write_tf_csv, write_tf_hdf5, OutputKind, RunMeta, Staging, TOOL_VERSION};
 use tiltnoise_job::tf::save as save_tf;
 
 fn freqs() -> Vec<f64> {
@@ -45,7 +45,7 @@ fn hdf5_round_trip_is_bit_exact_and_self_describing() {
     let path = dir.path().join("tf.h5");
     let tf = table_i_tf(&freqs());
     let meta = meta();
-    save_tf(&path, &tf, &meta, &Default::default()).unwrap();
+    Staging::committed(|s| save_tf(s, &path, &tf, &meta, &Default::default())).unwrap();
     assert_eq!(
         listing(dir.path()),
         vec![path.clone()],
@@ -144,7 +144,7 @@ fn hdf5_without_modes_has_no_modes_group() {
         modes: vec![],
         ..meta()
     };
-    write_tf_hdf5(&path, &table_i_tf(&[0.1, 1.0]), &meta).unwrap();
+    Staging::committed(|s| write_tf_hdf5(s, &path, &table_i_tf(&[0.1, 1.0]), &meta)).unwrap();
     let file = hdf5::File::open(&path).unwrap();
     assert!(file.group("modes").is_err());
     assert_eq!(file.dataset("transfer").unwrap().shape(), vec![2, 7, 3]);
@@ -155,7 +155,7 @@ fn csv_round_trip_is_bit_exact() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("tf.csv");
     let tf = table_i_tf(&freqs());
-    save_tf(&path, &tf, &meta(), &Default::default()).unwrap();
+    Staging::committed(|s| save_tf(s, &path, &tf, &meta(), &Default::default())).unwrap();
     assert_eq!(
         listing(dir.path()),
         vec![path.clone()],
@@ -228,7 +228,8 @@ fn extension_picks_the_format_case_insensitively() {
     }
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("tf.H5");
-    save_tf(&path, &table_i_tf(&[1.0]), &meta(), &Default::default()).unwrap();
+    Staging::committed(|s| save_tf(s, &path, &table_i_tf(&[1.0]), &meta(), &Default::default()))
+        .unwrap();
     assert!(hdf5::File::open(&path).is_ok());
 }
 
@@ -238,7 +239,8 @@ fn unknown_extension_is_rejected_naming_the_allowed_ones() {
     let tf = table_i_tf(&[1.0]);
     for name in ["tf.xyz", "tf", "tf.h5.bak"] {
         let path = dir.path().join(name);
-        let err = save_tf(&path, &tf, &meta(), &Default::default()).unwrap_err();
+        let err = Staging::committed(|s| save_tf(s, &path, &tf, &meta(), &Default::default()))
+            .unwrap_err();
         match &err {
             OutputError::UnknownFormat { path: p, allowed } => {
                 assert_eq!(p, &path);
@@ -261,7 +263,8 @@ fn missing_directory_is_an_error_naming_the_path_and_leaves_nothing() {
     let tf = table_i_tf(&[1.0]);
     for name in ["tf.h5", "tf.csv"] {
         let path = dir.path().join("no_such_dir").join(name);
-        let err = save_tf(&path, &tf, &meta(), &Default::default()).unwrap_err();
+        let err = Staging::committed(|s| save_tf(s, &path, &tf, &meta(), &Default::default()))
+            .unwrap_err();
         match &err {
             OutputError::Write { path: p, message } => {
                 assert_eq!(p, &path);
@@ -284,8 +287,8 @@ fn overwriting_an_existing_file_works() {
     let h5 = dir.path().join("tf.h5");
     let csv = dir.path().join("tf.csv");
     for tf in [&tf1, &tf2] {
-        save_tf(&h5, tf, &meta(), &Default::default()).unwrap();
-        save_tf(&csv, tf, &meta(), &Default::default()).unwrap();
+        Staging::committed(|s| save_tf(s, &h5, tf, &meta(), &Default::default())).unwrap();
+        Staging::committed(|s| save_tf(s, &csv, tf, &meta(), &Default::default())).unwrap();
     }
     let file = hdf5::File::open(&h5).unwrap();
     assert_eq!(
@@ -314,17 +317,26 @@ fn failed_write_does_not_clobber_an_existing_file() {
     let path = dir.path().join("tf.h5");
     std::fs::write(&path, b"precious").unwrap();
 
-    // A closure that fails after writing into the temporary file.
+    // A closure that fails after writing into its file, in a staging directory of its own
+    // beside the target.
     let mut seen = None;
-    let err = write_atomic(&path, |temp| {
-        assert_eq!(temp.parent(), Some(dir.path()), "same directory");
-        assert_eq!(temp.extension().unwrap(), "h5", "real extension kept");
-        assert!(temp.exists());
-        seen = Some(temp.to_path_buf());
-        std::fs::write(temp, b"half-written").unwrap();
-        Err("boom".to_string())
-    })
-    .unwrap_err();
+    let stage = Staging::new();
+    let err = stage
+        .write(&path, |temp| {
+            let staging = temp.parent().unwrap();
+            assert_eq!(staging.parent(), Some(dir.path()), "beside the target");
+            let name = staging.file_name().unwrap().to_str().unwrap();
+            assert!(
+                name.starts_with(".tf.h5.") && name.ends_with(".tmp"),
+                "{name}"
+            );
+            assert_eq!(temp.file_name().unwrap(), "tf.h5", "the target's name");
+            assert!(!temp.exists(), "created by the writer");
+            seen = Some(staging.to_path_buf());
+            std::fs::write(temp, b"half-written").unwrap();
+            Err("boom".to_string())
+        })
+        .unwrap_err();
     match err {
         OutputError::Write { path: p, message } => {
             assert_eq!(p, path);
@@ -332,20 +344,21 @@ fn failed_write_does_not_clobber_an_existing_file() {
         }
         other => panic!("expected Write, got {other:?}"),
     }
-    assert!(!seen.unwrap().exists(), "temporary file removed");
+    assert!(!seen.unwrap().exists(), "staging directory removed");
     assert_eq!(std::fs::read(&path).unwrap(), b"precious");
 
     // A real writer failing (inconsistent matrix) leaves the old file alone too.
     let mut bad = table_i_tf(&[1.0, 2.0]);
     bad.freqs_hz.push(3.0);
-    let err = write_tf_hdf5(&path, &bad, &meta()).unwrap_err();
+    let err = Staging::committed(|s| write_tf_hdf5(s, &path, &bad, &meta())).unwrap_err();
     assert!(matches!(err, OutputError::Write { .. }), "{err:?}");
     assert_eq!(std::fs::read(&path).unwrap(), b"precious");
     assert_eq!(listing(dir.path()), vec![path.clone()]);
 
     // And without an existing file, a failure leaves nothing.
     let csv = dir.path().join("new.csv");
-    assert!(write_atomic(&csv, |_| Err("no".into())).is_err());
+    assert!(stage.write(&csv, |_| Err("no".into())).is_err());
+    assert_eq!(stage.commit().unwrap(), Vec::<std::path::PathBuf>::new());
     assert_eq!(listing(dir.path()), vec![path]);
 }
 
@@ -353,11 +366,14 @@ fn failed_write_does_not_clobber_an_existing_file() {
 fn csv_writer_can_be_called_directly() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("direct.csv");
-    write_tf_csv(
-        &path,
-        &table_i_tf(&[1.0]),
-        &tiltnoise_io::RunMeta::default(),
-    )
+    Staging::committed(|s| {
+        write_tf_csv(
+            s,
+            &path,
+            &table_i_tf(&[1.0]),
+            &tiltnoise_io::RunMeta::default(),
+        )
+    })
     .unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
     // The `#` lines, the header and one line per frequency.
@@ -371,8 +387,8 @@ fn figures_are_dispatched_to_the_plot_module() {
     let tf = table_i_tf(&freqs()[1..]);
     let svg = dir.path().join("tf.SVG");
     let png = dir.path().join("tf.png");
-    save_tf(&svg, &tf, &meta(), &Default::default()).unwrap();
-    save_tf(&png, &tf, &meta(), &Default::default()).unwrap();
+    Staging::committed(|s| save_tf(s, &svg, &tf, &meta(), &Default::default())).unwrap();
+    Staging::committed(|s| save_tf(s, &png, &tf, &meta(), &Default::default())).unwrap();
     let text = std::fs::read_to_string(&svg).unwrap();
     assert!(text.contains("<svg"), "an SVG document");
     let bytes = std::fs::read(&png).unwrap();

@@ -1,8 +1,14 @@
 //! The process around the computation: a standard output that is closed or full, error
 //! messages that stay one short line whatever the user or a file holds, command-line errors,
 //! output paths checked before anything is computed and written all or none, and interrupts
-//! during a computation or a write. Every failure is one line on standard error with exit code 2, never a panic,
-//! and leaves no file behind.
+//! during a computation or a write (and, in [`stall`], at every step of the staging of an
+//! output). Every failure is one line on standard error with exit code 2, never a panic, and
+//! leaves no file behind.
+//!
+//! Every child starts with the default action for the signals the tests send
+//! ([`default_signals`]), whatever the test process inherited.
+
+mod stall;
 
 use crate::common;
 
@@ -12,14 +18,38 @@ use std::path::Path;
 use std::process::{Child, Command, ExitStatus, Output, Stdio};
 use std::time::{Duration, Instant};
 
-/// The binary, ready to spawn, with HDF5 file locking off (see [`common::tiltnoise`]).
+/// The binary, ready to spawn, with HDF5 file locking off (see [`common::tiltnoise`]) and the
+/// default action for the signals the tests send ([`default_signals`]).
 fn command(args: &[&str], dir: &Path) -> Command {
     common::disable_hdf5_file_locking();
     let mut c = Command::new(env!("CARGO_BIN_EXE_tiltnoise"));
     c.env("HDF5_USE_FILE_LOCKING", "FALSE")
         .current_dir(dir)
         .args(args);
+    default_signals(&mut c);
     c
+}
+
+/// The signals the tests send, and which a child must receive with their default action.
+const SENT_SIGNALS: [libc::c_int; 3] = [libc::SIGINT, libc::SIGTERM, libc::SIGHUP];
+
+/// Makes `child` start with the default action for [`SENT_SIGNALS`]. An ignored signal survives
+/// `exec`: under `nohup` SIGHUP is ignored, in a shell script's background job SIGINT is, and a
+/// child would inherit that from the test process. (The signal mask is reset by `spawn`.)
+fn default_signals(child: &mut Command) -> &mut Command {
+    use std::os::unix::process::CommandExt;
+    // SAFETY: between fork and exec the closure calls only signal(2), which is
+    // async-signal-safe, with constant arguments.
+    unsafe {
+        child.pre_exec(|| {
+            for signal in SENT_SIGNALS {
+                if libc::signal(signal, libc::SIG_DFL) == libc::SIG_ERR {
+                    return Err(std::io::Error::last_os_error());
+                }
+            }
+            Ok(())
+        })
+    }
 }
 
 /// Asserts one line on standard error, and neither a panic nor a backtrace.
@@ -498,9 +528,9 @@ fn outputs_of_a_run_appear_all_or_none() {
     assert_eq!(listing(d), vec![d.join("tf.csv"), d.join("tf.png")]);
 }
 
-/// Runs `args` in an empty directory, sends `signal` as soon as the temporary file of `target`
-/// exists (the write is under way), and checks the end: exit code 2, one line naming the
-/// signal, and no file left.
+/// Runs `args` in an empty directory, sends `signal` as soon as the file of `target` exists in
+/// its staging directory (the write is under way), and checks the end: exit code 2, one line
+/// naming the signal, and no file left.
 fn interrupt_during_write(args: &[&str], target: &str, signal: libc::c_int, name: &str) {
     let dir = tempfile::tempdir().unwrap();
     let mut child = command(args, dir.path())
@@ -508,16 +538,9 @@ fn interrupt_during_write(args: &[&str], target: &str, signal: libc::c_int, name
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let prefix = format!(".{target}.");
     let start = Instant::now();
     let writing = loop {
-        let temp = std::fs::read_dir(dir.path()).unwrap().any(|e| {
-            e.unwrap()
-                .file_name()
-                .to_string_lossy()
-                .starts_with(&prefix)
-        });
-        if temp {
+        if writing_file(dir.path(), target) {
             break true;
         }
         if child.try_wait().unwrap().is_some() || start.elapsed() > Duration::from_secs(120) {
@@ -527,17 +550,18 @@ fn interrupt_during_write(args: &[&str], target: &str, signal: libc::c_int, name
     };
     assert!(
         writing,
-        "{args:?}: no temporary file of {target} seen while running"
+        "{args:?}: no file of {target} seen in a staging directory while running"
     );
-    // SAFETY: kill only sends a signal to the child's process id, which is alive (its
-    // temporary file was just seen and it has not been waited for).
+    // SAFETY: kill only sends a signal to the child's process id, which is alive (its file
+    // was just seen and it has not been waited for).
     assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, signal) }, 0);
     let status = wait_bounded(&mut child, Duration::from_secs(60));
     let err = child_stderr(&mut child);
     assert_eq!(status.code(), Some(2), "{args:?}: {err}");
     assert_one_line(name, &err);
     assert!(
-        err.starts_with(&format!("tiltnoise: error: interrupted by {name}")),
+        err.starts_with(&format!("tiltnoise: error: interrupted by {name}; "))
+            && err.trim_end().ends_with(", no output written"),
         "{err}"
     );
     assert_eq!(
@@ -545,6 +569,15 @@ fn interrupt_during_write(args: &[&str], target: &str, signal: libc::c_int, name
         Vec::<std::path::PathBuf>::new(),
         "{args:?} left files after {name}"
     );
+}
+
+/// Whether the file of `target` exists in a staging directory `.<target>.XXXXXX.tmp` of `dir`.
+fn writing_file(dir: &Path, target: &str) -> bool {
+    let prefix = format!(".{target}.");
+    std::fs::read_dir(dir).unwrap().any(|e| {
+        let e = e.unwrap();
+        e.file_name().to_string_lossy().starts_with(&prefix) && e.path().join(target).exists()
+    })
 }
 
 /// Runs `args` (a long computation that saves its outputs only at the end) in an empty
@@ -571,7 +604,8 @@ fn interrupt_while_computing(args: &[&str], signal: libc::c_int, name: &str) {
     assert_eq!(status.code(), Some(2), "{args:?}: {err}");
     assert_one_line(name, &err);
     assert!(
-        err.starts_with(&format!("tiltnoise: error: interrupted by {name}")),
+        err.starts_with(&format!("tiltnoise: error: interrupted by {name}; "))
+            && err.trim_end().ends_with(", no output written"),
         "{err}"
     );
     assert_eq!(
@@ -615,6 +649,61 @@ fn an_interrupt_during_a_write_leaves_no_file() {
         libc::SIGHUP,
         "SIGHUP",
     );
+}
+
+#[test]
+fn a_hangup_ignored_as_under_nohup_lets_the_run_finish() {
+    use std::os::unix::process::CommandExt;
+    let dir = tempfile::tempdir().unwrap();
+    let mut child = command(
+        &["tf", "--freq", "1e-4:200000:30", "--save", "big.csv"],
+        dir.path(),
+    );
+    // SAFETY: between fork and exec (after the reset of [`default_signals`]) the closure calls
+    // only signal(2), which is async-signal-safe, with constant arguments.
+    unsafe {
+        child.pre_exec(|| match libc::signal(libc::SIGHUP, libc::SIG_IGN) {
+            libc::SIG_ERR => Err(std::io::Error::last_os_error()),
+            _ => Ok(()),
+        });
+    }
+    let mut child = child
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !writing_file(dir.path(), "big.csv") {
+        assert!(
+            child.try_wait().unwrap().is_none() && start.elapsed() < Duration::from_secs(120),
+            "no file of big.csv seen in a staging directory while running"
+        );
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let pid = child.id() as libc::pid_t;
+    // SAFETY: kill only sends a signal to the child's process id, which is alive (its file
+    // was just seen and it has not been waited for).
+    assert_eq!(unsafe { libc::kill(pid, libc::SIGHUP) }, 0);
+    let status = wait_bounded(&mut child, Duration::from_secs(120));
+    let err = child_stderr(&mut child);
+    assert_eq!(status.code(), Some(0), "{err}");
+    assert_eq!(err, "");
+    assert_eq!(listing(dir.path()), vec![dir.path().join("big.csv")]);
+    // Whole: a line per frequency of the grid, up to its last one.
+    let text = std::fs::read_to_string(dir.path().join("big.csv")).unwrap();
+    let rows: Vec<&str> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .skip(1)
+        .collect();
+    assert!(rows.len() >= 200_000, "{} rows", rows.len());
+    let last: f64 = rows[rows.len() - 1]
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(last, 30.0);
 }
 
 /// Standard output of a successful run.

@@ -1,7 +1,7 @@
 //! ASDs of observables as CSV (`tiltnoise simulate --save asd.csv`), in the layout the budget
 //! reads as a measured spectrum (`docs/input_formats.md`).
 
-use crate::atomic::write_atomic;
+use crate::atomic::Staging;
 use crate::csv_layout::{csv_head, CsvPreamble};
 use crate::run_meta::RunMeta;
 use crate::tf_csv::format_f64;
@@ -24,6 +24,7 @@ pub const SCHEMA_VERSION_OBSERVABLE_ASD_CSV: u32 = 2;
 ///
 /// [`OutputError::Write`] naming `path`; nothing is left there.
 pub fn write_asd_csv(
+    stage: &Staging,
     path: &Path,
     freqs_hz: &[f64],
     asd: &[(Observable, Vec<f64>)],
@@ -48,7 +49,7 @@ pub fn write_asd_csv(
         }
         text.push('\n');
     }
-    write_atomic(path, |temp| {
+    stage.write(path, |temp| {
         std::fs::write(temp, &text).map_err(|e| e.to_string())
     })
 }

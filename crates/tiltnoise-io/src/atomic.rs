@@ -1,136 +1,44 @@
-//! Atomic outputs: every file is written to a temporary file next to its target and renamed
-//! onto it only when complete, so that a failed run never leaves a partial file.
+//! Atomic outputs: every file is written inside a private staging directory next to its
+//! target and renamed onto it only when the whole run has succeeded, so that a failed or
+//! interrupted run never leaves a partial file, nor a temporary one.
 //!
-//! * [`write_atomic`]: one file.
-//! * [`AtomicFile`]: one file written over time (a long record, chunk by chunk), renamed when
-//!   finished, removed if dropped before.
-//! * [`Staging`]: every output of a run. While a `Staging` is active on the calling thread,
-//!   [`write_atomic`] leaves each finished temporary file in place, and [`Staging::commit`]
-//!   renames them all at the end; if the run fails before, dropping the `Staging` removes them,
-//!   so either every output of the run appears or none does.
-//! * [`remove_temporaries_for_exit`]: removes the temporary files that exist at that moment,
-//!   for an interrupt handler that then ends the process (signals are the command line's).
+//! * [`Staging`]: the outputs of one run, written all or none. The caller makes one, passes it
+//!   to every writer, and commits it at the end; dropped without a commit, it removes them all.
+//!   [`Staging::write`] writes one file.
+//! * [`AtomicFile`]: one file written over time (a long record, chunk by chunk), handed to the
+//!   run's [`Staging`] when finished, removed if dropped before.
+//! * [`remove_staging_for_exit`](crate::remove_staging_for_exit): removes every staging
+//!   directory, for an interrupt handler that then ends the process (signals are the command
+//!   line's); `staging_dir.rs` says why nothing can be left.
 
-use std::cell::RefCell;
-use std::ffi::OsString;
-use std::fs::{File, OpenOptions};
-use std::io;
+use crate::staging_dir::StagingDir;
+use std::collections::VecDeque;
+use std::fs::OpenOptions;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
-use tempfile::TempPath;
+use std::sync::{Mutex, PoisonError};
 use tiltnoise_core::error::OutputError;
 
-/// The longest file name most file systems accept (bytes).
-pub(crate) const NAME_MAX: usize = 255;
-
-/// How long [`remove_temporaries_for_exit`] waits before removing the temporary files again.
-const RECREATE_GRACE: std::time::Duration = std::time::Duration::from_millis(100);
-
-/// Temporary files that exist right now, for [`remove_temporaries_for_exit`].
-static LIVE_TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
-
-thread_local! {
-    /// The outputs staged by the active [`Staging`] of this thread, if any.
-    static STAGED: RefCell<Option<Vec<Staged>>> = const { RefCell::new(None) };
-}
-
-/// A finished temporary file and the path it is to be renamed to.
-struct Staged {
-    temp: Registered,
-    target: PathBuf,
-}
-
-/// A temporary file known to the interrupt handler for as long as it exists.
-struct Registered(Option<TempPath>);
-
-impl Registered {
-    /// Creates the temporary file with `create` and registers it, holding the registry's lock
-    /// throughout: an interrupt handled in between waits for the lock and then finds the file,
-    /// so there is no moment when the file exists unregistered.
-    fn create(create: impl FnOnce() -> io::Result<TempPath>) -> io::Result<Registered> {
-        let mut live = LIVE_TEMPORARIES
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        let temp = create()?;
-        live.push(temp.to_path_buf());
-        Ok(Registered(Some(temp)))
-    }
-
-    fn path(&self) -> &Path {
-        self.0.as_deref().expect("present until persisted")
-    }
-
-    fn forget(path: &Path) {
-        if let Ok(mut live) = LIVE_TEMPORARIES.lock() {
-            live.retain(|p| p != path);
-        }
-    }
-
-    /// Renames the file onto `target`; on failure the file is removed (on drop).
-    fn persist(mut self, target: &Path) -> io::Result<()> {
-        let temp = self.0.take().expect("present until persisted");
-        let path = temp.to_path_buf();
-        let result = temp.persist(target).map_err(|e| e.error);
-        Registered::forget(&path);
-        result
-    }
-}
-
-impl Drop for Registered {
-    fn drop(&mut self) {
-        if let Some(temp) = self.0.take() {
-            let path = temp.to_path_buf();
-            drop(temp); // removes the file
-            Registered::forget(&path);
-        }
-    }
-}
-
-/// Writes `path` atomically: `write` receives the path of a fresh, empty temporary file in the
-/// same directory as `path` (so the final rename never crosses a file system), fills it, and the
-/// temporary file is then flushed to disk and renamed onto `path` (at once, or by
-/// [`Staging::commit`] when a [`Staging`] is active on this thread).
-///
-/// The temporary file is named `.<file name>.<random>.<ext>`, the file name shortened so that
-/// the whole name fits in 255 bytes: it keeps the real extension as its suffix, for libraries
-/// that look at it. `write` may replace the file at that path (HDF5 opens it with
-/// `hdf5::File::create`), but must have closed it when it returns.
-///
-/// On any error the temporary file is removed and `path` is left as it was: absent if it did not
-/// exist, untouched if it did. A new file gets the usual permissions (`0o666` minus the umask);
-/// a replaced file's permissions are not carried over.
-///
-/// # Errors
-///
-/// [`OutputError::Write`] naming `path`, with the operating system's message (for example
-/// `No such file or directory (os error 2)` when the directory does not exist) or the message
-/// returned by `write`.
-pub fn write_atomic(
-    path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), String>,
-) -> Result<(), OutputError> {
-    let file = AtomicFile::create(path)?;
-    write(file.temp_path()).map_err(|message| file.fail(message))?;
-    file.finish()
-}
-
-/// An output written over time, atomically as by [`write_atomic`]: from
-/// [`AtomicFile::create`] to [`AtomicFile::finish`] the data go to a temporary file next to
-/// the target, which the interrupt handler knows; dropping an unfinished `AtomicFile` (the run
-/// failed) removes it, and `path` is left as it was. For a long record written chunk by chunk
-/// while it is computed.
+/// An output being written: its own staging directory `.<name>.XXXXXX.tmp` beside the target
+/// (the name shortened so that it fits in 255 bytes), registered for the interrupt handler
+/// from the moment it exists, and the path of the file to write inside it, which has the
+/// target's own name (for libraries that look at the extension). Finished, it goes to the
+/// run's [`Staging`] ([`AtomicFile::finish`]); dropped before (the run failed), the directory
+/// is removed with what it holds, and the target is left as it was.
 #[must_use = "an AtomicFile that is not finished removes its output"]
 pub struct AtomicFile {
-    temp: Registered,
+    dir: StagingDir,
+    file: PathBuf,
     target: PathBuf,
 }
 
 impl AtomicFile {
-    /// Creates the empty temporary file for `path` (named as by [`write_atomic`]).
+    /// Creates and registers the staging directory of `path`. The file itself is not created:
+    /// the writer creates it at [`AtomicFile::temp_path`].
     ///
     /// # Errors
     ///
-    /// [`OutputError::Write`] naming `path` when the temporary file cannot be created.
+    /// [`OutputError::Write`] naming `path`, with the operating system's message (for example
+    /// `No such file or directory (os error 2)` when the directory does not exist).
     pub fn create(path: &Path) -> Result<AtomicFile, OutputError> {
         let fail = |message: String| OutputError::Write {
             path: path.to_path_buf(),
@@ -139,43 +47,21 @@ impl AtomicFile {
         let file_name = path
             .file_name()
             .ok_or_else(|| fail("the path does not name a file".to_string()))?;
-        let dir = match path.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        let mut suffix = OsString::new();
-        if let Some(ext) = path.extension() {
-            suffix.push(".");
-            suffix.push(ext);
-        }
-        // `.` + name + `.` + 6 random characters + suffix <= NAME_MAX.
-        let room = NAME_MAX.saturating_sub(2 + RANDOM_LEN + suffix.len());
-        let mut prefix = OsString::from(".");
-        prefix.push(shortened(file_name, room));
-        prefix.push(".");
-
-        // `make_in` (unlike `tempfile_in`) returns the operating system's error unchanged, and
-        // lets the file be created with the ordinary umask-controlled mode instead of 0o600.
-        // Close our handle; keep the path, which deletes the file when dropped.
-        let temp = Registered::create(|| {
-            tempfile::Builder::new()
-                .prefix(&prefix)
-                .suffix(&suffix)
-                .rand_bytes(RANDOM_LEN)
-                .make_in(&dir, create_new)
-                .map(|t| t.into_temp_path())
-        })
-        .map_err(|e| fail(e.to_string()))?;
+        let parent = path.parent().unwrap_or(Path::new(""));
+        let dir = StagingDir::create(parent, file_name).map_err(|e| fail(e.to_string()))?;
+        let file = dir.path().join(file_name);
         Ok(AtomicFile {
-            temp,
+            dir,
+            file,
             target: path.to_path_buf(),
         })
     }
 
-    /// The temporary file to write (it may be replaced, as HDF5's `File::create` does, and
-    /// must be closed before [`AtomicFile::finish`]).
+    /// The file to write, inside the staging directory. The writer creates it (the usual
+    /// permissions, `0o666` minus the umask, are those the target gets) and must have closed it
+    /// before [`AtomicFile::finish`]; it may replace it (HDF5's `File::create` truncates).
     pub fn temp_path(&self) -> &Path {
-        self.temp.path()
+        &self.file
     }
 
     /// The path the output is renamed to.
@@ -191,181 +77,139 @@ impl AtomicFile {
         }
     }
 
-    /// Flushes the temporary file to disk and renames it onto the target: at once, or by
-    /// [`Staging::commit`] when a [`Staging`] is active on this thread.
+    /// Flushes the file to disk and hands it to `stage`, which renames it onto the target when
+    /// it commits.
     ///
     /// # Errors
     ///
-    /// [`OutputError::Write`] naming the target; the temporary file is then removed.
-    pub fn finish(self) -> Result<(), OutputError> {
+    /// [`OutputError::Write`] naming the target (also when the writer created no file); the
+    /// staging directory is then removed.
+    pub fn finish(self, stage: &Staging) -> Result<(), OutputError> {
         OpenOptions::new()
             .write(true)
-            .open(self.temp.path())
+            .open(&self.file)
             .and_then(|f| f.sync_all())
             .map_err(|e| self.fail(format!("cannot flush temporary file: {e}")))?;
-        let AtomicFile { temp, target } = self;
-        let staged = STAGED.with(|s| {
-            let mut s = s.borrow_mut();
-            match s.as_mut() {
-                Some(list) => {
-                    list.push(Staged {
-                        temp,
-                        target: target.clone(),
-                    });
-                    None
-                }
-                None => Some(temp),
-            }
-        });
-        match staged {
-            Some(temp) => temp.persist(&target).map_err(|e| OutputError::Write {
-                path: target,
-                message: e.to_string(),
-            }),
-            None => Ok(()),
-        }
+        stage
+            .finished
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .push(self);
+        Ok(())
     }
 }
 
-/// Creates and removes a temporary file in `dir`: whether the run can create its outputs there.
-pub(crate) fn probe_directory(dir: &Path) -> io::Result<()> {
-    // Registered while it exists, so that an interrupt removes it too.
-    drop(Registered::create(|| {
-        tempfile::Builder::new()
-            .prefix(".tiltnoise-probe.")
-            .rand_bytes(RANDOM_LEN)
-            .make_in(dir, create_new)
-            .map(|t| t.into_temp_path())
-    })?);
-    Ok(())
-}
-
-/// Random characters in a temporary file's name.
-const RANDOM_LEN: usize = 6;
-
-/// At most `max` bytes of `name`, cut at a character boundary when the name is UTF-8.
-fn shortened(name: &std::ffi::OsStr, max: usize) -> OsString {
-    if name.len() <= max {
-        return name.to_os_string();
-    }
-    match name.to_str() {
-        Some(s) => {
-            let mut end = max;
-            while !s.is_char_boundary(end) {
-                end -= 1;
-            }
-            OsString::from(&s[..end])
-        }
-        None => {
-            #[cfg(unix)]
-            {
-                use std::os::unix::ffi::{OsStrExt, OsStringExt};
-                OsString::from_vec(name.as_bytes()[..max].to_vec())
-            }
-            #[cfg(not(unix))]
-            {
-                OsString::from("output")
-            }
-        }
-    }
-}
-
-fn create_new(path: &Path) -> io::Result<File> {
-    let mut options = OpenOptions::new();
-    options.write(true).create_new(true);
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::OpenOptionsExt;
-        options.mode(0o666);
-    }
-    options.open(path)
-}
-
-/// The outputs of one run, written all or none: while it is active, [`write_atomic`] on this
-/// thread writes each output to its temporary file and leaves it there; [`Staging::commit`]
-/// renames them all. Dropping a `Staging` that was not committed (the run failed) removes every
-/// temporary file it holds, so no output of a failed run appears.
+/// The outputs of one run, written all or none. Every writer takes the run's `Staging` and
+/// leaves its finished file in its staging directory; [`Staging::commit`] renames them all
+/// onto their targets. Dropping a `Staging` that was not committed (the run failed) removes
+/// every staging directory it holds, so no output of a failed run appears.
+///
+/// Used from several threads at once if need be (`&Staging` is all a writer needs).
 #[must_use = "a Staging that is not committed removes its outputs"]
+#[derive(Default)]
 pub struct Staging {
-    _not_send: std::marker::PhantomData<*const ()>,
+    finished: Mutex<Vec<AtomicFile>>,
+}
+
+impl std::fmt::Debug for Staging {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let finished = self.finished.lock().unwrap_or_else(PoisonError::into_inner);
+        f.debug_struct("Staging")
+            .field(
+                "targets",
+                &finished.iter().map(|a| &a.target).collect::<Vec<_>>(),
+            )
+            .finish()
+    }
 }
 
 impl Staging {
-    /// Starts staging the outputs of this thread.
-    ///
-    /// # Panics
-    ///
-    /// If a `Staging` is already active on this thread.
-    pub fn begin() -> Staging {
-        STAGED.with(|s| {
-            let mut s = s.borrow_mut();
-            assert!(s.is_none(), "a Staging is already active on this thread");
-            *s = Some(Vec::new());
-        });
-        Staging {
-            _not_send: std::marker::PhantomData,
-        }
+    /// A run with no output yet.
+    pub fn new() -> Staging {
+        Staging::default()
     }
 
-    /// Renames every staged output onto its target, in the order they were written, and ends
-    /// the staging. Returns the targets.
+    /// Runs `write` with a `Staging` of its own and commits it when `write` succeeds: for a
+    /// front end that saves one result at a time (Python's `save` methods). On an error
+    /// nothing `write` wrote appears.
     ///
     /// # Errors
     ///
-    /// [`OutputError::Write`] naming the first target that cannot be renamed; the temporary
-    /// files not yet renamed are removed. (Renames within a directory that took the temporary
-    /// file do not fail in practice; the outputs renamed before stay.)
+    /// The error of `write`, or of [`Staging::commit`].
+    pub fn committed<T, E: From<OutputError>>(
+        write: impl FnOnce(&Staging) -> Result<T, E>,
+    ) -> Result<T, E> {
+        let stage = Staging::new();
+        let value = write(&stage)?;
+        stage.commit()?;
+        Ok(value)
+    }
+
+    /// Writes `path` as one of the run's outputs: `write` receives the path of the file to
+    /// create inside a fresh staging directory beside `path` (so the final rename never
+    /// crosses a file system) and fills it; the file is then flushed to disk and kept until
+    /// [`Staging::commit`].
+    ///
+    /// On any error the staging directory is removed and `path` is left as it was: absent if
+    /// it did not exist, untouched if it did. A new file gets the usual permissions (`0o666`
+    /// minus the umask); a replaced file's permissions are not carried over.
+    ///
+    /// # Errors
+    ///
+    /// [`OutputError::Write`] naming `path`, with the operating system's message (for example
+    /// `No such file or directory (os error 2)` when the directory does not exist) or the
+    /// message returned by `write`.
+    pub fn write(
+        &self,
+        path: &Path,
+        write: impl FnOnce(&Path) -> Result<(), String>,
+    ) -> Result<(), OutputError> {
+        let file = AtomicFile::create(path)?;
+        write(file.temp_path()).map_err(|message| file.fail(message))?;
+        file.finish(self)
+    }
+
+    /// Renames every finished output onto its target, in the order they were finished, and
+    /// removes their staging directories. Returns the targets.
+    ///
+    /// The renames are done under the lock of the interrupt handler's registry: an interrupt
+    /// finds either every output still staged (and removes them all) or every output in place.
+    ///
+    /// # Errors
+    ///
+    /// [`OutputError::Write`] naming the first target that cannot be renamed; the outputs not
+    /// yet renamed are removed. (Renames within a directory that took the staging directory
+    /// do not fail in practice; the outputs renamed before stay.)
     pub fn commit(self) -> Result<Vec<PathBuf>, OutputError> {
-        let staged = STAGED.with(|s| s.borrow_mut().take()).unwrap_or_default();
-        let mut done = Vec::with_capacity(staged.len());
-        let mut rest = staged.into_iter();
-        for s in rest.by_ref() {
-            if let Err(e) = s.temp.persist(&s.target) {
-                return Err(OutputError::Write {
-                    path: s.target,
-                    message: e.to_string(),
-                });
+        let mut pending: VecDeque<AtomicFile> = self
+            .finished
+            .into_inner()
+            .unwrap_or_else(PoisonError::into_inner)
+            .into();
+        let mut done = Vec::with_capacity(pending.len());
+        let mut registry = crate::staging_dir::registry();
+        while let Some(output) = pending.pop_front() {
+            if let Err(e) = std::fs::rename(&output.file, &output.target) {
+                // Released before the rest is dropped: dropping removes and unregisters.
+                drop(registry);
+                return Err(output.fail(e.to_string()));
             }
-            done.push(s.target);
+            let AtomicFile { dir, target, .. } = output;
+            dir.close_committed(&mut registry);
+            done.push(target);
         }
         Ok(done)
     }
 }
 
-impl Drop for Staging {
-    fn drop(&mut self) {
-        // Not committed: the staged temporary files are removed as they drop.
-        STAGED.with(|s| drop(s.borrow_mut().take()));
-    }
-}
-
-/// Removes every temporary file of [`write_atomic`], [`AtomicFile`] and [`Staging`] that exists
-/// now and returns how many there were, for a process about to end at once (the command
-/// line's interrupt handler). The registry stays locked afterwards, so that no temporary file
-/// can appear any more: a writer that tries to create one waits for the process to end.
-/// Safe to call from any thread: a writer holds the lock only for a moment.
-///
-/// A registered path can still be created again by a writer already past the registry: the
-/// HDF5 library creates its file over the (registered) temporary one, so a `File::create`
-/// running on another thread at the moment of the removal leaves a fresh file behind. The
-/// files are therefore removed a second time after a pause (100 ms), long enough for such a
-/// create to have finished.
-pub fn remove_temporaries_for_exit() -> usize {
-    let live = LIVE_TEMPORARIES
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner);
-    for p in live.iter() {
-        let _ = std::fs::remove_file(p);
-    }
-    if !live.is_empty() {
-        std::thread::sleep(RECREATE_GRACE);
-        for p in live.iter() {
-            let _ = std::fs::remove_file(p);
-        }
-    }
-    let removed = live.len();
-    std::mem::forget(live);
-    removed
+/// Creates and removes a staging directory in `dir`: whether the run can create its outputs
+/// there.
+pub(crate) fn probe_directory(dir: &Path) -> std::io::Result<()> {
+    drop(StagingDir::create(
+        dir,
+        std::ffi::OsStr::new("tiltnoise-probe"),
+    )?);
+    Ok(())
 }
 
 #[cfg(test)]
@@ -381,20 +225,22 @@ mod tests {
         v
     }
 
-    fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
-        write_atomic(path, |t| std::fs::write(t, text).map_err(|e| e.to_string()))
+    fn write_text(stage: &Staging, path: &Path, text: &str) -> Result<(), OutputError> {
+        stage.write(path, |t| std::fs::write(t, text).map_err(|e| e.to_string()))
     }
 
     #[test]
     fn a_failed_run_leaves_none_of_its_outputs() {
         let dir = tempfile::tempdir().unwrap();
         {
-            let _stage = Staging::begin();
-            write_text(&dir.path().join("a.csv"), "a").unwrap();
-            // Staged, not renamed: only the temporary file exists.
-            assert_eq!(listing(dir.path()).len(), 1);
+            let stage = Staging::new();
+            write_text(&stage, &dir.path().join("a.csv"), "a").unwrap();
+            // Staged, not renamed: only the staging directory exists.
+            let names = listing(dir.path());
+            assert_eq!(names.len(), 1);
+            assert!(names[0].starts_with(".a.csv.") && names[0].ends_with(".tmp"));
             assert!(!dir.path().join("a.csv").exists());
-            let err = write_atomic(&dir.path().join("b.csv"), |_| Err("drawing failed".into()));
+            let err = stage.write(&dir.path().join("b.csv"), |_| Err("drawing failed".into()));
             assert!(err.is_err());
         } // dropped without commit
         assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
@@ -403,19 +249,19 @@ mod tests {
     #[test]
     fn a_committed_run_has_every_output_and_no_temporary_file() {
         let dir = tempfile::tempdir().unwrap();
-        let stage = Staging::begin();
-        write_text(&dir.path().join("a.csv"), "a").unwrap();
-        write_text(&dir.path().join("b.csv"), "b").unwrap();
+        let stage = Staging::new();
+        write_text(&stage, &dir.path().join("a.csv"), "a").unwrap();
+        write_text(&stage, &dir.path().join("b.csv"), "b").unwrap();
         let done = stage.commit().unwrap();
-        assert_eq!(done.len(), 2);
+        assert_eq!(
+            done,
+            vec![dir.path().join("a.csv"), dir.path().join("b.csv")]
+        );
         assert_eq!(listing(dir.path()), vec!["a.csv", "b.csv"]);
         assert_eq!(
             std::fs::read_to_string(dir.path().join("b.csv")).unwrap(),
             "b"
         );
-        // Without a Staging, a write is renamed at once.
-        write_text(&dir.path().join("c.csv"), "c").unwrap();
-        assert!(dir.path().join("c.csv").exists());
     }
 
     #[test]
@@ -428,10 +274,11 @@ mod tests {
             assert_eq!(listing(dir.path()).len(), 1);
         } // dropped unfinished
         assert!(listing(dir.path()).is_empty());
-        let stage = Staging::begin();
+        let stage = Staging::new();
         let file = AtomicFile::create(&target).unwrap();
+        assert_eq!(file.temp_path().file_name(), target.file_name());
         std::fs::write(file.temp_path(), "all").unwrap();
-        file.finish().unwrap();
+        file.finish(&stage).unwrap();
         assert!(!target.exists(), "staged until the commit");
         stage.commit().unwrap();
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "all");
@@ -439,11 +286,58 @@ mod tests {
     }
 
     #[test]
+    fn a_writer_that_creates_no_file_fails() {
+        let dir = tempfile::tempdir().unwrap();
+        let stage = Staging::new();
+        let err = stage
+            .write(&dir.path().join("none.csv"), |_| Ok(()))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("none.csv") && err.contains("cannot flush"),
+            "{err}"
+        );
+        assert!(listing(dir.path()).is_empty());
+        assert_eq!(stage.commit().unwrap(), Vec::<PathBuf>::new());
+    }
+
+    #[test]
+    fn an_existing_target_is_replaced_only_by_the_commit() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("old.csv");
+        std::fs::write(&target, "old").unwrap();
+        let stage = Staging::new();
+        write_text(&stage, &target, "new").unwrap();
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "old");
+        drop(stage);
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "old");
+        assert_eq!(listing(dir.path()), vec!["old.csv"]);
+        let stage = Staging::new();
+        write_text(&stage, &target, "new").unwrap();
+        stage.commit().unwrap();
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
+        assert_eq!(listing(dir.path()), vec!["old.csv"]);
+    }
+
+    #[test]
     fn temporary_names_fit_in_255_bytes() {
         let dir = tempfile::tempdir().unwrap();
         let name = format!("{}.csv", "n".repeat(251));
         assert_eq!(name.len(), 255);
-        write_text(&dir.path().join(&name), "x").unwrap();
+        let stage = Staging::new();
+        write_text(&stage, &dir.path().join(&name), "x").unwrap();
+        stage.commit().unwrap();
         assert_eq!(listing(dir.path()), vec![name]);
+    }
+
+    #[test]
+    fn the_file_to_write_is_inside_a_staging_directory_beside_the_target() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = AtomicFile::create(&dir.path().join("x.h5")).unwrap();
+        assert!(file.temp_path().is_absolute());
+        assert_eq!(
+            file.temp_path().parent().unwrap().parent(),
+            Some(dir.path())
+        );
     }
 }

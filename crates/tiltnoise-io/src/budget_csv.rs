@@ -1,7 +1,7 @@
 //! Noise budget as CSV: one ASD column per observable and term (schema `docs/schemas.md`,
 //! section "Noise budgets, CSV").
 
-use crate::atomic::write_atomic;
+use crate::atomic::Staging;
 use crate::budget_hdf5::SPECTRAL_CONVENTION;
 use crate::csv_layout::{csv_head, drop_zero_columns, zero_columns_note, CsvPreamble};
 use crate::run_meta::RunMeta;
@@ -17,7 +17,7 @@ pub const SCHEMA_BUDGET_CSV: &str = "tiltnoise.budget_csv";
 /// Value of the `# schema_version:` line. Bumped on any change that can break a reader.
 pub const SCHEMA_VERSION_BUDGET_CSV: u32 = 2;
 
-/// Writes the budget's ASDs as CSV, atomically (see [`super::write_atomic`]).
+/// Writes the budget's ASDs as CSV, as one of the outputs of `stage` (see [`Staging::write`]).
 ///
 /// The layout of every tiltnoise CSV ([`crate::csv_layout`]): `#` lines (schema, provenance,
 /// notes, `# units:`), then one header line, `frequency_hz` followed by `OBS.TERM` for every
@@ -39,12 +39,13 @@ pub const SCHEMA_VERSION_BUDGET_CSV: u32 = 2;
 /// [`OutputError::Write`] naming `path` if the report is inconsistent (a spectrum whose length
 /// differs from the frequency grid) or on any I/O failure; nothing is left at `path`.
 pub fn write_budget_csv(
+    stage: &Staging,
     path: &Path,
     report: &BudgetReport,
     meta: &RunMeta,
     keep_zero_columns: bool,
 ) -> Result<(), OutputError> {
-    write_atomic(path, |temp| {
+    stage.write(path, |temp| {
         let text = budget_csv_string(report, meta, keep_zero_columns)?;
         let file = std::fs::File::create(temp).map_err(|e| e.to_string())?;
         let mut out = BufWriter::new(file);

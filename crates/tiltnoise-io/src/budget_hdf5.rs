@@ -1,7 +1,7 @@
 //! Noise budget as HDF5 (schema `tiltnoise.budget`, documented in `docs/schemas.md`).
 
 use super::h5util::{dataset, provenance, scalar_attr, str_attr, strs_attr};
-use crate::atomic::write_atomic;
+use crate::atomic::Staging;
 use crate::run_meta::RunMeta;
 use crate::tf_hdf5::SIGN_CONVENTION;
 use std::path::Path;
@@ -24,7 +24,7 @@ pub const SPECTRAL_CONVENTION: &str =
 
 /// Writes a budget report with the run's provenance `meta` and the tilt input's provenance
 /// `input` as an HDF5 file of schema [`SCHEMA_BUDGET`], atomically (see
-/// [`super::write_atomic`]).
+/// [`Staging::write`]).
 ///
 /// Layout: root attributes (schema, provenance, conventions, how the tilt spectra were
 /// obtained); `/frequency_hz`; one group per observable (`/X`, `/phi`, `/phi_a`) holding one
@@ -40,12 +40,13 @@ pub const SPECTRAL_CONVENTION: &str =
 /// [`OutputError::Write`] naming `path` if the report is inconsistent (a spectrum whose length
 /// differs from the frequency grid) or on any I/O or HDF5 failure; nothing is left at `path`.
 pub fn write_budget_hdf5(
+    stage: &Staging,
     path: &Path,
     report: &BudgetReport,
     meta: &RunMeta,
     input: &InputMeta,
 ) -> Result<(), OutputError> {
-    write_atomic(path, |temp| {
+    stage.write(path, |temp| {
         report.check()?;
         write_file(temp, report, meta, input)
             .map_err(|e| format!("HDF5: {}", crate::messages::first_line(&e.to_string())))

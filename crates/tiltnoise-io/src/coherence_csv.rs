@@ -1,7 +1,7 @@
 //! Coherence and measured transfer functions as CSV, units in the header (schema
 //! `docs/schemas.md`, section "Coherence, CSV").
 
-use crate::atomic::write_atomic;
+use crate::atomic::Staging;
 use crate::csv_layout::{csv_head, CsvPreamble};
 use crate::run_meta::RunMeta;
 use crate::tf_csv::format_f64;
@@ -16,7 +16,7 @@ pub const SCHEMA_COHERENCE_CSV: &str = "tiltnoise.coherence_csv";
 /// Value of the `# schema_version:` line. Bumped on any change that can break a reader.
 pub const SCHEMA_VERSION_COHERENCE_CSV: u32 = 2;
 
-/// Writes the report as CSV, atomically (see [`super::write_atomic`]).
+/// Writes the report as CSV, as one of the outputs of `stage` (see [`Staging::write`]).
 ///
 /// The layout of every tiltnoise CSV ([`crate::csv_layout`]: `#` lines ending with `# units:`,
 /// then one header line), then one line per Welch bin. Columns: `frequency_hz`, `estimable` (1
@@ -32,11 +32,12 @@ pub const SCHEMA_VERSION_COHERENCE_CSV: u32 = 2;
 ///
 /// [`OutputError::Write`] naming `path` on any I/O failure; nothing is left at `path`.
 pub fn write_coherence_csv(
+    stage: &Staging,
     path: &Path,
     report: &CoherenceReport,
     meta: &RunMeta,
 ) -> Result<(), OutputError> {
-    write_atomic(path, |temp| {
+    stage.write(path, |temp| {
         let text = coherence_csv_string(report, meta);
         let file = std::fs::File::create(temp).map_err(|e| e.to_string())?;
         let mut out = BufWriter::new(file);

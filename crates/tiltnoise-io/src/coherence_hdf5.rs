@@ -2,7 +2,7 @@
 //! in `docs/schemas.md` and `docs/coherence.md`).
 
 use super::h5util::{dataset, provenance, scalar_attr, str_attr, strs_attr};
-use crate::atomic::write_atomic;
+use crate::atomic::Staging;
 use crate::budget_hdf5::SPECTRAL_CONVENTION;
 use crate::run_meta::RunMeta;
 use crate::tf_hdf5::{SIGN_CONVENTION, TIME_DEPENDENCE};
@@ -31,7 +31,7 @@ pub struct CoherenceInputs {
 }
 
 /// Writes a coherence report with the run's provenance as an HDF5 file of schema
-/// [`SCHEMA_COHERENCE`], atomically (see [`super::write_atomic`]).
+/// [`SCHEMA_COHERENCE`], as one of the outputs of `stage` (see [`Staging::write`]).
 ///
 /// Layout: root attributes (schema, provenance, conventions, Welch settings, confidence level
 /// and thresholds, how the records were aligned, notes); `/frequency_hz`, `/estimable`,
@@ -44,12 +44,13 @@ pub struct CoherenceInputs {
 ///
 /// [`OutputError::Write`] naming `path` on any I/O or HDF5 failure; nothing is left at `path`.
 pub fn write_coherence_hdf5(
+    stage: &Staging,
     path: &Path,
     report: &CoherenceReport,
     meta: &RunMeta,
     inputs: &CoherenceInputs,
 ) -> Result<(), OutputError> {
-    write_atomic(path, |temp| {
+    stage.write(path, |temp| {
         write_file(temp, report, meta, inputs)
             .map_err(|e| format!("HDF5: {}", crate::messages::first_line(&e.to_string())))
     })

@@ -2,6 +2,7 @@
 //! `docs/fit.md` and `docs/schemas.md`).
 
 use super::h5util::{dataset, provenance, scalar_attr, str_attr, strings, strs_attr};
+use crate::atomic::Staging;
 use crate::run_meta::RunMeta;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
@@ -24,12 +25,13 @@ pub const SCHEMA_VERSION_FIT: i64 = 2;
 ///
 /// [`OutputError::Write`] naming `path`; nothing is left there.
 pub fn write_fit_hdf5(
+    stage: &Staging,
     path: &Path,
     r: &FitResult,
     origin: &str,
     meta: &RunMeta,
 ) -> Result<(), OutputError> {
-    crate::atomic::write_atomic(path, |tmp| {
+    stage.write(path, |tmp| {
         write_h5(tmp, r, origin, meta).map_err(|e| crate::messages::first_line(&e.to_string()))
     })
 }

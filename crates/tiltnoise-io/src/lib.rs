@@ -8,9 +8,11 @@
 //!   results as HDF5 or CSV (schemas in `docs/schemas.md`); the cleaned record of `subtract` in
 //!   the observable-series layout (`docs/subtract.md`).
 //! * [`check_outputs`]: the output paths of a run, checked before it computes anything.
-//! * [`write_atomic`]: every writer is atomic: a failed write leaves nothing at the target
-//!   path and never clobbers an existing file. Figures (`tiltnoise-plot`) are written through
-//!   it by the caller.
+//! * [`Staging`]: every writer is atomic and takes the run's `Staging`: each output is written
+//!   in a private staging directory beside its target and renamed onto it when the run commits,
+//!   so a failed or interrupted run leaves nothing at the target paths, nor a temporary file,
+//!   and never clobbers an existing file. Figures (`tiltnoise-plot`) are written through
+//!   [`Staging::write`] by the caller. [`remove_staging_for_exit`] is the interrupt handler's.
 //!
 //! Depends on `tiltnoise-core` for the data it stores; the numerical core never depends on this
 //! crate, and the figures never do either.
@@ -34,6 +36,7 @@ mod params_file;
 mod run_meta;
 mod series_hdf5;
 mod series_hdf5_stream;
+mod staging_dir;
 mod subtract_hdf5;
 mod text_file;
 mod tf_csv;
@@ -42,7 +45,7 @@ mod tf_notes;
 mod tf_stream;
 
 pub use asd_csv::{write_asd_csv, SCHEMA_OBSERVABLE_ASD_CSV, SCHEMA_VERSION_OBSERVABLE_ASD_CSV};
-pub use atomic::{remove_temporaries_for_exit, write_atomic, AtomicFile, Staging};
+pub use atomic::{AtomicFile, Staging};
 pub use budget_csv::{
     budget_csv_string, write_budget_csv, SCHEMA_BUDGET_CSV, SCHEMA_VERSION_BUDGET_CSV,
 };
@@ -67,6 +70,7 @@ pub use series_hdf5::{
     SCHEMA_VERSION_OBSERVABLE_SERIES,
 };
 pub use series_hdf5_stream::{ObservableSeriesWriter, COORDINATES_GROUP, SERIES_CHUNK_SAMPLES};
+pub use staging_dir::{remove_staging_for_exit, ExitCleanup};
 pub use subtract_hdf5::{write_subtract_hdf5, SubtractMeta};
 pub use tf_csv::{
     format_f64, push_tf_csv_rows, tf_csv_header, tf_csv_string, write_tf_csv, SCHEMA_TF_CSV,

@@ -2,7 +2,7 @@
 //! `docs/schemas.md`).
 
 use super::h5util::{dataset, provenance, scalar_attr, str_attr, strings, unit_dataset};
-use crate::atomic::write_atomic;
+use crate::atomic::Staging;
 use crate::run_meta::RunMeta;
 use ndarray::Array2;
 use std::path::Path;
@@ -20,7 +20,7 @@ pub const REJECTED_DRAWS: &str = "excluded: draws_hz holds the accepted draws on
                                   order; their sample numbers are in sample_index";
 
 /// Writes a Monte Carlo result as an HDF5 file of schema [`SCHEMA_MC`], atomically (see
-/// [`super::write_atomic`]): every accepted draw's eight mode frequencies (`/draws_hz`, N x 8,
+/// [`Staging::write`]): every accepted draw's eight mode frequencies (`/draws_hz`, N x 8,
 /// Hz), the mean, standard deviation and nominal frequency per mode, the seed, sample counts and
 /// error model of `cfg`, and the provenance of `meta` (its `modes` are not used: the nominal
 /// frequencies are `nominal_hz`).
@@ -29,13 +29,14 @@ pub const REJECTED_DRAWS: &str = "excluded: draws_hz holds the accepted draws on
 ///
 /// [`OutputError::Write`] naming `path` on any I/O or HDF5 failure; nothing is left at `path`.
 pub fn write_mc_hdf5(
+    stage: &Staging,
     path: &Path,
     result: &McResult,
     cfg: &McConfig,
     nominal_hz: &[f64; 8],
     meta: &RunMeta,
 ) -> Result<(), OutputError> {
-    write_atomic(path, |temp| {
+    stage.write(path, |temp| {
         write_file(temp, result, cfg, nominal_hz, meta)
             .map_err(|e| format!("HDF5: {}", crate::messages::first_line(&e.to_string())))
     })

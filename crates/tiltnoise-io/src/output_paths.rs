@@ -2,8 +2,9 @@
 //! not write its results fails in a moment instead of after the computation, and never
 //! replaces one of its own inputs.
 
-use crate::atomic::{probe_directory, NAME_MAX};
+use crate::atomic::probe_directory;
 use crate::input::split_hdf5_address;
+use crate::staging_dir::NAME_MAX;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::OutputError;
 
@@ -13,8 +14,8 @@ use tiltnoise_core::error::OutputError;
 ///
 /// * The path names a file of at most 255 bytes (which most file systems accept, so that the
 ///   final rename cannot fail on it) and is not an existing directory.
-/// * Its directory exists, is a directory, and a file can be created in it (a temporary file
-///   is created there and removed at once).
+/// * Its directory exists, is a directory, and the run can stage its outputs there (a staging
+///   directory is created there and removed at once).
 /// * No two outputs are the same file, and no output is an input of the run. Files are
 ///   compared by identity: device and inode for files that exist (following symbolic links),
 ///   else the canonical directory and the file name, so `./out.h5` and `out.h5`, a symbolic

@@ -9,7 +9,7 @@
 //! groups, which series readers ignore.
 
 use super::h5util::{dataset, scalar_attr, str_attr, strs_attr, unit_dataset, units_dataset};
-use crate::atomic::write_atomic;
+use crate::atomic::Staging;
 use crate::budget_hdf5::SPECTRAL_CONVENTION;
 use crate::run_meta::RunMeta;
 use std::path::Path;
@@ -69,12 +69,13 @@ pub struct SimulationMeta {
 /// [`OutputError::Write`] naming `path` on any I/O or HDF5 failure, or if an ASD's length
 /// differs from its frequency grid.
 pub fn write_observable_series_hdf5(
+    stage: &Staging,
     path: &Path,
     sim: &Simulation,
     asd: &SeriesAsd,
     meta: &SimulationMeta,
 ) -> Result<(), OutputError> {
-    write_atomic(path, |temp| {
+    stage.write(path, |temp| {
         check_asd(asd)?;
         write_file(temp, sim, asd, meta)
             .map_err(|e| format!("HDF5: {}", crate::messages::first_line(&e.to_string())))

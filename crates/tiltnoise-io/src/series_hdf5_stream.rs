@@ -2,12 +2,13 @@
 //! layout of [`crate::write_observable_series_hdf5`] (schema `tiltnoise.observable_series`):
 //! the series are chunked datasets that grow with each chunk appended, the ASDs and the other
 //! groups are written when the record is complete. Atomic as every output: the data go to a
-//! temporary file ([`AtomicFile`]) renamed onto the target by [`ObservableSeriesWriter::finish`],
-//! removed if the writer is dropped before (a failed or interrupted run).
+//! staging directory ([`AtomicFile`]) handed to the run's [`Staging`] by
+//! [`ObservableSeriesWriter::finish`], removed if the writer is dropped before (a failed or
+//! interrupted run).
 
 use super::h5util::str_attr;
 use super::series_hdf5::{check_asd, series_attrs, write_groups, write_root};
-use crate::atomic::AtomicFile;
+use crate::atomic::{AtomicFile, Staging};
 use crate::series_hdf5::{SeriesAsd, SimulationMeta};
 use ndarray::{s, ArrayView1};
 use std::path::Path;
@@ -61,7 +62,7 @@ fn append_to(ds: &hdf5::Dataset, start: usize, values: &[f64]) -> hdf5::Result<(
 }
 
 impl ObservableSeriesWriter {
-    /// Creates the temporary file of `path` with the root attributes of a series of step
+    /// Creates the file of `path`, in its staging directory, with the root attributes of a series of step
     /// `dt_s` (s) and empty series of the seven observables, plus the eight generalized
     /// coordinates (group `/coordinates`, noiseless) when `with_coordinates`.
     ///
@@ -159,13 +160,13 @@ impl ObservableSeriesWriter {
         Ok(())
     }
 
-    /// Writes the ASDs and the other groups, closes the file and renames it onto the target
-    /// (at once, or when the active `Staging` commits).
+    /// Writes the ASDs and the other groups, closes the file and hands it to `stage`, which
+    /// renames it onto the target when it commits.
     ///
     /// # Errors
     ///
     /// [`OutputError::Write`] naming the target; nothing is left there.
-    pub fn finish(self, asd: &SeriesAsd) -> Result<(), OutputError> {
+    pub fn finish(self, stage: &Staging, asd: &SeriesAsd) -> Result<(), OutputError> {
         let ObservableSeriesWriter {
             out,
             file,
@@ -179,6 +180,6 @@ impl ObservableSeriesWriter {
         write_groups(&file, asd, &meta)
             .and_then(|()| file.close())
             .map_err(|e| out.fail(h5_error(e)))?;
-        out.finish()
+        out.finish(stage)
     }
 }

@@ -10,7 +10,7 @@
 
 use super::h5util::{dataset, scalar_attr, str_attr, strs_attr, unit_dataset, units_dataset};
 use super::series_hdf5::{SCHEMA_OBSERVABLE_SERIES, SCHEMA_VERSION_OBSERVABLE_SERIES};
-use crate::atomic::write_atomic;
+use crate::atomic::Staging;
 use crate::budget_hdf5::SPECTRAL_CONVENTION;
 use crate::run_meta::RunMeta;
 use std::path::Path;
@@ -47,11 +47,12 @@ fn stored(v: f64) -> f64 {
 ///
 /// [`OutputError::Write`] naming `path` on any I/O or HDF5 failure.
 pub fn write_subtract_hdf5(
+    stage: &Staging,
     path: &Path,
     result: &SubtractResult,
     meta: &SubtractMeta,
 ) -> Result<(), OutputError> {
-    write_atomic(path, |temp| {
+    stage.write(path, |temp| {
         write_file(temp, result, meta)
             .map_err(|e| format!("HDF5: {}", crate::messages::first_line(&e.to_string())))
     })

@@ -1,6 +1,6 @@
 //! Transfer matrix as CSV (schema `docs/schemas.md`, section "Transfer functions, CSV").
 
-use crate::atomic::write_atomic;
+use crate::atomic::Staging;
 use crate::csv_layout::{csv_head, CsvPreamble};
 use crate::run_meta::RunMeta;
 use crate::tf_hdf5::{SIGN_CONVENTION, TIME_DEPENDENCE, TRANSLATION_CONVENTION};
@@ -10,7 +10,7 @@ use std::path::Path;
 use tiltnoise_core::error::OutputError;
 use tiltnoise_core::tf::TransferMatrix;
 
-/// Writes `tf` as CSV, atomically (see [`super::write_atomic`]).
+/// Writes `tf` as CSV, as one of the outputs of `stage` (see [`Staging::write`]).
 ///
 /// The layout of every tiltnoise CSV ([`crate::csv_layout`]): `#` lines (schema, provenance,
 /// conventions, `# units:`), one header line, `frequency_hz` followed by `OUT.IN.re,OUT.IN.im`
@@ -22,8 +22,13 @@ use tiltnoise_core::tf::TransferMatrix;
 /// # Errors
 ///
 /// [`OutputError::Write`] naming `path` on any I/O failure; nothing is left at `path`.
-pub fn write_tf_csv(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> Result<(), OutputError> {
-    write_atomic(path, |temp| {
+pub fn write_tf_csv(
+    stage: &Staging,
+    path: &Path,
+    tf: &TransferMatrix,
+    meta: &RunMeta,
+) -> Result<(), OutputError> {
+    stage.write(path, |temp| {
         let file = std::fs::File::create(temp).map_err(|e| e.to_string())?;
         let mut out = BufWriter::new(file);
         let text = tf_csv_string(tf, meta);

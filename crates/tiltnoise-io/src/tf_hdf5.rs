@@ -1,7 +1,7 @@
 //! Transfer matrix as HDF5 (schema `tiltnoise.tf`, documented in `docs/schemas.md`).
 
 use super::h5util::{dataset, provenance, str_attr, strings, strs_attr, unit_dataset};
-use crate::atomic::write_atomic;
+use crate::atomic::Staging;
 use crate::run_meta::RunMeta;
 use crate::tf_notes::{ground_quantity_note, has_translation};
 use ndarray::ArrayView3;
@@ -31,7 +31,7 @@ pub const TRANSLATION_CONVENTION: &str = "x_t, y_t, z_t = displacement of the fl
 pub const TIME_DEPENDENCE: &str = "exp(+i w t)";
 
 /// Writes `tf` and the run's provenance `meta` as an HDF5 file of schema [`SCHEMA_TF`],
-/// atomically (see [`super::write_atomic`]).
+/// as one of the outputs of `stage` (see [`Staging::write`]).
 ///
 /// Layout: root attributes `schema`, `schema_version`, `tool_version`, `created_by`, `method`,
 /// `parameters_toml`, `sign_convention`, `time_dependence` (and `translation_convention` with a
@@ -43,8 +43,13 @@ pub const TIME_DEPENDENCE: &str = "exp(+i w t)";
 /// # Errors
 ///
 /// [`OutputError::Write`] naming `path` on any I/O or HDF5 failure; nothing is left at `path`.
-pub fn write_tf_hdf5(path: &Path, tf: &TransferMatrix, meta: &RunMeta) -> Result<(), OutputError> {
-    write_atomic(path, |temp| {
+pub fn write_tf_hdf5(
+    stage: &Staging,
+    path: &Path,
+    tf: &TransferMatrix,
+    meta: &RunMeta,
+) -> Result<(), OutputError> {
+    stage.write(path, |temp| {
         write_file(temp, tf, meta)
             .map_err(|e| format!("HDF5: {}", crate::messages::first_line(&e.to_string())))
     })

@@ -1,14 +1,14 @@
 //! Transfer functions on a large grid written while they are computed, block of frequencies
 //! by block (`tiltnoise tf` on up to 10^8 points): the layouts of [`crate::write_tf_hdf5`]
 //! (the frequency and transfer datasets chunked and growing) and [`crate::write_tf_csv`] (the
-//! same text, line by line). Atomic as every output: the data go to a temporary file
-//! ([`AtomicFile`]) renamed onto the target by `finish`, removed if the writer is dropped
-//! before (a failed or interrupted run).
+//! same text, line by line). Atomic as every output: the data go to a staging directory
+//! ([`AtomicFile`]) handed to the run's [`Staging`] by `finish`, removed if the writer is
+//! dropped before (a failed or interrupted run).
 
 use super::h5util::str_attr;
 use super::tf_csv::{push_tf_csv_rows, tf_csv_header};
 use super::tf_hdf5::{transfer_attrs, write_labels, write_modes, write_root};
-use crate::atomic::AtomicFile;
+use crate::atomic::{AtomicFile, Staging};
 use crate::run_meta::RunMeta;
 use ndarray::{s, ArrayView1, ArrayView3};
 use num_complex::Complex64;
@@ -46,7 +46,7 @@ impl std::fmt::Debug for TfHdf5Writer {
 }
 
 impl TfHdf5Writer {
-    /// Creates the temporary file of `path`; the run's provenance `meta` is stored with it.
+    /// Creates the file of `path` in its staging directory; the run's provenance `meta` is stored with it.
     ///
     /// # Errors
     ///
@@ -125,14 +125,14 @@ impl TfHdf5Writer {
         Ok(())
     }
 
-    /// Writes the modes, closes the file and renames it onto the target (at once, or when the
-    /// active `Staging` commits).
+    /// Writes the modes, closes the file and hands it to `stage`, which renames it onto the
+    /// target when it commits.
     ///
     /// # Errors
     ///
     /// [`OutputError::Write`] naming the target (also when no block was appended); nothing is
     /// left there.
-    pub fn finish(self) -> Result<(), OutputError> {
+    pub fn finish(self, stage: &Staging) -> Result<(), OutputError> {
         let TfHdf5Writer {
             out,
             file,
@@ -147,7 +147,7 @@ impl TfHdf5Writer {
         write_modes(&file, &meta)
             .and_then(|()| file.close())
             .map_err(|e| out.fail(h5_error(e)))?;
-        out.finish()
+        out.finish(stage)
     }
 }
 
@@ -170,7 +170,7 @@ impl std::fmt::Debug for TfCsvWriter {
 }
 
 impl TfCsvWriter {
-    /// Creates the temporary file of `path`.
+    /// Creates the file of `path` in its staging directory.
     ///
     /// # Errors
     ///
@@ -215,14 +215,14 @@ impl TfCsvWriter {
         Ok(())
     }
 
-    /// Flushes and closes the file and renames it onto the target (at once, or when the
-    /// active `Staging` commits).
+    /// Flushes and closes the file and hands it to `stage`, which renames it onto the target
+    /// when it commits.
     ///
     /// # Errors
     ///
     /// [`OutputError::Write`] naming the target (also when no block was appended); nothing is
     /// left there.
-    pub fn finish(self) -> Result<(), OutputError> {
+    pub fn finish(self, stage: &Staging) -> Result<(), OutputError> {
         let TfCsvWriter {
             out,
             writer,
@@ -236,6 +236,6 @@ impl TfCsvWriter {
             .into_inner()
             .map_err(|e| out.fail(e.error().to_string()))?;
         drop(file);
-        out.finish()
+        out.finish(stage)
     }
 }

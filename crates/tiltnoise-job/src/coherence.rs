@@ -156,7 +156,7 @@ pub fn run(req: CoherenceRequest<'_>, cancel: &Cancel) -> Result<CoherenceResult
 
 /// Saves a coherence report in the format named by the extension of `path`: HDF5 (schema
 /// `tiltnoise.coherence`, with `meta` and the records' provenance), CSV, or the PNG/SVG figure
-/// titled with the records' names and drawn with `view`; atomically, the same for every front
+/// titled with the records' names and drawn with `view`, as one of the outputs of `stage`; the same for every front
 /// end.
 ///
 /// # Errors
@@ -164,6 +164,7 @@ pub fn run(req: CoherenceRequest<'_>, cancel: &Cancel) -> Result<CoherenceResult
 /// [`OutputError::UnknownFormat`] for another extension (nothing is written), or the writer's
 /// [`OutputError::Write`] naming `path`.
 pub fn save(
+    stage: &tiltnoise_io::Staging,
     path: &std::path::Path,
     result: &CoherenceResult,
     meta: &RunMeta,
@@ -171,8 +172,8 @@ pub fn save(
 ) -> Result<(), OutputError> {
     let (report, inputs) = (&result.report, &result.inputs);
     match OutputKind::from_path(path)? {
-        OutputKind::Hdf5 => write_coherence_hdf5(path, report, meta, inputs),
-        OutputKind::Csv => write_coherence_csv(path, report, meta),
+        OutputKind::Hdf5 => write_coherence_hdf5(stage, path, report, meta, inputs),
+        OutputKind::Csv => write_coherence_csv(stage, path, report, meta),
         OutputKind::Png | OutputKind::Svg => {
             let options = tiltnoise_plot::CoherenceFigureOptions {
                 tilt_name: inputs.tilt.path.clone(),
@@ -180,7 +181,7 @@ pub fn save(
                 view: view.clone(),
                 ..tiltnoise_plot::CoherenceFigureOptions::default()
             };
-            crate::save_image(path, |format| {
+            crate::save_image(stage, path, |format| {
                 tiltnoise_plot::coherence_figure(report, format, &options)
             })
         }

@@ -8,7 +8,7 @@ use tiltnoise_core::methods::{methods_table, MethodRow};
 use tiltnoise_core::model::{Input, Model, Observable, Request};
 use tiltnoise_core::tf::planner::{NoChoice, DEFAULT_REL_TOL};
 use tiltnoise_core::tf::Method;
-use tiltnoise_io::OutputError;
+use tiltnoise_io::{OutputError, Staging};
 use tiltnoise_plot::methods_figure::{methods_figure, MethodPoint};
 use tiltnoise_plot::View;
 
@@ -118,14 +118,19 @@ pub fn run(req: MethodsRequest<'_>, cancel: &Cancel) -> Result<MethodsResult, Jo
 }
 
 /// Saves the chart of a comparison (time per point against worst error, one point per usable
-/// method, the target error marked) as `.png` or `.svg`, drawn with `view`; atomically, the
+/// method, the target error marked) as `.png` or `.svg`, drawn with `view`, as one of the outputs of `stage`; the
 /// same for every front end.
 ///
 /// # Errors
 ///
 /// [`OutputError::UnknownFormat`] for another extension (nothing is written), or
 /// [`OutputError::Write`] naming `path`.
-pub fn save(path: &Path, result: &MethodsResult, view: &View) -> Result<(), OutputError> {
+pub fn save(
+    stage: &Staging,
+    path: &Path,
+    result: &MethodsResult,
+    view: &View,
+) -> Result<(), OutputError> {
     let points: Vec<MethodPoint> = result
         .rows
         .iter()
@@ -142,7 +147,7 @@ pub fn save(path: &Path, result: &MethodsResult, view: &View) -> Result<(), Outp
         result.matrix_label(),
         result.grid_label()
     );
-    crate::save_image(path, |format| {
+    crate::save_image(stage, path, |format| {
         methods_figure(&points, result.target_rel_err, &title, view, format)
     })
 }

@@ -8,7 +8,7 @@ use crate::subtract_report::band_top;
 use std::path::Path;
 use tiltnoise_core::error::Num;
 use tiltnoise_core::subtract::{Estimate, Status, SubtractResult};
-use tiltnoise_io::OutputError;
+use tiltnoise_io::{OutputError, Staging};
 use tiltnoise_plot::subtract_figure::{subtract_figure, ObservablePanel, SubtractFigureData};
 use tiltnoise_plot::View;
 
@@ -42,15 +42,21 @@ impl SubtractOutcome {
     }
 
     /// Draws the figure in the format the extension of `path` names (`.png`, `.svg`) with
-    /// `view`'s limits, size and resolution, and writes it atomically.
+    /// `view`'s limits, size and resolution, and writes it as one of the
+    /// outputs of `stage`.
     ///
     /// # Errors
     ///
     /// [`OutputError::UnknownFormat`] for another extension, [`OutputError::Write`] naming
     /// `path` when it cannot be drawn or written (nothing is left there).
-    pub fn save_figure(&self, path: &Path, view: &View) -> Result<(), OutputError> {
+    pub fn save_figure(
+        &self,
+        stage: &Staging,
+        path: &Path,
+        view: &View,
+    ) -> Result<(), OutputError> {
         let data = self.figure_data();
-        crate::save_image(path, |format| subtract_figure(&data, view, format))
+        crate::save_image(stage, path, |format| subtract_figure(&data, view, format))
     }
 }
 

@@ -4,7 +4,7 @@
 
 use crate::subtract::SubtractOutcome;
 use std::path::Path;
-use tiltnoise_io::{write_subtract_hdf5, OutputError};
+use tiltnoise_io::{write_subtract_hdf5, OutputError, Staging};
 use tiltnoise_plot::View;
 
 /// The extensions a subtraction is saved to, for messages.
@@ -46,18 +46,18 @@ impl SaveKind {
 }
 
 impl SubtractOutcome {
-    /// Writes the output `path` names by its extension ([`SaveKind`]), atomically; a figure
+    /// Writes the output `path` names by its extension ([`SaveKind`]) as one of the outputs of `stage`; a figure
     /// with `view`'s limits, size and resolution.
     ///
     /// # Errors
     ///
     /// [`OutputError::UnknownFormat`] for another extension, [`OutputError::Write`] naming
     /// `path` when it cannot be written (nothing is left there).
-    pub fn save(&self, path: &Path, view: &View) -> Result<(), OutputError> {
+    pub fn save(&self, stage: &Staging, path: &Path, view: &View) -> Result<(), OutputError> {
         match SaveKind::of(path)? {
-            SaveKind::Hdf5 => write_subtract_hdf5(path, &self.result, &self.meta),
-            SaveKind::Json => self.report().write(path),
-            SaveKind::Image => self.save_figure(path, view),
+            SaveKind::Hdf5 => write_subtract_hdf5(stage, path, &self.result, &self.meta),
+            SaveKind::Json => self.report().write(stage, path),
+            SaveKind::Image => self.save_figure(stage, path, view),
         }
     }
 }

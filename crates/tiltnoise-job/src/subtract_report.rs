@@ -6,7 +6,7 @@ use crate::subtract::SubtractOutcome;
 use serde::Serialize;
 use std::path::Path;
 use tiltnoise_core::subtract::{Method, NoiseLevel};
-use tiltnoise_io::{write_atomic, OutputError};
+use tiltnoise_io::{OutputError, Staging};
 
 fn finite(v: f64) -> Option<f64> {
     v.is_finite().then_some(v)
@@ -147,14 +147,14 @@ impl SubtractReport {
         serde_json::to_string_pretty(self).expect("a report of numbers and strings serializes")
     }
 
-    /// Writes the report (`.json`, with a final newline) atomically.
+    /// Writes the report (`.json`, with a final newline) as one of the outputs of `stage`.
     ///
     /// # Errors
     ///
     /// An [`OutputError`] naming `path` when it cannot be written.
-    pub fn write(&self, path: &Path) -> Result<(), OutputError> {
+    pub fn write(&self, stage: &Staging, path: &Path) -> Result<(), OutputError> {
         let text = self.to_json() + "\n";
-        write_atomic(path, |tmp| {
+        stage.write(path, |tmp| {
             std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
         })
     }

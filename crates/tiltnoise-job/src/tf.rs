@@ -13,7 +13,9 @@ use tiltnoise_core::model::Observable;
 use tiltnoise_core::model::{Model, Request};
 use tiltnoise_core::tf::planner::{Choice, Scene, DEFAULT_REL_TOL};
 use tiltnoise_core::tf::{self, Method, TransferFunction, TransferMatrix};
-use tiltnoise_io::{read_freq_file, write_tf_csv, write_tf_hdf5, OutputError, OutputKind, RunMeta};
+use tiltnoise_io::{
+    read_freq_file, write_tf_csv, write_tf_hdf5, OutputError, OutputKind, RunMeta, Staging,
+};
 use tiltnoise_plot::TfFigureOptions;
 
 /// Frequencies per block of a streamed grid: 16384 points of the largest request (7 x 15
@@ -377,7 +379,7 @@ pub fn figure_options(model: &Model, drawn: Vec<Observable>, phase: bool) -> TfF
 }
 
 /// Saves a transfer matrix in the format named by the extension of `path`: HDF5 (schema
-/// `tiltnoise.tf`, with `meta`), CSV, or the PNG/SVG figure drawn with `figure`; atomically,
+/// `tiltnoise.tf`, with `meta`), CSV, or the PNG/SVG figure drawn with `figure`, as one of the outputs of `stage`;
 /// the same for every front end.
 ///
 /// # Errors
@@ -385,15 +387,16 @@ pub fn figure_options(model: &Model, drawn: Vec<Observable>, phase: bool) -> TfF
 /// [`OutputError::UnknownFormat`] for another extension (nothing is written), or the writer's
 /// [`OutputError::Write`] naming `path`.
 pub fn save(
+    stage: &Staging,
     path: &Path,
     tf: &TransferMatrix,
     meta: &RunMeta,
     figure: &TfFigureOptions,
 ) -> Result<(), OutputError> {
     match OutputKind::from_path(path)? {
-        OutputKind::Hdf5 => write_tf_hdf5(path, tf, meta),
-        OutputKind::Csv => write_tf_csv(path, tf, meta),
-        OutputKind::Png | OutputKind::Svg => crate::save_image(path, |format| {
+        OutputKind::Hdf5 => write_tf_hdf5(stage, path, tf, meta),
+        OutputKind::Csv => write_tf_csv(stage, path, tf, meta),
+        OutputKind::Png | OutputKind::Svg => crate::save_image(stage, path, |format| {
             tiltnoise_plot::tf_figure_with(tf, format, figure)
         }),
     }

@@ -90,7 +90,7 @@ fn the_streamed_file_is_the_record_and_its_visibilities_are_the_records() {
         },
     ));
     assert!(!h5.exists(), "the file appears when it is complete");
-    r.finish_records().unwrap();
+    tiltnoise_io::Staging::committed(|s| r.finish_records(s)).unwrap();
     let vis = tiltnoise_job::visibility::run(
         VisibilityRequest {
             model: &model,

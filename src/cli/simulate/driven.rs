@@ -116,9 +116,9 @@ pub(super) fn run(
         run: &meta,
         figure: &figure,
     };
-    run.write_outputs(json, || {
+    run.write_outputs(json, |stage| {
         for out in &args.save {
-            save(out, &outputs, view)?;
+            save(stage, out, &outputs, view)?;
         }
         Ok(())
     })

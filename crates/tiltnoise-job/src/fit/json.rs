@@ -6,7 +6,7 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
 use tiltnoise_core::fit::{Bound, FitResult, SigmaSource};
-use tiltnoise_io::{write_atomic, write_fit_hdf5, OutputError, RunMeta};
+use tiltnoise_io::{write_fit_hdf5, OutputError, RunMeta, Staging};
 
 /// The formats a fit is saved in.
 enum SaveKind {
@@ -48,24 +48,29 @@ impl FitOutcome {
 }
 
 /// Saves a fit in the format named by the extension of `path`: `.json` (the JSON report) or
-/// `.h5`/`.hdf5` (schema `tiltnoise.fit`, with `meta`); atomically.
+/// `.h5`/`.hdf5` (schema `tiltnoise.fit`, with `meta`), as one of the outputs of `stage`.
 ///
 /// # Errors
 ///
 /// [`OutputError::UnknownFormat`] for another extension (nothing is written), or the writer's
 /// [`OutputError::Write`] naming `path`.
-pub fn save(path: &Path, fit: &FitOutcome, meta: &RunMeta) -> Result<(), OutputError> {
+pub fn save(
+    stage: &Staging,
+    path: &Path,
+    fit: &FitOutcome,
+    meta: &RunMeta,
+) -> Result<(), OutputError> {
     match save_kind(path)? {
         SaveKind::Json => {
             let text = fit.json().map_err(|e| OutputError::Write {
                 path: path.to_path_buf(),
                 message: e.to_string(),
             })? + "\n";
-            write_atomic(path, |tmp| {
+            stage.write(path, |tmp| {
                 std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
             })
         }
-        SaveKind::Hdf5 => write_fit_hdf5(path, &fit.result, &fit.origin, meta),
+        SaveKind::Hdf5 => write_fit_hdf5(stage, path, &fit.result, &fit.origin, meta),
     }
 }
 

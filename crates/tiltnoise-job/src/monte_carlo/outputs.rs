@@ -5,7 +5,7 @@
 use super::McRun;
 use serde::Serialize;
 use std::path::Path;
-use tiltnoise_io::{write_mc_hdf5, OutputError, RunMeta};
+use tiltnoise_io::{write_mc_hdf5, OutputError, RunMeta, Staging};
 
 /// The formats a Monte Carlo is saved in.
 enum SaveKind {
@@ -40,23 +40,26 @@ pub fn check_save_path(path: &Path) -> Result<(), OutputError> {
 
 /// Saves a Monte Carlo in the format named by the extension of `path`: `.h5`/`.hdf5` (schema
 /// `tiltnoise.mc`, every draw, the error model and `meta`) or the histograms of the eight
-/// modes as `.png`/`.svg`, drawn with `view`; atomically.
+/// modes as `.png`/`.svg`, drawn with `view`, as one of the outputs of `stage`.
 ///
 /// # Errors
 ///
 /// [`OutputError::UnknownFormat`] for another extension (nothing is written), or the
 /// writer's [`OutputError::Write`] naming `path`.
 pub fn save(
+    stage: &Staging,
     path: &Path,
     run: &McRun,
     meta: &RunMeta,
     view: &tiltnoise_plot::View,
 ) -> Result<(), OutputError> {
     match save_kind(path)? {
-        SaveKind::Hdf5 => write_mc_hdf5(path, &run.result, &run.config, &run.nominal_hz, meta),
+        SaveKind::Hdf5 => {
+            write_mc_hdf5(stage, path, &run.result, &run.config, &run.nominal_hz, meta)
+        }
         SaveKind::Figure => {
             let caption = caption(run);
-            crate::save_image(path, |format| {
+            crate::save_image(stage, path, |format| {
                 tiltnoise_plot::mc_figure::mc_figure(
                     &run.result,
                     &run.nominal_hz,

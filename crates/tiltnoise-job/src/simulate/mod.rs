@@ -118,14 +118,18 @@ impl SimulateResult {
         }
     }
 
-    /// Completes the HDF5 files of [`Keep::hdf5`] with the spectra (each appears atomically).
+    /// Completes the HDF5 files of [`Keep::hdf5`] with the spectra and hands them to `stage`
+    /// (they appear when it commits).
     ///
     /// # Errors
     ///
     /// The writer's [`tiltnoise_io::OutputError`], naming the file.
-    pub fn finish_records(&mut self) -> Result<(), tiltnoise_io::OutputError> {
+    pub fn finish_records(
+        &mut self,
+        stage: &tiltnoise_io::Staging,
+    ) -> Result<(), tiltnoise_io::OutputError> {
         for writer in std::mem::take(&mut self.streamed) {
-            writer.finish(&self.asd)?;
+            writer.finish(stage, &self.asd)?;
         }
         Ok(())
     }

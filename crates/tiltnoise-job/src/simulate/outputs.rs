@@ -8,7 +8,7 @@ use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::simulate::{aliased_frequency_hz, Simulation};
 use tiltnoise_io::{
     write_asd_csv, write_observable_series_hdf5, OutputError, OutputKind, RunMeta, SeriesAsd,
-    SimulationMeta,
+    SimulationMeta, Staging,
 };
 use tiltnoise_plot::simulate_figure::{asd_figure, ModeMark, SimAsdData};
 use tiltnoise_plot::View;
@@ -65,21 +65,26 @@ pub struct RecordOutputs<'a> {
 
 /// Saves a simulated record in the format named by the extension of `path`: `.h5`/`.hdf5`
 /// (series, ASDs and provenance; schema `tiltnoise.observable_series`), `.csv` (the ASDs) or
-/// `.png`/`.svg` (the ASD figure, drawn with `view`); atomically.
+/// `.png`/`.svg` (the ASD figure, drawn with `view`), as one of the outputs of `stage`.
 ///
 /// # Errors
 ///
 /// [`OutputError::UnknownFormat`] for another extension (nothing is written), or the writer's
 /// [`OutputError::Write`] naming `path`.
-pub fn save(path: &Path, out: &RecordOutputs<'_>, view: &View) -> Result<(), OutputError> {
+pub fn save(
+    stage: &Staging,
+    path: &Path,
+    out: &RecordOutputs<'_>,
+    view: &View,
+) -> Result<(), OutputError> {
     match OutputKind::from_path(path)? {
         OutputKind::Hdf5 => match out.record {
-            Some((sim, meta)) => write_observable_series_hdf5(path, sim, out.asd, meta),
+            Some((sim, meta)) => write_observable_series_hdf5(stage, path, sim, out.asd, meta),
             None => Ok(()),
         },
-        OutputKind::Csv => write_asd_csv(path, &out.asd.freqs_hz, &out.asd.asd, out.run),
+        OutputKind::Csv => write_asd_csv(stage, path, &out.asd.freqs_hz, &out.asd.asd, out.run),
         OutputKind::Png | OutputKind::Svg => {
-            save_image(path, |format| asd_figure(out.figure, view, format))
+            save_image(stage, path, |format| asd_figure(out.figure, view, format))
         }
     }
 }
