@@ -47,6 +47,7 @@ mod block;
 mod buffer;
 mod direct;
 mod grid;
+mod low_frequency;
 mod matrix;
 mod modal;
 pub mod planner;
@@ -74,6 +75,7 @@ pub use grid::{
     eval_grid_threads, eval_grid_threads_cancellable, evaluate, evaluate_into,
     evaluate_into_cancellable, Destination, STREAM_MIN_BYTES,
 };
+pub use low_frequency::{LowFrequency, EXACT_BELOW_HZ};
 pub use matrix::{Layout, TransferMatrix};
 pub use modal::Modal;
 pub use planner::{

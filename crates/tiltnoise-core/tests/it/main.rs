@@ -15,6 +15,7 @@ mod cancel;
 mod coherence;
 mod energy_crosscheck;
 mod freq_grid;
+mod low_frequency;
 mod mc;
 mod methods;
 mod modes;
