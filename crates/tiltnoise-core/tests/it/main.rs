@@ -31,6 +31,7 @@ mod subtract_ground;
 mod subtract_pulls;
 mod synthetic;
 mod tilt_tf;
+mod tiny_asymmetry;
 mod translation_tf;
 mod visibility_fit;
 mod welch_scipy;
