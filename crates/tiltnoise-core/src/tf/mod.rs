@@ -41,7 +41,15 @@
 //! [`Method::PoleZero`] factors the coupled system as a whole (8 poles, up to 8 factors per
 //! entry), with a relative error of 1.1e-12 at most outside 1 % of each entry's poles and zeros
 //! on the test models of `tests/it/methods.rs` (the reference's own error, `DD_EPS` times an
-//! entry's condition from the data's rounding scales, is part of the bound there).
+//! entry's condition from the data's rounding scales, is part of the bound there). Keys below
+//! [`crate::params::asymmetry::LINEAR_BELOW`] are evaluated as their linear response, on two
+//! plans of the method ([`Linearized`]): their effects are subnormal or below the structural
+//! decisions of double-double otherwise.
+//!
+//! Per unit floor velocity or acceleration ([`TransferMatrix::per_ground_quantity`]), and below
+//! [`EXACT_BELOW_HZ`] per unit displacement too, the floor's columns come from each entry's exact
+//! product form scaled by powers of two ([`LowFrequency`]), so that a value within `f64`'s range
+//! is computed and one beyond it refused ([`TfError::Overflow`]).
 
 mod block;
 mod buffer;
