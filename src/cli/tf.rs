@@ -292,35 +292,45 @@ fn stream_tf(
     let to_stdout = args.save.is_empty();
     let mut text = String::new();
     let cancel = run.cancel.clone();
-    planned.blocks(&cancel, |block, done| -> Result<()> {
-        for w in &mut hdf5 {
-            w.append(block)?;
-        }
-        for w in &mut csv {
-            w.append(block)?;
-        }
-        if to_stdout {
-            text.clear();
-            let first = done == block.freqs_hz.len();
-            match (json, first) {
-                (true, true) => text.push_str(&json_head(block, planned)),
-                (false, true) => text.push_str(&tiltnoise_io::tf_csv_header(block, meta)),
-                _ => {}
-            }
-            match json {
-                true => push_json_points(&mut text, block, first),
-                false => tiltnoise_io::push_tf_csv_rows(&mut text, block),
-            }
-            if json && done == n {
-                text.push_str(&json_tail(block));
-            }
-            write!(run.out, "{text}")?;
-        }
-        if let Some(b) = &bar {
-            b.set_position(done as u64);
-        }
-        Ok(())
-    })?;
+    planned
+        .blocks(
+            &cancel,
+            |block, done| -> std::result::Result<(), Streamed> {
+                let mut write = || -> Result<()> {
+                    for w in &mut hdf5 {
+                        w.append(block)?;
+                    }
+                    for w in &mut csv {
+                        w.append(block)?;
+                    }
+                    if to_stdout {
+                        text.clear();
+                        let first = done == block.freqs_hz.len();
+                        match (json, first) {
+                            (true, true) => text.push_str(&json_head(block, planned)),
+                            (false, true) => {
+                                text.push_str(&tiltnoise_io::tf_csv_header(block, meta))
+                            }
+                            _ => {}
+                        }
+                        match json {
+                            true => push_json_points(&mut text, block, first),
+                            false => tiltnoise_io::push_tf_csv_rows(&mut text, block),
+                        }
+                        if json && done == n {
+                            text.push_str(&json_tail(block));
+                        }
+                        write!(run.out, "{text}")?;
+                    }
+                    if let Some(b) = &bar {
+                        b.set_position(done as u64);
+                    }
+                    Ok(())
+                };
+                write().map_err(Streamed)
+            },
+        )
+        .map_err(|e| e.0)?;
     if let Some(b) = bar {
         b.finish_and_clear();
     }
@@ -388,4 +398,14 @@ fn json_tail(block: &TransferMatrix) -> String {
         .map(|o| (0..block.inputs.len()).map(|i| block.unit(o, i)).collect())
         .collect();
     format!("\n  ],\n  \"units\": {}\n}}\n", json_value(units))
+}
+
+/// An error of the streamed evaluation: the job's errors with their one-line message (as
+/// [`super::job_error`] gives it, not followed by their sources), the writers' as they are.
+struct Streamed(anyhow::Error);
+
+impl From<tiltnoise_job::JobError> for Streamed {
+    fn from(e: tiltnoise_job::JobError) -> Streamed {
+        Streamed(super::job_error(e))
+    }
 }

@@ -266,6 +266,26 @@ pub enum TfError {
         /// The first frequency (in grid order) with a non-finite value.
         freq_hz: f64,
     },
+    /// An entry of a transfer function whose value is beyond the range of `f64` at a frequency
+    /// (e.g. a tilt's response per unit floor acceleration, `H / w^2`, below 1e-150 Hz): decided
+    /// from the exact exponent ([`crate::tf::LowFrequency`]), refused rather than returned as
+    /// inf or NaN.
+    #[error(
+        "the transfer function {entry} per unit floor {per} overflows f64 at {} Hz{}: use \
+         frequencies where it is below 1.8e308, or the transfer function per unit displacement",
+        Num(*.freq_hz),
+        .log10_magnitude.map_or(String::new(), |l| format!(" (its magnitude is about 1e{:.0})", l.floor()))
+    )]
+    Overflow {
+        /// The frequency (Hz).
+        freq_hz: f64,
+        /// `OUTPUT/INPUT`, e.g. `X/eta_t`.
+        entry: String,
+        /// The floor quantity with its unit, e.g. `acceleration (rad/s^2)`.
+        per: String,
+        /// `log10 |H|` from the exact exponent, when known.
+        log10_magnitude: Option<f64>,
+    },
     /// A grid whose result does not fit into the memory available ([`crate::tf::evaluate`]).
     #[error(transparent)]
     TooLarge(#[from] LimitError),

@@ -164,6 +164,8 @@ pub fn plan(
 /// A planned job: the grid read and checked, the method chosen and its plan built.
 pub struct Planned {
     plan: Box<dyn TransferFunction>,
+    /// The exact form of the floor's columns where `w^2` leaves the range of `f64`.
+    low: tf::LowFrequency,
     grid: Grid,
     per: GroundQuantity,
     block_freqs: usize,
@@ -197,8 +199,8 @@ impl Planned {
         cancel.check().map_err(|e| tf_error(e.into()))?;
         let m = tf::evaluate(self.plan.as_ref(), freqs_hz).map_err(tf_error)?;
         match self.per {
-            GroundQuantity::Displacement => Ok(m),
-            per => m.per_ground_quantity(per).map_err(tf_error),
+            GroundQuantity::Displacement if !self.low.applies_to(freqs_hz) => Ok(m),
+            per => m.per_ground_quantity(per, &self.low).map_err(tf_error),
         }
     }
 
@@ -307,6 +309,7 @@ pub fn prepare(req: TfRequest<'_>) -> Result<Planned, JobError> {
     };
     Ok(Planned {
         plan: plan(req.model, &req.request, method)?,
+        low: tf::LowFrequency::new(req.model, &req.request),
         grid,
         per: req.per,
         block_freqs,

@@ -74,7 +74,10 @@ fn the_tf_job_gives_the_librarys_transfer_functions_bit_for_bit() {
     let per = tiltnoise_job::tf::run(req, &Cancel::never()).unwrap();
     assert!(per.choice.is_none(), "a method asked for is not chosen");
     let expected = direct
-        .per_ground_quantity(GroundQuantity::Acceleration)
+        .per_ground_quantity(
+            GroundQuantity::Acceleration,
+            &tf::LowFrequency::new(&model, &ground_request()),
+        )
         .unwrap();
     assert_same_bits(&per.tf, &expected);
 }

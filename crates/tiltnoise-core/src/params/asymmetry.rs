@@ -30,6 +30,17 @@ use serde::{Deserialize, Serialize};
 /// equilibrium is no longer a small departure from the drawing.
 pub const MAX_OFFSET_FRACTION: f64 = 0.1;
 
+/// Keys whose magnitude is below this (`2^-80`, about 8.3e-25 m or rad) are taken as a linear
+/// response ([`Asymmetry::linear_split`]). Their effects on the transfer functions are of order
+/// `key x 1e-11` and below: near the bottom of `f64`'s range subnormal numbers, where neither
+/// `f64` nor double-double keeps relative precision, and below about 1e-28 already small enough
+/// against the terms they are computed with to be taken for structural cancellations (by the
+/// pole-zero factors for a readout rotation about x of 1e-30 rad, by the double-double
+/// reference's solve for offsets along x of 1e-29 m). At `2^-80` the terms of second order in a
+/// key are about `3e-19` of its first-order ones (`tests/it/tiny_asymmetry.rs` measures it),
+/// far below `f64`'s rounding, and the key is far above those 1e-28.
+pub const LINEAR_BELOW: f64 = 8.271806125530277e-25;
+
 /// The largest rotation of the readout's axes from the lab axes (rad).
 pub const MAX_SENSOR_ROT_RAD: f64 = 0.1;
 
@@ -100,6 +111,52 @@ impl Asymmetry {
         self.crossbar_com_x_m == 0.0 && self.tm_com_x_m == 0.0 && self.lower_attachment_x_m == 0.0
     }
 
+    /// The pendulum with tiny keys as a linear response: when some key is nonzero with
+    /// `|value| < LINEAR_BELOW`, `(base, scaled, k)` with those keys set to 0 in `base` and
+    /// multiplied by the exact power of two `2^k` in `scaled` (the largest of them then in
+    /// `[LINEAR_BELOW / 2, LINEAR_BELOW)`, 2^-81 to 2^-80); the other keys as they are in both. A transfer
+    /// function is then `H = H(base) + (H(scaled) - H(base)) 2^-k`, exact to far below any
+    /// rounding (see [`LINEAR_BELOW`] and `docs/asymmetry.md`). `None` when no key is that
+    /// small.
+    pub fn linear_split(&self) -> Option<(Asymmetry, Asymmetry, i32)> {
+        let values = self.values();
+        let tiny = |v: f64| v != 0.0 && v.abs() < LINEAR_BELOW;
+        let largest = values
+            .iter()
+            .copied()
+            .filter(|&v| tiny(v))
+            .map(f64::abs)
+            .fold(0.0f64, f64::max);
+        if largest == 0.0 {
+            return None;
+        }
+        // 2^k largest in [LINEAR_BELOW / 2, LINEAR_BELOW): k from the exponents, exact.
+        let mut k = (LINEAR_BELOW / largest).log2().floor() as i32;
+        while largest * 2f64.powi(k) >= LINEAR_BELOW {
+            k -= 1;
+        }
+        while largest * 2f64.powi(k + 1) < LINEAR_BELOW {
+            k += 1;
+        }
+        let map = |f: &dyn Fn(f64) -> f64| {
+            let v = values.map(|v| if tiny(v) { f(v) } else { v });
+            Asymmetry {
+                crossbar_com_x_m: v[0],
+                crossbar_com_y_m: v[1],
+                tm_com_x_m: v[2],
+                tm_com_y_m: v[3],
+                lower_attachment_x_m: v[4],
+                lower_attachment_y_m: v[5],
+                sensor_rot_x_rad: v[6],
+                sensor_rot_y_rad: v[7],
+                sensor_rot_z_rad: v[8],
+            }
+        };
+        // v 2^k is exact: v is at least 2^-1074 and the product below 2^-80 (k <= 994).
+        let scale = |v: f64| v * 2f64.powi(k.min(1023)) * 2f64.powi(k - k.min(1023));
+        Some((map(&|_| 0.0), map(&scale), k))
+    }
+
     /// The nine values in key order: crossbar x, y; test mass x, y; lower attachment x, y;
     /// sensor rotation x, y, z.
     pub fn values(&self) -> [f64; 9] {
@@ -160,6 +217,40 @@ impl Asymmetry {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The split scales exactly the tiny keys by a power of two into `[2^-81, 2^-80)` and
+    /// leaves the others.
+    #[test]
+    fn linear_split_scales_the_tiny_keys_by_a_power_of_two() {
+        assert_eq!(LINEAR_BELOW, 2f64.powi(-80));
+        assert_eq!(Asymmetry::default().linear_split(), None);
+        let a = Asymmetry {
+            tm_com_x_m: 5e-324,
+            sensor_rot_z_rad: -1e-310,
+            crossbar_com_y_m: 1e-4,
+            ..Asymmetry::default()
+        };
+        let (base, scaled, k) = a.linear_split().unwrap();
+        assert_eq!((base.tm_com_x_m, base.sensor_rot_z_rad), (0.0, 0.0));
+        assert_eq!(
+            (base.crossbar_com_y_m, scaled.crossbar_com_y_m),
+            (1e-4, 1e-4)
+        );
+        assert_eq!(scaled.sensor_rot_z_rad.abs(), 1e-310 * 2f64.powi(k));
+        assert!((LINEAR_BELOW / 2.0..LINEAR_BELOW).contains(&scaled.sensor_rot_z_rad.abs()));
+        assert_eq!(scaled.tm_com_x_m, 2f64.powi(k - 1074));
+        for v in [1e-25, 1e-150, 1e-300, 8.2e-25] {
+            let b = Asymmetry {
+                tm_com_x_m: v,
+                ..Asymmetry::default()
+            };
+            let (_, s, k) = b.linear_split().unwrap();
+            assert!(
+                (LINEAR_BELOW / 2.0..LINEAR_BELOW).contains(&s.tm_com_x_m),
+                "{v:e}: {k}"
+            );
+        }
+    }
 
     #[test]
     fn classification() {

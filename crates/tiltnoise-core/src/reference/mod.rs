@@ -110,6 +110,9 @@ pub struct ReferenceModel {
     absolute: Formulation,
     /// The paper's coordinates, for the condition numbers of methods that work in them.
     paper: Formulation,
+    /// With asymmetry keys below [`crate::params::asymmetry::LINEAR_BELOW`]: the references
+    /// without them and with them scaled by `2^k`, whose linear combination `eval_dd` returns.
+    linear: Option<Box<(ReferenceModel, ReferenceModel, i32)>>,
 }
 
 /// `M` and `K_c` of one coordinate system.
@@ -367,12 +370,28 @@ impl ReferenceModel {
     /// For parameters with `[asymmetry]` offsets that have no stable rest configuration (those
     /// [`crate::model::Model::new`] refuses): see [`crate::geometry::dd_matrices`].
     pub fn new(params: &Params) -> ReferenceModel {
+        let mut reference = ReferenceModel::exact(params);
+        reference.linear = params.asymmetry.linear_split().map(|(base, scaled, k)| {
+            let with = |asymmetry| {
+                let mut p = params.clone();
+                p.asymmetry = asymmetry;
+                ReferenceModel::exact(&p)
+            };
+            Box::new((with(base), with(scaled), k))
+        });
+        reference
+    }
+
+    /// [`ReferenceModel::new`] without the linear response in tiny keys: the matrices of the
+    /// parameters as they are, for the tests that check that response.
+    pub fn exact(params: &Params) -> ReferenceModel {
         let (m, scales) = crate::geometry::dd_matrices(params);
         let scales = scales.unwrap_or_else(|| Scales::own(&m));
         ReferenceModel {
             absolute: Formulation::absolute(&m, &scales),
             paper: Formulation::paper(&m, &scales),
             m,
+            linear: None,
         }
     }
 
@@ -444,8 +463,25 @@ impl ReferenceModel {
     /// [`TfError::Singular`] when a pivot is exactly zero or the equilibrated dynamic stiffness
     /// is singular to double-double precision (`rcond` is then the ratio of the smallest pivot
     /// to the largest entry, see [`SINGULAR_PIVOT_RATIO`]).
+    ///
+    /// With asymmetry keys below [`crate::params::asymmetry::LINEAR_BELOW`] (their effects then
+    /// subnormal numbers, where double-double keeps no relative precision either) the value is
+    /// their linear response, `H(base) + (H(scaled) - H(base)) 2^-k` in double-double from the
+    /// references without those keys and with them scaled by `2^k` into `[2^-81, 2^-80)`
+    /// ([`crate::params::Asymmetry::linear_split`]): exact to far below `DD_EPS`, the terms of
+    /// second order below `1e-18` of the first-order ones (`docs/asymmetry.md`).
     pub fn eval_dd(&self, request: &Request, freq_hz: f64) -> Result<Vec<CDd>, TfError> {
-        self.absolute.eval_dd(request, freq_hz)
+        let Some(linear) = &self.linear else {
+            return self.absolute.eval_dd(request, freq_hz);
+        };
+        let (base, scaled, k) = linear.as_ref();
+        let h0 = base.eval_dd(request, freq_hz)?;
+        let h1 = scaled.eval_dd(request, freq_hz)?;
+        Ok(h0
+            .into_iter()
+            .zip(h1)
+            .map(|(a, b)| a + (b - a).ldexp(-*k))
+            .collect())
     }
 
     /// Componentwise relative condition number `kappa` of each entry of `H(f)` (row-major like

@@ -13,7 +13,7 @@
 //! of the dense matrix, bit for bit; only the storage differs. Methods without that knowledge
 //! (direct, block, split, modal, torsion2) use the dense layout, two planes per entry.
 
-use super::{Input, Method};
+use super::{Input, LowFrequency, Method};
 use crate::error::TfError;
 use crate::ground::GroundQuantity;
 use crate::model::Observable;
@@ -274,37 +274,40 @@ impl TransferMatrix {
     /// The same transfer functions with the floor's motion (the tilt and translation columns)
     /// per unit `quantity` instead of per unit displacement: each such value times
     /// [`GroundQuantity::to_displacement`] at its frequency (per unit floor acceleration
-    /// `H / (-w^2)`); force and torque columns unchanged. Dense layout.
+    /// `H / (-w^2)`), and below [`LowFrequency::exact_below_hz`] the exact low-frequency form's
+    /// value, which stays within the range of `f64` where the plan's values and the factor
+    /// do not ([`crate::tf::LowFrequency`]); force and torque columns unchanged. Dense layout.
     ///
     /// # Errors
     ///
     /// [`TfError::NoGroundFactor`] at the first frequency where the factor does not exist
-    /// (0 Hz for velocity and acceleration) when the matrix has a tilt or translation column.
+    /// (0 Hz for velocity and acceleration) when the matrix has a tilt or translation column;
+    /// [`TfError::Overflow`] at the first frequency where an entry's value is beyond the range
+    /// of `f64`, naming the entry, the quantity and the frequency.
     ///
     /// # Panics
     ///
-    /// If the matrix is not per unit displacement (converted already).
-    pub fn per_ground_quantity(&self, quantity: GroundQuantity) -> Result<TransferMatrix, TfError> {
+    /// If the matrix is not per unit displacement (converted already), or `low` was built for
+    /// another request.
+    pub fn per_ground_quantity(
+        &self,
+        quantity: GroundQuantity,
+        low: &LowFrequency,
+    ) -> Result<TransferMatrix, TfError> {
         assert_eq!(
             self.ground_quantity,
             GroundQuantity::Displacement,
             "converts transfer functions per unit displacement"
         );
+        assert!(
+            low.request().outputs == self.outputs && low.request().inputs == self.inputs,
+            "the low-frequency form of this matrix's request"
+        );
         let (no, ni) = (self.outputs.len(), self.inputs.len());
-        let ground: Vec<bool> = self.inputs.iter().map(|i| i.is_ground()).collect();
         let mut values = self.dense_values();
-        if no > 0 && ground.iter().any(|&g| g) {
+        if no > 0 && self.inputs.iter().any(|i| i.is_ground()) {
             for (k, point) in values.chunks_exact_mut(no * ni).enumerate() {
-                let f = self.freqs_hz[k];
-                let c = quantity.to_displacement(f).ok_or(TfError::NoGroundFactor {
-                    quantity: quantity.name(),
-                    freq_hz: f,
-                })?;
-                for (e, h) in point.iter_mut().enumerate() {
-                    if ground[e % ni] {
-                        *h *= c;
-                    }
-                }
+                low.convert(quantity, self.freqs_hz[k], point)?;
             }
         }
         let mut m = TransferMatrix::from_dense(
@@ -417,7 +420,17 @@ mod tests {
             Method::Direct,
             &values,
         );
-        let a = m.per_ground_quantity(GroundQuantity::Acceleration).unwrap();
+        let model = crate::model::Model::new(&crate::params::Params::table_i()).unwrap();
+        let low = LowFrequency::new(
+            &model,
+            &crate::model::Request {
+                outputs: vec![Observable::X],
+                inputs: inputs.clone(),
+            },
+        );
+        let a = m
+            .per_ground_quantity(GroundQuantity::Acceleration, &low)
+            .unwrap();
         let w2 = crate::units::angular(0.5).powi(2);
         assert_eq!(a.get(0, 0, 0), values[0] * (-1.0 / w2));
         assert_eq!(a.get(0, 0, 1), values[1]);
@@ -434,7 +447,7 @@ mod tests {
             &values,
         );
         assert!(matches!(
-            at_dc.per_ground_quantity(GroundQuantity::Velocity),
+            at_dc.per_ground_quantity(GroundQuantity::Velocity, &low),
             Err(TfError::NoGroundFactor { .. })
         ));
     }

@@ -41,12 +41,22 @@
 //! [`Method::PoleZero`] factors the coupled system as a whole (8 poles, up to 8 factors per
 //! entry), with a relative error of 1.1e-12 at most outside 1 % of each entry's poles and zeros
 //! on the test models of `tests/it/methods.rs` (the reference's own error, `DD_EPS` times an
-//! entry's condition from the data's rounding scales, is part of the bound there).
+//! entry's condition from the data's rounding scales, is part of the bound there). Keys below
+//! [`crate::params::asymmetry::LINEAR_BELOW`] are evaluated as their linear response, on two
+//! plans of the method ([`Linearized`]): their effects are subnormal or below the structural
+//! decisions of double-double otherwise.
+//!
+//! Per unit floor velocity or acceleration ([`TransferMatrix::per_ground_quantity`]), and below
+//! [`EXACT_BELOW_HZ`] per unit displacement too, the floor's columns come from each entry's exact
+//! product form scaled by powers of two ([`LowFrequency`]), so that a value within `f64`'s range
+//! is computed and one beyond it refused ([`TfError::Overflow`]).
 
 mod block;
 mod buffer;
 mod direct;
 mod grid;
+mod linear;
+mod low_frequency;
 mod matrix;
 mod modal;
 pub mod planner;
@@ -74,6 +84,8 @@ pub use grid::{
     eval_grid_threads, eval_grid_threads_cancellable, evaluate, evaluate_into,
     evaluate_into_cancellable, Destination, STREAM_MIN_BYTES,
 };
+pub use linear::Linearized;
+pub use low_frequency::{LowFrequency, EXACT_BELOW_HZ};
 pub use matrix::{Layout, TransferMatrix};
 pub use modal::Modal;
 pub use planner::{
@@ -273,7 +285,9 @@ pub trait TransferFunction: Send + Sync {
 /// Builds the plan for `method` (factorizations and forcing matrices prepared once). Fails
 /// for a method that cannot represent part of the request ([`Method::Torsion2`]), viscous
 /// damping (the methods that solve only `K_c`), or the pendulum as built: `block` refuses the
-/// coupled model (an offset along x), `split` and `torsion2` any `[asymmetry]` key.
+/// coupled model (an offset along x), `split` and `torsion2` any `[asymmetry]` key. Keys below
+/// [`crate::params::asymmetry::LINEAR_BELOW`] are evaluated as a linear response
+/// ([`Linearized`]), on two plans of `method`.
 pub fn plan(
     model: &Model,
     request: &Request,
@@ -300,6 +314,34 @@ pub fn plan(
             reason: reason.into(),
         });
     }
+    if let Some((base, scaled, k)) = model.params().asymmetry.linear_split() {
+        let build = |asymmetry| {
+            let mut params = model.params().clone();
+            params.asymmetry = asymmetry;
+            Model::new(&params).map_err(|e| PlanError::Unsupported {
+                method,
+                item: "the pendulum as built".into(),
+                reason: format!(
+                    "its keys below 2^-80 are evaluated as a linear response, and the model \
+                     with them scaled up by 2^{k} cannot be built: {e}"
+                ),
+            })
+        };
+        return Ok(Box::new(Linearized {
+            base: plan_exact(&build(base)?, request, method)?,
+            scaled: plan_exact(&build(scaled)?, request, method)?,
+            k,
+        }));
+    }
+    plan_exact(model, request, method)
+}
+
+/// [`plan`] on `model` as it is (no linear response in tiny keys).
+fn plan_exact(
+    model: &Model,
+    request: &Request,
+    method: Method,
+) -> Result<Box<dyn TransferFunction>, PlanError> {
     Ok(match method {
         Method::Direct => Box::new(Direct::new(model, request.clone())),
         Method::Block => Box::new(BlockReduced::new(model, request.clone())),

@@ -190,3 +190,16 @@ pub const QUANTILE_REL: f64 = 1e-11;
 /// Welch bin frequencies computed as `k fs / L` here and `k / (L / fs)` by scipy: each side
 /// rounds twice, so they agree to `2 eps` relative.
 pub const BIN_FREQ_REL: f64 = 2.0 * EPS;
+
+/// Relative error of a floor column below [`tf::EXACT_BELOW_HZ`] against the split method's
+/// asymptote (`tests/it/low_frequency.rs`): the split method's own error outside the poles'
+/// zones (`4e-13`, its row of the table in `tf`), the pole-zero factors' (`3e-14`, same table),
+/// and the logarithms the reference is formed in (`ln |H|` up to ~745, each rounding `u` of it:
+/// `745 * 2 u = 1.7e-13`), summed and rounded up: `1e-12`. The asymptote's own correction at
+/// the frequencies it is taken from is measured by the test and added.
+pub const LOW_FREQ_REL: f64 = 1e-12;
+
+/// One unit in the last place of the subnormal range, `2^-1074`: a value below the normal
+/// range rounded once (half a unit) plus the reference's relative error on it (less than half
+/// a unit there).
+pub const SUBNORMAL_ABS: f64 = 5e-324;
