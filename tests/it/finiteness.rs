@@ -435,9 +435,15 @@ fn newest_outputs_are_finite_or_their_inputs_refused_where_they_enter() {
         x.iter_mut().for_each(|v| *v += 0.1 * sd * rng.gaussian());
     });
     let co = co.display().to_string();
-    let (lo, hi) = tiltnoise_core::limits::NOISE_RATIO_RANGE;
-    for r in [lo, 1.0, hi] {
-        let save = d.join(format!("s_{r}.h5"));
+    // Every ratio from 0 (a noiseless co-located instrument) to the largest.
+    for r in [
+        0.0,
+        1e-300,
+        1e-3,
+        1.0,
+        tiltnoise_core::limits::MAX_NOISE_RATIO,
+    ] {
+        let save = d.join(format!("s_{r:e}.h5"));
         let ratio = format!("eta_t={r:e}");
         let out = tiltnoise(&[
             "subtract",
@@ -474,7 +480,7 @@ fn newest_outputs_are_finite_or_their_inputs_refused_where_they_enter() {
         }
     }
     let before = listing(d);
-    for r in ["1e150", "1e300", "9.9e-4", "0", "nan"] {
+    for r in ["1e150", "1e300", "1001", "-1e-3", "nan"] {
         let ratio = format!("eta_t={r}");
         assert_fails(
             &[
@@ -490,7 +496,7 @@ fn newest_outputs_are_finite_or_their_inputs_refused_where_they_enter() {
                 "--save",
                 &d.join("never.h5").display().to_string(),
             ],
-            &["--colocated-ratio eta_t=", "must be from 1e-3 to 1e3"],
+            &["--colocated-ratio eta_t=", "must be from 0 to 1e3"],
         );
     }
     assert_eq!(listing(d), before, "a refused run wrote something");

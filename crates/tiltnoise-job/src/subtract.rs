@@ -12,7 +12,7 @@ use std::time::Duration;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::error::Num;
 use tiltnoise_core::input::{GroundMap, InputMeta, Provenance, Sensors, TiltSeries};
-use tiltnoise_core::limits::NOISE_RATIOS;
+use tiltnoise_core::limits::{admits_noise_ratio, allowed_noise_ratios};
 use tiltnoise_core::model::{Input, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::option_key::{self, OptionKey};
@@ -211,14 +211,14 @@ fn check_options(req: &SubtractRequest<'_>) -> Result<(), JobError> {
                 ),
             ));
         }
-        if !NOISE_RATIOS.admits(r) {
+        if !admits_noise_ratio(r) {
             return Err(JobError::option(
                 "colocated_ratio",
                 Some(&item),
                 format!(
-                    "the ratio of noise ASDs is not allowed: must be {} (beyond it the \
+                    "the ratio of noise ASDs is not allowed: must be {} (above it the \
                      huddle's estimate no longer depends on it; see docs/subtract.md)",
-                    NOISE_RATIOS.allowed("")
+                    allowed_noise_ratios()
                 ),
             ));
         }

@@ -74,7 +74,7 @@ fn options_are_refused_by_key_before_any_file_is_read() {
                 r.colocated_ratio = vec![(Input::from_name("eta_t").unwrap(), -1.0)];
             }),
             "colocated_ratio eta_t=-1: the ratio of noise ASDs is not allowed: must be from \
-             1e-3 to 1e3",
+             0 to 1e3",
         ),
         (
             Box::new(|r| {
@@ -82,7 +82,7 @@ fn options_are_refused_by_key_before_any_file_is_read() {
                 r.colocated_ratio = vec![(Input::from_name("eta_t").unwrap(), 1e150)];
             }),
             "colocated_ratio eta_t=1e150: the ratio of noise ASDs is not allowed: must be from \
-             1e-3 to 1e3",
+             0 to 1e3",
         ),
         (
             Box::new(|r| {

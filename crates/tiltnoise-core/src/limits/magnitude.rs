@@ -66,18 +66,30 @@ pub const MIN_SPECTRUM_FREQUENCY_HZ: f64 = 1e-9;
 /// tiltmeter off by six orders of magnitude either way is a wrong unit, not a calibration.
 pub const GAIN_RANGE: (f64, f64) = (1e-6, 1e6);
 
-/// Smallest and largest ratio `r` of a co-located instrument's noise ASD to the witness's
-/// (`subtract --colocated-ratio`, a huddle test). The witness's noise is estimated as
+/// Largest ratio `r` of a co-located instrument's noise ASD to the witness's
+/// (`subtract --colocated-ratio`, a huddle test); every ratio from 0 (a noiseless co-located
+/// instrument) to it is allowed. The witness's noise is estimated as
 /// `N_1 = PSD(x_1 - x_2 / g) / (1 + r^2 / g^2)`, floored at `1e-6` of the witness's PSD
 /// (`subtract::colocated::NOISE_FLOOR_REL`); the relative gain `g` of two instruments
 /// recording the same motion in the same unit is near 1. Where the two are coherent enough
 /// for the gain (coherence >= 0.9) the difference's PSD is below a ninth of the witness's, so
 /// for `r / |g| >= 1e3 = 1 / sqrt(1e-6)` the estimate is the floor whatever the records hold
-/// (the witness's noise is hidden under the other's); and for `r / |g| <= 1e-3` the share
-/// `1 + r^2 / g^2` differs from 1 by less than the floor: the estimate is that of a noiseless
-/// co-located instrument. A ratio outside tells nothing the bounds do not, and is a PSD ratio
-/// given for an ASD ratio, or a unit slip.
-pub const NOISE_RATIO_RANGE: (f64, f64) = (1e-3, 1e3);
+/// (the witness's noise is hidden under the other's): a larger ratio tells nothing, and is a
+/// PSD ratio given for an ASD ratio, or a unit slip. A small ratio is a true statement (a much
+/// quieter co-located instrument): below `1e-3` the estimate is that of a noiseless one to
+/// within the floor, and the gain is computed without cancellation down to 0.
+pub const MAX_NOISE_RATIO: f64 = 1e3;
+
+/// Whether `r` is an allowed noise ratio of a huddle test: from 0 to [`MAX_NOISE_RATIO`]
+/// (NaN is not).
+pub fn admits_noise_ratio(r: f64) -> bool {
+    (0.0..=MAX_NOISE_RATIO).contains(&r)
+}
+
+/// The allowed noise ratios of a huddle test, for messages: `from 0 to 1e3`.
+pub fn allowed_noise_ratios() -> String {
+    format!("from 0 to {MAX_NOISE_RATIO:e}")
+}
 
 /// Smallest and largest nonzero absolute error bar of an `[asymmetry]` offset in a parameter
 /// file's `[uncertainty]` table (`sigma`, in m or rad; 0 keeps the offset exact). An offset
@@ -201,14 +213,6 @@ pub const GAINS: Magnitudes = Magnitudes {
     largest: GAIN_RANGE.1,
     signed: true,
     zero: true,
-};
-
-/// Ratios of two co-located instruments' noise ASDs ([`NOISE_RATIO_RANGE`]).
-pub const NOISE_RATIOS: Magnitudes = Magnitudes {
-    smallest: NOISE_RATIO_RANGE.0,
-    largest: NOISE_RATIO_RANGE.1,
-    signed: false,
-    zero: false,
 };
 
 /// Absolute error bars of `[asymmetry]` offsets ([`OFFSET_SIGMA_RANGE`]); 0 (exact) allowed.

@@ -1008,11 +1008,11 @@ fn check_config(
         }
     }
     for (input, r) in &cfg.colocated_noise_ratio {
-        if !crate::limits::NOISE_RATIOS.admits(*r) {
+        if !crate::limits::admits_noise_ratio(*r) {
             return Err(SubtractError::Config(format!(
                 "{}: the ratio of noise ASDs is not allowed: must be {}",
                 OptionKey::COLOCATED_RATIO.given(format!("{}={}", input.name(), Num(*r))),
-                crate::limits::NOISE_RATIOS.allowed("")
+                crate::limits::allowed_noise_ratios()
             )));
         }
     }
