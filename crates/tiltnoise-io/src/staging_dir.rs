@@ -299,13 +299,18 @@ mod tests {
         let writer = {
             let dir = dir.clone();
             std::thread::spawn(move || {
-                // Files until the directory is gone: the first failure is ENOENT.
+                // Files until the directory is gone (the first failure is ENOENT), a few
+                // microseconds apart, so that files appear during a removal's pass. Back to
+                // back, on two free cores, the writer can refill the directory as fast as a
+                // pass empties it and the removal never ends; a real writer creates one file
+                // in its staging directory, so that is no case for the handler.
                 let mut i = 0u64;
                 loop {
                     match std::fs::write(dir.join(format!("f{i}")), "x") {
                         Ok(()) => i += 1,
                         Err(e) => return (i, e.kind()),
                     }
+                    std::thread::sleep(std::time::Duration::from_micros(20));
                 }
             })
         };
