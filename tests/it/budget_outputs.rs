@@ -143,23 +143,27 @@ fn read(group: &hdf5::Group, name: &str) -> (Vec<f64>, String) {
     (d.read_raw::<f64>().unwrap(), str_attr(&d, "unit"))
 }
 
-#[test]
-fn hdf5_round_trip_is_bit_exact_and_self_describing() {
-    let report = synthetic_report();
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("budget.h5");
+/// Saves `report` to `path` alone, with the test's provenance and input, committed at once.
+fn save_one(path: &std::path::Path, report: &BudgetReport) -> Result<(), OutputError> {
     tiltnoise_io::Staging::committed(|s| {
         save_budget(
             s,
-            &path,
-            &report,
+            path,
+            report,
             &meta(),
             &input_meta(),
             &Default::default(),
             true,
         )
     })
-    .unwrap();
+}
+
+#[test]
+fn hdf5_round_trip_is_bit_exact_and_self_describing() {
+    let report = synthetic_report();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("budget.h5");
+    save_one(&path, &report).unwrap();
     assert_eq!(listing(dir.path()), vec![path.clone()], "no temporary file");
 
     let file = hdf5::File::open(&path).unwrap();
@@ -286,18 +290,7 @@ fn csv_header_and_values_round_trip() {
     let report = synthetic_report();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("budget.csv");
-    tiltnoise_io::Staging::committed(|s| {
-        save_budget(
-            s,
-            &path,
-            &report,
-            &meta(),
-            &input_meta(),
-            &Default::default(),
-            true,
-        )
-    })
-    .unwrap();
+    save_one(&path, &report).unwrap();
     let text = std::fs::read_to_string(&path).unwrap();
     assert_eq!(text, budget_csv_string(&report, &meta(), true).unwrap());
     let mut lines = text.lines().skip_while(|l| l.starts_with('#'));
@@ -446,18 +439,7 @@ fn inconsistent_report_is_rejected_and_leaves_nothing() {
     let dir = tempfile::tempdir().unwrap();
     for name in ["b.h5", "b.csv", "b.png", "b.svg"] {
         let path = dir.path().join(name);
-        let err = tiltnoise_io::Staging::committed(|s| {
-            save_budget(
-                s,
-                &path,
-                &report,
-                &meta(),
-                &input_meta(),
-                &Default::default(),
-                true,
-            )
-        })
-        .unwrap_err();
+        let err = save_one(&path, &report).unwrap_err();
         let text = err.to_string();
         assert!(text.contains("phi.tilt") && text.contains(name), "{text}");
     }
@@ -470,30 +452,8 @@ fn figures_are_written() {
     let dir = tempfile::tempdir().unwrap();
     let png = dir.path().join("budget.png");
     let svg = dir.path().join("budget.svg");
-    tiltnoise_io::Staging::committed(|s| {
-        save_budget(
-            s,
-            &png,
-            &report,
-            &meta(),
-            &input_meta(),
-            &Default::default(),
-            true,
-        )
-    })
-    .unwrap();
-    tiltnoise_io::Staging::committed(|s| {
-        save_budget(
-            s,
-            &svg,
-            &report,
-            &meta(),
-            &input_meta(),
-            &Default::default(),
-            true,
-        )
-    })
-    .unwrap();
+    save_one(&png, &report).unwrap();
+    save_one(&svg, &report).unwrap();
     let bytes = std::fs::read(&png).unwrap();
     assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
     assert!(bytes.len() > 30_000, "PNG only {} bytes", bytes.len());
@@ -526,18 +486,7 @@ fn missing_directory_is_an_error_naming_the_path() {
     let dir = tempfile::tempdir().unwrap();
     for name in ["b.h5", "b.hdf5", "b.csv", "b.png", "b.svg"] {
         let path = dir.path().join("no-such-dir").join(name);
-        let err = tiltnoise_io::Staging::committed(|s| {
-            save_budget(
-                s,
-                &path,
-                &report,
-                &meta(),
-                &input_meta(),
-                &Default::default(),
-                true,
-            )
-        })
-        .unwrap_err();
+        let err = save_one(&path, &report).unwrap_err();
         match &err {
             OutputError::Write { path: p, .. } => assert_eq!(p, &path),
             other => panic!("{name}: unexpected error {other:?}"),
@@ -555,18 +504,7 @@ fn missing_directory_is_an_error_naming_the_path() {
 fn unknown_extension_is_rejected_before_writing() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("b.pdf");
-    let err = tiltnoise_io::Staging::committed(|s| {
-        save_budget(
-            s,
-            &path,
-            &synthetic_report(),
-            &meta(),
-            &input_meta(),
-            &Default::default(),
-            true,
-        )
-    })
-    .unwrap_err();
+    let err = save_one(&path, &synthetic_report()).unwrap_err();
     assert!(matches!(err, OutputError::UnknownFormat { .. }), "{err:?}");
     assert!(listing(dir.path()).is_empty());
 }
