@@ -5,11 +5,11 @@ use super::args::{AverageArg, ChannelArgs, Format};
 use super::budget_terms::{parse_observables, parse_readout, parse_terms};
 use super::figure_args::FigureArgs;
 use super::output::save_budget;
+use super::progress::Bar;
 use super::witness_noise::parse_witness_items;
 use super::Run;
 use anyhow::{anyhow, Result};
 use clap::Args;
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::freq;
@@ -19,6 +19,7 @@ use tiltnoise_core::params::Params;
 use tiltnoise_core::spectral::Averaging;
 use tiltnoise_io::{OutputKind, RunMeta};
 use tiltnoise_job::budget::{BudgetRequest, BudgetResult, ReadRequest, TiltSource, WelchRequest};
+use tiltnoise_job::Progress;
 
 /// Arguments of `tiltnoise budget`.
 #[derive(Debug, Args)]
@@ -221,15 +222,10 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
         at_band: args.at_band,
     };
     run.check_job_outputs(&args.save, req.input_files())?;
-    let mut bar = None;
-    let result = tiltnoise_job::budget::run(req, &run.cancel, &mut |done, total| {
-        bar.get_or_insert_with(|| progress_bar(total, WORTH_A_BAR))
-            .as_ref()
-            .map_or((), |b| b.set_position(done))
-    });
-    if let Some(Some(b)) = bar {
-        b.finish_and_clear();
-    }
+    let bar = Bar::new("samples", WORTH_A_BAR);
+    let result =
+        tiltnoise_job::budget::run(req, &run.cancel, &mut |done, total| bar.report(done, total));
+    bar.finish();
     let BudgetResult { report, input } = result.map_err(super::job_error)?;
     let json = args.format == Format::Json;
     if json {
@@ -263,19 +259,3 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
 
 /// Samples of a budget's input worth a progress bar.
 const WORTH_A_BAR: u64 = 1 << 22;
-
-/// A progress bar on stderr when it is a terminal and the work (`total` samples) is long
-/// enough to wait for (`worth_a_bar` samples or more).
-pub(super) fn progress_bar(total: u64, worth_a_bar: u64) -> Option<indicatif::ProgressBar> {
-    if total < worth_a_bar || !std::io::stderr().is_terminal() {
-        return None;
-    }
-    let bar = indicatif::ProgressBar::new(total);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{spinner} {wide_bar} {pos}/{len} samples ({percent}%, eta {eta})",
-        )
-        .expect("valid template"),
-    );
-    Some(bar)
-}

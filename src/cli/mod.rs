@@ -14,6 +14,7 @@ mod fit;
 mod mc;
 mod methods;
 mod output;
+mod progress;
 mod report;
 mod simulate;
 mod stdout;

@@ -4,9 +4,9 @@
 //! bar (only when stderr is a terminal and the run is long). Documented in `docs/simulate.md`.
 
 use super::args::{scientific, Format};
-use super::budget::progress_bar;
 use super::figure_args::FigureArgs;
 use super::output::save_image;
+use super::progress::Bar;
 use super::Run;
 use anyhow::{bail, Result};
 use clap::Args;
@@ -22,6 +22,7 @@ use tiltnoise_io::{OutputKind, RunMeta};
 use tiltnoise_job::simulate::{
     asd_figure_data, save, Keep, RecordOutputs, SimulateRequest, SimulateResult,
 };
+use tiltnoise_job::Progress;
 use tiltnoise_plot::simulate_figure::{time_series_figure, ASD_SIZE};
 
 mod driven;
@@ -266,15 +267,10 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
             time_figure: !args.save_time.is_empty(),
         },
     };
-    let mut bar = None;
-    let result = tiltnoise_job::simulate::run(req, &run.cancel, &mut |done, total| {
-        bar.get_or_insert_with(|| progress_bar(total, WORTH_A_BAR))
-            .as_ref()
-            .map_or((), |b| b.set_position(done))
-    });
-    if let Some(Some(b)) = bar {
-        b.finish_and_clear();
-    }
+    let bar = Bar::new("samples", WORTH_A_BAR);
+    let result =
+        tiltnoise_job::simulate::run(req, &run.cancel, &mut |done, total| bar.report(done, total));
+    bar.finish();
     let mut result = result.map_err(super::job_error)?;
     let json = args.format == Format::Json;
     match json {
