@@ -144,9 +144,9 @@ pub fn run(
 /// their readout noise, the coordinates, the one-sided Welch ASDs and the resonance check.
 ///
 /// ``time_s``, ``observables`` (``{observable: samples}``, m or rad), ``coordinates``
-/// (``{coordinate: samples}``, noiseless, rad or m), ``freq_hz`` and ``asd``
-/// (``{observable: ASD}`` in unit/sqrt(Hz), periodic Hann, ``nperseg`` samples, 50 % overlap,
-/// mean), ``resonance_check`` (the command line's table: which modes each channel shows,
+/// (``{coordinate: samples}``, noiseless, rad or m), ``frequency_hz`` (also ``freq_hz``, the
+/// same) and ``asd`` (``{observable: ASD}`` in unit/sqrt(Hz), periodic Hann, ``nperseg``
+/// samples, 50 % overlap, mean), ``resonance_check`` (the command line's table: which modes each channel shows,
 /// against the observability table) and ``resonances_agree``. :meth:`save` writes the
 /// command line's files; an ``.h5`` file is a measured record for ``budget(measured=...)``.
 #[pyclass(module = "tiltnoise", frozen)]

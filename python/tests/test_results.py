@@ -134,6 +134,15 @@ def test_budget_values_cannot_be_edited_and_lost(lab_budget):
 
 # --- simulations ----------------------------------------------------------------------------
 
+def test_simulation_and_budget_frequencies_are_frequency_hz_and_its_alias_freq_hz(sim, lab_budget):
+    f = sim.frequency_hz
+    # k fs / nperseg, DC included, up to at most the Nyquist frequency.
+    np.testing.assert_allclose(f, np.arange(f.size) * f[1], rtol=1e-12, atol=0)
+    assert f[0] == 0.0 and f[-1] <= 0.5 / sim.dt_s
+    for result in (sim, lab_budget):
+        assert result.freq_hz.tobytes() == result.frequency_hz.tobytes()
+        assert result.frequency_hz.size > 100
+
 def test_simulation_to_gwpy_and_pandas(sim):
     pytest.importorskip("gwpy")
     pytest.importorskip("pandas")
