@@ -17,8 +17,14 @@
 //!
 //! A block that reads `../shared/` (the GPL/LGPL record kept out of the repository) runs when
 //! that data is beside the repository and is skipped with a printed line otherwise.
+//!
+//! The figures a block draws into `plots/` are compared with the committed ones
+//! (`committed_figures`): a committed figure that differs from what its block draws now, or
+//! that no block draws, fails.
 
+use crate::committed_figures;
 use crate::common::{disable_hdf5_file_locking, repo};
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -235,6 +241,15 @@ fn readme_and_docs_blocks_run_and_quote_what_the_program_prints() {
     let shared_present = repo("../shared/tilt_data").exists();
     let (mut ran, mut skipped, mut checked) = (0, 0, 0);
     let mut failures = Vec::new();
+    let committed = committed_figures::committed();
+    let mut compared = BTreeSet::new();
+    // Committed figures of blocks that did not run here, or ran on data not in the repository.
+    let mut not_compared: BTreeMap<String, String> = BTreeMap::new();
+    let mut leave = |block: &Block, why: &str| {
+        for name in committed_figures::figures_named(&script(block)) {
+            not_compared.insert(name, format!("{} ({why})", block.place));
+        }
+    };
     for doc in documents() {
         for block in blocks(&doc) {
             let marker = block.marker.as_deref().unwrap_or("");
@@ -266,26 +281,71 @@ fn readme_and_docs_blocks_run_and_quote_what_the_program_prints() {
                     block.place,
                     why.trim()
                 ));
+                leave(&block, "skipped");
                 skipped += 1;
                 continue;
             }
-            if block.text.contains("../shared/") && !shared_present {
+            let from_shared = block.text.contains("../shared/");
+            if from_shared && !shared_present {
                 say(&format!(
                     "docs-run: skipped {}: reads ../shared/tilt_data, not beside the repository \
                      (GPL/LGPL data kept out of it; CI has it)",
                     block.place
                 ));
+                leave(&block, "skipped");
                 skipped += 1;
                 continue;
             }
             match work.run(&script(&block)) {
                 Ok(_) => ran += 1,
-                Err(e) => failures.push(format!("{}: {e}", block.place)),
+                Err(e) => {
+                    failures.push(format!("{}: {e}", block.place));
+                    continue;
+                }
+            }
+            if from_shared {
+                leave(
+                    &block,
+                    "drawn from ../shared, not from the repository's data",
+                );
+                continue;
+            }
+            for name in committed_figures::figures_named(&script(&block)) {
+                let Some(committed) = committed.get(&name) else {
+                    continue;
+                };
+                match committed_figures::difference(&work.dir.join("plots").join(&name), committed)
+                {
+                    Ok(None) => {
+                        compared.insert(name);
+                    }
+                    Ok(Some(why)) => failures.push(format!(
+                        "{}: plots/{name} differs from what the block draws now ({why}); run \
+                         the block's command and commit the figure it draws",
+                        block.place
+                    )),
+                    Err(e) => failures.push(format!("{}: plots/{name}: {e}", block.place)),
+                }
             }
         }
     }
+    for name in committed.keys().filter(|n| !compared.contains(*n)) {
+        let not_redrawn = committed_figures::NOT_REDRAWN
+            .iter()
+            .find(|(n, _)| *n == name.as_str())
+            .map(|(_, why)| why.to_string());
+        match not_compared.get(name).cloned().or(not_redrawn) {
+            Some(why) => say(&format!("docs-run: plots/{name} not compared: {why}")),
+            None => failures.push(format!(
+                "plots/{name} is committed, but no command block of README.md or docs/*.md \
+                 draws it (add the command that draws it, or remove the figure)"
+            )),
+        }
+    }
     say(&format!(
-        "docs-run: {ran} command blocks ran, {skipped} skipped, {checked} quoted outputs checked"
+        "docs-run: {ran} command blocks ran, {skipped} skipped, {checked} quoted outputs checked, \
+         {} committed figures the same as drawn now",
+        compared.len()
     ));
     assert!(failures.is_empty(), "{}", failures.join("\n\n"));
     assert!(ran > 0 && checked > 0, "no block ran or was checked");

@@ -13,12 +13,14 @@ mod output;
 #[path = "../../crates/tiltnoise-core/tests/it/tolerances.rs"]
 mod tolerances;
 
+mod build_cmake;
 mod budget_at;
 mod budget_open;
 mod budget_outputs;
 mod cli;
 mod cli_budget;
 mod coherence_cli;
+mod committed_figures;
 mod crate_roles;
 mod damping;
 mod docs_run;
