@@ -98,7 +98,13 @@ fn fit_hdf5_holds_the_visibilities_of_its_json() {
     assert!(out.status.success(), "{}", stderr(&out));
     let out = tiltnoise(&["visibility", "--measured", &record, "--save", &vis]);
     assert!(out.status.success(), "{}", stderr(&out));
+    let params = path("p.toml");
+    let mut toml = String::from_utf8(tiltnoise(&["params"]).stdout).unwrap();
+    toml.push_str("\n[uncertainty]\n\"asymmetry.tm_com_x_m\" = { sigma = 1e-3 }\n");
+    std::fs::write(&params, toml).unwrap();
     let out = tiltnoise(&[
+        "--params",
+        &params,
         "fit",
         "--visibility",
         &vis,
