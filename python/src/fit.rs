@@ -14,8 +14,9 @@ use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::fit::{FitResult, SigmaSource};
 use tiltnoise_core::params::Params;
-use tiltnoise_io::Staging;
+use tiltnoise_job::files::Staging;
 use tiltnoise_job::fit::{FitOutcome, FitRequest};
+use tiltnoise_job::{Invocation, Outcome, Provenance, Silent};
 
 /// What `Model.fit` measures against: the frequency file, or Table II's measured column; with
 /// visibilities and no frequency file, no frequency at all (Table II belongs to the paper's
@@ -47,15 +48,20 @@ pub fn run(
         free,
         bound_sigmas,
         prior,
+        invocation: Invocation::of_this_process(),
     };
     let cancel = Cancel::new();
-    let FitOutcome { result, origin } = interrupt::watch(py, &cancel, || {
-        tiltnoise_job::fit::run(req, &cancel).map_err(job_error)
+    let FitOutcome {
+        result,
+        origin,
+        provenance,
+    } = interrupt::watch(py, &cancel, || {
+        tiltnoise_job::fit::run(&req, &cancel, &Silent).map_err(job_error)
     })?;
     Ok(Fit {
         result,
         origin,
-        nominal: params.clone(),
+        provenance,
         inputs: files,
     })
 }
@@ -70,8 +76,8 @@ pub fn run(
 pub struct Fit {
     result: FitResult,
     origin: String,
-    /// The nominal parameters (the saved files' run metadata).
-    nominal: Params,
+    /// What the saved files record (the job's provenance).
+    provenance: Provenance,
     /// The files read: no `save` may replace one.
     inputs: Inputs,
 }
@@ -82,6 +88,7 @@ impl Fit {
         FitOutcome {
             result: self.result.clone(),
             origin: self.origin.clone(),
+            provenance: self.provenance.clone(),
         }
     }
 }
@@ -255,9 +262,7 @@ impl Fit {
     /// The report as the command line's ``fit --format json`` prints it (keys in alphabetical
     /// order, non-finite numbers as ``null``).
     fn to_json(&self) -> PyResult<String> {
-        self.outcome()
-            .json()
-            .map_err(|e| value_error(e.to_string()))
+        serde_json::to_string_pretty(&self.outcome().json()).map_err(|e| value_error(e.to_string()))
     }
 
     /// Writes the fit as the command line's ``fit --save`` does: ``.json`` (the report of
@@ -267,12 +272,9 @@ impl Fit {
     fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
         tiltnoise_job::fit::check_save_path(&path).py()?;
         self.inputs.check_save(&path)?;
-        let meta = tiltnoise_io::RunMeta::of_this_run(&self.nominal, None);
         let fit = self.outcome();
-        py.detach(|| {
-            Staging::committed(|stage| tiltnoise_job::fit::save(stage, &path, &fit, &meta))
-        })
-        .py()
+        py.detach(|| Staging::committed(|stage| fit.save(stage, &path)))
+            .map_err(job_error)
     }
 
     /// Pickles as its state (see the module's pickling notes).

@@ -15,8 +15,10 @@ use pyo3::prelude::*;
 use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::mc::McResult;
-use tiltnoise_io::{RunMeta, Staging};
+use tiltnoise_job::figures::View;
+use tiltnoise_job::files::Staging;
 use tiltnoise_job::monte_carlo::{self, McRequest, McRun};
+use tiltnoise_job::{Invocation, Outcome, Provenance, Silent};
 
 /// Runs the Monte Carlo job for `params` with Ctrl-C honoured.
 pub fn run(
@@ -31,11 +33,14 @@ pub fn run(
         samples,
         seed,
         threads,
+        invocation: Invocation::of_this_process(),
+        figure: View::default(),
     };
     let cancel = Cancel::new();
     let run = interrupt::watch(py, &cancel, || {
-        monte_carlo::run(req, &cancel, &|_| {}).map_err(job_error)
+        monte_carlo::run(&req, &cancel, &Silent).map_err(job_error)
     })?;
+    let provenance = run.provenance;
     let r = run.result;
     Ok(MonteCarlo {
         samples: r.samples,
@@ -48,6 +53,7 @@ pub fn run(
         seed,
         threads,
         params,
+        provenance,
     })
 }
 
@@ -81,6 +87,8 @@ pub struct MonteCarlo {
     threads: usize,
     /// The nominal parameters and their error model.
     params: PyParams,
+    /// What the saved files record (the job's).
+    provenance: Provenance,
 }
 
 impl MonteCarlo {
@@ -92,6 +100,8 @@ impl MonteCarlo {
             samples: self.samples,
             seed: self.seed,
             threads: self.threads,
+            invocation: Invocation::default(),
+            figure: View::default(),
         };
         let array = |v: &[f64]| <[f64; 8]>::try_from(v).expect("eight modes, as made");
         McRun {
@@ -105,6 +115,8 @@ impl MonteCarlo {
             },
             config: monte_carlo::config(&req, &Cancel::never()),
             nominal_hz: array(&self.nominal_hz),
+            provenance: self.provenance.clone(),
+            figure: View::default(),
         }
     }
 }
@@ -156,13 +168,9 @@ impl MonteCarlo {
     fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
         monte_carlo::check_save_path(&path).py()?;
         Inputs::of_params(self.params.file.as_deref()).check_save(&path)?;
-        let meta = RunMeta::of_this_run(&self.params.inner, None);
         let run = self.job_run();
-        let view = tiltnoise_plot::View::default();
-        py.detach(|| {
-            Staging::committed(|stage| monte_carlo::save(stage, &path, &run, &meta, &view))
-        })
-        .py()
+        py.detach(|| Staging::committed(|stage| run.save(stage, &path)))
+            .map_err(job_error)
     }
 
     /// The draws drawn with matplotlib: one histogram per mode, the nominal frequency and the

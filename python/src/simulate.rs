@@ -22,9 +22,10 @@ use tiltnoise_core::simulate::{
     parse_coordinates, record_description, set_coordinate, Excitation, InitialState,
     Simulation as CoreSimulation,
 };
-use tiltnoise_io::{OutputKind, RunMeta, SeriesAsd, SimulationMeta, Staging};
+use tiltnoise_job::figures::View;
+use tiltnoise_job::files::{OutputKind, SeriesAsd, SimulationMeta, Staging};
 use tiltnoise_job::simulate::{asd_figure_data, save, Keep, RecordOutputs, SimulateRequest};
-use tiltnoise_plot::View;
+use tiltnoise_job::{Invocation, Provenance, Silent};
 
 /// The options of `Model.simulate`, as given.
 pub struct SimulateArgs<'a, 'py> {
@@ -110,10 +111,11 @@ pub fn run(
             record: true,
             ..Keep::default()
         },
+        invocation: Invocation::of_this_process(),
     };
     let cancel = Cancel::new();
     let r = interrupt::watch(py, &cancel, || {
-        tiltnoise_job::simulate::run(req, &cancel, &mut |_, _| {}).map_err(job_error)
+        tiltnoise_job::simulate::run(&req, &cancel, &Silent).map_err(job_error)
     })?;
     let sim = r
         .record
@@ -136,6 +138,7 @@ pub fn run(
             .iter()
             .map(|m| (m.index, m.frequency_hz))
             .collect(),
+        provenance: r.provenance,
         inputs: Inputs::of_params(params_file),
     })
 }
@@ -164,6 +167,8 @@ pub struct Simulation {
     check_agrees: bool,
     params: Params,
     modes: Vec<(usize, f64)>,
+    /// What the saved files record (the job's provenance).
+    provenance: Provenance,
     /// The parameter file, which no `save` may replace.
     inputs: Inputs,
 }
@@ -326,10 +331,7 @@ impl Simulation {
     fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
         OutputKind::from_path(&path).py()?;
         self.inputs.check_save(&path)?;
-        let run = RunMeta {
-            modes: self.modes.clone(),
-            ..RunMeta::of_this_run(&self.params, None)
-        };
+        let run = self.provenance.clone();
         let model = Model::new(&self.params).py()?;
         py.detach(|| {
             let meta = SimulationMeta {

@@ -19,9 +19,10 @@ use tiltnoise_core::model::{Input, Observable};
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::options;
 use tiltnoise_core::subtract::{ResidualSpectra, DEFAULT_REPORT_BAND_HZ};
-use tiltnoise_io::Staging;
+use tiltnoise_job::files::Staging;
+use tiltnoise_job::subtract::outputs::SaveKind;
 use tiltnoise_job::subtract::{SubtractOutcome, SubtractRequest};
-use tiltnoise_job::subtract_outputs::SaveKind;
+use tiltnoise_job::Outcome;
 
 /// `colocated_ratio`: `{input: R}` as inputs and numbers (the job checks them).
 fn parse_colocated_ratio(ratios: BTreeMap<String, f64>) -> PyResult<Vec<(Input, f64)>> {
@@ -116,12 +117,15 @@ pub fn subtract(
         nperseg,
         holdout,
         max_delay_s: max_delay,
+        invocation: tiltnoise_job::Invocation::of_this_process(),
+        figure: tiltnoise_job::figures::View::default(),
     };
     let inputs = Inputs::of_params(params.file.as_deref())
         .with_all(job_args::python_names(req.input_files(), &[]));
     let cancel = Cancel::new();
     let outcome = crate::interrupt::watch(py, &cancel, || {
-        tiltnoise_job::subtract::run(req, &cancel).map_err(job_args::job_error)
+        tiltnoise_job::subtract::run(&req, &cancel, &tiltnoise_job::Silent)
+            .map_err(job_args::job_error)
     })?;
     Ok(Subtraction { outcome, inputs })
 }
@@ -311,9 +315,8 @@ impl Subtraction {
     fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
         SaveKind::of(&path).py()?;
         self.inputs.check_save(&path)?;
-        let view = tiltnoise_plot::View::default();
-        py.detach(|| Staging::committed(|stage| self.outcome.save(stage, &path, &view)))
-            .py()
+        py.detach(|| Staging::committed(|stage| self.outcome.save(stage, &path)))
+            .map_err(job_args::job_error)
     }
 
     /// The held-out spectra drawn with matplotlib: one log-log panel per observable, the

@@ -2,17 +2,20 @@
 //! `Visibilities` it returns: the visibility job's peaks and ratios with names and units.
 
 use crate::args::kw;
+use crate::arrays;
 use crate::budget::model_of;
 use crate::errors::PyResultExt;
 use crate::inputs::Inputs;
 use crate::job_args;
 use crate::state;
+use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
-use tiltnoise_io::{OutputError, Staging};
+use tiltnoise_job::files::Staging;
 use tiltnoise_job::visibility::{VisibilityRequest, VisibilityResult};
+use tiltnoise_job::{Invocation, Outcome, Silent};
 
 /// Mode visibilities measured from a recorded free motion (the command line's ``tiltnoise
 /// visibility --measured MEASURED``): for each mode of the model whose peak the record shows,
@@ -38,11 +41,12 @@ pub fn visibility(
     let req = VisibilityRequest {
         model: &model,
         measured,
+        invocation: Invocation::of_this_process(),
     };
     let inputs = Inputs::of_params(params.file.as_deref()).with_all(req.input_files());
     let cancel = Cancel::new();
     let result = crate::interrupt::watch(py, &cancel, || {
-        tiltnoise_job::visibility::run(req, &cancel).map_err(job_args::job_error)
+        tiltnoise_job::visibility::run(&req, &cancel, &Silent).map_err(job_args::job_error)
     })?;
     Ok(Visibilities { result, inputs })
 }
@@ -112,6 +116,36 @@ impl Visibilities {
         self.result.channels.iter().map(|o| o.name()).collect()
     }
 
+    /// ``mode`` of each ratio of :attr:`items` (k of nu_k), as an array (read-only).
+    #[getter]
+    fn mode<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<usize>>> {
+        let items = &self.result.measured.visibilities.items;
+        let mode: Vec<usize> = items.iter().map(|v| v.mode).collect();
+        arrays::read_only(PyArray1::from_vec(py, mode))
+    }
+
+    /// ``ratio`` of each entry of :attr:`items` (signed, dimensionless), as an array
+    /// (read-only).
+    #[getter]
+    fn ratio<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let items = &self.result.measured.visibilities.items;
+        arrays::read_only(PyArray1::from_vec(
+            py,
+            items.iter().map(|v| v.ratio).collect(),
+        ))
+    }
+
+    /// ``sigma`` of each entry of :attr:`items` (1-sigma error of the ratio), as an array
+    /// (read-only).
+    #[getter]
+    fn sigma<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let items = &self.result.measured.visibilities.items;
+        arrays::read_only(PyArray1::from_vec(
+            py,
+            items.iter().map(|v| v.sigma).collect(),
+        ))
+    }
+
     /// The record the visibilities were measured from.
     #[getter]
     fn origin(&self) -> &str {
@@ -124,26 +158,22 @@ impl Visibilities {
         self.result.csv()
     }
 
+    /// The measurement as JSON: ``{"channels", "origin", "peaks": [{"expected_hz",
+    /// "frequency_hz", "mode", "snr": {observable: SNR}}], "skipped": [{"mode", "reason"}],
+    /// "visibilities": [{"mode", "observable", "ratio", "reference", "sigma"}]}`` (keys in
+    /// alphabetical order, frequencies in Hz, a non-finite number as ``null``).
+    fn to_json(&self) -> PyResult<String> {
+        serde_json::to_string_pretty(&self.result.json())
+            .map_err(|e| crate::errors::value_error(e.to_string()))
+    }
+
     /// Writes :meth:`to_csv` to ``path`` (``.csv``), atomically. Raises ``OSError`` if it
     /// cannot be written or is one of the files read, ``ValueError`` for another extension.
     fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
-        if path.extension().and_then(|e| e.to_str()) != Some("csv") {
-            return Err(OutputError::UnknownFormat {
-                path,
-                allowed: ".csv",
-            })
-            .py();
-        }
         self.inputs.check_save(&path)?;
-        let text = self.result.csv();
-        py.detach(|| {
-            Staging::committed(|stage| {
-                stage.write(&path, |tmp| {
-                    std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
-                })
-            })
-        })
-        .py()
+        let result = self.result.clone();
+        py.detach(|| Staging::committed(|stage| result.save(stage, &path)))
+            .map_err(job_args::job_error)
     }
 
     /// Pickles as its state (see the module's pickling notes).

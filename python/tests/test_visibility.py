@@ -77,3 +77,28 @@ def test_errors_say_what_the_command_line_says(record, cli_error, tmp_path):
         tiltnoise.visibility(record).save(tmp_path / "v.json")
     with pytest.raises(OSError):
         tiltnoise.visibility(record).save(tmp_path / "missing" / "v.csv")
+
+
+def test_arrays_and_json_are_the_items(result, record, cli, tmp_path):
+    import json
+
+    import numpy as np
+
+    items = result.items
+    assert result.mode.tolist() == [v["mode"] for v in items]
+    assert result.ratio.tolist() == [v["ratio"] for v in items]
+    assert result.sigma.tolist() == [v["sigma"] for v in items]
+    assert not result.ratio.flags.writeable
+    doc = json.loads(result.to_json())
+    assert doc["origin"] == str(record) and doc["channels"] == result.channels
+    assert [(v["mode"], v["observable"], v["reference"], v["ratio"], v["sigma"])
+            for v in doc["visibilities"]] == [
+        (v["mode"], v["observable"], v["reference"], v["ratio"], v["sigma"]) for v in items]
+    assert doc["peaks"] == result.peaks
+    assert [[s["mode"], s["reason"]] for s in doc["skipped"]] == [list(s) for s in result.skipped]
+    # The CSV the command line writes for the same record holds the same ratios.
+    theirs = tmp_path / "cli.csv"
+    cli("visibility", "--measured", record, "--save", theirs)
+    rows = [l.split(",") for l in theirs.read_text().splitlines() if not l.startswith("#")][1:]
+    np.testing.assert_array_equal(np.array([float(r[3]) for r in rows]), result.ratio)
+    np.testing.assert_array_equal(np.array([float(r[4]) for r in rows]), result.sigma)

@@ -10,6 +10,7 @@ use std::path::PathBuf;
 use tiltnoise_core::fit::{Bound, FitResult};
 use tiltnoise_core::params::Params;
 use tiltnoise_job::fit::FitRequest;
+use tiltnoise_job::{Invocation, Outcome, Silent};
 
 /// Arguments of `tiltnoise fit`.
 #[derive(Debug, Args)]
@@ -67,18 +68,18 @@ pub(crate) fn run_fit(params: &Params, args: FitArgs, run: &mut Run) -> Result<(
         free: args.free.clone(),
         bound_sigmas: args.bound_sigmas,
         prior: args.prior,
+        invocation: Invocation::of_this_process(),
     };
     run.check_job_outputs(&args.save, req.input_files())?;
-    let fit = tiltnoise_job::fit::run(req, &run.cancel).map_err(super::job_error)?;
+    let fit = tiltnoise_job::fit::run(&req, &run.cancel, &Silent).map_err(super::job_error)?;
     match args.format {
-        FitFormat::Json => writeln!(run.out, "{}", fit.json()?)?,
+        FitFormat::Json => writeln!(run.out, "{}", serde_json::to_string_pretty(&fit.json())?)?,
         FitFormat::Table => write!(run.out, "{}", fit_table(&fit.result, &fit.origin))?,
     }
-    let meta = tiltnoise_io::RunMeta::of_this_run(params, None);
     // JSON on standard output stays parseable: the `wrote` lines go to standard error.
     run.write_outputs(args.format == FitFormat::Json, |stage| {
         for path in &args.save {
-            tiltnoise_job::fit::save(stage, path, &fit, &meta)?;
+            fit.save(stage, path).map_err(super::job_error)?;
         }
         Ok(())
     })
@@ -295,10 +296,11 @@ mod tests {
             free: None,
             bound_sigmas: 1.0,
             prior: false,
+            invocation: Invocation::default(),
         };
         let fit: FitOutcome =
-            tiltnoise_job::fit::run(req, &tiltnoise_job::Cancel::never()).unwrap();
-        let text = fit.json().unwrap();
+            tiltnoise_job::fit::run(&req, &tiltnoise_job::Cancel::never(), &Silent).unwrap();
+        let text = serde_json::to_string_pretty(&fit.json()).unwrap();
         let value = assert_keys_sorted(&text);
         assert_eq!(value["measured_origin"], "embedded Table II");
     }

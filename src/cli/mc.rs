@@ -3,13 +3,18 @@
 //! histograms (PNG/SVG) and HDF5 with `--save`.
 
 use super::figure_args::SizeArgs;
+use super::progress::Bar;
 use super::Run;
 use anyhow::Result;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::mc::McResult;
 use tiltnoise_core::params::Params;
-use tiltnoise_io::RunMeta;
+use tiltnoise_job::figures::MC_FIGURE_SIZE;
 use tiltnoise_job::monte_carlo::{self, McRequest};
+use tiltnoise_job::{Invocation, Outcome};
+
+/// The draws worth a progress bar.
+const WORTH_A_BAR: u64 = 10_000;
 
 /// The options of `tiltnoise mc`.
 pub(crate) struct McOptions {
@@ -31,47 +36,35 @@ pub(crate) struct McOptions {
 /// Monte Carlo job run (with a progress bar on a terminal), the table or JSON printed and the
 /// files written.
 pub(crate) fn run_mc(params: &Params, opts: McOptions, run: &mut Run) -> Result<()> {
-    use std::io::IsTerminal;
     for path in &opts.save {
         monte_carlo::check_save_path(path)?;
     }
     opts.figure.refuse_without_figure(&opts.save)?;
-    let view = opts
-        .figure
-        .view_for(tiltnoise_plot::mc_figure::DEFAULT_SIZE)?;
     let req = McRequest {
         params,
         samples: opts.samples,
         seed: opts.seed,
         threads: opts.threads,
+        invocation: Invocation::of_this_process(),
+        figure: opts.figure.view_for(MC_FIGURE_SIZE)?,
     };
     monte_carlo::check(&req).map_err(super::job_error)?;
     let saves: Vec<&Path> = opts.save.iter().map(PathBuf::as_path).collect();
     run.check_outputs(&saves, &[])?;
-    let bar = (std::io::stderr().is_terminal() && opts.samples >= 10_000)
-        .then(|| indicatif::ProgressBar::new(opts.samples as u64));
-    let mc = monte_carlo::run(req, &run.cancel, &|done| {
-        if let Some(b) = &bar {
-            b.set_position(done as u64);
-        }
-    })
-    .map_err(super::job_error)?;
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
+    let bar = Bar::new("draws", WORTH_A_BAR);
+    let mc = monte_carlo::run(&req, &run.cancel, &bar).map_err(super::job_error)?;
     if opts.json {
-        writeln!(run.out, "{}", monte_carlo::summary_json(&mc)?)?;
+        writeln!(run.out, "{}", serde_json::to_string_pretty(&mc.json())?)?;
     } else {
         write!(run.out, "{}", table(&mc.result, &mc.nominal_hz, opts.seed))?;
     }
     if opts.save.is_empty() {
         return Ok(());
     }
-    let meta = RunMeta::of_this_run(params, None);
     // JSON on standard output stays parseable: the `wrote` lines go to standard error.
     run.write_outputs(opts.json, |stage| {
         for path in &opts.save {
-            monte_carlo::save(stage, path, &mc, &meta, &view)?;
+            mc.save(stage, path).map_err(super::job_error)?;
         }
         Ok(())
     })

@@ -5,7 +5,6 @@
 
 use super::args::{scientific, Format};
 use super::figure_args::FigureArgs;
-use super::output::save_image;
 use super::progress::Bar;
 use super::Run;
 use anyhow::{bail, Result};
@@ -18,12 +17,12 @@ use tiltnoise_core::params::Params;
 use tiltnoise_core::simulate::{
     aliased_frequency_hz, parse_coordinates, readout_text, Excitation, DEFAULT_MODE_ENERGY_J,
 };
-use tiltnoise_io::{OutputKind, RunMeta};
+use tiltnoise_job::figures::{ImageFormat, SIMULATE_FIGURE_SIZE};
+use tiltnoise_job::files::OutputKind;
 use tiltnoise_job::simulate::{
-    asd_figure_data, save, Keep, RecordOutputs, SimulateRequest, SimulateResult,
+    asd_figure_data, save, save_time_figure, Keep, RecordOutputs, SimulateRequest, SimulateResult,
 };
-use tiltnoise_job::Progress;
-use tiltnoise_plot::simulate_figure::{time_series_figure, ASD_SIZE};
+use tiltnoise_job::Invocation;
 
 mod driven;
 
@@ -229,7 +228,7 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
     let model = Model::new(params)?;
     let figures: Vec<PathBuf> = args.save.iter().chain(&args.save_time).cloned().collect();
     args.figure.refuse_without_figure(&figures)?;
-    let view = args.figure.view_for(ASD_SIZE)?;
+    let view = args.figure.view_for(SIMULATE_FIGURE_SIZE)?;
     if let Some(path) = &args.tilt {
         return driven::run(&model, &args, path, &view, run);
     }
@@ -238,7 +237,7 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
         OutputKind::from_path(path)?;
     }
     for path in &args.save_time {
-        tiltnoise_plot::ImageFormat::from_path(path)?;
+        ImageFormat::from_path(path)?;
     }
     let hdf5: Vec<PathBuf> = args
         .save
@@ -266,12 +265,11 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
             hdf5_coordinates: args.with_coordinates,
             time_figure: !args.save_time.is_empty(),
         },
+        invocation: Invocation::of_this_process(),
     };
     let bar = Bar::new("samples", WORTH_A_BAR);
-    let result =
-        tiltnoise_job::simulate::run(req, &run.cancel, &mut |done, total| bar.report(done, total));
-    bar.finish();
-    let mut result = result.map_err(super::job_error)?;
+    let mut result =
+        tiltnoise_job::simulate::run(&req, &run.cancel, &bar).map_err(super::job_error)?;
     let json = args.format == Format::Json;
     match json {
         true => writeln!(
@@ -281,7 +279,7 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
         )?,
         false => write!(run.out, "{}{}", summary(&result), result.check.table())?,
     }
-    let meta = RunMeta::of_this_run(params, Some(&result.modes));
+    let meta = result.provenance.clone();
     let figure = asd_figure_data(
         &result.asd,
         &result.readout,
@@ -302,9 +300,7 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
         }
         if let Some(data) = &result.time_figure {
             for path in &args.save_time {
-                save_image(stage, path, |format| {
-                    time_series_figure(data, &view, format)
-                })?;
+                save_time_figure(stage, path, data, &view)?;
             }
         }
         Ok(())

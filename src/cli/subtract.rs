@@ -1,7 +1,7 @@
 //! The `subtract` subcommand: the options parsed into the subtract job's request
 //! ([`tiltnoise_job::subtract`]: the records read and checked, the coupling fitted, the tilt
 //! part predicted and removed), the job run, then the report (table or JSON) and the outputs
-//! ([`tiltnoise_job::subtract_outputs`]: the cleaned record, the report, the figure).
+//! ([`tiltnoise_job::subtract::outputs`]: the cleaned record, the report, the figure).
 //! Documented in `docs/subtract.md`.
 
 use super::args::{parse_readout_item, ChannelArgs, Format};
@@ -18,9 +18,11 @@ use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::options;
 use tiltnoise_core::params::Params;
 use tiltnoise_job::budget::ReadRequest;
+use tiltnoise_job::figures::View;
+use tiltnoise_job::subtract::figure::FIGURE_SIZE;
+use tiltnoise_job::subtract::outputs::SaveKind;
 use tiltnoise_job::subtract::SubtractRequest;
-use tiltnoise_job::subtract_figure::FIGURE_SIZE;
-use tiltnoise_job::subtract_outputs::SaveKind;
+use tiltnoise_job::{Invocation, Outcome, Silent};
 
 /// Arguments of `tiltnoise subtract`.
 #[derive(Debug, Args)]
@@ -215,6 +217,8 @@ fn request<'a>(args: &SubtractArgs, model: &'a Model) -> Result<SubtractRequest<
         nperseg: args.nperseg,
         holdout: args.holdout,
         max_delay_s: args.max_delay,
+        invocation: Invocation::of_this_process(),
+        figure: View::default(),
     })
 }
 
@@ -225,11 +229,15 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
         SaveKind::of(path)?;
     }
     args.figure.refuse_without_figure(&args.save)?;
-    let view = args.figure.view_for(FIGURE_SIZE)?;
+    let figure = args.figure.view_for(FIGURE_SIZE)?;
     let model = Model::new(params)?;
-    let req = request(&args, &model)?;
+    let req = SubtractRequest {
+        figure,
+        ..request(&args, &model)?
+    };
     run.check_job_outputs(&args.save, req.input_files())?;
-    let outcome = tiltnoise_job::subtract::run(req, &run.cancel).map_err(super::job_error)?;
+    let outcome =
+        tiltnoise_job::subtract::run(&req, &run.cancel, &Silent).map_err(super::job_error)?;
     for note in &outcome.input_notes {
         match args.format {
             Format::Json => super::note(&format!("input: {note}")),
@@ -242,7 +250,7 @@ pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -
     }
     run.write_outputs(args.format == Format::Json, |stage| {
         for path in &args.save {
-            outcome.save(stage, path, &view)?;
+            outcome.save(stage, path).map_err(super::job_error)?;
         }
         Ok(())
     })

@@ -7,8 +7,8 @@ use tiltnoise_core::error::Num;
 use tiltnoise_core::subtract::{
     BandCheck, ColocatedEstimate, Estimate, Method, ResidualSpectra, Status, SubtractResult,
 };
-use tiltnoise_job::subtract_figure::with_sigma;
-use tiltnoise_job::subtract_report::band_top;
+use tiltnoise_job::subtract::figure::with_sigma;
+use tiltnoise_job::subtract::report::band_top;
 
 /// The report as the table `subtract` prints.
 pub(crate) fn report_table(r: &SubtractResult) -> String {

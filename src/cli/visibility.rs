@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use tiltnoise_core::model::Model;
 use tiltnoise_core::params::Params;
 use tiltnoise_job::visibility::{VisibilityRequest, VisibilityResult};
+use tiltnoise_job::{Invocation, Outcome, Silent};
 
 /// Arguments of `tiltnoise visibility`.
 #[derive(Debug, Args)]
@@ -47,22 +48,20 @@ pub(crate) fn run_visibility(params: &Params, args: VisibilityArgs, run: &mut Ru
     let req = VisibilityRequest {
         model: &model,
         measured: args.record.clone(),
+        invocation: Invocation::of_this_process(),
     };
     run.check_job_outputs(args.save.as_slice(), req.input_files())?;
-    let result = tiltnoise_job::visibility::run(req, &run.cancel).map_err(super::job_error)?;
-    let text = result.csv();
+    let result =
+        tiltnoise_job::visibility::run(&req, &run.cancel, &Silent).map_err(super::job_error)?;
     match args.format {
         VisibilityFormat::Table => write!(run.out, "{}", table(&result))?,
-        VisibilityFormat::Csv => write!(run.out, "{text}")?,
+        VisibilityFormat::Csv => write!(run.out, "{}", result.csv())?,
     }
     let Some(path) = &args.save else {
         return Ok(());
     };
     run.write_outputs(args.format == VisibilityFormat::Csv, |stage| {
-        stage.write(path, |tmp| {
-            std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
-        })?;
-        Ok(())
+        result.save(stage, path).map_err(super::job_error)
     })
 }
 

@@ -75,6 +75,89 @@ fn simulated_record_to_fitted_offset() {
     assert!(v["visibilities"].as_array().unwrap().len() >= 20);
 }
 
+/// A fit's HDF5 file holds the visibilities its JSON report holds, entry by entry, bit for
+/// bit (the JSON's shortest round-trip decimals read back to the same doubles; a `null`
+/// nominal is NaN in the file).
+#[test]
+fn fit_hdf5_holds_the_visibilities_of_its_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    let (record, vis) = (path("rec.h5"), path("vis.csv"));
+    let (json_path, h5_path) = (path("fit.json"), path("fit.h5"));
+    let truth = format!("asymmetry.tm_com_x_m={TRUTH_M:e}");
+    let mut sim = vec!["simulate", "--set", &truth, "--mode-energy", "1e-10"];
+    let readout: Vec<String> = ["X", "Y", "Z", "theta", "eta", "phi", "phi_a"]
+        .iter()
+        .map(|o| format!("{o}=1e-9"))
+        .collect();
+    for r in &readout {
+        sim.extend(["--readout", r.as_str()]);
+    }
+    sim.extend(["--save", &record]);
+    let out = tiltnoise(&sim);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = tiltnoise(&["visibility", "--measured", &record, "--save", &vis]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let params = path("p.toml");
+    let mut toml = String::from_utf8(tiltnoise(&["params"]).stdout).unwrap();
+    toml.push_str("\n[uncertainty]\n\"asymmetry.tm_com_x_m\" = { sigma = 1e-3 }\n");
+    std::fs::write(&params, toml).unwrap();
+    let out = tiltnoise(&[
+        "--params",
+        &params,
+        "fit",
+        "--visibility",
+        &vis,
+        "--free",
+        "asymmetry.tm_com_x_m",
+        "--save",
+        &json_path,
+        "--save",
+        &h5_path,
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json_path).unwrap()).unwrap();
+    let rows = v["visibilities"].as_array().unwrap();
+    assert!(rows.len() >= 20, "{}", rows.len());
+    let file = hdf5::File::open(&h5_path).unwrap();
+    assert_eq!(
+        file.attr("schema_version")
+            .unwrap()
+            .read_scalar::<i64>()
+            .unwrap(),
+        3
+    );
+    let g = file.group("visibilities").unwrap();
+    let numbers = |name: &str| -> Vec<f64> { g.dataset(name).unwrap().read_raw().unwrap() };
+    let texts = |name: &str| -> Vec<String> {
+        let raw: Vec<hdf5::types::VarLenUnicode> = g.dataset(name).unwrap().read_raw().unwrap();
+        raw.iter().map(|s| s.as_str().to_string()).collect()
+    };
+    let mode: Vec<i64> = g.dataset("mode").unwrap().read_raw().unwrap();
+    assert_eq!(mode.len(), rows.len());
+    for name in ["observable", "reference", "sigma_source"] {
+        let column = texts(name);
+        assert_eq!(column.len(), rows.len(), "{name}");
+        for (row, text) in rows.iter().zip(&column) {
+            assert_eq!(row[name].as_str().unwrap(), text, "{name}");
+        }
+    }
+    for name in ["measured", "sigma", "nominal", "fitted", "residual_sigmas"] {
+        let column = numbers(name);
+        assert_eq!(column.len(), rows.len(), "{name}");
+        for (row, &x) in rows.iter().zip(&column) {
+            match row[name].as_f64() {
+                Some(expected) => assert_eq!(x.to_bits(), expected.to_bits(), "{name}"),
+                None => assert!(x.is_nan(), "{name}: {x} where the JSON has null"),
+            }
+        }
+    }
+    for (row, &m) in rows.iter().zip(&mode) {
+        assert_eq!(row["mode"].as_i64().unwrap(), m);
+    }
+}
+
 #[test]
 fn bad_input_exits_2_without_output() {
     let dir = tempfile::tempdir().unwrap();

@@ -6,18 +6,19 @@ use crate::atomic::Staging;
 use crate::run_meta::RunMeta;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
-use tiltnoise_core::fit::{Bound, FitResult};
+use tiltnoise_core::fit::{Bound, FitResult, SigmaSource, VisibilityFit};
 
 /// Value of the root attribute `schema`.
 pub const SCHEMA_FIT: &str = "tiltnoise.fit";
 
 /// Value of the root attribute `schema_version`. Bumped on any change that can break a reader.
-pub const SCHEMA_VERSION_FIT: i64 = 2;
+pub const SCHEMA_VERSION_FIT: i64 = 3;
 
 /// Writes the result of a fit to `path` as HDF5, atomically: root attributes (schema and
 /// provenance, origin of the measured frequencies, stop reason, fitted parameter file, chi^2),
-/// group `/parameters` (one entry per free parameter) and `/modes` (one per measured mode),
-/// and the singular values of the weighted Jacobian. Every numeric dataset has a `unit`
+/// group `/parameters` (one entry per free parameter), `/modes` (one per measured mode) and
+/// `/visibilities` (one per measured visibility, the entries of the JSON report's
+/// `visibilities`), and the singular values of the weighted Jacobian. Every numeric dataset has a `unit`
 /// attribute (an array of one unit per entry where the entries differ); indices and counts
 /// are integers.
 ///
@@ -109,8 +110,46 @@ fn write_h5(path: &Path, r: &FitResult, origin: &str, meta: &RunMeta) -> hdf5::R
     with_unit(&m, "nominal_hz", &hz(|x| x.nominal_hz), "Hz")?;
     with_unit(&m, "fitted_hz", &hz(|x| x.fitted_hz), "Hz")?;
     with_unit(&m, "residual_hz", &hz(|x| x.residual_hz()), "Hz")?;
+    write_visibilities(&file, r)?;
     // Of the Jacobian weighted by the measurement errors: dimensionless.
     with_unit(&file, "singular_values", &r.singular_values, "1")?;
+    Ok(())
+}
+
+/// Group `/visibilities`: one entry per measured visibility, in the order of the JSON report's
+/// `visibilities` (empty datasets when the fit had none). Ratios are dimensionless; `nominal`
+/// is NaN where the reference channel does not see the mode at the nominal parameters (null in
+/// the JSON).
+fn write_visibilities(file: &hdf5::File, r: &FitResult) -> hdf5::Result<()> {
+    let v = file.create_group("visibilities")?;
+    let mode: Vec<i64> = r
+        .visibilities
+        .iter()
+        .map(|x| int(x.measured.mode))
+        .collect::<hdf5::Result<_>>()?;
+    let d = dataset(&v, "mode", &mode)?;
+    str_attr(&d, "unit", "1")?;
+    let text = |name: &str, f: fn(&VisibilityFit) -> &'static str| -> hdf5::Result<()> {
+        let data: Vec<String> = r.visibilities.iter().map(|x| f(x).to_string()).collect();
+        dataset(&v, name, &strings(&data)?)?;
+        Ok(())
+    };
+    text("observable", |x| x.measured.observable.name())?;
+    text("reference", |x| x.measured.reference.name())?;
+    text("sigma_source", |x| match x.measured.sigma_source {
+        SigmaSource::File => "file",
+        SigmaSource::Digits => "digits",
+    })?;
+    let ratio = |name: &str, f: fn(&VisibilityFit) -> f64| -> hdf5::Result<()> {
+        let data: Vec<f64> = r.visibilities.iter().map(f).collect();
+        let d = dataset(&v, name, &data)?;
+        str_attr(&d, "unit", "1")
+    };
+    ratio("measured", |x| x.measured.ratio)?;
+    ratio("sigma", |x| x.measured.sigma)?;
+    ratio("nominal", |x| x.nominal)?;
+    ratio("fitted", |x| x.fitted)?;
+    ratio("residual_sigmas", VisibilityFit::residual_sigmas)?;
     Ok(())
 }
 

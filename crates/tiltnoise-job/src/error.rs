@@ -1,7 +1,7 @@
 //! The errors of a job, naming the option or key that failed by its snake-case name; each
 //! front end renders them in its own spelling ([`JobError::message`]).
 
-use crate::subtract_error::SubtractFailure;
+use crate::subtract::SubtractFailure;
 use std::fmt;
 use tiltnoise_core::budget::option_checks::{
     percentiles_error, require_segments_for_percentiles, InputKind,

@@ -7,6 +7,8 @@
 use crate::error::JobError;
 use std::path::Path;
 use tiltnoise_core::error::OutputError;
+use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::params::Params;
 use tiltnoise_io::{OutputKind, RunMeta, Staging};
 
 /// The provenance every output of a run records: this tool's version, the effective
@@ -27,6 +29,15 @@ impl Invocation {
     pub fn of_this_process() -> Self {
         Self {
             command_line: std::env::args().collect::<Vec<_>>().join(" "),
+        }
+    }
+
+    /// The provenance of a run of `params` that this invocation asked for, with the normal
+    /// `modes` when the run computed them (the one place a job builds its [`Provenance`]).
+    pub fn provenance(&self, params: &Params, modes: Option<&NormalModes>) -> Provenance {
+        Provenance {
+            command_line: self.command_line.clone(),
+            ..RunMeta::of_this_run(params, modes)
         }
     }
 }

@@ -32,11 +32,12 @@ fn request(model: &Model, chunk_samples: Option<usize>, keep: Keep) -> SimulateR
         nperseg: Some(2048),
         chunk_samples,
         keep,
+        invocation: tiltnoise_job::Invocation::default(),
     }
 }
 
 fn simulated(req: SimulateRequest<'_>) -> SimulateResult {
-    run(req, &Cancel::never(), &mut |_, _| {}).unwrap()
+    run(&req, &Cancel::never(), &tiltnoise_job::Silent).unwrap()
 }
 
 #[test]
@@ -92,11 +93,13 @@ fn the_streamed_file_is_the_record_and_its_visibilities_are_the_records() {
     assert!(!h5.exists(), "the file appears when it is complete");
     tiltnoise_io::Staging::committed(|s| r.finish_records(s)).unwrap();
     let vis = tiltnoise_job::visibility::run(
-        VisibilityRequest {
+        &VisibilityRequest {
             model: &model,
             measured: h5.clone(),
+            invocation: tiltnoise_job::Invocation::default(),
         },
         &Cancel::never(),
+        &tiltnoise_job::Silent,
     )
     .unwrap();
     let record = r.record.unwrap();
@@ -126,7 +129,7 @@ fn the_streamed_file_is_the_record_and_its_visibilities_are_the_records() {
 #[test]
 fn options_are_refused_by_their_keys() {
     let model = Model::new(&Params::table_i()).unwrap();
-    let message = |req| match run(req, &Cancel::never(), &mut |_, _| {}) {
+    let message = |req| match run(&req, &Cancel::never(), &tiltnoise_job::Silent) {
         Ok(_) => panic!("refused"),
         Err(e) => e.message(),
     };
@@ -169,6 +172,7 @@ fn driven(model: &Model, tilt: std::path::PathBuf) -> DrivenRequest<'_> {
         readout: Vec::new(),
         seed: 1,
         nperseg: Some(256),
+        invocation: tiltnoise_job::Invocation::default(),
     }
 }
 
@@ -213,15 +217,17 @@ fn a_fit_refuses_a_key_given_twice_and_fits_visibilities_alone() {
     let params = Params::table_i();
     let fit = |free: &[&str], visibility| {
         tiltnoise_job::fit::run(
-            FitRequest {
+            &FitRequest {
                 params: &params,
                 measured: None,
                 visibility,
                 free: Some(free.iter().map(|k| k.to_string()).collect()),
                 bound_sigmas: 1.0,
                 prior: false,
+                invocation: tiltnoise_job::Invocation::default(),
             },
             &Cancel::never(),
+            &tiltnoise_job::Silent,
         )
     };
     match fit(&["mass.m_b_kg", " mass.m_b_kg"], None) {

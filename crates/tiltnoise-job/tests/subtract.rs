@@ -28,6 +28,8 @@ fn request(model: &Model) -> SubtractRequest<'_> {
         nperseg: None,
         holdout: 0.25,
         max_delay_s: None,
+        invocation: tiltnoise_job::Invocation::default(),
+        figure: tiltnoise_job::figures::View::default(),
     }
 }
 
@@ -35,7 +37,7 @@ fn request(model: &Model) -> SubtractRequest<'_> {
 type Change = Box<dyn Fn(&mut SubtractRequest)>;
 
 fn message(req: SubtractRequest<'_>) -> String {
-    match run(req, &Cancel::never()) {
+    match run(&req, &Cancel::never(), &tiltnoise_job::Silent) {
         Ok(_) => panic!("the request ran"),
         Err(e) => e.message(),
     }
@@ -127,6 +129,8 @@ fn a_cancelled_run_returns_cancelled() {
     let model = Model::new(&Params::table_i()).unwrap();
     let cancel = Cancel::new();
     cancel.cancel();
-    let e = run(request(&model), &cancel).map(|_| ()).unwrap_err();
+    let e = run(&request(&model), &cancel, &tiltnoise_job::Silent)
+        .map(|_| ())
+        .unwrap_err();
     assert!(matches!(e, JobError::Cancelled), "{e:?}");
 }

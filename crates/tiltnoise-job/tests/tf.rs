@@ -220,8 +220,10 @@ fn the_monte_carlo_job_gives_the_librarys_draws() {
         samples: 200,
         seed: 11,
         threads: 2,
+        invocation: tiltnoise_job::Invocation::default(),
+        figure: tiltnoise_job::figures::View::default(),
     };
-    let run = monte_carlo::run(req, &Cancel::never(), &|_| {}).unwrap();
+    let run = monte_carlo::run(&req, &Cancel::never(), &tiltnoise_job::Silent).unwrap();
     let cfg = McConfig {
         samples: 200,
         seed: 11,
@@ -235,10 +237,14 @@ fn the_monte_carlo_job_gives_the_librarys_draws() {
 
     let e = monte_carlo::check(&McRequest {
         samples: usize::MAX,
-        ..req
+        ..req.clone()
     })
     .unwrap_err();
     assert!(e.message().contains("samples"), "{e}");
-    let e = monte_carlo::run(McRequest { samples: 0, ..req }, &Cancel::never(), &|_| {});
+    let e = monte_carlo::run(
+        &McRequest { samples: 0, ..req },
+        &Cancel::never(),
+        &tiltnoise_job::Silent,
+    );
     assert!(matches!(e, Err(JobError::MonteCarlo(_))));
 }

@@ -11,14 +11,15 @@ use tiltnoise_core::error::{Num, Shown};
 use tiltnoise_core::model::Model;
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::repeats::{list_entries, refuse_repeated_keys};
-use tiltnoise_io::{OutputKind, RunMeta};
+use tiltnoise_job::files::OutputKind;
 
 /// Fine steps per record sample of the driven propagation when `--oversample` is not given.
 const DEFAULT_OVERSAMPLE: usize = 10;
 use tiltnoise_job::budget::ReadRequest;
+use tiltnoise_job::figures::View;
 use tiltnoise_job::simulate::driven::{DrivenRequest, DrivenResult};
 use tiltnoise_job::simulate::{asd_figure_data, save, RecordOutputs};
-use tiltnoise_plot::View;
+use tiltnoise_job::Invocation;
 
 /// `--drive-gain INPUT=GAIN,...` as `(input, gain)`, each input once (the job checks them
 /// against the record).
@@ -68,6 +69,7 @@ fn request<'a>(model: &'a Model, args: &SimulateArgs, path: &Path) -> Result<Dri
         readout: parse_readout(&args.readout)?,
         seed: args.seed,
         nperseg: args.nperseg,
+        invocation: Invocation::of_this_process(),
     })
 }
 
@@ -107,7 +109,7 @@ pub(super) fn run(
             )?;
         }
     }
-    let meta = RunMeta::of_this_run(model.params(), Some(&r.modes));
+    let meta = r.provenance.clone();
     let record_meta = r.simulation_meta(meta.clone());
     let figure = asd_figure_data(&r.asd, &r.readout, &r.modes, r.fs_hz, &r.description);
     let outputs = RecordOutputs {

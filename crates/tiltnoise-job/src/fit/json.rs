@@ -2,11 +2,39 @@
 //! json`) and the HDF5 file, written atomically, the same for every front end.
 
 use super::FitOutcome;
+use crate::error::JobError;
+use crate::outcome::{Outcome, Provenance};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
 use tiltnoise_core::fit::{Bound, FitResult, SigmaSource};
-use tiltnoise_io::{write_fit_hdf5, OutputError, RunMeta, Staging};
+use tiltnoise_io::{write_fit_hdf5, OutputError, OutputKind, RunMeta, Staging};
+
+/// The kinds of file of [`OutputKind`] a fit is saved as (HDF5); besides them, `.json` holds
+/// the report ([`Outcome::json`]).
+pub const OUTPUT_KINDS: &[OutputKind] = &[OutputKind::Hdf5];
+
+impl Outcome for FitOutcome {
+    fn provenance(&self) -> &Provenance {
+        &self.provenance
+    }
+
+    fn output_kinds(&self) -> &'static [OutputKind] {
+        OUTPUT_KINDS
+    }
+
+    /// Saves `.json` (the report) or `.h5`/`.hdf5` (schema `tiltnoise.fit`).
+    fn save(&self, stage: &Staging, path: &Path) -> Result<(), JobError> {
+        Ok(save(stage, path, self, &self.provenance)?)
+    }
+
+    /// The report: keys in alphabetical order, non-finite numbers as `null` (JSON has no
+    /// infinity); a saved `.json` file holds it pretty-printed with a final newline.
+    fn json(&self) -> serde_json::Value {
+        serde_json::to_value(fit_json(&self.result, &self.origin))
+            .expect("a report with string keys serializes")
+    }
+}
 
 /// The formats a fit is saved in.
 enum SaveKind {
@@ -35,18 +63,6 @@ pub fn check_save_path(path: &Path) -> Result<(), OutputError> {
     save_kind(path).map(|_| ())
 }
 
-impl FitOutcome {
-    /// The JSON report, pretty-printed, keys in alphabetical order, non-finite numbers as
-    /// `null` (JSON has no infinity); a saved `.json` file holds it with a final newline.
-    ///
-    /// # Errors
-    ///
-    /// The serializer's error (none is expected: every key is a string).
-    pub fn json(&self) -> Result<String, serde_json::Error> {
-        serde_json::to_string_pretty(&fit_json(&self.result, &self.origin))
-    }
-}
-
 /// Saves a fit in the format named by the extension of `path`: `.json` (the JSON report) or
 /// `.h5`/`.hdf5` (schema `tiltnoise.fit`, with `meta`), as one of the outputs of `stage`.
 ///
@@ -62,10 +78,11 @@ pub fn save(
 ) -> Result<(), OutputError> {
     match save_kind(path)? {
         SaveKind::Json => {
-            let text = fit.json().map_err(|e| OutputError::Write {
-                path: path.to_path_buf(),
-                message: e.to_string(),
-            })? + "\n";
+            let text =
+                serde_json::to_string_pretty(&fit.json()).map_err(|e| OutputError::Write {
+                    path: path.to_path_buf(),
+                    message: e.to_string(),
+                })? + "\n";
             stage.write(path, |tmp| {
                 std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
             })

@@ -4,9 +4,11 @@
 
 mod json;
 
-pub use json::{check_save_path, save};
+pub use json::{check_save_path, save, OUTPUT_KINDS};
 
 use crate::error::JobError;
+use crate::outcome::{Invocation, Provenance};
+use crate::progress::Progress;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::fit::{self, FitConfig, FitError, FitResult, Measured, Visibilities};
@@ -29,6 +31,8 @@ pub struct FitRequest<'a> {
     pub bound_sigmas: f64,
     /// Add the Gaussian prior to chi^2.
     pub prior: bool,
+    /// Who asked for the fit (the provenance of its files).
+    pub invocation: Invocation,
 }
 
 impl FitRequest<'_> {
@@ -51,6 +55,8 @@ pub struct FitOutcome {
     pub result: FitResult,
     /// Where the measured frequencies came from.
     pub origin: String,
+    /// What the files record: the nominal parameters and the invocation.
+    pub provenance: Provenance,
 }
 
 fn file_error(e: FitError) -> JobError {
@@ -58,14 +64,24 @@ fn file_error(e: FitError) -> JobError {
 }
 
 /// Runs the fit: reads the measured frequencies and visibilities, checks the free keys and
-/// fits.
+/// fits. A fit takes seconds: `progress` is only told that it is over.
 ///
 /// # Errors
 ///
 /// A [`JobError`]: `FitFile` for a file that cannot be read or is not valid (named); `Fit`
 /// for a key or bound that is not allowed, a fit that fails or is cancelled; `Repeated` for a key given
 /// twice.
-pub fn run(req: FitRequest<'_>, cancel: &Cancel) -> Result<FitOutcome, JobError> {
+pub fn run(
+    req: &FitRequest<'_>,
+    cancel: &Cancel,
+    progress: &dyn Progress,
+) -> Result<FitOutcome, JobError> {
+    let outcome = fit(req, cancel);
+    progress.finish();
+    outcome
+}
+
+fn fit(req: &FitRequest<'_>, cancel: &Cancel) -> Result<FitOutcome, JobError> {
     // Visibilities without a frequency file are fitted alone: Table II's frequencies belong to
     // the paper's pendulum, not to the one whose record gave the visibilities.
     let measured = match (&req.measured, &req.visibility) {
@@ -80,7 +96,7 @@ pub fn run(req: FitRequest<'_>, cancel: &Cancel) -> Result<FitOutcome, JobError>
         Some(path) => tiltnoise_io::read_visibilities(path).map_err(file_error)?,
         None => Visibilities::none(),
     };
-    let free = match req.free {
+    let free = match &req.free {
         Some(keys) => {
             let keys: Vec<String> = keys.iter().map(|k| k.trim().to_string()).collect();
             refuse_repeats(OptionKey::FREE, "parameter key", &keys, String::clone)
@@ -99,5 +115,6 @@ pub fn run(req: FitRequest<'_>, cancel: &Cancel) -> Result<FitOutcome, JobError>
     Ok(FitOutcome {
         result,
         origin: measured.origin,
+        provenance: req.invocation.provenance(req.params, None),
     })
 }

@@ -4,18 +4,21 @@
 
 mod outputs;
 
-pub use outputs::{caption, check_save_path, save, summary_json};
+pub use outputs::{caption, check_save_path, save, summary_json, OUTPUT_KINDS};
 
 use crate::error::JobError;
+use crate::outcome::{Invocation, Provenance};
+use crate::progress::Progress;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::mc::{self, McConfig, McResult};
 use tiltnoise_core::model::Model;
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::params::Params;
+use tiltnoise_plot::View;
 
 /// A Monte Carlo of the modes to run.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct McRequest<'a> {
     /// The nominal parameters and their error model.
     pub params: &'a Params,
@@ -25,6 +28,10 @@ pub struct McRequest<'a> {
     pub seed: u64,
     /// Worker threads (0: every core); the result does not depend on it.
     pub threads: usize,
+    /// Who asked for the run (the provenance of its files).
+    pub invocation: Invocation,
+    /// The histograms' limits, size and resolution (`.png`/`.svg` outputs).
+    pub figure: View,
 }
 
 /// The draws, the configuration they were made with and the nominal modes.
@@ -35,6 +42,10 @@ pub struct McRun {
     pub config: McConfig,
     /// The nominal mode frequencies (Hz), ascending.
     pub nominal_hz: [f64; 8],
+    /// What the files record: the parameters and the invocation.
+    pub provenance: Provenance,
+    /// The histograms' limits, size and resolution.
+    pub figure: View,
 }
 
 /// Refuses more draws or threads than allowed or than fit into memory, before anything is
@@ -64,21 +75,27 @@ pub fn config(req: &McRequest<'_>, cancel: &Cancel) -> McConfig {
     }
 }
 
-/// Runs the Monte Carlo; `progress` is called from the workers with the draws done so far.
+/// Runs the Monte Carlo; `progress` is told, from the workers, the draws done of
+/// `req.samples` (and finished once, also on a failure).
 ///
 /// # Errors
 ///
 /// [`JobError::MonteCarlo`]: sizes over their limits, an error model that cannot be used,
 /// every draw rejected, or `cancel` set.
 pub fn run(
-    req: McRequest<'_>,
+    req: &McRequest<'_>,
     cancel: &Cancel,
-    progress: &(dyn Fn(usize) + Sync),
+    progress: &dyn Progress,
 ) -> Result<McRun, JobError> {
-    check(&req)?;
-    let config = config(&req, cancel);
+    check(req)?;
+    let config = config(req, cancel);
     let mc_error = |e: mc::McError| JobError::MonteCarlo(Box::new(e));
-    let result = mc::run(req.params, &config, progress).map_err(mc_error)?;
+    let total = req.samples as u64;
+    let drawn = mc::run(req.params, &config, &|done| {
+        progress.report(done as u64, total)
+    });
+    progress.finish();
+    let result = drawn.map_err(mc_error)?;
     let model = Model::new(req.params).map_err(|e| mc_error(e.into()))?;
     let nominal: Vec<f64> = NormalModes::new(&model).frequencies_hz();
     let nominal_hz = <[f64; 8]>::try_from(nominal.as_slice())
@@ -87,5 +104,7 @@ pub fn run(
         result,
         config,
         nominal_hz,
+        provenance: req.invocation.provenance(req.params, None),
+        figure: req.figure.clone(),
     })
 }

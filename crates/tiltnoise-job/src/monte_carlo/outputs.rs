@@ -3,9 +3,32 @@
 //! histograms, written atomically, the same for every front end.
 
 use super::McRun;
+use crate::error::JobError;
+use crate::outcome::{Outcome, Provenance};
 use serde::Serialize;
 use std::path::Path;
-use tiltnoise_io::{write_mc_hdf5, OutputError, RunMeta, Staging};
+use tiltnoise_io::{write_mc_hdf5, OutputError, OutputKind, RunMeta, Staging};
+
+/// The kinds of file a Monte Carlo is saved as: the draws (HDF5) and the histograms.
+pub const OUTPUT_KINDS: &[OutputKind] = &[OutputKind::Hdf5, OutputKind::Png, OutputKind::Svg];
+
+impl Outcome for McRun {
+    fn provenance(&self) -> &Provenance {
+        &self.provenance
+    }
+
+    fn output_kinds(&self) -> &'static [OutputKind] {
+        OUTPUT_KINDS
+    }
+
+    fn save(&self, stage: &Staging, path: &Path) -> Result<(), JobError> {
+        Ok(save(stage, path, self, &self.provenance, &self.figure)?)
+    }
+
+    fn json(&self) -> serde_json::Value {
+        serde_json::to_value(summary(self)).expect("a report of numbers serializes")
+    }
+}
 
 /// The formats a Monte Carlo is saved in.
 enum SaveKind {
@@ -97,6 +120,10 @@ struct McModeJson {
 ///
 /// The serializer's error (none is expected: every key is a string).
 pub fn summary_json(run: &McRun) -> serde_json::Result<String> {
+    serde_json::to_string_pretty(&summary(run))
+}
+
+fn summary(run: &McRun) -> McJson {
     let result = &run.result;
     let modes = (0..8)
         .map(|k| McModeJson {
@@ -106,12 +133,12 @@ pub fn summary_json(run: &McRun) -> serde_json::Result<String> {
             std_hz: result.std_hz[k],
         })
         .collect();
-    serde_json::to_string_pretty(&McJson {
+    McJson {
         modes,
         rejected: result.rejected,
         samples: result.samples,
         seed: run.config.seed,
-    })
+    }
 }
 
 /// The histograms' caption: what is marked, counts, seed and the error model, grouped by
@@ -185,6 +212,8 @@ mod tests {
                 ..McConfig::default_for(&Params::table_i())
             },
             nominal_hz: [1.0; 8],
+            provenance: Provenance::default(),
+            figure: tiltnoise_plot::View::default(),
         };
         let text = summary_json(&run).unwrap();
         // A `serde_json::Value`'s objects are sorted maps: printed again, a document whose

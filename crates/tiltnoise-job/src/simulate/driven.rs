@@ -43,6 +43,8 @@ pub struct DrivenRequest<'a> {
     pub seed: u64,
     /// Welch segment of the ASDs (default `default_sim_nperseg`).
     pub nperseg: Option<usize>,
+    /// Who asked for the run (the provenance of its files).
+    pub invocation: crate::Invocation,
 }
 
 impl DrivenRequest<'_> {
@@ -74,6 +76,8 @@ pub struct DrivenResult {
     pub start_time: Option<String>,
     /// The model's normal modes.
     pub modes: NormalModes,
+    /// What the files record: the parameters, the modes and the invocation.
+    pub provenance: crate::Provenance,
 }
 
 impl DrivenResult {
@@ -248,6 +252,9 @@ pub fn run(req: DrivenRequest<'_>, cancel: &Cancel) -> Result<DrivenResult, JobE
         description,
         notes,
         start_time: series.provenance.start_time.clone(),
+        provenance: req
+            .invocation
+            .provenance(model.params(), Some(&NormalModes::new(model))),
         modes: NormalModes::new(model),
     })
 }

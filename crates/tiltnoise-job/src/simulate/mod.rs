@@ -7,9 +7,11 @@
 pub mod driven;
 mod outputs;
 
-pub use outputs::{asd_figure_data, save, RecordOutputs};
+pub use outputs::{asd_figure_data, save, save_time_figure, RecordOutputs};
 
 use crate::error::JobError;
+use crate::outcome::{Invocation, Provenance};
+use crate::progress::Progress;
 use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::limits::{check_memory, planned_bytes, STREAMED_WELCH_BYTES_PER_SAMPLE};
@@ -50,6 +52,8 @@ pub struct SimulateRequest<'a> {
     pub chunk_samples: Option<usize>,
     /// What of the record to keep besides its spectra.
     pub keep: Keep,
+    /// Who asked for the run (the provenance of its files).
+    pub invocation: Invocation,
 }
 
 /// What a simulation keeps of its record: its spectra always; the rest only when asked, so
@@ -90,6 +94,8 @@ pub struct SimulateResult {
     pub check: ResonanceCheck,
     /// The model's normal modes.
     pub modes: NormalModes,
+    /// What the files record: the parameters, the modes and the invocation.
+    pub provenance: Provenance,
     /// The whole record, when [`Keep::record`].
     pub record: Option<Simulation>,
     /// The time-series figure, when [`Keep::time_figure`].
@@ -219,19 +225,29 @@ fn check(req: &SimulateRequest<'_>) -> Result<(usize, usize, usize), JobError> {
 }
 
 /// Runs the simulation: checks the request, streams the record chunk by chunk through the
-/// HDF5 files, the Welch accumulators and what is kept (`progress(done, total)` called with
-/// samples done after each chunk), and checks the resonances.
+/// HDF5 files, the Welch accumulators and what is kept (`progress` told the samples done
+/// after each chunk, and finished once), and checks the resonances.
 ///
 /// # Errors
 ///
 /// A [`JobError`] naming the option that is not allowed; `Simulate` wrapping the cancellation
 /// when `cancel` was set; `Output` for an HDF5 file that cannot be written.
 pub fn run(
-    req: SimulateRequest<'_>,
+    req: &SimulateRequest<'_>,
     cancel: &Cancel,
-    progress: &mut dyn FnMut(u64, u64),
+    progress: &dyn Progress,
 ) -> Result<SimulateResult, JobError> {
-    let (n, nperseg, chunk_samples) = check(&req)?;
+    let result = simulate(req, cancel, progress);
+    progress.finish();
+    result
+}
+
+fn simulate(
+    req: &SimulateRequest<'_>,
+    cancel: &Cancel,
+    progress: &dyn Progress,
+) -> Result<SimulateResult, JobError> {
+    let (n, nperseg, chunk_samples) = check(req)?;
     let model = req.model;
     let readout = readout(&req.readout)?;
     let (init, init_source) = initial_state(model, &req.excitation)?;
@@ -269,18 +285,22 @@ pub fn run(
             channels: Vec::new(),
         },
         modes: NormalModes::new(model),
+        provenance: Provenance::default(),
         record: None,
         time_figure: None,
         streamed: Vec::new(),
     };
-    let mut sinks = Sinks::new(&req.keep, &result, model)?;
+    result.provenance = req
+        .invocation
+        .provenance(model.params(), Some(&result.modes));
+    let mut sinks = Sinks::new(&req.keep, &result)?;
     let mut chunk = SimChunk::default();
     while {
         cancel.check().map_err(SimError::from)?;
         motion.next_chunk(chunk_samples, &mut chunk)
     } {
         sinks.push(&chunk)?;
-        progress(motion.samples_done() as u64, n as u64);
+        progress.report(motion.samples_done() as u64, n as u64);
     }
     sinks.finish(&mut result, model)?;
     Ok(result)
@@ -288,11 +308,10 @@ pub fn run(
 
 impl Sinks {
     /// The sinks of `keep` for the run `result` describes (its HDF5 files created).
-    fn new(keep: &Keep, result: &SimulateResult, model: &Model) -> Result<Sinks, JobError> {
+    fn new(keep: &Keep, result: &SimulateResult) -> Result<Sinks, JobError> {
         let (n, dt_s) = (result.n_samples, result.dt_s);
         let wcfg = WelchConfig::new(result.asd.segment_len);
-        let meta =
-            result.simulation_meta(RunMeta::of_this_run(model.params(), Some(&result.modes)));
+        let meta = result.simulation_meta(result.provenance.clone());
         let writers = keep
             .hdf5
             .iter()

@@ -10,7 +10,9 @@ use tiltnoise_io::{
     write_asd_csv, write_observable_series_hdf5, OutputError, OutputKind, RunMeta, SeriesAsd,
     SimulationMeta, Staging,
 };
-use tiltnoise_plot::simulate_figure::{asd_figure, ModeMark, SimAsdData};
+use tiltnoise_plot::simulate_figure::{
+    asd_figure, time_series_figure, ModeMark, SimAsdData, TimeSeriesData,
+};
 use tiltnoise_plot::View;
 
 /// The ASD figure of a record sampled at `fs_hz`: its ASDs, the readout levels, the modes
@@ -87,4 +89,20 @@ pub fn save(
             save_image(stage, path, |format| asd_figure(out.figure, view, format))
         }
     }
+}
+
+/// Draws the time-series figure (Figures 4 and 5) of `data` with `view`'s limits, size and
+/// resolution in the format `path`'s extension names (`.png`, `.svg`), as one of the outputs
+/// of `stage`.
+///
+/// # Errors
+///
+/// [`OutputError::UnknownFormat`] for another extension, [`OutputError::Write`] naming `path`.
+pub fn save_time_figure(
+    stage: &Staging,
+    path: &Path,
+    data: &TimeSeriesData,
+    view: &View,
+) -> Result<(), OutputError> {
+    save_image(stage, path, |format| time_series_figure(data, view, format))
 }

@@ -2,11 +2,17 @@
 //! visibilities of the modes it shows (the signed ratio of each mode's peaks in two channels,
 //! with its error) and the CSV that the fit reads back.
 
+mod outcome;
+
+pub use outcome::{VisibilityResult, OUTPUT_KINDS};
+
 use crate::error::{shown_path, JobError};
+use crate::outcome::Invocation;
+use crate::progress::Progress;
 use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
-use tiltnoise_core::fit::peaks::{self, RecordVisibilities, MIN_SNR};
-use tiltnoise_core::model::{Model, Observable};
+use tiltnoise_core::fit::peaks;
+use tiltnoise_core::model::Model;
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_io::input::{read_measured_input, MeasuredInput};
 
@@ -17,6 +23,8 @@ pub struct VisibilityRequest<'a> {
     /// The free-motion or ring-down record of the observables (HDF5 or CSV time series, the
     /// layout `simulate` writes).
     pub measured: PathBuf,
+    /// Who asked for the measurement (its provenance).
+    pub invocation: Invocation,
 }
 
 impl VisibilityRequest<'_> {
@@ -26,44 +34,25 @@ impl VisibilityRequest<'_> {
     }
 }
 
-/// The visibilities of a record, the peaks they were read from, and the record's channels.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct VisibilityResult {
-    /// The measurement.
-    pub measured: RecordVisibilities,
-    /// The record's channels, in its order (the order of each peak's SNRs).
-    pub channels: Vec<Observable>,
-    /// The record, as given.
-    pub origin: String,
-}
-
-impl VisibilityResult {
-    /// The visibilities as the CSV `mode,observable,reference,ratio,sigma` that the fit reads
-    /// (`docs/fit.md`), with comment lines that say where and how they were measured.
-    pub fn csv(&self) -> String {
-        let comment = [
-            format!(
-                "mode visibilities measured from {} by tiltnoise visibility",
-                self.origin
-            ),
-            format!(
-                "Hann-windowed peaks of each mode near the model's frequency; reference: the \
-                 strongest channel of each unit with SNR >= {MIN_SNR}; sigma: first-order \
-                 error from the local noise"
-            ),
-        ];
-        self.measured.visibilities.to_csv(&comment)
-    }
-}
-
 /// Runs the measurement: reads the record once and measures each mode's peak near the
-/// model's frequency in every channel.
+/// model's frequency in every channel. The peaks take a moment: `progress` is only told that
+/// the measurement is over.
 ///
 /// # Errors
 ///
 /// A [`JobError`] naming the file: one that cannot be read, holds spectra, or shows no mode;
 /// `Fit` wrapping the cancellation when `cancel` was set.
-pub fn run(req: VisibilityRequest<'_>, cancel: &Cancel) -> Result<VisibilityResult, JobError> {
+pub fn run(
+    req: &VisibilityRequest<'_>,
+    cancel: &Cancel,
+    progress: &dyn Progress,
+) -> Result<VisibilityResult, JobError> {
+    let result = measure(req, cancel);
+    progress.finish();
+    result
+}
+
+fn measure(req: &VisibilityRequest<'_>, cancel: &Cancel) -> Result<VisibilityResult, JobError> {
     let origin = shown_path(&req.measured);
     let series = match read_measured_input(&req.measured)? {
         MeasuredInput::Series(s) => s,
@@ -95,5 +84,6 @@ pub fn run(req: VisibilityRequest<'_>, cancel: &Cancel) -> Result<VisibilityResu
         measured,
         channels: series.channels.iter().map(|(o, _)| *o).collect(),
         origin,
+        provenance: req.invocation.provenance(req.model.params(), Some(&modes)),
     })
 }

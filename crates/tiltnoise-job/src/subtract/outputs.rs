@@ -2,9 +2,11 @@
 //! record (the observable-series layout `budget --measured` reads) with the predicted tilt
 //! parts, estimates and residual spectra; `.json` the report; `.png`/`.svg` the figure.
 
+use crate::error::JobError;
+use crate::outcome::{Outcome, Provenance};
 use crate::subtract::SubtractOutcome;
 use std::path::Path;
-use tiltnoise_io::{write_subtract_hdf5, OutputError, Staging};
+use tiltnoise_io::{write_subtract_hdf5, OutputError, OutputKind, Staging};
 use tiltnoise_plot::View;
 
 /// The extensions a subtraction is saved to, for messages.
@@ -45,19 +47,44 @@ impl SaveKind {
     }
 }
 
+/// The kinds of file of [`OutputKind`] a subtraction is saved as: the cleaned record (HDF5)
+/// and the figure; besides them, `.json` holds the report ([`Outcome::json`]).
+pub const OUTPUT_KINDS: &[OutputKind] = &[OutputKind::Hdf5, OutputKind::Png, OutputKind::Svg];
+
 impl SubtractOutcome {
-    /// Writes the output `path` names by its extension ([`SaveKind`]) as one of the outputs of `stage`; a figure
-    /// with `view`'s limits, size and resolution.
+    /// Writes the output `path` names by its extension ([`SaveKind`]) as one of the outputs of
+    /// `stage`; a figure with `view`'s limits, size and resolution.
     ///
     /// # Errors
     ///
     /// [`OutputError::UnknownFormat`] for another extension, [`OutputError::Write`] naming
     /// `path` when it cannot be written (nothing is left there).
-    pub fn save(&self, stage: &Staging, path: &Path, view: &View) -> Result<(), OutputError> {
+    pub fn save_with(&self, stage: &Staging, path: &Path, view: &View) -> Result<(), OutputError> {
         match SaveKind::of(path)? {
             SaveKind::Hdf5 => write_subtract_hdf5(stage, path, &self.result, &self.meta),
             SaveKind::Json => self.report().write(stage, path),
             SaveKind::Image => self.save_figure(stage, path, view),
         }
+    }
+}
+
+impl Outcome for SubtractOutcome {
+    fn provenance(&self) -> &Provenance {
+        &self.meta.run
+    }
+
+    fn output_kinds(&self) -> &'static [OutputKind] {
+        OUTPUT_KINDS
+    }
+
+    /// Saves `.h5`/`.hdf5` (the cleaned record), `.json` (the report) or the figure (with the
+    /// request's figure options).
+    fn save(&self, stage: &Staging, path: &Path) -> Result<(), JobError> {
+        Ok(self.save_with(stage, path, &self.figure)?)
+    }
+
+    /// The report (the schema in `docs/subtract.md`).
+    fn json(&self) -> serde_json::Value {
+        serde_json::to_value(self.report()).expect("a report of numbers and strings serializes")
     }
 }

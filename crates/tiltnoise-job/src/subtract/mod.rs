@@ -7,6 +7,8 @@
 use crate::budget::ReadRequest;
 use crate::error::{shown_path, JobError};
 use crate::given::{witness_noise, AsdSpec, WitnessItem};
+use crate::outcome::Invocation;
+use crate::progress::Progress;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 use tiltnoise_core::cancel::Cancel;
@@ -24,9 +26,15 @@ use tiltnoise_core::subtract::{
 use tiltnoise_io::input::{
     parse_start_time, read_measured_input, read_tilt, utc_text, MeasuredInput, TiltInput,
 };
-use tiltnoise_io::{RunMeta, SubtractMeta};
+use tiltnoise_io::SubtractMeta;
+use tiltnoise_plot::View;
 
-pub use crate::subtract_error::{RunFailure, SubtractFailure};
+mod error;
+pub mod figure;
+pub mod outputs;
+pub mod report;
+
+pub use error::{RunFailure, SubtractFailure};
 
 /// The model inputs a witness can record, for messages.
 const FLOOR_INPUTS: &str = "theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)";
@@ -64,6 +72,10 @@ pub struct SubtractRequest<'a> {
     pub holdout: f64,
     /// Largest delay between the records to search (s) (default: 5 % of a segment).
     pub max_delay_s: Option<f64>,
+    /// Who asked for the run (the provenance of its files).
+    pub invocation: Invocation,
+    /// The figure's limits, size and resolution (`.png`/`.svg` outputs).
+    pub figure: View,
 }
 
 impl SubtractRequest<'_> {
@@ -91,8 +103,11 @@ pub struct SubtractOutcome {
     pub tilt_path: String,
     /// The notes of reading the witness record.
     pub input_notes: Vec<String>,
-    /// The metadata of the cleaned record.
+    /// The metadata of the cleaned record (its `run` is the provenance).
     pub meta: SubtractMeta,
+    /// The figure's limits, size and resolution (not kept in a saved state: the default).
+    #[serde(skip)]
+    pub figure: View,
 }
 
 /// A witness record as the subtraction takes it: one series per input, each the input's
@@ -336,8 +351,22 @@ fn select_observables(
 /// A [`JobError`] naming the option or file that failed; `Subtract` for records the
 /// subtraction refuses and for a result that is not finite; `Cancelled` when `cancel` was
 /// set (the subtraction polls it between its stages, in its spectra and across the
-/// prediction's bins).
-pub fn run(req: SubtractRequest<'_>, cancel: &Cancel) -> Result<SubtractOutcome, JobError> {
+/// prediction's bins). The stages are few and long: `progress` is only told that the run is
+/// over.
+pub fn run(
+    req: &SubtractRequest<'_>,
+    cancel: &Cancel,
+    progress: &dyn Progress,
+) -> Result<SubtractOutcome, JobError> {
+    let outcome = subtract_records(req, cancel);
+    progress.finish();
+    outcome
+}
+
+fn subtract_records(
+    req: &SubtractRequest<'_>,
+    cancel: &Cancel,
+) -> Result<SubtractOutcome, JobError> {
     let stage = || cancel.check().map_err(|_| JobError::Cancelled);
     check_options(&req)?;
     let cfg = SubtractConfig {
@@ -425,7 +454,9 @@ pub fn run(req: SubtractRequest<'_>, cancel: &Cancel) -> Result<SubtractOutcome,
         .and_then(|t| t.checked_add(skipped).ok())
         .map(utc_text);
     let meta = SubtractMeta {
-        run: RunMeta::of_this_run(params, Some(&NormalModes::new(req.model))),
+        run: req
+            .invocation
+            .provenance(params, Some(&NormalModes::new(req.model))),
         tilt: InputMeta::from(&series.provenance),
         measured_path: shown_path(&req.measured),
         start_time: overlap_start,
@@ -436,6 +467,7 @@ pub fn run(req: SubtractRequest<'_>, cancel: &Cancel) -> Result<SubtractOutcome,
         tilt_path: shown_path(&req.tilt),
         input_notes: series.provenance.notes,
         meta,
+        figure: req.figure.clone(),
     })
 }
 

@@ -3,8 +3,8 @@
 //! cleaned, Wiener residual, coherence limit, witness-noise limit), the bands left raw, the
 //! readout, and a caption with the fit.
 
+use super::report::band_top;
 use crate::subtract::SubtractOutcome;
-use crate::subtract_report::band_top;
 use std::path::Path;
 use tiltnoise_core::error::Num;
 use tiltnoise_core::subtract::{Estimate, Status, SubtractResult};
