@@ -6,15 +6,16 @@ use crate::budget::model_of;
 use crate::errors::PyResultExt;
 use crate::inputs::Inputs;
 use crate::job_args;
-use crate::params::PyParams;
 use numpy::{Complex64, PyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::coherence::CoherenceReport;
-use tiltnoise_io::{CoherenceInputs, OutputKind, RunMeta, Staging};
-use tiltnoise_job::coherence::{CoherenceRequest, CoherenceResult};
+use tiltnoise_job::coherence::{CoherenceOutcome, CoherenceRequest};
+use tiltnoise_job::figures::View;
+use tiltnoise_job::files::{OutputKind, Staging};
+use tiltnoise_job::{Invocation, Outcome};
 
 /// Coherence of measured observables with the tilt axes, and their measured transfer
 /// functions (multiple-input estimate with confidence intervals) against the model's: the
@@ -63,28 +64,17 @@ pub fn coherence(
         overlap,
         confidence,
         fit_band_hz: fit_band,
+        view: View::default(),
+        invocation: Invocation::of_this_process(),
     };
     let inputs = Inputs::of_params(params.file.as_deref())
         .with_all(job_args::python_names(req.input_files(), &[]));
     let cancel = Cancel::new();
-    let CoherenceResult {
-        report,
-        inputs: records,
-    } = crate::interrupt::watch(py, &cancel, || {
-        tiltnoise_job::coherence::run(req, &cancel).map_err(job_args::job_error)
+    let outcome = crate::interrupt::watch(py, &cancel, || {
+        tiltnoise_job::coherence::run(&req, &cancel, &tiltnoise_job::Silent)
+            .map_err(job_args::job_error)
     })?;
-    let modes = tiltnoise_core::modes::NormalModes::new(&model)
-        .modes
-        .iter()
-        .map(|m| (m.index, m.frequency_hz))
-        .collect();
-    Ok(Coherence {
-        report,
-        records,
-        params,
-        modes,
-        inputs,
-    })
+    Ok(Coherence { outcome, inputs })
 }
 
 /// A coherence analysis: on the Welch grid ``frequency_hz``, for each observable the multiple
@@ -95,20 +85,15 @@ pub fn coherence(
 #[pyclass(module = "tiltnoise", frozen)]
 #[derive(serde::Serialize, serde::Deserialize)]
 pub struct Coherence {
-    report: CoherenceReport,
-    records: CoherenceInputs,
-    params: PyParams,
-    modes: Vec<(usize, f64)>,
+    /// The job's outcome: the report, the records' provenance and the run's.
+    outcome: CoherenceOutcome,
     /// The files read: no `save` may replace one.
     inputs: Inputs,
 }
 
 impl Coherence {
-    fn run_meta(&self) -> RunMeta {
-        RunMeta {
-            modes: self.modes.clone(),
-            ..RunMeta::of_this_run(&self.params.inner, None)
-        }
+    fn report(&self) -> &CoherenceReport {
+        &self.outcome.report
     }
 
     /// `{observable: {axis: f(axis estimate)}}`.
@@ -118,7 +103,7 @@ impl Coherence {
         f: impl Fn(&tiltnoise_core::coherence::AxisEstimate) -> &[T],
     ) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for ob in &self.report.observables {
+        for ob in &self.report().observables {
             let a = PyDict::new(py);
             for axis in &ob.axes {
                 a.set_item(axis.axis.name(), PyArray1::from_slice(py, f(axis)))?;
@@ -135,7 +120,7 @@ impl Coherence {
         f: impl Fn(&tiltnoise_core::coherence::ObservableEstimate) -> &[f64],
     ) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for ob in &self.report.observables {
+        for ob in &self.report().observables {
             d.set_item(ob.observable.name(), PyArray1::from_slice(py, f(ob)))?;
         }
         Ok(d)
@@ -147,13 +132,13 @@ impl Coherence {
     /// Frequencies of the Welch bins (Hz), DC excluded.
     #[getter]
     fn frequency_hz<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_slice(py, &self.report.freqs_hz)
+        PyArray1::from_slice(py, &self.report().freqs_hz)
     }
 
     /// The tilt axes of the record.
     #[getter]
     fn axes(&self) -> Vec<&'static str> {
-        self.report.axes.iter().map(|a| a.name()).collect()
+        self.report().axes.iter().map(|a| a.name()).collect()
     }
 
     /// The observables analysed.
@@ -218,7 +203,7 @@ impl Coherence {
     #[getter]
     fn agreement<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for ob in &self.report.observables {
+        for ob in &self.report().observables {
             let a = PyDict::new(py);
             for axis in &ob.axes {
                 if let Some(g) = &axis.agreement {
@@ -241,36 +226,37 @@ impl Coherence {
     /// Confidence level of the intervals and thresholds.
     #[getter]
     fn confidence(&self) -> f64 {
-        self.report.confidence
+        self.report().confidence
     }
 
     /// Ordinary coherence that noise alone exceeds with probability ``1 - confidence``.
     #[getter]
     fn coherence_threshold(&self) -> f64 {
-        self.report.coherence_threshold
+        self.report().coherence_threshold
     }
 
     /// The same for the multiple coherence with every axis.
     #[getter]
     fn multiple_coherence_threshold(&self) -> f64 {
-        self.report.multiple_coherence_threshold
+        self.report().multiple_coherence_threshold
     }
 
     /// The tilt reader's notes, then the analysis's.
     #[getter]
     fn notes(&self) -> Vec<String> {
-        self.records
+        self.outcome
+            .inputs
             .tilt
             .notes
             .iter()
-            .chain(&self.report.notes)
+            .chain(&self.report().notes)
             .cloned()
             .collect()
     }
 
     /// The report as the command line's CSV (``docs/schemas.md``).
     fn to_csv(&self) -> String {
-        tiltnoise_io::coherence_csv_string(&self.report, &self.run_meta())
+        self.outcome.csv()
     }
 
     /// Writes the report as the command line's ``--save`` does: ``.h5``/``.hdf5`` (schema
@@ -283,18 +269,8 @@ impl Coherence {
     fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
         OutputKind::from_path(&path).py()?;
         self.inputs.check_save(&path)?;
-        let meta = self.run_meta();
-        let result = CoherenceResult {
-            report: self.report.clone(),
-            inputs: self.records.clone(),
-        };
-        py.detach(|| {
-            Staging::committed(|stage| {
-                let view = tiltnoise_plot::View::default();
-                tiltnoise_job::coherence::save(stage, &path, &result, &meta, &view)
-            })
-        })
-        .py()
+        py.detach(|| Staging::committed(|stage| self.outcome.save(stage, &path)))
+            .map_err(job_args::job_error)
     }
 
     /// ``{"coherence": {observable: {axis: FrequencySeries}}, "multiple_coherence":
@@ -347,9 +323,9 @@ impl Coherence {
     fn __repr__(&self) -> String {
         format!(
             "Coherence({} bins of {} vs {}; axes {}; observables {})",
-            self.report.freqs_hz.len(),
-            self.records.measured_path,
-            self.records.tilt.path,
+            self.report().freqs_hz.len(),
+            self.outcome.inputs.measured_path,
+            self.outcome.inputs.tilt.path,
             self.axes().join(", "),
             self.observables().join(", ")
         )

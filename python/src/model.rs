@@ -24,18 +24,16 @@ use tiltnoise_core::simulate::DEFAULT_MODE_ENERGY_J;
 use tiltnoise_core::tf::{
     self, eval_grid_threads_cancellable, Destination, Method, Scene, TransferFunction,
 };
-use tiltnoise_io::Staging;
-use tiltnoise_job::JobError;
+use tiltnoise_job::figures::{ImageFormat, View};
+use tiltnoise_job::files::{OutputKind, Staging};
+use tiltnoise_job::modes::{ModesOutcome, ModesRequest, DOMINANT_SHARE};
+use tiltnoise_job::{Invocation, JobError, Outcome, Silent};
 
 // The defaults of `transfer`, `explain` and `simulate` are written as literals in their
 // signatures, so that Python's `inspect.signature` (and the type stubs) show the numbers; they
 // are the library's defaults, as the command line's.
 const _: () = assert!(tf::DEFAULT_REL_TOL == 1e-9);
 const _: () = assert!(DEFAULT_MODE_ENERGY_J == 1e-12);
-
-/// Share of a mode's kinetic energy above which a coordinate is listed as dominant (the
-/// command line's `modes` table and JSON).
-const DOMINANT_SHARE: f64 = 0.05;
 
 /// Grids of at most this many points are evaluated without releasing the GIL: releasing and
 /// taking it back costs more than evaluating so few points, and even the slowest method
@@ -75,7 +73,7 @@ pub struct PyModel {
     pub model: Arc<Model>,
     /// The parameter file the model's parameters were read from, if any.
     pub params_file: Option<std::path::PathBuf>,
-    modes: OnceLock<NormalModes>,
+    modes: OnceLock<ModesOutcome>,
     plans: Mutex<PlanCache>,
     choices: Mutex<ChoiceCache>,
     last: Mutex<Option<LastPlan>>,
@@ -106,8 +104,17 @@ impl PyModel {
         })
     }
 
+    /// The normal modes, as the modes job finds them (once per model).
     pub fn normal_modes(&self) -> &NormalModes {
-        self.modes.get_or_init(|| NormalModes::new(&self.model))
+        let outcome = self.modes.get_or_init(|| {
+            let req = ModesRequest {
+                model: &self.model,
+                invocation: Invocation::of_this_process(),
+            };
+            tiltnoise_job::modes::run(&req, &Cancel::never(), &Silent)
+                .expect("a run that cannot be cancelled has no error")
+        });
+        &outcome.modes
     }
 
     /// The method `auto` takes for `request` on `band` (see [`grid::auto_band`]) and `rel_tol`,
@@ -302,6 +309,23 @@ fn check_rel_tol(rel_tol: f64) -> PyResult<()> {
     tiltnoise_job::tf::rel_tol(Some(rel_tol))
         .map(drop)
         .map_err(job_error)
+}
+
+/// The methods job's request of [`PyModel::methods`] and [`PyModel::save_methods`]: the chart
+/// in the default view; the grid is an array, so it has no spelling for the JSON's `grid`.
+fn methods_request<'a>(
+    model: &'a Model,
+    freq_hz: &Bound<'_, PyAny>,
+    inputs: Option<&Bound<'_, PyAny>>,
+) -> PyResult<tiltnoise_job::methods::MethodsRequest<'a>> {
+    Ok(tiltnoise_job::methods::MethodsRequest {
+        model,
+        grid_hz: grid::frequencies(freq_hz, grid::GRID)?,
+        inputs: Some(parse_inputs(inputs)?),
+        grid_spec: String::new(),
+        view: View::default(),
+        invocation: Invocation::of_this_process(),
+    })
 }
 
 /// An 8x8 (or other) nalgebra matrix as a row-major NumPy array.
@@ -540,7 +564,7 @@ impl PyModel {
         drawn: Vec<String>,
         #[pyo3(from_py_with = kw::phase)] phase: bool,
     ) -> PyResult<()> {
-        tiltnoise_io::OutputKind::from_path(&path).py()?;
+        OutputKind::from_path(&path).py()?;
         crate::inputs::Inputs::of_params(self.params_file.as_deref()).check_save(&path)?;
         let request = Request {
             inputs: parse_inputs(inputs)?,
@@ -569,18 +593,14 @@ impl PyModel {
             rel_tol: Some(rel_tol),
             block_freqs: None,
             figure: None,
+            figure_options: tiltnoise_job::tf::figure_options(model, drawn, phase),
+            invocation: Invocation::of_this_process(),
         };
-        let figure = tiltnoise_job::tf::figure_options(model, drawn, phase);
-        let meta =
-            tiltnoise_io::RunMeta::of_this_run(model.params(), Some(&NormalModes::new(model)));
-        let tf = py
-            .detach(|| tiltnoise_job::tf::run(req, &Cancel::never()))
-            .map_err(job_error)?
-            .tf;
-        py.detach(|| {
-            Staging::committed(|stage| tiltnoise_job::tf::save(stage, &path, &tf, &meta, &figure))
-        })
-        .py()
+        let outcome = py
+            .detach(|| tiltnoise_job::tf::run(&req, &Cancel::never(), &Silent))
+            .map_err(job_error)?;
+        py.detach(|| Staging::committed(|stage| outcome.save(stage, &path)))
+            .map_err(job_error)
     }
 
     /// Which method ``method="auto"`` picks for this request and grid, and why: every
@@ -698,13 +718,9 @@ impl PyModel {
         freq_hz: &Bound<'py, PyAny>,
         inputs: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let req = tiltnoise_job::methods::MethodsRequest {
-            model: &self.model,
-            grid_hz: grid::frequencies(freq_hz, grid::GRID)?,
-            inputs: Some(parse_inputs(inputs)?),
-        };
+        let req = methods_request(&self.model, freq_hz, inputs)?;
         let result = py
-            .detach(|| tiltnoise_job::methods::run(req, &Cancel::never()))
+            .detach(|| tiltnoise_job::methods::run(&req, &Cancel::never(), &Silent))
             .map_err(job_error)?;
         let methods = PyList::empty(py);
         for r in &result.rows {
@@ -740,18 +756,13 @@ impl PyModel {
         freq_hz: &Bound<'_, PyAny>,
         inputs: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        tiltnoise_plot::ImageFormat::from_path(&path).py()?;
+        ImageFormat::from_path(&path).py()?;
         crate::inputs::Inputs::of_params(self.params_file.as_deref()).check_save(&path)?;
-        let req = tiltnoise_job::methods::MethodsRequest {
-            model: &self.model,
-            grid_hz: grid::frequencies(freq_hz, grid::GRID)?,
-            inputs: Some(parse_inputs(inputs)?),
-        };
+        let req = methods_request(&self.model, freq_hz, inputs)?;
         py.detach(|| {
-            let result = tiltnoise_job::methods::run(req, &Cancel::never()).map_err(job_error)?;
-            let view = tiltnoise_plot::View::default();
-            Staging::committed(|stage| tiltnoise_job::methods::save(stage, &path, &result, &view))
-                .py()
+            let result =
+                tiltnoise_job::methods::run(&req, &Cancel::never(), &Silent).map_err(job_error)?;
+            Staging::committed(|stage| result.save(stage, &path)).map_err(job_error)
         })
     }
 

@@ -87,7 +87,7 @@ impl PyParams {
     fn from_toml(source: &Bound<'_, PyAny>) -> PyResult<Self> {
         match toml_source(source)? {
             Ok(path) => {
-                let inner = tiltnoise_io::read_params(&path).map_err(|e| match e {
+                let inner = tiltnoise_job::params::read(&path).map_err(|e| match e {
                     ParamError::Read { .. } => e.into_py_err(),
                     other => InputFileError::new_err(other.to_string()),
                 })?;

@@ -10,14 +10,14 @@ use anyhow::{anyhow, Result};
 use clap::Args;
 use std::fmt::Write as _;
 use std::path::PathBuf;
-use tiltnoise_core::coherence::{with_error, AxisEstimate, CoherenceReport, ObservableEstimate};
+use tiltnoise_core::coherence::{with_error, CoherenceReport, ObservableEstimate};
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::Model;
-use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
-use tiltnoise_io::{OutputKind, RunMeta};
 use tiltnoise_job::budget::ReadRequest;
-use tiltnoise_job::coherence::{CoherenceRequest, CoherenceResult};
+use tiltnoise_job::coherence::{peak_bin, significant_bins, CoherenceOutcome, CoherenceRequest};
+use tiltnoise_job::files::OutputKind;
+use tiltnoise_job::{Invocation, Outcome};
 
 /// Arguments of `tiltnoise coherence`.
 #[derive(Debug, Args)]
@@ -124,10 +124,14 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
         overlap: args.overlap,
         confidence: args.confidence,
         fit_band_hz: args.fit_band.as_deref().map(parse_fit_band).transpose()?,
+        view,
+        invocation: Invocation::of_this_process(),
     };
     run.check_job_outputs(&args.save, req.input_files())?;
-    let result = tiltnoise_job::coherence::run(req, &run.cancel).map_err(super::job_error)?;
-    let CoherenceResult { report, inputs } = &result;
+    let outcome: CoherenceOutcome =
+        tiltnoise_job::coherence::run(&req, &run.cancel, &tiltnoise_job::Silent)
+            .map_err(super::job_error)?;
+    let CoherenceOutcome { report, inputs, .. } = &outcome;
     match args.format {
         Format::Table => {
             for note in &inputs.tilt.notes {
@@ -136,14 +140,16 @@ pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run)
             write!(run.out, "{}", summary(report))?;
         }
         Format::Json => {
-            let json = summary_json(report, &inputs.tilt.notes);
-            writeln!(run.out, "{}", serde_json::to_string_pretty(&json)?)?;
+            writeln!(
+                run.out,
+                "{}",
+                serde_json::to_string_pretty(&outcome.json())?
+            )?;
         }
     }
-    let meta = RunMeta::of_this_run(params, Some(&NormalModes::new(&model)));
     run.write_outputs(args.format == Format::Json, |stage| {
         for out in &args.save {
-            tiltnoise_job::coherence::save(stage, out, &result, &meta, &view)?;
+            outcome.save(stage, out).map_err(super::job_error)?;
         }
         Ok(())
     })
@@ -194,82 +200,6 @@ fn summary(report: &CoherenceReport) -> String {
         let _ = writeln!(s, "note: {note}");
     }
     s
-}
-
-/// The bins where the multiple coherence of `ob` is above the noise threshold.
-fn significant_bins(report: &CoherenceReport, ob: &ObservableEstimate) -> Vec<usize> {
-    (0..report.freqs_hz.len())
-        .filter(|&k| ob.multiple_coherence[k] >= report.multiple_coherence_threshold)
-        .collect()
-}
-
-/// The bin of the largest finite coherence of `axis`, if any.
-fn peak_bin(axis: &AxisEstimate) -> Option<usize> {
-    (0..axis.coherence.len())
-        .filter(|&k| axis.coherence[k].is_finite())
-        .max_by(|&i, &j| axis.coherence[i].total_cmp(&axis.coherence[j]))
-}
-
-/// The summary as JSON (`--format json`): the numbers the table prints, unrounded; NaN is
-/// null.
-fn summary_json(report: &CoherenceReport, input_notes: &[String]) -> serde_json::Value {
-    use serde_json::json;
-    let f = &report.freqs_hz;
-    let w = &report.welch;
-    let observables: Vec<serde_json::Value> = report
-        .observables
-        .iter()
-        .map(|ob| {
-            let significant = significant_bins(report, ob);
-            let axes: Vec<serde_json::Value> = ob
-                .axes
-                .iter()
-                .map(|a| {
-                    let peak = peak_bin(a);
-                    let model_zero = a.model.iter().all(|z| z.norm() == 0.0);
-                    let agreement = a.agreement.as_ref().filter(|_| !model_zero).map(|g| {
-                        json!({
-                            "gain": g.gain(), "gain_sigma": g.sigma,
-                            "phase_deg": g.phase_deg(), "phase_sigma_deg": g.phase_sigma_deg(),
-                            "n_bins": g.n_bins, "band_hz": [g.band_hz.0, g.band_hz.1],
-                            "chi2_per_dof": g.chi2_per_dof,
-                        })
-                    });
-                    json!({
-                        "axis": a.axis.name(),
-                        "max_coherence": peak.map(|k| a.coherence[k]),
-                        "max_coherence_at_hz": peak.map(|k| f[k]),
-                        "model_identically_zero": model_zero,
-                        "measured_over_model": agreement,
-                        "transfer_unit": format!("{}/rad", ob.observable.unit()),
-                    })
-                })
-                .collect();
-            json!({
-                "observable": ob.observable.name(),
-                "unit": ob.observable.unit(),
-                "significant_bins": significant.len(),
-                "significant_band_hz": significant.first().zip(significant.last())
-                    .map(|(&a, &b)| [f[a], f[b]]),
-                "expected_from_noise": (1.0 - report.confidence) * f.len() as f64,
-                "axes": axes,
-            })
-        })
-        .collect();
-    json!({
-        "welch": {
-            "n_samples": w.n_samples, "sample_rate_hz": w.sample_rate_hz,
-            "segment_len": w.segment_len, "overlap": w.overlap,
-            "n_segments": w.n_segments, "n_equivalent": w.n_equivalent,
-        },
-        "bins": f.len(),
-        "confidence": report.confidence,
-        "coherence_threshold": report.coherence_threshold,
-        "multiple_coherence_threshold": report.multiple_coherence_threshold,
-        "observables": observables,
-        "input_notes": input_notes,
-        "notes": report.notes,
-    })
 }
 
 fn observable_summary(s: &mut String, report: &CoherenceReport, ob: &ObservableEstimate) {

@@ -8,7 +8,7 @@ use anyhow::{bail, Result};
 use clap::Args;
 use std::path::PathBuf;
 use tiltnoise_core::error::Shown;
-use tiltnoise_plot::View;
+use tiltnoise_job::figures::{ImageFormat, View, MAX_PIXELS};
 
 /// Smallest and largest figure side accepted by `--size` (pixels at 100 dpi).
 const SIZE_RANGE_PX: (u32, u32) = (200, 10_000);
@@ -68,10 +68,10 @@ impl SizeArgs {
             view.dpi = dpi;
         }
         let (w, h) = view.pixels(default);
-        if u64::from(w) * u64::from(h) > tiltnoise_plot::MAX_PIXELS {
+        if u64::from(w) * u64::from(h) > MAX_PIXELS {
             bail!(
                 "--size/--dpi: a {w} x {h} pixel image is too large (at most {} megapixels)",
-                tiltnoise_plot::MAX_PIXELS / 1_000_000
+                MAX_PIXELS / 1_000_000
             );
         }
         Ok(view)
@@ -99,9 +99,7 @@ impl SizeArgs {
 /// Refuses the figure options `given` (their flags) when none of `outputs` is a figure
 /// (`.png`, `.svg`): an option that would change nothing is an error, never ignored.
 pub fn refuse_without_figure(given: &[&str], outputs: &[PathBuf]) -> Result<()> {
-    let figure = outputs
-        .iter()
-        .any(|p| tiltnoise_plot::ImageFormat::from_path(p).is_ok());
+    let figure = outputs.iter().any(|p| ImageFormat::from_path(p).is_ok());
     match given.first() {
         Some(flag) if !figure => bail!(
             "{flag} applies to the figures, and no figure is saved: add --save FILE.png (or \

@@ -6,12 +6,13 @@ use super::figure_args::SizeArgs;
 use super::Run;
 use anyhow::Result;
 use clap::Args;
-use serde::Serialize;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::freq;
 use tiltnoise_core::model::Model;
 use tiltnoise_core::params::Params;
-use tiltnoise_job::methods::{MethodsRequest, MethodsResult};
+use tiltnoise_job::figures::{ImageFormat, METHODS_FIGURE_SIZE};
+use tiltnoise_job::methods::{MethodsOutcome, MethodsRequest};
+use tiltnoise_job::{Invocation, Outcome};
 
 /// Arguments of `tiltnoise methods`.
 #[derive(Debug, Args)]
@@ -39,27 +40,6 @@ pub struct MethodsArgs {
     figure: SizeArgs,
 }
 
-/// One method's row of the JSON output (keys in alphabetical order, as documented).
-#[derive(Serialize)]
-struct MethodJson {
-    exact_zeros: Option<bool>,
-    max_rel_err: Option<f64>,
-    name: &'static str,
-    ns_per_point: Option<f64>,
-    unusable: Option<String>,
-    worst_entry: Option<String>,
-    worst_freq_hz: Option<f64>,
-}
-
-/// The JSON output of `tiltnoise methods` (keys in alphabetical order).
-#[derive(Serialize)]
-struct MethodsJson<'a> {
-    auto: String,
-    grid: &'a str,
-    methods: Vec<MethodJson>,
-    target_rel_err: f64,
-}
-
 /// Runs `tiltnoise methods`: the grid and inputs parsed into the methods job's request, the
 /// job run, the table or JSON printed and the chart saved.
 pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> Result<()> {
@@ -72,10 +52,10 @@ pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> 
     } = args;
     let (spec, save) = (spec.as_str(), save.as_slice());
     for path in save {
-        tiltnoise_plot::ImageFormat::from_path(path)?;
+        ImageFormat::from_path(path)?;
     }
     figure.refuse_without_figure(save)?;
-    let view = figure.view_for(tiltnoise_plot::methods_figure::DEFAULT_SIZE)?;
+    let view = figure.view_for(METHODS_FIGURE_SIZE)?;
     let saves: Vec<&Path> = save.iter().map(PathBuf::as_path).collect();
     run.check_outputs(&saves, &[])?;
     let model = Model::new(params)?;
@@ -83,47 +63,28 @@ pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> 
         model: &model,
         grid_hz: freq::parse_spec(spec)?,
         inputs: Some(super::tf::parse_inputs(&inputs)?),
+        grid_spec: spec.to_string(),
+        view,
+        invocation: Invocation::of_this_process(),
     };
-    let result = tiltnoise_job::methods::run(req, &run.cancel).map_err(super::job_error)?;
+    let result = tiltnoise_job::methods::run(&req, &run.cancel, &tiltnoise_job::Silent)
+        .map_err(super::job_error)?;
     let out = &mut run.out;
     match format {
-        Format::Json => writeln!(out, "{}", json(&result, spec)?)?,
+        Format::Json => writeln!(out, "{}", serde_json::to_string_pretty(&result.json())?)?,
         Format::Table => write!(out, "{}", table(&result, spec))?,
     }
     // JSON on standard output stays parseable: the `wrote` lines go to standard error.
     run.write_outputs(format == Format::Json, |stage| {
         for path in save {
-            tiltnoise_job::methods::save(stage, path, &result, &view)?;
+            result.save(stage, path).map_err(super::job_error)?;
         }
         Ok(())
     })
 }
 
-/// The JSON report (`--format json`) of the grid `spec`.
-fn json(result: &MethodsResult, spec: &str) -> Result<String> {
-    let methods = result
-        .rows
-        .iter()
-        .map(|r| MethodJson {
-            name: r.method.name(),
-            max_rel_err: r.worst.as_ref().map(|w| w.0),
-            worst_entry: r.worst.as_ref().map(|w| w.1.clone()),
-            worst_freq_hz: r.worst.as_ref().map(|w| w.2),
-            ns_per_point: r.ns_per_point,
-            exact_zeros: r.exact_zeros,
-            unusable: r.unusable.clone(),
-        })
-        .collect();
-    Ok(serde_json::to_string_pretty(&MethodsJson {
-        auto: result.auto_text(),
-        target_rel_err: result.target_rel_err,
-        grid: spec,
-        methods,
-    })?)
-}
-
 /// The table of the grid `spec`.
-fn table(result: &MethodsResult, spec: &str) -> String {
+fn table(result: &MethodsOutcome, spec: &str) -> String {
     let mut s = format!(
         "{} on {spec} Hz ({} points; accuracy checked > 1 % from every mode)\n",
         result.matrix_label(),

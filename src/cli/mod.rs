@@ -32,11 +32,13 @@ use clap::{Args, Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::model::Model;
-use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::repeats::refuse_repeated_keys;
-use tiltnoise_io::Staging;
+use tiltnoise_job::files::Staging;
+use tiltnoise_job::modes::ModesRequest;
+use tiltnoise_job::params::ParamsRequest;
+use tiltnoise_job::{Invocation, Outcome};
 
 /// Tilt-noise budgets for double torsion pendulums (the 8-DoF PETER model of
 /// De Marchi et al., Phys. Rev. D 87, 122006, 2013).
@@ -127,7 +129,7 @@ enum Command {
 impl ParamArgs {
     fn resolve(&self) -> Result<Params> {
         let mut params = match &self.params {
-            Some(path) => tiltnoise_io::read_params(path)?,
+            Some(path) => tiltnoise_job::params::read(path)?,
             None => Params::table_i(),
         };
         refuse_repeated_keys(OptionKey::SET, "parameter key", &self.set)?;
@@ -150,14 +152,14 @@ pub(crate) struct Run {
 
 impl Run {
     /// Checks every output path of the command before anything is computed (the rules of
-    /// [`tiltnoise_io::check_outputs`]); `inputs` are the files the command reads besides the
+    /// [`tiltnoise_job::files::check_outputs`]); `inputs` are the files the command reads besides the
     /// parameter file, with the options that name them.
     pub(crate) fn check_outputs(&self, outputs: &[&Path], inputs: &[(&str, &Path)]) -> Result<()> {
         let mut all = inputs.to_vec();
         if let Some(p) = &self.params_file {
             all.push(("--params", p));
         }
-        Ok(tiltnoise_io::check_outputs(outputs, &all)?)
+        Ok(tiltnoise_job::files::check_outputs(outputs, &all)?)
     }
 
     /// [`Run::check_outputs`] for a job: `files` are the job's inputs, named by their options
@@ -189,6 +191,12 @@ impl Run {
     ) -> Result<()> {
         let stage = Staging::new();
         write(&stage)?;
+        self.commit_outputs(stage, report_on_stderr)
+    }
+
+    /// The end of [`Run::write_outputs`] for outputs a job wrote into `stage` itself (a
+    /// streamed run): standard output flushed, then every output committed and reported.
+    pub(crate) fn commit_outputs(&mut self, stage: Staging, report_on_stderr: bool) -> Result<()> {
         self.out.flush()?;
         for path in stage.commit()? {
             match report_on_stderr {
@@ -223,15 +231,32 @@ fn run_command(cli: Cli, run: &mut Run) -> Result<()> {
     let params = cli.params.resolve()?;
     match cli.command {
         Command::Params => {
-            write!(run.out, "{}", params.to_toml())?;
+            let req = ParamsRequest {
+                params,
+                invocation: Invocation::of_this_process(),
+            };
+            let outcome = tiltnoise_job::params::run(&req, &run.cancel, &tiltnoise_job::Silent)
+                .map_err(job_error)?;
+            write!(run.out, "{}", outcome.toml())?;
             Ok(())
         }
         Command::Modes { format } => {
             let model = Model::new(&params)?;
-            let modes = NormalModes::new(&model);
+            let req = ModesRequest {
+                model: &model,
+                invocation: Invocation::of_this_process(),
+            };
+            let outcome = tiltnoise_job::modes::run(&req, &run.cancel, &tiltnoise_job::Silent)
+                .map_err(job_error)?;
             match format {
-                Format::Table => write!(run.out, "{}", report::modes_report(&model, &modes))?,
-                Format::Json => writeln!(run.out, "{}", report::modes_json(&model, &modes))?,
+                Format::Table => {
+                    write!(run.out, "{}", report::modes_report(&model, &outcome.modes))?
+                }
+                Format::Json => writeln!(
+                    run.out,
+                    "{}",
+                    serde_json::to_string_pretty(&outcome.json())?
+                )?,
             }
             Ok(())
         }

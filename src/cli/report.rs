@@ -1,15 +1,12 @@
 //! Text and JSON renderings of results for the terminal (tables, summaries). Sits above the
 //! numerics: it reads `modes` and `tf`, and nothing numeric depends on it.
 
-use serde::Serialize;
-use std::collections::BTreeMap;
 use std::fmt::Write;
 use tiltnoise_core::model::{Coord, Model, Observable, TiltAxis, TranslationAxis};
 use tiltnoise_core::modes::{NormalModes, RATIO_THRESHOLD};
 use tiltnoise_core::tf::{self, Input, Method, Request};
 
-/// Share of modal kinetic energy above which a coordinate is listed as dominant.
-const DOMINANT_SHARE: f64 = 0.05;
+use tiltnoise_job::modes::DOMINANT_SHARE;
 
 /// A frequency with an SI prefix chosen for reading: `1.310 mHz`, `0.4149 Hz`.
 pub fn format_hz(f: f64) -> String {
@@ -126,101 +123,6 @@ pub fn format_q(q: f64) -> String {
     }
 }
 
-/// `{"modes": [{"index": 1, "frequency_hz": ..., ...}, ...], "ratio_threshold": ...,
-/// "rest_configuration": {...}}`.
-pub fn modes_json(model: &Model, modes: &NormalModes) -> String {
-    let list = modes
-        .modes
-        .iter()
-        .enumerate()
-        .map(|(k, m)| ModeJson {
-            block: m.block_name(),
-            dominant_coordinates: m
-                .dominant_coords(DOMINANT_SHARE)
-                .into_iter()
-                .map(|(c, energy_share)| CoordinateShare {
-                    coordinate: c.name(),
-                    energy_share,
-                })
-                .collect(),
-            frequency_hz: m.frequency_hz,
-            index: m.index,
-            loss_angle_rad: m.loss_angle,
-            observable_amplitude: Observable::ALL
-                .iter()
-                .map(|o| (o.name(), m.observable_amplitude[o.index()]))
-                .collect(),
-            omega_sq_rad2_per_s2: m.omega_sq,
-            overlap: m.overlap,
-            quality_factor: m.quality_factor.is_finite().then_some(m.quality_factor),
-            ratio: Observable::ALL
-                .iter()
-                .map(|o| (o.name(), modes.ratio[k][o.index()]))
-                .collect(),
-            seen_above_ratio: modes
-                .observables_above_ratio(k)
-                .iter()
-                .map(|o| o.name())
-                .collect(),
-            seen_by: modes
-                .observables_seeing(k)
-                .iter()
-                .map(|o| o.name())
-                .collect(),
-            undamped: !m.quality_factor.is_finite(),
-        })
-        .collect();
-    let rest = model.rest_configuration();
-    serde_json::to_string_pretty(&ModesJson {
-        modes: list,
-        ratio_threshold: RATIO_THRESHOLD,
-        rest_configuration: Coord::ALL
-            .iter()
-            .map(|c| (c.name(), rest[c.index()]))
-            .collect(),
-    })
-    .expect("JSON of plain data")
-}
-
-// The JSON reports list the keys of every object in alphabetical order (as they always have):
-// the fields of these structs are declared in that order, maps are BTreeMaps.
-
-#[derive(Serialize)]
-struct ModesJson {
-    modes: Vec<ModeJson>,
-    /// [`RATIO_THRESHOLD`]: `seen_above_ratio` lists the observables whose ratio reaches it.
-    ratio_threshold: f64,
-    /// The rest configuration `q0` (rad, m): all 0 for the symmetric pendulum.
-    rest_configuration: BTreeMap<&'static str, f64>,
-}
-
-#[derive(Serialize)]
-struct ModeJson {
-    block: &'static str,
-    dominant_coordinates: Vec<CoordinateShare>,
-    frequency_hz: f64,
-    index: usize,
-    loss_angle_rad: f64,
-    observable_amplitude: BTreeMap<&'static str, f64>,
-    omega_sq_rad2_per_s2: f64,
-    /// Overlap with the symmetric pendulum's mode of the same label (1 when symmetric).
-    overlap: f64,
-    /// `null` when undamped (JSON has no infinity; numbers are never strings).
-    quality_factor: Option<f64>,
-    /// Amplitude over the largest of the observable's unit group, in this mode.
-    ratio: BTreeMap<&'static str, f64>,
-    seen_above_ratio: Vec<&'static str>,
-    seen_by: Vec<&'static str>,
-    /// No loss reaches the mode: Q is infinite, `quality_factor` is null.
-    undamped: bool,
-}
-
-#[derive(Serialize)]
-struct CoordinateShare {
-    coordinate: &'static str,
-    energy_share: f64,
-}
-
 /// The quasi-static (f = 0) tilt response next to the paper's stated limits.
 pub fn static_limits(model: &Model) -> String {
     let plan =
@@ -302,19 +204,4 @@ pub(crate) fn assert_keys_sorted(text: &str) -> serde_json::Value {
     let value: serde_json::Value = serde_json::from_str(text).unwrap();
     assert_eq!(text, serde_json::to_string_pretty(&value).unwrap());
     value
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use tiltnoise_core::params::Params;
-
-    #[test]
-    fn modes_json_lists_keys_alphabetically() {
-        let model = Model::new(&Params::table_i()).unwrap();
-        let modes = NormalModes::new(&model);
-        let value = assert_keys_sorted(&modes_json(&model, &modes));
-        assert!(value["modes"][0]["quality_factor"].is_null());
-        assert_eq!(value["modes"][0]["undamped"], true);
-    }
 }

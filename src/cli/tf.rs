@@ -12,23 +12,24 @@
 
 use super::args::{scientific, Format, MethodArg, PerArg};
 use super::figure_args::FigureArgs;
+use super::progress::Bar;
 use super::Run;
 use anyhow::{bail, Result};
 use clap::Args;
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use tiltnoise_core::freq;
 use tiltnoise_core::limits::MAX_STREAMED_GRID_POINTS;
 use tiltnoise_core::model::{Model, Observable};
-use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::options;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::tf::planner::DEFAULT_REL_TOL;
-use tiltnoise_core::tf::{Input, Request, TransferMatrix};
-use tiltnoise_io::{OutputKind, RunMeta, TfCsvWriter, TfHdf5Writer};
-use tiltnoise_job::tf::{FreqGrid, Planned, TfRequest};
-use tiltnoise_job::JobError;
+use tiltnoise_core::tf::{Input, Request};
+use tiltnoise_job::figures::{tf_figure_size, TfFigureOptions};
+use tiltnoise_job::files::{OutputKind, Staging};
+use tiltnoise_job::modes::ModesRequest;
+use tiltnoise_job::tf::{FreqGrid, TfRequest, TfText};
+use tiltnoise_job::{Invocation, JobError, Outcome};
 
 /// Arguments of `tiltnoise tf`.
 #[derive(Debug, Args)]
@@ -119,11 +120,7 @@ pub fn parse_observables(specs: &[String]) -> Result<Vec<Observable>> {
 /// The figure's options: panels from `--plot-observables` (each one of the computed
 /// observables), else every one of `--observables`, else the paper's Figure 5 (X, phi, phi_a);
 /// phase, limits, size, resolution.
-fn figure_options(
-    args: &TfArgs,
-    request: &Request,
-    model: &Model,
-) -> Result<tiltnoise_plot::TfFigureOptions> {
+fn figure_options(args: &TfArgs, request: &Request, model: &Model) -> Result<TfFigureOptions> {
     let mut given = args.figure.given();
     if !args.plot_observables.is_empty() {
         given.insert(0, "--plot-observables");
@@ -150,15 +147,20 @@ fn figure_options(
         tiltnoise_job::tf::FIGURE5_OBSERVABLES.to_vec()
     };
     let options = tiltnoise_job::tf::figure_options(model, observables, args.phase);
-    let size = tiltnoise_plot::tf_figure::default_size(&options, &request.inputs);
-    Ok(tiltnoise_plot::TfFigureOptions {
+    let size = tf_figure_size(&options, &request.inputs);
+    Ok(TfFigureOptions {
         view: args.figure.view_for(size)?,
         ..options
     })
 }
 
 /// The request of the transfer-function job from the options.
-fn request<'a>(args: &TfArgs, model: &'a Model, request: Request) -> Result<TfRequest<'a>> {
+fn request<'a>(
+    args: &TfArgs,
+    model: &'a Model,
+    request: Request,
+    figure_options: TfFigureOptions,
+) -> Result<TfRequest<'a>> {
     let grid = match (&args.freq, &args.freq_file) {
         (Some(spec), _) => FreqGrid::Log(freq::parse_log_spec(spec, MAX_STREAMED_GRID_POINTS)?),
         (None, Some(path)) => FreqGrid::File(path.clone()),
@@ -179,6 +181,8 @@ fn request<'a>(args: &TfArgs, model: &'a Model, request: Request) -> Result<TfRe
         rel_tol: Some(args.rel_tol),
         block_freqs: args.block_freqs,
         figure: figure.cloned(),
+        figure_options,
+        invocation: Invocation::of_this_process(),
     })
 }
 
@@ -197,10 +201,10 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
     }
     let model = Model::new(params)?;
     let figure = figure_options(&args, &request_names, &model)?;
-    let req = request(&args, &model, request_names)?;
+    let req = request(&args, &model, request_names, figure)?;
     run.check_job_outputs(&args.save, req.input_files())?;
     let has_figure = req.figure.is_some();
-    let planned = match tiltnoise_job::tf::prepare(req) {
+    let planned = match tiltnoise_job::tf::prepare(&req) {
         Ok(planned) => planned,
         Err(JobError::NoMethod(refusal)) if args.explain => {
             super::note(&refusal.explain());
@@ -211,39 +215,67 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
     if let (Some(choice), true) = (&planned.choice, args.explain) {
         super::note(&choice.explain());
     }
-    let modes = NormalModes::new(&model);
-    let meta = RunMeta::of_this_run(params, Some(&modes));
     let json = args.format == Format::Json;
-    if !has_figure {
-        return stream_tf(&planned, &args, &model, &meta, run);
+    let bar = Bar::new("frequencies", TF_WORTH_A_BAR);
+    if has_figure {
+        let outcome = planned
+            .outcome(&run.cancel, &bar)
+            .map_err(super::job_error)?;
+        write_report(&mut run.out, &model, planned.request(), json)?;
+        return run.write_outputs(json, |stage| {
+            for path in &args.save {
+                outcome.save(stage, path).map_err(super::job_error)?;
+            }
+            Ok(())
+        });
     }
-    let tf = planned.whole(&run.cancel).map_err(super::job_error)?;
-    write_report(&mut run.out, &model, &modes, planned.request(), json)?;
-    run.write_outputs(json, |stage| {
-        for path in &args.save {
-            tiltnoise_job::tf::save(stage, path, &tf, &meta, &figure)?;
-        }
-        Ok(())
-    })
+    // Streamed: every block into every file (or onto standard output) as it is computed.
+    let to_stdout = args.save.is_empty();
+    let text = to_stdout.then_some(match json {
+        true => TfText::Json,
+        false => TfText::Csv,
+    });
+    let stage = Staging::new();
+    let cancel = run.cancel.clone();
+    let out = &mut run.out;
+    planned
+        .stream(&args.save, &stage, text, &cancel, &bar, |chunk| {
+            write!(out, "{chunk}").map_err(|e| Streamed(e.into()))
+        })
+        .map_err(|e| e.0)?;
+    if to_stdout {
+        return Ok(());
+    }
+    write_report(&mut run.out, &model, planned.request(), json)?;
+    run.commit_outputs(stage, json)
 }
 
 /// Grids with at least this many points get a progress bar on a terminal (about 2 s).
-const TF_WORTH_A_BAR: usize = 1 << 19;
+const TF_WORTH_A_BAR: u64 = 1 << 19;
 
 /// The modes table and, for tilt inputs, the static limits, for translations their limits per
-/// unit acceleration (printed when files are saved); with `json`, the modes as JSON.
+/// unit acceleration (printed when files are saved); with `json`, the modes as JSON (the
+/// modes job's).
 fn write_report(
     out: &mut super::stdout::Out,
     model: &Model,
-    modes: &NormalModes,
     request: &Request,
     json: bool,
 ) -> Result<()> {
+    let modes = tiltnoise_job::modes::run(
+        &ModesRequest {
+            model,
+            invocation: Invocation::of_this_process(),
+        },
+        &tiltnoise_core::cancel::Cancel::never(),
+        &tiltnoise_job::Silent,
+    )
+    .map_err(super::job_error)?;
     if json {
-        writeln!(out, "{}", super::report::modes_json(model, modes))?;
+        writeln!(out, "{}", serde_json::to_string_pretty(&modes.json())?)?;
         return Ok(());
     }
-    write!(out, "{}", super::report::modes_table(modes))?;
+    write!(out, "{}", super::report::modes_table(&modes.modes))?;
     if request.inputs.iter().any(|i| matches!(i, Input::Tilt(_))) {
         writeln!(out)?;
         write!(out, "{}", super::report::static_limits(model))?;
@@ -257,147 +289,6 @@ fn write_report(
         write!(out, "{}", super::report::translation_limits(model))?;
     }
     Ok(())
-}
-
-/// Evaluates the grid block by block and writes each block to every HDF5 and CSV output (or
-/// to standard output, as CSV or JSON, without --save) before the next is computed.
-fn stream_tf(
-    planned: &Planned,
-    args: &TfArgs,
-    model: &Model,
-    meta: &RunMeta,
-    run: &mut Run,
-) -> Result<()> {
-    let mut hdf5 = Vec::new();
-    let mut csv = Vec::new();
-    for path in &args.save {
-        match OutputKind::from_path(path)? {
-            OutputKind::Hdf5 => hdf5.push(TfHdf5Writer::create(path, meta)?),
-            OutputKind::Csv => csv.push(TfCsvWriter::create(path, meta)?),
-            OutputKind::Png | OutputKind::Svg => unreachable!("figures are drawn from memory"),
-        }
-    }
-    let n = planned.len();
-    let bar = (n >= TF_WORTH_A_BAR && std::io::stderr().is_terminal()).then(|| {
-        let b = indicatif::ProgressBar::new(n as u64);
-        b.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{spinner} {wide_bar} {pos}/{len} frequencies ({percent}%, eta {eta})",
-            )
-            .expect("valid template"),
-        );
-        b
-    });
-    let json = args.format == Format::Json;
-    let to_stdout = args.save.is_empty();
-    let mut text = String::new();
-    let cancel = run.cancel.clone();
-    planned
-        .blocks(
-            &cancel,
-            |block, done| -> std::result::Result<(), Streamed> {
-                let mut write = || -> Result<()> {
-                    for w in &mut hdf5 {
-                        w.append(block)?;
-                    }
-                    for w in &mut csv {
-                        w.append(block)?;
-                    }
-                    if to_stdout {
-                        text.clear();
-                        let first = done == block.freqs_hz.len();
-                        match (json, first) {
-                            (true, true) => text.push_str(&json_head(block, planned)),
-                            (false, true) => {
-                                text.push_str(&tiltnoise_io::tf_csv_header(block, meta))
-                            }
-                            _ => {}
-                        }
-                        match json {
-                            true => push_json_points(&mut text, block, first),
-                            false => tiltnoise_io::push_tf_csv_rows(&mut text, block),
-                        }
-                        if json && done == n {
-                            text.push_str(&json_tail(block));
-                        }
-                        write!(run.out, "{text}")?;
-                    }
-                    if let Some(b) = &bar {
-                        b.set_position(done as u64);
-                    }
-                    Ok(())
-                };
-                write().map_err(Streamed)
-            },
-        )
-        .map_err(|e| e.0)?;
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
-    if to_stdout {
-        return Ok(());
-    }
-    let modes = NormalModes::new(model);
-    write_report(&mut run.out, model, &modes, planned.request(), json)?;
-    run.write_outputs(json, |stage| {
-        for w in hdf5 {
-            w.finish(stage)?;
-        }
-        for w in csv {
-            w.finish(stage)?;
-        }
-        Ok(())
-    })
-}
-
-/// A JSON value written by serde (a number that is not finite is `null`).
-fn json_value(v: impl serde::Serialize) -> String {
-    serde_json::to_string(&v).expect("JSON of plain data")
-}
-
-/// The keys of the JSON document before its points (keys in alphabetical order, as every JSON
-/// report): `inputs`, `method`, `observables`, `per`, then `points` opened.
-fn json_head(block: &TransferMatrix, planned: &Planned) -> String {
-    let names = |v: Vec<&str>| json_value(v);
-    format!(
-        "{{\n  \"inputs\": {},\n  \"method\": {},\n  \"observables\": {},\n  \"per\": {},\n  \
-         \"points\": [",
-        names(block.inputs.iter().map(|i| i.name()).collect()),
-        json_value(planned.method().name()),
-        names(block.outputs.iter().map(|o| o.name()).collect()),
-        json_value(block.ground_quantity().name()),
-    )
-}
-
-/// One line per frequency: `{"H": [[[re, im] per input] per observable], "frequency_hz": f}`.
-fn push_json_points(s: &mut String, block: &TransferMatrix, first: bool) {
-    let (no, ni) = (block.outputs.len(), block.inputs.len());
-    for (k, &f) in block.freqs_hz.iter().enumerate() {
-        let h: Vec<Vec<[f64; 2]>> = (0..no)
-            .map(|o| {
-                (0..ni)
-                    .map(|i| {
-                        let z = block.get(k, o, i);
-                        [z.re, z.im]
-                    })
-                    .collect()
-            })
-            .collect();
-        let comma = if first && k == 0 { "" } else { "," };
-        s.push_str(&format!(
-            "{comma}\n    {{\"H\": {}, \"frequency_hz\": {}}}",
-            json_value(h),
-            json_value(f)
-        ));
-    }
-}
-
-/// The end of the JSON document: the points closed, then `units` (per observable, per input).
-fn json_tail(block: &TransferMatrix) -> String {
-    let units: Vec<Vec<String>> = (0..block.outputs.len())
-        .map(|o| (0..block.inputs.len()).map(|i| block.unit(o, i)).collect())
-        .collect();
-    format!("\n  ],\n  \"units\": {}\n}}\n", json_value(units))
 }
 
 /// An error of the streamed evaluation: the job's errors with their one-line message (as

@@ -55,7 +55,7 @@ fn write_h5(
 /// The two input files in `dir`: `tilt.h5` (theta_t, eta_t) and `pendulum.h5` (X, phi_a)
 /// with `GAIN` times the model's response, both starting at `start`; the pendulum's sample
 /// rate and first `skip` samples adjustable for the error cases.
-fn inputs(dir: &Path, fs_measured: f64, measured_start: &str) -> (PathBuf, PathBuf) {
+pub(crate) fn inputs(dir: &Path, fs_measured: f64, measured_start: &str) -> (PathBuf, PathBuf) {
     let model = Model::new(&Params::table_i()).unwrap();
     let outputs = [Observable::X, Observable::PhiA];
     let (tilt, measured) = through_model(&model, N, &outputs, &[9e-10, 1e-10], GAIN, 0.0, 5);

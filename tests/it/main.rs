@@ -32,6 +32,7 @@ mod fuzz;
 mod input_readers;
 mod input_units;
 mod io_roundtrip;
+mod job_outcomes;
 mod limits;
 mod mc_outputs;
 mod miniseed_input;

@@ -13,7 +13,7 @@ use tiltnoise_core::tf::{self, Method, TransferMatrix};
 use tiltnoise_job::methods::MethodsRequest;
 use tiltnoise_job::monte_carlo::{self, McRequest};
 use tiltnoise_job::tf::{FreqGrid, TfRequest};
-use tiltnoise_job::{Cancel, JobError};
+use tiltnoise_job::{Cancel, JobError, Silent};
 
 fn model() -> Model {
     Model::new(&Params::table_i()).unwrap()
@@ -36,6 +36,8 @@ fn request(model: &Model, grid: FreqGrid) -> TfRequest<'_> {
         rel_tol: None,
         block_freqs: None,
         figure: None,
+        figure_options: Default::default(),
+        invocation: Default::default(),
     }
 }
 
@@ -59,9 +61,12 @@ fn assert_same_bits(a: &TransferMatrix, b: &TransferMatrix) {
 #[test]
 fn the_tf_job_gives_the_librarys_transfer_functions_bit_for_bit() {
     let model = model();
-    let result =
-        tiltnoise_job::tf::run(request(&model, FreqGrid::Points(freqs())), &Cancel::never())
-            .unwrap();
+    let result = tiltnoise_job::tf::run(
+        &request(&model, FreqGrid::Points(freqs())),
+        &Cancel::never(),
+        &Silent,
+    )
+    .unwrap();
     let choice = result.choice.expect("auto reports its pick");
     let plan = tf::plan(&model, &ground_request(), choice.method).unwrap();
     let direct = tf::evaluate(plan.as_ref(), &freqs()).unwrap();
@@ -71,7 +76,7 @@ fn the_tf_job_gives_the_librarys_transfer_functions_bit_for_bit() {
     let mut req = request(&model, FreqGrid::Points(freqs()));
     req.per = GroundQuantity::Acceleration;
     req.method = Some(choice.method);
-    let per = tiltnoise_job::tf::run(req, &Cancel::never()).unwrap();
+    let per = tiltnoise_job::tf::run(&req, &Cancel::never(), &Silent).unwrap();
     assert!(per.choice.is_none(), "a method asked for is not chosen");
     let expected = direct
         .per_ground_quantity(
@@ -88,7 +93,7 @@ fn a_grid_streamed_in_blocks_gives_the_matrix_computed_whole() {
     let grid = LogGrid::new(1e-4, 30.0, 101, MAX_GRID_POINTS).unwrap();
     let mut req = request(&model, FreqGrid::Log(grid));
     req.block_freqs = Some(7);
-    let planned = tiltnoise_job::tf::prepare(req).unwrap();
+    let planned = tiltnoise_job::tf::prepare(&req).unwrap();
     let whole = planned.whole(&Cancel::never()).unwrap();
     let mut freqs = Vec::new();
     let mut values = Vec::new();
@@ -119,7 +124,7 @@ fn options_that_do_not_fit_fail_naming_their_key() {
 
     let mut req = request(&model, FreqGrid::Points(freqs()));
     req.rel_tol = Some(0.0);
-    let e = tiltnoise_job::tf::prepare(req).err().unwrap();
+    let e = tiltnoise_job::tf::prepare(&req).err().unwrap();
     assert_eq!(key_of(&e), "rel_tol");
     assert_eq!(
         e.message(),
@@ -129,14 +134,14 @@ fn options_that_do_not_fit_fail_naming_their_key() {
     let mut req = request(&model, FreqGrid::Points(freqs()));
     req.block_freqs = Some(0);
     assert_eq!(
-        key_of(&tiltnoise_job::tf::prepare(req).err().unwrap()),
+        key_of(&tiltnoise_job::tf::prepare(&req).err().unwrap()),
         "block_freqs"
     );
 
     // 0 Hz has no value per unit floor velocity: refused before anything is computed.
     let mut req = request(&model, FreqGrid::Points(vec![1e-3, 0.0]));
     req.per = GroundQuantity::Velocity;
-    let e = tiltnoise_job::tf::prepare(req).err().unwrap();
+    let e = tiltnoise_job::tf::prepare(&req).err().unwrap();
     assert_eq!(key_of(&e), "per");
     assert!(
         e.message()
@@ -147,13 +152,13 @@ fn options_that_do_not_fit_fail_naming_their_key() {
     let mut req = request(&model, FreqGrid::Points(vec![0.0, 1e-3]));
     req.per = GroundQuantity::Velocity;
     req.request.inputs = vec![Input::Force(tiltnoise_core::model::ForceInput::ALL[0])];
-    assert!(tiltnoise_job::tf::prepare(req).is_ok());
+    assert!(tiltnoise_job::tf::prepare(&req).is_ok());
 
     // A figure is drawn from a grid held whole.
     let big = LogGrid::new(1e-4, 30.0, MAX_GRID_POINTS + 1, usize::MAX).unwrap();
     let mut req = request(&model, FreqGrid::Log(big));
     req.figure = Some("tf.png".into());
-    let e = tiltnoise_job::tf::prepare(req).err().unwrap();
+    let e = tiltnoise_job::tf::prepare(&req).err().unwrap();
     assert_eq!(key_of(&e), "save");
     assert!(e.message().contains("and freq_hz asks for"), "{e}");
 }
@@ -164,7 +169,7 @@ fn auto_next_to_a_mode_says_what_to_do_in_the_front_ends_spelling() {
     let nu_3 = NormalModes::new(&model).frequencies_hz()[2];
     let mut req = request(&model, FreqGrid::Points(vec![nu_3 * 1.001]));
     req.request.inputs = vec![Input::all_tilts()[1]];
-    let e = tiltnoise_job::tf::prepare(req).err().unwrap();
+    let e = tiltnoise_job::tf::prepare(&req).err().unwrap();
     assert!(matches!(e, JobError::NoMethod(_)), "{e}");
     // Without a front end's style a key is shown as itself, `key=value` given.
     assert!(
@@ -182,8 +187,11 @@ fn the_methods_job_measures_every_method_and_names_autos_pick() {
         model: &model,
         grid_hz: grid.clone(),
         inputs: None,
+        grid_spec: String::new(),
+        view: Default::default(),
+        invocation: Default::default(),
     };
-    let result = tiltnoise_job::methods::run(req, &Cancel::never()).unwrap();
+    let result = tiltnoise_job::methods::run(&req, &Cancel::never(), &Silent).unwrap();
     let names: Vec<Method> = result.rows.iter().map(|r| r.method).collect();
     assert_eq!(names, Method::ALL.to_vec());
     let expected = tiltnoise_job::tf::choose(
@@ -202,7 +210,7 @@ fn the_methods_job_measures_every_method_and_names_autos_pick() {
             grid_hz: bad.clone(),
             inputs: None,
         };
-        match tiltnoise_job::methods::run(req, &Cancel::never()) {
+        match tiltnoise_job::methods::run(&req, &Cancel::never(), &Silent) {
             Err(JobError::Option {
                 option: "freq_hz", ..
             }) => {}

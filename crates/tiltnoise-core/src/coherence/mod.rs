@@ -1,4 +1,4 @@
-//! The coherence job: a tilt record and a measured record of the pendulum's observables ->
+//! The coherence estimate: a tilt record and a measured record of the pendulum's observables ->
 //! their common stretch ([`crate::align`]) -> one Welch cross-spectral matrix of all channels
 //! ([`crate::spectral::csd_matrix`]) -> for each observable its ordinary coherence with each tilt
 //! axis, its multiple coherence with all axes, and the measured multiple-input transfer function
@@ -52,7 +52,7 @@ use crate::tf::{self, Scene};
 use num_complex::Complex64;
 use resolution::{kernel, smoothed, RESOLUTION_FRACTION};
 
-/// A uniformly sampled record handed to the job: its name for messages (the option and the
+/// A uniformly sampled record to estimate from: its name for messages (the option and the
 /// file), sample rate, start time and channels (all of equal length, finite samples).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Record<'a, C> {
@@ -81,7 +81,7 @@ impl<C> Record<'_, C> {
     }
 }
 
-/// Options of the coherence job.
+/// Options of the coherence estimate.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CoherenceOptions {
     /// Welch segment length in samples (`None`: the budget's default for the common stretch,
@@ -177,7 +177,7 @@ pub struct ObservableEstimate {
     pub axes: Vec<AxisEstimate>,
 }
 
-/// Everything the coherence job found.
+/// Everything the coherence estimate found.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CoherenceReport {
     /// Welch bins (Hz), DC left out.
@@ -211,7 +211,7 @@ pub struct CoherenceReport {
     pub notes: Vec<String>,
 }
 
-/// Failures of the coherence job, each naming the record, channel or option.
+/// Failures of the coherence estimate, each naming the record, channel or option.
 #[derive(Debug, thiserror::Error)]
 pub enum CoherenceError {
     /// The records cannot be paired in time.
@@ -228,7 +228,8 @@ pub enum CoherenceError {
     Config(String),
 }
 
-/// Runs the coherence job on a tilt record and a measured record (module docs).
+/// Estimates the coherence of a measured record with a tilt record, and the transfer
+/// functions between them (module docs).
 ///
 /// # Errors
 ///

@@ -2,18 +2,25 @@
 //! file read once, aligned by their start times, to the coherence, the measured transfer
 //! functions with their confidence intervals and the model's beside them.
 
+mod json;
+mod outcome;
+
+pub use json::{peak_bin, significant_bins};
+pub use outcome::CoherenceOutcome;
+pub use tiltnoise_io::CoherenceInputs;
+
 use crate::budget::ReadRequest;
 use crate::error::{shown_path, JobError};
+use crate::figures::View;
+use crate::outcome::Invocation;
+use crate::progress::Progress;
 use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
-use tiltnoise_core::coherence::{coherence_from_series, CoherenceOptions, CoherenceReport, Record};
+use tiltnoise_core::coherence::{coherence_from_series, CoherenceOptions, Record};
 use tiltnoise_core::input::InputMeta;
 use tiltnoise_core::model::{Model, Observable, TiltAxis};
 use tiltnoise_io::input::{
     parse_start_time, read_measured_input, read_start_time, read_tilt_series, MeasuredInput,
-};
-use tiltnoise_io::{
-    write_coherence_csv, write_coherence_hdf5, CoherenceInputs, OutputError, OutputKind, RunMeta,
 };
 
 /// A coherence analysis to run.
@@ -36,13 +43,19 @@ pub struct CoherenceRequest<'a> {
     pub confidence: Option<f64>,
     /// Band (Hz) of the measured/model fit, `0 <= lo < hi` (default: every bin).
     pub fit_band_hz: Option<(f64, f64)>,
+    /// Size, resolution and axis limits of the figure [`Outcome::save`](crate::Outcome::save)
+    /// draws.
+    pub view: View,
+    /// Who asked, for the provenance.
+    pub invocation: Invocation,
 }
 
-/// A coherence report and where its records came from.
+/// A coherence report and where its records came from: the numbers of a
+/// [`CoherenceOutcome`], without the run's provenance.
 #[derive(Debug, Clone)]
 pub struct CoherenceResult {
     /// The report.
-    pub report: CoherenceReport,
+    pub report: tiltnoise_core::coherence::CoherenceReport,
     /// The records' provenance, as the files keep it.
     pub inputs: CoherenceInputs,
 }
@@ -61,7 +74,11 @@ impl CoherenceRequest<'_> {
 ///
 /// A [`JobError`] naming the option or file that failed; `Coherence` for records that give
 /// no estimate (and when `cancel` was set).
-pub fn run(req: CoherenceRequest<'_>, cancel: &Cancel) -> Result<CoherenceResult, JobError> {
+pub fn run(
+    req: &CoherenceRequest<'_>,
+    cancel: &Cancel,
+    progress: &dyn Progress,
+) -> Result<CoherenceOutcome, JobError> {
     if let Some((lo, hi)) = req.fit_band_hz {
         if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && lo < hi) {
             return Err(JobError::option(
@@ -144,8 +161,11 @@ pub fn run(req: CoherenceRequest<'_>, cancel: &Cancel) -> Result<CoherenceResult
     };
     let report = coherence_from_series(req.model, &tilt_record, &measured_record, &opts)
         .map_err(|e| JobError::Coherence(Box::new(e)))?;
-    Ok(CoherenceResult {
+    progress.finish();
+    Ok(CoherenceOutcome {
         report,
+        provenance: crate::modes::provenance(req.model, &req.invocation),
+        view: req.view.clone(),
         inputs: CoherenceInputs {
             tilt: InputMeta::from(&tilt.provenance),
             measured_path,
@@ -154,36 +174,20 @@ pub fn run(req: CoherenceRequest<'_>, cancel: &Cancel) -> Result<CoherenceResult
     })
 }
 
-/// Saves a coherence report in the format named by the extension of `path`: HDF5 (schema
-/// `tiltnoise.coherence`, with `meta` and the records' provenance), CSV, or the PNG/SVG figure
-/// titled with the records' names and drawn with `view`, as one of the outputs of `stage`; the same for every front
-/// end.
+/// Saves a coherence report with the provenance `meta` in the format named by the extension
+/// of `path` (as [`CoherenceOutcome`]'s `save`, which writes through the same code), drawn with
+/// `view`, as one of the outputs of `stage`.
 ///
 /// # Errors
 ///
-/// [`OutputError::UnknownFormat`] for another extension (nothing is written), or the writer's
-/// [`OutputError::Write`] naming `path`.
+/// [`OutputError::UnknownFormat`](tiltnoise_core::error::OutputError::UnknownFormat) for
+/// another extension (nothing is written), or the writer's error naming `path`.
 pub fn save(
     stage: &tiltnoise_io::Staging,
     path: &std::path::Path,
     result: &CoherenceResult,
-    meta: &RunMeta,
-    view: &tiltnoise_plot::View,
-) -> Result<(), OutputError> {
-    let (report, inputs) = (&result.report, &result.inputs);
-    match OutputKind::from_path(path)? {
-        OutputKind::Hdf5 => write_coherence_hdf5(stage, path, report, meta, inputs),
-        OutputKind::Csv => write_coherence_csv(stage, path, report, meta),
-        OutputKind::Png | OutputKind::Svg => {
-            let options = tiltnoise_plot::CoherenceFigureOptions {
-                tilt_name: inputs.tilt.path.clone(),
-                measured_name: inputs.measured_path.clone(),
-                view: view.clone(),
-                ..tiltnoise_plot::CoherenceFigureOptions::default()
-            };
-            crate::save_image(stage, path, |format| {
-                tiltnoise_plot::coherence_figure(report, format, &options)
-            })
-        }
-    }
+    meta: &crate::Provenance,
+    view: &View,
+) -> Result<(), tiltnoise_core::error::OutputError> {
+    outcome::write(stage, path, &result.report, &result.inputs, meta, view)
 }

@@ -3,8 +3,17 @@
 //! unit displacement, velocity or acceleration, and a method (or `auto`, the planner's pick)
 //! to the transfer matrix, whole or block by block in memory that does not grow with the grid.
 
+mod outcome;
+mod stream;
+
+pub use outcome::TfOutcome;
+pub use stream::TfText;
+
 use crate::error::{shown_path, JobError};
-use std::path::{Path, PathBuf};
+use crate::figures::TfFigureOptions;
+use crate::outcome::{Invocation, Provenance};
+use crate::progress::Progress;
+use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::freq::{self, LogGrid};
 use tiltnoise_core::ground::GroundQuantity;
@@ -13,10 +22,7 @@ use tiltnoise_core::model::Observable;
 use tiltnoise_core::model::{Model, Request};
 use tiltnoise_core::tf::planner::{Choice, Scene, DEFAULT_REL_TOL};
 use tiltnoise_core::tf::{self, Method, TransferFunction, TransferMatrix};
-use tiltnoise_io::{
-    read_freq_file, write_tf_csv, write_tf_hdf5, OutputError, OutputKind, RunMeta, Staging,
-};
-use tiltnoise_plot::TfFigureOptions;
+use tiltnoise_io::read_freq_file;
 
 /// Frequencies per block of a streamed grid: 16384 points of the largest request (7 x 15
 /// complex values) are 27 MB with the CSV text of the block.
@@ -56,6 +62,10 @@ pub struct TfRequest<'a> {
     pub block_freqs: Option<usize>,
     /// A figure the whole matrix is drawn into: the grid must then fit in memory.
     pub figure: Option<PathBuf>,
+    /// The figures' panels, phase, limits and view ([`figure_options`]).
+    pub figure_options: TfFigureOptions,
+    /// Who asked, for the provenance.
+    pub invocation: Invocation,
 }
 
 impl TfRequest<'_> {
@@ -171,6 +181,8 @@ pub struct Planned {
     block_freqs: usize,
     /// `auto`'s pick with every candidate's measured error (`None` for a method asked for).
     pub choice: Option<Choice>,
+    provenance: Provenance,
+    figure: TfFigureOptions,
 }
 
 impl Planned {
@@ -204,6 +216,11 @@ impl Planned {
         }
     }
 
+    /// The provenance every output of the run records.
+    pub fn provenance(&self) -> &Provenance {
+        &self.provenance
+    }
+
     /// The whole grid at once.
     ///
     /// # Errors
@@ -211,6 +228,22 @@ impl Planned {
     /// [`JobError::Tf`] at the first frequency without a value, or when cancelled.
     pub fn whole(&self, cancel: &Cancel) -> Result<TransferMatrix, JobError> {
         self.evaluate(&self.grid.block(0, self.grid.len()), cancel)
+    }
+
+    /// The outcome of the whole grid at once, to save by output kind.
+    ///
+    /// # Errors
+    ///
+    /// As [`Planned::whole`].
+    pub fn outcome(&self, cancel: &Cancel, progress: &dyn Progress) -> Result<TfOutcome, JobError> {
+        let tf = self.whole(cancel);
+        progress.finish();
+        Ok(TfOutcome {
+            tf: tf?,
+            choice: self.choice.clone(),
+            provenance: self.provenance.clone(),
+            figure: self.figure.clone(),
+        })
     }
 
     /// The grid block by block, each handed to `sink` with the number of frequencies done
@@ -237,14 +270,6 @@ impl Planned {
     }
 }
 
-/// A transfer matrix computed whole, and how its method was chosen.
-pub struct TfResult {
-    /// The matrix.
-    pub tf: TransferMatrix,
-    /// `auto`'s pick with its evidence (`None` for a method asked for).
-    pub choice: Option<Choice>,
-}
-
 fn tf_error(e: tiltnoise_core::error::TfError) -> JobError {
     JobError::Tf(Box::new(e))
 }
@@ -256,7 +281,7 @@ fn tf_error(e: tiltnoise_core::error::TfError) -> JobError {
 ///
 /// A [`JobError`] naming the option or file that failed; [`JobError::NoMethod`] when `auto`
 /// finds none.
-pub fn prepare(req: TfRequest<'_>) -> Result<Planned, JobError> {
+pub fn prepare(req: &TfRequest<'_>) -> Result<Planned, JobError> {
     let rel_tol = rel_tol(req.rel_tol)?;
     let block_freqs = match req.block_freqs {
         Some(0) => {
@@ -269,7 +294,7 @@ pub fn prepare(req: TfRequest<'_>) -> Result<Planned, JobError> {
         Some(b) => b,
         None => DEFAULT_BLOCK_FREQS,
     };
-    let (grid, origin) = match req.grid {
+    let (grid, origin) = match req.grid.clone() {
         FreqGrid::Default => (Grid::Points(freq::default_grid(req.model)), None),
         FreqGrid::Log(g) => (Grid::Log(g), None),
         FreqGrid::Points(v) => (Grid::Points(v), Some(("freq_hz", None))),
@@ -314,6 +339,8 @@ pub fn prepare(req: TfRequest<'_>) -> Result<Planned, JobError> {
         per: req.per,
         block_freqs,
         choice,
+        provenance: crate::modes::provenance(req.model, &req.invocation),
+        figure: req.figure_options.clone(),
     })
 }
 
@@ -351,18 +378,18 @@ fn refuse_zero_for_per(
     ))
 }
 
-/// Runs the job whole: [`prepare`], then the matrix on the whole grid.
+/// Runs the job whole: [`prepare`], then the matrix on the whole grid (to stream a grid
+/// larger than memory, [`Planned::stream`]).
 ///
 /// # Errors
 ///
 /// As [`prepare`] and [`Planned::whole`].
-pub fn run(req: TfRequest<'_>, cancel: &Cancel) -> Result<TfResult, JobError> {
-    let planned = prepare(req)?;
-    let tf = planned.whole(cancel)?;
-    Ok(TfResult {
-        tf,
-        choice: planned.choice,
-    })
+pub fn run(
+    req: &TfRequest<'_>,
+    cancel: &Cancel,
+    progress: &dyn Progress,
+) -> Result<TfOutcome, JobError> {
+    prepare(req)?.outcome(cancel, progress)
 }
 
 /// The observables a figure draws when none are chosen: those of the paper's Figure 5.
@@ -376,29 +403,30 @@ pub fn figure_options(model: &Model, drawn: Vec<Observable>, phase: bool) -> TfF
         observables: Some(drawn),
         phase,
         damped: !model.is_undamped(),
-        view: tiltnoise_plot::View::default(),
+        view: crate::figures::View::default(),
         note: None,
     }
 }
 
-/// Saves a transfer matrix in the format named by the extension of `path`: HDF5 (schema
-/// `tiltnoise.tf`, with `meta`), CSV, or the PNG/SVG figure drawn with `figure`, as one of the outputs of `stage`;
-/// the same for every front end.
+/// Writes a transfer matrix in the format named by the extension of `path`: HDF5 (schema
+/// `tiltnoise.tf`, with `meta`), CSV, or the PNG/SVG figure drawn with `figure`, as one of
+/// the outputs of `stage`: the one writer by kind behind [`TfOutcome`]'s `save`.
 ///
 /// # Errors
 ///
 /// [`OutputError::UnknownFormat`] for another extension (nothing is written), or the writer's
 /// [`OutputError::Write`] naming `path`.
 pub fn save(
-    stage: &Staging,
-    path: &Path,
+    stage: &tiltnoise_io::Staging,
+    path: &std::path::Path,
     tf: &TransferMatrix,
-    meta: &RunMeta,
+    meta: &Provenance,
     figure: &TfFigureOptions,
-) -> Result<(), OutputError> {
+) -> Result<(), tiltnoise_core::error::OutputError> {
+    use tiltnoise_io::OutputKind;
     match OutputKind::from_path(path)? {
-        OutputKind::Hdf5 => write_tf_hdf5(stage, path, tf, meta),
-        OutputKind::Csv => write_tf_csv(stage, path, tf, meta),
+        OutputKind::Hdf5 => tiltnoise_io::write_tf_hdf5(stage, path, tf, meta),
+        OutputKind::Csv => tiltnoise_io::write_tf_csv(stage, path, tf, meta),
         OutputKind::Png | OutputKind::Svg => crate::save_image(stage, path, |format| {
             tiltnoise_plot::tf_figure_with(tf, format, figure)
         }),
