@@ -1,7 +1,7 @@
 //! SIGINT, SIGTERM and SIGHUP (unless SIGHUP is ignored, as under `nohup`) end the run: the
 //! handler sets the run's [`Cancel`] token (so that the computation stops where it polls it),
 //! removes the staging directory of every output being written or staged
-//! ([`tiltnoise_io::remove_staging_for_exit`], which keeps any from being created afterwards),
+//! ([`tiltnoise_job::files::remove_staging_for_exit`], which keeps any from being created afterwards),
 //! prints one line naming the signal and ends the process with exit code 2, at once, whatever
 //! the main thread is doing. An output is only ever created inside a staging directory that
 //! exists and is registered, so nothing is left, however far a writer had got.
@@ -51,7 +51,7 @@ mod unix {
                 return;
             };
             cancel.cancel();
-            let cleanup = tiltnoise_io::remove_staging_for_exit();
+            let cleanup = tiltnoise_job::files::remove_staging_for_exit();
             let name = match signal {
                 SIGINT => "SIGINT",
                 SIGHUP => "SIGHUP",
@@ -67,7 +67,7 @@ mod unix {
     }
 
     /// The one line the handler prints.
-    fn message(signal: &str, cleanup: &tiltnoise_io::ExitCleanup) -> String {
+    fn message(signal: &str, cleanup: &tiltnoise_job::files::ExitCleanup) -> String {
         let mut line = format!(
             "tiltnoise: error: interrupted by {signal}; {} staged output(s) removed",
             cleanup.removed

@@ -21,7 +21,7 @@ fn main() -> ExitCode {
     let version = format!(
         "{} (HDF5 {}, static)",
         env!("CARGO_PKG_VERSION"),
-        tiltnoise_io::hdf5_version()
+        tiltnoise_job::files::hdf5_version()
     );
     let parsed = cli::Cli::command()
         .version(version)

@@ -144,7 +144,7 @@ impl Coherence {
     /// The observables analysed.
     #[getter]
     fn observables(&self) -> Vec<&'static str> {
-        self.report
+        self.report()
             .observables
             .iter()
             .map(|o| o.observable.name())
@@ -154,7 +154,7 @@ impl Coherence {
     /// ``{observable: unit of its transfer functions}``, e.g. ``m/rad``.
     #[getter]
     fn units(&self) -> std::collections::BTreeMap<&'static str, String> {
-        self.report
+        self.report()
             .observables
             .iter()
             .map(|o| (o.observable.name(), format!("{}/rad", o.observable.unit())))

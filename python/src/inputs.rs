@@ -1,11 +1,11 @@
 //! The files a result was computed from, kept with it so that no `save` of the result replaces
-//! one of them: the command line's rule for `--save` (`tiltnoise_io::check_outputs`: compared
+//! one of them: the command line's rule for `--save` (`tiltnoise_job::files::check_outputs`: compared
 //! by file identity, whatever the spelling, HDF5 addresses included).
 
 use crate::errors::PyResultExt;
 use pyo3::PyResult;
 use std::path::{Path, PathBuf};
-use tiltnoise_io::OutputError;
+use tiltnoise_core::error::OutputError;
 
 /// The input files of a result, each with the keyword that named it in its call (`path`,
 /// `tilt`, `measured`, `Params.from_toml`), for the message.
@@ -48,7 +48,7 @@ impl Inputs {
             .map(|(a, p)| (described(a), p.as_path()))
             .collect();
         let labelled: Vec<(&str, &Path)> = inputs.iter().map(|(a, p)| (a.as_str(), *p)).collect();
-        match tiltnoise_io::check_outputs(&[path], &labelled) {
+        match tiltnoise_job::files::check_outputs(&[path], &labelled) {
             Err(OutputError::Refused { path, rule }) => {
                 // The library's rule reads `the file OPTION PATH reads` (the command line's
                 // spelling, `the file --tilt tilt.h5 reads`): said here without the option.

@@ -61,7 +61,7 @@ fn tiltnoise_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // Before any message: the libraries' errors name options as keyword arguments.
     tiltnoise_core::option_key::install_style(&errors::Keywords);
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
-    m.add("hdf5_version", tiltnoise_io::hdf5_version())?;
+    m.add("hdf5_version", tiltnoise_job::files::hdf5_version())?;
     m.add(
         "InputFileError",
         m.py().get_type::<errors::InputFileError>(),

@@ -4,7 +4,6 @@
 use crate::args::kw;
 use crate::arrays;
 use crate::budget::model_of;
-use crate::errors::PyResultExt;
 use crate::inputs::Inputs;
 use crate::job_args;
 use crate::state;

@@ -5,11 +5,11 @@ use anyhow::{anyhow, Result};
 use clap::{Args, ValueEnum};
 use tiltnoise_core::ground::GroundQuantity;
 use tiltnoise_core::input::{parse_scales, parse_units};
+use tiltnoise_core::input::{AxisMap, ReadOptions};
 use tiltnoise_core::model::Observable;
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::repeats::{list_entries, refuse_repeats};
 use tiltnoise_core::tf::Method;
-use tiltnoise_io::input::{AxisMap, ReadOptions};
 
 /// Welch averaging.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

@@ -35,7 +35,7 @@ pub fn parse_readout(items: &[String]) -> Result<Vec<ReadoutItem>> {
             let file = item
                 .split_once('=')
                 .map(|(_, v)| Path::new(v.trim()))
-                .filter(|p| tiltnoise_io::input::input_format(p).is_ok());
+                .filter(|p| tiltnoise_job::files::input_format(p).is_ok());
             let Some(path) = file else {
                 let (observable, asd) = parse_readout_item(item)?;
                 return Ok(ReadoutItem {

@@ -50,7 +50,7 @@ pub fn parse_witness_items(items: &[String]) -> Result<Vec<WitnessItem>> {
                 }
                 _ => (value.trim(), 0.0),
             };
-            let asd = if tiltnoise_io::input::input_format(Path::new(level)).is_ok() {
+            let asd = if tiltnoise_job::files::input_format(Path::new(level)).is_ok() {
                 AsdSpec::File(PathBuf::from(level))
             } else {
                 AsdSpec::White(level.parse().map_err(|_| {

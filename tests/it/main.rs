@@ -13,10 +13,10 @@ mod output;
 #[path = "../../crates/tiltnoise-core/tests/it/tolerances.rs"]
 mod tolerances;
 
-mod build_cmake;
 mod budget_at;
 mod budget_open;
 mod budget_outputs;
+mod build_cmake;
 mod cli;
 mod cli_budget;
 mod coherence_cli;
@@ -33,6 +33,7 @@ mod input_readers;
 mod input_units;
 mod io_roundtrip;
 mod job_outcomes;
+mod layout;
 mod limits;
 mod mc_outputs;
 mod miniseed_input;

@@ -209,6 +209,9 @@ fn the_methods_job_measures_every_method_and_names_autos_pick() {
             model: &model,
             grid_hz: bad.clone(),
             inputs: None,
+            grid_spec: String::new(),
+            view: Default::default(),
+            invocation: Default::default(),
         };
         match tiltnoise_job::methods::run(&req, &Cancel::never(), &Silent) {
             Err(JobError::Option {
