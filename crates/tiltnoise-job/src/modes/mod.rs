@@ -26,10 +26,7 @@ pub struct ModesRequest<'a> {
 /// The provenance of a run on `model`: its parameters, its normal modes and `invocation`'s
 /// command; every job that records the modes builds it here.
 pub(crate) fn provenance(model: &Model, invocation: &Invocation) -> Provenance {
-    Provenance {
-        command_line: invocation.command_line.clone(),
-        ..Provenance::of_this_run(model.params(), Some(&NormalModes::new(model)))
-    }
+    invocation.provenance(model.params(), Some(&NormalModes::new(model)))
 }
 
 /// Runs the job: the normal modes of the model, with its rest configuration.
@@ -44,10 +41,7 @@ pub fn run(
 ) -> Result<ModesOutcome, JobError> {
     cancel.check().map_err(|_| JobError::Cancelled)?;
     let modes = NormalModes::new(req.model);
-    let provenance = Provenance {
-        command_line: req.invocation.command_line.clone(),
-        ..Provenance::of_this_run(req.model.params(), Some(&modes))
-    };
+    let provenance = req.invocation.provenance(req.model.params(), Some(&modes));
     progress.finish();
     Ok(ModesOutcome {
         modes,

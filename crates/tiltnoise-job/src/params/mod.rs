@@ -7,7 +7,7 @@ mod outcome;
 pub use outcome::ParamsOutcome;
 
 use crate::error::JobError;
-use crate::outcome::{Invocation, Provenance};
+use crate::outcome::Invocation;
 use crate::progress::Progress;
 use std::path::Path;
 use tiltnoise_core::cancel::Cancel;
@@ -44,10 +44,7 @@ pub fn run(
     progress: &dyn Progress,
 ) -> Result<ParamsOutcome, JobError> {
     cancel.check().map_err(|_| JobError::Cancelled)?;
-    let provenance = Provenance {
-        command_line: req.invocation.command_line.clone(),
-        ..Provenance::of_this_run(&req.params, None)
-    };
+    let provenance = req.invocation.provenance(&req.params, None);
     progress.finish();
     Ok(ParamsOutcome {
         params: req.params.clone(),

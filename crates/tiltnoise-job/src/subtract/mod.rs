@@ -368,7 +368,7 @@ fn subtract_records(
     cancel: &Cancel,
 ) -> Result<SubtractOutcome, JobError> {
     let stage = || cancel.check().map_err(|_| JobError::Cancelled);
-    check_options(&req)?;
+    check_options(req)?;
     let cfg = SubtractConfig {
         segment_len: req.nperseg,
         holdout_fraction: req.holdout,
@@ -382,13 +382,13 @@ fn subtract_records(
         cancel: cancel.clone(),
     };
     stage()?;
-    let series = Witness::read("tilt", &req.tilt, &req)?;
+    let series = Witness::read("tilt", &req.tilt, req)?;
     let colocated_series = req
         .colocated
         .iter()
-        .map(|p| Witness::read("colocated", p, &req))
+        .map(|p| Witness::read("colocated", p, req))
         .collect::<Result<Vec<_>, _>>()?;
-    check_ratio_inputs(&req, &series, &colocated_series)?;
+    check_ratio_inputs(req, &series, &colocated_series)?;
     stage()?;
     let measured = match read_measured_input(&req.measured)? {
         MeasuredInput::Series(m) => m,

@@ -414,8 +414,8 @@ pub fn figure_options(model: &Model, drawn: Vec<Observable>, phase: bool) -> TfF
 ///
 /// # Errors
 ///
-/// [`OutputError::UnknownFormat`] for another extension (nothing is written), or the writer's
-/// [`OutputError::Write`] naming `path`.
+/// [`OutputError::UnknownFormat`](tiltnoise_core::error::OutputError::UnknownFormat) for another extension (nothing is written), or the writer's
+/// [`OutputError::Write`](tiltnoise_core::error::OutputError::Write) naming `path`.
 pub fn save(
     stage: &tiltnoise_io::Staging,
     path: &std::path::Path,
