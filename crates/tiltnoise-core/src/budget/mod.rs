@@ -289,6 +289,8 @@ pub fn budget_from_series(
             n_segments: 0,
         },
         filled: 0,
+        projected: opts.averaging == Averaging::Mean,
+        psds: Vec::new(),
         tf: None,
         rows: Vec::new(),
         tilt: vec![Vec::new(); opts.outputs.len()],
@@ -415,6 +417,12 @@ struct Segments<'a> {
     spectra: CrossSpectra,
     /// Samples of the current segment pushed so far.
     filled: usize,
+    /// A mean: every Welch segment's spectra are projected on the transfer functions at once
+    /// ([`WelchAccumulator::with_projections`]), and only the total's PSD of each output is
+    /// summed. A median keeps the cross-spectra and propagates their median.
+    projected: bool,
+    /// The last segment's projected PSDs, `[output][bin]` from DC, reused.
+    psds: Vec<Vec<f64>>,
     /// The transfer functions on the segments' grid, computed with the first segment.
     tf: Option<TransferMatrix>,
     /// The same, dense, for the segments' propagation: `[bin][output][input]`.
@@ -425,19 +433,46 @@ struct Segments<'a> {
 }
 
 impl Segments<'_> {
+    /// The transfer functions on the segments' grid (kept for the whole record's budget) as
+    /// weights of the channels' spectra ([`GroundMap::channel_weights`]), `[bin][output]
+    /// [channel]` from DC (whose weights are 0: the budget drops that bin).
+    fn channel_weights(&mut self) -> Result<Vec<Complex64>, BudgetError> {
+        let (n_in, n_out) = (self.inputs.len(), self.opts.outputs.len());
+        let n_freqs = self.cfg.n_freqs();
+        let grid: Vec<f64> = crate::spectral::bin_freqs(self.cfg.segment_len, self.fs, n_freqs)
+            .skip(1)
+            .collect();
+        let tf = ground_tf(self.model, &self.opts.outputs, self.inputs, &grid)?;
+        let rows = dense_rows(&tf, self.inputs);
+        self.tf = Some(tf);
+        let mut weights = vec![Complex64::new(0.0, 0.0); n_out * n_in];
+        weights.extend_from_slice(&rows);
+        for (row, &f) in weights[n_out * n_in..]
+            .chunks_exact_mut(n_in)
+            .zip(grid.iter().flat_map(|f| std::iter::repeat_n(f, n_out)))
+        {
+            self.map.channel_weights(f, row);
+        }
+        Ok(weights)
+    }
+
     /// Pushes the next `len` samples of every channel (`views`), finishing the segments they
     /// complete.
     fn push(&mut self, views: &[&[f64]], len: usize) -> Result<(), BudgetError> {
         let (opts, seg) = (self.opts, self.samples);
         let mut offset = 0;
         while offset < len {
-            let acc = match self.current.as_mut() {
-                Some(acc) => acc,
-                None => self.current.insert(
-                    WelchAccumulator::new(self.spectra.n_channels, self.fs, self.cfg)?
-                        .with_cancel(opts.cancel.clone()),
-                ),
-            };
+            if self.current.is_none() {
+                let acc = WelchAccumulator::new(self.spectra.n_channels, self.fs, self.cfg)?
+                    .with_cancel(opts.cancel.clone());
+                self.current = Some(if self.projected {
+                    let weights = self.channel_weights()?;
+                    acc.with_projections(opts.outputs.len(), &weights)
+                } else {
+                    acc
+                });
+            }
+            let acc = self.current.as_mut().expect("made above");
             let take = (seg - self.filled).min(len - offset);
             let part: Vec<&[f64]> = views.iter().map(|c| &c[offset..offset + take]).collect();
             acc.push(&part)?;
@@ -445,8 +480,15 @@ impl Segments<'_> {
             offset += take;
             if self.filled == seg {
                 opts.cancel.check()?;
-                acc.finish_into(&mut self.spectra)?;
                 self.filled = 0;
+                if self.projected {
+                    acc.finish_projections_into(&mut self.psds)?;
+                    for (kept, psd) in self.tilt.iter_mut().zip(&self.psds) {
+                        kept.push(psd[1..].iter().map(|&p| p as f32).collect());
+                    }
+                    continue;
+                }
+                acc.finish_into(&mut self.spectra)?;
                 if self.tf.is_none() {
                     let grid = &self.spectra.freqs_hz[1..];
                     let tf = ground_tf(self.model, &opts.outputs, self.inputs, grid)?;

@@ -122,6 +122,8 @@ pub struct WelchAccumulator {
     sums: Vec<f64>,
     /// Median: `[segment][channel][freq]` all segment spectra.
     stored: Vec<Complex64>,
+    /// Mean of projections ([`WelchAccumulator::with_projections`]) instead of the pair sums.
+    projection: Option<Projection>,
     n_segments: usize,
     n_samples: usize,
     /// Polled before each segment.
@@ -176,10 +178,45 @@ impl WelchAccumulator {
             spectra: vec![Complex64::new(0.0, 0.0); n_channels * n_freqs],
             sums,
             stored: Vec::new(),
+            projection: None,
             n_segments: 0,
             n_samples: 0,
             cancel: Cancel::never(),
         })
+    }
+
+    /// The accumulator of the PSDs of `n_outputs` combinations of the channels instead of their
+    /// cross-spectra: output `o` at bin `k` is `Y_o = sum_c weights[(k * n_outputs + o) *
+    /// n_channels + c] X_c`, and its mean `|Y_o|^2` over the segments, scaled as a PSD, is what
+    /// [`WelchAccumulator::finish_projections_into`] returns. Equal, up to rounding, to
+    /// `sum_ij conj(w_i) S_ij w_j` of the cross-spectral matrix `S` ([`WelchAccumulator::finish`])
+    /// at bin `k`, at `n_outputs * n_channels` products per bin instead of the
+    /// matrix's `n_channels (n_channels + 1) / 2` and a propagation: the cheaper road when only
+    /// a few combinations of many channels are wanted, and never negative.
+    ///
+    /// # Panics
+    ///
+    /// If the averaging is not [`Averaging::Mean`] (a median of cross-spectra is not the median
+    /// of a projection), or `weights` has not `n_freqs * n_outputs * n_channels` entries.
+    pub fn with_projections(mut self, n_outputs: usize, weights: &[Complex64]) -> Self {
+        assert_eq!(
+            self.cfg.averaging,
+            Averaging::Mean,
+            "projections are averaged by their mean"
+        );
+        assert_eq!(
+            weights.len(),
+            self.n_freqs * n_outputs * self.n_channels,
+            "one weight per bin, output and channel"
+        );
+        self.sums = Vec::new();
+        self.projection = Some(Projection::new(
+            n_outputs,
+            self.n_channels,
+            self.n_freqs,
+            weights,
+        ));
+        self
     }
 
     /// The accumulator polling `cancel` before each segment: a push after the token is set
@@ -307,6 +344,10 @@ impl WelchAccumulator {
                 })?;
         }
         match self.cfg.averaging {
+            Averaging::Mean if self.projection.is_some() => {
+                let p = self.projection.as_mut().expect("checked");
+                p.push(&mut self.spectra, nc, nf);
+            }
             Averaging::Mean => {
                 let mut pairs = self.sums.chunks_exact_mut(2 * nf);
                 for i in 0..nc {
@@ -354,12 +395,79 @@ impl WelchAccumulator {
     /// As [`WelchAccumulator::finish`]; the accumulator is emptied all the same.
     pub fn finish_into(&mut self, out: &mut CrossSpectra) -> Result<(), SpectralError> {
         let written = self.write_into(out);
+        self.reset();
+        written
+    }
+
+    /// Empties the accumulator for the next record of the same channels.
+    fn reset(&mut self) {
         self.sums.fill(0.0);
         self.stored.clear();
+        if let Some(p) = self.projection.as_mut() {
+            p.sums.fill(0.0);
+            p.held = 0;
+        }
         self.n_segments = 0;
         self.n_samples = 0;
         self.filled = 0;
+    }
+
+    /// The PSDs of the projections ([`WelchAccumulator::with_projections`]) into `out`
+    /// (`out[o][k]`, `n_freqs` bins from DC, in the squared unit of the weighted sum per Hz,
+    /// one-sided), and the accumulator emptied for the next record as
+    /// [`WelchAccumulator::finish_into`] does.
+    ///
+    /// # Errors
+    ///
+    /// [`SpectralError::SeriesTooShort`] if not even one segment was complete; the
+    /// accumulator is emptied all the same.
+    ///
+    /// # Panics
+    ///
+    /// If the accumulator was not made with projections.
+    pub fn finish_projections_into(
+        &mut self,
+        out: &mut Vec<Vec<f64>>,
+    ) -> Result<(), SpectralError> {
+        if let Some(p) = self.projection.as_mut() {
+            p.flush(self.n_channels, self.n_freqs);
+        }
+        let written = self.write_projections(out);
+        self.reset();
         written
+    }
+
+    fn write_projections(&self, out: &mut Vec<Vec<f64>>) -> Result<(), SpectralError> {
+        let p = self
+            .projection
+            .as_ref()
+            .expect("an accumulator made with projections");
+        if self.n_segments == 0 {
+            return Err(SpectralError::SeriesTooShort {
+                n_samples: self.n_samples,
+                segment_len: self.cfg.segment_len,
+            });
+        }
+        let (nf, len, nseg) = (self.n_freqs, self.cfg.segment_len, self.n_segments);
+        out.resize(p.n_outputs, Vec::new());
+        for (o, psd) in out.iter_mut().enumerate() {
+            psd.clear();
+            psd.extend(
+                p.sums[o * nf..(o + 1) * nf]
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &s)| {
+                        // The one-sided doubling of every bin but DC and an even length's Nyquist.
+                        let one_sided = if k == 0 || (len % 2 == 0 && k == nf - 1) {
+                            1.0
+                        } else {
+                            2.0
+                        };
+                        s * (self.scale * one_sided / nseg as f64)
+                    }),
+            );
+        }
+        Ok(())
     }
 
     fn write_into(&self, out: &mut CrossSpectra) -> Result<(), SpectralError> {
@@ -435,6 +543,112 @@ impl WelchAccumulator {
         out.n_channels = nc;
         out.n_segments = nseg;
         Ok(())
+    }
+}
+
+/// Segments whose spectra a projection holds before it adds them: the weights, the largest
+/// array of the work (`n_outputs * n_channels` complex numbers per bin), are then read once
+/// for this many segments rather than once per segment.
+const PROJECTION_BATCH: usize = 4;
+
+/// Bins of one pass of a batch's projection: the outputs' sums of every held segment for
+/// these bins stay in the first-level caches.
+const PROJECTION_BINS: usize = 512;
+
+/// Per-bin linear combinations of the channels and the running sums of their squared moduli.
+struct Projection {
+    n_outputs: usize,
+    /// Planar weights, `[output][channel][freq]`: real parts, then imaginary parts.
+    weights_re: Vec<f64>,
+    weights_im: Vec<f64>,
+    /// `[output][freq]`: sums over the segments of `|sum_c w_c X_c|^2`.
+    sums: Vec<f64>,
+    /// The spectra (`[channel][freq]`) of the segments held, the first `held` of them.
+    batch: Vec<Vec<Complex64>>,
+    held: usize,
+    /// One pass's `sum_c w_c X_c` of every held segment, planar `[segment][bin]`.
+    y_re: Vec<f64>,
+    y_im: Vec<f64>,
+}
+
+impl Projection {
+    /// From weights `[freq][output][channel]`.
+    fn new(n_outputs: usize, nc: usize, nf: usize, weights: &[Complex64]) -> Projection {
+        let mut weights_re = vec![0.0; n_outputs * nc * nf];
+        let mut weights_im = vec![0.0; n_outputs * nc * nf];
+        for (k, w) in weights.chunks_exact(n_outputs * nc).enumerate() {
+            for (oc, w) in w.iter().enumerate() {
+                weights_re[oc * nf + k] = w.re;
+                weights_im[oc * nf + k] = w.im;
+            }
+        }
+        Projection {
+            n_outputs,
+            weights_re,
+            weights_im,
+            sums: vec![0.0; n_outputs * nf],
+            batch: Vec::new(),
+            held: 0,
+            y_re: vec![0.0; PROJECTION_BATCH * PROJECTION_BINS],
+            y_im: vec![0.0; PROJECTION_BATCH * PROJECTION_BINS],
+        }
+    }
+
+    /// Holds one segment's channel-major `[channel][freq]` spectra, swapping `spectra` for an
+    /// earlier buffer (the caller overwrites it), and adds the batch once it is full.
+    fn push(&mut self, spectra: &mut Vec<Complex64>, nc: usize, nf: usize) {
+        if self.batch.len() == self.held {
+            self.batch
+                .push(vec![Complex64::new(0.0, 0.0); spectra.len()]);
+        }
+        std::mem::swap(spectra, &mut self.batch[self.held]);
+        self.held += 1;
+        if self.held == PROJECTION_BATCH {
+            self.flush(nc, nf);
+        }
+    }
+
+    /// Adds the held segments' `|Y_o|^2`, segment after segment at every bin (the order of
+    /// adding them one at a time): output by output, channel by channel over contiguous bins,
+    /// with the complex product and sum written out as `Complex64` forms them (`w X = (w_r x_r
+    /// - w_i x_i, w_r x_i + w_i x_r)`, summed from 0 in channel order).
+    fn flush(&mut self, nc: usize, nf: usize) {
+        let held = &self.batch[..self.held];
+        let mut start = 0;
+        while start < nf {
+            let end = (start + PROJECTION_BINS).min(nf);
+            let len = end - start;
+            for o in 0..self.n_outputs {
+                self.y_re.fill(0.0);
+                self.y_im.fill(0.0);
+                for c in 0..nc {
+                    let at = (o * nc + c) * nf;
+                    let wr = &self.weights_re[at + start..at + end];
+                    let wi = &self.weights_im[at + start..at + end];
+                    for (s, spectra) in held.iter().enumerate() {
+                        let x = &spectra[c * nf + start..c * nf + end];
+                        let yr = &mut self.y_re[s * len..(s + 1) * len];
+                        let yi = &mut self.y_im[s * len..(s + 1) * len];
+                        for ((((yr, yi), x), &a), &b) in
+                            yr.iter_mut().zip(yi.iter_mut()).zip(x).zip(wr).zip(wi)
+                        {
+                            *yr += a * x.re - b * x.im;
+                            *yi += a * x.im + b * x.re;
+                        }
+                    }
+                }
+                let sums = &mut self.sums[o * nf + start..o * nf + end];
+                for s in 0..held.len() {
+                    let yr = &self.y_re[s * len..(s + 1) * len];
+                    let yi = &self.y_im[s * len..(s + 1) * len];
+                    for ((sum, &r), &m) in sums.iter_mut().zip(yr).zip(yi) {
+                        *sum += r * r + m * m;
+                    }
+                }
+            }
+            start = end;
+        }
+        self.held = 0;
     }
 }
 
@@ -723,6 +937,42 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A projection on one channel (weight 1) is that channel's PSD bit for bit (the same
+    /// products, sums and scaling), and a reused projecting accumulator is a fresh one; a
+    /// combination of two channels is `w^H S w` of their matrix to rounding.
+    #[test]
+    fn projections_are_the_matrix_seen_through_the_weights() {
+        let (a, b) = (series(700, 21), series(700, 22));
+        let cfg = WelchConfig::new(64);
+        let m = csd_matrix(&[&a, &b], 5.0, &cfg).unwrap();
+        let nf = m.n_freqs();
+        let (one, zero) = (Complex64::new(1.0, 0.0), Complex64::new(0.0, 0.0));
+        let w2 = Complex64::new(0.3, -1.7);
+        let weights: Vec<Complex64> = (0..nf).flat_map(|_| [zero, one, one, w2]).collect();
+        let mut acc = WelchAccumulator::new(2, 5.0, &cfg)
+            .unwrap()
+            .with_projections(2, &weights);
+        let mut out = Vec::new();
+        for _ in 0..2 {
+            acc.push(&[&a, &b]).unwrap();
+            acc.finish_projections_into(&mut out).unwrap();
+            assert_eq!(out[0], m.psd(1));
+            for (k, &got) in out[1].iter().enumerate() {
+                let s = m.matrix(k);
+                let want = (s[0] + w2.conj() * s[2] * one + s[1] * w2 + w2.norm_sqr() * s[3]).re;
+                let bound = (m.psd(0)[k].sqrt() + w2.norm() * m.psd(1)[k].sqrt()).powi(2);
+                // The rounding bound of the integration tests' `PROJECTION_C`: 8 eps per unit
+                // of n^2 + n_segments.
+                let gamma = 8.0 * (4.0 + m.n_segments as f64) * f64::EPSILON;
+                assert!((got - want).abs() <= gamma * bound, "bin {k}");
+            }
+        }
+        assert!(matches!(
+            acc.finish_projections_into(&mut out),
+            Err(SpectralError::SeriesTooShort { n_samples: 0, .. })
+        ));
     }
 
     #[test]
