@@ -34,6 +34,7 @@ use crate::noise::{
 };
 use crate::spectral::{Averaging, CrossSpectra, SpectralError, WelchAccumulator, WelchConfig};
 use crate::tf::{self, Request, TransferMatrix};
+use num_complex::Complex64;
 
 /// Samples per channel read from the input at a time: 2^18 samples x 3 channels x 8 bytes
 /// = 6 MiB, large enough to amortize HDF5 calls, small against the 256 MB memory goal.
@@ -277,7 +278,6 @@ pub fn budget_from_series(
         opts,
         map: &map,
         inputs: &inputs,
-        term: &segment_term,
         cfg: &cfg,
         fs,
         samples,
@@ -289,7 +289,10 @@ pub fn budget_from_series(
             n_segments: 0,
         },
         filled: 0,
+        projected: opts.averaging == Averaging::Mean,
+        psds: Vec::new(),
         tf: None,
+        rows: Vec::new(),
         tilt: vec![Vec::new(); opts.outputs.len()],
     });
 
@@ -404,8 +407,6 @@ struct Segments<'a> {
     opts: &'a BudgetOptions,
     map: &'a GroundMap,
     inputs: &'a [Input],
-    /// The term of the floor's motion whose PSDs are kept.
-    term: &'a TermKind,
     cfg: &'a WelchConfig,
     fs: f64,
     /// Samples per segment.
@@ -416,26 +417,62 @@ struct Segments<'a> {
     spectra: CrossSpectra,
     /// Samples of the current segment pushed so far.
     filled: usize,
+    /// A mean: every Welch segment's spectra are projected on the transfer functions at once
+    /// ([`WelchAccumulator::with_projections`]), and only the total's PSD of each output is
+    /// summed. A median keeps the cross-spectra and propagates their median.
+    projected: bool,
+    /// The last segment's projected PSDs, `[output][bin]` from DC, reused.
+    psds: Vec<Vec<f64>>,
     /// The transfer functions on the segments' grid, computed with the first segment.
     tf: Option<TransferMatrix>,
-    /// Per output, the PSDs of every finished segment.
+    /// The same, dense, for the segments' propagation: `[bin][output][input]`.
+    rows: Vec<Complex64>,
+    /// Per output, the PSDs of every finished segment: the term of the floor's motion that
+    /// adds to the total ([`total_ground_term`]).
     tilt: Vec<Vec<Vec<f32>>>,
 }
 
 impl Segments<'_> {
+    /// The transfer functions on the segments' grid (kept for the whole record's budget) as
+    /// weights of the channels' spectra ([`GroundMap::channel_weights`]), `[bin][output]
+    /// [channel]` from DC (whose weights are 0: the budget drops that bin).
+    fn channel_weights(&mut self) -> Result<Vec<Complex64>, BudgetError> {
+        let (n_in, n_out) = (self.inputs.len(), self.opts.outputs.len());
+        let n_freqs = self.cfg.n_freqs();
+        let grid: Vec<f64> = crate::spectral::bin_freqs(self.cfg.segment_len, self.fs, n_freqs)
+            .skip(1)
+            .collect();
+        let tf = ground_tf(self.model, &self.opts.outputs, self.inputs, &grid)?;
+        let rows = dense_rows(&tf, self.inputs);
+        self.tf = Some(tf);
+        let mut weights = vec![Complex64::new(0.0, 0.0); n_out * n_in];
+        weights.extend_from_slice(&rows);
+        for (row, &f) in weights[n_out * n_in..]
+            .chunks_exact_mut(n_in)
+            .zip(grid.iter().flat_map(|f| std::iter::repeat_n(f, n_out)))
+        {
+            self.map.channel_weights(f, row);
+        }
+        Ok(weights)
+    }
+
     /// Pushes the next `len` samples of every channel (`views`), finishing the segments they
     /// complete.
     fn push(&mut self, views: &[&[f64]], len: usize) -> Result<(), BudgetError> {
         let (opts, seg) = (self.opts, self.samples);
         let mut offset = 0;
         while offset < len {
-            let acc = match self.current.as_mut() {
-                Some(acc) => acc,
-                None => self.current.insert(
-                    WelchAccumulator::new(self.spectra.n_channels, self.fs, self.cfg)?
-                        .with_cancel(opts.cancel.clone()),
-                ),
-            };
+            if self.current.is_none() {
+                let acc = WelchAccumulator::new(self.spectra.n_channels, self.fs, self.cfg)?
+                    .with_cancel(opts.cancel.clone());
+                self.current = Some(if self.projected {
+                    let weights = self.channel_weights()?;
+                    acc.with_projections(opts.outputs.len(), &weights)
+                } else {
+                    acc
+                });
+            }
+            let acc = self.current.as_mut().expect("made above");
             let take = (seg - self.filled).min(len - offset);
             let part: Vec<&[f64]> = views.iter().map(|c| &c[offset..offset + take]).collect();
             acc.push(&part)?;
@@ -443,16 +480,27 @@ impl Segments<'_> {
             offset += take;
             if self.filled == seg {
                 opts.cancel.check()?;
-                acc.finish_into(&mut self.spectra)?;
                 self.filled = 0;
+                if self.projected {
+                    acc.finish_projections_into(&mut self.psds)?;
+                    for (kept, psd) in self.tilt.iter_mut().zip(&self.psds) {
+                        kept.push(psd[1..].iter().map(|&p| p as f32).collect());
+                    }
+                    continue;
+                }
+                acc.finish_into(&mut self.spectra)?;
                 if self.tf.is_none() {
                     let grid = &self.spectra.freqs_hz[1..];
-                    self.tf = Some(ground_tf(self.model, &opts.outputs, self.inputs, grid)?);
+                    let tf = ground_tf(self.model, &opts.outputs, self.inputs, grid)?;
+                    self.rows = dense_rows(&tf, self.inputs);
+                    self.tf = Some(tf);
                 }
-                let tf = self.tf.as_ref().expect("computed above");
-                let psds = segment_psds(self.map, tf, &mut self.spectra, self.term);
-                for (kept, psd) in self.tilt.iter_mut().zip(psds) {
-                    kept.push(psd);
+                self.map.apply_in_place(&mut self.spectra);
+                let nn = self.spectra.n_channels * self.spectra.n_channels;
+                let csd = &self.spectra.data[nn..];
+                for (o, kept) in self.tilt.iter_mut().enumerate() {
+                    let shape = (opts.outputs.len(), self.inputs.len());
+                    kept.push(ground_total_psd(&self.rows, shape, o, csd));
                 }
             }
         }
@@ -460,31 +508,42 @@ impl Segments<'_> {
     }
 }
 
-/// The PSDs (f32, enough for percentile bands) of the term `term` of the floor's motion of
-/// every output of `tf`, from the channels' cross-spectra of one segment, which become the
-/// inputs' in place: a finished segment reduced at once, so that memory stays bounded.
-fn segment_psds(
-    map: &GroundMap,
-    tf: &TransferMatrix,
-    spectra: &mut CrossSpectra,
-    term: &TermKind,
-) -> Vec<Vec<f32>> {
-    map.apply_in_place(spectra);
-    let nn = spectra.n_channels * spectra.n_channels;
-    let inputs = map.inputs();
-    let b = ground_budget(
-        tf,
-        &GroundCsd {
-            inputs: &inputs,
-            csd: &spectra.data[nn..],
-        },
-        &Readout::none(),
-    );
-    b.observables
+/// `tf`'s columns of `inputs`, dense: `rows[(k * n_outputs + o) * inputs.len() + i]` is
+/// `H_o,inputs[i]` at bin `k`.
+fn dense_rows(tf: &TransferMatrix, inputs: &[Input]) -> Vec<Complex64> {
+    let cols: Vec<usize> = inputs
         .iter()
-        .map(|ob| {
-            let psd = &ob.term(term).expect("the total's ground term").psd;
-            psd.iter().map(|&p| p as f32).collect()
+        .map(|&a| {
+            tf.input_index(a)
+                .expect("the budget's transfer matrix has every input")
+        })
+        .collect();
+    let n_out = tf.outputs.len();
+    let mut rows = Vec::with_capacity(tf.freqs_hz.len() * n_out * cols.len());
+    for k in 0..tf.freqs_hz.len() {
+        for o in 0..n_out {
+            rows.extend(cols.iter().map(|&c| tf.get(k, o, c)));
+        }
+    }
+    rows
+}
+
+/// The PSD (f32, enough for percentile bands) of output `o` driven by the whole motion of the
+/// floor, from one segment's cross-spectra of the inputs `csd` (`[bin][i][j]`, Hermitian) and
+/// the dense transfer rows ([`dense_rows`]): the term of [`ground_budget`] that adds to the
+/// total (`ground`, or `tilt` or `translation` alone), summed in its order so that the value is
+/// its value bit for bit, without the breakdown a segment does not keep.
+fn ground_total_psd(
+    rows: &[Complex64],
+    (n_out, n): (usize, usize),
+    o: usize,
+    csd: &[Complex64],
+) -> Vec<f32> {
+    (0..csd.len() / (n * n))
+        .map(|k| {
+            let h = &rows[(k * n_out + o) * n..(k * n_out + o + 1) * n];
+            let s = &csd[k * n * n..(k + 1) * n * n];
+            crate::noise::propagate_total(h, s) as f32
         })
         .collect()
 }

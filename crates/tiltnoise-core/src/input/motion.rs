@@ -317,6 +317,42 @@ impl GroundMap {
         }
     }
 
+    /// The weights of the channels' spectra that give, at a bin `f > 0`, the response
+    /// `sum_i h[i] U_i` to the inputs' spectra `U` (the displacements [`GroundMap::apply`]
+    /// describes): `h` (one transfer function per input, in channel order) becomes, in place,
+    /// the `g` of `sum_c g[c] X_c` over the channels' spectra `X`. The inertial corrections are
+    /// applied transposed, in reverse order, then each channel's factor to displacement; the
+    /// propagation of [`GroundMap::apply`]'s matrix through `h` is then `|sum_c g[c] X_c|^2`,
+    /// equal up to rounding.
+    pub fn channel_weights(&self, f: f64, h: &mut [Complex64]) {
+        assert_eq!(
+            h.len(),
+            self.channels.len(),
+            "one transfer function per channel of the map"
+        );
+        if self.is_identity() {
+            return;
+        }
+        let w2 = angle_psd_divisor(Quantity::Rate, f).expect("Welch bins above DC have f > 0");
+        let w = crate::units::angular(f);
+        // u_target += a u_partner turns sum_i h_i u_i into the same sum with h_partner += a
+        // h_target: the last correction made is the first undone.
+        for c in self.corrections.iter().rev() {
+            let coefficient = c.sign * (self.g_m_per_s2 / w2).powi(c.power);
+            let add = h[c.target] * coefficient;
+            h[c.partner] += add;
+        }
+        for (g, channel) in h.iter_mut().zip(&self.channels) {
+            let (phase, k) = factor_parts(channel.quantity);
+            *g *= phase;
+            match k {
+                0 => {}
+                1 => *g /= w,
+                _ => *g /= w2,
+            }
+        }
+    }
+
     /// The channels' series turned into the inputs' displacements (rad, m), one per channel,
     /// each sampled at `sample_rate_hz` and of one length: the same factors and corrections as
     /// [`GroundMap::apply`], applied to the DFT of the whole record (taken as periodic after

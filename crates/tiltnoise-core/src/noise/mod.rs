@@ -292,6 +292,28 @@ fn propagate(
     }
 }
 
+/// The whole motion's term `sum_ij conj(h_i) S_ij h_j` of one observable at one bin, from its
+/// transfer row `h` (one entry per input) and the inputs' Hermitian cross-spectral matrix `s`
+/// (row-major): the `all` of [`propagate`], summed in the same order (so equal to it bit for
+/// bit) and clipped the same way, without the breakdown per input and per motion.
+pub(crate) fn propagate_total(h: &[Complex64], s: &[Complex64]) -> f64 {
+    let n = h.len();
+    let mut all = 0.0;
+    for i in 0..n {
+        let diagonal = h[i].norm_sqr() * s[i * n + i].re;
+        all += diagonal;
+        let row = h[i].conj();
+        for j in i + 1..n {
+            all += 2.0 * (row * s[i * n + j] * h[j]).re;
+        }
+    }
+    if all < 0.0 {
+        0.0
+    } else {
+        all
+    }
+}
+
 /// Builds the budget of every output of `tf` from the cross-spectra of the floor's inputs (same
 /// grid as `tf`) and the readout noise: `tilt` and `tilt.<axis>` for the tilt inputs,
 /// `translation` and `translation.<axis>` for the translations, and `ground` (first) when there

@@ -116,10 +116,14 @@ pub struct WelchAccumulator {
     filled: usize,
     /// Channel-major `[channel][n_freqs]` FFT of the last segment.
     spectra: Vec<Complex64>,
-    /// Mean: `[freq][i][j]` running sums of `conj(X_i) X_j` (upper triangle `j >= i` only).
-    sums: Vec<Complex64>,
+    /// Mean: running sums of `conj(X_i) X_j` over the upper triangle `j >= i`, pair by pair in
+    /// row order ([`pair_index`]), each pair's real parts over the bins, then its imaginary
+    /// parts: `[pair][re, im][freq]`, so that one pair's update is a pass over contiguous bins.
+    sums: Vec<f64>,
     /// Median: `[segment][channel][freq]` all segment spectra.
     stored: Vec<Complex64>,
+    /// Mean of projections ([`WelchAccumulator::with_projections`]) instead of the pair sums.
+    projection: Option<Projection>,
     n_segments: usize,
     n_samples: usize,
     /// Polled before each segment.
@@ -156,7 +160,7 @@ impl WelchAccumulator {
         let fft = RealFftPlanner::<f64>::new().plan_fft_forward(len);
         let fft_scratch = fft.make_scratch_vec();
         let sums = match cfg.averaging {
-            Averaging::Mean => vec![Complex64::new(0.0, 0.0); n_freqs * n_channels * n_channels],
+            Averaging::Mean => vec![0.0; 2 * n_freqs * n_pairs(n_channels)],
             Averaging::Median => Vec::new(),
         };
         Ok(Self {
@@ -174,10 +178,45 @@ impl WelchAccumulator {
             spectra: vec![Complex64::new(0.0, 0.0); n_channels * n_freqs],
             sums,
             stored: Vec::new(),
+            projection: None,
             n_segments: 0,
             n_samples: 0,
             cancel: Cancel::never(),
         })
+    }
+
+    /// The accumulator of the PSDs of `n_outputs` combinations of the channels instead of their
+    /// cross-spectra: output `o` at bin `k` is `Y_o = sum_c weights[(k * n_outputs + o) *
+    /// n_channels + c] X_c`, and its mean `|Y_o|^2` over the segments, scaled as a PSD, is what
+    /// [`WelchAccumulator::finish_projections_into`] returns. Equal, up to rounding, to
+    /// `sum_ij conj(w_i) S_ij w_j` of the cross-spectral matrix `S` ([`WelchAccumulator::finish`])
+    /// at bin `k`, at `n_outputs * n_channels` products per bin instead of the
+    /// matrix's `n_channels (n_channels + 1) / 2` and a propagation: the cheaper road when only
+    /// a few combinations of many channels are wanted, and never negative.
+    ///
+    /// # Panics
+    ///
+    /// If the averaging is not [`Averaging::Mean`] (a median of cross-spectra is not the median
+    /// of a projection), or `weights` has not `n_freqs * n_outputs * n_channels` entries.
+    pub fn with_projections(mut self, n_outputs: usize, weights: &[Complex64]) -> Self {
+        assert_eq!(
+            self.cfg.averaging,
+            Averaging::Mean,
+            "projections are averaged by their mean"
+        );
+        assert_eq!(
+            weights.len(),
+            self.n_freqs * n_outputs * self.n_channels,
+            "one weight per bin, output and channel"
+        );
+        self.sums = Vec::new();
+        self.projection = Some(Projection::new(
+            n_outputs,
+            self.n_channels,
+            self.n_freqs,
+            weights,
+        ));
+        self
     }
 
     /// The accumulator polling `cancel` before each segment: a push after the token is set
@@ -305,14 +344,18 @@ impl WelchAccumulator {
                 })?;
         }
         match self.cfg.averaging {
+            Averaging::Mean if self.projection.is_some() => {
+                let p = self.projection.as_mut().expect("checked");
+                p.push(&mut self.spectra, nc, nf);
+            }
             Averaging::Mean => {
-                for k in 0..nf {
-                    let block = &mut self.sums[k * nc * nc..(k + 1) * nc * nc];
-                    for i in 0..nc {
-                        let xi = self.spectra[i * nf + k].conj();
-                        for j in i..nc {
-                            block[i * nc + j] += xi * self.spectra[j * nf + k];
-                        }
+                let mut pairs = self.sums.chunks_exact_mut(2 * nf);
+                for i in 0..nc {
+                    let xi = &self.spectra[i * nf..(i + 1) * nf];
+                    for j in i..nc {
+                        let xj = &self.spectra[j * nf..(j + 1) * nf];
+                        let (re, im) = pairs.next().expect("one sum per pair").split_at_mut(nf);
+                        accumulate_pair(xi, xj, re, im);
                     }
                 }
             }
@@ -352,12 +395,79 @@ impl WelchAccumulator {
     /// As [`WelchAccumulator::finish`]; the accumulator is emptied all the same.
     pub fn finish_into(&mut self, out: &mut CrossSpectra) -> Result<(), SpectralError> {
         let written = self.write_into(out);
-        self.sums.fill(Complex64::new(0.0, 0.0));
+        self.reset();
+        written
+    }
+
+    /// Empties the accumulator for the next record of the same channels.
+    fn reset(&mut self) {
+        self.sums.fill(0.0);
         self.stored.clear();
+        if let Some(p) = self.projection.as_mut() {
+            p.sums.fill(0.0);
+            p.held = 0;
+        }
         self.n_segments = 0;
         self.n_samples = 0;
         self.filled = 0;
+    }
+
+    /// The PSDs of the projections ([`WelchAccumulator::with_projections`]) into `out`
+    /// (`out[o][k]`, `n_freqs` bins from DC, in the squared unit of the weighted sum per Hz,
+    /// one-sided), and the accumulator emptied for the next record as
+    /// [`WelchAccumulator::finish_into`] does.
+    ///
+    /// # Errors
+    ///
+    /// [`SpectralError::SeriesTooShort`] if not even one segment was complete; the
+    /// accumulator is emptied all the same.
+    ///
+    /// # Panics
+    ///
+    /// If the accumulator was not made with projections.
+    pub fn finish_projections_into(
+        &mut self,
+        out: &mut Vec<Vec<f64>>,
+    ) -> Result<(), SpectralError> {
+        if let Some(p) = self.projection.as_mut() {
+            p.flush(self.n_channels, self.n_freqs);
+        }
+        let written = self.write_projections(out);
+        self.reset();
         written
+    }
+
+    fn write_projections(&self, out: &mut Vec<Vec<f64>>) -> Result<(), SpectralError> {
+        let p = self
+            .projection
+            .as_ref()
+            .expect("an accumulator made with projections");
+        if self.n_segments == 0 {
+            return Err(SpectralError::SeriesTooShort {
+                n_samples: self.n_samples,
+                segment_len: self.cfg.segment_len,
+            });
+        }
+        let (nf, len, nseg) = (self.n_freqs, self.cfg.segment_len, self.n_segments);
+        out.resize(p.n_outputs, Vec::new());
+        for (o, psd) in out.iter_mut().enumerate() {
+            psd.clear();
+            psd.extend(
+                p.sums[o * nf..(o + 1) * nf]
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &s)| {
+                        // The one-sided doubling of every bin but DC and an even length's Nyquist.
+                        let one_sided = if k == 0 || (len % 2 == 0 && k == nf - 1) {
+                            1.0
+                        } else {
+                            2.0
+                        };
+                        s * (self.scale * one_sided / nseg as f64)
+                    }),
+            );
+        }
+        Ok(())
     }
 
     fn write_into(&self, out: &mut CrossSpectra) -> Result<(), SpectralError> {
@@ -384,11 +494,13 @@ impl WelchAccumulator {
         data.resize(nf * nc * nc, Complex64::new(0.0, 0.0));
         match self.cfg.averaging {
             Averaging::Mean => {
-                for k in 0..nf {
-                    let f = self.scale * one_sided(k) / nseg as f64;
-                    for i in 0..nc {
-                        for j in i..nc {
-                            data[(k * nc + i) * nc + j] = self.sums[(k * nc + i) * nc + j] * f;
+                for i in 0..nc {
+                    for j in i..nc {
+                        let p = pair_index(nc, i, j);
+                        let (re, im) = self.sums[2 * p * nf..2 * (p + 1) * nf].split_at(nf);
+                        for (k, (&r, &m)) in re.iter().zip(im).enumerate() {
+                            let f = self.scale * one_sided(k) / nseg as f64;
+                            data[(k * nc + i) * nc + j] = Complex64::new(r, m) * f;
                         }
                     }
                 }
@@ -431,6 +543,135 @@ impl WelchAccumulator {
         out.n_channels = nc;
         out.n_segments = nseg;
         Ok(())
+    }
+}
+
+/// Segments whose spectra a projection holds before it adds them: the weights, the largest
+/// array of the work (`n_outputs * n_channels` complex numbers per bin), are then read once
+/// for this many segments rather than once per segment.
+const PROJECTION_BATCH: usize = 4;
+
+/// Bins of one pass of a batch's projection: the outputs' sums of every held segment for
+/// these bins stay in the first-level caches.
+const PROJECTION_BINS: usize = 512;
+
+/// Per-bin linear combinations of the channels and the running sums of their squared moduli.
+struct Projection {
+    n_outputs: usize,
+    /// Planar weights, `[output][channel][freq]`: real parts, then imaginary parts.
+    weights_re: Vec<f64>,
+    weights_im: Vec<f64>,
+    /// `[output][freq]`: sums over the segments of `|sum_c w_c X_c|^2`.
+    sums: Vec<f64>,
+    /// The spectra (`[channel][freq]`) of the segments held, the first `held` of them.
+    batch: Vec<Vec<Complex64>>,
+    held: usize,
+    /// One pass's `sum_c w_c X_c` of every held segment, planar `[segment][bin]`.
+    y_re: Vec<f64>,
+    y_im: Vec<f64>,
+}
+
+impl Projection {
+    /// From weights `[freq][output][channel]`.
+    fn new(n_outputs: usize, nc: usize, nf: usize, weights: &[Complex64]) -> Projection {
+        let mut weights_re = vec![0.0; n_outputs * nc * nf];
+        let mut weights_im = vec![0.0; n_outputs * nc * nf];
+        for (k, w) in weights.chunks_exact(n_outputs * nc).enumerate() {
+            for (oc, w) in w.iter().enumerate() {
+                weights_re[oc * nf + k] = w.re;
+                weights_im[oc * nf + k] = w.im;
+            }
+        }
+        Projection {
+            n_outputs,
+            weights_re,
+            weights_im,
+            sums: vec![0.0; n_outputs * nf],
+            batch: Vec::new(),
+            held: 0,
+            y_re: vec![0.0; PROJECTION_BATCH * PROJECTION_BINS],
+            y_im: vec![0.0; PROJECTION_BATCH * PROJECTION_BINS],
+        }
+    }
+
+    /// Holds one segment's channel-major `[channel][freq]` spectra, swapping `spectra` for an
+    /// earlier buffer (the caller overwrites it), and adds the batch once it is full.
+    fn push(&mut self, spectra: &mut Vec<Complex64>, nc: usize, nf: usize) {
+        if self.batch.len() == self.held {
+            self.batch
+                .push(vec![Complex64::new(0.0, 0.0); spectra.len()]);
+        }
+        std::mem::swap(spectra, &mut self.batch[self.held]);
+        self.held += 1;
+        if self.held == PROJECTION_BATCH {
+            self.flush(nc, nf);
+        }
+    }
+
+    /// Adds the held segments' `|Y_o|^2`, segment after segment at every bin (the order of
+    /// adding them one at a time): output by output, channel by channel over contiguous bins,
+    /// with the complex product and sum written out as `Complex64` forms them (`w X = (w_r x_r
+    /// - w_i x_i, w_r x_i + w_i x_r)`, summed from 0 in channel order).
+    fn flush(&mut self, nc: usize, nf: usize) {
+        let held = &self.batch[..self.held];
+        let mut start = 0;
+        while start < nf {
+            let end = (start + PROJECTION_BINS).min(nf);
+            let len = end - start;
+            for o in 0..self.n_outputs {
+                self.y_re.fill(0.0);
+                self.y_im.fill(0.0);
+                for c in 0..nc {
+                    let at = (o * nc + c) * nf;
+                    let wr = &self.weights_re[at + start..at + end];
+                    let wi = &self.weights_im[at + start..at + end];
+                    for (s, spectra) in held.iter().enumerate() {
+                        let x = &spectra[c * nf + start..c * nf + end];
+                        let yr = &mut self.y_re[s * len..(s + 1) * len];
+                        let yi = &mut self.y_im[s * len..(s + 1) * len];
+                        for ((((yr, yi), x), &a), &b) in
+                            yr.iter_mut().zip(yi.iter_mut()).zip(x).zip(wr).zip(wi)
+                        {
+                            *yr += a * x.re - b * x.im;
+                            *yi += a * x.im + b * x.re;
+                        }
+                    }
+                }
+                let sums = &mut self.sums[o * nf + start..o * nf + end];
+                for s in 0..held.len() {
+                    let yr = &self.y_re[s * len..(s + 1) * len];
+                    let yi = &self.y_im[s * len..(s + 1) * len];
+                    for ((sum, &r), &m) in sums.iter_mut().zip(yr).zip(yi) {
+                        *sum += r * r + m * m;
+                    }
+                }
+            }
+            start = end;
+        }
+        self.held = 0;
+    }
+}
+
+/// Number of pairs `(i, j)`, `j >= i`, of `n` channels: the upper triangle with its diagonal.
+fn n_pairs(n: usize) -> usize {
+    n * (n + 1) / 2
+}
+
+/// Position of the pair `(i, j)`, `i <= j < n`, in the row order of the upper triangle.
+fn pair_index(n: usize, i: usize, j: usize) -> usize {
+    // Rows 0 .. i hold n, n - 1, ..., n - i + 1 pairs.
+    i * n - i * i.saturating_sub(1) / 2 + (j - i)
+}
+
+/// `re[k] + i im[k] += conj(a[k]) b[k]` over the bins, rounded as `Complex64` arithmetic
+/// rounds it (`conj(a) * b` then the sum), so that the planar sums are the complex ones bit for
+/// bit; a loop over contiguous bins that the compiler vectorizes.
+#[inline]
+fn accumulate_pair(a: &[Complex64], b: &[Complex64], re: &mut [f64], im: &mut [f64]) {
+    for (((a, b), r), m) in a.iter().zip(b).zip(re.iter_mut()).zip(im.iter_mut()) {
+        let p = a.conj() * b;
+        *r += p.re;
+        *m += p.im;
     }
 }
 
@@ -629,6 +870,109 @@ mod tests {
                 Err(SpectralError::SeriesTooShort { n_samples: 0, .. })
             ));
         }
+    }
+
+    /// The accumulation walks the pairs in row order; `pair_index` must name the same slots.
+    #[test]
+    fn pairs_are_indexed_in_row_order() {
+        for n in 1..8 {
+            let mut next = 0;
+            for i in 0..n {
+                for j in i..n {
+                    assert_eq!(pair_index(n, i, j), next, "({i}, {j}) of {n}");
+                    next += 1;
+                }
+            }
+            assert_eq!(next, n_pairs(n));
+        }
+    }
+
+    /// The planar sums are the complex arithmetic's, bit for bit: six channels against the
+    /// sums written out as `Complex64` operations, the way the estimator has always formed them.
+    #[test]
+    fn planar_sums_are_the_complex_sums_bitwise() {
+        let chans: Vec<Vec<f64>> = (0..6).map(|c| series(900, 10 + c)).collect();
+        let views: Vec<&[f64]> = chans.iter().map(Vec::as_slice).collect();
+        let cfg = WelchConfig::new(128);
+        let got = csd_matrix(&views, 3.0, &cfg).unwrap();
+        // The same segments by hand: detrend, window, FFT, then complex sums per bin.
+        let (len, nf, nc) = (128, 65, 6);
+        let window = hann_periodic(len);
+        let w2: Vec<f64> = window.iter().map(|w| w * w).collect();
+        let scale = 1.0 / (3.0 * pairwise_sum(&w2));
+        let fft = RealFftPlanner::<f64>::new().plan_fft_forward(len);
+        let mut sums = vec![Complex64::new(0.0, 0.0); nf * nc * nc];
+        let n_seg = cfg.n_segments(900);
+        for s in 0..n_seg {
+            let spectra: Vec<Vec<Complex64>> = chans
+                .iter()
+                .map(|x| {
+                    let seg = &x[s * cfg.step()..s * cfg.step() + len];
+                    let mean = pairwise_sum(seg) / len as f64;
+                    let mut input: Vec<f64> = seg
+                        .iter()
+                        .zip(&window)
+                        .map(|(v, w)| (v - mean) * w)
+                        .collect();
+                    let mut out = fft.make_output_vec();
+                    fft.process(&mut input, &mut out).unwrap();
+                    out
+                })
+                .collect();
+            for k in 0..nf {
+                for i in 0..nc {
+                    for j in i..nc {
+                        sums[(k * nc + i) * nc + j] += spectra[i][k].conj() * spectra[j][k];
+                    }
+                }
+            }
+        }
+        for k in 0..nf {
+            let f = scale * if k == 0 || k == nf - 1 { 1.0 } else { 2.0 } / n_seg as f64;
+            for i in 0..nc {
+                for j in i..nc {
+                    let want = sums[(k * nc + i) * nc + j] * f;
+                    assert_eq!(got.get(k, i, j), want, "bin {k}, ({i}, {j})");
+                    assert_eq!(got.get(k, j, i), want.conj(), "bin {k}, ({j}, {i})");
+                }
+            }
+        }
+    }
+
+    /// A projection on one channel (weight 1) is that channel's PSD bit for bit (the same
+    /// products, sums and scaling), and a reused projecting accumulator is a fresh one; a
+    /// combination of two channels is `w^H S w` of their matrix to rounding.
+    #[test]
+    fn projections_are_the_matrix_seen_through_the_weights() {
+        let (a, b) = (series(700, 21), series(700, 22));
+        let cfg = WelchConfig::new(64);
+        let m = csd_matrix(&[&a, &b], 5.0, &cfg).unwrap();
+        let nf = m.n_freqs();
+        let (one, zero) = (Complex64::new(1.0, 0.0), Complex64::new(0.0, 0.0));
+        let w2 = Complex64::new(0.3, -1.7);
+        let weights: Vec<Complex64> = (0..nf).flat_map(|_| [zero, one, one, w2]).collect();
+        let mut acc = WelchAccumulator::new(2, 5.0, &cfg)
+            .unwrap()
+            .with_projections(2, &weights);
+        let mut out = Vec::new();
+        for _ in 0..2 {
+            acc.push(&[&a, &b]).unwrap();
+            acc.finish_projections_into(&mut out).unwrap();
+            assert_eq!(out[0], m.psd(1));
+            for (k, &got) in out[1].iter().enumerate() {
+                let s = m.matrix(k);
+                let want = (s[0] + w2.conj() * s[2] * one + s[1] * w2 + w2.norm_sqr() * s[3]).re;
+                let bound = (m.psd(0)[k].sqrt() + w2.norm() * m.psd(1)[k].sqrt()).powi(2);
+                // The rounding bound of the integration tests' `PROJECTION_C`: 8 eps per unit
+                // of n^2 + n_segments.
+                let gamma = 8.0 * (4.0 + m.n_segments as f64) * f64::EPSILON;
+                assert!((got - want).abs() <= gamma * bound, "bin {k}");
+            }
+        }
+        assert!(matches!(
+            acc.finish_projections_into(&mut out),
+            Err(SpectralError::SeriesTooShort { n_samples: 0, .. })
+        ));
     }
 
     #[test]

@@ -24,6 +24,7 @@ mod polezero_batch;
 mod rate_spectra;
 mod reference_precision;
 mod scenes;
+mod segment_projection;
 mod simulate;
 mod stability;
 mod subtract;

@@ -203,3 +203,19 @@ pub const LOW_FREQ_REL: f64 = 1e-12;
 /// range rounded once (half a unit) plus the reference's relative error on it (less than half
 /// a unit there).
 pub const SUBNORMAL_ABS: f64 = 5e-324;
+
+/// Per-segment budget PSD by projection (`|sum_c g_c X_c|^2` per Welch segment) against the
+/// cross-spectral matrix carried through the ground map and propagated (`h^H S h`), in units
+/// of `eps (n^2 + n_seg) B^2`, `B = sum_c |g|_c sqrt(S_cc)` (`S_cc` the channels' PSDs, `|g|`
+/// the map's weights taken in absolute value). Both sum the same `n_seg` segments (`n_seg u`
+/// of the sum of the moduli each, which Cauchy-Schwarz bounds by `B^2`); the matrix road rounds
+/// each of the `n (n + 1) / 2` products `conj(X_i) X_j` (a complex product: `sqrt(2) 2 u`),
+/// scales and corrects them (one product and one sum each, `2 u`), and propagates them (a
+/// triple complex product and a doubling each, `3 sqrt(2) 2 u`, summed over `n^2` terms:
+/// `n^2 u`); the projection rounds `n` complex products and their sum, and a square. Every term
+/// is at most `(2 + 2 + 9) u <= 8 eps` of its bound `B^2` per unit of `n^2 + n_seg`.
+pub const PROJECTION_C: f64 = 8.0;
+
+/// The unit roundoff of `f32`, in which a budget keeps its per-segment PSDs: one rounding of
+/// the value.
+pub const F32_U: f64 = f32::EPSILON as f64 / 2.0;
