@@ -1,4 +1,4 @@
-//! The budget job: a record of the floor's motion (a time series of tilt and translation
+//! The noise budget, computed from series or spectra: a record of the floor's motion (a time series of tilt and translation
 //! channels, or tilt spectra) -> the cross-spectra of the model's inputs -> transfer functions
 //! on the same grid -> the noise budget of the chosen observables (tilt, translation and
 //! ground, readout, thermal, user-named terms), whole record and per segment, and read at

@@ -1,7 +1,7 @@
 //! Checks of a budget's options that depend on which options were given: the percentile band
-//! needs segments and ordered percentiles; and the kinds of tilt input, against which the
-//! budget job refuses the options of the other kind. Each front end spells the options its
-//! own way ([`OptionKey`]).
+//! needs segments and ordered percentiles; and the kinds of tilt input, against which a budget
+//! refuses the options of the other kind. Each front end spells the options its own way
+//! ([`OptionKey`]).
 
 use crate::error::Shown;
 use crate::option_key::{self, OptionKey};

@@ -58,7 +58,7 @@
 //!
 //! * [`TiltInput`]: a [`TiltSeries`] or [`TiltSpectra`], each with its [`Provenance`] for the
 //!   output files.
-//! * A [`SeriesSource`]: chunked, sequential access to a series (the budget job streams long
+//! * A [`SeriesSource`]: chunked, sequential access to a series (the noise budget streams long
 //!   records through it); [`TiltSeries`] is one, held in memory.
 
 mod axis_map;

@@ -1,8 +1,8 @@
-//! [`SeriesSource`]: what the budget job needs of a record of the floor's motion, so that it can
-//! stream a long record from a file (`tiltnoise-io`'s HDF5 reader) or run on one held in memory
-//! ([`TiltSeries`], or arrays handed over by the Python package) without knowing which. Only
-//! samples and what each channel measures: where they came from ([`super::Provenance`]) is the
-//! caller's to record.
+//! [`SeriesSource`]: what the noise budget needs of a record of the floor's motion, so that it
+//! can stream a long record from a file (`tiltnoise-io`'s HDF5 reader) or run on one held in
+//! memory ([`TiltSeries`], read from a file or built from arrays a caller holds) without knowing
+//! which. Only samples and what each channel measures: where they came from
+//! ([`super::Provenance`]) is the caller's to record.
 
 use super::error::InputError;
 use super::motion::GroundChannel;
