@@ -13,7 +13,7 @@
 //! whole decades and limited to [`Panel::max_decades`] below its top, and lines are clipped at
 //! the frame (not flattened onto it).
 
-use super::{DrawError, Figure, FONT_FAMILY};
+use super::{DrawError, Figure, ImageFormat, FONT_FAMILY};
 use plotters::coord::Shift;
 use plotters::element::{Circle, DashedPathElement, DottedPathElement, PathElement, Polygon};
 use plotters::prelude::*;
@@ -435,9 +435,14 @@ impl Figure for LogLogFigure {
         self.size
     }
 
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        format: ImageFormat,
+    ) -> Result<(), DrawError> {
         let (w, h) = root.dim_in_pixel();
         let ts = TextSizes::for_figure(w, h);
+        let raster = format == ImageFormat::Png;
         let mut area = root.clone();
         if let Some(title) = &self.title {
             let (top, rest) = area.split_vertically((ts.title * 2.0).round() as u32);
@@ -495,9 +500,9 @@ impl Figure for LogLogFigure {
             if self.shared_legend {
                 let mut quiet = panel.clone();
                 quiet.legend = LegendPlacement::Hidden;
-                draw_panel(cell, &quiet, &ts)?;
+                draw_panel(cell, &quiet, &ts, raster)?;
             } else {
-                draw_panel(cell, panel, &ts)?;
+                draw_panel(cell, panel, &ts, raster)?;
             }
         }
         if free_cell {
@@ -588,17 +593,19 @@ impl PlotRect {
     }
 }
 
-/// Draws one panel into `area` (its whole extent: title, axes, frame, curves, legend).
+/// Draws one panel into `area` (its whole extent: title, axes, frame, curves, legend); `raster`
+/// when the figure is a bitmap (PNG), whose polylines are split where they turn back.
 pub fn draw_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     panel: &Panel,
     ts: &TextSizes,
+    raster: bool,
 ) -> Result<(), DrawError> {
     match panel.y_scale {
-        YScale::Log => draw_log_panel(area, panel, ts, None),
+        YScale::Log => draw_log_panel(area, panel, ts, None, raster),
         YScale::Linear { tick_step } => {
             let (log, ticks) = linear_as_log(panel, panel.resolved_y_range(), tick_step);
-            draw_log_panel(area, &log, ts, Some(ticks))
+            draw_log_panel(area, &log, ts, Some(ticks), raster)
         }
     }
 }
@@ -610,6 +617,7 @@ fn draw_log_panel<DB: DrawingBackend>(
     panel: &Panel,
     ts: &TextSizes,
     linear_ticks: Option<Vec<(f64, String)>>,
+    raster: bool,
 ) -> Result<(), DrawError> {
     let xr = panel.resolved_x_range();
     let yr = panel.resolved_y_range();
@@ -718,6 +726,7 @@ fn draw_log_panel<DB: DrawingBackend>(
         rect: &rect,
         xr,
         yr,
+        raster,
     };
     draw_data(&mut chart, &data)?;
 
@@ -825,6 +834,8 @@ struct PanelData<'a> {
     rect: &'a PlotRect,
     xr: (f64, f64),
     yr: (f64, f64),
+    /// A bitmap (PNG): polylines are split at reversals (see [`split_at_reversals`]).
+    raster: bool,
 }
 
 /// The band, then the curves, each reduced to the pixel grid.
@@ -848,7 +859,7 @@ where
     }
     for (line, style) in d.lines {
         let line = decimate(line, d.rect, d.xr, d.yr);
-        if RASTER.with(|r| r.get()) {
+        if d.raster {
             for run in split_at_reversals(&line, d.rect, d.xr, d.yr) {
                 draw_polyline(chart, run, *style)?;
             }
@@ -1301,23 +1312,6 @@ pub(crate) fn decimate(
 // (stroke-miterlimit 4), and a noisy curve stays one element instead of thousands. Raster
 // output splits at every reversal (the bitmap backend draws unlimited miters: spikes above a
 // noisy thick line, capped undamped peaks).
-thread_local! {
-    /// Whether the figure being drawn on this thread is a raster image (set by
-    /// [`super::render`] for the duration of one drawing).
-    static RASTER: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-}
-
-/// Marks this thread's drawing as raster (`true`) or vector until the guard is dropped.
-pub(crate) fn raster_scope(raster: bool) -> impl Drop {
-    struct Restore(bool);
-    impl Drop for Restore {
-        fn drop(&mut self) {
-            RASTER.with(|r| r.set(self.0));
-        }
-    }
-    Restore(RASTER.with(|r| r.replace(raster)))
-}
-
 /// Cuts a polyline where it turns back on itself by more than 90 degrees in pixel space (the two
 /// sides of a resonance peak drawn in one pixel column): a thick plotters path joins such a
 /// U-turn with a degenerate miter and drops the segments around it, so an undamped peak would

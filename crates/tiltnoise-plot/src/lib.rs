@@ -183,8 +183,12 @@ impl<F: Figure> Figure for Resized<'_, F> {
         self.size
     }
 
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
-        self.inner.draw(root)
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        format: ImageFormat,
+    ) -> Result<(), DrawError> {
+        self.inner.draw(root, format)
     }
 }
 
@@ -216,8 +220,13 @@ pub trait Figure {
     /// Width and height in pixels (SVG: user units of the same size).
     fn size(&self) -> (u32, u32);
 
-    /// Draws the figure.
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError>;
+    /// Draws the figure onto `root`, a drawing of the file kind `format` (a bitmap draws some
+    /// lines otherwise than a vector image).
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        format: ImageFormat,
+    ) -> Result<(), DrawError>;
 }
 
 /// Registers the embedded font with plotters, once per process. Every later call returns the
@@ -254,7 +263,6 @@ pub fn ensure_font() -> Result<(), DrawError> {
 /// [`DrawError`] if the font cannot be registered, drawing fails or the PNG cannot be encoded.
 pub fn render(format: ImageFormat, figure: &impl Figure) -> Result<Vec<u8>, DrawError> {
     ensure_font()?;
-    let _raster = chart::raster_scope(format == ImageFormat::Png);
     let (w, h) = figure.size();
     if u64::from(w) * u64::from(h) > MAX_PIXELS {
         return Err(DrawError(format!(
@@ -274,7 +282,7 @@ pub fn render(format: ImageFormat, figure: &impl Figure) -> Result<Vec<u8>, Draw
             {
                 let root = GlyphPlacement::new(BitMapBackend::with_buffer(&mut rgb, (w, h)))
                     .into_drawing_area();
-                draw_on(&root, figure)?;
+                draw_on(&root, figure, format)?;
                 root.present()
                     .map_err(|e| DrawError(format!("cannot finish the bitmap: {e}")))?;
             }
@@ -288,7 +296,7 @@ pub fn render(format: ImageFormat, figure: &impl Figure) -> Result<Vec<u8>, Draw
             let mut text = String::new();
             {
                 let root = SVGBackend::with_string(&mut text, (w, h)).into_drawing_area();
-                draw_on(&root, figure)?;
+                draw_on(&root, figure, format)?;
                 root.present()
                     .map_err(|e| DrawError(format!("cannot finish SVG: {e}")))?;
             }
@@ -300,9 +308,10 @@ pub fn render(format: ImageFormat, figure: &impl Figure) -> Result<Vec<u8>, Draw
 fn draw_on<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     figure: &impl Figure,
+    format: ImageFormat,
 ) -> Result<(), DrawError> {
     root.fill(&plotters::style::WHITE)?;
-    figure.draw(root)
+    figure.draw(root, format)
 }
 
 #[cfg(test)]

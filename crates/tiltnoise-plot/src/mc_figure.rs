@@ -247,7 +247,11 @@ impl Figure for McFigure {
         DEFAULT_SIZE
     }
 
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        _format: ImageFormat,
+    ) -> Result<(), DrawError> {
         let (w, h) = root.dim_in_pixel();
         let ts = TextSizes::for_figure(w, h);
         let (top, rest) = root.split_vertically((ts.title * 2.2) as u32);

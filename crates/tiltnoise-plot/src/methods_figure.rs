@@ -37,7 +37,11 @@ impl Figure for MethodsChart {
         DEFAULT_SIZE
     }
 
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        _format: ImageFormat,
+    ) -> Result<(), DrawError> {
         root.fill(&WHITE)?;
         // Text, markers and margins scale with the drawing area (--size, --dpi).
         let (w, h) = root.dim_in_pixel();

@@ -318,7 +318,11 @@ impl Figure for TimeSeriesData {
         (1400, 450 * self.panels.len().max(1) as u32 + 60)
     }
 
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, Shift>,
+        _format: ImageFormat,
+    ) -> Result<(), DrawError> {
         let (w, h) = root.dim_in_pixel();
         let ts = TextSizes::for_figure(w, h);
         let (top, rest) = root.split_vertically((ts.title * 2.0).round() as u32);

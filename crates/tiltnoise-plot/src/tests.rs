@@ -111,7 +111,11 @@ fn drawing_error_is_returned_in_every_format() {
         fn size(&self) -> (u32, u32) {
             (100, 100)
         }
-        fn draw<DB: DrawingBackend>(&self, _: &DrawingArea<DB, Shift>) -> Result<(), DrawError> {
+        fn draw<DB: DrawingBackend>(
+            &self,
+            _: &DrawingArea<DB, Shift>,
+            _: ImageFormat,
+        ) -> Result<(), DrawError> {
             Err(DrawError("deliberate".to_string()))
         }
     }
