@@ -102,3 +102,5 @@ def test_arrays_and_json_are_the_items(result, record, cli, tmp_path):
     rows = [l.split(",") for l in theirs.read_text().splitlines() if not l.startswith("#")][1:]
     np.testing.assert_array_equal(np.array([float(r[3]) for r in rows]), result.ratio)
     np.testing.assert_array_equal(np.array([float(r[4]) for r in rows]), result.sigma)
+    # The command line's `--format json` is the same document.
+    assert json.loads(cli("visibility", "--measured", record, "--format", "json")) == doc

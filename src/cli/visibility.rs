@@ -20,8 +20,9 @@ pub(crate) struct VisibilityArgs {
     /// Output CSV `mode,observable,reference,ratio,sigma` for `fit --visibility`.
     #[arg(long, value_name = "PATH")]
     save: Option<PathBuf>,
-    /// Output format on the terminal: table (the peaks and the ratios), or csv (the file
-    /// --save writes; `wrote` lines then go to standard error).
+    /// Output format on the terminal: table (the peaks and the ratios), csv (the file --save
+    /// writes) or json (the peaks, the skipped modes and the ratios, as Python's
+    /// `Visibilities.to_json()`); with csv and json, `wrote` lines go to standard error.
     #[arg(long, value_enum, default_value_t = VisibilityFormat::Table)]
     format: VisibilityFormat,
 }
@@ -31,6 +32,7 @@ pub(crate) struct VisibilityArgs {
 enum VisibilityFormat {
     Table,
     Csv,
+    Json,
 }
 
 /// Runs `tiltnoise visibility`: the visibility job run on `--measured`, the table or the CSV
@@ -56,11 +58,14 @@ pub(crate) fn run_visibility(params: &Params, args: VisibilityArgs, run: &mut Ru
     match args.format {
         VisibilityFormat::Table => write!(run.out, "{}", table(&result))?,
         VisibilityFormat::Csv => write!(run.out, "{}", result.csv())?,
+        VisibilityFormat::Json => {
+            writeln!(run.out, "{}", serde_json::to_string_pretty(&result.json())?)?
+        }
     }
     let Some(path) = &args.save else {
         return Ok(());
     };
-    run.write_outputs(args.format == VisibilityFormat::Csv, |stage| {
+    run.write_outputs(args.format != VisibilityFormat::Table, |stage| {
         result.save(stage, path).map_err(super::job_error)
     })
 }

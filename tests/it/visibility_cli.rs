@@ -41,6 +41,28 @@ fn simulated_record_to_fitted_offset() {
         let ratio: f64 = row.split(',').nth(3).unwrap().parse().unwrap();
         assert!(table.contains(&format!("{ratio:.5e}")), "{row}\n{table}");
     }
+    // `--format json` holds the CSV's rows, bit for bit (shortest round-trip decimals).
+    let printed = tiltnoise(&["visibility", "--measured", &record, "--format", "json"]);
+    assert!(printed.status.success(), "{}", stderr(&printed));
+    let doc: serde_json::Value = serde_json::from_slice(&printed.stdout).unwrap();
+    let rows: Vec<Vec<&str>> = (csv.lines().filter(|l| !l.starts_with('#')).skip(1))
+        .map(|l| l.split(',').collect())
+        .collect();
+    let items = doc["visibilities"].as_array().unwrap();
+    assert_eq!(items.len(), rows.len());
+    for (item, row) in items.iter().zip(&rows) {
+        assert_eq!(item["mode"].as_u64().unwrap().to_string(), row[0]);
+        assert_eq!(item["observable"].as_str().unwrap(), row[1]);
+        assert_eq!(item["reference"].as_str().unwrap(), row[2]);
+        for (key, column) in [("ratio", 3), ("sigma", 4)] {
+            let parsed: f64 = row[column].parse().unwrap();
+            assert_eq!(
+                item[key].as_f64().unwrap().to_bits(),
+                parsed.to_bits(),
+                "{row:?}"
+            );
+        }
+    }
 
     let toml = tiltnoise(&["params"]).stdout;
     let mut toml = String::from_utf8(toml).unwrap();
