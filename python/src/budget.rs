@@ -28,12 +28,13 @@ use tiltnoise_core::input::{
 };
 use tiltnoise_core::model::{Input, Model, Observable};
 use tiltnoise_core::noise::equivalent::referred_terms;
-use tiltnoise_core::noise::{BudgetReport, SpectralSource};
+use tiltnoise_core::noise::SpectralSource;
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::repeats::refuse_repeats;
-use tiltnoise_io::{RunMeta, Staging};
-use tiltnoise_job::budget::{BudgetRequest, BudgetResult, TiltSource, WelchRequest};
+use tiltnoise_job::budget::{BudgetOutcome, BudgetRequest, SaveOptions, TiltSource, WelchRequest};
+use tiltnoise_job::files::{OutputKind, Staging};
+use tiltnoise_job::{Invocation, Outcome, Silent};
 
 /// A record of the floor's motion handed over as arrays: one channel per input, in canonical
 /// order, each in the SI unit of its quantity.
@@ -524,7 +525,7 @@ pub fn budget(
         .collect::<Vec<_>>()
         .join(",");
     let cancel = Cancel::new();
-    let result = interrupt::watch(py, &cancel, || -> PyResult<(BudgetResult, Inputs)> {
+    let result = interrupt::watch(py, &cancel, || -> PyResult<(BudgetOutcome, Inputs)> {
         let mut notes = Vec::new();
         for (((input, data), channel), &(factor, stated)) in channels
             .iter_mut()
@@ -580,14 +581,19 @@ pub fn budget(
             measured,
             at_hz: at,
             at_band,
+            invocation: Invocation::of_this_process(),
         };
         let inputs = Inputs::of_params(params.file.as_deref())
             .with_all(job_args::python_names(req.input_files(), &[]));
-        let result = tiltnoise_job::budget::run(req, &cancel, &mut |_, _| {});
+        let result = tiltnoise_job::budget::run(req, &cancel, &Silent);
         Ok((result.map_err(job_args::job_error)?, inputs))
     })?;
-    let (BudgetResult { report, input }, inputs) = result;
-    Ok(Budget::new(&model, report, params, inputs, input))
+    let (outcome, inputs) = result;
+    Ok(Budget {
+        outcome,
+        params,
+        inputs,
+    })
 }
 
 /// Noise budget of X, phi and phi_a (or any observables) from a tilt file (the command line's
@@ -669,16 +675,21 @@ pub fn budget_from_file(
         measured,
         at_hz: at,
         at_band,
+        invocation: Invocation::of_this_process(),
     };
     let inputs = Inputs::of_params(params.file.as_deref()).with_all(job_args::python_names(
         req.input_files(),
         &[("tilt", "path")],
     ));
     let cancel = Cancel::new();
-    let BudgetResult { report, input } = interrupt::watch(py, &cancel, || {
-        tiltnoise_job::budget::run(req, &cancel, &mut |_, _| {}).map_err(job_args::job_error)
+    let outcome = interrupt::watch(py, &cancel, || {
+        tiltnoise_job::budget::run(req, &cancel, &Silent).map_err(job_args::job_error)
     })?;
-    Ok(Budget::new(&model, report, params, inputs, input))
+    Ok(Budget {
+        outcome,
+        params,
+        inputs,
+    })
 }
 
 /// A noise budget: one-sided spectra of each observable's terms on one frequency grid.
@@ -694,38 +705,17 @@ pub fn budget_from_file(
 #[pyclass(module = "tiltnoise", frozen)]
 #[derive(serde::Serialize, serde::Deserialize)]
 pub struct Budget {
-    report: BudgetReport,
+    /// The job's outcome: the report, the input's provenance and the run's.
+    outcome: BudgetOutcome,
     params: PyParams,
-    modes: Vec<(usize, f64)>,
-    input: InputMeta,
     /// The files read: no `save` may replace one.
     inputs: Inputs,
 }
 
 impl Budget {
-    fn new(
-        model: &Model,
-        report: BudgetReport,
-        params: PyParams,
-        inputs: Inputs,
-        input: InputMeta,
-    ) -> Budget {
-        let modes = tiltnoise_core::modes::NormalModes::new(model)
-            .modes
-            .iter()
-            .map(|m| (m.index, m.frequency_hz))
-            .collect();
-        Budget {
-            report,
-            params,
-            modes,
-            input,
-            inputs,
-        }
-    }
-
     fn observable(&self, name: &str) -> PyResult<&tiltnoise_core::noise::ObservableBudget> {
         let observables: Vec<&str> = self
+            .outcome
             .report
             .budget
             .observables
@@ -733,7 +723,7 @@ impl Budget {
             .map(|o| o.observable.name())
             .collect();
         Observable::from_name(name)
-            .and_then(|o| self.report.budget.observable(o))
+            .and_then(|o| self.outcome.report.budget.observable(o))
             .ok_or_else(|| {
                 pyo3::exceptions::PyKeyError::new_err(format!(
                     "observable {name:?} is not in the budget; it has {}",
@@ -773,22 +763,15 @@ fn read_only_dict<'py>(d: Bound<'py, PyDict>) -> PyResult<Bound<'py, PyAny>> {
     py.import("types")?.getattr("MappingProxyType")?.call1((d,))
 }
 
-impl Budget {
-    /// The provenance written into files: this process, the budget's parameters and modes.
-    fn run_meta(&self) -> RunMeta {
-        RunMeta {
-            modes: self.modes.clone(),
-            ..RunMeta::of_this_run(&self.params.inner, None)
-        }
-    }
-}
-
 #[pymethods]
 impl Budget {
     /// Frequencies (Hz), increasing, all > 0: the files' ``frequency_hz`` (read-only).
     #[getter]
     fn frequency_hz<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        arrays::read_only(PyArray1::from_slice(py, &self.report.budget.freqs_hz))
+        arrays::read_only(PyArray1::from_slice(
+            py,
+            &self.outcome.report.budget.freqs_hz,
+        ))
     }
 
     /// The same as ``frequency_hz`` (the name of ``transfer``'s argument).
@@ -800,7 +783,8 @@ impl Budget {
     /// The observables, in report order (``X``, ``phi``, ``phi_a``).
     #[getter]
     fn observables(&self) -> Vec<&'static str> {
-        self.report
+        self.outcome
+            .report
             .budget
             .observables
             .iter()
@@ -814,7 +798,7 @@ impl Budget {
     #[getter]
     fn terms<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let d = PyDict::new(py);
-        for ob in &self.report.budget.observables {
+        for ob in &self.outcome.report.budget.observables {
             let t = PyDict::new(py);
             for term in &ob.terms {
                 t.set_item(term.name(), fixed_asd(py, &term.psd)?)?;
@@ -829,7 +813,7 @@ impl Budget {
     #[getter]
     fn total<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let d = PyDict::new(py);
-        for ob in &self.report.budget.observables {
+        for ob in &self.outcome.report.budget.observables {
             d.set_item(ob.observable.name(), fixed_asd(py, &ob.total())?)?;
         }
         read_only_dict(d)
@@ -839,7 +823,7 @@ impl Budget {
     #[getter]
     fn units<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for ob in &self.report.budget.observables {
+        for ob in &self.outcome.report.budget.observables {
             d.set_item(
                 ob.observable.name(),
                 format!("{}/sqrt(Hz)", ob.observable.unit()),
@@ -877,7 +861,7 @@ impl Budget {
     #[getter]
     fn equivalent<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for ob in &self.report.budget.observables {
+        for ob in &self.outcome.report.budget.observables {
             let Some(r) = referred_terms(ob) else {
                 continue;
             };
@@ -902,7 +886,7 @@ impl Budget {
     #[getter]
     fn segment_bands<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for (o, band) in &self.report.segment_bands {
+        for (o, band) in &self.outcome.report.segment_bands {
             let b = PyDict::new(py);
             b.set_item("term", band.term.name())?;
             b.set_item("median", asd(py, &band.median))?;
@@ -919,7 +903,7 @@ impl Budget {
     /// Segment length (s) of ``segment_bands``, or ``None``.
     #[getter]
     fn segment_duration_s(&self) -> Option<f64> {
-        self.report.segment_duration_s
+        self.outcome.report.segment_duration_s
     }
 
     /// How the tilt spectra were obtained: ``{"source": "welch", "sample_rate_hz",
@@ -928,7 +912,7 @@ impl Budget {
     #[getter]
     fn source<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        match &self.report.source {
+        match &self.outcome.report.source {
             SpectralSource::Welch {
                 sample_rate_hz,
                 segment_len,
@@ -956,7 +940,8 @@ impl Budget {
     /// The tilt axes that entered the budget.
     #[getter]
     fn axes(&self) -> Vec<&'static str> {
-        self.report
+        self.outcome
+            .report
             .inputs
             .iter()
             .filter(|i| matches!(i, Input::Tilt(_)))
@@ -967,14 +952,19 @@ impl Budget {
     /// The inputs of the floor's motion that entered the budget: tilt axes, then translations.
     #[getter]
     fn inputs(&self) -> Vec<&'static str> {
-        self.report.inputs.iter().map(|a| a.name()).collect()
+        self.outcome
+            .report
+            .inputs
+            .iter()
+            .map(|a| a.name())
+            .collect()
     }
 
     /// ``{observable: white readout ASD}`` used (unit/sqrt(Hz)).
     #[getter]
     fn readout<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for (o, a) in &self.report.readout.asd {
+        for (o, a) in &self.outcome.report.readout.asd {
             d.set_item(o.name(), a)?;
         }
         Ok(d)
@@ -984,10 +974,11 @@ impl Budget {
     /// segments, gaps bridged).
     #[getter]
     fn notes(&self) -> Vec<String> {
-        self.input
+        self.outcome
+            .input
             .notes
             .iter()
-            .chain(&self.report.notes)
+            .chain(&self.outcome.report.notes)
             .cloned()
             .collect()
     }
@@ -996,7 +987,7 @@ impl Budget {
     /// ``start_time`` (the ``input_*`` attributes of the budget's HDF5 file).
     #[getter]
     fn input<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let i = &self.input;
+        let i = &self.outcome.input;
         let d = PyDict::new(py);
         d.set_item("path", &i.path)?;
         d.set_item("format", &i.format)?;
@@ -1016,8 +1007,8 @@ impl Budget {
     /// (``None`` where unknown).
     #[getter]
     fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let text = tiltnoise_job::budget::summary_json(&self.report, &self.input.notes)
-            .map_err(|e| value_error(e.to_string()))?;
+        let text =
+            serde_json::to_string(&self.outcome.json()).map_err(|e| value_error(e.to_string()))?;
         py.import("json")?.call_method1("loads", (text,))
     }
 
@@ -1035,8 +1026,7 @@ impl Budget {
         &self,
         #[pyo3(from_py_with = kw::keep_zero_columns)] keep_zero_columns: bool,
     ) -> PyResult<String> {
-        tiltnoise_io::budget_csv_string(&self.report, &self.run_meta(), keep_zero_columns)
-            .map_err(value_error)
+        self.outcome.csv(keep_zero_columns).map_err(value_error)
     }
 
     /// Writes the budget as the command line's ``--save`` does: ``.h5``/``.hdf5`` (schema
@@ -1054,34 +1044,14 @@ impl Budget {
         #[pyo3(from_py_with = kw::path)] path: PathBuf,
         #[pyo3(from_py_with = kw::keep_zero_columns)] keep_zero_columns: bool,
     ) -> PyResult<()> {
-        use tiltnoise_io::OutputKind;
-        let kind = OutputKind::from_path(&path).py()?;
+        OutputKind::from_path(&path).py()?;
         self.inputs.check_save(&path)?;
-        let meta = self.run_meta();
-        py.detach(|| {
-            Staging::committed(|stage| match kind {
-                OutputKind::Hdf5 => {
-                    tiltnoise_io::write_budget_hdf5(stage, &path, &self.report, &meta, &self.input)
-                }
-                OutputKind::Csv => tiltnoise_io::write_budget_csv(
-                    stage,
-                    &path,
-                    &self.report,
-                    &meta,
-                    keep_zero_columns,
-                ),
-                OutputKind::Png | OutputKind::Svg => {
-                    let options = tiltnoise_plot::BudgetFigureOptions {
-                        input: Some(self.input.clone()),
-                        ..tiltnoise_plot::BudgetFigureOptions::default()
-                    };
-                    tiltnoise_job::save_image(stage, &path, |format| {
-                        tiltnoise_plot::budget_figure_with(&self.report, format, &options)
-                    })
-                }
-            })
-        })
-        .py()
+        let options = SaveOptions {
+            keep_zero_columns,
+            ..SaveOptions::default()
+        };
+        py.detach(|| Staging::committed(|stage| self.outcome.save_with(stage, &path, &options)))
+            .map_err(job_args::job_error)
     }
 
     /// ``{observable: {term: gwpy.frequencyseries.FrequencySeries}}`` of the ASDs, ``total``
@@ -1131,7 +1101,7 @@ impl Budget {
     }
 
     fn __repr__(&self) -> String {
-        let b = &self.report.budget;
+        let b = &self.outcome.report.budget;
         let (lo, hi) = (
             b.freqs_hz.first().copied().unwrap_or(f64::NAN),
             b.freqs_hz.last().copied().unwrap_or(f64::NAN),
@@ -1154,7 +1124,7 @@ impl Budget {
         format!(
             "Budget({} frequencies {lo:.4e}..{hi:.4e} Hz from {}; {})",
             b.freqs_hz.len(),
-            self.input.path,
+            self.outcome.input.path,
             obs.join("; ")
         )
     }

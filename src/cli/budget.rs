@@ -4,7 +4,6 @@
 use super::args::{AverageArg, ChannelArgs, Format};
 use super::budget_terms::{parse_observables, parse_readout, parse_terms};
 use super::figure_args::FigureArgs;
-use super::output::save_budget;
 use super::progress::Bar;
 use super::witness_noise::parse_witness_items;
 use super::Run;
@@ -14,12 +13,14 @@ use std::path::PathBuf;
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::freq;
 use tiltnoise_core::model::Model;
-use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::spectral::Averaging;
-use tiltnoise_io::{OutputKind, RunMeta};
-use tiltnoise_job::budget::{BudgetRequest, BudgetResult, ReadRequest, TiltSource, WelchRequest};
-use tiltnoise_job::Progress;
+use tiltnoise_job::budget::{
+    BudgetOutcome, BudgetRequest, ReadRequest, SaveOptions, TiltSource, WelchRequest,
+};
+use tiltnoise_job::figures::BudgetFigureOptions;
+use tiltnoise_job::files::OutputKind;
+use tiltnoise_job::{Invocation, Outcome};
 
 /// Arguments of `tiltnoise budget`.
 #[derive(Debug, Args)]
@@ -175,17 +176,18 @@ fn read_request(args: &BudgetArgs) -> Result<ReadRequest> {
 }
 
 /// Runs `tiltnoise budget`: the options parsed into the budget job's request, the job run
-/// (with a progress bar on a terminal), the summary printed and the files written.
+/// (with a progress bar on a terminal), the summary printed and the outcome saved.
 pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Result<()> {
     for path in &args.save {
         OutputKind::from_path(path)?;
     }
     args.figure.refuse_without_figure(&args.save)?;
-    let figure = tiltnoise_plot::BudgetFigureOptions {
-        view: args
-            .figure
-            .view_for(tiltnoise_plot::BudgetFigureOptions::default().size)?,
-        ..tiltnoise_plot::BudgetFigureOptions::default()
+    let save = SaveOptions {
+        keep_zero_columns: args.keep_zero_columns,
+        figure: BudgetFigureOptions {
+            view: args.figure.view_for(BudgetFigureOptions::default().size)?,
+            ..BudgetFigureOptions::default()
+        },
     };
     let model = Model::new(params)?;
     let req = BudgetRequest {
@@ -220,38 +222,30 @@ pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Re
         measured: args.measured.clone(),
         at_hz: args.at.as_deref().map(parse_at).transpose()?,
         at_band: args.at_band,
+        invocation: Invocation::of_this_process(),
     };
     run.check_job_outputs(&args.save, req.input_files())?;
     let bar = Bar::new("samples", WORTH_A_BAR);
-    let result =
-        tiltnoise_job::budget::run(req, &run.cancel, &mut |done, total| bar.report(done, total));
-    bar.finish();
-    let BudgetResult { report, input } = result.map_err(super::job_error)?;
+    let outcome: BudgetOutcome =
+        tiltnoise_job::budget::run(req, &run.cancel, &bar).map_err(super::job_error)?;
     let json = args.format == Format::Json;
     if json {
         writeln!(
             run.out,
             "{}",
-            tiltnoise_job::budget::summary_json(&report, &input.notes)?
+            serde_json::to_string_pretty(&outcome.json())?
         )?;
     } else {
-        for note in &input.notes {
+        for note in &outcome.input.notes {
             writeln!(run.out, "input: {note}")?;
         }
-        write!(run.out, "{}", super::budget_summary::table(&report))?;
+        write!(run.out, "{}", super::budget_summary::table(&outcome.report))?;
     }
-    let meta = RunMeta::of_this_run(params, Some(&NormalModes::new(&model)));
     run.write_outputs(json, |stage| {
         for out in &args.save {
-            save_budget(
-                stage,
-                out,
-                &report,
-                &meta,
-                &input,
-                &figure,
-                args.keep_zero_columns,
-            )?;
+            outcome
+                .save_with(stage, out, &save)
+                .map_err(super::job_error)?;
         }
         Ok(())
     })

@@ -1,7 +1,7 @@
 //! The budget read at the `--at` frequencies, for the terminal: a table (values exact at the
 //! frequency for the model's terms, band means with their 1-sigma statistical error for Welch
-//! estimates); `--format json` prints the budget job's summary document
-//! (`tiltnoise_job::budget::summary_json`).
+//! estimates); `--format json` prints the budget outcome's summary document
+//! (`BudgetOutcome::json`).
 
 use std::fmt::Write as _;
 use tiltnoise_core::noise::{BandMean, BudgetReport, Evaluation, ObservableAt, TermAt, TermKind};

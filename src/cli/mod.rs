@@ -13,7 +13,6 @@ mod figure_args;
 mod fit;
 mod mc;
 mod methods;
-mod output;
 mod progress;
 mod report;
 mod simulate;

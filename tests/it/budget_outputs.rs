@@ -4,7 +4,6 @@
 
 use crate::common;
 
-use crate::output::{save_budget, save_image};
 use common::{listing, str_attr, strs_attr};
 use num_complex::Complex64;
 use std::path::PathBuf;
@@ -17,9 +16,11 @@ use tiltnoise_core::noise::{
 use tiltnoise_core::params::Params;
 use tiltnoise_core::tf::{evaluate, plan, Input, Method, Request, TransferFunction};
 use tiltnoise_io::{
-    budget_csv_string, write_budget_hdf5, InputMeta, RunMeta, SCHEMA_BUDGET, SCHEMA_VERSION_BUDGET,
-    TOOL_VERSION,
+    budget_csv_string, write_budget_hdf5, InputMeta, RunMeta, Staging, SCHEMA_BUDGET,
+    SCHEMA_VERSION_BUDGET, TOOL_VERSION,
 };
+use tiltnoise_job::budget::{BudgetOutcome, SaveOptions};
+use tiltnoise_job::{save_image, JobError};
 use tiltnoise_plot::budget_figure;
 
 fn term(name: &str, psd: Vec<f64>) -> NoiseTerm {
@@ -143,19 +144,29 @@ fn read(group: &hdf5::Group, name: &str) -> (Vec<f64>, String) {
     (d.read_raw::<f64>().unwrap(), str_attr(&d, "unit"))
 }
 
+/// Saves `report` to `path` as the budget outcome does, with the test's provenance and input
+/// and every CSV column kept, as one of the outputs of `stage`.
+fn save_budget(
+    stage: &Staging,
+    path: &std::path::Path,
+    report: &BudgetReport,
+) -> Result<(), OutputError> {
+    let outcome = BudgetOutcome::new(report.clone(), input_meta(), meta());
+    let options = SaveOptions {
+        keep_zero_columns: true,
+        ..SaveOptions::default()
+    };
+    outcome
+        .save_with(stage, path, &options)
+        .map_err(|e| match e {
+            JobError::Output(e) => *e,
+            other => panic!("saving a budget: {other}"),
+        })
+}
+
 /// Saves `report` to `path` alone, with the test's provenance and input, committed at once.
 fn save_one(path: &std::path::Path, report: &BudgetReport) -> Result<(), OutputError> {
-    tiltnoise_io::Staging::committed(|s| {
-        save_budget(
-            s,
-            path,
-            report,
-            &meta(),
-            &input_meta(),
-            &Default::default(),
-            true,
-        )
-    })
+    Staging::committed(|s| save_budget(s, path, report))
 }
 
 #[test]
@@ -637,32 +648,11 @@ fn realistic_budget_renders() {
     for (stem, r) in [("budget", &report), ("budget_measured", &measured)] {
         for ext in ["png", "svg", "h5", "csv"] {
             let path = dir.path().join(format!("{stem}.{ext}"));
-            tiltnoise_io::Staging::committed(|s| {
-                save_budget(
-                    s,
-                    &path,
-                    r,
-                    &meta(),
-                    &input_meta(),
-                    &Default::default(),
-                    true,
-                )
-            })
-            .unwrap();
+            Staging::committed(|s| save_budget(s, &path, r)).unwrap();
             assert!(std::fs::metadata(&path).unwrap().len() > 1000);
             if let Some(out) = &out {
-                tiltnoise_io::Staging::committed(|s| {
-                    save_budget(
-                        s,
-                        &out.join(format!("{stem}.{ext}")),
-                        r,
-                        &meta(),
-                        &input_meta(),
-                        &Default::default(),
-                        true,
-                    )
-                })
-                .unwrap();
+                Staging::committed(|s| save_budget(s, &out.join(format!("{stem}.{ext}")), r))
+                    .unwrap();
             }
         }
     }

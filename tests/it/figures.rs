@@ -1,13 +1,13 @@
-//! Figures written to files: `tiltnoise-plot` returns the bytes and the command line's output
-//! dispatch (`src/cli/output.rs`) writes them atomically. A failure names the file and leaves
+//! Figures written to files: `tiltnoise-plot` returns the bytes and the job layer's
+//! `save_image` (every outcome's figures) writes them atomically. A failure names the file and leaves
 //! nothing behind; an existing file is replaced only by a complete figure.
 
 use crate::common::listing;
-use crate::output::save_image;
 use tiltnoise_core::error::OutputError;
 use tiltnoise_core::model::{Model, Request};
 use tiltnoise_core::params::Params;
 use tiltnoise_core::tf::{evaluate, plan, Method, TransferMatrix};
+use tiltnoise_job::save_image;
 use tiltnoise_plot::{tf_figure, DrawError};
 
 /// Table I, all tilt inputs, at a few frequencies off the undamped resonances.

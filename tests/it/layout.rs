@@ -135,15 +135,6 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// Front-end files that still name the file or figure layer: the budget command's saving and
-/// its figure options, which have not moved into a budget outcome yet. A file leaves this list
-/// when it stops naming them (the test fails until it is taken off), and no file joins it.
-const NOT_YET_THROUGH_THE_JOB: [&str; 3] = [
-    "python/src/budget.rs",
-    "src/cli/budget.rs",
-    "src/cli/output.rs",
-];
-
 #[test]
 fn the_front_ends_reach_the_file_layer_only_through_the_job_crate() {
     let mut files = Vec::new();
@@ -152,7 +143,6 @@ fn the_front_ends_reach_the_file_layer_only_through_the_job_crate() {
     }
     files.sort();
     let mut found = Vec::new();
-    let mut still_naming = std::collections::BTreeSet::new();
     for file in &files {
         let text = std::fs::read_to_string(file).unwrap();
         for (n, line) in text.lines().enumerate() {
@@ -167,23 +157,10 @@ fn the_front_ends_reach_the_file_layer_only_through_the_job_crate() {
             });
             let shown = file.strip_prefix(root()).unwrap().display().to_string();
             if names_lower {
-                if NOT_YET_THROUGH_THE_JOB.contains(&shown.as_str()) {
-                    still_naming.insert(shown);
-                } else {
-                    found.push(format!("{shown}:{}: {}", n + 1, line.trim()));
-                }
+                found.push(format!("{shown}:{}: {}", n + 1, line.trim()));
             }
         }
     }
-    let moved: Vec<&str> = NOT_YET_THROUGH_THE_JOB
-        .iter()
-        .copied()
-        .filter(|f| !still_naming.contains(*f))
-        .collect();
-    assert!(
-        moved.is_empty(),
-        "{moved:?} no longer name the file layer: take them off NOT_YET_THROUGH_THE_JOB"
-    );
     assert!(
         found.is_empty(),
         "the front ends must import the file layer through tiltnoise_job (its `files` and \

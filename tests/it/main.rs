@@ -6,10 +6,6 @@
 const REPO_ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
 mod common;
-/// Saving by extension (`src/cli/output.rs`): the command line has no library, so the tests of
-/// its output dispatch compile that module in here.
-#[path = "../../src/cli/output.rs"]
-mod output;
 #[path = "../../crates/tiltnoise-core/tests/it/tolerances.rs"]
 mod tolerances;
 

@@ -28,7 +28,6 @@ pub mod params;
 pub mod progress;
 pub mod simulate;
 pub mod subtract;
-mod summary;
 pub mod tf;
 pub mod visibility;
 

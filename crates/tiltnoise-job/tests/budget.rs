@@ -3,6 +3,7 @@
 //! computation, every error rendered in either front end's spelling.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 use tiltnoise_core::budget::option_checks::InputKind;
 use tiltnoise_core::budget::BudgetError;
 use tiltnoise_core::input::{GapPolicy, InputMeta, TiltInput};
@@ -10,7 +11,17 @@ use tiltnoise_core::model::{Model, Observable};
 use tiltnoise_core::params::Params;
 use tiltnoise_io::input::{read_tilt, ReadOptions};
 use tiltnoise_job::budget::{run, BudgetRequest, ReadRequest, TiltSource, WelchRequest};
-use tiltnoise_job::{AsdSpec, Cancel, JobError, ReadoutItem};
+use tiltnoise_job::{AsdSpec, Cancel, Invocation, JobError, Progress, ReadoutItem, Silent};
+
+/// The last progress reported.
+#[derive(Default)]
+struct Last(AtomicU64);
+
+impl Progress for Last {
+    fn report(&self, done: u64, _total: u64) {
+        self.0.store(done, Ordering::Relaxed);
+    }
+}
 
 fn tilt_data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -34,6 +45,7 @@ fn request<'a>(model: &'a Model, tilt: TiltSource<'a>) -> BudgetRequest<'a> {
         measured: None,
         at_hz: None,
         at_band: None,
+        invocation: Invocation::default(),
     }
 }
 
@@ -48,14 +60,12 @@ fn file<'a>(path: PathBuf) -> TiltSource<'a> {
 fn a_streamed_hdf5_series_gives_the_budget_of_the_series_read_whole() {
     let model = Model::new(&Params::table_i()).unwrap();
     let path = tilt_data("lab_tilt_24h.h5");
-    let mut done = 0;
-    let streamed = run(
-        request(&model, file(path.clone())),
-        &Cancel::never(),
-        &mut |d, _| done = d,
-    )
-    .unwrap();
-    assert!(done > 0, "the streamed run reports its progress");
+    let done = Last::default();
+    let streamed = run(request(&model, file(path.clone())), &Cancel::never(), &done).unwrap();
+    assert!(
+        done.0.load(Ordering::Relaxed) > 0,
+        "the streamed run reports its progress"
+    );
     let TiltInput::Series(mut series) = read_tilt(&path, &ReadOptions::default()).unwrap() else {
         panic!("{} holds a series", path.display());
     };
@@ -64,7 +74,7 @@ fn a_streamed_hdf5_series_gives_the_budget_of_the_series_read_whole() {
         source: &mut series,
         input,
     };
-    let whole = run(request(&model, tilt), &Cancel::never(), &mut |_, _| {}).unwrap();
+    let whole = run(request(&model, tilt), &Cancel::never(), &Silent).unwrap();
     // The same samples through the same arithmetic: equal to the last bit.
     assert_eq!(streamed.report.budget, whole.report.budget);
     assert_eq!(streamed.input, whole.input);
@@ -83,7 +93,7 @@ fn options_of_the_other_kind_of_input_are_refused_in_each_spelling() {
         },
     };
     req.welch = WelchRequest::default();
-    let e = run(req, &Cancel::never(), &mut |_, _| {}).unwrap_err();
+    let e = run(req, &Cancel::never(), &Silent).unwrap_err();
     assert!(matches!(
         e,
         JobError::NotForInput {
@@ -102,7 +112,7 @@ fn options_of_the_other_kind_of_input_are_refused_in_each_spelling() {
     );
     let mut req = request(&model, file(tilt_data("lab_tilt_24h.h5")));
     req.freq_hz = Some(vec![1e-3, 1e-2]);
-    let e = run(req, &Cancel::never(), &mut |_, _| {}).unwrap_err();
+    let e = run(req, &Cancel::never(), &Silent).unwrap_err();
     assert!(e.message().starts_with("freq applies to spectra input"));
 }
 
@@ -112,7 +122,7 @@ fn options_are_checked_before_any_file_is_opened() {
     let missing = PathBuf::from("no/such/tilt.h5");
     let mut req = request(&model, file(missing.clone()));
     req.welch.percentiles = Some((5.0, 95.0));
-    let e = run(req, &Cancel::never(), &mut |_, _| {}).unwrap_err();
+    let e = run(req, &Cancel::never(), &Silent).unwrap_err();
     assert!(matches!(e, JobError::PercentilesNeedSegments), "{e}");
     assert!(e
         .message()
@@ -123,7 +133,7 @@ fn options_are_checked_before_any_file_is_opened() {
         observable: Observable::Y,
         asd: AsdSpec::White(1e-9),
     }];
-    let e = run(req, &Cancel::never(), &mut |_, _| {}).unwrap_err();
+    let e = run(req, &Cancel::never(), &Silent).unwrap_err();
     assert_eq!(
         e.message(),
         "readout Y=1e-9: Y is not budgeted; allowed: X, phi, phi_a (add it with observables)"
@@ -131,7 +141,7 @@ fn options_are_checked_before_any_file_is_opened() {
 
     let mut req = request(&model, file(missing));
     req.at_hz = Some(vec![1e-3, 1e-3]);
-    let e = run(req, &Cancel::never(), &mut |_, _| {}).unwrap_err();
+    let e = run(req, &Cancel::never(), &Silent).unwrap_err();
     assert!(e.message().starts_with("at: "), "{}", e.message());
 }
 
@@ -143,7 +153,7 @@ fn a_cancelled_run_returns_no_budget() {
     let e = run(
         request(&model, file(tilt_data("lab_tilt_24h.h5"))),
         &cancel,
-        &mut |_, _| {},
+        &Silent,
     )
     .unwrap_err();
     assert!(

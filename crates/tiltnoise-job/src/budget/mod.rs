@@ -1,10 +1,19 @@
 //! The budget job: the floor's motion (a file, opened once, an HDF5 series streamed from it;
 //! or a series the caller holds), the readout, user terms, witness noise, the measured record
-//! and the frequencies to read the budget at, to a [`BudgetReport`] with the input's
-//! provenance.
+//! and the frequencies to read the budget at, to a [`BudgetOutcome`]: the
+//! [`BudgetReport`](tiltnoise_core::noise::BudgetReport) with the input's provenance and the
+//! run's, its files, figure and summary.
+
+mod outcome;
+mod summary;
+
+pub use outcome::{BudgetOutcome, SaveOptions};
+pub use summary::asd_rel_std;
 
 use crate::error::{shown_path, JobError};
 use crate::given::{self, ReadoutItem, TermItem, WitnessItem};
+use crate::outcome::Invocation;
+use crate::progress::Progress;
 use std::path::{Path, PathBuf};
 use tiltnoise_core::budget::option_checks::InputKind;
 use tiltnoise_core::budget::{
@@ -18,13 +27,11 @@ use tiltnoise_core::input::{
     AxisMap, ChannelScale, ChannelUnit, GapPolicy, InputMeta, Quantity, ReadOptions, SeriesSource,
 };
 use tiltnoise_core::model::{Model, Observable};
-use tiltnoise_core::noise::BudgetReport;
+use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_core::spectral::Averaging;
 use tiltnoise_io::input::{add_measured_file, open_tilt, OpenedTilt};
-
-pub use crate::summary::{asd_rel_std, summary_json};
 
 /// How to read a file of the floor's motion; `None` and empty take the file's own statements,
 /// else the documented defaults (`docs/input_formats.md`).
@@ -119,15 +126,8 @@ pub struct BudgetRequest<'a> {
     pub at_hz: Option<Vec<f64>>,
     /// Half-width of the band of the Welch band means, relative (default 0.1).
     pub at_band: Option<f64>,
-}
-
-/// A computed budget and where its floor's motion came from.
-#[derive(Debug, Clone)]
-pub struct BudgetResult {
-    /// The budget.
-    pub report: BudgetReport,
-    /// The input's provenance; its notes are the reader's.
-    pub input: InputMeta,
+    /// Who asked, for the provenance.
+    pub invocation: Invocation,
 }
 
 impl BudgetRequest<'_> {
@@ -240,9 +240,9 @@ fn refuse(given: &[&'static str], holds: InputKind, path: &str) -> Result<(), Jo
 }
 
 /// Runs the budget: checks the options, reads every given file, opens the floor's motion
-/// once (an HDF5 series is streamed, `progress(done, total)` called with samples processed),
-/// computes the budget, checks the witness noise against the record's inputs and adds the
-/// measured record.
+/// once (an HDF5 series is streamed, `progress` told the samples processed), computes the
+/// budget, checks the witness noise against the record's inputs and adds the measured record.
+/// The request is taken whole: a series it holds is read, not copied.
 ///
 /// # Errors
 ///
@@ -251,8 +251,19 @@ fn refuse(given: &[&'static str], holds: InputKind, path: &str) -> Result<(), Jo
 pub fn run(
     req: BudgetRequest<'_>,
     cancel: &Cancel,
+    progress: &dyn Progress,
+) -> Result<BudgetOutcome, JobError> {
+    let result = budget(req, cancel, &mut |done, total| progress.report(done, total));
+    progress.finish();
+    result
+}
+
+/// [`run`], `progress(done, total)` called with the samples processed.
+fn budget(
+    req: BudgetRequest<'_>,
+    cancel: &Cancel,
     progress: &mut dyn FnMut(u64, u64),
-) -> Result<BudgetResult, JobError> {
+) -> Result<BudgetOutcome, JobError> {
     let mut opts = options(&req, cancel)?;
     let series_given = req.series_options_given();
     let spectra_given: Vec<&'static str> = req.freq_hz.iter().map(|_| "freq").collect();
@@ -319,5 +330,8 @@ pub fn run(
             other => JobError::option("measured", Some(&shown_path(path)), other.to_string()),
         })?;
     }
-    Ok(BudgetResult { report, input })
+    let provenance = req
+        .invocation
+        .provenance(model.params(), Some(&NormalModes::new(model)));
+    Ok(BudgetOutcome::new(report, input, provenance))
 }

@@ -1,6 +1,6 @@
 //! The budget read at its summary frequencies as a JSON document: what `tiltnoise budget
-//! --format json` prints and what the Python package's `Budget.summary` holds. Fields in
-//! alphabetical order, as every JSON report of the tool.
+//! --format json` prints and what the Python package's `Budget.summary` holds (the budget
+//! outcome's `json()`). Fields in alphabetical order, as every JSON report of the tool.
 
 use serde::Serialize;
 use tiltnoise_core::noise::{BudgetReport, Evaluation, TermAt};
@@ -63,12 +63,9 @@ struct TotalJson {
     psd: f64,
 }
 
-/// The summary as JSON, with the input's and the budget's notes.
-///
-/// # Errors
-///
-/// Only if a value cannot be written (serde_json writes non-finite numbers as `null`).
-pub fn summary_json(report: &BudgetReport, input_notes: &[String]) -> serde_json::Result<String> {
+/// The summary as JSON, with the input's and the budget's notes; non-finite numbers are
+/// `null`.
+pub(crate) fn summary_json(report: &BudgetReport, input_notes: &[String]) -> serde_json::Value {
     let doc = SummaryJson {
         notes: input_notes
             .iter()
@@ -100,7 +97,8 @@ pub fn summary_json(report: &BudgetReport, input_notes: &[String]) -> serde_json
             })
             .collect(),
     };
-    serde_json::to_string_pretty(&doc)
+    // Plain structs of strings and numbers: their serialization cannot fail.
+    serde_json::to_value(&doc).unwrap_or_default()
 }
 
 fn term_json(t: &TermAt) -> TermJson {
