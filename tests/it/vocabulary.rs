@@ -377,7 +377,11 @@ fn commands_that_print_a_summary_take_format() {
                 .collect()
         })
         .unwrap_or_default();
-    assert_eq!(values, ["table", "csv"], "visibility prints its CSV");
+    assert_eq!(
+        values,
+        ["table", "csv", "json"],
+        "visibility prints its table, its CSV or its JSON"
+    );
     for (command, args) in commands() {
         if [
             "modes",
