@@ -15,65 +15,23 @@ use crate::state;
 use numpy::{PyArray1, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 use tiltnoise_core::cancel::Cancel;
-use tiltnoise_core::error::Num;
 use tiltnoise_core::freq;
-use tiltnoise_core::ground::GroundQuantity;
-use tiltnoise_core::input::{
-    check_sensors, ground_index, ground_inputs, motion_of, parse_units, process_channel,
-    unstated_excess, ChannelCtx, DetrendedRms, GapPolicy, GroundChannel, InputError, InputMeta,
-    Motion, Quantity, Sensors, SeriesSource,
-};
+use tiltnoise_core::input::{parse_units, GapPolicy};
 use tiltnoise_core::model::{Input, Model, Observable};
 use tiltnoise_core::noise::equivalent::referred_terms;
 use tiltnoise_core::noise::SpectralSource;
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::repeats::refuse_repeats;
-use tiltnoise_job::budget::{BudgetOutcome, BudgetRequest, SaveOptions, TiltSource, WelchRequest};
+use tiltnoise_job::budget::{
+    array_input, ArrayOptions, ArrayRecord, BudgetOutcome, BudgetRequest, SaveOptions, TiltSource,
+    WelchRequest,
+};
 use tiltnoise_job::files::{OutputKind, Staging};
 use tiltnoise_job::{Invocation, Outcome, Silent};
-
-/// A record of the floor's motion handed over as arrays: one channel per input, in canonical
-/// order, each in the SI unit of its quantity.
-struct ArraySeries {
-    sample_rate_hz: f64,
-    channels: Vec<GroundChannel>,
-    data: Vec<Vec<f64>>,
-}
-
-impl SeriesSource for ArraySeries {
-    fn sample_rate_hz(&self) -> f64 {
-        self.sample_rate_hz
-    }
-
-    fn len(&self) -> usize {
-        self.data.first().map_or(0, Vec::len)
-    }
-
-    fn channels(&self) -> Vec<GroundChannel> {
-        self.channels.clone()
-    }
-
-    fn read_chunk(&mut self, start: usize, len: usize) -> Result<Vec<Vec<f64>>, InputError> {
-        let available = SeriesSource::len(self);
-        if start.checked_add(len).is_none_or(|end| end > available) {
-            return Err(InputError::ChunkOutOfRange {
-                path: PathBuf::from("(arrays)"),
-                start,
-                len,
-                available,
-            });
-        }
-        Ok(self
-            .data
-            .iter()
-            .map(|c| c[start..start + len].to_vec())
-            .collect())
-    }
-}
 
 /// The model of `params`: a `Model` (reused as it is), a `Params`, or Table I for `None`; and
 /// its parameters (with the file they were read from).
@@ -126,57 +84,7 @@ fn welch(
 
 /// The input of the floor of a name, or a `ValueError` naming what is allowed.
 fn ground_input(name: &str) -> PyResult<Input> {
-    ground_inputs()
-        .into_iter()
-        .find(|a| a.name() == name)
-        .ok_or_else(|| {
-            value_error(format!(
-                "input {name:?} is not allowed: must be a tilt axis theta_t, eta_t or phi_t (the \
-                 rotation taking the floor frame to the inertial frame) or a floor translation \
-                 x_t, y_t or z_t"
-            ))
-        })
-}
-
-/// A gap or non-finite sample of an array, named by the axis instead of a file.
-fn array_error(e: InputError) -> PyErr {
-    match e {
-        InputError::NonFinite {
-            channel,
-            index,
-            value,
-            unit,
-            ..
-        } => value_error(format!(
-            "tilt[{channel:?}][{index}] is {value:?} {unit}; allowed: finite values (or \
-             gaps=\"interpolate\" to bridge interior gaps linearly)"
-        )),
-        InputError::OutOfRange {
-            channel,
-            index,
-            value,
-            unit,
-            ..
-        } => value_error(format!(
-            "tilt[{channel:?}][{index}] is {} {unit}; allowed: {} (beyond that the spectra \
-             overflow or underflow f64; see docs/limits.md)",
-            Num(value),
-            tiltnoise_core::limits::SAMPLES.allowed(unit)
-        )),
-        InputError::EdgeGap {
-            channel,
-            edge,
-            first,
-            last,
-            len,
-            ..
-        } => value_error(format!(
-            "tilt[{channel:?}] has a {edge} gap of non-finite samples at indices \
-             {first}..={last} (of {len}); gap interpolation needs a finite sample on both \
-             sides: trim the series"
-        )),
-        other => value_error(other.to_string()),
-    }
+    array_input(name).map_err(job_args::job_error)
 }
 
 /// `(input, samples)` from a dict `{input: array}` or a 2-D array with `axes`, each input
@@ -234,182 +142,6 @@ fn tilt_channels(
         )));
     }
     Ok(axes.into_iter().zip(rows).collect())
-}
-
-/// What the arrays of `budget` are: a channel per input, the factor of its unit's prefix,
-/// whether its unit is given, the tilt quantity and the provenance note on the units.
-struct Described {
-    channels: Vec<GroundChannel>,
-    /// `(factor into SI, unit given)` per channel.
-    factors: Vec<(f64, bool)>,
-    quantity: Quantity,
-    units_note: String,
-}
-
-/// Describes the arrays `channels` (canonical order) from `quantity` (tilt without a unit),
-/// `units` (`{input: unit}`), and the inputs declared `corrected` or read by a
-/// `pendulum_tiltmeter`, as the readers do for files.
-fn describe_arrays(
-    channels: &[(Input, Vec<f64>)],
-    quantity: &str,
-    units: std::collections::BTreeMap<String, String>,
-    channels_of: job_args::ChannelLists,
-) -> PyResult<Described> {
-    let quantity: Quantity = quantity.parse().map_err(value_error)?;
-    let items: Vec<String> = units.iter().map(|(k, u)| format!("{k}={u}")).collect();
-    let units = parse_units(OptionKey::UNITS, &items).py()?;
-    let inputs: Vec<Input> = channels.iter().map(|(i, _)| *i).collect();
-    for u in &units {
-        if !inputs.iter().any(|i| i.name() == u.channel) {
-            return Err(value_error(format!(
-                "units: {:?} is not an input of tilt; it has {}",
-                u.channel,
-                inputs
-                    .iter()
-                    .map(|i| i.name())
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )));
-        }
-    }
-    let mut sensors = Sensors::default();
-    for (option, names, motion) in [
-        (
-            OptionKey::CORRECTED,
-            &channels_of.corrected,
-            Motion::Translation,
-        ),
-        (
-            OptionKey::PENDULUM_TILTMETER,
-            &channels_of.pendulum_tiltmeter,
-            Motion::Rotation,
-        ),
-    ] {
-        refuse_repeats(option, "input", names, |n| n.clone())
-            .map_err(|e| value_error(e.to_string()))?;
-        for name in names {
-            let input = ground_input(name)?;
-            if !inputs.contains(&input) || motion_of(input) != motion {
-                return Err(value_error(format!(
-                    "{option}: {name:?} is not allowed: must be one of the {} inputs of tilt ({})",
-                    motion.name(),
-                    inputs
-                        .iter()
-                        .filter(|i| motion_of(**i) == motion)
-                        .map(|i| i.name())
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                )));
-            }
-            match input {
-                Input::Tilt(a) => sensors.pendulum.push(a),
-                Input::Translation(t) => sensors.corrected.push(t),
-                Input::Force(_) => unreachable!("ground inputs only"),
-            }
-        }
-    }
-    let mut tilt_quantity: Option<(Quantity, &str)> = None;
-    let mut out = Vec::new();
-    let mut factors = Vec::new();
-    for &input in &inputs {
-        let given = units.iter().find(|u| u.channel == input.name());
-        if let Some(u) = given {
-            if u.unit.motion != motion_of(input) {
-                return Err(value_error(format!(
-                    "units: {} is a {} of the floor, and {:?} is a unit of {}",
-                    input.name(),
-                    motion_of(input).name(),
-                    u.text,
-                    u.unit.motion.name()
-                )));
-            }
-        }
-        let ground_quantity = match (input, given) {
-            (Input::Translation(_), None) => {
-                return Err(value_error(format!(
-                    "units: the translation {0} has no unit; allowed: m, m/s, m/s^2 or a \
-                     prefixed form, e.g. units={{\"{0}\": \"m/s^2\"}}",
-                    input.name()
-                )))
-            }
-            (Input::Translation(_), Some(u)) => u.unit.quantity,
-            (_, given) => {
-                let q = given
-                    .and_then(|u| u.unit.tilt_quantity())
-                    .unwrap_or(quantity);
-                match tilt_quantity {
-                    Some((other, name)) if other != q => {
-                        return Err(value_error(format!(
-                            "units: tilt inputs {name} and {} are in different quantities ({} \
-                             and {}); allowed: one quantity for every tilt input",
-                            input.name(),
-                            other.unit(),
-                            q.unit()
-                        )))
-                    }
-                    _ => tilt_quantity = Some((q, input.name())),
-                }
-                match q {
-                    Quantity::Angle => GroundQuantity::Displacement,
-                    Quantity::Rate => GroundQuantity::Velocity,
-                }
-            }
-        };
-        out.push(GroundChannel {
-            input,
-            quantity: ground_quantity,
-            sensing: sensors.sensing(input),
-        });
-        factors.push((given.map_or(1.0, |u| u.unit.factor), given.is_some()));
-    }
-    check_sensors(&out).map_err(|e| value_error(format!("tilt: {e}")))?;
-    let units_note = format!(
-        "units: {}",
-        out.iter()
-            .zip(&factors)
-            .map(|(c, (_, given))| format!(
-                "{} {}{}",
-                c.input.name(),
-                c.unit(),
-                if *given { "" } else { " (assumed)" }
-            ))
-            .collect::<Vec<_>>()
-            .join(", ")
-    );
-    Ok(Described {
-        channels: out,
-        factors,
-        quantity: tilt_quantity.map_or(quantity, |(q, _)| q),
-        units_note,
-    })
-}
-
-/// Refuses a tilt array whose unit is not given and whose detrended RMS exceeds what a
-/// laboratory floor reaches, naming the likely unit.
-fn check_unstated_array(name: &str, quantity: Quantity, data: &[f64], fs: f64) -> PyResult<()> {
-    let Some(excess) = unstated_excess(DetrendedRms::of(data), quantity, fs) else {
-        return Ok(());
-    };
-    let first = excess
-        .likely
-        .first()
-        .cloned()
-        .unwrap_or_else(|| "nrad".to_string());
-    Err(value_error(format!(
-        "tilt[{name:?}] has no unit and is read in {}, but its detrended RMS is {} {}, above \
-         the {} {} no laboratory floor reaches; its values are likely in {}: give its unit, \
-         e.g. units={{\"{name}\": \"{first}\"}}",
-        quantity.unit(),
-        Num(excess.rms),
-        quantity.unit(),
-        Num(excess.bound),
-        quantity.unit(),
-        if excess.likely.is_empty() {
-            "a smaller unit".to_string()
-        } else {
-            excess.likely.join(" or ")
-        }
-    )))
 }
 
 /// Noise budget of X, phi and phi_a (or any observables) from a time series of the floor's
@@ -488,25 +220,20 @@ pub fn budget(
     let (model, params) = model_of(params)?;
     let gaps: GapPolicy = gaps.parse().map_err(value_error)?;
     check_fs(fs)?;
-    let mut channels = tilt_channels(tilt, axes)?;
-    channels.sort_by_key(|(a, _)| ground_index(*a));
-    if channels.is_empty() {
-        return Err(value_error(
-            "tilt: no input given; give at least one of theta_t, eta_t, phi_t, x_t, y_t, z_t",
-        ));
-    }
-    let described = describe_arrays(&channels, &quantity, units.unwrap_or_default(), channels_of)?;
-    for w in channels.windows(2) {
-        if w[0].1.len() != w[1].1.len() {
-            return Err(value_error(format!(
-                "tilt: {} has {} samples but {} has {}: the axes must have equal length",
-                w[0].0.name(),
-                w[0].1.len(),
-                w[1].0.name(),
-                w[1].1.len()
-            )));
-        }
-    }
+    let channels = tilt_channels(tilt, axes)?;
+    let items: Vec<String> = units
+        .unwrap_or_default()
+        .iter()
+        .map(|(k, u)| format!("{k}={u}"))
+        .collect();
+    let options = ArrayOptions {
+        quantity: quantity.parse().map_err(value_error)?,
+        units: parse_units(OptionKey::UNITS, &items).py()?,
+        corrected: channels_of.corrected,
+        pendulum_tiltmeter: channels_of.pendulum_tiltmeter,
+        gaps,
+    };
+    let record = ArrayRecord::new(fs, channels, options).map_err(job_args::job_error)?;
     let welch = welch(
         nperseg,
         overlap,
@@ -518,60 +245,11 @@ pub fn budget(
     let readout = job_args::readout(readout.as_ref())?;
     let terms = job_args::terms(term.as_ref())?;
     let witness_noise = job_args::witness_noise(witness_noise.as_ref())?;
-    let axis_map = described
-        .channels
-        .iter()
-        .map(|c| format!("{0}={0}", c.input.name()))
-        .collect::<Vec<_>>()
-        .join(",");
     let cancel = Cancel::new();
     let result = interrupt::watch(py, &cancel, || -> PyResult<(BudgetOutcome, Inputs)> {
-        let mut notes = Vec::new();
-        for (((input, data), channel), &(factor, stated)) in channels
-            .iter_mut()
-            .zip(&described.channels)
-            .zip(&described.factors)
-        {
-            // Each step is a pass over a whole channel (a tenth of a second at the largest
-            // size): the token is polled between them.
-            interrupt::check(&cancel)?;
-            if factor != 1.0 {
-                data.iter_mut().for_each(|v| *v *= factor);
-            }
-            let ctx = ChannelCtx {
-                path: Path::new("tilt"),
-                channel: input.name(),
-                unit: channel.unit(),
-            };
-            let bridged = process_channel(data, gaps, &ctx).map_err(array_error)?;
-            if bridged > 0 {
-                notes.push(tiltnoise_core::input::gap_note(input.name(), bridged));
-            }
-            if !stated {
-                interrupt::check(&cancel)?;
-                check_unstated_array(input.name(), described.quantity, data, fs)?;
-            }
-        }
-        notes.push(described.units_note.clone());
-        let mut source = ArraySeries {
-            sample_rate_hz: fs,
-            channels: described.channels.clone(),
-            data: channels.into_iter().map(|(_, d)| d).collect(),
-        };
         let req = BudgetRequest {
             model: &model,
-            tilt: TiltSource::Series {
-                source: &mut source,
-                input: InputMeta {
-                    path: "(arrays)".into(),
-                    format: "numpy".into(),
-                    kind: "series".into(),
-                    quantity: described.quantity.name().into(),
-                    axis_map,
-                    start_time: None,
-                    notes,
-                },
-            },
+            tilt: TiltSource::Arrays(record),
             welch,
             freq_hz: None,
             observables,

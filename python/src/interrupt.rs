@@ -85,15 +85,3 @@ where
         false => py.detach(work),
     }
 }
-
-/// `Err` once `cancel` is set, for the steps of a watched computation that are not the
-/// library's own (whose errors say `Cancelled`): [`watch`] returns the signal's exception
-/// instead of this one.
-pub fn check(cancel: &Cancel) -> PyResult<()> {
-    match cancel.check() {
-        Ok(()) => Ok(()),
-        Err(e) => Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(
-            e.to_string(),
-        )),
-    }
-}

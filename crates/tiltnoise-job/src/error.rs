@@ -1,6 +1,7 @@
 //! The errors of a job, naming the option or key that failed by its snake-case name; each
 //! front end renders them in its own spelling ([`JobError::message`]).
 
+use crate::budget::ArrayError;
 use crate::subtract::SubtractFailure;
 use std::fmt;
 use tiltnoise_core::budget::option_checks::{
@@ -118,6 +119,8 @@ pub enum JobError {
     Spectral(Box<SpectralError>),
     /// An output the job writes while it runs (a record streamed to its file).
     Output(Box<OutputError>),
+    /// Arrays that are not a record of the floor's motion (the message names the input).
+    Arrays(Box<ArrayError>),
 }
 
 impl JobError {
@@ -213,6 +216,7 @@ impl JobError {
             JobError::Fit(e) | JobError::FitFile(e) => e.to_string(),
             JobError::Spectral(e) => e.to_string(),
             JobError::Output(e) => e.to_string(),
+            JobError::Arrays(e) => e.to_string(),
         }
     }
 
@@ -257,6 +261,7 @@ impl std::error::Error for JobError {
             JobError::Fit(e) | JobError::FitFile(e) => Some(e.as_ref()),
             JobError::Spectral(e) => Some(e.as_ref()),
             JobError::Output(e) => Some(e.as_ref()),
+            JobError::Arrays(e) => Some(e.as_ref()),
             _ => None,
         }
     }

@@ -81,7 +81,7 @@ pub use scale::{check_scales, parse_scales, scale_for, scale_note, ChannelScale}
 pub use series::{
     gap_note, process_channel, ChannelCtx, Gap, GapScanner, TiltSeries, TranslationChannel,
 };
-pub use source::SeriesSource;
+pub use source::{chunk_of, SeriesSource};
 pub use spectra::{assemble, check_csd_finite, frequency_refusal, TiltSpectra, CSD_RTOL};
 pub use unit::{
     likely_units, normalize_unit, parse_unit, parse_units, si_unit, unstated_excess,

@@ -7,6 +7,7 @@
 use super::error::InputError;
 use super::motion::GroundChannel;
 use super::TiltSeries;
+use std::path::Path;
 
 /// A record of the floor's motion read in sequential chunks, uniformly sampled: tilt channels
 /// (angle `t` in rad or its rate in rad/s, in the convention of [`crate::model::tilt`]) and
@@ -52,19 +53,34 @@ impl SeriesSource for TiltSeries {
     }
 
     fn read_chunk(&mut self, start: usize, len: usize) -> Result<Vec<Vec<f64>>, InputError> {
-        let available = TiltSeries::len(self);
-        if start.checked_add(len).is_none_or(|end| end > available) {
-            return Err(InputError::ChunkOutOfRange {
-                path: self.provenance.path.clone(),
-                start,
-                len,
-                available,
-            });
-        }
-        Ok(self
-            .channel_data()
-            .iter()
-            .map(|c| c[start..start + len].to_vec())
-            .collect())
+        chunk_of(&self.channel_data(), &self.provenance.path, start, len)
     }
+}
+
+/// Samples `start .. start + len` of every channel of a record held in memory (`channels`,
+/// all of one length), as [`SeriesSource::read_chunk`] returns them: the one rule of every
+/// in-memory source.
+///
+/// # Errors
+///
+/// [`InputError::ChunkOutOfRange`] naming `path` if `start + len` exceeds the channels' length.
+pub fn chunk_of(
+    channels: &[&[f64]],
+    path: &Path,
+    start: usize,
+    len: usize,
+) -> Result<Vec<Vec<f64>>, InputError> {
+    let available = channels.first().map_or(0, |c| c.len());
+    if start.checked_add(len).is_none_or(|end| end > available) {
+        return Err(InputError::ChunkOutOfRange {
+            path: path.to_path_buf(),
+            start,
+            len,
+            available,
+        });
+    }
+    Ok(channels
+        .iter()
+        .map(|c| c[start..start + len].to_vec())
+        .collect())
 }

@@ -4,9 +4,11 @@
 //! [`BudgetReport`](tiltnoise_core::noise::BudgetReport) with the input's provenance and the
 //! run's, its files, figure and summary.
 
+mod arrays;
 mod outcome;
 mod summary;
 
+pub use arrays::{array_input, ArrayError, ArrayOptions, ArrayRecord, ARRAYS_FORMAT, ARRAYS_PATH};
 pub use outcome::{BudgetOutcome, SaveOptions};
 pub use summary::asd_rel_std;
 
@@ -77,7 +79,10 @@ pub enum TiltSource<'a> {
         /// How to read it.
         read: ReadRequest,
     },
-    /// A series the caller holds (arrays), already in SI units, and what is known of it.
+    /// Arrays the caller holds, described ([`ArrayRecord::new`]); their samples are checked
+    /// (gaps, magnitudes, units) before the options.
+    Arrays(ArrayRecord),
+    /// A series the caller holds, already checked and in SI units, and what is known of it.
     Series {
         /// The series.
         source: &'a mut (dyn SeriesSource + Send),
@@ -264,6 +269,11 @@ fn budget(
     cancel: &Cancel,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<BudgetOutcome, JobError> {
+    // Arrays are checked as they are handed over, before the options (a file is read after).
+    let mut req = req;
+    if let TiltSource::Arrays(record) = &mut req.tilt {
+        record.check_samples(cancel)?;
+    }
     let mut opts = options(&req, cancel)?;
     let series_given = req.series_options_given();
     let spectra_given: Vec<&'static str> = req.freq_hz.iter().map(|_| "freq").collect();
@@ -295,6 +305,14 @@ fn budget(
                     (budget_from_spectra(model, &spectra, &opts), input)
                 }
             }
+        }
+        TiltSource::Arrays(record) => {
+            let (mut series, input) = record.into_series();
+            refuse(&spectra_given, InputKind::Series, &input.path)?;
+            (
+                budget_from_series(model, &mut series, &opts, progress),
+                input,
+            )
         }
         TiltSource::Series { source, input } => {
             refuse(&spectra_given, InputKind::Series, &input.path)?;
