@@ -6,3 +6,4 @@
 
 pub mod cli;
 pub mod interrupt;
+pub mod option_style;

@@ -1,19 +1,15 @@
 //! The `tiltnoise` binary: parse, run, map errors to exit code 2 with a one-line message.
 
-mod option_style;
-
 use clap::error::ErrorKind;
 use clap::{CommandFactory, FromArgMatches};
 use std::process::ExitCode;
-use tiltnoise::{cli, interrupt};
+use tiltnoise::{cli, interrupt, option_style};
 use tiltnoise_core::error::shown_within;
 
 /// The longest error line printed (characters); values inside it are already cut to 200.
 const MAX_ERROR_CHARS: usize = 2000;
 
 fn main() -> ExitCode {
-    // Before any message: the libraries' errors name options as flags (`--nperseg`).
-    tiltnoise_core::option_key::install_style(&option_style::Flags);
     // First: SIGINT, SIGTERM and SIGHUP cancel the run, remove the staging directories of the
     // outputs being written, print one line and end the process with exit code 2.
     let cancel = interrupt::install();
@@ -36,7 +32,8 @@ fn main() -> ExitCode {
         Err(_) if cancel.is_cancelled() => interrupt::wait_for_the_handler(),
         // The reader of standard output has gone (`tiltnoise tf | head -1`): nothing to say.
         Err(e) if cli::is_closed_pipe(&e) => ExitCode::SUCCESS,
-        Err(e) => fail(&format!("{e:#}")),
+        // The libraries' errors name options as flags (`--nperseg`) when rendered here.
+        Err(e) => fail(&option_style::rendered(&format_args!("{e:#}"))),
     }
 }
 

@@ -2,9 +2,16 @@
 //! ([`OptionKey`]): the flag `--segment-duration` for the key `segment_duration`, a value after a
 //! space (`--nperseg 8`), a mapping entry as `--units eta_t=urad`, a pair as `LOWER:UPPER`.
 
-use tiltnoise_core::option_key::{OptionKey, OptionStyle};
+use std::fmt;
+use tiltnoise_core::option_key::{render, OptionKey, OptionStyle};
 
-/// The command line's [`OptionStyle`], installed by `main` before anything runs.
+/// `message` (an error of the libraries, or a chain of them) as the command line shows it:
+/// every option it names spelled as a flag.
+pub fn rendered(message: &dyn fmt::Display) -> String {
+    render(&Flags, message)
+}
+
+/// The command line's [`OptionStyle`], with which `main` renders every error it prints.
 pub struct Flags;
 
 impl OptionStyle for Flags {
@@ -16,7 +23,7 @@ impl OptionStyle for Flags {
             OptionKey::INPUTS => "--input".to_string(),
             OptionKey::OUTPUTS => "--observables".to_string(),
             // The grid of a model evaluation, `freq_hz` in Python.
-            k if k.key() == "freq_hz" => "--freq".to_string(),
+            OptionKey::FREQ_HZ => "--freq".to_string(),
             _ => format!("--{}", key.key().replace('_', "-")),
         }
     }

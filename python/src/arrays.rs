@@ -32,10 +32,7 @@ pub struct Size {
 /// A size over a limit as its Python exception: `MemoryError` when the machine's memory is
 /// the bound, else `ValueError`; the message names the argument, the count and the limit.
 pub fn limit_error(e: LimitError) -> PyErr {
-    match e {
-        LimitError::Memory { .. } => PyMemoryError::new_err(e.to_string()),
-        _ => value_error(e.to_string()),
-    }
+    crate::errors::IntoPyErr::into_py_err(e)
 }
 
 /// Refuses `n` elements of `what` over `size` (count, then memory), before anything is copied.

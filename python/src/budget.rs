@@ -19,18 +19,19 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::freq;
-use tiltnoise_core::input::{parse_units, GapPolicy};
+use tiltnoise_core::input::GapPolicy;
 use tiltnoise_core::model::{Input, Model, Observable};
 use tiltnoise_core::noise::equivalent::referred_terms;
 use tiltnoise_core::noise::SpectralSource;
 use tiltnoise_core::option_key::OptionKey;
+use tiltnoise_core::options::parse_keyed_items;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_job::budget::{
     array_input, ArrayOptions, ArrayRecord, BudgetOutcome, BudgetRequest, SaveOptions, TiltSource,
     WelchRequest,
 };
-use tiltnoise_job::files::{OutputKind, Staging};
+use tiltnoise_job::files::Staging;
 use tiltnoise_job::{Invocation, Outcome, Silent};
 
 /// The model of `params`: a `Model` (reused as it is), a `Params`, or Table I for `None`; and
@@ -132,7 +133,7 @@ fn tilt_channels(
         .map(|n| ground_input(n))
         .collect::<PyResult<Vec<_>>>()?;
     refuse_repeats(OptionKey::AXES, "input", &axes, |a| a.name().to_string())
-        .map_err(|e| value_error(e.to_string()))?;
+        .map_err(|e| value_error(crate::errors::shown(&e)))?;
     let rows = arrays::rows("tilt", tilt, SERIES)?;
     if rows.len() != axes.len() {
         return Err(value_error(format!(
@@ -228,7 +229,7 @@ pub fn budget(
         .collect();
     let options = ArrayOptions {
         quantity: quantity.parse().map_err(value_error)?,
-        units: parse_units(OptionKey::UNITS, &items).py()?,
+        units: parse_keyed_items(OptionKey::UNITS, "channel", &items).py()?,
         corrected: channels_of.corrected,
         pendulum_tiltmeter: channels_of.pendulum_tiltmeter,
         gaps,
@@ -722,7 +723,7 @@ impl Budget {
         #[pyo3(from_py_with = kw::path)] path: PathBuf,
         #[pyo3(from_py_with = kw::keep_zero_columns)] keep_zero_columns: bool,
     ) -> PyResult<()> {
-        OutputKind::from_path(&path).py()?;
+        tiltnoise_job::output_kind(&path, tiltnoise_job::budget::OUTPUT_KINDS).py()?;
         self.inputs.check_save(&path)?;
         let options = SaveOptions {
             keep_zero_columns,

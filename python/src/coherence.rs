@@ -14,7 +14,7 @@ use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::coherence::CoherenceReport;
 use tiltnoise_job::coherence::{CoherenceOutcome, CoherenceRequest};
 use tiltnoise_job::figures::View;
-use tiltnoise_job::files::{OutputKind, Staging};
+use tiltnoise_job::files::Staging;
 use tiltnoise_job::{Invocation, Outcome};
 
 /// Coherence of measured observables with the tilt axes, and their measured transfer
@@ -267,7 +267,7 @@ impl Coherence {
     /// --save x.png`` for the same records); atomically. Raises ``OSError`` if it cannot be
     /// written or is one of the files read, ``ValueError`` for another extension.
     fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
-        OutputKind::from_path(&path).py()?;
+        tiltnoise_job::output_kind(&path, tiltnoise_job::coherence::OUTPUT_KINDS).py()?;
         self.inputs.check_save(&path)?;
         py.detach(|| Staging::committed(|stage| self.outcome.save(stage, &path)))
             .map_err(job_args::job_error)

@@ -45,7 +45,7 @@ impl OptionStyle for Keywords {
             OptionKey::SET => "Params.set".to_string(),
             OptionKey::DRAWN_OBSERVABLES => "observables".to_string(),
             // The planner's reasoning is a method of its own in Python.
-            k if k.key() == "explain" => "Model.explain()".to_string(),
+            OptionKey::EXPLAIN => "Model.explain()".to_string(),
             _ => key.key().to_string(),
         }
     }
@@ -95,15 +95,15 @@ pub trait IntoPyErr {
 impl IntoPyErr for LimitError {
     fn into_py_err(self) -> PyErr {
         match self {
-            LimitError::Memory { .. } => PyMemoryError::new_err(self.to_string()),
-            _ => PyValueError::new_err(self.to_string()),
+            LimitError::Memory { .. } => PyMemoryError::new_err(shown(&self)),
+            _ => PyValueError::new_err(shown(&self)),
         }
     }
 }
 
 impl IntoPyErr for ParamError {
     fn into_py_err(self) -> PyErr {
-        let message = self.to_string();
+        let message = shown(&self);
         match self {
             ParamError::Read { reason, .. } => read_error(&reason, message),
             ParamError::TooLarge(e) => e.into_py_err(),
@@ -114,7 +114,7 @@ impl IntoPyErr for ParamError {
 
 impl IntoPyErr for InputError {
     fn into_py_err(self) -> PyErr {
-        let message = self.to_string();
+        let message = shown(&self);
         match self {
             InputError::Io { reason, .. } => read_error(&reason, message),
             // A path whose extension names no supported format: the argument is wrong, not
@@ -134,7 +134,7 @@ macro_rules! value_or_limit {
             fn into_py_err(self) -> PyErr {
                 match self {
                     $ty::TooLarge(e) => e.into_py_err(),
-                    other => PyValueError::new_err(other.to_string()),
+                    other => PyValueError::new_err(shown(&other)),
                 }
             }
         }
@@ -148,14 +148,14 @@ impl IntoPyErr for BudgetError {
         match self {
             BudgetError::Input(e) => e.into_py_err(),
             BudgetError::TooLarge(e) => e.into_py_err(),
-            other => PyValueError::new_err(other.to_string()),
+            other => PyValueError::new_err(shown(&other)),
         }
     }
 }
 
 impl IntoPyErr for OutputError {
     fn into_py_err(self) -> PyErr {
-        let message = self.to_string();
+        let message = shown(&self);
         match self {
             OutputError::UnknownFormat { .. } => PyValueError::new_err(message),
             _ => PyOSError::new_err(message),
@@ -173,6 +173,12 @@ impl<T, E: IntoPyErr> PyResultExt<T> for Result<T, E> {
     fn py(self) -> pyo3::PyResult<T> {
         self.map_err(IntoPyErr::into_py_err)
     }
+}
+
+/// `message` (an error of the libraries) as Python shows it: every option it names spelled as
+/// the keyword argument ([`Keywords`]).
+pub fn shown(message: &dyn std::fmt::Display) -> String {
+    tiltnoise_core::option_key::render(&Keywords, message)
 }
 
 /// A `ValueError` with `message`.

@@ -270,7 +270,7 @@ impl Fit {
     /// ``OSError`` if it cannot be written or is one of the files read, ``ValueError`` for
     /// another extension.
     fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
-        tiltnoise_job::fit::check_save_path(&path).py()?;
+        tiltnoise_job::output_kind(&path, tiltnoise_job::fit::OUTPUT_KINDS).py()?;
         self.inputs.check_save(&path)?;
         let fit = self.outcome();
         py.detach(|| Staging::committed(|stage| fit.save(stage, &path)))

@@ -10,7 +10,7 @@ use pyo3::types::PyDict;
 
 use tiltnoise_core::budget::BudgetError;
 use tiltnoise_core::fit::FitError;
-use tiltnoise_core::input::{parse_scales, parse_units, AxisMap};
+use tiltnoise_core::input::AxisMap;
 use tiltnoise_core::model::{Input, Observable};
 use tiltnoise_core::noise::UserSource;
 use tiltnoise_core::option_key::OptionKey;
@@ -23,7 +23,7 @@ use tiltnoise_job::{AsdSpec, JobError, ReadoutItem, TermItem, WitnessItem};
 /// A job's error as the exception of its kind (`errors`' rules), with the message in keyword
 /// spelling.
 pub fn job_error(e: JobError) -> PyErr {
-    let message = e.message();
+    let message = crate::errors::shown(&e);
     let kind = match e {
         JobError::Input(e) | JobError::OptionFile { source: e, .. } => (*e).into_py_err(),
         JobError::Budget { source, .. } => match *source {
@@ -75,7 +75,7 @@ pub fn read_request(
             .as_deref()
             .map(AxisMap::parse)
             .transpose()
-            .map_err(|e| value_error(e.to_string()))?,
+            .map_err(|e| value_error(crate::errors::shown(&e)))?,
         quantity: quantity
             .as_deref()
             .map(str::parse)
@@ -86,7 +86,7 @@ pub fn read_request(
             .map(str::parse)
             .transpose()
             .map_err(value_error)?,
-        scale: parse_scales(OptionKey::SCALE, &scale).py()?,
+        scale: options::parse_keyed_items(OptionKey::SCALE, "channel", &scale).py()?,
         ..ReadRequest::default()
     })
 }
@@ -127,12 +127,13 @@ pub fn file_read_request(
 ) -> PyResult<ReadRequest> {
     let names_once = |option: OptionKey, names: Vec<String>| -> PyResult<Vec<String>> {
         refuse_repeats(option, "channel", &names, |n| n.clone())
-            .map_err(|e| value_error(e.to_string()))?;
+            .map_err(|e| value_error(crate::errors::shown(&e)))?;
         Ok(names)
     };
     Ok(ReadRequest {
-        units: parse_units(
+        units: options::parse_keyed_items(
             OptionKey::UNITS,
+            "channel",
             &units
                 .unwrap_or_default()
                 .iter()
@@ -254,14 +255,8 @@ pub fn witness_noise(arg: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<WitnessIte
                             with its relative uncertainty as (value, rel)}";
     let mut items = Vec::new();
     for (name, value) in args::entries("witness_noise", d, EXPECTED)? {
-        let input = Input::from_name(&name)
-            .filter(|i| i.is_ground())
-            .ok_or_else(|| {
-                value_error(format!(
-                    "witness_noise {name}=...: `{name}` is not a floor input of the model; \
-                     allowed: theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)"
-                ))
-            })?;
+        let input =
+            options::floor_input(OptionKey::WITNESS_NOISE, &format!("{name}=..."), &name).py()?;
         let (level, rel) = match value.extract::<(Bound<'_, PyAny>, Bound<'_, PyAny>)>() {
             Ok((level, rel)) => match args::number_of(&rel) {
                 Some(rel) => (level, rel),

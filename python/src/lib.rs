@@ -58,8 +58,6 @@ fn tiltnoise_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // code: at a later first use, a pending Ctrl-C would fail the import and the lookup would
     // panic. Looked up here, while the import of tiltnoise runs, it is never looked up again.
     numpy::PyArray1::<f64>::zeros(m.py(), 0, false);
-    // Before any message: the libraries' errors name options as keyword arguments.
-    tiltnoise_core::option_key::install_style(&errors::Keywords);
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("hdf5_version", tiltnoise_job::files::hdf5_version())?;
     m.add(

@@ -24,8 +24,8 @@ use tiltnoise_core::simulate::DEFAULT_MODE_ENERGY_J;
 use tiltnoise_core::tf::{
     self, eval_grid_threads_cancellable, Destination, Method, Scene, TransferFunction,
 };
-use tiltnoise_job::figures::{ImageFormat, View};
-use tiltnoise_job::files::{OutputKind, Staging};
+use tiltnoise_job::figures::View;
+use tiltnoise_job::files::Staging;
 use tiltnoise_job::modes::{ModesOutcome, ModesRequest, DOMINANT_SHARE};
 use tiltnoise_job::{Invocation, JobError, Outcome, Silent};
 
@@ -564,7 +564,7 @@ impl PyModel {
         drawn: Vec<String>,
         #[pyo3(from_py_with = kw::phase)] phase: bool,
     ) -> PyResult<()> {
-        OutputKind::from_path(&path).py()?;
+        tiltnoise_job::output_kind(&path, tiltnoise_job::tf::OUTPUT_KINDS).py()?;
         crate::inputs::Inputs::of_params(self.params_file.as_deref()).check_save(&path)?;
         let request = Request {
             inputs: parse_inputs(inputs)?,
@@ -593,7 +593,12 @@ impl PyModel {
             rel_tol: Some(rel_tol),
             block_freqs: None,
             figure: None,
-            figure_options: tiltnoise_job::tf::figure_options(model, drawn, phase),
+            figure_options: tiltnoise_job::tf::figure_options(
+                model,
+                drawn,
+                phase,
+                crate::errors::shown(&OptionKey::DRAWN_OBSERVABLES),
+            ),
             invocation: Invocation::of_this_process(),
         };
         let outcome = py
@@ -756,7 +761,7 @@ impl PyModel {
         freq_hz: &Bound<'_, PyAny>,
         inputs: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        ImageFormat::from_path(&path).py()?;
+        tiltnoise_job::figures::image_format(&path).py()?;
         crate::inputs::Inputs::of_params(self.params_file.as_deref()).check_save(&path)?;
         let req = methods_request(&self.model, freq_hz, inputs)?;
         py.detach(|| {

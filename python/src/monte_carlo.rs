@@ -166,7 +166,7 @@ impl MonteCarlo {
     /// ``OSError`` if it cannot be written or is the parameter file, ``ValueError`` for
     /// another extension.
     fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
-        monte_carlo::check_save_path(&path).py()?;
+        tiltnoise_job::output_kind(&path, monte_carlo::OUTPUT_KINDS).py()?;
         Inputs::of_params(self.params.file.as_deref()).check_save(&path)?;
         let run = self.job_run();
         py.detach(|| Staging::committed(|stage| run.save(stage, &path)))

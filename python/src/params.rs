@@ -89,7 +89,7 @@ impl PyParams {
             Ok(path) => {
                 let inner = tiltnoise_job::params::read(&path).map_err(|e| match e {
                     ParamError::Read { .. } => e.into_py_err(),
-                    other => InputFileError::new_err(other.to_string()),
+                    other => InputFileError::new_err(crate::errors::shown(&other)),
                 })?;
                 Ok(PyParams {
                     inner,

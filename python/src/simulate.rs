@@ -13,19 +13,14 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
-use tiltnoise_core::model::{Coord, Model, Observable};
-use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::model::{Coord, Model};
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::options;
-use tiltnoise_core::params::Params;
-use tiltnoise_core::simulate::{
-    parse_coordinates, record_description, set_coordinate, Excitation, InitialState,
-    Simulation as CoreSimulation,
-};
+use tiltnoise_core::simulate::{parse_coordinates, set_coordinate, Excitation};
 use tiltnoise_job::figures::View;
-use tiltnoise_job::files::{OutputKind, SeriesAsd, SimulationMeta, Staging};
-use tiltnoise_job::simulate::{asd_figure_data, save, Keep, RecordOutputs, SimulateRequest};
-use tiltnoise_job::{Invocation, Provenance, Silent};
+use tiltnoise_job::files::Staging;
+use tiltnoise_job::simulate::{HeldSimulation, Keep, SimulateRequest};
+use tiltnoise_job::{Invocation, Outcome, Silent};
 
 /// The options of `Model.simulate`, as given.
 pub struct SimulateArgs<'a, 'py> {
@@ -111,34 +106,18 @@ pub fn run(
             record: true,
             ..Keep::default()
         },
+        view: View::default(),
         invocation: Invocation::of_this_process(),
     };
     let cancel = Cancel::new();
     let r = interrupt::watch(py, &cancel, || {
         tiltnoise_job::simulate::run(&req, &cancel, &Silent).map_err(job_error)
     })?;
-    let sim = r
-        .record
+    let held = r
+        .into_held(model.params())
         .ok_or_else(|| value_error("the simulation kept no record"))?;
     Ok(Simulation {
-        sim,
-        asd: r.asd,
-        init: r.init,
-        init_source: r.init_source,
-        readout: r.readout,
-        seed: r.seed,
-        duration_s: r.duration_s,
-        description: r.description,
-        check_table: r.check.table(),
-        check_agrees: r.check.all_agree(),
-        params: model.params().clone(),
-        modes: r
-            .modes
-            .modes
-            .iter()
-            .map(|m| (m.index, m.frequency_hz))
-            .collect(),
-        provenance: r.provenance,
+        held,
         inputs: Inputs::of_params(params_file),
     })
 }
@@ -155,20 +134,8 @@ pub fn run(
 #[pyclass(module = "tiltnoise", frozen)]
 #[derive(serde::Serialize, serde::Deserialize)]
 pub struct Simulation {
-    sim: CoreSimulation,
-    asd: SeriesAsd,
-    init: InitialState,
-    init_source: String,
-    readout: Vec<(Observable, f64)>,
-    seed: u64,
-    duration_s: f64,
-    description: String,
-    check_table: String,
-    check_agrees: bool,
-    params: Params,
-    modes: Vec<(usize, f64)>,
-    /// What the saved files record (the job's provenance).
-    provenance: Provenance,
+    /// The record and all its files need (the job's).
+    held: HeldSimulation,
     /// The parameter file, which no `save` may replace.
     inputs: Inputs,
 }
@@ -178,26 +145,26 @@ impl Simulation {
     /// Sampling step (s).
     #[getter]
     fn dt_s(&self) -> f64 {
-        self.sim.dt_s
+        self.held.sim.dt_s
     }
 
     /// Sample rate (Hz).
     #[getter]
     fn fs_hz(&self) -> f64 {
-        self.sim.fs_hz()
+        self.held.sim.fs_hz()
     }
 
     /// Number of samples.
     #[getter]
     fn n_samples(&self) -> usize {
-        self.sim.len()
+        self.held.sim.len()
     }
 
     /// Sample times ``i * dt_s`` (s).
     #[getter]
     fn time_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        let dt = self.sim.dt_s;
-        PyArray1::from_iter(py, (0..self.sim.len()).map(|i| i as f64 * dt))
+        let dt = self.held.sim.dt_s;
+        PyArray1::from_iter(py, (0..self.held.sim.len()).map(|i| i as f64 * dt))
     }
 
     /// ``{observable: samples}`` of all seven observables (m for X, Y, Z; rad for the angles),
@@ -205,7 +172,7 @@ impl Simulation {
     #[getter]
     fn observables<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for (o, x) in &self.sim.observables {
+        for (o, x) in &self.held.sim.observables {
             d.set_item(o.name(), PyArray1::from_slice(py, x))?;
         }
         Ok(d)
@@ -219,7 +186,7 @@ impl Simulation {
         for c in Coord::ALL {
             d.set_item(
                 c.name(),
-                PyArray1::from_vec(py, self.sim.coordinate(c.index())),
+                PyArray1::from_vec(py, self.held.sim.coordinate(c.index())),
             )?;
         }
         Ok(d)
@@ -229,7 +196,7 @@ impl Simulation {
     #[getter]
     fn initial_state<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for (key, values) in [("q", &self.init.q), ("qdot", &self.init.qdot)] {
+        for (key, values) in [("q", &self.held.init.q), ("qdot", &self.held.init.qdot)] {
             let v = PyDict::new(py);
             for c in Coord::ALL {
                 v.set_item(c.name(), values[c.index()])?;
@@ -242,14 +209,14 @@ impl Simulation {
     /// Where the initial state came from (kick, given values, or equal energy per mode).
     #[getter]
     fn init_source(&self) -> &str {
-        &self.init_source
+        &self.held.init_source
     }
 
     /// ``{observable: white readout ASD}`` (unit/sqrt(Hz)); the others are noiseless.
     #[getter]
     fn readout<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for (o, a) in &self.readout {
+        for (o, a) in &self.held.readout {
             d.set_item(o.name(), a)?;
         }
         Ok(d)
@@ -258,14 +225,14 @@ impl Simulation {
     /// Seed of the readout noise.
     #[getter]
     fn seed(&self) -> u64 {
-        self.seed
+        self.held.seed
     }
 
     /// Frequencies of the ASDs (Hz): ``k fs / nperseg``, DC included (the files'
     /// ``frequency_hz``).
     #[getter]
     fn frequency_hz<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_slice(py, &self.asd.freqs_hz)
+        PyArray1::from_slice(py, &self.held.asd.freqs_hz)
     }
 
     /// The same as ``frequency_hz``.
@@ -278,7 +245,7 @@ impl Simulation {
     #[getter]
     fn asd<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for (o, a) in &self.asd.asd {
+        for (o, a) in &self.held.asd.asd {
             d.set_item(o.name(), PyArray1::from_slice(py, a))?;
         }
         Ok(d)
@@ -287,38 +254,38 @@ impl Simulation {
     /// ``[(k, frequency_hz)]`` of the model's modes nu_k (Hz).
     #[getter]
     fn modes_hz(&self) -> Vec<(usize, f64)> {
-        self.modes.clone()
+        self.held.modes_hz.clone()
     }
 
     /// Welch segment of the ASDs (samples).
     #[getter]
     fn nperseg(&self) -> usize {
-        self.asd.segment_len
+        self.held.asd.segment_len
     }
 
     /// Welch segments averaged.
     #[getter]
     fn n_welch_segments(&self) -> usize {
-        self.asd.n_segments
+        self.held.asd.n_segments
     }
 
     /// The resonance check as the command line prints it: for each channel, the modes its
     /// ASD shows and whether that agrees with the observability table.
     #[getter]
     fn resonance_check(&self) -> &str {
-        &self.check_table
+        &self.held.check_table
     }
 
     /// Whether every tested mode is seen exactly where the observability table says.
     #[getter]
     fn resonances_agree(&self) -> bool {
-        self.check_agrees
+        self.held.check_agrees
     }
 
     /// One sentence on the run (samples, step, initial state, readout, seed).
     #[getter]
     fn description(&self) -> &str {
-        &self.description
+        &self.held.description
     }
 
     /// Writes the run as the command line's ``simulate --save`` does, atomically: ``.h5`` /
@@ -329,33 +296,10 @@ impl Simulation {
     /// Raises ``OSError`` if it cannot be written or is the parameter file of the model,
     /// ``ValueError`` for another extension.
     fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
-        OutputKind::from_path(&path).py()?;
+        tiltnoise_job::output_kind(&path, tiltnoise_job::simulate::OUTPUT_KINDS).py()?;
         self.inputs.check_save(&path)?;
-        let run = self.provenance.clone();
-        let model = Model::new(&self.params).py()?;
-        py.detach(|| {
-            let meta = SimulationMeta {
-                run: run.clone(),
-                description: record_description(&self.description),
-                start_time: None,
-                seed: self.seed,
-                init: self.init,
-                init_source: self.init_source.clone(),
-                readout_asd: self.readout.clone(),
-                duration_s: self.duration_s,
-            };
-            let modes = NormalModes::new(&model);
-            let fs = self.sim.fs_hz();
-            let figure = asd_figure_data(&self.asd, &self.readout, &modes, fs, &self.description);
-            let outputs = RecordOutputs {
-                record: Some((&self.sim, &meta)),
-                asd: &self.asd,
-                run: &run,
-                figure: &figure,
-            };
-            Staging::committed(|stage| save(stage, &path, &outputs, &View::default()))
-        })
-        .py()
+        py.detach(|| Staging::committed(|stage| self.held.save(stage, &path)))
+            .map_err(job_error)
     }
 
     /// ``{"observables": {observable: gwpy.timeseries.TimeSeries}, "asd": {observable:
@@ -397,6 +341,6 @@ impl Simulation {
     }
 
     fn __repr__(&self) -> String {
-        format!("Simulation({})", self.description)
+        format!("Simulation({})", self.held.description)
     }
 }

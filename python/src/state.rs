@@ -16,7 +16,7 @@ use serde::Serialize;
 
 /// The version of the states: raised whenever a pickled type changes, so that an old pickle is
 /// refused instead of misread.
-pub const STATE_VERSION: u32 = 4;
+pub const STATE_VERSION: u32 = 5;
 
 /// What `__reduce__` returns: the class's `_from_state` and its arguments.
 pub type Reduced<'py> = (Bound<'py, PyAny>, Bound<'py, PyTuple>);

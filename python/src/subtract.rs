@@ -20,7 +20,6 @@ use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::options;
 use tiltnoise_core::subtract::{ResidualSpectra, DEFAULT_REPORT_BAND_HZ};
 use tiltnoise_job::files::Staging;
-use tiltnoise_job::subtract::outputs::SaveKind;
 use tiltnoise_job::subtract::{SubtractOutcome, SubtractRequest};
 use tiltnoise_job::Outcome;
 
@@ -313,7 +312,7 @@ impl Subtraction {
     /// atomically. Raises ``OSError`` if it cannot be written or is one of the files read,
     /// ``ValueError`` for another extension.
     fn save(&self, py: Python<'_>, #[pyo3(from_py_with = kw::path)] path: PathBuf) -> PyResult<()> {
-        SaveKind::of(&path).py()?;
+        tiltnoise_job::output_kind(&path, tiltnoise_job::subtract::outputs::OUTPUT_KINDS).py()?;
         self.inputs.check_save(&path)?;
         py.detach(|| Staging::committed(|stage| self.outcome.save(stage, &path)))
             .map_err(job_args::job_error)

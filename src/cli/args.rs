@@ -4,10 +4,10 @@
 use anyhow::{anyhow, Result};
 use clap::{Args, ValueEnum};
 use tiltnoise_core::ground::GroundQuantity;
-use tiltnoise_core::input::{parse_scales, parse_units};
 use tiltnoise_core::input::{AxisMap, ReadOptions};
 use tiltnoise_core::model::Observable;
 use tiltnoise_core::option_key::OptionKey;
+use tiltnoise_core::options::parse_keyed_items;
 use tiltnoise_core::repeats::{list_entries, refuse_repeats};
 use tiltnoise_core::tf::Method;
 
@@ -86,14 +86,6 @@ impl MethodArg {
     }
 }
 
-/// The two ends of a range written `LO:HI`, or `LO,HI` as it was written before ranges took
-/// the band syntax; anything else (one part, three parts, both separators) is a single part
-/// list the caller refuses.
-pub fn range_parts(text: &str) -> Vec<&str> {
-    let separator = if text.contains(':') { ':' } else { ',' };
-    text.split(separator).map(str::trim).collect()
-}
-
 /// A default value as help prints it, in scientific notation (`1e-9`, not `0.000000001`).
 pub fn scientific(x: f64) -> String {
     format!("{x:e}")
@@ -158,8 +150,8 @@ pub fn read_options(
             .unwrap_or("reject")
             .parse()
             .map_err(|e: String| anyhow!("--gaps: {e}"))?,
-        scale: parse_scales(OptionKey::SCALE, scale)?,
-        units: parse_units(OptionKey::UNITS, &channels.units)?,
+        scale: parse_keyed_items(OptionKey::SCALE, "channel", scale)?,
+        units: parse_keyed_items(OptionKey::UNITS, "channel", &channels.units)?,
         corrected: channel_names(OptionKey::CORRECTED, &channels.corrected)?,
         pendulum: channel_names(OptionKey::PENDULUM_TILTMETER, &channels.pendulum_tiltmeter)?,
     })

@@ -13,13 +13,14 @@ use std::path::PathBuf;
 use tiltnoise_core::error::Shown;
 use tiltnoise_core::freq;
 use tiltnoise_core::model::Model;
+use tiltnoise_core::option_key::OptionKey;
+use tiltnoise_core::options;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::spectral::Averaging;
 use tiltnoise_job::budget::{
     BudgetOutcome, BudgetRequest, ReadRequest, SaveOptions, TiltSource, WelchRequest,
 };
 use tiltnoise_job::figures::BudgetFigureOptions;
-use tiltnoise_job::files::OutputKind;
 use tiltnoise_job::{Invocation, Outcome};
 
 /// Arguments of `tiltnoise budget`.
@@ -136,22 +137,13 @@ fn parse_at(text: &str) -> Result<Vec<f64>> {
         .collect()
 }
 
-/// `--percentiles LO:HI`: numbers, 0 <= LO < HI <= 100.
+/// `--percentiles LO:HI`: two numbers (the job checks 0 <= LO < HI <= 100).
 fn parse_percentiles(text: &str) -> Result<(f64, f64)> {
-    let err = || {
-        anyhow!(
-            "--percentiles {}: expected LO:HI with 0 <= LO < HI <= 100, e.g. 10:90",
-            Shown(text)
-        )
-    };
-    let [a, b] = super::args::range_parts(text)[..] else {
-        return Err(err());
-    };
-    let (a, b): (f64, f64) = (a.parse().map_err(|_| err())?, b.parse().map_err(|_| err())?);
-    if !(0.0 <= a && a < b && b <= 100.0) {
-        return Err(err());
-    }
-    Ok((a, b))
+    Ok(options::parse_range(
+        OptionKey::PERCENTILES,
+        text,
+        "expected LO:HI with 0 <= LO < HI <= 100, e.g. 10:90",
+    )?)
 }
 
 /// How to read `--tilt`: the channel options as every command reads them, `--gaps` kept as
@@ -179,7 +171,7 @@ fn read_request(args: &BudgetArgs) -> Result<ReadRequest> {
 /// (with a progress bar on a terminal), the summary printed and the outcome saved.
 pub(crate) fn run_budget(params: &Params, args: BudgetArgs, run: &mut Run) -> Result<()> {
     for path in &args.save {
-        OutputKind::from_path(path)?;
+        tiltnoise_job::output_kind(path, tiltnoise_job::budget::OUTPUT_KINDS)?;
     }
     args.figure.refuse_without_figure(&args.save)?;
     let save = SaveOptions {

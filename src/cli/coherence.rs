@@ -6,17 +6,17 @@ use super::args::{tilt_read_options, Format};
 use super::figure_args::FigureArgs;
 use super::tf::parse_observables;
 use super::Run;
-use anyhow::{anyhow, Result};
+use anyhow::Result;
 use clap::Args;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use tiltnoise_core::coherence::{with_error, CoherenceReport, ObservableEstimate};
-use tiltnoise_core::error::Shown;
 use tiltnoise_core::model::Model;
+use tiltnoise_core::option_key::OptionKey;
+use tiltnoise_core::options;
 use tiltnoise_core::params::Params;
 use tiltnoise_job::budget::ReadRequest;
 use tiltnoise_job::coherence::{peak_bin, significant_bins, CoherenceOutcome, CoherenceRequest};
-use tiltnoise_job::files::OutputKind;
 use tiltnoise_job::{Invocation, Outcome};
 
 /// Arguments of `tiltnoise coherence`.
@@ -78,23 +78,18 @@ const COHERENCE_SIZE: (u32, u32) = (1650, 900);
 
 /// `--fit-band FLO:FHI` as numbers (the job checks the band).
 fn parse_fit_band(text: &str) -> Result<(f64, f64)> {
-    let shown = Shown(text);
-    let (lo, hi) = text
-        .split_once(':')
-        .ok_or_else(|| anyhow!("--fit-band {shown}: expected FLO:FHI in Hz, e.g. 1e-3:0.1"))?;
-    let number = |s: &str| -> Result<f64> {
-        s.trim()
-            .parse::<f64>()
-            .map_err(|_| anyhow!("--fit-band {shown}: `{}` is not a number", Shown(s)))
-    };
-    Ok((number(lo)?, number(hi)?))
+    Ok(options::parse_range(
+        OptionKey::FIT_BAND,
+        text,
+        "expected FLO:FHI in Hz, e.g. 1e-3:0.1",
+    )?)
 }
 
 /// Runs `tiltnoise coherence`: the options parsed into the coherence job's request, the job
 /// run, the summary printed and the files written.
 pub(crate) fn run_coherence(params: &Params, args: CoherenceArgs, run: &mut Run) -> Result<()> {
     for path in &args.save {
-        OutputKind::from_path(path)?;
+        tiltnoise_job::output_kind(path, tiltnoise_job::coherence::OUTPUT_KINDS)?;
     }
     args.figure.refuse_without_figure(&args.save)?;
     let view = args.figure.view_for(COHERENCE_SIZE)?;
@@ -247,7 +242,7 @@ mod tests {
     fn fit_band_parses_and_refuses() {
         assert_eq!(parse_fit_band("1e-3:0.1").unwrap(), (1e-3, 0.1));
         for bad in ["1e-3", "a:1", "1:b"] {
-            let e = parse_fit_band(bad).unwrap_err().to_string();
+            let e = crate::option_style::rendered(&parse_fit_band(bad).unwrap_err());
             assert!(e.starts_with("--fit-band"), "{bad}: {e}");
         }
     }

@@ -3,12 +3,13 @@
 //! messages, so the options mean the same everywhere, and a command's help lists only the
 //! ones it takes.
 
-use super::args::range_parts;
 use anyhow::{bail, Result};
 use clap::Args;
 use std::path::PathBuf;
 use tiltnoise_core::error::Shown;
-use tiltnoise_job::figures::{ImageFormat, View, MAX_PIXELS};
+use tiltnoise_core::option_key::OptionKey;
+use tiltnoise_core::options::{self, OptionError};
+use tiltnoise_job::figures::{View, MAX_PIXELS};
 
 /// Smallest and largest figure side accepted by `--size` (pixels at 100 dpi).
 const SIZE_RANGE_PX: (u32, u32) = (200, 10_000);
@@ -99,7 +100,9 @@ impl SizeArgs {
 /// Refuses the figure options `given` (their flags) when none of `outputs` is a figure
 /// (`.png`, `.svg`): an option that would change nothing is an error, never ignored.
 pub fn refuse_without_figure(given: &[&str], outputs: &[PathBuf]) -> Result<()> {
-    let figure = outputs.iter().any(|p| ImageFormat::from_path(p).is_ok());
+    let figure = outputs
+        .iter()
+        .any(|p| tiltnoise_job::figures::image_format(p).is_ok());
     match given.first() {
         Some(flag) if !figure => bail!(
             "{flag} applies to the figures, and no figure is saved: add --save FILE.png (or \
@@ -136,37 +139,29 @@ impl FigureArgs {
     pub fn view_for(&self, default: (u32, u32)) -> Result<View> {
         let mut view = self.size.view_for(default)?;
         if let Some(text) = &self.xlim {
-            view.x_range = Some(parse_range("--xlim", text, "Hz")?);
+            view.x_range = Some(parse_range(OptionKey::XLIM, text, "Hz")?);
         }
         if let Some(text) = &self.ylim {
-            view.y_range = Some(parse_range("--ylim", text, "the panels' unit")?);
+            view.y_range = Some(parse_range(OptionKey::YLIM, text, "the panels' unit")?);
         }
         Ok(view)
     }
 }
 
-/// `LO:HI` (or `LO,HI`) with 0 < LO < HI, both finite.
-fn parse_range(option: &str, text: &str, unit: &str) -> Result<(f64, f64)> {
+/// `LO:HI` (or `LO,HI`, [`options::parse_range`]) with 0 < LO < HI.
+fn parse_range(option: OptionKey, text: &str, unit: &str) -> Result<(f64, f64)> {
     let expected = format!("expected LO:HI in {unit} with 0 < LO < HI (log axes), e.g. 1e-3:1");
-    let parts: Vec<&str> = range_parts(text);
-    if parts.len() != 2 {
-        bail!("{option} {}: {expected}", Shown(text));
+    let (lo, hi) = options::parse_range(option, text, &expected)?;
+    if !(lo > 0.0 && hi > lo) {
+        return Err(OptionError::Range {
+            option,
+            text: text.to_string(),
+            part: None,
+            expected,
+        }
+        .into());
     }
-    let mut v = [0.0; 2];
-    for (slot, part) in v.iter_mut().zip(&parts) {
-        *slot = match part.parse::<f64>() {
-            Ok(x) if x.is_finite() => x,
-            _ => bail!(
-                "{option} {}: `{}` is not a finite number; {expected}",
-                Shown(text),
-                Shown(part)
-            ),
-        };
-    }
-    if !(v[0] > 0.0 && v[1] > v[0]) {
-        bail!("{option} {}: {expected}", Shown(text));
-    }
-    Ok((v[0], v[1]))
+    Ok((lo, hi))
 }
 
 /// `WxH` in pixels, each side within [`SIZE_RANGE_PX`].
@@ -195,10 +190,14 @@ mod tests {
     #[test]
     fn limits_and_sizes_parse_or_say_why_not() {
         for good in ["1e-3:1", "1e-3, 1", " 1e-3 : 1 "] {
-            assert_eq!(parse_range("--xlim", good, "Hz").unwrap(), (1e-3, 1.0));
+            assert_eq!(
+                parse_range(OptionKey::XLIM, good, "Hz").unwrap(),
+                (1e-3, 1.0)
+            );
         }
         for bad in ["1", "0,1", "2:1", "a,1", "1,inf", "1,2,3", "1:2:3", "1:2,3"] {
-            let e = parse_range("--xlim", bad, "Hz").unwrap_err().to_string();
+            let e = parse_range(OptionKey::XLIM, bad, "Hz").unwrap_err();
+            let e = crate::option_style::rendered(&e);
             assert!(e.starts_with("--xlim ") && e.contains("0 < LO < HI"), "{e}");
         }
         assert_eq!(parse_size("1600x1200").unwrap(), (1600, 1200));

@@ -59,7 +59,7 @@ enum FitFormat {
 /// printed and the files written.
 pub(crate) fn run_fit(params: &Params, args: FitArgs, run: &mut Run) -> Result<()> {
     for path in &args.save {
-        tiltnoise_job::fit::check_save_path(path)?;
+        tiltnoise_job::output_kind(path, tiltnoise_job::fit::OUTPUT_KINDS)?;
     }
     let req = FitRequest {
         params,

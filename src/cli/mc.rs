@@ -37,7 +37,7 @@ pub(crate) struct McOptions {
 /// files written.
 pub(crate) fn run_mc(params: &Params, opts: McOptions, run: &mut Run) -> Result<()> {
     for path in &opts.save {
-        monte_carlo::check_save_path(path)?;
+        tiltnoise_job::output_kind(path, monte_carlo::OUTPUT_KINDS)?;
     }
     opts.figure.refuse_without_figure(&opts.save)?;
     let req = McRequest {

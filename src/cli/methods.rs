@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use tiltnoise_core::freq;
 use tiltnoise_core::model::Model;
 use tiltnoise_core::params::Params;
-use tiltnoise_job::figures::{ImageFormat, METHODS_FIGURE_SIZE};
+use tiltnoise_job::figures::METHODS_FIGURE_SIZE;
 use tiltnoise_job::methods::{MethodsOutcome, MethodsRequest};
 use tiltnoise_job::{Invocation, Outcome};
 
@@ -52,7 +52,7 @@ pub(crate) fn run_methods(params: &Params, args: MethodsArgs, run: &mut Run) -> 
     } = args;
     let (spec, save) = (spec.as_str(), save.as_slice());
     for path in save {
-        ImageFormat::from_path(path)?;
+        tiltnoise_job::figures::image_format(path)?;
     }
     figure.refuse_without_figure(save)?;
     let view = figure.view_for(METHODS_FIGURE_SIZE)?;

@@ -171,7 +171,7 @@ impl Run {
         let outputs: Vec<&Path> = outputs.iter().map(PathBuf::as_path).collect();
         let flags: Vec<(String, &Path)> = files
             .into_iter()
-            .map(|(option, path)| (OptionKey::new(option).to_string(), path))
+            .map(|(option, path)| (crate::option_style::rendered(&OptionKey::new(option)), path))
             .collect();
         let inputs: Vec<(&str, &Path)> = flags.iter().map(|(o, p)| (o.as_str(), *p)).collect();
         self.check_outputs(&outputs, &inputs)
@@ -209,7 +209,8 @@ impl Run {
 
 /// A job's error in the command line's spelling of its options.
 pub(crate) fn job_error(e: tiltnoise_job::JobError) -> anyhow::Error {
-    anyhow::anyhow!(e.message())
+    // Its message whole (it names its causes itself), spelled when `main` renders it.
+    anyhow::Error::msg(e)
 }
 
 /// Runs the parsed command line. Everything printed is flushed before it returns; when the

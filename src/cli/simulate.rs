@@ -17,12 +17,10 @@ use tiltnoise_core::params::Params;
 use tiltnoise_core::simulate::{
     aliased_frequency_hz, parse_coordinates, readout_text, Excitation, DEFAULT_MODE_ENERGY_J,
 };
-use tiltnoise_job::figures::{ImageFormat, SIMULATE_FIGURE_SIZE};
+use tiltnoise_job::figures::SIMULATE_FIGURE_SIZE;
 use tiltnoise_job::files::OutputKind;
-use tiltnoise_job::simulate::{
-    asd_figure_data, save, save_time_figure, Keep, RecordOutputs, SimulateRequest, SimulateResult,
-};
-use tiltnoise_job::Invocation;
+use tiltnoise_job::simulate::{Keep, SimulateRequest, SimulateResult};
+use tiltnoise_job::{Invocation, Outcome};
 
 mod driven;
 
@@ -234,10 +232,10 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
     }
     refuse_record_options(&args)?;
     for path in &args.save {
-        OutputKind::from_path(path)?;
+        tiltnoise_job::output_kind(path, tiltnoise_job::simulate::OUTPUT_KINDS)?;
     }
     for path in &args.save_time {
-        ImageFormat::from_path(path)?;
+        tiltnoise_job::figures::image_format(path)?;
     }
     let hdf5: Vec<PathBuf> = args
         .save
@@ -265,43 +263,24 @@ pub(crate) fn run_simulate(params: &Params, args: SimulateArgs, run: &mut Run) -
             hdf5_coordinates: args.with_coordinates,
             time_figure: !args.save_time.is_empty(),
         },
+        view,
         invocation: Invocation::of_this_process(),
     };
     let bar = Bar::new("samples", WORTH_A_BAR);
-    let mut result =
-        tiltnoise_job::simulate::run(&req, &run.cancel, &bar).map_err(super::job_error)?;
+    let result = tiltnoise_job::simulate::run(&req, &run.cancel, &bar).map_err(super::job_error)?;
     let json = args.format == Format::Json;
     match json {
-        true => writeln!(
-            run.out,
-            "{}",
-            serde_json::to_string_pretty(&summary_json(&result))?
-        )?,
+        true => writeln!(run.out, "{}", serde_json::to_string_pretty(&result.json())?)?,
         false => write!(run.out, "{}{}", summary(&result), result.check.table())?,
     }
-    let meta = result.provenance.clone();
-    let figure = asd_figure_data(
-        &result.asd,
-        &result.readout,
-        &result.modes,
-        result.fs_hz(),
-        &result.description,
-    );
     run.write_outputs(json, |stage| {
-        result.finish_records(stage)?;
-        let outputs = RecordOutputs {
-            record: None,
-            asd: &result.asd,
-            run: &meta,
-            figure: &figure,
-        };
         for path in &args.save {
-            save(stage, path, &outputs, &view)?;
+            result.save(stage, path).map_err(super::job_error)?;
         }
-        if let Some(data) = &result.time_figure {
-            for path in &args.save_time {
-                save_time_figure(stage, path, data, &view)?;
-            }
+        for path in &args.save_time {
+            result
+                .save_time_figure(stage, path)
+                .map_err(super::job_error)?;
         }
         Ok(())
     })
@@ -360,76 +339,4 @@ fn summary(r: &SimulateResult) -> String {
         );
     }
     s
-}
-
-/// The summary as JSON (`--format json`): the numbers of the table, unrounded, and the
-/// resonance check per channel and mode.
-fn summary_json(r: &SimulateResult) -> serde_json::Value {
-    use serde_json::json;
-    let fs = r.fs_hz();
-    let modes: Vec<serde_json::Value> = r
-        .modes
-        .modes
-        .iter()
-        .enumerate()
-        .map(|(k, m)| {
-            let seen: Vec<&str> = r
-                .modes
-                .observables_seeing(k)
-                .iter()
-                .map(|o| o.name())
-                .collect();
-            json!({
-                "index": m.index,
-                "frequency_hz": m.frequency_hz,
-                "apparent_frequency_hz": aliased_frequency_hz(m.frequency_hz, fs),
-                "seen_by": seen,
-            })
-        })
-        .collect();
-    let channels: Vec<serde_json::Value> = r
-        .check
-        .channels
-        .iter()
-        .map(|c| {
-            let modes: Vec<serde_json::Value> = c
-                .modes
-                .iter()
-                .map(|m| {
-                    json!({
-                        "mode": m.mode_index,
-                        "spectrum": m.spectrum.name(),
-                        "table_seen": m.table_seen,
-                        "agrees": m.agrees(),
-                    })
-                })
-                .collect();
-            json!({ "observable": c.observable.name(), "readout_asd": c.readout_asd, "modes": modes })
-        })
-        .collect();
-    let readout: serde_json::Map<String, serde_json::Value> = r
-        .readout
-        .iter()
-        .map(|(o, a)| (o.name().to_string(), json!(a)))
-        .collect();
-    json!({
-        "samples": r.n_samples,
-        "dt_s": r.dt_s,
-        "duration_s": r.n_samples as f64 * r.dt_s,
-        "nyquist_hz": fs / 2.0,
-        "initial_state": r.init_source,
-        "readout_asd": readout,
-        "seed": r.seed,
-        "welch": {
-            "segment_len": r.asd.segment_len,
-            "overlap": r.asd.overlap,
-            "n_segments": r.asd.n_segments,
-        },
-        "modes": modes,
-        "resonance_check": {
-            "all_agree": r.check.all_agree(),
-            "tested": r.check.n_tested(),
-            "channels": channels,
-        },
-    })
 }

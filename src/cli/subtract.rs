@@ -20,7 +20,6 @@ use tiltnoise_core::params::Params;
 use tiltnoise_job::budget::ReadRequest;
 use tiltnoise_job::figures::View;
 use tiltnoise_job::subtract::figure::FIGURE_SIZE;
-use tiltnoise_job::subtract::outputs::SaveKind;
 use tiltnoise_job::subtract::SubtractRequest;
 use tiltnoise_job::{Invocation, Outcome, Silent};
 
@@ -122,18 +121,12 @@ pub(crate) struct SubtractArgs {
 }
 
 /// `FLO:FHI` as numbers (the job checks the band).
-fn parse_band(option: &str, text: &str) -> Result<(f64, f64)> {
-    let err = || {
-        anyhow!(
-            "{option} {}: expected FLO:FHI in Hz with 0 < FLO < FHI, e.g. 3e-3:3e-2",
-            Shown(text)
-        )
-    };
-    let (a, b) = text.split_once(':').ok_or_else(err)?;
-    Ok((
-        a.trim().parse().map_err(|_| err())?,
-        b.trim().parse().map_err(|_| err())?,
-    ))
+fn parse_band(option: OptionKey, text: &str) -> Result<(f64, f64)> {
+    Ok(options::parse_range(
+        option,
+        text,
+        "expected FLO:FHI in Hz with 0 < FLO < FHI, e.g. 3e-3:3e-2",
+    )?)
 }
 
 /// `--colocated-ratio INPUT=R` as an input and a number (the job checks them).
@@ -145,12 +138,7 @@ fn parse_colocated_ratio(items: &[String]) -> Result<Vec<(Input, f64)>> {
             let (name, value) = item.split_once('=').ok_or_else(|| {
                 anyhow!("--colocated-ratio {shown}: expected INPUT=R, e.g. eta_t=1.5")
             })?;
-            let input = Input::from_name(name.trim()).ok_or_else(|| {
-                anyhow!(
-                    "--colocated-ratio {shown}: `{}` is not a floor input of the model",
-                    Shown(name)
-                )
-            })?;
+            let input = options::floor_input(OptionKey::COLOCATED_RATIO, item, name)?;
             let r = value.trim().parse().map_err(|_| {
                 anyhow!(
                     "--colocated-ratio {shown}: `{}` is not a number",
@@ -211,9 +199,9 @@ fn request<'a>(args: &SubtractArgs, model: &'a Model) -> Result<SubtractRequest<
         band_hz: args
             .band
             .as_deref()
-            .map(|b| parse_band("--band", b))
+            .map(|b| parse_band(OptionKey::BAND, b))
             .transpose()?,
-        report_band_hz: parse_band("--report-band", &args.report_band)?,
+        report_band_hz: parse_band(OptionKey::REPORT_BAND, &args.report_band)?,
         nperseg: args.nperseg,
         holdout: args.holdout,
         max_delay_s: args.max_delay,
@@ -226,7 +214,7 @@ fn request<'a>(args: &SubtractArgs, model: &'a Model) -> Result<SubtractRequest<
 /// the report printed and the files written.
 pub(crate) fn run_subtract(params: &Params, args: SubtractArgs, run: &mut Run) -> Result<()> {
     for path in &args.save {
-        SaveKind::of(path)?;
+        tiltnoise_job::output_kind(path, tiltnoise_job::subtract::outputs::OUTPUT_KINDS)?;
     }
     args.figure.refuse_without_figure(&args.save)?;
     let figure = args.figure.view_for(FIGURE_SIZE)?;

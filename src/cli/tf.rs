@@ -146,7 +146,12 @@ fn figure_options(args: &TfArgs, request: &Request, model: &Model) -> Result<TfF
     } else {
         tiltnoise_job::tf::FIGURE5_OBSERVABLES.to_vec()
     };
-    let options = tiltnoise_job::tf::figure_options(model, observables, args.phase);
+    let options = tiltnoise_job::tf::figure_options(
+        model,
+        observables,
+        args.phase,
+        crate::option_style::rendered(&OptionKey::DRAWN_OBSERVABLES),
+    );
     let size = tf_figure_size(&options, &request.inputs);
     Ok(TfFigureOptions {
         view: args.figure.view_for(size)?,
@@ -197,7 +202,7 @@ pub(crate) fn run_tf(params: &Params, args: TfArgs, run: &mut Run) -> Result<()>
     tiltnoise_job::tf::rel_tol(Some(args.rel_tol)).map_err(super::job_error)?;
     // Check every output before computing, so a typo costs nothing.
     for path in &args.save {
-        OutputKind::from_path(path)?;
+        tiltnoise_job::output_kind(path, tiltnoise_job::tf::OUTPUT_KINDS)?;
     }
     let model = Model::new(params)?;
     let figure = figure_options(&args, &request_names, &model)?;

@@ -7,18 +7,10 @@
 use anyhow::{anyhow, Result};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::Shown;
-use tiltnoise_core::model::Input;
 use tiltnoise_core::option_key::OptionKey;
+use tiltnoise_core::options;
 use tiltnoise_core::repeats::refuse_repeated_keys;
 use tiltnoise_job::{AsdSpec, WitnessItem};
-
-/// The model inputs a witness can record.
-const FLOOR_INPUTS: &str = "theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)";
-
-/// Whether `input` is a motion of the floor (what a witness records): a tilt or a translation.
-pub fn is_floor_input(input: Input) -> bool {
-    input.is_ground()
-}
 
 /// Parses every `--witness-noise` item into the job's items, each input once.
 pub fn parse_witness_items(items: &[String]) -> Result<Vec<WitnessItem>> {
@@ -33,15 +25,7 @@ pub fn parse_witness_items(items: &[String]) -> Result<Vec<WitnessItem>> {
                      eta_t=noise.csv:0.1"
                 )
             })?;
-            let input = Input::from_name(name.trim())
-                .filter(|&i| is_floor_input(i))
-                .ok_or_else(|| {
-                    anyhow!(
-                        "--witness-noise {shown}: `{}` is not a floor input of the model; \
-                         allowed: {FLOOR_INPUTS}",
-                        Shown(name)
-                    )
-                })?;
+            let input = options::floor_input(OptionKey::WITNESS_NOISE, item, name)?;
             let (level, rel) = match value.rsplit_once(':') {
                 Some((head, tail))
                     if !head.trim().is_empty() && tail.trim().parse::<f64>().is_ok() =>

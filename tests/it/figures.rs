@@ -57,7 +57,9 @@ fn drawing_error_leaves_existing_target_untouched() {
         let path = dir.path().join(name);
         std::fs::write(&path, b"previous").unwrap();
         let err = tiltnoise_io::Staging::committed(|s| {
-            save_image(s, &path, |_| Err(DrawError("deliberate".to_string())))
+            save_image(s, &path, |_| {
+                Err(DrawError("deliberate".to_string().into()))
+            })
         })
         .unwrap_err();
         assert!(err.to_string().contains("deliberate"), "{err}");

@@ -268,6 +268,7 @@ fn missing_directory_is_an_error_naming_the_path_and_leaves_nothing() {
         match &err {
             OutputError::Write { path: p, message } => {
                 assert_eq!(p, &path);
+                let message = message.to_string();
                 #[cfg(unix)]
                 assert!(message.contains("No such file or directory"), "{message}");
                 assert!(!message.contains(".tmp"), "no temporary name: {message}");
@@ -340,7 +341,7 @@ fn failed_write_does_not_clobber_an_existing_file() {
     match err {
         OutputError::Write { path: p, message } => {
             assert_eq!(p, path);
-            assert_eq!(message, "boom");
+            assert_eq!(message, "boom".into());
         }
         other => panic!("expected Write, got {other:?}"),
     }

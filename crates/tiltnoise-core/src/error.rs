@@ -222,8 +222,8 @@ pub enum FreqError {
     /// A malformed `FLO:N:FHI` specification or frequency file.
     #[error("{origin}: {message}")]
     Spec {
-        /// The specification or file.
-        origin: String,
+        /// The specification (the option and its value) or the file.
+        origin: crate::option_key::Message,
         /// What is wrong and what is allowed.
         message: String,
     },
@@ -319,8 +319,8 @@ pub enum OutputError {
     UnknownFormat {
         /// The path asked for.
         path: PathBuf,
-        /// The supported extensions.
-        allowed: &'static str,
+        /// The supported extensions, as the message lists them (`.h5, .hdf5, .png, .svg`).
+        allowed: String,
     },
     /// An output path that breaks a rule of the run, found before anything is computed: no
     /// such directory, not writable, a directory, given twice, or an input of the run.
@@ -337,7 +337,7 @@ pub enum OutputError {
         /// The path asked for.
         path: PathBuf,
         /// What went wrong.
-        message: String,
+        message: crate::option_key::Message,
     },
 }
 

@@ -59,7 +59,7 @@ impl LogGrid {
         check_count(spec, n as f64, POINTS, limit)?;
         if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi >= lo && n >= 1) {
             return Err(FreqError::Spec {
-                origin: spec(),
+                origin: spec().into(),
                 message: "need 0 < FLO <= FHI, both finite, and N >= 1".into(),
             });
         }
@@ -142,7 +142,7 @@ pub fn parse_spec(spec: &str) -> Result<Vec<f64>, FreqError> {
 /// Parses `FLO:N:FHI` as [`parse_spec`] into a [`LogGrid`] of at most `limit` points (for a
 /// grid evaluated block by block, [`crate::limits::MAX_STREAMED_GRID_POINTS`]).
 pub fn parse_log_spec(spec: &str, limit: usize) -> Result<LogGrid, FreqError> {
-    let origin = || OptionKey::FREQ.given(Shown(spec)).to_string();
+    let origin = || crate::message!("{}", OptionKey::FREQ.given(Shown(spec)));
     let err = |message: &str| FreqError::Spec {
         origin: origin(),
         message: message.into(),

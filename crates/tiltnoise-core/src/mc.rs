@@ -35,6 +35,7 @@ use crate::limits::{
 };
 use crate::model::{Block, Model};
 use crate::modes::reduced_pencil;
+use crate::option_key::OptionKey;
 use crate::params::uncertainty::{check, UncertaintyError};
 use crate::params::Params;
 use crate::rng::Rng;
@@ -161,11 +162,15 @@ pub fn mode_frequencies_hz(model: &Model) -> Option<[f64; 8]> {
 /// ([`MC_BYTES_PER_DRAW`] each), or more than [`MAX_THREADS`] threads, before anything is
 /// allocated. `names` are what the messages call the two counts, e.g. the options
 /// `("--samples", "--threads")`.
-pub fn check_size(samples: usize, threads: usize, names: (&str, &str)) -> Result<(), LimitError> {
-    let what = || format!("{} {samples}", names.0);
+pub fn check_size(
+    samples: usize,
+    threads: usize,
+    names: (OptionKey, OptionKey),
+) -> Result<(), LimitError> {
+    let what = || crate::message!("{} {samples}", names.0);
     check_count(what, samples as f64, "Monte Carlo draws", MAX_MC_DRAWS)?;
     check_memory(what, planned_bytes(samples, MC_BYTES_PER_DRAW))?;
-    let what = || format!("{} {threads}", names.1);
+    let what = || crate::message!("{} {threads}", names.1);
     check_count(what, threads as f64, "threads", MAX_THREADS)
 }
 
@@ -269,7 +274,11 @@ impl Plan {
         if cfg.samples == 0 {
             return Err(McError::NoSamples);
         }
-        check_size(cfg.samples, cfg.threads, ("samples", "threads"))?;
+        check_size(
+            cfg.samples,
+            cfg.threads,
+            (OptionKey::SAMPLES, OptionKey::THREADS),
+        )?;
         Model::new(params)?;
         let keys: Vec<&str> = params.fields().iter().map(|f| f.key).collect();
         check(&cfg.uncertainties, &keys)?;
@@ -406,7 +415,12 @@ mod tests {
             assert!(matches!(e, McError::TooLarge(_)), "{e}");
             assert!(e.to_string().contains(needle), "{e}");
         }
-        assert!(check_size(MAX_MC_DRAWS, MAX_THREADS, ("a", "b")).is_ok());
+        assert!(check_size(
+            MAX_MC_DRAWS,
+            MAX_THREADS,
+            (OptionKey::SAMPLES, OptionKey::THREADS)
+        )
+        .is_ok());
     }
 
     #[test]

@@ -8,7 +8,7 @@ use crate::error::{Num, Shown};
 use crate::limits::{LimitError, ASDS};
 use crate::model::{ForceInput, Input, Observable};
 use crate::noise::Readout;
-use crate::option_key::OptionKey;
+use crate::option_key::{Message, OptionKey};
 use crate::repeats::{refuse_repeats, Repeated};
 
 /// A name or option value that is not allowed; the message names the option, the value and
@@ -107,13 +107,147 @@ pub enum OptionError {
         /// What is wrong with the item and what is allowed.
         message: String,
     },
+    /// An item naming an input that is not a motion of the floor (what a witness records).
+    #[error(
+        "{option} {}: `{}` is not a floor input of the model; allowed: {}",
+        Shown(.item),
+        Shown(.name),
+        floor_input_names()
+    )]
+    NotAFloorInput {
+        /// The option.
+        option: OptionKey,
+        /// The item given.
+        item: String,
+        /// The name given.
+        name: String,
+    },
+    /// A range that is not two numbers `LO:HI` (or `LO,HI`).
+    #[error("{option} {}: {}{expected}", Shown(.text), RangePart(.part.as_deref()))]
+    Range {
+        /// The option.
+        option: OptionKey,
+        /// The range given.
+        text: String,
+        /// The part that is not a finite number, when the range has two parts.
+        part: Option<String>,
+        /// What the option takes, e.g. `expected FLO:FHI in Hz, e.g. 1e-3:0.1`.
+        expected: String,
+    },
     /// An option that does not fit the others or the input, or a value out of its range (the
     /// message says why and what to do instead).
     #[error("{0}")]
-    Conflict(String),
+    Conflict(Message),
     /// A size beyond a documented limit or the memory available.
     #[error(transparent)]
     TooLarge(#[from] LimitError),
+}
+
+/// The part of a range that is not a number, for [`OptionError::Range`].
+struct RangePart<'a>(Option<&'a str>);
+
+impl std::fmt::Display for RangePart<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            Some(part) => write!(f, "`{}` is not a finite number; ", Shown(part)),
+            None => Ok(()),
+        }
+    }
+}
+
+/// The floor inputs of the model (what a witness records) with their SI units, for messages:
+/// `theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)`.
+pub fn floor_input_names() -> String {
+    let mut groups: Vec<(&str, Vec<&str>)> = Vec::new();
+    for input in Input::all_ground() {
+        match groups.last_mut() {
+            Some((unit, names)) if *unit == input.unit() => names.push(input.name()),
+            _ => groups.push((input.unit(), vec![input.name()])),
+        }
+    }
+    groups
+        .iter()
+        .map(|(unit, names)| format!("{} ({unit})", names.join(", ")))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The floor input (a tilt angle or a translation of the floor) `name`, of the item `item` of
+/// `option` (the one rule for witness items, co-located noise ratios and drives).
+///
+/// # Errors
+///
+/// [`OptionError::NotAFloorInput`] for a name that is no input, or a force or torque.
+pub fn floor_input(option: OptionKey, item: &str, name: &str) -> Result<Input, OptionError> {
+    Input::from_name(name.trim())
+        .filter(|i| i.is_ground())
+        .ok_or_else(|| OptionError::NotAFloorInput {
+            option,
+            item: item.to_string(),
+            name: name.trim().to_string(),
+        })
+}
+
+/// The two finite numbers of a range `LO:HI` of `option` (or `LO,HI`, as ranges were written
+/// before they took the band syntax), the one reading of every range the command line takes
+/// (bands, percentiles, axis limits); `expected` says what the option takes. Whether the ends
+/// are in order and range is for the option's own check, which Python's `(LO, HI)` tuples
+/// meet too.
+///
+/// # Errors
+///
+/// [`OptionError::Range`] for a range of other than two parts, or a part that is not a finite
+/// number.
+pub fn parse_range(
+    option: OptionKey,
+    text: &str,
+    expected: &str,
+) -> Result<(f64, f64), OptionError> {
+    let error = |part: Option<&str>| OptionError::Range {
+        option,
+        text: text.to_string(),
+        part: part.map(str::to_string),
+        expected: expected.to_string(),
+    };
+    let separator = if text.contains(':') { ':' } else { ',' };
+    let parts: Vec<&str> = text.split(separator).map(str::trim).collect();
+    let [lo, hi] = parts[..] else {
+        return Err(error(None));
+    };
+    let number = |part: &str| match part.parse::<f64>() {
+        Ok(x) if x.is_finite() => Ok(x),
+        _ => Err(error(Some(part))),
+    };
+    Ok((number(lo)?, number(hi)?))
+}
+
+/// The `KEY=VALUE` items of `option`, each key once (`what` names a key in the message:
+/// `channel`), each parsed by `T`'s `FromStr` (whose error says what is expected): the one
+/// reading of the unit and scale maps of both front ends (Python's dicts are handed over as
+/// such items).
+///
+/// # Errors
+///
+/// [`OptionError::Repeated`] for a key given twice, [`OptionError::Item`] for the first item
+/// that does not parse.
+pub fn parse_keyed_items<T, S>(
+    option: OptionKey,
+    what: &'static str,
+    items: &[S],
+) -> Result<Vec<T>, OptionError>
+where
+    T: std::str::FromStr<Err = String>,
+    S: AsRef<str>,
+{
+    crate::repeats::refuse_repeated_keys(option, what, items)?;
+    items
+        .iter()
+        .map(|s| {
+            s.as_ref()
+                .parse()
+                .map_err(|message| OptionError::Item { option, message })
+        })
+        .collect()
 }
 
 /// Every input name, for messages.

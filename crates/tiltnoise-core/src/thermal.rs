@@ -134,7 +134,7 @@ pub fn thermal_noise(
         for (k, &f) in freqs_hz.iter().enumerate() {
             if !(f.is_finite() && f > 0.0) {
                 return Err(FreqError::Spec {
-                    origin: format!("thermal noise at {f} Hz"),
+                    origin: format!("thermal noise at {f} Hz").into(),
                     message: "frequency must be finite and > 0 (structural thermal noise \
                               diverges as 1/f at 0 Hz)"
                         .into(),

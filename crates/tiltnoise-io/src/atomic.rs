@@ -42,7 +42,7 @@ impl AtomicFile {
     pub fn create(path: &Path) -> Result<AtomicFile, OutputError> {
         let fail = |message: String| OutputError::Write {
             path: path.to_path_buf(),
-            message,
+            message: message.into(),
         };
         let file_name = path
             .file_name()
@@ -73,7 +73,7 @@ impl AtomicFile {
     pub fn fail(&self, message: String) -> OutputError {
         OutputError::Write {
             path: self.target.clone(),
-            message,
+            message: message.into(),
         }
     }
 

@@ -25,7 +25,7 @@ pub fn read_freq_file(path: &Path) -> Result<Vec<f64>, FreqError> {
     let text = read_text_file(path, MAX_FREQ_FILE_BYTES, &name, "a frequency file").map_err(
         |e| match e {
             TextFileError::Io(e) => FreqError::Spec {
-                origin: origin.clone(),
+                origin: origin.clone().into(),
                 message: format!("cannot read: {e}"),
             },
             TextFileError::TooLarge(e) => FreqError::TooLarge(e),
@@ -45,7 +45,7 @@ fn parse_freq_text(text: &str, origin: &str) -> Result<Vec<f64>, FreqError> {
             Ok(None) => break,
             Err(e) => {
                 return Err(FreqError::Spec {
-                    origin: e.line().map_or_else(|| origin.to_string(), at),
+                    origin: e.line().map_or_else(|| origin.to_string(), at).into(),
                     message: e.to_string(),
                 })
             }
@@ -56,7 +56,7 @@ fn parse_freq_text(text: &str, origin: &str) -> Result<Vec<f64>, FreqError> {
         };
         let Some(value) = value else {
             return Err(FreqError::Spec {
-                origin: at(line),
+                origin: at(line).into(),
                 message: format!(
                     "`{}` is not a number (one frequency in Hz per line)",
                     Shown(line_text(text, line))

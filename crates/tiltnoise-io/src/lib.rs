@@ -90,9 +90,6 @@ pub fn hdf5_version() -> String {
     format!("{major}.{minor}.{release}")
 }
 
-/// Extensions accepted by [`OutputKind::from_path`], as shown in error messages.
-pub const ALLOWED_EXTENSIONS: &str = ".h5, .hdf5, .csv, .png, .svg";
-
 /// Output format, chosen by the file extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum OutputKind {
@@ -100,6 +97,8 @@ pub enum OutputKind {
     Hdf5,
     /// Comma-separated text (`.csv`).
     Csv,
+    /// A command's report as JSON (`.json`).
+    Json,
     /// PNG bitmap figure (`.png`).
     Png,
     /// SVG vector figure (`.svg`).
@@ -107,26 +106,64 @@ pub enum OutputKind {
 }
 
 impl OutputKind {
-    /// The format named by the extension of `path`, compared case-insensitively.
+    /// Every kind, in the order messages list them.
+    pub const ALL: [OutputKind; 5] = [
+        OutputKind::Hdf5,
+        OutputKind::Csv,
+        OutputKind::Json,
+        OutputKind::Png,
+        OutputKind::Svg,
+    ];
+
+    /// The extensions of this kind, without the dot, lower case.
+    pub fn extensions(self) -> &'static [&'static str] {
+        match self {
+            OutputKind::Hdf5 => &["h5", "hdf5"],
+            OutputKind::Csv => &["csv"],
+            OutputKind::Json => &["json"],
+            OutputKind::Png => &["png"],
+            OutputKind::Svg => &["svg"],
+        }
+    }
+
+    /// The kind among `allowed` that the extension of `path` names, compared
+    /// case-insensitively: the one output-kind rule of every command and writer.
     ///
     /// # Errors
     ///
-    /// [`OutputError::UnknownFormat`] naming `path` and [`ALLOWED_EXTENSIONS`] when the
-    /// extension is missing or not supported.
-    pub fn from_path(path: &Path) -> Result<OutputKind, OutputError> {
+    /// [`OutputError::UnknownFormat`] naming `path` and the extensions of `allowed` when the
+    /// extension is missing or names no kind of `allowed`.
+    pub fn of_path(path: &Path, allowed: &[OutputKind]) -> Result<OutputKind, OutputError> {
         let ext = path
             .extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
-        match ext.as_deref() {
-            Some("h5" | "hdf5") => Ok(OutputKind::Hdf5),
-            Some("csv") => Ok(OutputKind::Csv),
-            Some("png") => Ok(OutputKind::Png),
-            Some("svg") => Ok(OutputKind::Svg),
-            _ => Err(OutputError::UnknownFormat {
+        allowed
+            .iter()
+            .copied()
+            .find(|k| ext.as_deref().is_some_and(|e| k.extensions().contains(&e)))
+            .ok_or_else(|| OutputError::UnknownFormat {
                 path: path.to_path_buf(),
-                allowed: ALLOWED_EXTENSIONS,
-            }),
-        }
+                allowed: extensions_of(allowed),
+            })
     }
+
+    /// [`OutputKind::of_path`] among every kind.
+    ///
+    /// # Errors
+    ///
+    /// [`OutputError::UnknownFormat`] as [`OutputKind::of_path`].
+    pub fn from_path(path: &Path) -> Result<OutputKind, OutputError> {
+        Self::of_path(path, &Self::ALL)
+    }
+}
+
+/// The extensions of `kinds` as messages show them: `.h5, .hdf5, .png, .svg`.
+pub fn extensions_of(kinds: &[OutputKind]) -> String {
+    kinds
+        .iter()
+        .flat_map(|k| k.extensions())
+        .map(|e| format!(".{e}"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }

@@ -11,13 +11,13 @@ use tiltnoise_core::budget::BudgetError;
 use tiltnoise_core::cancel::Cancelled;
 use tiltnoise_core::coherence::CoherenceError;
 use tiltnoise_core::error::OutputError;
-use tiltnoise_core::error::{FreqError, TfError};
+use tiltnoise_core::error::{FreqError, ParamError, TfError};
 use tiltnoise_core::error::{Num, Shown};
 use tiltnoise_core::fit::FitError;
 use tiltnoise_core::input::InputError;
 use tiltnoise_core::mc::McError;
 use tiltnoise_core::model::Observable;
-use tiltnoise_core::option_key::{self, OptionKey};
+use tiltnoise_core::option_key::{self, Message, OptionKey};
 use tiltnoise_core::options::OptionError;
 use tiltnoise_core::repeats::Repeated;
 use tiltnoise_core::simulate::SimError;
@@ -36,7 +36,7 @@ pub enum JobError {
     /// or is not valid.
     OptionFile {
         /// The option.
-        option: &'static str,
+        option: OptionKey,
         /// The item, as `KEY=VALUE`.
         item: String,
         /// What is wrong with the file.
@@ -45,16 +45,16 @@ pub enum JobError {
     /// An option or an item of one whose value does not fit.
     Option {
         /// The option.
-        option: &'static str,
+        option: OptionKey,
         /// The item or value, when the message shows it.
-        value: Option<String>,
+        value: Option<Message>,
         /// What is wrong and what is allowed.
-        problem: String,
+        problem: Message,
     },
     /// An option that applies to the other kind of input than the one `path` holds.
     NotForInput {
         /// The option.
-        option: &'static str,
+        option: OptionKey,
         /// What the input holds.
         holds: InputKind,
         /// The input, as given.
@@ -63,7 +63,7 @@ pub enum JobError {
     /// An item on an observable the budget does not compute.
     NotBudgeted {
         /// The option.
-        option: &'static str,
+        option: OptionKey,
         /// The item, as `KEY=VALUE`.
         item: String,
         /// Its observable.
@@ -121,30 +121,31 @@ pub enum JobError {
     Output(Box<OutputError>),
     /// Arrays that are not a record of the floor's motion (the message names the input).
     Arrays(Box<ArrayError>),
+    /// Parameters that describe no pendulum.
+    Params(Box<ParamError>),
 }
 
 impl JobError {
     /// The message, one line, with the options spelled as the front end in use does
     /// ([`tiltnoise_core::option_key`]).
     pub fn message(&self) -> String {
-        let opt = |name: &'static str| OptionKey::new(name).to_string();
         match self {
             JobError::Input(e) => e.to_string(),
             JobError::OptionFile {
                 option,
                 item,
                 source,
-            } => format!("{} {}: {source}", opt(option), Shown(item)),
+            } => format!("{option} {}: {source}", Shown(item)),
             JobError::Option {
                 option,
                 value: Some(value),
                 problem,
-            } => format!("{} {}: {problem}", opt(option), Shown(value)),
+            } => format!("{option} {}: {problem}", Shown(&value.to_string())),
             JobError::Option {
                 option,
                 value: None,
                 problem,
-            } => format!("{}: {problem}", opt(option)),
+            } => format!("{option}: {problem}"),
             JobError::NotForInput {
                 option,
                 holds: InputKind::Spectra,
@@ -152,9 +153,9 @@ impl JobError {
             } => format!(
                 "{} applies to time-series input, and {} holds spectra; leave it out (the model \
                  grid of spectra input is set with {})",
-                opt(option),
+                option,
                 Shown(path),
-                opt("freq")
+                OptionKey::FREQ
             ),
             JobError::NotForInput {
                 option,
@@ -163,9 +164,9 @@ impl JobError {
             } => format!(
                 "{} applies to spectra input, and {} holds a time series, whose budget is on the \
                  Welch grid (set its resolution with {})",
-                opt(option),
+                option,
                 Shown(path),
-                opt("nperseg")
+                OptionKey::NPERSEG
             ),
             JobError::NotBudgeted {
                 option,
@@ -174,7 +175,7 @@ impl JobError {
                 budgeted,
             } => format!(
                 "{} {}: {} is not budgeted; allowed: {} (add it with {})",
-                opt(option),
+                option,
                 Shown(item),
                 observable.name(),
                 budgeted
@@ -182,13 +183,13 @@ impl JobError {
                     .map(|o| o.name())
                     .collect::<Vec<_>>()
                     .join(", "),
-                opt("observables")
+                OptionKey::OBSERVABLES
             ),
             JobError::PercentilesNeedSegments => require_segments_for_percentiles(false)
                 .err()
                 .map_or_else(String::new, |e| e.to_string()),
             JobError::Percentiles { lower, upper } => {
-                let given = option_key::pair(&Num(*lower).to_string(), &Num(*upper).to_string());
+                let given = option_key::pair(Num(*lower), Num(*upper)).to_string();
                 percentiles_error(&given).to_string()
             }
             JobError::Repeated(r) => r.to_string(),
@@ -197,12 +198,15 @@ impl JobError {
             JobError::Subtract(e) => e.message(),
             JobError::NoMethod(refusal) => match refusal.as_ref() {
                 NoChoice::Tolerance { .. } => {
-                    format!("{refusal}; run with {} for every candidate", opt("explain"))
+                    format!(
+                        "{refusal}; run with {} for every candidate",
+                        OptionKey::EXPLAIN
+                    )
                 }
                 NoChoice::NearMode { .. } => format!(
                     "{refusal} ({}, or another {})",
-                    OptionKey::new("method").given("polezero"),
-                    opt("freq_hz")
+                    OptionKey::METHOD.given("polezero"),
+                    OptionKey::FREQ_HZ
                 ),
                 NoChoice::Band(_) => refusal.to_string(),
             },
@@ -217,11 +221,12 @@ impl JobError {
             JobError::Spectral(e) => e.to_string(),
             JobError::Output(e) => e.to_string(),
             JobError::Arrays(e) => e.to_string(),
+            JobError::Params(e) => e.to_string(),
         }
     }
 
     /// A file named by an option item.
-    pub(crate) fn option_file(option: &'static str, item: &str, source: InputError) -> JobError {
+    pub(crate) fn option_file(option: OptionKey, item: &str, source: InputError) -> JobError {
         JobError::OptionFile {
             option,
             item: item.to_string(),
@@ -230,11 +235,30 @@ impl JobError {
     }
 
     /// An option item that does not fit.
-    pub(crate) fn option(option: &'static str, value: Option<&str>, problem: String) -> JobError {
+    pub(crate) fn option(
+        option: OptionKey,
+        value: Option<&str>,
+        problem: impl Into<Message>,
+    ) -> JobError {
         JobError::Option {
             option,
-            value: value.map(str::to_string),
-            problem,
+            value: value.map(Message::from),
+            problem: problem.into(),
+        }
+    }
+
+    /// An option's pair of values that does not fit (a band), the pair in the front end's
+    /// form.
+    pub(crate) fn option_pair(
+        option: OptionKey,
+        (first, second): (f64, f64),
+        problem: impl Into<Message>,
+    ) -> JobError {
+        let pair = option_key::pair(Num(first), Num(second));
+        JobError::Option {
+            option,
+            value: Some(tiltnoise_core::message!("{pair}")),
+            problem: problem.into(),
         }
     }
 }

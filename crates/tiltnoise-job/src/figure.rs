@@ -17,7 +17,7 @@ pub fn save_image(
     path: &Path,
     draw: impl FnOnce(ImageFormat) -> Result<Vec<u8>, DrawError>,
 ) -> Result<(), OutputError> {
-    let format = ImageFormat::from_path(path)?;
+    let format = crate::figures::image_format(path)?;
     let bytes = draw(format).map_err(|e| OutputError::Write {
         path: path.to_path_buf(),
         message: e.0,

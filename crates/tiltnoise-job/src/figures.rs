@@ -12,5 +12,24 @@ pub use tiltnoise_plot::simulate_figure::ASD_SIZE as SIMULATE_FIGURE_SIZE;
 pub use tiltnoise_plot::tf_figure::default_size as tf_figure_size;
 pub use tiltnoise_plot::tf_figure::TfFigureOptions;
 pub use tiltnoise_plot::ImageFormat;
+
+use std::path::Path;
+use tiltnoise_io::{OutputError, OutputKind};
+
+/// The output kinds of a figure.
+pub const IMAGE_KINDS: &[OutputKind] = &[OutputKind::Png, OutputKind::Svg];
+
+/// The image format the extension of `path` names ([`OutputKind::of_path`] among
+/// [`IMAGE_KINDS`]).
+///
+/// # Errors
+///
+/// [`OutputError::UnknownFormat`] for an extension other than `.png`, `.svg`.
+pub fn image_format(path: &Path) -> Result<ImageFormat, OutputError> {
+    match OutputKind::of_path(path, IMAGE_KINDS)? {
+        OutputKind::Svg => Ok(ImageFormat::Svg),
+        _ => Ok(ImageFormat::Png),
+    }
+}
 pub use tiltnoise_plot::View;
 pub use tiltnoise_plot::MAX_PIXELS;

@@ -9,5 +9,5 @@
 pub use tiltnoise_io::input::input_format;
 pub use tiltnoise_io::{
     check_outputs, hdf5_version, remove_staging_for_exit, ExitCleanup, OutputKind, SeriesAsd,
-    SimulationMeta, Staging, ALLOWED_EXTENSIONS, TOOL_VERSION,
+    SimulationMeta, Staging, TOOL_VERSION,
 };

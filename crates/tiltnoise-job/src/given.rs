@@ -8,6 +8,7 @@ use tiltnoise_core::model::{Input, Observable};
 use tiltnoise_core::noise::{
     is_term_name, GivenAsd, NoiseLevel, Readout, UserSource, UserTerm, WitnessNoise,
 };
+use tiltnoise_core::option_key::{Message, OptionKey};
 use tiltnoise_io::input::read_asd_column;
 
 /// A one-sided ASD as the user gives it: white (a number, in the quantity's unit/sqrt(Hz),
@@ -109,7 +110,7 @@ pub fn witness_noise(items: &[WitnessItem]) -> Result<Vec<WitnessNoise>, JobErro
             let level = match &it.asd {
                 AsdSpec::White(a) => NoiseLevel::White(*a),
                 AsdSpec::File(path) => NoiseLevel::Curve(read_given(
-                    "witness_noise",
+                    OptionKey::WITNESS_NOISE,
                     &it.item(),
                     path,
                     input.name(),
@@ -121,19 +122,15 @@ pub fn witness_noise(items: &[WitnessItem]) -> Result<Vec<WitnessNoise>, JobErro
                 level,
                 rel: it.rel,
             };
-            // The check names the input first; the message names it once, with the item.
-            noise.check("").map_err(|e| {
-                let problem = e.trim_start();
-                let problem = problem
-                    .strip_prefix(&format!("{}: ", input.name()))
-                    .unwrap_or(problem);
-                JobError::option(
-                    "witness_noise",
+            // The message names the input once, with the item.
+            match noise.problem() {
+                Some(problem) => Err(JobError::option(
+                    OptionKey::WITNESS_NOISE,
                     Some(input.name()),
                     format!("{problem} (in {})", it.item()),
-                )
-            })?;
-            Ok(noise)
+                )),
+                None => Ok(noise),
+            }
         })
         .collect()
 }
@@ -157,7 +154,7 @@ fn asd_unit(unit: &str) -> &'static str {
 /// [`JobError::OptionFile`] when the file cannot be read or has no such column,
 /// [`JobError::Option`] when its frequencies or values are not allowed.
 pub fn read_given(
-    option: &'static str,
+    option: OptionKey,
     item: &str,
     path: &Path,
     quantity: &str,
@@ -167,7 +164,7 @@ pub fn read_given(
         .map_err(|e| JobError::option_file(option, item, e))?;
     let origin = format!("{} (column {})", path.display(), column.column);
     GivenAsd::new(column.freqs_hz, column.asd, &origin)
-        .map_err(|e| JobError::option(option, Some(item), e.to_string()))
+        .map_err(|e| JobError::option(option, Some(item), Message::shown(e)))
 }
 
 /// The readout: the paper's 9e-9 m/sqrt(Hz) on X, replaced per observable by `items` in
@@ -178,7 +175,7 @@ pub(crate) fn readout(items: &[ReadoutItem], budgeted: &[Observable]) -> Result<
         let o = it.observable;
         if !budgeted.contains(&o) {
             return Err(JobError::NotBudgeted {
-                option: "readout",
+                option: OptionKey::READOUT,
                 item: it.item(),
                 observable: o,
                 budgeted: budgeted.to_vec(),
@@ -190,7 +187,7 @@ pub(crate) fn readout(items: &[ReadoutItem], budgeted: &[Observable]) -> Result<
             AsdSpec::White(asd) if *asd > 0.0 => readout.asd.push((o, *asd)),
             AsdSpec::White(_) => {}
             AsdSpec::File(path) => {
-                let given = read_given("readout", &it.item(), path, o.name(), o.unit())?;
+                let given = read_given(OptionKey::READOUT, &it.item(), path, o.name(), o.unit())?;
                 readout.given.push((o, given));
             }
         }
@@ -211,7 +208,7 @@ pub(crate) fn terms(
             let item = it.item();
             if !is_term_name(&it.name) {
                 return Err(JobError::option(
-                    "term",
+                    OptionKey::TERM,
                     Some(&item),
                     format!(
                         "the name `{}` is not allowed: 1 to 64 letters, digits or _, starting \
@@ -223,7 +220,7 @@ pub(crate) fn terms(
             let unit = match it.source {
                 UserSource::Observable(o) if !budgeted.contains(&o) => {
                     return Err(JobError::NotBudgeted {
-                        option: "term",
+                        option: OptionKey::TERM,
                         item,
                         observable: o,
                         budgeted: budgeted.to_vec(),
@@ -232,7 +229,7 @@ pub(crate) fn terms(
                 UserSource::Observable(o) => o.unit(),
                 UserSource::Input(i) => i.unit(),
             };
-            let asd = read_given("term", &item, &it.file, it.source.name(), unit)?;
+            let asd = read_given(OptionKey::TERM, &item, &it.file, it.source.name(), unit)?;
             Ok(UserTerm {
                 name: it.name.clone(),
                 source: it.source,

@@ -64,20 +64,21 @@ pub trait Outcome {
     fn json(&self) -> serde_json::Value;
 }
 
+/// The kinds of file of a result on a frequency grid (a budget, a coherence, transfer functions,
+/// a simulation's spectra): HDF5, CSV and the figure.
+pub const SPECTRA_KINDS: &[OutputKind] = &[
+    OutputKind::Hdf5,
+    OutputKind::Csv,
+    OutputKind::Png,
+    OutputKind::Svg,
+];
+
 /// The output kind of `path` when it is one of `allowed`: the one output-kind rule of every
 /// command.
 ///
 /// # Errors
 ///
 /// [`OutputError::UnknownFormat`] naming `path` and the extensions of `allowed`.
-pub fn output_kind(path: &Path, allowed: &'static [OutputKind]) -> Result<OutputKind, OutputError> {
-    let kind = OutputKind::from_path(path)?;
-    if allowed.contains(&kind) {
-        Ok(kind)
-    } else {
-        Err(OutputError::UnknownFormat {
-            path: path.to_path_buf(),
-            allowed: tiltnoise_io::ALLOWED_EXTENSIONS,
-        })
-    }
+pub fn output_kind(path: &Path, allowed: &[OutputKind]) -> Result<OutputKind, OutputError> {
+    OutputKind::of_path(path, allowed)
 }

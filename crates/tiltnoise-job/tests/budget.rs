@@ -8,6 +8,7 @@ use tiltnoise_core::budget::option_checks::InputKind;
 use tiltnoise_core::budget::BudgetError;
 use tiltnoise_core::input::{GapPolicy, InputMeta, TiltInput, TiltSeries};
 use tiltnoise_core::model::{Input, Model, Observable, TiltAxis, TranslationAxis};
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::params::Params;
 use tiltnoise_io::input::{read_tilt, ReadOptions};
 use tiltnoise_job::budget::{
@@ -100,7 +101,7 @@ fn options_of_the_other_kind_of_input_are_refused_in_each_spelling() {
     assert!(matches!(
         e,
         JobError::NotForInput {
-            option: "gaps",
+            option: OptionKey::GAPS,
             holds: InputKind::Spectra,
             ..
         }

@@ -35,7 +35,12 @@ fn tf_request(model: &Model) -> TfRequest<'_> {
         rel_tol: None,
         block_freqs: Some(7),
         figure: None,
-        figure_options: tiltnoise_job::tf::figure_options(model, vec![Observable::X], false),
+        figure_options: tiltnoise_job::tf::figure_options(
+            model,
+            vec![Observable::X],
+            false,
+            String::new(),
+        ),
         invocation: invocation(),
     }
 }

@@ -17,7 +17,7 @@ use tiltnoise_job::fit::FitRequest;
 use tiltnoise_job::simulate::driven::DrivenRequest;
 use tiltnoise_job::simulate::{run, Keep, SimulateRequest, SimulateResult};
 use tiltnoise_job::visibility::VisibilityRequest;
-use tiltnoise_job::{Cancel, JobError};
+use tiltnoise_job::{Cancel, JobError, Outcome};
 
 fn request(model: &Model, chunk_samples: Option<usize>, keep: Keep) -> SimulateRequest<'_> {
     SimulateRequest {
@@ -32,6 +32,7 @@ fn request(model: &Model, chunk_samples: Option<usize>, keep: Keep) -> SimulateR
         nperseg: Some(2048),
         chunk_samples,
         keep,
+        view: Default::default(),
         invocation: tiltnoise_job::Invocation::default(),
     }
 }
@@ -81,7 +82,7 @@ fn the_streamed_file_is_the_record_and_its_visibilities_are_the_records() {
     let model = Model::new(&Params::table_i()).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let h5 = dir.path().join("free.h5");
-    let mut r = simulated(request(
+    let r = simulated(request(
         &model,
         Some(333),
         Keep {
@@ -91,7 +92,7 @@ fn the_streamed_file_is_the_record_and_its_visibilities_are_the_records() {
         },
     ));
     assert!(!h5.exists(), "the file appears when it is complete");
-    tiltnoise_io::Staging::committed(|s| r.finish_records(s)).unwrap();
+    tiltnoise_io::Staging::committed(|s| r.save(s, &h5)).unwrap();
     let vis = tiltnoise_job::visibility::run(
         &VisibilityRequest {
             model: &model,
@@ -172,6 +173,7 @@ fn driven(model: &Model, tilt: std::path::PathBuf) -> DrivenRequest<'_> {
         readout: Vec::new(),
         seed: 1,
         nperseg: Some(256),
+        view: Default::default(),
         invocation: tiltnoise_job::Invocation::default(),
     }
 }
@@ -181,8 +183,12 @@ fn a_driven_record_has_the_drives_rate_and_its_spectra() {
     let model = Model::new(&Params::table_i()).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let tilt = tilt_csv(dir.path(), 2048);
-    let r = tiltnoise_job::simulate::driven::run(driven(&model, tilt.clone()), &Cancel::never())
-        .unwrap();
+    let r = tiltnoise_job::simulate::driven::run(
+        &driven(&model, tilt.clone()),
+        &Cancel::never(),
+        &tiltnoise_job::Silent,
+    )
+    .unwrap();
     assert_eq!((r.record.len(), r.fs_hz), (2048, 1.0));
     let wcfg = WelchConfig::new(256);
     for (o, asd) in &r.asd.asd {
@@ -190,7 +196,11 @@ fn a_driven_record_has_the_drives_rate_and_its_spectra() {
         assert_eq!(asd, &want, "{}", o.name());
     }
     assert!(r.description.contains("eta_t x 0.97"), "{}", r.description);
-    let refused = |req| match tiltnoise_job::simulate::driven::run(req, &Cancel::never()) {
+    let refused = |req: DrivenRequest<'_>| match tiltnoise_job::simulate::driven::run(
+        &req,
+        &Cancel::never(),
+        &tiltnoise_job::Silent,
+    ) {
         Ok(_) => panic!("refused"),
         Err(e) => e.message(),
     };

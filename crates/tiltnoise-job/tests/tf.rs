@@ -8,6 +8,7 @@ use tiltnoise_core::limits::MAX_GRID_POINTS;
 use tiltnoise_core::mc::{self, McConfig};
 use tiltnoise_core::model::{Input, Model, Observable, Request};
 use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::params::Params;
 use tiltnoise_core::tf::{self, Method, TransferMatrix};
 use tiltnoise_job::methods::MethodsRequest;
@@ -125,7 +126,7 @@ fn options_that_do_not_fit_fail_naming_their_key() {
     let mut req = request(&model, FreqGrid::Points(freqs()));
     req.rel_tol = Some(0.0);
     let e = tiltnoise_job::tf::prepare(&req).err().unwrap();
-    assert_eq!(key_of(&e), "rel_tol");
+    assert_eq!(key_of(&e), OptionKey::REL_TOL);
     assert_eq!(
         e.message(),
         "rel_tol 0: the tolerance must be a finite relative error in (0, 1)"
@@ -135,14 +136,14 @@ fn options_that_do_not_fit_fail_naming_their_key() {
     req.block_freqs = Some(0);
     assert_eq!(
         key_of(&tiltnoise_job::tf::prepare(&req).err().unwrap()),
-        "block_freqs"
+        OptionKey::BLOCK_FREQS
     );
 
     // 0 Hz has no value per unit floor velocity: refused before anything is computed.
     let mut req = request(&model, FreqGrid::Points(vec![1e-3, 0.0]));
     req.per = GroundQuantity::Velocity;
     let e = tiltnoise_job::tf::prepare(&req).err().unwrap();
-    assert_eq!(key_of(&e), "per");
+    assert_eq!(key_of(&e), OptionKey::PER);
     assert!(
         e.message()
             .starts_with("per velocity: frequency 2 of freq_hz is 0 Hz"),
@@ -159,7 +160,7 @@ fn options_that_do_not_fit_fail_naming_their_key() {
     let mut req = request(&model, FreqGrid::Log(big));
     req.figure = Some("tf.png".into());
     let e = tiltnoise_job::tf::prepare(&req).err().unwrap();
-    assert_eq!(key_of(&e), "save");
+    assert_eq!(key_of(&e), OptionKey::SAVE);
     assert!(e.message().contains("and freq_hz asks for"), "{e}");
 }
 
@@ -215,7 +216,8 @@ fn the_methods_job_measures_every_method_and_names_autos_pick() {
         };
         match tiltnoise_job::methods::run(&req, &Cancel::never(), &Silent) {
             Err(JobError::Option {
-                option: "freq_hz", ..
+                option: OptionKey::FREQ_HZ,
+                ..
             }) => {}
             Err(e) => panic!("{bad:?}: {e}"),
             Ok(_) => panic!("{bad:?} accepted"),

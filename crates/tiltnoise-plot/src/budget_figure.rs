@@ -70,7 +70,7 @@ pub fn budget_figure_with(
     format: ImageFormat,
     options: &BudgetFigureOptions,
 ) -> Result<Vec<u8>, DrawError> {
-    let figure = build_budget_figure(report, options).map_err(DrawError)?;
+    let figure = build_budget_figure(report, options).map_err(|e| DrawError(e.into()))?;
     render(format, &options.view.apply(figure))
 }
 

@@ -54,7 +54,7 @@ pub fn coherence_figure(
     format: ImageFormat,
     options: &CoherenceFigureOptions,
 ) -> Result<Vec<u8>, DrawError> {
-    let figure = build_coherence_figure(report, options).map_err(DrawError)?;
+    let figure = build_coherence_figure(report, options).map_err(|e| DrawError(e.into()))?;
     render(format, &options.view.apply(figure))
 }
 

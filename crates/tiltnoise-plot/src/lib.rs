@@ -47,9 +47,7 @@ use image::ImageEncoder;
 use plotters::coord::Shift;
 use plotters::prelude::{BitMapBackend, DrawingArea, DrawingAreaErrorKind, DrawingBackend};
 use plotters::prelude::{IntoDrawingArea, SVGBackend};
-use std::path::Path;
 use std::sync::OnceLock;
-use tiltnoise_core::error::OutputError;
 use tiltnoise_core::option_key::OptionKey;
 
 /// The embedded font (DejaVu Sans 2.37, Bitstream Vera / DejaVu licence).
@@ -68,26 +66,6 @@ pub enum ImageFormat {
 }
 
 impl ImageFormat {
-    /// Extensions accepted by [`ImageFormat::from_path`], for messages.
-    pub const ALLOWED: &'static str = ".png, .svg";
-
-    /// Chooses the format from the extension of `path` (case-insensitive).
-    pub fn from_path(path: &Path) -> Result<ImageFormat, OutputError> {
-        match path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase)
-            .as_deref()
-        {
-            Some("png") => Ok(ImageFormat::Png),
-            Some("svg") => Ok(ImageFormat::Svg),
-            _ => Err(OutputError::UnknownFormat {
-                path: path.to_path_buf(),
-                allowed: Self::ALLOWED,
-            }),
-        }
-    }
-
     /// The canonical extension, without the dot.
     pub fn extension(self) -> &'static str {
         match self {
@@ -195,11 +173,11 @@ impl<F: Figure> Figure for Resized<'_, F> {
 /// A failure while drawing: a backend error, a font that cannot be used, or data that cannot be
 /// plotted. The caller turns it into an error naming the file.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct DrawError(pub String);
+pub struct DrawError(pub tiltnoise_core::option_key::Message);
 
 impl std::fmt::Display for DrawError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
+        write!(f, "{}", self.0)
     }
 }
 
@@ -207,7 +185,7 @@ impl std::error::Error for DrawError {}
 
 impl<E: std::error::Error + Send + Sync> From<DrawingAreaErrorKind<E>> for DrawError {
     fn from(e: DrawingAreaErrorKind<E>) -> Self {
-        DrawError(format!("drawing failed: {e}"))
+        DrawError(format!("drawing failed: {e}").into())
     }
 }
 
@@ -245,7 +223,8 @@ pub fn ensure_font() -> Result<(), DrawError> {
                 DrawError(
                     "the embedded font assets/DejaVuSans.ttf is not a usable TrueType font \
                      (rebuild with an intact assets/ directory)"
-                        .to_string(),
+                        .to_string()
+                        .into(),
                 )
             })
         })
@@ -265,7 +244,7 @@ pub fn render(format: ImageFormat, figure: &impl Figure) -> Result<Vec<u8>, Draw
     ensure_font()?;
     let (w, h) = figure.size();
     if u64::from(w) * u64::from(h) > MAX_PIXELS {
-        return Err(DrawError(format!(
+        return Err(DrawError(tiltnoise_core::message!(
             "a {w} x {h} pixel image is too large (at most {} megapixels; lower {} or {})",
             MAX_PIXELS / 1_000_000,
             OptionKey::SIZE,
@@ -277,19 +256,19 @@ pub fn render(format: ImageFormat, figure: &impl Figure) -> Result<Vec<u8>, Draw
             let n = (w as usize)
                 .checked_mul(h as usize)
                 .and_then(|n| n.checked_mul(3))
-                .ok_or_else(|| DrawError(format!("a {w} x {h} pixel image is too large")))?;
+                .ok_or_else(|| DrawError(format!("a {w} x {h} pixel image is too large").into()))?;
             let mut rgb = vec![0u8; n];
             {
                 let root = GlyphPlacement::new(BitMapBackend::with_buffer(&mut rgb, (w, h)))
                     .into_drawing_area();
                 draw_on(&root, figure, format)?;
                 root.present()
-                    .map_err(|e| DrawError(format!("cannot finish the bitmap: {e}")))?;
+                    .map_err(|e| DrawError(format!("cannot finish the bitmap: {e}").into()))?;
             }
             let mut png = Vec::new();
             image::codecs::png::PngEncoder::new(&mut png)
                 .write_image(&rgb, w, h, image::ColorType::Rgb8)
-                .map_err(|e| DrawError(format!("cannot encode PNG: {e}")))?;
+                .map_err(|e| DrawError(format!("cannot encode PNG: {e}").into()))?;
             Ok(png)
         }
         ImageFormat::Svg => {
@@ -298,7 +277,7 @@ pub fn render(format: ImageFormat, figure: &impl Figure) -> Result<Vec<u8>, Draw
                 let root = SVGBackend::with_string(&mut text, (w, h)).into_drawing_area();
                 draw_on(&root, figure, format)?;
                 root.present()
-                    .map_err(|e| DrawError(format!("cannot finish SVG: {e}")))?;
+                    .map_err(|e| DrawError(format!("cannot finish SVG: {e}").into()))?;
             }
             Ok(text.into_bytes())
         }

@@ -203,7 +203,7 @@ pub fn asd_figure(
     view: &View,
     format: ImageFormat,
 ) -> Result<Vec<u8>, DrawError> {
-    let figure = build_asd_figure(data).map_err(DrawError)?;
+    let figure = build_asd_figure(data).map_err(|e| DrawError(e.into()))?;
     render(format, &view.apply(figure))
 }
 
@@ -337,7 +337,9 @@ impl Figure for TimeSeriesData {
         let cells = rest.split_evenly((self.panels.len().max(1), 1));
         for (p, cell) in self.panels.iter().zip(cells.iter()) {
             if p.values.is_empty() {
-                return Err(DrawError(format!("panel `{}` has no samples", p.title)));
+                return Err(DrawError(
+                    format!("panel `{}` has no samples", p.title).into(),
+                ));
             }
             let trace = decimate(p);
             let ((x0, x1), (mut y0, mut y1)) = trace.extent();
@@ -347,10 +349,9 @@ impl Figure for TimeSeriesData {
             let (x0, x1) = (x0 / per_unit_s, x1 / per_unit_s);
             let trace = trace.in_time_unit(per_unit_s);
             if !(y0.is_finite() && y1.is_finite()) {
-                return Err(DrawError(format!(
-                    "panel `{}` has non-finite samples",
-                    p.title
-                )));
+                return Err(DrawError(
+                    format!("panel `{}` has non-finite samples", p.title).into(),
+                ));
             }
             let pad = if y1 > y0 {
                 0.05 * (y1 - y0)

@@ -203,6 +203,6 @@ pub fn subtract_figure(
     view: &View,
     format: ImageFormat,
 ) -> Result<Vec<u8>, DrawError> {
-    let figure = build_subtract_figure(data).map_err(DrawError)?;
+    let figure = build_subtract_figure(data).map_err(|e| DrawError(e.into()))?;
     render(format, &view.apply(figure))
 }

@@ -29,6 +29,10 @@ pub struct TfFigureOptions {
     pub damped: bool,
     /// Axis limits, size, resolution; the default size grows with the number of panels.
     pub view: View,
+    /// The option that chooses the panels, as the front end that draws the figure spells it
+    /// (`--plot-observables`, `observables`): the caption names it when computed observables
+    /// are left out. Empty: its canonical key, `drawn_observables`.
+    pub panels_option: String,
 }
 
 /// Draws Figure 5 of the paper as a PNG or SVG file's bytes: |H| of X (m/rad), φ (rad/rad)
@@ -50,7 +54,7 @@ pub fn tf_figure_with(
     format: ImageFormat,
     options: &TfFigureOptions,
 ) -> Result<Vec<u8>, DrawError> {
-    let figure = build_tf_figure(tf, options).map_err(DrawError)?;
+    let figure = build_tf_figure(tf, options).map_err(|e| DrawError(e.into()))?;
     render(format, &options.view.apply(figure))
 }
 
@@ -406,10 +410,13 @@ fn caption(
         .map(|o| o.name())
         .collect();
     if !omitted.is_empty() {
+        let option = match options.panels_option.as_str() {
+            "" => OptionKey::DRAWN_OBSERVABLES.key(),
+            spelled => spelled,
+        };
         caption.push(format!(
-            "Not drawn (in the files): {}; {} chooses the panels.",
+            "Not drawn (in the files): {}; {option} chooses the panels.",
             omitted.join(", "),
-            OptionKey::DRAWN_OBSERVABLES
         ));
     }
     caption

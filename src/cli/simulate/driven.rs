@@ -11,15 +11,13 @@ use tiltnoise_core::error::{Num, Shown};
 use tiltnoise_core::model::Model;
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::repeats::{list_entries, refuse_repeated_keys};
-use tiltnoise_job::files::OutputKind;
+use tiltnoise_job::budget::ReadRequest;
+use tiltnoise_job::figures::View;
+use tiltnoise_job::simulate::driven::DrivenRequest;
+use tiltnoise_job::{Invocation, Outcome, Silent};
 
 /// Fine steps per record sample of the driven propagation when `--oversample` is not given.
 const DEFAULT_OVERSAMPLE: usize = 10;
-use tiltnoise_job::budget::ReadRequest;
-use tiltnoise_job::figures::View;
-use tiltnoise_job::simulate::driven::{DrivenRequest, DrivenResult};
-use tiltnoise_job::simulate::{asd_figure_data, save, RecordOutputs};
-use tiltnoise_job::Invocation;
 
 /// `--drive-gain INPUT=GAIN,...` as `(input, gain)`, each input once (the job checks them
 /// against the record).
@@ -42,8 +40,13 @@ fn parse_gains(items: &[String]) -> Result<Vec<(String, f64)>> {
         .collect()
 }
 
-/// The request of `args` with the record at `path`.
-fn request<'a>(model: &'a Model, args: &SimulateArgs, path: &Path) -> Result<DrivenRequest<'a>> {
+/// The request of `args` with the record at `path`, its figures drawn with `view`.
+fn request<'a>(
+    model: &'a Model,
+    args: &SimulateArgs,
+    path: &Path,
+    view: &View,
+) -> Result<DrivenRequest<'a>> {
     let o = read_options(
         args.axes.as_deref(),
         args.quantity.as_deref(),
@@ -69,6 +72,7 @@ fn request<'a>(model: &'a Model, args: &SimulateArgs, path: &Path) -> Result<Dri
         readout: parse_readout(&args.readout)?,
         seed: args.seed,
         nperseg: args.nperseg,
+        view: view.clone(),
         invocation: Invocation::of_this_process(),
     })
 }
@@ -82,19 +86,15 @@ pub(super) fn run(
     run: &mut Run,
 ) -> Result<()> {
     for out in &args.save {
-        OutputKind::from_path(out)?;
+        tiltnoise_job::output_kind(out, tiltnoise_job::simulate::OUTPUT_KINDS)?;
     }
-    let req = request(model, args, path)?;
+    let req = request(model, args, path, view)?;
     run.check_job_outputs(&args.save, req.input_files())?;
-    let r =
-        tiltnoise_job::simulate::driven::run(req, &run.cancel).map_err(crate::cli::job_error)?;
+    let r = tiltnoise_job::simulate::driven::run(&req, &run.cancel, &Silent)
+        .map_err(crate::cli::job_error)?;
     let json = args.format == Format::Json;
     match json {
-        true => writeln!(
-            run.out,
-            "{}",
-            serde_json::to_string_pretty(&summary_json(&r))?
-        )?,
+        true => writeln!(run.out, "{}", serde_json::to_string_pretty(&r.json())?)?,
         false => {
             for note in &r.notes {
                 writeln!(run.out, "input: {note}")?;
@@ -109,32 +109,10 @@ pub(super) fn run(
             )?;
         }
     }
-    let meta = r.provenance.clone();
-    let record_meta = r.simulation_meta(meta.clone());
-    let figure = asd_figure_data(&r.asd, &r.readout, &r.modes, r.fs_hz, &r.description);
-    let outputs = RecordOutputs {
-        record: Some((&r.record, &record_meta)),
-        asd: &r.asd,
-        run: &meta,
-        figure: &figure,
-    };
     run.write_outputs(json, |stage| {
         for out in &args.save {
-            save(stage, out, &outputs, view)?;
+            r.save(stage, out).map_err(crate::cli::job_error)?;
         }
         Ok(())
-    })
-}
-
-/// The summary as JSON (`--format json`): the record's notes, its length and rate, and what
-/// was simulated.
-fn summary_json(r: &DrivenResult) -> serde_json::Value {
-    serde_json::json!({
-        "input_notes": r.notes,
-        "samples": r.record.len(),
-        "sample_rate_hz": r.fs_hz,
-        "duration_s": r.record.len() as f64 / r.fs_hz,
-        "description": r.description,
-        "seed": r.seed,
     })
 }

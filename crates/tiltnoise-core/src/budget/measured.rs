@@ -138,7 +138,7 @@ pub fn series_psds(
             let seg = (*segment_len as f64 * fs / sample_rate_hz).round() as usize;
             let ov = (*overlap as f64 / *segment_len as f64 * seg as f64).round() as usize;
             if seg < 2 || seg > n {
-                return Err(BudgetError::Config(format!(
+                return Err(BudgetError::Config(crate::message!(
                     "the measured series has {n} samples ({:.6e} s at {fs} Hz): the budget's \
                      Welch segment of {:.6e} s needs {seg} samples at this rate; use a longer \
                      record or a shorter {}",

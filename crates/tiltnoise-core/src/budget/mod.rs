@@ -70,7 +70,7 @@ pub enum BudgetError {
     Witness(#[from] WitnessNoiseError),
     /// Options that contradict each other or the input.
     #[error("{0}")]
-    Config(String),
+    Config(crate::option_key::Message),
     /// A spectrum or budget term that overflowed `f64`.
     #[error("{0}")]
     NotFinite(String),
@@ -184,10 +184,13 @@ fn welch_config(opts: &BudgetOptions, n: usize) -> Result<WelchConfig, BudgetErr
         .welch_segment_len
         .unwrap_or_else(|| default_segment_len(n));
     if !(0.0..1.0).contains(&opts.welch_overlap_fraction) {
-        return Err(BudgetError::Config(format!(
-            "Welch overlap {} is not allowed: must be a fraction in [0, 1)",
-            opts.welch_overlap_fraction
-        )));
+        return Err(BudgetError::Config(
+            format!(
+                "Welch overlap {} is not allowed: must be a fraction in [0, 1)",
+                opts.welch_overlap_fraction
+            )
+            .into(),
+        ));
     }
     let overlap = (seg_len as f64 * opts.welch_overlap_fraction).round() as usize;
     let cfg = WelchConfig::new(seg_len)
@@ -210,7 +213,7 @@ fn segment_samples(
         None => None,
         Some(d) => {
             if !(d.is_finite() && d > 0.0) {
-                return Err(BudgetError::Config(format!(
+                return Err(BudgetError::Config(crate::message!(
                     "{} is not allowed: the segment duration must be a positive number of \
                      seconds",
                     crate::option_key::OptionKey::SEGMENT_DURATION.given(crate::error::Num(d))
@@ -218,22 +221,28 @@ fn segment_samples(
             }
             let s = (d * fs).round();
             if s < seg_len as f64 {
-                return Err(BudgetError::Config(format!(
+                return Err(BudgetError::Config(
+                    format!(
                     "segment duration {} s is not allowed: must hold at least one Welch segment \
                      ({seg_len} samples = {} s at {fs} Hz); shorten the Welch segment (nperseg) \
                      to at most {} samples, or lengthen the segment duration",
                     crate::error::Num(d),
                     seg_len as f64 / fs,
                     s.max(0.0)
-                )));
+                )
+                    .into(),
+                ));
             }
             if s > n as f64 {
-                return Err(BudgetError::Config(format!(
-                    "segment duration {} s is not allowed: it is longer than the record \
+                return Err(BudgetError::Config(
+                    format!(
+                        "segment duration {} s is not allowed: it is longer than the record \
                      ({n} samples = {} s at {fs} Hz), which then has no segment to compare",
-                    crate::error::Num(d),
-                    crate::error::Num(n as f64 / fs)
-                )));
+                        crate::error::Num(d),
+                        crate::error::Num(n as f64 / fs)
+                    )
+                    .into(),
+                ));
             }
             Some(s as usize)
         }
@@ -255,7 +264,7 @@ pub fn budget_from_series(
     let n = series.len();
     let channels = series.channels();
     let map = GroundMap::new(&channels, model.params().environment.g_m_per_s2)
-        .map_err(BudgetError::Config)?;
+        .map_err(|e| BudgetError::Config(e.into()))?;
     let inputs = map.inputs();
     let segment_term = total_ground_term(&inputs);
     let cfg = welch_config(opts, n)?;
@@ -628,9 +637,12 @@ pub fn budget_from_spectra(
     let (grid, on_grid) = spectra.interpolate_loglog(&opts.spectra_grid_hz);
     if grid.is_empty() {
         let (a, b) = spectra.band_hz();
-        return Err(BudgetError::Config(format!(
-            "the tilt spectra cover {a} to {b} Hz, which contains no point of the model grid"
-        )));
+        return Err(BudgetError::Config(
+            format!(
+                "the tilt spectra cover {a} to {b} Hz, which contains no point of the model grid"
+            )
+            .into(),
+        ));
     }
     let mut notes = Vec::new();
     let (lo, hi) = (opts.spectra_grid_hz.first(), opts.spectra_grid_hz.last());

@@ -21,7 +21,7 @@ pub fn require_segments_for_percentiles(segment_duration_given: bool) -> Result<
     if segment_duration_given {
         return Ok(());
     }
-    Err(OptionError::Conflict(format!(
+    Err(OptionError::Conflict(crate::message!(
         "{} applies to the per-segment band and needs {} (e.g. {} with {} at 1 Hz: each \
          segment holds a Welch segment)",
         OptionKey::PERCENTILES,
@@ -34,10 +34,10 @@ pub fn require_segments_for_percentiles(segment_duration_given: bool) -> Result<
 /// The error for percentiles that do not parse or are out of order or range.
 pub fn percentiles_error(given: &str) -> OptionError {
     let form = option_key::pair("LOWER", "UPPER");
-    OptionError::Conflict(format!(
+    OptionError::Conflict(crate::message!(
         "{} {}: expected {form} with 0 <= LOWER < UPPER <= 100",
         OptionKey::PERCENTILES,
-        Shown(given)
+        Shown(given).to_string()
     ))
 }
 

@@ -51,17 +51,23 @@ impl SummaryRequest {
     /// Checks the frequencies (finite, > 0) and the band fraction (in (0, 1)).
     pub fn validate(&self) -> Result<(), BudgetError> {
         if let Some(&f) = self.freqs_hz.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
-            return Err(BudgetError::Config(format!(
-                "summary frequency {} Hz is not allowed: must be finite and > 0",
-                crate::error::Num(f)
-            )));
+            return Err(BudgetError::Config(
+                format!(
+                    "summary frequency {} Hz is not allowed: must be finite and > 0",
+                    crate::error::Num(f)
+                )
+                .into(),
+            ));
         }
         let b = self.band_fraction;
         if !(b > 0.0 && b < 1.0) {
-            return Err(BudgetError::Config(format!(
-                "band fraction {} is not allowed: the band f (1 +- b) needs 0 < b < 1",
-                crate::error::Num(b)
-            )));
+            return Err(BudgetError::Config(
+                format!(
+                    "band fraction {} is not allowed: the band f (1 +- b) needs 0 < b < 1",
+                    crate::error::Num(b)
+                )
+                .into(),
+            ));
         }
         Ok(())
     }
@@ -180,10 +186,13 @@ pub(super) fn summarize(
         let (csd, tilt_evaluation) = match csd {
             Ok(c) => c,
             Err(why) if req.strict => {
-                return Err(BudgetError::Config(format!(
-                    "the budget cannot be read at {} Hz: {why}",
-                    crate::error::Num(f)
-                )))
+                return Err(BudgetError::Config(
+                    format!(
+                        "the budget cannot be read at {} Hz: {why}",
+                        crate::error::Num(f)
+                    )
+                    .into(),
+                ))
             }
             Err(why) => {
                 skipped.push(format!(

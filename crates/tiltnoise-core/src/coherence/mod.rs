@@ -225,7 +225,7 @@ pub enum CoherenceError {
     Tf(#[from] TfError),
     /// Options or records that cannot give an estimate.
     #[error("{0}")]
-    Config(String),
+    Config(crate::option_key::Message),
 }
 
 /// Estimates the coherence of a measured record with a tilt record, and the transfer
@@ -255,12 +255,12 @@ pub fn coherence_from_series(
     let n_segments = cfg.n_segments(n);
     let n_d = equivalent_averages(&cfg, n_segments);
     if n_d < q as f64 + 1.0 {
-        return Err(CoherenceError::Config(format!(
+        return Err(CoherenceError::Config(crate::message!(
             "the common stretch of {} and {} ({n} samples) gives {n_segments} Welch segments of \
              {} samples, {n_d:.2} independent averages: {} tilt axes need at least {}; use a \
              shorter {}",
-            tilt.name,
-            measured.name,
+            tilt.name.to_string(),
+            measured.name.to_string(),
             cfg.segment_len,
             q,
             q + 1,
@@ -286,12 +286,12 @@ pub fn coherence_from_series(
     let axes: Vec<TiltAxis> = tilt.channels.iter().map(|(a, _)| *a).collect();
     if !estimable.iter().any(|&e| e) {
         let worst = input_rcond.iter().copied().fold(0.0, f64::max);
-        return Err(CoherenceError::Config(format!(
+        return Err(CoherenceError::Config(crate::message!(
             "the tilt axes {} of {} are linearly dependent at every frequency (largest \
              reciprocal condition {worst:.1e} of their cross-spectral matrix): analyse one of \
              them at a time ({})",
             axes.iter().map(|a| a.name()).collect::<Vec<_>>().join(", "),
-            tilt.name,
+            tilt.name.to_string(),
             OptionKey::AXES
         )));
     }
@@ -398,10 +398,13 @@ fn check_not_constant(channels: &[&[f64]], names: &[String]) -> Result<(), Coher
                 true => "zero at every sample".to_string(),
                 false => format!("constant ({})", Num(first)),
             };
-            return Err(CoherenceError::Config(format!(
-                "{name} is {what} over the common stretch: it has no power above DC to \
+            return Err(CoherenceError::Config(
+                format!(
+                    "{name} is {what} over the common stretch: it has no power above DC to \
                  analyse; leave it out"
-            )));
+                )
+                .into(),
+            ));
         }
     }
     Ok(())
@@ -412,16 +415,22 @@ fn check_spectra(spectra: &CrossSpectra, names: &[String]) -> Result<(), Coheren
     for (c, name) in names.iter().enumerate() {
         let psd = spectra.psd(c);
         if psd.iter().any(|p| !p.is_finite()) {
-            return Err(CoherenceError::Config(format!(
+            return Err(CoherenceError::Config(
+                format!(
                 "the power spectrum of {name} overflows f64: its samples are far too large for \
                  its unit (check the file's units)"
-            )));
+            )
+                .into(),
+            ));
         }
         if psd[1..].iter().all(|&p| p == 0.0) {
-            return Err(CoherenceError::Config(format!(
-                "{name} has no power at any frequency above DC (the series is constant): it \
+            return Err(CoherenceError::Config(
+                format!(
+                    "{name} has no power at any frequency above DC (the series is constant): it \
                  cannot be analysed; leave it out"
-            )));
+                )
+                .into(),
+            ));
         }
     }
     Ok(())
@@ -576,28 +585,34 @@ impl Estimation<'_> {
 fn check_record<C: Label>(record: &Record<'_, C>) -> Result<(), CoherenceError> {
     let name = record.name;
     let Some((first, x0)) = record.channels.first() else {
-        return Err(CoherenceError::Config(format!(
-            "{name}: no channel to analyse"
-        )));
+        return Err(CoherenceError::Config(
+            format!("{name}: no channel to analyse").into(),
+        ));
     };
     for (c, x) in &record.channels {
         if x.len() != x0.len() {
-            return Err(CoherenceError::Config(format!(
-                "{name}: channel {} has {} samples but channel {} has {}: channels must have \
+            return Err(CoherenceError::Config(
+                format!(
+                    "{name}: channel {} has {} samples but channel {} has {}: channels must have \
                  equal length",
-                c.label(),
-                x.len(),
-                first.label(),
-                x0.len()
-            )));
+                    c.label(),
+                    x.len(),
+                    first.label(),
+                    x0.len()
+                )
+                .into(),
+            ));
         }
         if let Some(k) = x.iter().position(|v| !v.is_finite()) {
-            return Err(CoherenceError::Config(format!(
+            return Err(CoherenceError::Config(
+                format!(
                 "{name}: channel {} has the non-finite sample {} at index {k}: every sample must \
                  be finite",
                 c.label(),
                 x[k]
-            )));
+            )
+                .into(),
+            ));
         }
     }
     Ok(())
@@ -622,22 +637,31 @@ impl Label for Observable {
 
 fn check_options(opts: &CoherenceOptions) -> Result<(), CoherenceError> {
     if !(0.0..1.0).contains(&opts.welch_overlap_fraction) {
-        return Err(CoherenceError::Config(format!(
-            "Welch overlap {} is not allowed: must be a fraction in [0, 1)",
-            opts.welch_overlap_fraction
-        )));
+        return Err(CoherenceError::Config(
+            format!(
+                "Welch overlap {} is not allowed: must be a fraction in [0, 1)",
+                opts.welch_overlap_fraction
+            )
+            .into(),
+        ));
     }
     if !(opts.confidence > 0.0 && opts.confidence < 1.0) {
-        return Err(CoherenceError::Config(format!(
-            "confidence level {} is not allowed: must be in (0, 1), e.g. 0.95",
-            opts.confidence
-        )));
+        return Err(CoherenceError::Config(
+            format!(
+                "confidence level {} is not allowed: must be in (0, 1), e.g. 0.95",
+                opts.confidence
+            )
+            .into(),
+        ));
     }
     if let Some((lo, hi)) = opts.fit_band_hz {
         if !(lo.is_finite() && hi.is_finite() && 0.0 <= lo && lo < hi) {
-            return Err(CoherenceError::Config(format!(
-                "fit band {lo}..{hi} Hz is not allowed: must be finite with 0 <= low < high"
-            )));
+            return Err(CoherenceError::Config(
+                format!(
+                    "fit band {lo}..{hi} Hz is not allowed: must be finite with 0 <= low < high"
+                )
+                .into(),
+            ));
         }
     }
     Ok(())
@@ -659,10 +683,12 @@ fn welch_config(
     let cfg = WelchConfig::new(seg).with_overlap(overlap.min(seg.saturating_sub(1)));
     cfg.validate()?;
     if n < seg {
-        return Err(CoherenceError::Config(format!(
-            "the common stretch of {tilt} and {measured} is {n} samples ({} s at {fs} Hz), \
+        return Err(CoherenceError::Config(crate::message!(
+            "the common stretch of {} and {} is {n} samples ({} s at {fs} Hz), \
              shorter than one Welch segment of {seg} samples: use a shorter {} or longer \
              records",
+            tilt.to_string(),
+            measured.to_string(),
             n as f64 / fs,
             OptionKey::NPERSEG
         )));

@@ -334,7 +334,8 @@ pub fn channel_motions(
                         Motion::Rotation => "rad or rad/s",
                         Motion::Translation => "m, m/s or m/s^2",
                     }
-                ),
+                )
+                .into(),
             }),
             (Some(u), _) => Ok(Some(*u)),
             (None, code) => Ok(code),

@@ -332,7 +332,7 @@ pub enum InputError {
         /// The source channel.
         channel: String,
         /// What is wrong and what is allowed.
-        message: String,
+        message: crate::option_key::Message,
     },
 
     /// A series whose unit nobody states (taken as rad or rad/s) with a detrended RMS that no

@@ -77,16 +77,16 @@ pub use axis_map::{
 };
 pub use error::{check_sample_rate, require_two, InputError};
 pub use motion::{check_sensors, GroundChannel, GroundMap, Sensing, Sensors};
-pub use scale::{check_scales, parse_scales, scale_for, scale_note, ChannelScale};
+pub use scale::{check_scales, scale_for, scale_note, ChannelScale};
 pub use series::{
     gap_note, process_channel, ChannelCtx, Gap, GapScanner, TiltSeries, TranslationChannel,
 };
 pub use source::{chunk_of, SeriesSource};
 pub use spectra::{assemble, check_csd_finite, frequency_refusal, TiltSpectra, CSD_RTOL};
 pub use unit::{
-    likely_units, normalize_unit, parse_unit, parse_units, si_unit, unstated_excess,
-    unstated_rms_bound, ChannelUnit, DetrendedRms, Motion, ParsedUnit, Unit, UnstatedExcess,
-    PHYSICAL_UNITS, UNITS_ALLOWED, UNSTATED_ANGLE_RMS_MAX_RAD,
+    likely_units, normalize_unit, parse_unit, si_unit, unstated_excess, unstated_rms_bound,
+    ChannelUnit, DetrendedRms, Motion, ParsedUnit, Unit, UnstatedExcess, PHYSICAL_UNITS,
+    UNITS_ALLOWED, UNSTATED_ANGLE_RMS_MAX_RAD,
 };
 
 use crate::error::Shown;

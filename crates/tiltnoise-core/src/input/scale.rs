@@ -5,8 +5,7 @@
 use super::error::InputError;
 use crate::error::{shown_list, Shown};
 use crate::option_key::OptionKey;
-use crate::options::OptionError;
-use crate::repeats::{refuse_repeated_keys, refuse_repeats};
+use crate::repeats::refuse_repeats;
 use std::fmt;
 use std::path::Path;
 use std::str::FromStr;
@@ -59,27 +58,6 @@ impl fmt::Display for ChannelScale {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}={}", self.channel, self.factor)
     }
-}
-
-/// The `CHANNEL=FACTOR` items of the option `option` ([`OptionKey::SCALE`]), each channel once.
-///
-/// # Errors
-///
-/// [`OptionError::Item`] for the first item that does not parse, [`OptionError::Repeated`] for
-/// a channel given twice.
-pub fn parse_scales<S: AsRef<str>>(
-    option: OptionKey,
-    items: &[S],
-) -> Result<Vec<ChannelScale>, OptionError> {
-    refuse_repeated_keys(option, "channel", items)?;
-    items
-        .iter()
-        .map(|s| {
-            s.as_ref()
-                .parse()
-                .map_err(|message| OptionError::Item { option, message })
-        })
-        .collect()
 }
 
 /// The factor given for `channel`, if any.

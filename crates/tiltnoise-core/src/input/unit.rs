@@ -11,9 +11,6 @@
 use super::Quantity;
 use crate::error::Shown;
 use crate::ground::GroundQuantity;
-use crate::option_key::OptionKey;
-use crate::options::OptionError;
-use crate::repeats::refuse_repeated_keys;
 use std::fmt;
 use std::str::FromStr;
 
@@ -246,27 +243,6 @@ impl fmt::Display for ChannelUnit {
     }
 }
 
-/// The `CHANNEL=UNIT` items of the option `option` ([`OptionKey::UNITS`]), each channel once.
-///
-/// # Errors
-///
-/// [`OptionError::Item`] for the first item that does not parse, [`OptionError::Repeated`] for
-/// a channel given twice.
-pub fn parse_units<S: AsRef<str>>(
-    option: OptionKey,
-    items: &[S],
-) -> Result<Vec<ChannelUnit>, OptionError> {
-    refuse_repeated_keys(option, "channel", items)?;
-    items
-        .iter()
-        .map(|s| {
-            s.as_ref()
-                .parse()
-                .map_err(|message| OptionError::Item { option, message })
-        })
-        .collect()
-}
-
 /// The largest detrended RMS (rad) of a tilt angle whose unit is not stated: 1e-2 rad, half a
 /// degree. No laboratory floor tilts that much about its mean and trend (its tilt noise is
 /// 1e-10 to 1e-5 rad), while a record in microradians or nanoradians read as radians exceeds
@@ -404,6 +380,8 @@ impl DetrendedRms {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::option_key::OptionKey;
+    use crate::options::parse_keyed_items;
 
     #[test]
     fn units_say_what_they_measure() {
@@ -434,15 +412,20 @@ mod tests {
     #[test]
     fn channel_units_are_parsed_once_per_channel() {
         let items = ["LHE=m/s^2", " LJE = rad/s"];
-        let u = parse_units(OptionKey::UNITS, &items).unwrap();
+        let u: Vec<ChannelUnit> = parse_keyed_items(OptionKey::UNITS, "channel", &items).unwrap();
         assert_eq!(u[1].channel, "LJE");
         assert_eq!(u[1].unit.si(), "rad/s");
-        let e = parse_units(OptionKey::UNITS, &["LHE=m/s^2", "LHE=m/s"]).unwrap_err();
+        let e = parse_keyed_items::<ChannelUnit, _>(
+            OptionKey::UNITS,
+            "channel",
+            &["LHE=m/s^2", "LHE=m/s"],
+        )
+        .unwrap_err();
         assert_eq!(
             e.to_string(),
             "units: LHE is given twice; name each channel once"
         );
-        let e = parse_units(OptionKey::UNITS, &["LJE=rad/s^2"])
+        let e = parse_keyed_items::<ChannelUnit, _>(OptionKey::UNITS, "channel", &["LJE=rad/s^2"])
             .unwrap_err()
             .to_string();
         assert!(

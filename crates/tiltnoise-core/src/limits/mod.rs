@@ -30,6 +30,7 @@ pub mod magnitude;
 pub use magnitude::*;
 
 use crate::num_text::Num;
+use crate::option_key::Message;
 use std::fmt;
 use std::io::{self, Read};
 
@@ -149,7 +150,7 @@ pub enum LimitError {
     #[error("{what}: {} {unit}, more than the {limit} allowed (see {DOCS})", Count(*.value))]
     TooMany {
         /// The option with its value, or the file, e.g. `--samples 1000000000000`.
-        what: String,
+        what: Message,
         /// The count requested (a float: it may be derived, e.g. duration / step).
         value: f64,
         /// What is counted, plural, e.g. `Monte Carlo draws`.
@@ -161,7 +162,7 @@ pub enum LimitError {
     #[error("{what}: longer than {} ({limit} bytes), the limit for {of} (see {DOCS})", Bytes(*.limit))]
     TooLong {
         /// The file, with the line when a line is too long.
-        what: String,
+        what: Message,
         /// The limit in bytes.
         limit: u64,
         /// What the limit is for, e.g. `a parameter file`, `one line`.
@@ -176,7 +177,7 @@ pub enum LimitError {
     )]
     Memory {
         /// The option with its value, or the file, and the size that needs the memory.
-        what: String,
+        what: Message,
         /// Bytes the run would allocate (`u64::MAX` when the product overflows).
         needed: u64,
         /// `MemAvailable` at the time of the check (at most half of it may be planned).
@@ -224,15 +225,15 @@ impl fmt::Display for Bytes {
 }
 
 /// Refuses `value` above `limit`: [`LimitError::TooMany`] with `what()` (built only then).
-pub fn check_count(
-    what: impl FnOnce() -> String,
+pub fn check_count<W: Into<Message>>(
+    what: impl FnOnce() -> W,
     value: f64,
     unit: &'static str,
     limit: usize,
 ) -> Result<(), LimitError> {
     if value.is_nan() || value > limit as f64 {
         return Err(LimitError::TooMany {
-            what: what(),
+            what: what().into(),
             value,
             unit,
             limit: limit as u64,
@@ -255,7 +256,10 @@ pub const UNCHECKED_BYTES: u64 = 64 << 20;
 /// Refuses an allocation of `needed` bytes larger than half of the memory available now
 /// ([`available_memory_bytes`]); without that information (not Linux), or for at most
 /// [`UNCHECKED_BYTES`], it accepts.
-pub fn check_memory(what: impl FnOnce() -> String, needed: u64) -> Result<(), LimitError> {
+pub fn check_memory<W: Into<Message>>(
+    what: impl FnOnce() -> W,
+    needed: u64,
+) -> Result<(), LimitError> {
     if needed <= UNCHECKED_BYTES {
         return Ok(());
     }
@@ -263,14 +267,14 @@ pub fn check_memory(what: impl FnOnce() -> String, needed: u64) -> Result<(), Li
 }
 
 /// [`check_memory`] against a given amount of available memory (`None`: unknown).
-pub fn check_memory_against(
-    what: impl FnOnce() -> String,
+pub fn check_memory_against<W: Into<Message>>(
+    what: impl FnOnce() -> W,
     needed: u64,
     available: Option<u64>,
 ) -> Result<(), LimitError> {
     match available {
         Some(available) if needed > available / 2 => Err(LimitError::Memory {
-            what: what(),
+            what: what().into(),
             needed,
             available,
         }),
@@ -341,7 +345,7 @@ pub fn check_file_len(
 ) -> Result<(), LimitError> {
     if len > limit {
         return Err(LimitError::TooLong {
-            what: what(),
+            what: what().into(),
             limit,
             of,
         });
@@ -389,12 +393,12 @@ impl Overrun {
     pub fn to_limit_error(self, file: &str, of: &'static str) -> LimitError {
         match self {
             Overrun::Total { limit } => LimitError::TooLong {
-                what: file.to_string(),
+                what: file.to_string().into(),
                 limit,
                 of,
             },
             Overrun::Line { line, limit } => LimitError::TooLong {
-                what: format!("{file}, line {line}"),
+                what: format!("{file}, line {line}").into(),
                 limit,
                 of: "one line",
             },
@@ -462,16 +466,16 @@ mod tests {
 
     #[test]
     fn counts_over_the_limit_and_nan_are_refused() {
-        assert!(check_count(|| "x".into(), 10.0, "points", 10).is_ok());
-        let e = check_count(|| "freq=1:11:2".into(), 11.0, "frequency points", 10)
+        assert!(check_count(|| "x", 10.0, "points", 10).is_ok());
+        let e = check_count(|| "freq=1:11:2", 11.0, "frequency points", 10)
             .unwrap_err()
             .to_string();
         assert_eq!(
             e,
             "freq=1:11:2: 11 frequency points, more than the 10 allowed (see docs/limits.md)"
         );
-        assert!(check_count(|| "x".into(), f64::NAN, "samples", 10).is_err());
-        let e = check_count(|| "x".into(), 1.8446744073709552e19, "draws", 10).unwrap_err();
+        assert!(check_count(|| "x", f64::NAN, "samples", 10).is_err());
+        let e = check_count(|| "x", 1.8446744073709552e19, "draws", 10).unwrap_err();
         assert!(e.to_string().contains("1.8446744073709552e19 draws"), "{e}");
     }
 
@@ -489,10 +493,10 @@ mod tests {
 
     #[test]
     fn memory_check_against_what_is_available() {
-        assert!(check_memory_against(|| "x".into(), 10, None).is_ok());
-        assert!(check_memory_against(|| "x".into(), 10, Some(20)).is_ok());
-        assert!(check_memory_against(|| "x".into(), 11, Some(20)).is_err());
-        let e = check_memory_against(|| "samples=5".into(), 3 << 30, Some(4 << 30))
+        assert!(check_memory_against(|| "x", 10, None).is_ok());
+        assert!(check_memory_against(|| "x", 10, Some(20)).is_ok());
+        assert!(check_memory_against(|| "x", 11, Some(20)).is_err());
+        let e = check_memory_against(|| "samples=5", 3 << 30, Some(4 << 30))
             .unwrap_err()
             .to_string();
         assert_eq!(
@@ -501,8 +505,8 @@ mod tests {
              ask for less (see docs/limits.md)"
         );
         // The machine running the tests has some memory, and not 16 EiB.
-        assert!(check_memory(|| "x".into(), 1).is_ok());
-        assert!(check_memory(|| "x".into(), u64::MAX).is_err() || !cfg!(target_os = "linux"));
+        assert!(check_memory(|| "x", 1).is_ok());
+        assert!(check_memory(|| "x", u64::MAX).is_err() || !cfg!(target_os = "linux"));
     }
 
     #[test]

@@ -15,11 +15,11 @@ pub struct GivenAsd {
 
 /// Why a [`GivenAsd`] cannot be made or used.
 #[derive(Debug, Clone, PartialEq)]
-pub struct GivenAsdError(pub String);
+pub struct GivenAsdError(pub crate::option_key::Message);
 
 impl fmt::Display for GivenAsdError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
+        write!(f, "{}", self.0)
     }
 }
 
@@ -31,7 +31,7 @@ impl GivenAsd {
     /// Fewer than 2 points, lengths that differ, a frequency that is not finite, > 0 and
     /// increasing, or an ASD that is not finite and >= 0, naming `origin`, the index and value.
     pub fn new(freqs_hz: Vec<f64>, asd: Vec<f64>, origin: &str) -> Result<GivenAsd, GivenAsdError> {
-        let err = |m: String| Err(GivenAsdError(format!("{origin}: {m}")));
+        let err = |m: String| Err(GivenAsdError(format!("{origin}: {m}").into()));
         if freqs_hz.len() != asd.len() {
             return err(format!(
                 "{} frequencies but {} ASD values",
@@ -83,11 +83,11 @@ impl GivenAsd {
     pub fn check_covers(&self, lo: f64, hi: f64) -> Result<(), GivenAsdError> {
         let (a, b) = self.band_hz();
         if lo < a || hi > b {
-            return Err(GivenAsdError(format!(
+            return Err(GivenAsdError(crate::message!(
                 "{}: the spectrum covers {a:e} .. {b:e} Hz, the budget's band is {lo:e} .. \
                  {hi:e} Hz; a given spectrum is never extrapolated: give one that covers the \
                  band, or narrow the band (Welch segments, or {} for spectra input)",
-                self.origin,
+                self.origin.clone(),
                 OptionKey::FREQ
             )));
         }
@@ -135,7 +135,7 @@ mod tests {
         assert_eq!(psd[0], 1e-12);
         assert!((psd[1] / 1e-14 - 1.0).abs() < 1e-14, "{}", psd[1]);
         assert!(g.check_covers(1e-3, 1e-1).is_ok());
-        let e = g.check_covers(1e-4, 1e-2).unwrap_err().0;
+        let e = g.check_covers(1e-4, 1e-2).unwrap_err().to_string();
         assert!(
             e.starts_with("r.csv: the spectrum covers 1e-3 .. 1e-1 Hz"),
             "{e}"
@@ -147,7 +147,7 @@ mod tests {
             (vec![1.0, 2.0], vec![f64::NAN, 1.0], "ASD NaN at index 0"),
             (vec![1.0], vec![1.0], "at least 2"),
         ] {
-            let e = GivenAsd::new(f, a, "x.csv").unwrap_err().0;
+            let e = GivenAsd::new(f, a, "x.csv").unwrap_err().to_string();
             assert!(e.starts_with("x.csv: ") && e.contains(what), "{e}");
         }
     }

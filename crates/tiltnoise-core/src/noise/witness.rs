@@ -9,6 +9,7 @@ use super::{Budget, GivenAsdError, NoiseTerm, TermKind};
 use crate::error::TfError;
 use crate::model::{Input, Model, Observable};
 use crate::noise::GivenAsd;
+use crate::option_key::{Message, OptionKey};
 use crate::tf::{self, Request};
 
 /// Largest relative uncertainty of a witness noise level accepted (1 sigma of the ASD).
@@ -41,13 +42,20 @@ impl WitnessNoise {
     ///
     /// A white level that is not finite and >= 0, or an uncertainty outside
     /// `[0, MAX_NOISE_REL]`, naming the input and the value.
-    pub fn check(&self, what: &str) -> Result<(), String> {
-        let name = self.input.name();
+    pub fn check(&self, what: OptionKey) -> Result<(), Message> {
+        match self.problem() {
+            Some(problem) => Err(crate::message!("{what} {}: {problem}", self.input.name())),
+            None => Ok(()),
+        }
+    }
+
+    /// What is wrong with the level or its uncertainty ([`WitnessNoise::check`] without the
+    /// option and the input), if anything.
+    pub fn problem(&self) -> Option<String> {
         if let NoiseLevel::White(asd) = self.level {
             if !crate::limits::ASDS.admits(asd) {
-                return Err(format!(
-                    "{what} {name}: the ASD {} {}/sqrt(Hz) is not allowed: must be {} (see \
-                     docs/limits.md)",
+                return Some(format!(
+                    "the ASD {} {}/sqrt(Hz) is not allowed: must be {} (see docs/limits.md)",
                     crate::error::Num(asd),
                     self.input.unit(),
                     crate::limits::ASDS.allowed(&format!("{}/sqrt(Hz)", self.input.unit()))
@@ -55,13 +63,13 @@ impl WitnessNoise {
             }
         }
         if !(self.rel.is_finite() && (0.0..=MAX_NOISE_REL).contains(&self.rel)) {
-            return Err(format!(
-                "{what} {name}: the relative uncertainty {} is not allowed: must be finite, in \
+            return Some(format!(
+                "the relative uncertainty {} is not allowed: must be finite, in \
                  [0, {MAX_NOISE_REL}] (1 sigma of the ASD, e.g. 0.1 for 10 %)",
                 self.rel
             ));
         }
-        Ok(())
+        None
     }
 
     /// The one-sided PSD (unit^2/Hz) on `freqs_hz`.

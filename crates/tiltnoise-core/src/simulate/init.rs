@@ -50,15 +50,15 @@ pub fn set_coordinate(
     rate: bool,
     out: &mut [f64; 8],
 ) -> Result<(), OptionError> {
-    let shown = Shown(item);
     let c = coordinate(option, item, name)?;
     let unit = match rate {
         true => format!("{}/s", c.unit()),
         false => c.unit().to_string(),
     };
     if !value.is_finite() {
-        return Err(OptionError::Conflict(format!(
-            "{option} {shown}: {value} {unit} is not allowed: must be finite"
+        return Err(OptionError::Conflict(crate::message!(
+            "{option} {}: {value} {unit} is not allowed: must be finite",
+            Shown(item).to_string()
         )));
     }
     out[c.index()] = value;
@@ -72,10 +72,10 @@ fn coordinate(option: OptionKey, item: &str, name: &str) -> Result<Coord, Option
         .find(|c| c.name() == name)
         .ok_or_else(|| {
             let names: Vec<&str> = Coord::ALL.iter().map(|c| c.name()).collect();
-            OptionError::Conflict(format!(
+            OptionError::Conflict(crate::message!(
                 "{option} {}: unknown coordinate `{}`; allowed: {}",
-                Shown(item),
-                Shown(name),
+                Shown(item).to_string(),
+                Shown(name).to_string(),
                 names.join(", ")
             ))
         })
@@ -92,18 +92,19 @@ pub fn parse_coordinates<S: AsRef<str>>(
     let entries = list_entries(items);
     refuse_repeated_keys(option, "coordinate", &entries)?;
     for entry in entries {
-        let shown = Shown(entry);
         let (name, value) = entry.split_once('=').ok_or_else(|| {
-            OptionError::Conflict(format!(
-                "{option} {shown}: expected COORD=VALUE, e.g. phi_b=0.01"
+            OptionError::Conflict(crate::message!(
+                "{option} {}: expected COORD=VALUE, e.g. phi_b=0.01",
+                Shown(entry).to_string()
             ))
         })?;
         // The name is checked first, as it comes first in the item.
         coordinate(option, entry, name.trim())?;
         let v: f64 = value.trim().parse().map_err(|_| {
-            OptionError::Conflict(format!(
-                "{option} {shown}: `{}` is not a number",
-                Shown(value.trim())
+            OptionError::Conflict(crate::message!(
+                "{option} {}: `{}` is not a number",
+                Shown(entry).to_string(),
+                Shown(value.trim()).to_string()
             ))
         })?;
         set_coordinate(option, entry, name.trim(), v, rate, out)?;
@@ -120,11 +121,13 @@ pub fn initial_state(
 ) -> Result<(InitialState, String), OptionError> {
     let (init, text) = excitation_state(model, excitation)?;
     let option = match *excitation {
-        Excitation::KickX { x_m } => OptionKey::KICK_X.given(Num(x_m)).to_string(),
+        Excitation::KickX { x_m } => crate::message!("{}", OptionKey::KICK_X.given(Num(x_m))),
         Excitation::EqualEnergy { energy_j } => {
-            OptionKey::MODE_ENERGY.given(Num(energy_j)).to_string()
+            crate::message!("{}", OptionKey::MODE_ENERGY.given(Num(energy_j)))
         }
-        Excitation::Given { .. } => format!("{}/{}", OptionKey::INIT, OptionKey::INIT_RATE),
+        Excitation::Given { .. } => {
+            crate::message!("{}/{}", OptionKey::INIT, OptionKey::INIT_RATE)
+        }
     };
     for c in Coord::ALL {
         for (what, value, unit) in [
@@ -132,7 +135,8 @@ pub fn initial_state(
             ("rate", init.qdot[c.index()], format!("{}/s", c.unit())),
         ] {
             if value != 0.0 && value.abs() < MIN_SAMPLE {
-                return Err(OptionError::Conflict(format!(
+                let option = option.clone();
+                return Err(OptionError::Conflict(crate::message!(
                     "{option}: the initial {what} of {} would be {} {unit}, nonzero and \
                      smaller than {MIN_SAMPLE:e} in magnitude: the spectra of the motion would \
                      underflow f64 (see docs/limits.md)",
@@ -154,19 +158,19 @@ fn excitation_state(
         Excitation::KickX { x_m: x } => {
             let option = OptionKey::KICK_X;
             if !(x.is_finite() && x != 0.0) {
-                return Err(OptionError::Conflict(format!(
+                return Err(OptionError::Conflict(crate::message!(
                     "{option} {x}: the displacement (m) must be finite and non-zero"
                 )));
             }
             let init = kick_x(model, x);
             if init.q.iter().any(|v| !v.is_finite()) {
-                return Err(OptionError::Conflict(format!(
+                return Err(OptionError::Conflict(crate::message!(
                     "{option} {x}: X does not respond statically to a force on the test mass \
                      along x for these parameters, so the kick is undefined"
                 )));
             }
             if let Err(e) = check_initial_state(&init) {
-                return Err(OptionError::Conflict(format!(
+                return Err(OptionError::Conflict(crate::message!(
                     "{option} {} m: the static deflection it starts from is outside the \
                      linear model ({e})",
                     Num(x)
@@ -179,7 +183,7 @@ fn excitation_state(
         }
         Excitation::Given { q, qdot } => {
             if q.iter().chain(&qdot).all(|&v| v == 0.0) {
-                return Err(OptionError::Conflict(format!(
+                return Err(OptionError::Conflict(crate::message!(
                     "{}/{}: every coordinate and rate is 0: nothing moves",
                     OptionKey::INIT,
                     OptionKey::INIT_RATE
@@ -205,7 +209,7 @@ fn excitation_state(
         }
         Excitation::EqualEnergy { energy_j: e } => {
             if !(e.is_finite() && e > 0.0) {
-                return Err(OptionError::Conflict(format!(
+                return Err(OptionError::Conflict(crate::message!(
                     "{} {e}: the energy per mode (J) must be finite and > 0",
                     OptionKey::MODE_ENERGY
                 )));
@@ -246,24 +250,24 @@ pub fn check_sampling(
 ) -> Result<(usize, usize), OptionError> {
     let (step, duration) = (OptionKey::STEP, OptionKey::DURATION);
     if !(step_s.is_finite() && step_s > 0.0) {
-        return Err(OptionError::Conflict(format!(
+        return Err(OptionError::Conflict(crate::message!(
             "{step} {step_s}: the sampling step (s) must be finite and > 0"
         )));
     }
     if !(duration_s.is_finite() && duration_s > 0.0) {
-        return Err(OptionError::Conflict(format!(
+        return Err(OptionError::Conflict(crate::message!(
             "{duration} {duration_s}: the duration (s) must be finite and > 0"
         )));
     }
     let n_f = (duration_s / step_s * (1.0 + 1e-9)).floor();
     if n_f < 2.0 {
-        return Err(OptionError::Conflict(format!(
+        return Err(OptionError::Conflict(crate::message!(
             "{duration} {duration_s} s at {step} {step_s} s gives {n_f} sample(s): at least 2 \
              are needed"
         )));
     }
     let what = || {
-        format!(
+        crate::message!(
             "{duration} {} s at {step} {} s",
             Num(duration_s),
             Num(step_s)
@@ -277,12 +281,12 @@ pub fn check_sampling(
     let seg = nperseg.unwrap_or_else(|| default_sim_nperseg(n));
     let option = OptionKey::NPERSEG;
     if seg < MIN_SIM_NPERSEG {
-        return Err(OptionError::Conflict(format!(
+        return Err(OptionError::Conflict(crate::message!(
             "{option} {seg}: the Welch segment must have at least {MIN_SIM_NPERSEG} samples"
         )));
     }
     if seg > n {
-        return Err(OptionError::Conflict(format!(
+        return Err(OptionError::Conflict(crate::message!(
             "{duration} {} s at {step} {} s gives {n} samples, shorter than one Welch segment \
              ({option} {seg} = {} s): lengthen {duration} or lower {option}",
             Num(duration_s),

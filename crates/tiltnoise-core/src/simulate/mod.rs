@@ -64,7 +64,10 @@ pub use init::{
 /// integer) over [`MAX_SIM_SAMPLES`] or over the memory available ([`SIM_BYTES_PER_SAMPLE`]
 /// each, outputs included), before anything is allocated. `what` names the request in the
 /// message, e.g. `--duration 9e7 s at --step 0.1 s`.
-pub fn check_samples(what: impl Fn() -> String, n_samples: f64) -> Result<(), LimitError> {
+pub fn check_samples<W: Into<crate::option_key::Message>>(
+    what: impl Fn() -> W,
+    n_samples: f64,
+) -> Result<(), LimitError> {
     check_count(&what, n_samples, "samples", MAX_SIM_SAMPLES)?;
     // Within the limit, so a whole number of samples that fits a usize.
     let n = n_samples as usize;

@@ -72,7 +72,10 @@ pub struct FreeMotion {
 /// Refuses a record of `n_samples` (a float: `floor(duration / dt)` may be beyond any integer)
 /// over [`MAX_STREAMED_SIM_SAMPLES`]; `what` names the request in the message. The memory of a
 /// streamed record does not depend on its length, so this is the only size check it needs.
-pub fn check_streamed_samples(what: impl Fn() -> String, n_samples: f64) -> Result<(), LimitError> {
+pub fn check_streamed_samples<W: Into<crate::option_key::Message>>(
+    what: impl Fn() -> W,
+    n_samples: f64,
+) -> Result<(), LimitError> {
     check_count(&what, n_samples, "samples", MAX_STREAMED_SIM_SAMPLES)
 }
 

@@ -126,12 +126,15 @@ pub fn estimate(
         .filter(|&k| (0..n).all(|i| (i + 1..n).all(|j| coherent(i, j, k))))
         .collect();
     if bins.is_empty() {
-        return Err(SubtractError::Config(format!(
-            "the co-located records of {} are nowhere coherent with the witness (coherence \
+        return Err(SubtractError::Config(
+            format!(
+                "the co-located records of {} are nowhere coherent with the witness (coherence \
              below {GAIN_COHERENCE} at every frequency): they do not record the same motion; \
              check their axis maps and start times",
-            input.name()
-        )));
+                input.name()
+            )
+            .into(),
+        ));
     }
     let (gains, method) = match others.len() {
         1 => {
@@ -275,23 +278,29 @@ pub fn estimate_all(
             (rec.fs_hz, n_c, rec.start),
         )
         .map_err(|e| {
-            SubtractError::Config(format!(
-                "co-located record {}: {}",
-                c + 1,
-                e.to_string()
-                    .replace("measured record", "co-located record")
-            ))
+            SubtractError::Config(
+                format!(
+                    "co-located record {}: {}",
+                    c + 1,
+                    e.to_string()
+                        .replace("measured record", "co-located record")
+                )
+                .into(),
+            )
         })?;
         first = first.max(a.witness_first);
         end = end.min(a.witness_first + a.len);
         starts.push(a.measured_first as i64 - a.witness_first as i64);
     }
     if end < first + 4 * segment_len {
-        return Err(SubtractError::Config(format!(
-            "the co-located records and the witness share {} samples: at least 4 Welch \
+        return Err(SubtractError::Config(
+            format!(
+                "the co-located records and the witness share {} samples: at least 4 Welch \
              segments of {segment_len} are needed to estimate the witness noise",
-            end.saturating_sub(first)
-        )));
+                end.saturating_sub(first)
+            )
+            .into(),
+        ));
     }
     let mut out = Vec::new();
     for (a, &input) in witness.inputs.iter().enumerate() {
@@ -308,12 +317,15 @@ pub fn estimate_all(
             continue;
         }
         if others.len() > 2 {
-            return Err(SubtractError::Config(format!(
-                "{} is recorded by {} co-located records: give one (a huddle) or two (a \
+            return Err(SubtractError::Config(
+                format!(
+                    "{} is recorded by {} co-located records: give one (a huddle) or two (a \
                  three-cornered hat)",
-                input.name(),
-                others.len()
-            )));
+                    input.name(),
+                    others.len()
+                )
+                .into(),
+            ));
         }
         let ratio = ratios
             .iter()

@@ -34,11 +34,14 @@ pub(super) fn check_channels(
 ) -> Result<(), SubtractError> {
     for (name, samples) in names.iter().zip(w.iter().chain(y)) {
         if let Some(k) = samples.iter().position(|v| !v.is_finite()) {
-            return Err(SubtractError::Record(format!(
-                "{name} has the non-finite sample {} at index {k} of the overlap; allowed: \
+            return Err(SubtractError::Record(
+                format!(
+                    "{name} has the non-finite sample {} at index {k} of the overlap; allowed: \
                  finite samples (the estimation decomposes their spectra)",
-                Num(samples[k])
-            )));
+                    Num(samples[k])
+                )
+                .into(),
+            ));
         }
         if let Some(&first) = samples.first() {
             if samples.iter().all(|&v| v == first) {
@@ -46,7 +49,8 @@ pub(super) fn check_channels(
                     true => "is zero at every sample".to_string(),
                     false => format!("is constant ({}) at every sample", Num(first)),
                 };
-                return Err(SubtractError::Record(format!(
+                let name = name.clone();
+                return Err(SubtractError::Record(crate::message!(
                     "{name} {what} of the overlap: a dead channel has no power to fit or \
                      subtract; leave it out ({}, {}) or check the record",
                     OptionKey::OBSERVABLES,
@@ -69,16 +73,22 @@ pub(super) fn check_spectra(
     for (c, name) in names.iter().enumerate() {
         let psd = spectra.psd(c);
         if psd.iter().any(|p| !p.is_finite()) {
-            return Err(SubtractError::Record(format!(
-                "the power spectrum of {name} over the {stretch} stretch is not finite: its \
+            return Err(SubtractError::Record(
+                format!(
+                    "the power spectrum of {name} over the {stretch} stretch is not finite: its \
                  samples are far too large for its unit (check the units and the scale factor)"
-            )));
+                )
+                .into(),
+            ));
         }
         if psd.iter().skip(1).all(|&p| p == 0.0) {
-            return Err(SubtractError::Record(format!(
+            return Err(SubtractError::Record(
+                format!(
                 "{name} has no power above DC over the {stretch} stretch (constant within every \
                  Welch segment): a dead channel has no power to fit or subtract; leave it out"
-            )));
+            )
+                .into(),
+            ));
         }
         for (d, other) in names.iter().enumerate() {
             if spectra
@@ -86,10 +96,13 @@ pub(super) fn check_spectra(
                 .iter()
                 .any(|z| !(z.re.is_finite() && z.im.is_finite()))
             {
-                return Err(SubtractError::Record(format!(
+                return Err(SubtractError::Record(
+                    format!(
                     "the cross spectrum of {name} and {other} over the {stretch} stretch is not \
                      finite: the samples are far too large for their units"
-                )));
+                )
+                    .into(),
+                ));
             }
         }
     }

@@ -236,13 +236,13 @@ pub enum SubtractError {
     },
     /// The overlap is too short for the spectral estimates.
     #[error("{0}")]
-    TooShort(String),
+    TooShort(crate::option_key::Message),
     /// An option outside its allowed range.
     #[error("{0}")]
-    Config(String),
+    Config(crate::option_key::Message),
     /// A record the estimation cannot use: a non-finite sample or spectrum, a dead channel.
     #[error("{0}")]
-    Record(String),
+    Record(crate::option_key::Message),
     /// A band with no bin.
     #[error(
         "the {what} band {} .. {} Hz holds no bin of the Welch grid {} .. {} Hz; allowed: a band \
@@ -603,7 +603,7 @@ impl SegmentPlan {
             let needed = (MIN_TRAINING_SEGMENTS * needed_seg) as f64 / (1.0 - cfg.holdout_fraction);
             let needed =
                 needed.max((MIN_HOLDOUT_SEGMENTS * needed_seg) as f64 / cfg.holdout_fraction);
-            return Err(SubtractError::TooShort(format!(
+            return Err(SubtractError::TooShort(crate::message!(
                 "the records overlap for {}: with a held-out fraction of {} and a Welch segment of {} \
                  the overlap must be at least {} (training >= {MIN_TRAINING_SEGMENTS} segments, \
                  held-out >= {MIN_HOLDOUT_SEGMENTS}); use longer records or a shorter {}",
@@ -618,7 +618,7 @@ impl SegmentPlan {
         let max_delay_s = match cfg.max_delay_s {
             Some(d) if d.is_finite() && d > 0.0 && d <= MAX_DELAY_FRACTION * segment_s => d,
             Some(d) => {
-                return Err(SubtractError::Config(format!(
+                return Err(SubtractError::Config(crate::message!(
                     "{} is not allowed: must be > 0 and at most {} of the Welch segment, {} s \
                      (longer delays need a longer {})",
                     OptionKey::MAX_DELAY.given(format!("{} s", Num(d))),
@@ -647,7 +647,7 @@ fn all_witness_noise(
     let mut noise = given.to_vec();
     for e in colocated {
         if noise.iter().any(|x| x.input == e.noise.input) {
-            return Err(SubtractError::Config(format!(
+            return Err(SubtractError::Config(crate::message!(
                 "{}: the noise of {} is also estimated from the co-located records; give one \
                  or the other",
                 OptionKey::WITNESS_NOISE.given(e.noise.input.name()),
@@ -895,7 +895,9 @@ fn noise_on_grid(
         .map(|i| match noise.iter().find(|x| x.input == *i) {
             None => Ok(vec![0.0; freqs.len()]),
             Some(x) => {
-                let mut psd = x.psd_on(&freqs[1..]).map_err(SubtractError::Config)?;
+                let mut psd = x
+                    .psd_on(&freqs[1..])
+                    .map_err(|e| SubtractError::Config(e.into()))?;
                 psd.insert(0, psd[0]);
                 Ok(psd)
             }
@@ -986,7 +988,7 @@ fn check_config(
 ) -> Result<(), SubtractError> {
     let f = cfg.holdout_fraction;
     if !(f > 0.0 && f <= MAX_HOLDOUT_FRACTION) {
-        return Err(SubtractError::Config(format!(
+        return Err(SubtractError::Config(crate::message!(
             "{} is not allowed: must be > 0 and <= {MAX_HOLDOUT_FRACTION} (the fit needs the \
              larger part of the overlap)",
             OptionKey::HOLDOUT.given(Num(f))
@@ -994,22 +996,28 @@ fn check_config(
     }
     for (i, input) in witness.inputs.iter().enumerate() {
         if !input.is_ground() {
-            return Err(SubtractError::Config(format!(
+            return Err(SubtractError::Config(
+                format!(
                 "the witness record's channel {} is not a motion of the floor; a witness records \
                  floor inputs of the model (theta_t, eta_t, phi_t, x_t, y_t, z_t)",
                 input.name()
-            )));
+            )
+                .into(),
+            ));
         }
         if witness.inputs[..i].contains(input) {
-            return Err(SubtractError::Config(format!(
-                "the witness record has input {} twice; give each input once",
-                input.name()
-            )));
+            return Err(SubtractError::Config(
+                format!(
+                    "the witness record has input {} twice; give each input once",
+                    input.name()
+                )
+                .into(),
+            ));
         }
     }
     for (input, r) in &cfg.colocated_noise_ratio {
         if !crate::limits::admits_noise_ratio(*r) {
-            return Err(SubtractError::Config(format!(
+            return Err(SubtractError::Config(crate::message!(
                 "{}: the ratio of noise ASDs is not allowed: must be {}",
                 OptionKey::COLOCATED_RATIO.given(format!("{}={}", input.name(), Num(*r))),
                 crate::limits::allowed_noise_ratios()
@@ -1018,19 +1026,19 @@ fn check_config(
     }
     for x in &cfg.witness_noise {
         if !witness.inputs.contains(&x.input) {
-            return Err(SubtractError::Config(format!(
+            return Err(SubtractError::Config(crate::message!(
                 "{}: the witness record has no input {}; it has {}",
                 OptionKey::WITNESS_NOISE.given(x.input.name()),
                 x.input.name(),
                 names(witness.inputs.iter().map(|a| a.name()))
             )));
         }
-        x.check(&OptionKey::WITNESS_NOISE.to_string())
+        x.check(OptionKey::WITNESS_NOISE)
             .map_err(SubtractError::Config)?;
     }
     for (o, asd) in &cfg.readout_asd {
         if !measured.channels.iter().any(|c| c.0 == *o) {
-            return Err(SubtractError::Config(format!(
+            return Err(SubtractError::Config(crate::message!(
                 "{}: the measured record has no channel {}; it has {}",
                 OptionKey::READOUT.given(o.name()),
                 o.name(),
@@ -1038,7 +1046,7 @@ fn check_config(
             )));
         }
         if !(asd.is_finite() && *asd >= 0.0) {
-            return Err(SubtractError::Config(format!(
+            return Err(SubtractError::Config(crate::message!(
                 "{}: the ASD ({}/sqrt(Hz)) must be finite and >= 0",
                 OptionKey::READOUT.given(format!("{}={}", o.name(), Num(*asd))),
                 o.unit()
@@ -1047,7 +1055,7 @@ fn check_config(
     }
     if let Some((a, b)) = cfg.fit_band_hz {
         if !(a.is_finite() && b.is_finite() && 0.0 < a && a < b) {
-            return Err(SubtractError::Config(format!(
+            return Err(SubtractError::Config(crate::message!(
                 "{}: must be FLO:FHI with 0 < FLO < FHI (Hz)",
                 OptionKey::BAND.given(format!("{}:{}", Num(a), Num(b)))
             )));
@@ -1055,7 +1063,7 @@ fn check_config(
     }
     let (a, b) = cfg.report_band_hz;
     if !(a.is_finite() && b.is_finite() && 0.0 < a && a < b) {
-        return Err(SubtractError::Config(format!(
+        return Err(SubtractError::Config(crate::message!(
             "{}: must be FLO:FHI with 0 < FLO < FHI (Hz)",
             OptionKey::REPORT_BAND.given(format!("{}:{}", Num(a), Num(b)))
         )));

@@ -193,7 +193,7 @@ fn tilt_at_f_is_the_exact_transfer_function_on_the_band_mean_cross_spectra() {
         };
         let mut s = series(vec![a.clone(), eta.clone()]);
         match budget_from_series(&model, &mut s, &opts, &mut |_, _| {}) {
-            Err(BudgetError::Config(e)) => assert!(e.contains(why), "{e}"),
+            Err(BudgetError::Config(e)) => assert!(e.to_string().contains(why), "{e}"),
             other => panic!("expected a refusal, got {:?}", other.map(|r| r.summary)),
         }
         opts.summary.strict = false;

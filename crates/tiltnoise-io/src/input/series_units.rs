@@ -89,7 +89,8 @@ pub(crate) fn merge_given(
                      {kind}s: {}",
                     Shown(&g.text),
                     shown_list(available)
-                ),
+                )
+                .into(),
             });
         };
         let mine = Stated {
@@ -124,7 +125,8 @@ pub(crate) fn merge_given(
                          channel",
                         Shown(&s.text),
                         Shown(&g.text)
-                    ),
+                    )
+                    .into(),
                 })
             }
             Some(s) => {
@@ -138,7 +140,8 @@ pub(crate) fn merge_given(
                         Shown(&s.text),
                         s.origin,
                         Shown(&g.text)
-                    ),
+                    )
+                    .into(),
                 })
             }
         });
@@ -251,7 +254,7 @@ pub(crate) fn plan(
                     return Err(InputError::ChannelUnit {
                         path: path.to_path_buf(),
                         channel: m.source.clone(),
-                        message: format!(
+                        message: tiltnoise_core::message!(
                             "feeds {}, a translation of the floor, and {}; allowed: a unit of \
                              length, velocity or acceleration (m, m/s, m/s^2 or a prefixed \
                              form), stated in the file (a `# units:` line, a `units` \

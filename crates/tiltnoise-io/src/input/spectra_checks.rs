@@ -19,7 +19,8 @@ pub(super) fn refuse_translation_spectra(
                  spectra of the tilt axes (theta_t, eta_t, phi_t); give translations as a time \
                  series",
                 m.input.name()
-            ),
+            )
+            .into(),
         }),
     }
 }

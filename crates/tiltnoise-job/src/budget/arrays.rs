@@ -240,7 +240,7 @@ impl fmt::Display for ArrayError {
                     f,
                     "tilt[{channel:?}][{index}] is {value:?} {unit}; allowed: finite values (or \
                      {} to bridge interior gaps linearly)",
-                    OptionKey::new("gaps").given("\"interpolate\"")
+                    OptionKey::GAPS.given("\"interpolate\"")
                 ),
                 InputError::OutOfRange {
                     channel,

@@ -9,7 +9,7 @@ mod outcome;
 mod summary;
 
 pub use arrays::{array_input, ArrayError, ArrayOptions, ArrayRecord, ARRAYS_FORMAT, ARRAYS_PATH};
-pub use outcome::{BudgetOutcome, SaveOptions};
+pub use outcome::{BudgetOutcome, SaveOptions, OUTPUT_KINDS};
 pub use summary::asd_rel_std;
 
 use crate::error::{shown_path, JobError};
@@ -30,7 +30,7 @@ use tiltnoise_core::input::{
 };
 use tiltnoise_core::model::{Model, Observable};
 use tiltnoise_core::modes::NormalModes;
-use tiltnoise_core::option_key::OptionKey;
+use tiltnoise_core::option_key::{Message, OptionKey};
 use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_core::spectral::Averaging;
 use tiltnoise_io::input::{add_measured_file, open_tilt, OpenedTilt};
@@ -159,21 +159,24 @@ impl BudgetRequest<'_> {
     }
 
     /// The options of a time series that were given, in the order they are reported.
-    fn series_options_given(&self) -> Vec<&'static str> {
+    fn series_options_given(&self) -> Vec<OptionKey> {
         let w = &self.welch;
         let mut given = vec![
-            ("nperseg", w.nperseg.is_some()),
-            ("overlap", w.overlap.is_some()),
-            ("average", w.averaging.is_some()),
-            ("segment_duration", w.segment_duration_s.is_some()),
+            (OptionKey::NPERSEG, w.nperseg.is_some()),
+            (OptionKey::OVERLAP, w.overlap.is_some()),
+            (OptionKey::AVERAGE, w.averaging.is_some()),
+            (OptionKey::SEGMENT_DURATION, w.segment_duration_s.is_some()),
         ];
         if let TiltSource::File { read, .. } = &self.tilt {
             given.extend([
-                ("gaps", read.gaps.is_some()),
-                ("scale", !read.scale.is_empty()),
-                ("units", !read.units.is_empty()),
-                ("corrected", !read.corrected.is_empty()),
-                ("pendulum_tiltmeter", !read.pendulum_tiltmeter.is_empty()),
+                (OptionKey::GAPS, read.gaps.is_some()),
+                (OptionKey::SCALE, !read.scale.is_empty()),
+                (OptionKey::UNITS, !read.units.is_empty()),
+                (OptionKey::CORRECTED, !read.corrected.is_empty()),
+                (
+                    OptionKey::PENDULUM_TILTMETER,
+                    !read.pendulum_tiltmeter.is_empty(),
+                ),
             ]);
         }
         given
@@ -197,8 +200,11 @@ fn summary(at_hz: Option<&[f64]>, at_band: Option<f64>) -> Result<SummaryRequest
         req.freqs_hz = f.to_vec();
     }
     req.validate().map_err(|e| {
-        let option = if at_band.is_some() { "at_band" } else { "at" };
-        JobError::option(option, None, e.to_string())
+        let option = match at_band {
+            Some(_) => OptionKey::AT_BAND,
+            None => OptionKey::AT,
+        };
+        JobError::option(option, None, Message::shown(e))
     })?;
     Ok(req)
 }
@@ -233,9 +239,9 @@ fn options(req: &BudgetRequest<'_>, cancel: &Cancel) -> Result<BudgetOptions, Jo
 }
 
 /// Refuses the first option given in `given` that does not apply to what `path` holds.
-fn refuse(given: &[&'static str], holds: InputKind, path: &str) -> Result<(), JobError> {
+fn refuse(given: &[OptionKey], holds: InputKind, path: &str) -> Result<(), JobError> {
     match given.first() {
-        Some(option) => Err(JobError::NotForInput {
+        Some(&option) => Err(JobError::NotForInput {
             option,
             holds,
             path: path.to_string(),
@@ -276,7 +282,7 @@ fn budget(
     }
     let mut opts = options(&req, cancel)?;
     let series_given = req.series_options_given();
-    let spectra_given: Vec<&'static str> = req.freq_hz.iter().map(|_| "freq").collect();
+    let spectra_given: Vec<OptionKey> = req.freq_hz.iter().map(|_| OptionKey::FREQ).collect();
     let model = req.model;
     let (report, input) = match req.tilt {
         TiltSource::File { path, read } => {
@@ -326,7 +332,7 @@ fn budget(
     for x in &opts.witness_noise {
         if !report.inputs.contains(&x.input) {
             return Err(JobError::option(
-                "witness_noise",
+                OptionKey::WITNESS_NOISE,
                 Some(x.input.name()),
                 format!(
                     "the record {} has no input {}; it has {}",
@@ -345,7 +351,11 @@ fn budget(
     if let Some(path) = &req.measured {
         add_measured_file(&mut report, path).map_err(|e| match e {
             BudgetError::Input(e) => JobError::from(e),
-            other => JobError::option("measured", Some(&shown_path(path)), other.to_string()),
+            other => JobError::option(
+                OptionKey::MEASURED,
+                Some(&shown_path(path)),
+                Message::shown(other),
+            ),
         })?;
     }
     let provenance = req

@@ -10,6 +10,10 @@ use tiltnoise_core::input::InputMeta;
 use tiltnoise_core::noise::BudgetReport;
 use tiltnoise_io::{budget_csv_string, write_budget_csv, write_budget_hdf5, OutputKind, Staging};
 
+/// The kinds of file a budget result is saved as: HDF5 (schema `tiltnoise.budget`), CSV and
+/// the figure.
+pub const OUTPUT_KINDS: &[OutputKind] = crate::outcome::SPECTRA_KINDS;
+
 /// A noise budget, where its floor's motion came from, and the provenance its files record.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct BudgetOutcome {
@@ -75,7 +79,7 @@ impl BudgetOutcome {
             OutputKind::Csv => {
                 write_budget_csv(stage, path, report, meta, options.keep_zero_columns)
             }
-            OutputKind::Png | OutputKind::Svg => {
+            _ => {
                 let figure = BudgetFigureOptions {
                     input: Some(self.input.clone()),
                     ..options.figure.clone()
@@ -96,12 +100,7 @@ impl Outcome for BudgetOutcome {
 
     /// `.h5` (schema `tiltnoise.budget`), `.csv`, `.png`, `.svg`.
     fn output_kinds(&self) -> &'static [OutputKind] {
-        &[
-            OutputKind::Hdf5,
-            OutputKind::Csv,
-            OutputKind::Png,
-            OutputKind::Svg,
-        ]
+        OUTPUT_KINDS
     }
 
     /// [`BudgetOutcome::save_with`] the default options: zero CSV columns left out, the

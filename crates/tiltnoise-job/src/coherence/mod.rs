@@ -6,7 +6,7 @@ mod json;
 mod outcome;
 
 pub use json::{peak_bin, significant_bins};
-pub use outcome::CoherenceOutcome;
+pub use outcome::{CoherenceOutcome, OUTPUT_KINDS};
 pub use tiltnoise_io::CoherenceInputs;
 
 use crate::budget::ReadRequest;
@@ -19,6 +19,7 @@ use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::coherence::{coherence_from_series, CoherenceOptions, Record};
 use tiltnoise_core::input::InputMeta;
 use tiltnoise_core::model::{Model, Observable, TiltAxis};
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_io::input::{
     parse_start_time, read_measured_input, read_start_time, read_tilt_series, MeasuredInput,
 };
@@ -82,7 +83,7 @@ pub fn run(
     if let Some((lo, hi)) = req.fit_band_hz {
         if !(lo.is_finite() && hi.is_finite() && lo >= 0.0 && lo < hi) {
             return Err(JobError::option(
-                "fit_band",
+                OptionKey::FIT_BAND,
                 Some(&format!("{lo}:{hi}")),
                 "must be finite with 0 <= FLO < FHI (Hz)".to_string(),
             ));
@@ -94,7 +95,7 @@ pub fn run(
         match read_measured_input(&req.measured)? {
             MeasuredInput::Series(s) => s,
             MeasuredInput::Spectra(_) => return Err(JobError::option(
-                "measured",
+                OptionKey::MEASURED,
                 Some(&measured_path),
                 "the file holds spectra (header frequency_hz); coherence needs a time series of \
                  the observables (header time_s, or HDF5)"
@@ -116,7 +117,7 @@ pub fn run(
                     let present: Vec<&str> =
                         measured.channels.iter().map(|(o, _)| o.name()).collect();
                     JobError::option(
-                        "observables",
+                        OptionKey::OBSERVABLES,
                         Some(o.name()),
                         format!(
                             "the measured file {measured_path} has no channel {}; it has {}",

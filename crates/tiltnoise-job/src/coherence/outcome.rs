@@ -8,6 +8,10 @@ use crate::outcome::{output_kind, Outcome, Provenance};
 use std::path::Path;
 use tiltnoise_core::coherence::CoherenceReport;
 use tiltnoise_core::error::OutputError;
+
+/// The kinds of file a coherence result is saved as: HDF5 (schema `tiltnoise.coherence`), CSV and
+/// the figure.
+pub const OUTPUT_KINDS: &[OutputKind] = crate::outcome::SPECTRA_KINDS;
 use tiltnoise_io::{
     coherence_csv_string, write_coherence_csv, write_coherence_hdf5, OutputKind, Staging,
 };
@@ -39,12 +43,7 @@ impl Outcome for CoherenceOutcome {
 
     /// `.h5` (schema `tiltnoise.coherence`), `.csv`, `.png`, `.svg`.
     fn output_kinds(&self) -> &'static [OutputKind] {
-        &[
-            OutputKind::Hdf5,
-            OutputKind::Csv,
-            OutputKind::Png,
-            OutputKind::Svg,
-        ]
+        OUTPUT_KINDS
     }
 
     /// Saves the report: HDF5 (schema `tiltnoise.coherence`, with the provenance and the
@@ -81,10 +80,10 @@ pub(super) fn write(
     meta: &Provenance,
     view: &View,
 ) -> Result<(), OutputError> {
-    match OutputKind::from_path(path)? {
+    match crate::output_kind(path, OUTPUT_KINDS)? {
         OutputKind::Hdf5 => write_coherence_hdf5(stage, path, report, meta, inputs),
         OutputKind::Csv => write_coherence_csv(stage, path, report, meta),
-        OutputKind::Png | OutputKind::Svg => {
+        _ => {
             let options = CoherenceFigureOptions {
                 tilt_name: inputs.tilt.path.clone(),
                 measured_name: inputs.measured_path.clone(),

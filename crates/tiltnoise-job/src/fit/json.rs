@@ -10,9 +10,8 @@ use std::path::Path;
 use tiltnoise_core::fit::{Bound, FitResult, SigmaSource};
 use tiltnoise_io::{write_fit_hdf5, OutputError, OutputKind, RunMeta, Staging};
 
-/// The kinds of file of [`OutputKind`] a fit is saved as (HDF5); besides them, `.json` holds
-/// the report ([`Outcome::json`]).
-pub const OUTPUT_KINDS: &[OutputKind] = &[OutputKind::Hdf5];
+/// The kinds of file a fit is saved as: the report ([`Outcome::json`]) and HDF5.
+pub const OUTPUT_KINDS: &[OutputKind] = &[OutputKind::Json, OutputKind::Hdf5];
 
 impl Outcome for FitOutcome {
     fn provenance(&self) -> &Provenance {
@@ -36,33 +35,6 @@ impl Outcome for FitOutcome {
     }
 }
 
-/// The formats a fit is saved in.
-enum SaveKind {
-    Json,
-    Hdf5,
-}
-
-/// The format `path` names by its extension.
-fn save_kind(path: &Path) -> Result<SaveKind, OutputError> {
-    match path.extension().and_then(|e| e.to_str()) {
-        Some("json") => Ok(SaveKind::Json),
-        Some("h5" | "hdf5") => Ok(SaveKind::Hdf5),
-        _ => Err(OutputError::UnknownFormat {
-            path: path.to_path_buf(),
-            allowed: ".json, .h5, .hdf5",
-        }),
-    }
-}
-
-/// Checks that `path` names a format a fit is saved in (before the fit runs).
-///
-/// # Errors
-///
-/// [`OutputError::UnknownFormat`] for an extension other than `.json`, `.h5`, `.hdf5`.
-pub fn check_save_path(path: &Path) -> Result<(), OutputError> {
-    save_kind(path).map(|_| ())
-}
-
 /// Saves a fit in the format named by the extension of `path`: `.json` (the JSON report) or
 /// `.h5`/`.hdf5` (schema `tiltnoise.fit`, with `meta`), as one of the outputs of `stage`.
 ///
@@ -76,18 +48,18 @@ pub fn save(
     fit: &FitOutcome,
     meta: &RunMeta,
 ) -> Result<(), OutputError> {
-    match save_kind(path)? {
-        SaveKind::Json => {
+    match crate::output_kind(path, OUTPUT_KINDS)? {
+        OutputKind::Json => {
             let text =
                 serde_json::to_string_pretty(&fit.json()).map_err(|e| OutputError::Write {
                     path: path.to_path_buf(),
-                    message: e.to_string(),
+                    message: e.to_string().into(),
                 })? + "\n";
             stage.write(path, |tmp| {
                 std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
             })
         }
-        SaveKind::Hdf5 => write_fit_hdf5(stage, path, &fit.result, &fit.origin, meta),
+        _ => write_fit_hdf5(stage, path, &fit.result, &fit.origin, meta),
     }
 }
 

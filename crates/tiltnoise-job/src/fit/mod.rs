@@ -4,7 +4,7 @@
 
 mod json;
 
-pub use json::{check_save_path, save, OUTPUT_KINDS};
+pub use json::{save, OUTPUT_KINDS};
 
 use crate::error::JobError;
 use crate::outcome::{Invocation, Provenance};

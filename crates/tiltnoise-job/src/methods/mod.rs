@@ -12,6 +12,7 @@ use crate::progress::Progress;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::methods::methods_table;
 use tiltnoise_core::model::{Input, Model, Observable, Request};
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::tf::planner::{NoChoice, DEFAULT_REL_TOL};
 
 /// A comparison of the methods to run.
@@ -45,14 +46,14 @@ pub fn run(
     let grid = req.grid_hz.clone();
     if let Some(f) = grid.iter().find(|f| !(f.is_finite() && **f > 0.0)) {
         return Err(JobError::option(
-            "freq_hz",
+            OptionKey::FREQ_HZ,
             Some(&f.to_string()),
             "every frequency of the comparison must be finite and > 0 Hz".to_string(),
         ));
     }
     let (Some(&lo), Some(&hi)) = (grid.first(), grid.last()) else {
         return Err(JobError::option(
-            "freq_hz",
+            OptionKey::FREQ_HZ,
             None,
             "the comparison needs at least one frequency".to_string(),
         ));

@@ -4,7 +4,7 @@
 
 mod outputs;
 
-pub use outputs::{caption, check_save_path, save, summary_json, OUTPUT_KINDS};
+pub use outputs::{caption, save, summary_json, OUTPUT_KINDS};
 
 use crate::error::JobError;
 use crate::outcome::{Invocation, Provenance};
@@ -55,11 +55,8 @@ pub struct McRun {
 ///
 /// [`JobError::MonteCarlo`] naming `samples` or `threads`.
 pub fn check(req: &McRequest<'_>) -> Result<(), JobError> {
-    let names = (
-        OptionKey::new("samples").to_string(),
-        OptionKey::new("threads").to_string(),
-    );
-    mc::check_size(req.samples, req.threads, (&names.0, &names.1))
+    let names = (OptionKey::SAMPLES, OptionKey::THREADS);
+    mc::check_size(req.samples, req.threads, names)
         .map_err(|e| JobError::MonteCarlo(Box::new(e.into())))
 }
 

@@ -30,37 +30,6 @@ impl Outcome for McRun {
     }
 }
 
-/// The formats a Monte Carlo is saved in.
-enum SaveKind {
-    Hdf5,
-    Figure,
-}
-
-/// The format `path` names by its extension (any case).
-fn save_kind(path: &Path) -> Result<SaveKind, OutputError> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    match ext.as_deref() {
-        Some("h5" | "hdf5") => Ok(SaveKind::Hdf5),
-        Some("png" | "svg") => Ok(SaveKind::Figure),
-        _ => Err(OutputError::UnknownFormat {
-            path: path.to_path_buf(),
-            allowed: ".h5, .hdf5, .png, .svg",
-        }),
-    }
-}
-
-/// Checks that `path` names a format a Monte Carlo is saved in (before the draws are made).
-///
-/// # Errors
-///
-/// [`OutputError::UnknownFormat`] for an extension other than `.h5`, `.hdf5`, `.png`, `.svg`.
-pub fn check_save_path(path: &Path) -> Result<(), OutputError> {
-    save_kind(path).map(|_| ())
-}
-
 /// Saves a Monte Carlo in the format named by the extension of `path`: `.h5`/`.hdf5` (schema
 /// `tiltnoise.mc`, every draw, the error model and `meta`) or the histograms of the eight
 /// modes as `.png`/`.svg`, drawn with `view`, as one of the outputs of `stage`.
@@ -76,11 +45,11 @@ pub fn save(
     meta: &RunMeta,
     view: &tiltnoise_plot::View,
 ) -> Result<(), OutputError> {
-    match save_kind(path)? {
-        SaveKind::Hdf5 => {
+    match crate::output_kind(path, OUTPUT_KINDS)? {
+        OutputKind::Hdf5 => {
             write_mc_hdf5(stage, path, &run.result, &run.config, &run.nominal_hz, meta)
         }
-        SaveKind::Figure => {
+        _ => {
             let caption = caption(run);
             crate::save_image(stage, path, |format| {
                 tiltnoise_plot::mc_figure::mc_figure(
@@ -227,9 +196,14 @@ mod tests {
     #[test]
     fn only_hdf5_and_images_are_saved() {
         for ok in ["a.h5", "a.HDF5", "a.png", "a.svg"] {
-            assert!(check_save_path(Path::new(ok)).is_ok(), "{ok}");
+            assert!(
+                crate::output_kind(Path::new(ok), OUTPUT_KINDS).is_ok(),
+                "{ok}"
+            );
         }
-        let err = check_save_path(Path::new("a.csv")).unwrap_err().to_string();
+        let err = crate::output_kind(Path::new("a.csv"), OUTPUT_KINDS)
+            .unwrap_err()
+            .to_string();
         assert!(
             err.contains("a.csv") && err.contains(".h5, .hdf5, .png, .svg"),
             "{err}"

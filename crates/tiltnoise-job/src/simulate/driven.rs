@@ -3,8 +3,12 @@
 //! miscalibrated, late sensors (gains, a delay): a controlled record of the observables, for
 //! example to test a subtraction, which should find those gains and that delay.
 
+use super::outputs::{asd_figure_data, RecordOutputs};
 use crate::budget::ReadRequest;
 use crate::error::{shown_path, JobError};
+use crate::outcome::{Outcome, Provenance};
+use crate::progress::Progress;
+use std::path::Path;
 use std::path::PathBuf;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::error::Num;
@@ -20,7 +24,8 @@ use tiltnoise_core::simulate::driven::{
 use tiltnoise_core::simulate::{InitialState, SimError, Simulation};
 use tiltnoise_core::spectral::{welch, WelchConfig};
 use tiltnoise_io::input::{read_tilt, TiltInput};
-use tiltnoise_io::{RunMeta, SeriesAsd, SimulationMeta};
+use tiltnoise_io::{OutputKind, SeriesAsd, SimulationMeta, Staging};
+use tiltnoise_plot::View;
 
 /// A driven simulation to run.
 pub struct DrivenRequest<'a> {
@@ -43,6 +48,8 @@ pub struct DrivenRequest<'a> {
     pub seed: u64,
     /// Welch segment of the ASDs (default `default_sim_nperseg`).
     pub nperseg: Option<usize>,
+    /// The limits, size and resolution of the figures the run is saved to.
+    pub view: View,
     /// Who asked for the run (the provenance of its files).
     pub invocation: crate::Invocation,
 }
@@ -78,13 +85,15 @@ pub struct DrivenResult {
     pub modes: NormalModes,
     /// What the files record: the parameters, the modes and the invocation.
     pub provenance: crate::Provenance,
+    /// The view of the figures (the request's).
+    view: View,
 }
 
 impl DrivenResult {
     /// The provenance a saved record carries.
-    pub fn simulation_meta(&self, run: RunMeta) -> SimulationMeta {
+    pub fn simulation_meta(&self) -> SimulationMeta {
         SimulationMeta {
-            run,
+            run: self.provenance.clone(),
             description: self.description.clone(),
             start_time: self.start_time.clone(),
             seed: self.seed,
@@ -107,7 +116,7 @@ fn gains(given: &[(String, f64)], inputs: &[Input]) -> Result<Vec<f64>, JobError
             .ok_or_else(|| {
                 let names: Vec<&str> = inputs.iter().map(|a| a.name()).collect();
                 JobError::option(
-                    "drive_gain",
+                    OptionKey::DRIVE_GAIN,
                     Some(&item),
                     format!(
                         "the record has no input `{name}`; it has {}",
@@ -117,7 +126,7 @@ fn gains(given: &[(String, f64)], inputs: &[Input]) -> Result<Vec<f64>, JobError
             })?;
         if !GAINS.admits(*g) {
             return Err(JobError::option(
-                "drive_gain",
+                OptionKey::DRIVE_GAIN,
                 Some(&item),
                 format!(
                     "the gain {} is not allowed: must be {} (see docs/limits.md)",
@@ -137,12 +146,12 @@ fn delay_steps(delay_s: f64, fs_hz: f64, oversample: usize) -> Result<i64, JobEr
     let steps = delay_s / fine_step;
     if !(steps.is_finite() && (steps - steps.round()).abs() <= 1e-9 * steps.abs().max(1.0)) {
         return Err(JobError::option(
-            "drive_delay",
+            OptionKey::DRIVE_DELAY,
             Some(&format!("{} s", Num(delay_s))),
-            format!(
+            tiltnoise_core::message!(
                 "must be a whole number of fine steps of {} s (the record's step / {})",
                 Num(fine_step),
-                OptionKey::new("oversample").given(oversample)
+                OptionKey::OVERSAMPLE.given(oversample)
             ),
         ));
     }
@@ -155,7 +164,7 @@ fn spectra(sim: &Simulation, fs: f64, nperseg: Option<usize>) -> Result<SeriesAs
     let nperseg = nperseg.unwrap_or_else(|| default_sim_nperseg(n));
     if !(16..=n).contains(&nperseg) {
         return Err(JobError::option(
-            "nperseg",
+            OptionKey::NPERSEG,
             Some(&nperseg.to_string()),
             format!("the Welch segment must have 16 to {n} samples (the record's length)"),
         ));
@@ -183,7 +192,17 @@ fn spectra(sim: &Simulation, fs: f64, nperseg: Option<usize>) -> Result<SeriesAs
 ///
 /// A [`JobError`] naming the option or file that failed; `Simulate` wrapping the cancellation
 /// when `cancel` was set.
-pub fn run(req: DrivenRequest<'_>, cancel: &Cancel) -> Result<DrivenResult, JobError> {
+pub fn run(
+    req: &DrivenRequest<'_>,
+    cancel: &Cancel,
+    progress: &dyn Progress,
+) -> Result<DrivenResult, JobError> {
+    let result = driven(req, cancel);
+    progress.finish();
+    result
+}
+
+fn driven(req: &DrivenRequest<'_>, cancel: &Cancel) -> Result<DrivenResult, JobError> {
     let model = req.model;
     if !model.is_undamped() {
         return Err(SimError::Damped.into());
@@ -193,7 +212,7 @@ pub fn run(req: DrivenRequest<'_>, cancel: &Cancel) -> Result<DrivenResult, JobE
         TiltInput::Series(s) => s,
         TiltInput::Spectra(_) => {
             return Err(JobError::option(
-                "tilt",
+                OptionKey::TILT,
                 Some(&shown),
                 "holds spectra; a driven simulation needs a time series".to_string(),
             ))
@@ -201,7 +220,7 @@ pub fn run(req: DrivenRequest<'_>, cancel: &Cancel) -> Result<DrivenResult, JobE
     };
     let g = model.params().environment.g_m_per_s2;
     let map = GroundMap::new(&series.channels(), g)
-        .map_err(|e| JobError::option("tilt", Some(&shown), e.to_string()))?;
+        .map_err(|e| JobError::option(OptionKey::TILT, Some(&shown), e.to_string()))?;
     let inputs: Vec<Input> = map.inputs();
     let channel_data: Vec<Vec<f64>> = series.channel_data().iter().map(|c| c.to_vec()).collect();
     let displacements = map.displacements(&channel_data, series.sample_rate_hz);
@@ -256,5 +275,48 @@ pub fn run(req: DrivenRequest<'_>, cancel: &Cancel) -> Result<DrivenResult, JobE
             .invocation
             .provenance(model.params(), Some(&NormalModes::new(model))),
         modes: NormalModes::new(model),
+        view: req.view.clone(),
     })
+}
+
+impl Outcome for DrivenResult {
+    fn provenance(&self) -> &Provenance {
+        &self.provenance
+    }
+
+    fn output_kinds(&self) -> &'static [OutputKind] {
+        super::OUTPUT_KINDS
+    }
+
+    /// `.h5` (the record, its spectra and provenance), `.csv` (the ASDs) or the ASD figure
+    /// with the request's view.
+    fn save(&self, stage: &Staging, path: &Path) -> Result<(), JobError> {
+        let meta = self.simulation_meta();
+        let figure = asd_figure_data(
+            &self.asd,
+            &self.readout,
+            &self.modes,
+            self.fs_hz,
+            &self.description,
+        );
+        let outputs = RecordOutputs {
+            record: Some((&self.record, &meta)),
+            asd: &self.asd,
+            run: &self.provenance,
+            figure: &figure,
+        };
+        Ok(super::outputs::save(stage, path, &outputs, &self.view)?)
+    }
+
+    /// The record's notes, its length and rate, and what was simulated.
+    fn json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "input_notes": self.notes,
+            "samples": self.record.len(),
+            "sample_rate_hz": self.fs_hz,
+            "duration_s": self.record.len() as f64 / self.fs_hz,
+            "description": self.description,
+            "seed": self.seed,
+        })
+    }
 }

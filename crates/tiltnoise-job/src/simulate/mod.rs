@@ -5,14 +5,21 @@
 //! of the floor's motion instead. The record is held whole only when the caller asks for it.
 
 pub mod driven;
+mod outcome;
 mod outputs;
 
-pub use outputs::{asd_figure_data, save, save_time_figure, RecordOutputs};
+pub use outcome::HeldSimulation;
+pub use outputs::asd_figure_data;
+
+/// The kinds of file a simulation is saved as: the record with its spectra (HDF5), the spectra
+/// (CSV) and the ASD figure.
+pub const OUTPUT_KINDS: &[tiltnoise_io::OutputKind] = crate::outcome::SPECTRA_KINDS;
 
 use crate::error::JobError;
 use crate::outcome::{Invocation, Provenance};
 use crate::progress::Progress;
 use std::path::PathBuf;
+use std::sync::Mutex;
 use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::limits::{check_memory, planned_bytes, STREAMED_WELCH_BYTES_PER_SAMPLE};
 use tiltnoise_core::model::{Model, Observable};
@@ -23,12 +30,13 @@ use tiltnoise_core::options::{self, OptionError};
 use tiltnoise_core::simulate::resonance::{check_resonances, ResonanceCheck};
 use tiltnoise_core::simulate::stream::{FreeMotion, MinMaxEnvelope, SimChunk};
 use tiltnoise_core::simulate::{
-    check_sampling, describe_run, initial_state, record_description, Excitation, InitialState,
-    ModalPropagator, SimConfig, SimError, Simulation,
+    check_sampling, describe_run, initial_state, Excitation, InitialState, ModalPropagator,
+    SimConfig, SimError, Simulation,
 };
 use tiltnoise_core::spectral::{Psd, WelchAccumulator, WelchConfig};
-use tiltnoise_io::{ObservableSeriesWriter, RunMeta, SeriesAsd, SimulationMeta};
+use tiltnoise_io::{ObservableSeriesWriter, SeriesAsd};
 use tiltnoise_plot::simulate_figure::{TimePanel, TimeSeriesData};
+use tiltnoise_plot::View;
 
 /// A free-motion simulation to run.
 pub struct SimulateRequest<'a> {
@@ -52,6 +60,8 @@ pub struct SimulateRequest<'a> {
     pub chunk_samples: Option<usize>,
     /// What of the record to keep besides its spectra.
     pub keep: Keep,
+    /// The limits, size and resolution of the figures the run is saved to.
+    pub view: View,
     /// Who asked for the run (the provenance of its files).
     pub invocation: Invocation,
 }
@@ -62,7 +72,8 @@ pub struct SimulateRequest<'a> {
 pub struct Keep {
     /// The whole record, coordinates included ([`SimulateResult::record`]).
     pub record: bool,
-    /// HDF5 files the record streams to (completed by [`SimulateResult::finish_records`]).
+    /// HDF5 files the record streams to (each completed with the spectra when the result
+    /// saves it: [`Outcome::save`](crate::Outcome::save)).
     pub hdf5: Vec<PathBuf>,
     /// Write the generalized coordinates to the HDF5 files too.
     pub hdf5_coordinates: bool,
@@ -100,8 +111,11 @@ pub struct SimulateResult {
     pub record: Option<Simulation>,
     /// The time-series figure, when [`Keep::time_figure`].
     pub time_figure: Option<TimeSeriesData>,
-    /// The HDF5 files written as the record streamed, to be completed with the spectra.
-    streamed: Vec<ObservableSeriesWriter>,
+    /// The view of the figures (the request's).
+    view: View,
+    /// The HDF5 files written as the record streamed, each to be completed with the spectra
+    /// when it is saved.
+    streamed: Mutex<Vec<(PathBuf, ObservableSeriesWriter)>>,
 }
 
 impl SimulateResult {
@@ -110,34 +124,11 @@ impl SimulateResult {
         1.0 / self.dt_s
     }
 
-    /// The provenance a saved record carries.
-    pub fn simulation_meta(&self, run: RunMeta) -> SimulationMeta {
-        SimulationMeta {
-            run,
-            description: record_description(&self.description),
-            start_time: None,
-            seed: self.seed,
-            init: self.init,
-            init_source: self.init_source.clone(),
-            readout_asd: self.readout.clone(),
-            duration_s: self.duration_s,
-        }
-    }
-
-    /// Completes the HDF5 files of [`Keep::hdf5`] with the spectra and hands them to `stage`
-    /// (they appear when it commits).
-    ///
-    /// # Errors
-    ///
-    /// The writer's [`tiltnoise_io::OutputError`], naming the file.
-    pub fn finish_records(
-        &mut self,
-        stage: &tiltnoise_io::Staging,
-    ) -> Result<(), tiltnoise_io::OutputError> {
-        for writer in std::mem::take(&mut self.streamed) {
-            writer.finish(stage, &self.asd)?;
-        }
-        Ok(())
+    /// The writer of the HDF5 file `path` the record streamed to, once.
+    fn take_streamed(&self, path: &std::path::Path) -> Option<ObservableSeriesWriter> {
+        let mut streamed = self.streamed.lock().unwrap_or_else(|e| e.into_inner());
+        let k = streamed.iter().position(|(p, _)| p == path)?;
+        Some(streamed.swap_remove(k).1)
     }
 }
 
@@ -161,7 +152,7 @@ type HeldRecord = (Vec<[f64; 8]>, Vec<Vec<f64>>);
 /// record and the time-figure pieces when kept.
 struct Sinks {
     welch: Vec<WelchAccumulator>,
-    writers: Vec<ObservableSeriesWriter>,
+    writers: Vec<(PathBuf, ObservableSeriesWriter)>,
     record: Option<HeldRecord>,
     phi: Option<MinMaxEnvelope>,
     x_start: Option<(Vec<f64>, usize)>,
@@ -169,7 +160,7 @@ struct Sinks {
 
 impl Sinks {
     fn push(&mut self, chunk: &SimChunk) -> Result<(), JobError> {
-        for w in &mut self.writers {
+        for (_, w) in &mut self.writers {
             w.append(chunk)?;
         }
         for (acc, x) in self.welch.iter_mut().zip(&chunk.observables) {
@@ -203,7 +194,7 @@ fn check(req: &SimulateRequest<'_>) -> Result<(usize, usize, usize), JobError> {
     let (n, nperseg) = check_sampling(req.duration_s, req.step_s, req.nperseg, !req.keep.record)?;
     check_memory(
         || {
-            format!(
+            tiltnoise_core::message!(
                 "{}: Welch segments of the 7 observables",
                 OptionKey::NPERSEG.given(nperseg)
             )
@@ -213,7 +204,7 @@ fn check(req: &SimulateRequest<'_>) -> Result<(usize, usize, usize), JobError> {
     let chunk = match req.chunk_samples {
         Some(0) => {
             return Err(JobError::option(
-                "chunk_samples",
+                OptionKey::CHUNK_SAMPLES,
                 Some("0"),
                 "a chunk must hold at least 1 sample".to_string(),
             ))
@@ -288,7 +279,8 @@ fn simulate(
         provenance: Provenance::default(),
         record: None,
         time_figure: None,
-        streamed: Vec::new(),
+        view: req.view.clone(),
+        streamed: Mutex::new(Vec::new()),
     };
     result.provenance = req
         .invocation
@@ -311,12 +303,15 @@ impl Sinks {
     fn new(keep: &Keep, result: &SimulateResult) -> Result<Sinks, JobError> {
         let (n, dt_s) = (result.n_samples, result.dt_s);
         let wcfg = WelchConfig::new(result.asd.segment_len);
-        let meta = result.simulation_meta(result.provenance.clone());
+        let meta = result.simulation_meta();
         let writers = keep
             .hdf5
             .iter()
-            .map(|p| ObservableSeriesWriter::create(p, dt_s, &meta, keep.hdf5_coordinates))
-            .collect::<Result<Vec<_>, _>>()?;
+            .map(|p| {
+                let w = ObservableSeriesWriter::create(p, dt_s, &meta, keep.hdf5_coordinates)?;
+                Ok((p.clone(), w))
+            })
+            .collect::<Result<Vec<_>, tiltnoise_io::OutputError>>()?;
         let welch = Observable::ALL
             .iter()
             .map(|_| WelchAccumulator::new(1, 1.0 / dt_s, &wcfg))
@@ -383,7 +378,7 @@ impl Sinks {
                 &result.init_source,
             ));
         }
-        result.streamed = self.writers;
+        result.streamed = Mutex::new(self.writers);
         Ok(())
     }
 }

@@ -79,15 +79,13 @@ pub fn save(
     out: &RecordOutputs<'_>,
     view: &View,
 ) -> Result<(), OutputError> {
-    match OutputKind::from_path(path)? {
+    match crate::output_kind(path, super::OUTPUT_KINDS)? {
         OutputKind::Hdf5 => match out.record {
             Some((sim, meta)) => write_observable_series_hdf5(stage, path, sim, out.asd, meta),
             None => Ok(()),
         },
         OutputKind::Csv => write_asd_csv(stage, path, &out.asd.freqs_hz, &out.asd.asd, out.run),
-        OutputKind::Png | OutputKind::Svg => {
-            save_image(stage, path, |format| asd_figure(out.figure, view, format))
-        }
+        _ => save_image(stage, path, |format| asd_figure(out.figure, view, format)),
     }
 }
 

@@ -21,7 +21,7 @@ pub enum SubtractFailure {
         /// The input.
         input: String,
         /// The option of the record that lacks it (`tilt` or `colocated`).
-        option: &'static str,
+        option: OptionKey,
         /// The record.
         path: String,
         /// The inputs the record has.
@@ -30,7 +30,7 @@ pub enum SubtractFailure {
     /// A record of the floor's motion (`option`) holds spectra.
     WitnessSpectra {
         /// The option.
-        option: &'static str,
+        option: OptionKey,
         /// The file.
         path: String,
     },
@@ -39,7 +39,7 @@ pub enum SubtractFailure {
     /// A record of the floor's motion whose channels do not map to the model's inputs.
     Channels {
         /// The option.
-        option: &'static str,
+        option: OptionKey,
         /// The file.
         path: String,
         /// Why.
@@ -48,7 +48,7 @@ pub enum SubtractFailure {
     /// A start time that is not ISO 8601.
     StartTime {
         /// The option.
-        option: &'static str,
+        option: OptionKey,
         /// The file.
         path: String,
         /// The start time as the file gives it.
@@ -128,18 +128,17 @@ pub enum RunFailure {
 impl SubtractFailure {
     /// The message, one line, with the options spelled as the front end in use does.
     pub(crate) fn message(&self) -> String {
-        let opt = |name: &'static str| OptionKey::new(name).to_string();
         match self {
             SubtractFailure::TooManyColocated(n) => format!(
                 "{} is given {n} times: give one record (a huddle test with the witness) or two \
                  (a three-cornered hat)",
-                opt("colocated")
+                OptionKey::COLOCATED
             ),
             SubtractFailure::RatioNeedsOneColocated => format!(
                 "{} applies to a huddle test: give exactly one {} record (a three-cornered hat \
                  needs no noise ratio)",
-                opt("colocated_ratio"),
-                opt("colocated")
+                OptionKey::COLOCATED_RATIO,
+                OptionKey::COLOCATED
             ),
             SubtractFailure::RatioUnrecorded {
                 item,
@@ -150,37 +149,37 @@ impl SubtractFailure {
             } => format!(
                 "{} {item}: {} {path} has no input {input}; it has {} (the ratio applies to an \
                  input that the witness and the co-located record both record)",
-                opt("colocated_ratio"),
-                opt(option),
+                OptionKey::COLOCATED_RATIO,
+                option,
                 present.join(", ")
             ),
             SubtractFailure::WitnessSpectra { option, path } => format!(
                 "{} {path}: holds spectra; subtract needs a time series of the floor's motion \
                  (tilt angle or rate, and translation)",
-                opt(option)
+                option
             ),
             SubtractFailure::MeasuredSpectra(path) => format!(
                 "{} {path}: holds spectra; subtract needs a time series of the observables \
                  (HDF5 as `tiltnoise simulate` writes, or CSV time_s,X,...)",
-                opt("measured")
+                OptionKey::MEASURED
             ),
             SubtractFailure::Channels {
                 option,
                 path,
                 problem,
-            } => format!("{} {path}: {problem}", opt(option)),
+            } => format!("{} {path}: {problem}", option),
             SubtractFailure::StartTime {
                 option,
                 path,
                 value,
             } => format!(
                 "{} {path}: start time `{}` is not an ISO 8601 date-time",
-                opt(option),
+                option,
                 Shown(value)
             ),
             SubtractFailure::RepeatedChannel { path, observable } => format!(
                 "{} {path}: channel {} appears twice; give each observable once",
-                opt("measured"),
+                OptionKey::MEASURED,
                 observable.name()
             ),
             SubtractFailure::MissingChannel {
@@ -189,8 +188,8 @@ impl SubtractFailure {
                 present,
             } => format!(
                 "{} {name}: {} {path} has no channel {name}; it has {}",
-                opt("observables"),
-                opt("measured"),
+                OptionKey::OBSERVABLES,
+                OptionKey::MEASURED,
                 present
                     .iter()
                     .map(|o| o.name())
@@ -204,8 +203,8 @@ impl SubtractFailure {
                 reason,
             } => format!(
                 "subtract {} {tilt} {} {measured}: {}",
-                opt("tilt"),
-                opt("measured"),
+                OptionKey::TILT,
+                OptionKey::MEASURED,
                 reason.message()
             ),
         }

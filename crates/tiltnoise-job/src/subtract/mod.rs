@@ -17,7 +17,8 @@ use tiltnoise_core::input::{GroundMap, InputMeta, Provenance, Sensors, TiltSerie
 use tiltnoise_core::limits::{admits_noise_ratio, allowed_noise_ratios};
 use tiltnoise_core::model::{Input, Model, Observable};
 use tiltnoise_core::modes::NormalModes;
-use tiltnoise_core::option_key::{self, OptionKey};
+use tiltnoise_core::option_key::OptionKey;
+use tiltnoise_core::options;
 use tiltnoise_core::repeats::refuse_repeats;
 use tiltnoise_core::subtract::{
     subtract, MeasuredRecord, StartTime, Status, SubtractConfig, SubtractResult, WitnessNoise,
@@ -35,9 +36,6 @@ pub mod outputs;
 pub mod report;
 
 pub use error::{RunFailure, SubtractFailure};
-
-/// The model inputs a witness can record, for messages.
-const FLOOR_INPUTS: &str = "theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)";
 
 /// A subtraction to run.
 pub struct SubtractRequest<'a> {
@@ -157,7 +155,7 @@ impl Witness {
 
     /// Reads the record of the floor's motion `path`, named by `option`.
     fn read(
-        option: &'static str,
+        option: OptionKey,
         path: &Path,
         req: &SubtractRequest<'_>,
     ) -> Result<Witness, JobError> {
@@ -186,18 +184,15 @@ fn failure(f: SubtractFailure) -> JobError {
 }
 
 /// Refuses a band that is not finite with `0 < FLO < FHI` (Hz).
-fn check_band(option: &'static str, band: (f64, f64)) -> Result<(), JobError> {
+fn check_band(option: OptionKey, band: (f64, f64)) -> Result<(), JobError> {
     let (lo, hi) = band;
     if lo.is_finite() && hi.is_finite() && 0.0 < lo && lo < hi {
         return Ok(());
     }
-    Err(JobError::option(
+    Err(JobError::option_pair(
         option,
-        Some(&option_key::pair(
-            &Num(lo).to_string(),
-            &Num(hi).to_string(),
-        )),
-        "must be finite with 0 < FLO < FHI (Hz)".to_string(),
+        band,
+        "must be finite with 0 < FLO < FHI (Hz)",
     ))
 }
 
@@ -206,9 +201,9 @@ fn check_band(option: &'static str, band: (f64, f64)) -> Result<(), JobError> {
 /// readout (each observable once).
 fn check_options(req: &SubtractRequest<'_>) -> Result<(), JobError> {
     if let Some(band) = req.band_hz {
-        check_band("band", band)?;
+        check_band(OptionKey::BAND, band)?;
     }
-    check_band("report_band", req.report_band_hz)?;
+    check_band(OptionKey::REPORT_BAND, req.report_band_hz)?;
     if req.colocated.len() > 2 {
         return Err(failure(SubtractFailure::TooManyColocated(
             req.colocated.len(),
@@ -216,19 +211,11 @@ fn check_options(req: &SubtractRequest<'_>) -> Result<(), JobError> {
     }
     for &(input, r) in &req.colocated_ratio {
         let item = format!("{}={}", input.name(), Num(r));
-        if !input.is_ground() {
-            return Err(JobError::option(
-                "colocated_ratio",
-                Some(&item),
-                format!(
-                    "`{}` is not a floor input of the model; allowed: {FLOOR_INPUTS}",
-                    input.name()
-                ),
-            ));
-        }
+        options::floor_input(OptionKey::COLOCATED_RATIO, &item, input.name())
+            .map_err(|e| JobError::Refused(Box::new(e)))?;
         if !admits_noise_ratio(r) {
             return Err(JobError::option(
-                "colocated_ratio",
+                OptionKey::COLOCATED_RATIO,
                 Some(&item),
                 format!(
                     "the ratio of noise ASDs is not allowed: must be {} (above it the \
@@ -262,11 +249,11 @@ fn check_ratio_inputs(
     witness: &Witness,
     colocated: &[Witness],
 ) -> Result<(), JobError> {
-    let records = std::iter::once(("tilt", &req.tilt, witness)).chain(
+    let records = std::iter::once((OptionKey::TILT, &req.tilt, witness)).chain(
         colocated
             .iter()
             .zip(&req.colocated)
-            .map(|(w, p)| ("colocated", p, w)),
+            .map(|(w, p)| (OptionKey::COLOCATED, p, w)),
     );
     for (option, path, record) in records {
         if let Some(&(input, r)) = req
@@ -287,7 +274,7 @@ fn check_ratio_inputs(
 }
 
 fn start_of(
-    option: &'static str,
+    option: OptionKey,
     path: &Path,
     start: &Option<String>,
 ) -> Result<Option<StartTime>, JobError> {
@@ -382,11 +369,11 @@ fn subtract_records(
         cancel: cancel.clone(),
     };
     stage()?;
-    let series = Witness::read("tilt", &req.tilt, req)?;
+    let series = Witness::read(OptionKey::TILT, &req.tilt, req)?;
     let colocated_series = req
         .colocated
         .iter()
-        .map(|p| Witness::read("colocated", p, req))
+        .map(|p| Witness::read(OptionKey::COLOCATED, p, req))
         .collect::<Result<Vec<_>, _>>()?;
     check_ratio_inputs(req, &series, &colocated_series)?;
     stage()?;
@@ -400,8 +387,8 @@ fn subtract_records(
     };
     let channels =
         select_observables(&req.measured, req.observables.as_deref(), measured.channels)?;
-    let tilt_start = start_of("tilt", &req.tilt, &series.provenance.start_time)?;
-    let measured_start = start_of("measured", &req.measured, &measured.start_time)?;
+    let tilt_start = start_of(OptionKey::TILT, &req.tilt, &series.provenance.start_time)?;
+    let measured_start = start_of(OptionKey::MEASURED, &req.measured, &measured.start_time)?;
     let colocated = colocated_series
         .iter()
         .zip(&req.colocated)
@@ -410,7 +397,7 @@ fn subtract_records(
                 fs_hz: s.sample_rate_hz,
                 inputs: &s.inputs,
                 data: &s.data,
-                start: start_of("colocated", path, &s.provenance.start_time)?,
+                start: start_of(OptionKey::COLOCATED, path, &s.provenance.start_time)?,
             })
         })
         .collect::<Result<Vec<_>, JobError>>()?;

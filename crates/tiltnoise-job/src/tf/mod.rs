@@ -6,7 +6,7 @@
 mod outcome;
 mod stream;
 
-pub use outcome::TfOutcome;
+pub use outcome::{TfOutcome, OUTPUT_KINDS};
 pub use stream::TfText;
 
 use crate::error::{shown_path, JobError};
@@ -20,6 +20,7 @@ use tiltnoise_core::ground::GroundQuantity;
 use tiltnoise_core::limits::MAX_GRID_POINTS;
 use tiltnoise_core::model::Observable;
 use tiltnoise_core::model::{Model, Request};
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::tf::planner::{Choice, Scene, DEFAULT_REL_TOL};
 use tiltnoise_core::tf::{self, Method, TransferFunction, TransferMatrix};
 use tiltnoise_io::read_freq_file;
@@ -132,7 +133,7 @@ pub fn rel_tol(rel_tol: Option<f64>) -> Result<f64, JobError> {
         None => Ok(DEFAULT_REL_TOL),
         Some(r) if r.is_finite() && r > 0.0 && r < 1.0 => Ok(r),
         Some(r) => Err(JobError::option(
-            "rel_tol",
+            OptionKey::REL_TOL,
             Some(&r.to_string()),
             "the tolerance must be a finite relative error in (0, 1)".to_string(),
         )),
@@ -286,7 +287,7 @@ pub fn prepare(req: &TfRequest<'_>) -> Result<Planned, JobError> {
     let block_freqs = match req.block_freqs {
         Some(0) => {
             return Err(JobError::option(
-                "block_freqs",
+                OptionKey::BLOCK_FREQS,
                 Some("0"),
                 "a block must hold at least 1 frequency".to_string(),
             ))
@@ -297,29 +298,29 @@ pub fn prepare(req: &TfRequest<'_>) -> Result<Planned, JobError> {
     let (grid, origin) = match req.grid.clone() {
         FreqGrid::Default => (Grid::Points(freq::default_grid(req.model)), None),
         FreqGrid::Log(g) => (Grid::Log(g), None),
-        FreqGrid::Points(v) => (Grid::Points(v), Some(("freq_hz", None))),
+        FreqGrid::Points(v) => (Grid::Points(v), Some((OptionKey::FREQ_HZ, None))),
         FreqGrid::File(path) => {
             let freqs = read_freq_file(&path).map_err(|e| JobError::Freq(Box::new(e)))?;
             (
                 Grid::Points(freqs),
-                Some(("freq_file", Some(shown_path(&path)))),
+                Some((OptionKey::FREQ_FILE, Some(shown_path(&path)))),
             )
         }
     };
     if let (Grid::Points(freqs), Some((option, file))) = (&grid, &origin) {
-        refuse_zero_for_per(freqs, req.per, &req.request, option, file.as_deref())?;
+        refuse_zero_for_per(freqs, req.per, &req.request, *option, file.as_deref())?;
     }
     if let (Some(path), Grid::Log(g)) = (&req.figure, &grid) {
         if g.len() > MAX_GRID_POINTS {
             return Err(JobError::option(
-                "save",
+                OptionKey::SAVE,
                 Some(&shown_path(path)),
-                format!(
+                tiltnoise_core::message!(
                     "a figure is drawn from at most {MAX_GRID_POINTS} frequency points and {} \
                      asks for {}; draw it from a smaller grid (the default grid resolves every \
                      resonance) and write the large one to .h5 or .csv only (see \
                      docs/limits.md)",
-                    tiltnoise_core::option_key::OptionKey::new("freq_hz"),
+                    OptionKey::FREQ_HZ,
                     g.len()
                 ),
             ));
@@ -350,7 +351,7 @@ fn refuse_zero_for_per(
     freqs: &[f64],
     per: GroundQuantity,
     request: &Request,
-    option: &'static str,
+    option: OptionKey,
     file: Option<&str>,
 ) -> Result<(), JobError> {
     if !request.inputs.iter().any(|i| i.is_ground()) {
@@ -361,17 +362,13 @@ fn refuse_zero_for_per(
     };
     let q = per.name();
     let at = match file {
-        Some(file) => format!("frequency {} of {file}", k + 1),
-        None => format!(
-            "frequency {} of {}",
-            k + 1,
-            tiltnoise_core::option_key::OptionKey::new(option)
-        ),
+        Some(file) => tiltnoise_core::message!("frequency {} of {}", k + 1, file.to_string()),
+        None => tiltnoise_core::message!("frequency {} of {}", k + 1, option),
     };
     Err(JobError::option(
-        "per",
+        OptionKey::PER,
         Some(q),
-        format!(
+        tiltnoise_core::message!(
             "{at} is 0 Hz, where a transfer function per unit floor {q} has no value (a floor {q} \
              carries no displacement at DC); use frequencies above 0 Hz"
         ),
@@ -397,14 +394,21 @@ pub const FIGURE5_OBSERVABLES: [Observable; 3] = [Observable::X, Observable::Phi
 
 /// The figure of a matrix of `model`: a row of panels per observable of `drawn` (each one
 /// computed), a phase panel beside each with `phase`, the caption saying whether the model is
-/// damped, in the default view.
-pub fn figure_options(model: &Model, drawn: Vec<Observable>, phase: bool) -> TfFigureOptions {
+/// damped and naming the option that chooses the panels as `panels_option` (the front end's
+/// spelling of [`OptionKey::DRAWN_OBSERVABLES`]), in the default view.
+pub fn figure_options(
+    model: &Model,
+    drawn: Vec<Observable>,
+    phase: bool,
+    panels_option: String,
+) -> TfFigureOptions {
     TfFigureOptions {
         observables: Some(drawn),
         phase,
         damped: !model.is_undamped(),
         view: crate::figures::View::default(),
         note: None,
+        panels_option,
     }
 }
 
@@ -424,10 +428,10 @@ pub fn save(
     figure: &TfFigureOptions,
 ) -> Result<(), tiltnoise_core::error::OutputError> {
     use tiltnoise_io::OutputKind;
-    match OutputKind::from_path(path)? {
+    match crate::output_kind(path, OUTPUT_KINDS)? {
         OutputKind::Hdf5 => tiltnoise_io::write_tf_hdf5(stage, path, tf, meta),
         OutputKind::Csv => tiltnoise_io::write_tf_csv(stage, path, tf, meta),
-        OutputKind::Png | OutputKind::Svg => crate::save_image(stage, path, |format| {
+        _ => crate::save_image(stage, path, |format| {
             tiltnoise_plot::tf_figure_with(tf, format, figure)
         }),
     }

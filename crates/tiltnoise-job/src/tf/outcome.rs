@@ -9,6 +9,10 @@ use tiltnoise_core::tf::planner::Choice;
 use tiltnoise_core::tf::TransferMatrix;
 use tiltnoise_io::{OutputKind, Staging};
 
+/// The kinds of file a tf result is saved as: HDF5 (schema `tiltnoise.tf`), CSV and
+/// the figure.
+pub const OUTPUT_KINDS: &[OutputKind] = crate::outcome::SPECTRA_KINDS;
+
 /// A transfer matrix computed whole, how its method was chosen, and what its outputs record.
 pub struct TfOutcome {
     /// The matrix.
@@ -26,12 +30,7 @@ impl Outcome for TfOutcome {
 
     /// `.h5` (schema `tiltnoise.tf`), `.csv`, `.png`, `.svg`.
     fn output_kinds(&self) -> &'static [OutputKind] {
-        &[
-            OutputKind::Hdf5,
-            OutputKind::Csv,
-            OutputKind::Png,
-            OutputKind::Svg,
-        ]
+        OUTPUT_KINDS
     }
 
     /// Saves the matrix: HDF5 (schema `tiltnoise.tf`, with the provenance), CSV, or the

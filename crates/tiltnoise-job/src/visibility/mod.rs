@@ -14,6 +14,7 @@ use tiltnoise_core::cancel::Cancel;
 use tiltnoise_core::fit::peaks;
 use tiltnoise_core::model::Model;
 use tiltnoise_core::modes::NormalModes;
+use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_io::input::{read_measured_input, MeasuredInput};
 
 /// A measurement of mode visibilities to run.
@@ -58,7 +59,7 @@ fn measure(req: &VisibilityRequest<'_>, cancel: &Cancel) -> Result<VisibilityRes
         MeasuredInput::Series(s) => s,
         MeasuredInput::Spectra(_) => {
             return Err(JobError::option(
-                "measured",
+                OptionKey::MEASURED,
                 Some(&origin),
                 "holds spectra; the visibilities need the time series (header time_s, or HDF5)"
                     .to_string(),

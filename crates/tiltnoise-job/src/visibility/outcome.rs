@@ -6,7 +6,6 @@ use crate::outcome::{Outcome, Provenance};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
-use tiltnoise_core::error::OutputError;
 use tiltnoise_core::fit::peaks::{RecordVisibilities, MIN_SNR};
 use tiltnoise_core::model::Observable;
 use tiltnoise_io::{OutputKind, Staging};
@@ -57,13 +56,7 @@ impl Outcome for VisibilityResult {
 
     /// Writes [`VisibilityResult::csv`] to a `.csv` path.
     fn save(&self, stage: &Staging, path: &Path) -> Result<(), JobError> {
-        if crate::output_kind(path, OUTPUT_KINDS).is_err() {
-            return Err(OutputError::UnknownFormat {
-                path: path.to_path_buf(),
-                allowed: ".csv",
-            }
-            .into());
-        }
+        crate::output_kind(path, OUTPUT_KINDS)?;
         let text = self.csv();
         Ok(stage.write(path, |tmp| {
             std::fs::write(tmp, text.as_bytes()).map_err(|e| e.to_string())
