@@ -10,7 +10,7 @@ use crate::job_args;
 use crate::model::PyModel;
 use crate::params::PyParams;
 use crate::python_side;
-use crate::spectral::{averaging, check_fs, SERIES};
+use crate::spectral::{averaging, SERIES};
 use crate::state;
 use numpy::{PyArray1, PyUntypedArray, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -220,7 +220,6 @@ pub fn budget(
     let at = args::numbers("at", at)?;
     let (model, params) = model_of(params)?;
     let gaps: GapPolicy = gaps.parse().map_err(value_error)?;
-    check_fs(fs)?;
     let channels = tilt_channels(tilt, axes)?;
     let items: Vec<String> = units
         .unwrap_or_default()

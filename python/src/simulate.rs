@@ -196,7 +196,10 @@ impl Simulation {
     #[getter]
     fn initial_state<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for (key, values) in [("q", &self.held.init.q), ("qdot", &self.held.init.qdot)] {
+        for (key, values) in [
+            ("q", &self.held.meta.init.q),
+            ("qdot", &self.held.meta.init.qdot),
+        ] {
             let v = PyDict::new(py);
             for c in Coord::ALL {
                 v.set_item(c.name(), values[c.index()])?;
@@ -209,14 +212,14 @@ impl Simulation {
     /// Where the initial state came from (kick, given values, or equal energy per mode).
     #[getter]
     fn init_source(&self) -> &str {
-        &self.held.init_source
+        &self.held.meta.init_source
     }
 
     /// ``{observable: white readout ASD}`` (unit/sqrt(Hz)); the others are noiseless.
     #[getter]
     fn readout<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        for (o, a) in &self.held.readout {
+        for (o, a) in &self.held.meta.readout_asd {
             d.set_item(o.name(), a)?;
         }
         Ok(d)
@@ -225,7 +228,7 @@ impl Simulation {
     /// Seed of the readout noise.
     #[getter]
     fn seed(&self) -> u64 {
-        self.held.seed
+        self.held.meta.seed
     }
 
     /// Frequencies of the ASDs (Hz): ``k fs / nperseg``, DC included (the files'

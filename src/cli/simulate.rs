@@ -324,12 +324,7 @@ fn summary(r: &SimulateResult) -> String {
         } else {
             String::new()
         };
-        let seen: Vec<&str> = r
-            .modes
-            .observables_seeing(k)
-            .iter()
-            .map(|o| o.name())
-            .collect();
+        let seen = r.modes.names_seeing(k);
         let _ = writeln!(
             s,
             "  nu_{} {:>11.4e} Hz{alias}  seen by {}",

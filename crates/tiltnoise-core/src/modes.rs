@@ -397,6 +397,14 @@ impl NormalModes {
             .collect()
     }
 
+    /// The names of the observables that see mode `k` ([`NormalModes::observables_seeing`]).
+    pub fn names_seeing(&self, k: usize) -> Vec<&'static str> {
+        self.observables_seeing(k)
+            .iter()
+            .map(|o| o.name())
+            .collect()
+    }
+
     /// Mode frequencies (Hz), nu_1 first.
     pub fn frequencies_hz(&self) -> Vec<f64> {
         self.modes.iter().map(|m| m.frequency_hz).collect()

@@ -123,6 +123,8 @@ impl OptionKey {
     pub const FREQ_FILE: Self = Self("freq_file");
     /// The time-series figures a simulation is saved to.
     pub const SAVE_TIME: Self = Self("save_time");
+    /// The sample rate of a record given as arrays (Hz).
+    pub const FS: Self = Self("fs");
     /// A figure's resolution (dots per inch).
     pub const DPI: Self = Self("dpi");
     /// The relative width of the band a budget's value at a frequency is read over.

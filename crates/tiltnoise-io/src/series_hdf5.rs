@@ -41,7 +41,7 @@ pub struct SeriesAsd {
 }
 
 /// Provenance of a simulation run.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SimulationMeta {
     /// Tool version, parameters, command line, mode frequencies.
     pub run: RunMeta,

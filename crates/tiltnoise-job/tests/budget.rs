@@ -283,4 +283,14 @@ fn arrays_that_describe_no_record_are_refused_before_any_computation() {
         "{}",
         e.message()
     );
+    // A rate outside the documented range, whatever the channels: named with its key.
+    let tilt = vec![(Input::Tilt(TiltAxis::EtaT), samples.clone())];
+    for fs in [0.0, -1.0, f64::NAN, f64::INFINITY, 1e300] {
+        let e = ArrayRecord::new(fs, tilt.clone(), ArrayOptions::default()).unwrap_err();
+        assert!(
+            e.message().starts_with("fs = ") && e.message().contains("Hz is not allowed"),
+            "{fs}: {}",
+            e.message()
+        );
+    }
 }

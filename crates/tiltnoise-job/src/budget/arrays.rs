@@ -18,6 +18,7 @@ use tiltnoise_core::input::{
     unstated_excess, ChannelCtx, ChannelUnit, DetrendedRms, GapPolicy, GroundChannel, InputError,
     InputMeta, Motion, Quantity, Sensors, SeriesSource, UnstatedExcess,
 };
+use tiltnoise_core::limits::SAMPLE_RATES;
 use tiltnoise_core::model::Input;
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::repeats::refuse_repeats;
@@ -93,6 +94,11 @@ pub enum ArrayError {
     },
     /// No channel at all.
     NoInput,
+    /// A sample rate outside [`SAMPLE_RATES`].
+    SampleRate {
+        /// The rate given (Hz).
+        fs_hz: f64,
+    },
     /// A unit given for an input the record does not have.
     UnitOfNoInput {
         /// The input named.
@@ -173,6 +179,14 @@ impl fmt::Display for ArrayError {
                 "input {name:?} is not allowed: must be a tilt axis theta_t, eta_t or phi_t (the \
                  rotation taking the floor frame to the inertial frame) or a floor translation \
                  x_t, y_t or z_t"
+            ),
+            ArrayError::SampleRate { fs_hz } => write!(
+                f,
+                "{} = {} Hz is not allowed: the sample rate must be {} (the spectra would leave \
+                 the range of f64; see docs/limits.md)",
+                OptionKey::FS,
+                Num(*fs_hz),
+                SAMPLE_RATES.allowed("Hz")
             ),
             ArrayError::NoInput => f.write_str(
                 "tilt: no input given; give at least one of theta_t, eta_t, phi_t, x_t, y_t, z_t",
@@ -331,9 +345,9 @@ pub fn array_input(name: &str) -> Result<Input, JobError> {
 
 impl ArrayRecord {
     /// The record of `channels` (`(input, samples)`, each input once, in any order) sampled
-    /// at `sample_rate_hz`, described by `options` as the readers describe a file: each
-    /// channel's unit (given, or the tilt's `quantity`), the sensors of the inputs listed
-    /// `corrected` and `pendulum_tiltmeter`, all channels of one length.
+    /// at `sample_rate_hz` (within [`SAMPLE_RATES`]), described by `options` as the readers
+    /// describe a file: each channel's unit (given, or the tilt's `quantity`), the sensors of
+    /// the inputs listed `corrected` and `pendulum_tiltmeter`, all channels of one length.
     ///
     /// # Errors
     ///
@@ -344,6 +358,12 @@ impl ArrayRecord {
         mut channels: Vec<(Input, Vec<f64>)>,
         options: ArrayOptions,
     ) -> Result<ArrayRecord, JobError> {
+        if !SAMPLE_RATES.admits(sample_rate_hz) {
+            return Err(ArrayError::SampleRate {
+                fs_hz: sample_rate_hz,
+            }
+            .into());
+        }
         let inputs: Vec<Input> = channels.iter().map(|(i, _)| *i).collect();
         refuse_repeats(OptionKey::AXES, "input", &inputs, |a| a.name().to_string())
             .map_err(JobError::Repeated)?;

@@ -8,13 +8,11 @@ use super::{SimulateResult, OUTPUT_KINDS};
 use crate::error::{shown_path, JobError};
 use crate::outcome::{output_kind, Outcome, Provenance};
 use std::path::Path;
-use tiltnoise_core::model::{Model, Observable};
+use tiltnoise_core::model::Model;
 use tiltnoise_core::modes::NormalModes;
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::params::Params;
-use tiltnoise_core::simulate::{
-    aliased_frequency_hz, record_description, InitialState, Simulation,
-};
+use tiltnoise_core::simulate::{aliased_frequency_hz, record_description, Simulation};
 use tiltnoise_io::{OutputKind, SeriesAsd, SimulationMeta, Staging};
 use tiltnoise_plot::View;
 
@@ -63,20 +61,16 @@ impl SimulateResult {
             .map(|m| (m.index, m.frequency_hz))
             .collect();
         let json = self.json();
+        let meta = self.simulation_meta();
         Some(HeldSimulation {
             sim: self.record?,
             asd: self.asd,
-            init: self.init,
-            init_source: self.init_source,
-            readout: self.readout,
-            seed: self.seed,
-            duration_s: self.duration_s,
+            meta,
             description: self.description,
             check_table,
             check_agrees,
             modes_hz,
             params: params.clone(),
-            provenance: self.provenance,
             json,
         })
     }
@@ -141,16 +135,9 @@ pub struct HeldSimulation {
     pub sim: Simulation,
     /// One-sided Welch ASDs of the observables.
     pub asd: SeriesAsd,
-    /// The initial state.
-    pub init: InitialState,
-    /// Where it came from (kick, given values, equal energy).
-    pub init_source: String,
-    /// The readout, in observable order.
-    pub readout: Vec<(Observable, f64)>,
-    /// Seed of the readout noise.
-    pub seed: u64,
-    /// Length asked for (s).
-    pub duration_s: f64,
+    /// What a saved record says of the run: the provenance, the initial state and where it
+    /// came from, the readout, the seed, the length asked for.
+    pub meta: SimulationMeta,
     /// One sentence on the run.
     pub description: String,
     /// The resonance check as the command line prints it.
@@ -161,15 +148,13 @@ pub struct HeldSimulation {
     pub modes_hz: Vec<(usize, f64)>,
     /// The parameters of the model.
     pub params: Params,
-    /// What the files record.
-    pub provenance: Provenance,
     /// The run's JSON summary ([`Outcome::json`] of the run).
     json: serde_json::Value,
 }
 
 impl Outcome for HeldSimulation {
     fn provenance(&self) -> &Provenance {
-        &self.provenance
+        &self.meta.run
     }
 
     fn output_kinds(&self) -> &'static [OutputKind] {
@@ -182,22 +167,13 @@ impl Outcome for HeldSimulation {
         output_kind(path, OUTPUT_KINDS)?;
         let model = Model::new(&self.params).map_err(|e| JobError::Params(Box::new(e)))?;
         let modes = NormalModes::new(&model);
-        let meta = SimulationMeta {
-            run: self.provenance.clone(),
-            description: record_description(&self.description),
-            start_time: None,
-            seed: self.seed,
-            init: self.init,
-            init_source: self.init_source.clone(),
-            readout_asd: self.readout.clone(),
-            duration_s: self.duration_s,
-        };
+        let readout = &self.meta.readout_asd;
         let fs = self.sim.fs_hz();
-        let figure = asd_figure_data(&self.asd, &self.readout, &modes, fs, &self.description);
+        let figure = asd_figure_data(&self.asd, readout, &modes, fs, &self.description);
         let outputs = RecordOutputs {
-            record: Some((&self.sim, &meta)),
+            record: Some((&self.sim, &self.meta)),
             asd: &self.asd,
-            run: &self.provenance,
+            run: &self.meta.run,
             figure: &figure,
         };
         Ok(save(stage, path, &outputs, &View::default())?)
@@ -219,12 +195,7 @@ fn summary_json(r: &SimulateResult) -> serde_json::Value {
         .iter()
         .enumerate()
         .map(|(k, m)| {
-            let seen: Vec<&str> = r
-                .modes
-                .observables_seeing(k)
-                .iter()
-                .map(|o| o.name())
-                .collect();
+            let seen = r.modes.names_seeing(k);
             json!({
                 "index": m.index,
                 "frequency_hz": m.frequency_hz,
