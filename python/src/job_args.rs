@@ -11,8 +11,7 @@ use pyo3::types::PyDict;
 use tiltnoise_core::budget::BudgetError;
 use tiltnoise_core::fit::FitError;
 use tiltnoise_core::input::AxisMap;
-use tiltnoise_core::model::{Input, Observable};
-use tiltnoise_core::noise::UserSource;
+use tiltnoise_core::model::Observable;
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::options::{self, observable_names};
 use tiltnoise_core::repeats::refuse_repeats;
@@ -210,18 +209,7 @@ pub fn terms(arg: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<TermItem>> {
         let Some((source, file)) = pair else {
             return Err(args::entry_error("term", d, EXPECTED, &name, &value));
         };
-        let source = match (Observable::from_name(&source), Input::from_name(&source)) {
-            (Some(o), _) => UserSource::Observable(o),
-            (None, Some(i)) => UserSource::Input(i),
-            (None, None) => {
-                return Err(value_error(format!(
-                    "term[{name:?}]: unknown source {source:?}; allowed: an observable ({}) or \
-                     an input of the model (theta_t, eta_t, phi_t, x_t, y_t, z_t, F_a.x .. \
-                     F_b.z, M_a.x .. M_b.z)",
-                    observable_names()
-                )))
-            }
-        };
+        let source = options::term_source(OptionKey::TERM, &format!("{name}=..."), &source).py()?;
         items.push(TermItem { name, source, file });
     }
     Ok(items)

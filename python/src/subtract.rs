@@ -4,7 +4,7 @@
 
 use crate::args::{self, kw};
 use crate::budget::model_of;
-use crate::errors::{value_error, PyResultExt};
+use crate::errors::PyResultExt;
 use crate::inputs::Inputs;
 use crate::job_args;
 use crate::params::PyParams;
@@ -28,12 +28,9 @@ fn parse_colocated_ratio(ratios: BTreeMap<String, f64>) -> PyResult<Vec<(Input, 
     ratios
         .into_iter()
         .map(|(name, r)| {
-            let input = Input::from_name(&name).ok_or_else(|| {
-                value_error(format!(
-                    "colocated_ratio {name}=...: `{name}` is not a floor input of the model; \
-                     allowed: theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)"
-                ))
-            })?;
+            let input =
+                options::floor_input(OptionKey::COLOCATED_RATIO, &format!("{name}=..."), &name)
+                    .py()?;
             Ok((input, r))
         })
         .collect()

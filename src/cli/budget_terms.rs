@@ -7,16 +7,11 @@ use super::args::parse_readout_item;
 use anyhow::{anyhow, Result};
 use std::path::{Path, PathBuf};
 use tiltnoise_core::error::Shown;
-use tiltnoise_core::model::{Input, Observable};
-use tiltnoise_core::noise::UserSource;
+use tiltnoise_core::model::Observable;
 use tiltnoise_core::option_key::OptionKey;
 use tiltnoise_core::options;
 use tiltnoise_core::repeats::refuse_repeated_keys;
 use tiltnoise_job::{AsdSpec, ReadoutItem, TermItem};
-
-const OBSERVABLES: &str = "X, Y, Z, theta, eta, phi, phi_a";
-const INPUTS: &str =
-    "theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m), F_a.x .. F_b.z (N), M_a.x .. M_b.z (N m)";
 
 /// `--observables X,phi,...`: known names, each once.
 pub fn parse_observables(text: &str) -> Result<Vec<Observable>> {
@@ -46,9 +41,10 @@ pub fn parse_readout(items: &[String]) -> Result<Vec<ReadoutItem>> {
             let name = item.split_once('=').map_or("", |(n, _)| n);
             let observable = Observable::from_name(name.trim()).ok_or_else(|| {
                 anyhow!(
-                    "--readout {}: unknown observable `{}`; allowed: {OBSERVABLES}",
+                    "--readout {}: unknown observable `{}`; allowed: {}",
                     Shown(item),
-                    Shown(name)
+                    Shown(name),
+                    options::observable_names()
                 )
             })?;
             Ok(ReadoutItem {
@@ -74,18 +70,7 @@ pub fn parse_terms(items: &[String]) -> Result<Vec<TermItem>> {
             let (source, file) = rest.split_once(':').ok_or_else(|| {
                 anyhow!("--term {shown}: expected NAME=SOURCE:FILE, e.g. magnetic=phi:phi_mag.csv")
             })?;
-            let source = source.trim();
-            let source = match (Observable::from_name(source), Input::from_name(source)) {
-                (Some(o), _) => UserSource::Observable(o),
-                (None, Some(i)) => UserSource::Input(i),
-                (None, None) => {
-                    return Err(anyhow!(
-                        "--term {shown}: unknown source `{}`; allowed: an observable \
-                         ({OBSERVABLES}) or an input ({INPUTS})",
-                        Shown(source)
-                    ))
-                }
-            };
+            let source = options::term_source(OptionKey::TERM, item, source)?;
             Ok(TermItem {
                 name: name.trim().to_string(),
                 source,

@@ -122,6 +122,23 @@ pub enum OptionError {
         /// The name given.
         name: String,
     },
+    /// The source of a user noise term that is neither an observable nor an input.
+    #[error(
+        "{option} {}: unknown source `{}`; allowed: an observable ({}) or an input of the model \
+         ({})",
+        Shown(.item),
+        Shown(.name),
+        observable_names(),
+        model_input_names()
+    )]
+    UnknownSource {
+        /// The option.
+        option: OptionKey,
+        /// The item given.
+        item: String,
+        /// The name given.
+        name: String,
+    },
     /// A range that is not two numbers `LO:HI` (or `LO,HI`).
     #[error("{option} {}: {}{expected}", Shown(.text), RangePart(.part.as_deref()))]
     Range {
@@ -170,6 +187,47 @@ pub fn floor_input_names() -> String {
         .map(|(unit, names)| format!("{} ({unit})", names.join(", ")))
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+/// Every input of the model with its SI unit, for messages: the floor inputs
+/// ([`floor_input_names`]), then the forces and torques, `F_a.x .. F_b.z (N), M_a.x .. M_b.z
+/// (N m)`.
+pub fn model_input_names() -> String {
+    let (forces, torques): (Vec<ForceInput>, Vec<ForceInput>) =
+        ForceInput::ALL.into_iter().partition(|f| f.unit() == "N");
+    let span = |group: &[ForceInput]| match (group.first(), group.last()) {
+        (Some(a), Some(b)) => format!("{} .. {} ({})", a.name(), b.name(), a.unit()),
+        _ => String::new(),
+    };
+    format!(
+        "{}, {}, {}",
+        floor_input_names(),
+        span(&forces),
+        span(&torques)
+    )
+}
+
+/// The source `name` of a user noise term of `option`: an observable (the term is that
+/// observable's ASD) or an input of the model (its ASD, propagated), for the item `item`.
+///
+/// # Errors
+///
+/// [`OptionError::UnknownSource`] for a name that is neither.
+pub fn term_source(
+    option: OptionKey,
+    item: &str,
+    name: &str,
+) -> Result<crate::noise::UserSource, OptionError> {
+    let name = name.trim();
+    match (Observable::from_name(name), Input::from_name(name)) {
+        (Some(o), _) => Ok(crate::noise::UserSource::Observable(o)),
+        (None, Some(i)) => Ok(crate::noise::UserSource::Input(i)),
+        (None, None) => Err(OptionError::UnknownSource {
+            option,
+            item: item.to_string(),
+            name: name.to_string(),
+        }),
+    }
 }
 
 /// The floor input (a tilt angle or a translation of the floor) `name`, of the item `item` of
@@ -433,6 +491,91 @@ pub fn apply_readout(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_lists_of_inputs_follow_the_model() {
+        assert_eq!(
+            floor_input_names(),
+            "theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m)"
+        );
+        assert_eq!(
+            model_input_names(),
+            "theta_t, eta_t, phi_t (rad), x_t, y_t, z_t (m), F_a.x .. F_b.z (N), \
+             M_a.x .. M_b.z (N m)"
+        );
+        let key = OptionKey::WITNESS_NOISE;
+        assert_eq!(floor_input(key, "x", " y_t ").unwrap().name(), "y_t");
+        for name in ["F_b.x", "M_a.z", "theta", "zz"] {
+            let e = floor_input(key, "ITEM", name).unwrap_err().to_string();
+            assert!(
+                e.starts_with("witness_noise ITEM: `") && e.contains("floor input"),
+                "{e}"
+            );
+        }
+        let term = OptionKey::TERM;
+        assert!(matches!(
+            term_source(term, "m=phi:f.csv", "phi"),
+            Ok(crate::noise::UserSource::Observable(Observable::Phi))
+        ));
+        assert!(matches!(
+            term_source(term, "m=F_b.x:f.csv", "F_b.x"),
+            Ok(crate::noise::UserSource::Input(_))
+        ));
+        let e = term_source(term, "m=F_c.x:f.csv", "F_c.x")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("unknown source `F_c.x`") && e.contains("M_a.x .. M_b.z (N m)"));
+    }
+
+    #[test]
+    fn ranges_are_two_finite_numbers_in_either_syntax() {
+        let key = OptionKey::BAND;
+        for text in ["1e-3:0.1", "1e-3,0.1", " 1e-3 : 0.1 "] {
+            assert_eq!(parse_range(key, text, "E").unwrap(), (1e-3, 0.1));
+        }
+        // Order and sign are the option's own check: the reading keeps them.
+        assert_eq!(parse_range(key, "2:-1", "E").unwrap(), (2.0, -1.0));
+        for (text, part) in [
+            ("1", None),
+            ("1:2:3", None),
+            ("1:2,3", Some("2,3")),
+            ("a:1", Some("a")),
+        ] {
+            match parse_range(key, text, "expected LO:HI").unwrap_err() {
+                OptionError::Range {
+                    part: p, expected, ..
+                } => {
+                    assert_eq!(p.as_deref(), part, "{text}");
+                    assert_eq!(expected, "expected LO:HI");
+                }
+                other => panic!("{text}: {other}"),
+            }
+        }
+        for text in ["1:inf", "nan:1"] {
+            assert!(parse_range(key, text, "E").is_err(), "{text}");
+        }
+    }
+
+    #[test]
+    fn keyed_items_parse_each_key_once() {
+        let units: Vec<crate::input::ChannelUnit> =
+            parse_keyed_items(OptionKey::UNITS, "channel", &["LHE=m/s^2", "LJE=rad/s"]).unwrap();
+        assert_eq!(units.len(), 2);
+        let e = parse_keyed_items::<crate::input::ChannelScale, _>(
+            OptionKey::SCALE,
+            "channel",
+            &["BJE=2", "BJE=3"],
+        )
+        .unwrap_err();
+        assert!(matches!(e, OptionError::Repeated(_)), "{e}");
+        let e = parse_keyed_items::<crate::input::ChannelScale, _>(
+            OptionKey::SCALE,
+            "channel",
+            &["BJE"],
+        )
+        .unwrap_err();
+        assert!(matches!(e, OptionError::Item { .. }), "{e}");
+    }
 
     #[test]
     fn inputs_parse_lists_groups_and_repeats() {

@@ -188,8 +188,11 @@ impl fmt::Display for ArrayError {
                 Num(*fs_hz),
                 SAMPLE_RATES.allowed("Hz")
             ),
-            ArrayError::NoInput => f.write_str(
-                "tilt: no input given; give at least one of theta_t, eta_t, phi_t, x_t, y_t, z_t",
+            ArrayError::NoInput => write!(
+                f,
+                "{}: no input given; give at least one of {}",
+                OptionKey::TILT,
+                tiltnoise_core::options::floor_input_names()
             ),
             ArrayError::UnitOfNoInput { channel, inputs } => write!(
                 f,
