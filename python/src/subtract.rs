@@ -28,9 +28,12 @@ fn parse_colocated_ratio(ratios: BTreeMap<String, f64>) -> PyResult<Vec<(Input, 
     ratios
         .into_iter()
         .map(|(name, r)| {
-            let input =
-                options::floor_input(OptionKey::COLOCATED_RATIO, &format!("{name}=..."), &name)
-                    .py()?;
+            let input = options::floor_input(
+                OptionKey::COLOCATED_RATIO,
+                &format!("{name}={}", tiltnoise_core::error::Num(r)),
+                &name,
+            )
+            .py()?;
             Ok((input, r))
         })
         .collect()
