@@ -167,3 +167,38 @@ pub fn extensions_of(kinds: &[OutputKind]) -> String {
         .collect::<Vec<_>>()
         .join(", ")
 }
+
+#[cfg(test)]
+mod output_kind_tests {
+    use super::*;
+
+    #[test]
+    fn a_path_names_one_of_the_kinds_allowed_in_any_case() {
+        let figure = [OutputKind::Png, OutputKind::Svg];
+        assert_eq!(
+            OutputKind::of_path(Path::new("a.Svg"), &figure).unwrap(),
+            OutputKind::Svg
+        );
+        assert_eq!(
+            OutputKind::from_path(Path::new("r.JSON")).unwrap(),
+            OutputKind::Json
+        );
+        assert_eq!(
+            OutputKind::from_path(Path::new("b.hdf5")).unwrap(),
+            OutputKind::Hdf5
+        );
+        for name in ["a.h5", "a.pdf", "a", "a.png.tmp"] {
+            match OutputKind::of_path(Path::new(name), &figure).unwrap_err() {
+                OutputError::UnknownFormat { path, allowed } => {
+                    assert_eq!(path, Path::new(name));
+                    assert_eq!(allowed, ".png, .svg");
+                }
+                other => panic!("{name}: {other}"),
+            }
+        }
+        assert_eq!(
+            extensions_of(&OutputKind::ALL),
+            ".h5, .hdf5, .csv, .json, .png, .svg"
+        );
+    }
+}

@@ -26,10 +26,11 @@ pub const IMAGE_KINDS: &[OutputKind] = &[OutputKind::Png, OutputKind::Svg];
 ///
 /// [`OutputError::UnknownFormat`] for an extension other than `.png`, `.svg`.
 pub fn image_format(path: &Path) -> Result<ImageFormat, OutputError> {
-    match OutputKind::of_path(path, IMAGE_KINDS)? {
-        OutputKind::Svg => Ok(ImageFormat::Svg),
-        _ => Ok(ImageFormat::Png),
-    }
+    Ok(match OutputKind::of_path(path, IMAGE_KINDS)? {
+        OutputKind::Svg => ImageFormat::Svg,
+        // The one other kind of `IMAGE_KINDS`.
+        _ => ImageFormat::Png,
+    })
 }
 pub use tiltnoise_plot::View;
 pub use tiltnoise_plot::MAX_PIXELS;
